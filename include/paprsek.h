@@ -1,0 +1,248 @@
+/*
+ * paprsek.h - the whole public interface of Paprsek, a Whitted ray tracer.
+ *
+ * Everything a program may use is declared here; everything else is private.
+ * Conventions: functions return pk_status (PK_OK == 0); fallible constructors
+ * fill an out-parameter; the first error of a context is latched with a message
+ * of the form "file:line: what is wrong" (pk_context_error). The library never
+ * prints, exits or aborts because of its input. Every object has one owner;
+ * pk_x_destroy(NULL) is a no-op. The header compiles as C11 and as C++.
+ */
+#ifndef PAPRSEK_H
+#define PAPRSEK_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#if defined(PK_BUILDING_LIBRARY) && defined(__GNUC__)
+#define PK_API __attribute__((visibility("default")))
+#else
+#define PK_API
+#endif
+
+#define PK_VERSION_MAJOR 0
+#define PK_VERSION_MINOR 1
+#define PK_VERSION_PATCH 0
+#define PK_VERSION_STRING "0.1.0"
+
+typedef enum pk_status {
+    PK_OK = 0,
+    PK_ERR_INVALID_ARGUMENT = 1, /* a bad value passed through the API */
+    PK_ERR_IO = 2,               /* a file could not be read or written */
+    PK_ERR_PARSE = 3,            /* a file is malformed */
+    PK_ERR_LIMIT = 4,            /* a size, count or depth is beyond the limits */
+    PK_ERR_NOMEM = 5,            /* an allocation failed */
+    PK_ERR_UNSUPPORTED = 6,      /* the feature is not built in (e.g. Embree) */
+    PK_ERR_CANCELLED = 7,        /* the render was stopped through its cancel flag */
+    PK_ERR_EMPTY_SCENE = 8       /* nothing renderable */
+} pk_status;
+
+/* ---- context: allocator, error latch, warnings ------------------------- */
+
+typedef struct pk_context pk_context;
+
+/* One allocation hook, as in Lua: realloc(user, ptr, size); size 0 frees and
+ * returns NULL. It may return NULL for size > 0 to report failure. */
+typedef struct pk_allocator {
+    void *(*realloc)(void *user, void *ptr, size_t size);
+    void *user;
+} pk_allocator;
+
+typedef void (*pk_warning_fn)(void *user, const char *message);
+
+/* alloc may be NULL (the C library's malloc). The context copies *alloc. */
+PK_API pk_status pk_context_create(const pk_allocator *alloc, pk_context **out);
+PK_API void pk_context_destroy(pk_context *ctx);
+/* The first error since the last clear ("" when there was none). Owned by ctx. */
+PK_API const char *pk_context_error(const pk_context *ctx);
+PK_API pk_status pk_context_status(const pk_context *ctx);
+PK_API void pk_context_clear_error(pk_context *ctx);
+/* Warnings (unknown OBJ statements, missing MTL, dropped faces...) go to fn;
+ * without a handler they are dropped. */
+PK_API void pk_context_set_warning_handler(pk_context *ctx, pk_warning_fn fn, void *user);
+
+PK_API const char *pk_status_string(pk_status status);
+
+/* ---- limits (checked on every input) ------------------------------------ */
+
+#define PK_MAX_IMAGE_SIDE 16384
+#define PK_MAX_IMAGE_PIXELS (64u * 1024u * 1024u)
+#define PK_MAX_SPP 65536
+#define PK_MAX_LIGHT_SAMPLES 4096
+#define PK_MAX_DEPTH 64
+#define PK_MAX_THREADS 1024
+#define PK_MAX_POLYGON_VERTICES 4096
+#define PK_MAX_FILE_BYTES ((size_t)1 << 31) /* 2 GiB */
+
+/* ---- camera, options, statistics ----------------------------------------- */
+
+/* A pinhole camera in world space; fov_deg is the vertical field of view. */
+typedef struct pk_camera {
+    float look_from[3];
+    float look_at[3];
+    float up[3];
+    float fov_deg;
+} pk_camera;
+
+typedef enum pk_accel_kind {
+    PK_ACCEL_DEFAULT = 0,  /* the best built in (PK_ACCEL_BVH) */
+    PK_ACCEL_NONE = 1,     /* every ray tests every primitive */
+    PK_ACCEL_MIDPOINT = 2, /* the seed's BVH: midpoint split, round-robin axis */
+    PK_ACCEL_BVH = 3,      /* binned SAH, wide SIMD BVH */
+    PK_ACCEL_EMBREE = 4    /* Embree 3, when built with it */
+} pk_accel_kind;
+
+PK_API const char *pk_accel_kind_name(pk_accel_kind kind);
+/* Returns PK_OK and sets *out for "none", "midpoint", "bvh", "embree". */
+PK_API pk_status pk_accel_kind_parse(const char *name, pk_accel_kind *out);
+/* 1 when the accelerator is compiled in. */
+PK_API int pk_accel_available(pk_accel_kind kind);
+
+typedef struct pk_render_options {
+    int width, height;   /* pixels */
+    int spp;             /* samples per pixel, stratified jitter when > 1 */
+    int light_samples;   /* shadow samples per shading point for area lights */
+    int max_depth;       /* reflection/refraction recursion limit */
+    int threads;         /* 0 = all cores */
+    pk_accel_kind accel;
+    int fresnel;         /* 1 = exact dielectric Fresnel; 0 = the seed's fixed mix */
+    int collect_stats;   /* 1 = count rays, tests and nodes (small cost) */
+    /* When non-NULL, the render stops soon after *cancel becomes non-zero and
+     * returns PK_ERR_CANCELLED; the image then holds the finished tiles. */
+    volatile const int *cancel;
+} pk_render_options;
+
+/* Defaults: 512x512, 1 spp, 32 light samples, depth 8, all threads, default
+ * accelerator, Fresnel on, no statistics. */
+PK_API void pk_render_options_init(pk_render_options *opt);
+
+typedef struct pk_stats {
+    uint64_t rays_camera, rays_shadow, rays_reflection, rays_refraction;
+    uint64_t intersection_tests; /* ray-primitive tests */
+    uint64_t nodes_visited;      /* acceleration-structure nodes */
+    double build_us;             /* acceleration build, microseconds */
+    double render_s;             /* rendering, seconds (wall clock) */
+    int threads;                 /* threads used */
+} pk_stats;
+
+/* ---- scenes ------------------------------------------------------------ */
+
+typedef struct pk_scene pk_scene;
+
+/* Loads by extension: .obj (with its MTL files) or .json. */
+PK_API pk_status pk_scene_load_file(pk_context *ctx, const char *path, pk_scene **out);
+/* OBJ from memory. name is used in messages; base_dir is where mtllib files are
+ * looked up (NULL: MTL files are not read). */
+PK_API pk_status pk_scene_load_obj_memory(pk_context *ctx, const char *data, size_t size,
+                                          const char *name, const char *base_dir,
+                                          pk_scene **out);
+/* JSON scene from memory; mesh paths are relative to base_dir. */
+PK_API pk_status pk_scene_load_json_memory(pk_context *ctx, const char *data, size_t size,
+                                           const char *name, const char *base_dir,
+                                           pk_scene **out);
+/* The built-in Cornell box (camera, light quad, two boxes). */
+PK_API pk_status pk_scene_create_cornell_box(pk_context *ctx, pk_scene **out);
+PK_API void pk_scene_destroy(pk_scene *scene);
+
+typedef struct pk_scene_info {
+    size_t triangles;            /* as numbered by the file, degenerate ones included */
+    size_t degenerate_triangles; /* never hit */
+    size_t spheres, materials, point_lights, emissive_triangles;
+    float bounds_min[3], bounds_max[3];
+    int has_camera;              /* 0: the camera is framed on the bounds */
+} pk_scene_info;
+
+PK_API void pk_scene_get_info(const pk_scene *scene, pk_scene_info *info);
+/* Vertices of triangle k (file numbering) as v0,v1,v2 xyz; PK_ERR_INVALID_ARGUMENT
+ * when k is out of range. */
+PK_API pk_status pk_scene_get_triangle(const pk_scene *scene, size_t k, float verts[9]);
+/* The scene's camera, or one framed automatically on its bounds. */
+PK_API void pk_scene_get_camera(const pk_scene *scene, pk_camera *cam);
+/* Validates (finite, fov in (0,180), look_from != look_at, up not parallel). */
+PK_API pk_status pk_scene_set_camera(pk_context *ctx, pk_scene *scene, const pk_camera *cam);
+/* The scene's own render settings (JSON "render") over the defaults. */
+PK_API void pk_scene_get_render_options(const pk_scene *scene, pk_render_options *opt);
+
+/* ---- images ------------------------------------------------------------ */
+
+/* Linear RGB float image, rows top to bottom. */
+typedef struct pk_image pk_image;
+
+PK_API pk_status pk_image_create(pk_context *ctx, int width, int height, pk_image **out);
+PK_API void pk_image_destroy(pk_image *img);
+PK_API int pk_image_width(const pk_image *img);
+PK_API int pk_image_height(const pk_image *img);
+/* 3 floats per pixel; owned by img. */
+PK_API float *pk_image_pixels(pk_image *img);
+PK_API const float *pk_image_pixels_const(const pk_image *img);
+/* Writes by extension: .png (8-bit sRGB) or .pfm (linear float). The image goes
+ * to a temporary file in the same folder that is renamed into place, so an
+ * existing file is only ever replaced by a complete image. */
+PK_API pk_status pk_image_write(pk_context *ctx, const pk_image *img, const char *path);
+
+/* ---- rendering --------------------------------------------------------- */
+
+/* Renders scene into a new image (*out, owned by the caller). stats may be NULL.
+ * On PK_ERR_CANCELLED *out still holds the partial image. */
+PK_API pk_status pk_render(pk_context *ctx, const pk_scene *scene, const pk_render_options *opt,
+                           pk_image **out, pk_stats *stats);
+
+/* ---- rays against an acceleration structure (benchmarks, tools) --------- */
+
+/* Same layout as a record of a .rays file (32 bytes). */
+typedef struct pk_ray {
+    float org[3];
+    float tmin;
+    float dir[3];
+    float tmax;
+} pk_ray;
+
+/* Same layout as a record of a .hits file (16 bytes). prim numbers the
+ * triangles in file order, then the spheres; PK_NO_HIT on a miss (t = +inf).
+ * Hit point = (1-u-v)*v0 + u*v1 + v*v2. */
+typedef struct pk_hit {
+    float t;
+    uint32_t prim;
+    float u, v;
+} pk_hit;
+
+#define PK_NO_HIT 0xFFFFFFFFu
+
+typedef struct pk_accel pk_accel;
+
+typedef struct pk_accel_info {
+    const char *name;
+    double build_ms;
+    size_t nodes, leaves, primitives;
+    size_t bytes;     /* memory held by the structure */
+    double sah_cost;  /* 0 when not computed */
+} pk_accel_info;
+
+typedef struct pk_trace_counters {
+    uint64_t intersection_tests, nodes_visited;
+} pk_trace_counters;
+
+enum {
+    PK_TRACE_ANY_HIT = 1u,  /* occlusion only: t of some hit, or +inf */
+    PK_TRACE_COHERENT = 2u  /* rays come in coherent groups: use packets */
+};
+
+/* Builds an accelerator over the scene's triangles and spheres with up to
+ * threads threads (0 = all). The accel borrows nothing from scene. */
+PK_API pk_status pk_accel_create(pk_context *ctx, const pk_scene *scene, pk_accel_kind kind,
+                                 int threads, pk_accel **out);
+PK_API void pk_accel_destroy(pk_accel *accel);
+PK_API void pk_accel_get_info(const pk_accel *accel, pk_accel_info *info);
+/* Traces n rays with up to threads threads; hits[i] answers rays[i].
+ * counters may be NULL (nothing is counted then). */
+PK_API void pk_accel_trace(const pk_accel *accel, const pk_ray *rays, pk_hit *hits, size_t n,
+                           int threads, unsigned flags, pk_trace_counters *counters);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* PAPRSEK_H */

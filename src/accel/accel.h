@@ -1,0 +1,113 @@
+/*
+ * accel.h - the interface every acceleration structure implements.
+ *
+ * An accelerator is built over a flat list of primitives: triangles
+ * 0..ntris-1 (three vertices each, in file order, degenerate ones included but
+ * never hit) followed by spheres ntris..ntris+nspheres-1. It knows nothing of
+ * materials. All accelerators return the same closest hit (see geom.h).
+ */
+#ifndef PK_ACCEL_H
+#define PK_ACCEL_H
+
+#include "geom.h"
+
+typedef struct accel_sphere {
+    vec3 center;
+    float radius;
+} accel_sphere;
+
+/* Borrowed by the builder for the duration of accel_create only. */
+typedef struct accel_input {
+    const vec3 *verts;           /* 3*ntris vertices: triangle k is verts[3k..3k+2] */
+    size_t ntris;
+    const accel_sphere *spheres;
+    size_t nspheres;
+    int threads;                 /* build threads, >= 1 */
+} accel_input;
+
+/* Counters are per thread; NULL means "do not count" and must cost nothing. */
+typedef struct accel_counters {
+    uint64_t tests; /* ray-primitive tests */
+    uint64_t nodes; /* nodes visited */
+} accel_counters;
+
+typedef struct accel accel;
+
+typedef struct accel_ops {
+    void (*destroy)(accel *a);
+    /* Closest hit in [r->tmin, r->tmax]; fills *h (cleared on a miss). */
+    bool (*intersect)(const accel *a, const ray *r, hit *h, accel_counters *c);
+    /* Any hit in [r->tmin, r->tmax]? */
+    bool (*occluded)(const accel *a, const ray *r, accel_counters *c);
+    /* Optional (may be NULL): n coherent rays at once; results as intersect.
+     * any_hit: only occlusion (h[i].t finite on a hit). */
+    void (*intersect_packet)(const accel *a, const ray *r, hit *h, size_t n, bool any_hit,
+                             accel_counters *c);
+} accel_ops;
+
+/* Every accelerator starts with this header. */
+struct accel {
+    const accel_ops *ops;
+    const pk_allocator *alloc;
+    pk_accel_info info;      /* name, build_ms, nodes, leaves, bytes, sah_cost */
+    size_t ntris, nspheres;
+};
+
+/* Builds kind over in. Errors (NOMEM, UNSUPPORTED) are latched in ctx. */
+PK_HIDDEN pk_status accel_create(pk_context *ctx, pk_accel_kind kind, const accel_input *in, accel **out);
+PK_HIDDEN void accel_destroy(accel *a);
+
+static inline bool accel_intersect(const accel *a, const ray *r, hit *h, accel_counters *c)
+{
+    return a->ops->intersect(a, r, h, c);
+}
+static inline bool accel_occluded(const accel *a, const ray *r, accel_counters *c)
+{
+    return a->ops->occluded(a, r, c);
+}
+/* Packets when the accelerator has them, single rays otherwise. */
+PK_HIDDEN void accel_intersect_many(const accel *a, const ray *r, hit *h, size_t n, bool any_hit,
+                                    accel_counters *c);
+
+/* Constructors, one per file (builders latch their own errors). */
+PK_HIDDEN pk_status accel_none_create(pk_context *ctx, const accel_input *in, accel **out);
+PK_HIDDEN pk_status accel_midpoint_create(pk_context *ctx, const accel_input *in, accel **out);
+PK_HIDDEN pk_status accel_bvh_create(pk_context *ctx, const accel_input *in, accel **out);
+PK_HIDDEN pk_status accel_embree_create(pk_context *ctx, const accel_input *in, accel **out);
+PK_HIDDEN bool accel_embree_available(void);
+
+/* A copy of the primitives for the scalar accelerators (none, midpoint). */
+typedef struct prim_set {
+    vec3 *verts;              /* 3 per triangle */
+    accel_sphere *spheres;
+    uint32_t ntris, nspheres;
+} prim_set;
+
+PK_HIDDEN pk_status prim_set_init(pk_context *ctx, const pk_allocator *a, const accel_input *in, prim_set *ps);
+PK_HIDDEN void prim_set_free(const pk_allocator *a, prim_set *ps);
+/* Bounds of primitive id; false when it can never be hit (degenerate). */
+PK_HIDDEN bool prim_bounds(const prim_set *ps, uint32_t id, aabb *box);
+
+/* Tests primitive id; updates *h when it is a better hit (closest-hit rule). */
+static inline bool prim_test(const prim_set *ps, uint32_t id, const ray_pre *r, hit *h)
+{
+    float t, u, v;
+    bool ok;
+    if (id < ps->ntris) {
+        const vec3 *p = ps->verts + 3 * (size_t)id;
+        ok = tri_intersect(r, p[0], p[1], p[2], h->t, &t, &u, &v);
+    } else {
+        const accel_sphere *s = &ps->spheres[id - ps->ntris];
+        ok = sphere_intersect(r, s->center, s->radius, h->t, &t, &u, &v);
+    }
+    if (ok && hit_better(t, id, h)) {
+        h->t = t;
+        h->prim = id;
+        h->u = u;
+        h->v = v;
+        return true;
+    }
+    return false;
+}
+
+#endif

@@ -1,0 +1,156 @@
+/*
+ * geom.h - rays, hits and the reference ray-primitive tests that every
+ * accelerator uses, so that all of them return bit-identical hits.
+ *
+ * Triangle test: watertight (Woop, Benthin and Wald, JCGT 2013): the ray is
+ * sheared to +z, the edge functions are evaluated in 2D and recomputed in
+ * double when one is exactly zero, so no hit is lost on a shared edge.
+ * Closest-hit rule: t in [tmin, tmax]; among equal t the lower prim wins.
+ * SIMD versions must perform the same float operations in the same order
+ * (the build uses -ffp-contract=off), which keeps them bit-identical.
+ */
+#ifndef PK_GEOM_H
+#define PK_GEOM_H
+
+#include "../math/vec3.h"
+#include "../paprsek_internal.h"
+
+#include <string.h>
+
+/* Same layout as pk_ray and a .rays record. */
+typedef struct ray {
+    vec3 o;
+    float tmin;
+    vec3 d;
+    float tmax;
+} ray;
+
+/* Same layout as pk_hit and a .hits record. */
+typedef struct hit {
+    float t;
+    uint32_t prim;
+    float u, v;
+} hit;
+
+_Static_assert(sizeof(ray) == 32 && sizeof(pk_ray) == 32, "ray layout");
+_Static_assert(sizeof(hit) == 16 && sizeof(pk_hit) == 16, "hit layout");
+
+static inline void hit_clear(hit *h)
+{
+    h->t = INFINITY;
+    h->prim = PK_NO_HIT;
+    h->u = h->v = 0.0f;
+}
+
+/* Ray data derived once per ray for traversal and the watertight test. */
+typedef struct ray_pre {
+    vec3 o, d;
+    vec3 inv_d;        /* 1/d per axis (+-inf for zero components) */
+    int kx, ky, kz;    /* shear axes: kz is the largest |d| component */
+    float sx, sy, sz;  /* shear constants */
+    float tmin;
+} ray_pre;
+
+static inline ray_pre ray_prepare(const ray *r)
+{
+    ray_pre p;
+    p.o = r->o;
+    p.d = r->d;
+    p.tmin = r->tmin;
+    p.inv_d = v3(1.0f / r->d.x, 1.0f / r->d.y, 1.0f / r->d.z);
+    int kz = v3_max_axis_abs(r->d);
+    int kx = kz + 1 == 3 ? 0 : kz + 1;
+    int ky = kx + 1 == 3 ? 0 : kx + 1;
+    float dz = v3_get(r->d, kz);
+    if (dz < 0.0f) {
+        int tmp = kx;
+        kx = ky;
+        ky = tmp;
+    }
+    p.kx = kx;
+    p.ky = ky;
+    p.kz = kz;
+    p.sx = v3_get(r->d, kx) / dz;
+    p.sy = v3_get(r->d, ky) / dz;
+    p.sz = 1.0f / dz;
+    return p;
+}
+
+/* Watertight ray-triangle test. On a hit with t in [tmin, tmax] returns true
+ * with t, u (weight of b) and v (weight of c). */
+static inline bool tri_intersect(const ray_pre *r, vec3 a, vec3 b, vec3 c, float tmax, float *t_out,
+                                 float *u_out, float *v_out)
+{
+    const float ox = v3_get(r->o, r->kx), oy = v3_get(r->o, r->ky), oz = v3_get(r->o, r->kz);
+    const float ax0 = v3_get(a, r->kx) - ox, ay0 = v3_get(a, r->ky) - oy, az0 = v3_get(a, r->kz) - oz;
+    const float bx0 = v3_get(b, r->kx) - ox, by0 = v3_get(b, r->ky) - oy, bz0 = v3_get(b, r->kz) - oz;
+    const float cx0 = v3_get(c, r->kx) - ox, cy0 = v3_get(c, r->ky) - oy, cz0 = v3_get(c, r->kz) - oz;
+    const float ax = ax0 - r->sx * az0, ay = ay0 - r->sy * az0;
+    const float bx = bx0 - r->sx * bz0, by = by0 - r->sy * bz0;
+    const float cx = cx0 - r->sx * cz0, cy = cy0 - r->sy * cz0;
+    float U = cx * by - cy * bx;
+    float V = ax * cy - ay * cx;
+    float W = bx * ay - by * ax;
+    if (PK_UNLIKELY(U == 0.0f || V == 0.0f || W == 0.0f)) {
+        U = (float)((double)cx * (double)by - (double)cy * (double)bx);
+        V = (float)((double)ax * (double)cy - (double)ay * (double)cx);
+        W = (float)((double)bx * (double)ay - (double)by * (double)ax);
+    }
+    if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f)) return false;
+    const float det = U + V + W;
+    if (det == 0.0f) return false;
+    const float az = r->sz * az0, bz = r->sz * bz0, cz = r->sz * cz0;
+    const float T = U * az + V * bz + W * cz;
+    const float rcp = 1.0f / det;
+    const float t = T * rcp;
+    if (!(t >= r->tmin && t <= tmax)) return false;
+    *t_out = t;
+    *u_out = V * rcp;
+    *v_out = W * rcp;
+    return true;
+}
+
+/* Ray-sphere test (geometric form, robust for rays starting inside). Returns
+ * the nearest root in [tmin, tmax]; u, v are the spherical coordinates of the
+ * hit point scaled to [0,1]. */
+static inline bool sphere_intersect(const ray_pre *r, vec3 center, float radius, float tmax,
+                                    float *t_out, float *u_out, float *v_out)
+{
+    vec3 oc = v3_sub(r->o, center);
+    float a = v3_dot(r->d, r->d);
+    float b = v3_dot(oc, r->d);
+    /* c computed as |oc - (oc.d/a) d|^2 - r^2 avoids cancellation far away */
+    vec3 perp = v3_sub(oc, v3_scale(r->d, b / a));
+    float disc = radius * radius - v3_dot(perp, perp);
+    if (disc < 0.0f) return false;
+    float c = v3_dot(oc, oc) - radius * radius;
+    float sq = sqrtf(a * disc);
+    float q = b > 0.0f ? -(b + sq) : -(b - sq);
+    float t0 = c / q, t1 = q / a;
+    if (q == 0.0f) t0 = t1 = 0.0f;
+    if (t0 > t1) {
+        float tmp = t0;
+        t0 = t1;
+        t1 = tmp;
+    }
+    float t = t0;
+    if (!(t >= r->tmin && t <= tmax)) {
+        t = t1;
+        if (!(t >= r->tmin && t <= tmax)) return false;
+    }
+    vec3 p = v3_scale(v3_sub(v3_add(r->o, v3_scale(r->d, t)), center), 1.0f / radius);
+    float phi = atan2f(p.z, p.x);
+    float theta = acosf(fminf(1.0f, fmaxf(-1.0f, p.y)));
+    *t_out = t;
+    *u_out = (phi + PK_PI) * (0.5f / PK_PI);
+    *v_out = theta * (1.0f / PK_PI);
+    return true;
+}
+
+/* The closest-hit rule shared by all accelerators. */
+static inline bool hit_better(float t, uint32_t prim, const hit *best)
+{
+    return t < best->t || (t == best->t && prim < best->prim);
+}
+
+#endif

@@ -1,0 +1,144 @@
+/*
+ * scene.h - the in-memory scene: positions, normals, triangles in file order,
+ * analytic spheres, materials, point lights, camera and render settings.
+ * Loaders (io/) fill it through the scene_add_* builders and then call
+ * scene_commit, which validates it and derives what rendering needs.
+ */
+#ifndef PK_SCENE_H
+#define PK_SCENE_H
+
+#include "../math/vec3.h"
+#include "../paprsek_internal.h"
+
+/* Material as read from MTL (or JSON); colours are linear RGB.
+ * illum follows the MTL convention: 3/5 add mirror reflection weighted by ks,
+ * 4/6/7 make the surface a dielectric of index ni tinted by tf. */
+typedef struct material {
+    char *name;    /* owned */
+    vec3 kd;       /* diffuse albedo */
+    vec3 ks;       /* specular (Phong lobe, or mirror weight) */
+    vec3 ke;       /* emitted radiance; non-zero makes every triangle an area light */
+    vec3 tf;       /* transmission filter for refraction */
+    vec3 ka;       /* ambient; only used when the scene sets an ambient light */
+    float ns;      /* Phong exponent */
+    float ni;      /* index of refraction */
+    float d;       /* dissolve, 1 = opaque (Tr = 1 - d) */
+    int illum;
+} material;
+
+/* Triangle k is the k-th triangle the file produced (fan order). */
+typedef struct triangle {
+    uint32_t v[3];   /* indices into positions */
+    int32_t n[3];    /* indices into normals, -1 when the face has none */
+    uint32_t material;
+} triangle;
+
+typedef struct sphere {
+    vec3 center;     /* world space */
+    float radius;    /* > 0 */
+    uint32_t material;
+} sphere;
+
+typedef struct point_light {
+    vec3 position;   /* world space */
+    vec3 intensity;  /* radiant intensity, linear RGB (W/sr per channel) */
+} point_light;
+
+/* Render settings a scene file may carry; a field is set when its has_ flag is. */
+typedef struct scene_render_settings {
+    pk_render_options opt;
+    bool has_width, has_height, has_spp, has_light_samples, has_max_depth, has_threads,
+        has_accel, has_fresnel;
+} scene_render_settings;
+
+/* Invariants (scene_check tests them after commit):
+ *  1. every triangle's v[] < npositions, n[] is -1 or < nnormals, material < nmaterials;
+ *  2. every position and normal is finite;
+ *  3. every sphere has a finite center and radius > 0, material < nmaterials;
+ *  4. material 0 exists and is the neutral grey default;
+ *  5. after commit, degenerate[k] says whether triangle k can never be hit,
+ *     and emissive lists the triangles whose material has ke > 0 (non-degenerate). */
+struct pk_scene {
+    pk_allocator alloc;
+    char *name;             /* file name for messages and statistics */
+
+    vec3 *positions; size_t npositions, cap_positions;
+    vec3 *normals;   size_t nnormals, cap_normals;
+    triangle *tris;  size_t ntris, cap_tris;
+    sphere *spheres; size_t nspheres, cap_spheres;
+    material *materials; size_t nmaterials, cap_materials;
+    point_light *lights; size_t nlights, cap_lights;
+
+    vec3 ambient;           /* ambient light; zero unless the scene asks */
+    bool has_camera;
+    pk_camera camera;
+    scene_render_settings render;
+
+    /* derived by scene_commit */
+    bool committed;
+    uint8_t *degenerate;    /* ntris flags */
+    size_t ndegenerate;
+    uint32_t *emissive;     /* indices of emissive triangles */
+    size_t nemissive;
+    aabb bounds;
+};
+
+/* An empty scene with the default material 0 ("default", grey 0.5 diffuse). */
+PK_HIDDEN pk_status scene_create(pk_context *ctx, const char *name, pk_scene **out);
+PK_HIDDEN void scene_destroy(pk_scene *s);
+
+/* Builders: return PK_OK or latch an error in ctx (PK_ERR_NOMEM / PK_ERR_LIMIT). */
+PK_HIDDEN pk_status scene_add_position(pk_context *ctx, pk_scene *s, vec3 p);
+PK_HIDDEN pk_status scene_add_normal(pk_context *ctx, pk_scene *s, vec3 n);
+PK_HIDDEN pk_status scene_add_triangle(pk_context *ctx, pk_scene *s, const triangle *t);
+PK_HIDDEN pk_status scene_add_sphere(pk_context *ctx, pk_scene *s, const sphere *sp);
+PK_HIDDEN pk_status scene_add_point_light(pk_context *ctx, pk_scene *s, const point_light *l);
+/* Adds a material initialised like MTL's defaults (kd 0.8, ks 0, ns 1, ni 1, d 1,
+ * illum 2) named name; *index receives its number. A later material of the same
+ * name replaces the earlier one for scene_find_material. */
+PK_HIDDEN pk_status scene_add_material(pk_context *ctx, pk_scene *s, const char *name, uint32_t *index);
+/* Material number by name, searching from the newest; -1 when absent. */
+PK_HIDDEN int64_t scene_find_material(const pk_scene *s, const char *name);
+PK_HIDDEN void material_init(material *m);
+
+/* Validates and derives (degenerate flags, emissive list, bounds).
+ * PK_ERR_EMPTY_SCENE when nothing can be hit. Warns about degenerate triangles. */
+PK_HIDDEN pk_status scene_commit(pk_context *ctx, pk_scene *s);
+/* Tests the invariants above; returns false and fills why (if non-NULL). */
+PK_HIDDEN bool scene_check(const pk_scene *s, char *why, size_t why_size);
+
+/* Geometry of triangle k. */
+static inline void scene_tri_verts(const pk_scene *s, size_t k, vec3 *a, vec3 *b, vec3 *c)
+{
+    const triangle *t = &s->tris[k];
+    *a = s->positions[t->v[0]];
+    *b = s->positions[t->v[1]];
+    *c = s->positions[t->v[2]];
+}
+
+/* Triangles that can never be hit: a non-finite vertex or zero area. */
+static inline bool tri_is_degenerate(vec3 a, vec3 b, vec3 c)
+{
+    if (!v3_finite(a) || !v3_finite(b) || !v3_finite(c)) return true;
+    vec3 n = v3_cross(v3_sub(b, a), v3_sub(c, a));
+    return !(v3_len2(n) > 0.0f) || !v3_finite(n);
+}
+
+/* ---- loaders (io/) ----------------------------------------------------- */
+
+/* Parses OBJ text into s, appending its triangles after those already there.
+ * name: for messages; base_dir: where mtllib files are read from (NULL: not read).
+ * xform: optional 4x4 row-major affine transform applied to positions (and its
+ * inverse transpose to normals); NULL = identity. Does not commit. */
+PK_HIDDEN pk_status obj_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,
+                              const char *name, const char *base_dir, const float *xform);
+/* Parses MTL text, adding its materials to s. */
+PK_HIDDEN pk_status mtl_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,
+                              const char *name);
+/* Parses a JSON scene into s (meshes are loaded relative to base_dir). Does not commit. */
+PK_HIDDEN pk_status scene_json_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,
+                                     const char *name, const char *base_dir);
+/* Fills s with the built-in Cornell box. Does not commit. */
+PK_HIDDEN pk_status scene_build_cornell(pk_context *ctx, pk_scene *s);
+
+#endif
