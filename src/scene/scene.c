@@ -1,0 +1,202 @@
+/*
+ * scene.c - building, validating and describing the in-memory scene.
+ * Loaders append with scene_add_*; scene_commit checks the invariants of
+ * scene.h and derives the degenerate flags, the emissive list and the bounds.
+ */
+#include "scene.h"
+
+#include <stdio.h>
+#include <string.h>
+
+#define SCENE_MAX_PRIMS ((size_t)1 << 30) /* triangle numbers fit uint32 with room */
+
+void material_init(material *m)
+{
+    memset(m, 0, sizeof *m);
+    m->kd = v3s(0.8f);
+    m->tf = v3s(1.0f);
+    m->ns = 1.0f;
+    m->ni = 1.0f;
+    m->d = 1.0f;
+    m->illum = 2;
+}
+
+pk_status scene_create(pk_context *ctx, const char *name, pk_scene **out)
+{
+    *out = NULL;
+    pk_scene *s = mem_calloc(&ctx->alloc, 1, sizeof *s);
+    if (!s) return ctx_nomem(ctx);
+    s->alloc = ctx->alloc;
+    s->bounds = aabb_empty();
+    pk_render_options_init(&s->render.opt);
+    s->name = mem_strdup(&s->alloc, name ? name : "scene");
+    uint32_t idx;
+    if (!s->name || scene_add_material(ctx, s, "default", &idx) != PK_OK) {
+        scene_destroy(s);
+        return ctx_nomem(ctx);
+    }
+    s->materials[0].kd = v3s(0.5f);
+    *out = s;
+    return PK_OK;
+}
+
+void scene_destroy(pk_scene *s)
+{
+    if (!s) return;
+    const pk_allocator *a = &s->alloc;
+    for (size_t i = 0; i < s->nmaterials; i++) mem_free(a, s->materials[i].name);
+    mem_free(a, s->materials);
+    mem_free(a, s->positions);
+    mem_free(a, s->normals);
+    mem_free(a, s->tris);
+    mem_free(a, s->spheres);
+    mem_free(a, s->lights);
+    mem_free(a, s->degenerate);
+    mem_free(a, s->emissive);
+    mem_free(a, s->name);
+    pk_allocator copy = *a;
+    mem_free(&copy, s);
+}
+
+#define APPEND(ctx, s, arr, n, cap, item, limit)                                          \
+    do {                                                                                  \
+        if ((s)->n >= (limit))                                                            \
+            return ctx_error(ctx, PK_ERR_LIMIT, "%s: more than %zu elements", (s)->name,  \
+                             (size_t)(limit));                                            \
+        if (!mem_grow(&(s)->alloc, (void **)&(s)->arr, &(s)->cap, (s)->n + 1, sizeof *(s)->arr)) \
+            return ctx_nomem(ctx);                                                        \
+        (s)->arr[(s)->n++] = (item);                                                      \
+        (s)->committed = false;                                                           \
+        return PK_OK;                                                                     \
+    } while (0)
+
+pk_status scene_add_position(pk_context *ctx, pk_scene *s, vec3 p)
+{
+    APPEND(ctx, s, positions, npositions, cap_positions, p, SCENE_MAX_PRIMS);
+}
+
+pk_status scene_add_normal(pk_context *ctx, pk_scene *s, vec3 n)
+{
+    APPEND(ctx, s, normals, nnormals, cap_normals, n, SCENE_MAX_PRIMS);
+}
+
+pk_status scene_add_triangle(pk_context *ctx, pk_scene *s, const triangle *t)
+{
+    APPEND(ctx, s, tris, ntris, cap_tris, *t, SCENE_MAX_PRIMS);
+}
+
+pk_status scene_add_sphere(pk_context *ctx, pk_scene *s, const sphere *sp)
+{
+    APPEND(ctx, s, spheres, nspheres, cap_spheres, *sp, SCENE_MAX_PRIMS);
+}
+
+pk_status scene_add_point_light(pk_context *ctx, pk_scene *s, const point_light *l)
+{
+    APPEND(ctx, s, lights, nlights, cap_lights, *l, SCENE_MAX_PRIMS);
+}
+
+pk_status scene_add_material(pk_context *ctx, pk_scene *s, const char *name, uint32_t *index)
+{
+    material m;
+    material_init(&m);
+    m.name = mem_strdup(&s->alloc, name);
+    if (!m.name) return ctx_nomem(ctx);
+    if (s->nmaterials >= UINT32_MAX / 2 ||
+        !mem_grow(&s->alloc, (void **)&s->materials, &s->cap_materials, s->nmaterials + 1, sizeof m)) {
+        mem_free(&s->alloc, m.name);
+        return ctx_nomem(ctx);
+    }
+    *index = (uint32_t)s->nmaterials;
+    s->materials[s->nmaterials++] = m;
+    return PK_OK;
+}
+
+int64_t scene_find_material(const pk_scene *s, const char *name)
+{
+    for (size_t i = s->nmaterials; i-- > 0;)
+        if (strcmp(s->materials[i].name, name) == 0) return (int64_t)i;
+    return -1;
+}
+
+static bool material_emits(const material *m) { return m->ke.x > 0.0f || m->ke.y > 0.0f || m->ke.z > 0.0f; }
+
+pk_status scene_commit(pk_context *ctx, pk_scene *s)
+{
+    char why[256];
+    if (!scene_check(s, why, sizeof why))
+        return ctx_error(ctx, PK_ERR_PARSE, "%s: invalid scene: %s", s->name, why);
+    mem_free(&s->alloc, s->degenerate);
+    mem_free(&s->alloc, s->emissive);
+    s->degenerate = NULL;
+    s->emissive = NULL;
+    s->ndegenerate = s->nemissive = 0;
+    s->bounds = aabb_empty();
+    if (s->ntris) {
+        s->degenerate = mem_calloc(&s->alloc, s->ntris, 1);
+        if (!s->degenerate) return ctx_nomem(ctx);
+    }
+    size_t nemit = 0;
+    for (size_t k = 0; k < s->ntris; k++) {
+        vec3 a, b, c;
+        scene_tri_verts(s, k, &a, &b, &c);
+        if (tri_is_degenerate(a, b, c)) {
+            s->degenerate[k] = 1;
+            s->ndegenerate++;
+            continue;
+        }
+        s->bounds = aabb_grow(aabb_grow(aabb_grow(s->bounds, a), b), c);
+        if (material_emits(&s->materials[s->tris[k].material])) nemit++;
+    }
+    for (size_t i = 0; i < s->nspheres; i++) {
+        const sphere *sp = &s->spheres[i];
+        s->bounds = aabb_grow(s->bounds, v3_sub(sp->center, v3s(sp->radius)));
+        s->bounds = aabb_grow(s->bounds, v3_add(sp->center, v3s(sp->radius)));
+    }
+    if (nemit) {
+        s->emissive = mem_alloc(&s->alloc, nemit * sizeof *s->emissive);
+        if (!s->emissive) return ctx_nomem(ctx);
+        for (size_t k = 0; k < s->ntris; k++)
+            if (!s->degenerate[k] && material_emits(&s->materials[s->tris[k].material]))
+                s->emissive[s->nemissive++] = (uint32_t)k;
+    }
+    if (s->ndegenerate)
+        ctx_warn(ctx, "%s: %zu degenerate triangle%s (zero area) dropped", s->name, s->ndegenerate,
+                 s->ndegenerate == 1 ? "" : "s");
+    if (s->ntris == s->ndegenerate && s->nspheres == 0)
+        return ctx_error(ctx, PK_ERR_EMPTY_SCENE, "%s: no renderable geometry (%zu triangles, %zu degenerate, no spheres)",
+                         s->name, s->ntris, s->ndegenerate);
+    if (!v3_finite(s->bounds.lo) || !v3_finite(s->bounds.hi))
+        return ctx_error(ctx, PK_ERR_PARSE, "%s: scene bounds are not finite", s->name);
+    s->committed = true;
+    return PK_OK;
+}
+
+bool scene_check(const pk_scene *s, char *why, size_t n)
+{
+#define FAIL(...) do { if (why) snprintf(why, n, __VA_ARGS__); return false; } while (0)
+    if (s->nmaterials == 0) FAIL("no default material");
+    for (size_t i = 0; i < s->npositions; i++)
+        if (!v3_finite(s->positions[i])) FAIL("position %zu is not finite", i);
+    for (size_t i = 0; i < s->nnormals; i++)
+        if (!v3_finite(s->normals[i])) FAIL("normal %zu is not finite", i);
+    for (size_t k = 0; k < s->ntris; k++) {
+        const triangle *t = &s->tris[k];
+        for (int j = 0; j < 3; j++) {
+            if (t->v[j] >= s->npositions) FAIL("triangle %zu: vertex index out of range", k);
+            if (t->n[j] < -1 || (t->n[j] >= 0 && (size_t)t->n[j] >= s->nnormals))
+                FAIL("triangle %zu: normal index out of range", k);
+        }
+        if (t->material >= s->nmaterials) FAIL("triangle %zu: material out of range", k);
+    }
+    for (size_t i = 0; i < s->nspheres; i++) {
+        const sphere *sp = &s->spheres[i];
+        if (!v3_finite(sp->center) || !(sp->radius > 0.0f) || !isfinite(sp->radius))
+            FAIL("sphere %zu: bad center or radius", i);
+        if (sp->material >= s->nmaterials) FAIL("sphere %zu: material out of range", i);
+    }
+    for (size_t i = 0; i < s->nlights; i++)
+        if (!v3_finite(s->lights[i].position) || !v3_finite(s->lights[i].intensity))
+            FAIL("light %zu is not finite", i);
+    return true;
+#undef FAIL
+}
