@@ -232,7 +232,8 @@ enum {
 };
 
 /* Builds an accelerator over the scene's triangles and spheres with up to
- * threads threads (0 = all). The accel borrows nothing from scene. */
+ * threads threads (0 = all). The accel borrows nothing from scene; ctx must
+ * outlive it (it allocates through ctx's allocator). */
 PK_API pk_status pk_accel_create(pk_context *ctx, const pk_scene *scene, pk_accel_kind kind,
                                  int threads, pk_accel **out);
 PK_API void pk_accel_destroy(pk_accel *accel);

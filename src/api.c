@@ -1,0 +1,398 @@
+/*
+ * api.c - the one door: every public function checks its arguments here,
+ * records errors in the context and calls into the modules.
+ */
+#include "paprsek_internal.h"
+
+#include "accel/accel.h"
+#include "io/image.h"
+#include "render/render.h"
+#include "scene/scene.h"
+
+#include <string.h>
+
+/* ---- options and names ---------------------------------------------------- */
+
+void pk_render_options_init(pk_render_options *opt)
+{
+    if (!opt) return;
+    memset(opt, 0, sizeof *opt);
+    opt->width = 512;
+    opt->height = 512;
+    opt->spp = 1;
+    opt->light_samples = 32;
+    opt->max_depth = 8;
+    opt->threads = 0;
+    opt->accel = PK_ACCEL_DEFAULT;
+    opt->fresnel = 1;
+}
+
+static const char *const accel_names[] = {"bvh", "none", "midpoint", "bvh", "embree"};
+
+const char *pk_accel_kind_name(pk_accel_kind kind)
+{
+    if ((unsigned)kind >= sizeof accel_names / sizeof accel_names[0]) return "unknown";
+    return accel_names[kind];
+}
+
+pk_status pk_accel_kind_parse(const char *name, pk_accel_kind *out)
+{
+    if (!name || !out) return PK_ERR_INVALID_ARGUMENT;
+    for (int k = PK_ACCEL_NONE; k <= PK_ACCEL_EMBREE; k++)
+        if (strcmp(name, accel_names[k]) == 0) {
+            *out = (pk_accel_kind)k;
+            return PK_OK;
+        }
+    if (strcmp(name, "default") == 0) {
+        *out = PK_ACCEL_DEFAULT;
+        return PK_OK;
+    }
+    return PK_ERR_INVALID_ARGUMENT;
+}
+
+int pk_accel_available(pk_accel_kind kind)
+{
+    if (kind == PK_ACCEL_EMBREE) return accel_embree_available();
+    return (unsigned)kind <= PK_ACCEL_BVH;
+}
+
+/* ---- scenes ----------------------------------------------------------------- */
+
+static const char *base_name(const char *path)
+{
+    const char *s = strrchr(path, '/');
+    return s ? s + 1 : path;
+}
+
+static bool has_ext(const char *path, const char *ext)
+{
+    size_t lp = strlen(path), le = strlen(ext);
+    if (lp < le) return false;
+    const char *p = path + lp - le;
+    for (size_t i = 0; i < le; i++) {
+        char c = p[i];
+        if (c >= 'A' && c <= 'Z') c = (char)(c - 'A' + 'a');
+        if (c != ext[i]) return false;
+    }
+    return true;
+}
+
+typedef enum { FMT_OBJ, FMT_JSON } scene_format;
+
+static pk_status load_memory(pk_context *ctx, scene_format fmt, const char *data, size_t size,
+                             const char *name, const char *base_dir, pk_scene **out)
+{
+    pk_scene *s = NULL;
+    pk_status st = scene_create(ctx, name, &s);
+    if (st != PK_OK) return st;
+    st = fmt == FMT_OBJ ? obj_parse(ctx, s, data, size, name, base_dir, NULL)
+                        : scene_json_parse(ctx, s, data, size, name, base_dir);
+    if (st == PK_OK) st = scene_commit(ctx, s);
+    if (st != PK_OK) {
+        scene_destroy(s);
+        if (ctx->status == PK_OK) ctx_error(ctx, st, "%s: %s", name, pk_status_string(st));
+        return ctx->status;
+    }
+    *out = s;
+    return PK_OK;
+}
+
+pk_status pk_scene_load_obj_memory(pk_context *ctx, const char *data, size_t size, const char *name,
+                                   const char *base_dir, pk_scene **out)
+{
+    if (!ctx || !out) return PK_ERR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!data && size) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "no data");
+    return load_memory(ctx, FMT_OBJ, data ? data : "", size, name ? name : "memory.obj", base_dir, out);
+}
+
+pk_status pk_scene_load_json_memory(pk_context *ctx, const char *data, size_t size, const char *name,
+                                    const char *base_dir, pk_scene **out)
+{
+    if (!ctx || !out) return PK_ERR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!data && size) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "no data");
+    return load_memory(ctx, FMT_JSON, data ? data : "", size, name ? name : "memory.json",
+                       base_dir ? base_dir : ".", out);
+}
+
+pk_status pk_scene_load_file(pk_context *ctx, const char *path, pk_scene **out)
+{
+    if (!ctx || !out) return PK_ERR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!path) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "no scene path");
+    scene_format fmt;
+    if (has_ext(path, ".obj"))
+        fmt = FMT_OBJ;
+    else if (has_ext(path, ".json"))
+        fmt = FMT_JSON;
+    else
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: unknown scene format (expected .obj or .json)", path);
+    char *data = NULL, *dir = NULL;
+    size_t size = 0;
+    pk_status st = file_read_all(ctx, path, &data, &size);
+    if (st != PK_OK) return st;
+    dir = path_dirname(&ctx->alloc, path);
+    if (!dir) {
+        st = ctx_nomem(ctx);
+        goto out;
+    }
+    st = load_memory(ctx, fmt, data, size, base_name(path), dir, out);
+out:
+    mem_free(&ctx->alloc, data);
+    mem_free(&ctx->alloc, dir);
+    return st;
+}
+
+pk_status pk_scene_create_cornell_box(pk_context *ctx, pk_scene **out)
+{
+    if (!ctx || !out) return PK_ERR_INVALID_ARGUMENT;
+    *out = NULL;
+    pk_scene *s = NULL;
+    pk_status st = scene_create(ctx, "cornell-box (built in)", &s);
+    if (st != PK_OK) return st;
+    st = scene_build_cornell(ctx, s);
+    if (st == PK_OK) st = scene_commit(ctx, s);
+    if (st != PK_OK) {
+        scene_destroy(s);
+        return st;
+    }
+    *out = s;
+    return PK_OK;
+}
+
+void pk_scene_destroy(pk_scene *scene) { scene_destroy(scene); }
+
+void pk_scene_get_info(const pk_scene *s, pk_scene_info *info)
+{
+    if (!s || !info) return;
+    memset(info, 0, sizeof *info);
+    info->triangles = s->ntris;
+    info->degenerate_triangles = s->ndegenerate;
+    info->spheres = s->nspheres;
+    info->materials = s->nmaterials;
+    info->point_lights = s->nlights;
+    info->emissive_triangles = s->nemissive;
+    info->bounds_min[0] = s->bounds.lo.x;
+    info->bounds_min[1] = s->bounds.lo.y;
+    info->bounds_min[2] = s->bounds.lo.z;
+    info->bounds_max[0] = s->bounds.hi.x;
+    info->bounds_max[1] = s->bounds.hi.y;
+    info->bounds_max[2] = s->bounds.hi.z;
+    info->has_camera = s->has_camera;
+}
+
+pk_status pk_scene_get_triangle(const pk_scene *s, size_t k, float verts[9])
+{
+    if (!s || !verts || k >= s->ntris) return PK_ERR_INVALID_ARGUMENT;
+    vec3 p[3];
+    scene_tri_verts(s, k, &p[0], &p[1], &p[2]);
+    for (int i = 0; i < 3; i++) {
+        verts[3 * i] = p[i].x;
+        verts[3 * i + 1] = p[i].y;
+        verts[3 * i + 2] = p[i].z;
+    }
+    return PK_OK;
+}
+
+void pk_scene_get_camera(const pk_scene *s, pk_camera *cam)
+{
+    if (!s || !cam) return;
+    if (s->has_camera) {
+        *cam = s->camera;
+        return;
+    }
+    /* Frame the bounding sphere from +z with a 40 degree field of view. */
+    aabb b = s->bounds;
+    if (!v3_finite(b.lo) || !v3_finite(b.hi)) b.lo = b.hi = v3s(0.0f);
+    vec3 c = aabb_center(b);
+    float r = 0.5f * v3_len(aabb_extent(b));
+    if (!(r > 0.0f)) r = 1.0f;
+    float fov = 40.0f;
+    float dist = r / sinf(0.5f * fov * PK_PI / 180.0f) * 1.05f;
+    pk_camera k = {{c.x, c.y, c.z + dist}, {c.x, c.y, c.z}, {0.0f, 1.0f, 0.0f}, fov};
+    *cam = k;
+}
+
+pk_status camera_validate(pk_context *ctx, const pk_camera *cam, const char *what)
+{
+    vec3 from = v3(cam->look_from[0], cam->look_from[1], cam->look_from[2]);
+    vec3 at = v3(cam->look_at[0], cam->look_at[1], cam->look_at[2]);
+    vec3 up = v3(cam->up[0], cam->up[1], cam->up[2]);
+    if (!v3_finite(from) || !v3_finite(at) || !v3_finite(up) || !isfinite(cam->fov_deg))
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: camera values must be finite numbers", what);
+    if (!(cam->fov_deg > 0.0f && cam->fov_deg < 180.0f))
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: fov %g must be between 0 and 180 degrees (exclusive)",
+                         what, (double)cam->fov_deg);
+    vec3 dir = v3_sub(at, from);
+    if (!(v3_len(dir) > 0.0f) || !isfinite(v3_len(dir)))
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: look_from and look_at are the same point", what);
+    vec3 x = v3_cross(v3_norm(dir), v3_norm(up));
+    if (!(v3_len(x) > 1e-6f))
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: up vector is zero or parallel to the view direction", what);
+    return PK_OK;
+}
+
+pk_status pk_scene_set_camera(pk_context *ctx, pk_scene *s, const pk_camera *cam)
+{
+    if (!ctx || !s || !cam) return PK_ERR_INVALID_ARGUMENT;
+    pk_status st = camera_validate(ctx, cam, "camera");
+    if (st != PK_OK) return st;
+    s->camera = *cam;
+    s->has_camera = true;
+    return PK_OK;
+}
+
+void pk_scene_get_render_options(const pk_scene *s, pk_render_options *opt)
+{
+    if (!opt) return;
+    pk_render_options_init(opt);
+    if (!s) return;
+    const scene_render_settings *r = &s->render;
+    if (r->has_width) opt->width = r->opt.width;
+    if (r->has_height) opt->height = r->opt.height;
+    if (r->has_spp) opt->spp = r->opt.spp;
+    if (r->has_light_samples) opt->light_samples = r->opt.light_samples;
+    if (r->has_max_depth) opt->max_depth = r->opt.max_depth;
+    if (r->has_threads) opt->threads = r->opt.threads;
+    if (r->has_accel) opt->accel = r->opt.accel;
+    if (r->has_fresnel) opt->fresnel = r->opt.fresnel;
+}
+
+/* ---- images ---------------------------------------------------------------- */
+
+pk_status pk_image_create(pk_context *ctx, int width, int height, pk_image **out)
+{
+    if (!ctx || !out) return PK_ERR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (width < 1 || height < 1 || width > PK_MAX_IMAGE_SIDE || height > PK_MAX_IMAGE_SIDE ||
+        (uint64_t)width * (uint64_t)height > PK_MAX_IMAGE_PIXELS)
+        return ctx_error(ctx, PK_ERR_LIMIT, "image size %dx%d is out of range (1..%d per side, at most %u pixels)",
+                         width, height, PK_MAX_IMAGE_SIDE, PK_MAX_IMAGE_PIXELS);
+    pk_image *img = mem_calloc(&ctx->alloc, 1, sizeof *img);
+    if (!img) return ctx_nomem(ctx);
+    img->alloc = ctx->alloc;
+    img->width = width;
+    img->height = height;
+    img->pixels = mem_calloc(&ctx->alloc, (size_t)width * (size_t)height * 3, sizeof(float));
+    if (!img->pixels) {
+        mem_free(&ctx->alloc, img);
+        return ctx_nomem(ctx);
+    }
+    *out = img;
+    return PK_OK;
+}
+
+void pk_image_destroy(pk_image *img)
+{
+    if (!img) return;
+    pk_allocator a = img->alloc;
+    mem_free(&a, img->pixels);
+    mem_free(&a, img);
+}
+
+int pk_image_width(const pk_image *img) { return img ? img->width : 0; }
+int pk_image_height(const pk_image *img) { return img ? img->height : 0; }
+float *pk_image_pixels(pk_image *img) { return img ? img->pixels : NULL; }
+const float *pk_image_pixels_const(const pk_image *img) { return img ? img->pixels : NULL; }
+
+pk_status pk_image_write(pk_context *ctx, const pk_image *img, const char *path)
+{
+    if (!ctx || !img || !path) return PK_ERR_INVALID_ARGUMENT;
+    return image_write(ctx, img, path);
+}
+
+/* ---- rendering ---------------------------------------------------------------- */
+
+static pk_status check_options(pk_context *ctx, const pk_render_options *o)
+{
+#define RANGE(field, lo, hi, what)                                                                   \
+    if (o->field < (lo) || o->field > (hi))                                                          \
+        return ctx_error(ctx, PK_ERR_LIMIT, "%s %d is out of range (%d..%d)", what, o->field, (int)(lo), (int)(hi));
+    RANGE(width, 1, PK_MAX_IMAGE_SIDE, "width")
+    RANGE(height, 1, PK_MAX_IMAGE_SIDE, "height")
+    RANGE(spp, 1, PK_MAX_SPP, "samples per pixel")
+    RANGE(light_samples, 0, PK_MAX_LIGHT_SAMPLES, "light samples")
+    RANGE(max_depth, 0, PK_MAX_DEPTH, "max depth")
+    RANGE(threads, 0, PK_MAX_THREADS, "threads")
+#undef RANGE
+    if ((uint64_t)o->width * (uint64_t)o->height > PK_MAX_IMAGE_PIXELS)
+        return ctx_error(ctx, PK_ERR_LIMIT, "image of %dx%d pixels is larger than %u pixels", o->width, o->height,
+                         PK_MAX_IMAGE_PIXELS);
+    if ((unsigned)o->accel > PK_ACCEL_EMBREE)
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "unknown accelerator %d", (int)o->accel);
+    if (!pk_accel_available(o->accel))
+        return ctx_error(ctx, PK_ERR_UNSUPPORTED, "accelerator '%s' is not available in this build",
+                         pk_accel_kind_name(o->accel));
+    return PK_OK;
+}
+
+pk_status pk_render(pk_context *ctx, const pk_scene *scene, const pk_render_options *opt, pk_image **out,
+                    pk_stats *stats)
+{
+    if (!ctx || !scene || !out) return PK_ERR_INVALID_ARGUMENT;
+    *out = NULL;
+    pk_render_options o;
+    if (opt)
+        o = *opt;
+    else
+        pk_scene_get_render_options(scene, &o);
+    if (!scene->committed) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "scene is not committed");
+    pk_status st = check_options(ctx, &o);
+    if (st != PK_OK) return st;
+    pk_camera cam;
+    pk_scene_get_camera(scene, &cam);
+    st = camera_validate(ctx, &cam, "camera");
+    if (st != PK_OK) return st;
+    return render_scene(ctx, scene, &cam, &o, out, stats);
+}
+
+/* ---- accelerators over scenes ---------------------------------------------------- */
+
+struct pk_accel {
+    pk_context *ctx;
+    accel *a;
+};
+
+pk_status pk_accel_create(pk_context *ctx, const pk_scene *scene, pk_accel_kind kind, int threads, pk_accel **out)
+{
+    if (!ctx || !scene || !out) return PK_ERR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (threads < 0 || threads > PK_MAX_THREADS)
+        return ctx_error(ctx, PK_ERR_LIMIT, "threads %d is out of range (0..%d)", threads, PK_MAX_THREADS);
+    if ((unsigned)kind > PK_ACCEL_EMBREE)
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "unknown accelerator %d", (int)kind);
+    if (!pk_accel_available(kind))
+        return ctx_error(ctx, PK_ERR_UNSUPPORTED, "accelerator '%s' is not available in this build",
+                         pk_accel_kind_name(kind));
+    pk_accel *pa = mem_calloc(&ctx->alloc, 1, sizeof *pa);
+    if (!pa) return ctx_nomem(ctx);
+    pa->ctx = ctx;
+    pk_status st = render_build_accel(ctx, scene, kind, threads, &pa->a);
+    if (st != PK_OK) {
+        mem_free(&ctx->alloc, pa);
+        return st;
+    }
+    *out = pa;
+    return PK_OK;
+}
+
+void pk_accel_destroy(pk_accel *pa)
+{
+    if (!pa) return;
+    accel_destroy(pa->a);
+    mem_free(&pa->ctx->alloc, pa);
+}
+
+void pk_accel_get_info(const pk_accel *pa, pk_accel_info *info)
+{
+    if (!pa || !info) return;
+    *info = pa->a->info;
+}
+
+void pk_accel_trace(const pk_accel *pa, const pk_ray *rays, pk_hit *hits, size_t n, int threads, unsigned flags,
+                    pk_trace_counters *counters)
+{
+    if (!pa || !rays || !hits || n == 0) return;
+    render_trace_rays(pa->a, (const ray *)rays, (hit *)hits, n, threads, flags, counters);
+}

@@ -1,0 +1,160 @@
+/*
+ * image_write.c - PNG (8-bit sRGB through libpng) and PFM (linear float RGB)
+ * writers. Each writes to a temporary file beside the target and renames it
+ * into place, so an existing image is only ever replaced by a complete one.
+ */
+#include "image.h"
+
+#include <errno.h>
+#include <math.h>
+#include <sys/stat.h>
+#include <png.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+unsigned char srgb_encode(float x)
+{
+    if (!(x > 0.0f)) return 0;
+    if (x >= 1.0f) return 255;
+    float s = x <= 0.0031308f ? 12.92f * x : 1.055f * powf(x, 1.0f / 2.4f) - 0.055f;
+    int v = (int)(s * 255.0f + 0.5f);
+    return (unsigned char)(v < 0 ? 0 : v > 255 ? 255 : v);
+}
+
+static bool ends_with(const char *s, const char *ext)
+{
+    size_t ls = strlen(s), le = strlen(ext);
+    if (ls < le) return false;
+    for (size_t i = 0; i < le; i++) {
+        char c = s[ls - le + i];
+        if (c >= 'A' && c <= 'Z') c = (char)(c - 'A' + 'a');
+        if (c != ext[i]) return false;
+    }
+    return true;
+}
+
+typedef struct png_err {
+    char msg[200];
+} png_err;
+
+static void png_error_fn(png_structp png, png_const_charp msg)
+{
+    png_err *e = png_get_error_ptr(png);
+    snprintf(e->msg, sizeof e->msg, "%s", msg);
+    png_longjmp(png, 1);
+}
+
+static void png_warn_fn(png_structp png, png_const_charp msg)
+{
+    (void)png;
+    (void)msg;
+}
+
+/* Returns 0 on success, or -1 with why filled. The row buffer is allocated
+ * before setjmp so that a longjmp cannot leak it. */
+static int write_png(FILE *f, const pk_image *img, unsigned char *row, char *why, size_t nwhy)
+{
+    png_err err = {{0}};
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &err, png_error_fn, png_warn_fn);
+    if (!png) {
+        snprintf(why, nwhy, "cannot start PNG encoder");
+        return -1;
+    }
+    png_infop info = png_create_info_struct(png);
+    if (!info) {
+        png_destroy_write_struct(&png, NULL);
+        snprintf(why, nwhy, "cannot start PNG encoder");
+        return -1;
+    }
+    if (setjmp(png_jmpbuf(png))) {
+        png_destroy_write_struct(&png, &info);
+        snprintf(why, nwhy, "PNG encoder: %s", err.msg);
+        return -1;
+    }
+    png_init_io(png, f);
+    png_set_IHDR(png, info, (png_uint_32)img->width, (png_uint_32)img->height, 8, PNG_COLOR_TYPE_RGB,
+                 PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+    png_write_info(png, info);
+    for (int y = 0; y < img->height; y++) {
+        const float *src = img->pixels + (size_t)y * (size_t)img->width * 3;
+        for (int i = 0; i < img->width * 3; i++) row[i] = srgb_encode(src[i]);
+        png_write_row(png, row);
+    }
+    png_write_end(png, info);
+    png_destroy_write_struct(&png, &info);
+    return 0;
+}
+
+static int write_pfm(FILE *f, const pk_image *img, char *why, size_t nwhy)
+{
+    /* PFM: rows bottom to top; a negative scale means little-endian floats */
+    if (fprintf(f, "PF\n%d %d\n-1.0\n", img->width, img->height) < 0) goto fail;
+    for (int y = img->height - 1; y >= 0; y--) {
+        const float *src = img->pixels + (size_t)y * (size_t)img->width * 3;
+        if (fwrite(src, sizeof(float) * 3, (size_t)img->width, f) != (size_t)img->width) goto fail;
+    }
+    return 0;
+fail:
+    snprintf(why, nwhy, "write error: %s", strerror(errno));
+    return -1;
+}
+
+pk_status image_write(pk_context *ctx, const pk_image *img, const char *path)
+{
+    bool png = ends_with(path, ".png"), pfm = ends_with(path, ".pfm");
+    if (!png && !pfm)
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: unknown image format (use .png or .pfm)", path);
+    size_t lp = strlen(path);
+    char *tmp = mem_alloc(&ctx->alloc, lp + 16);
+    unsigned char *row = png ? mem_alloc(&ctx->alloc, (size_t)img->width * 3) : NULL;
+    if (!tmp || (png && !row)) {
+        mem_free(&ctx->alloc, tmp);
+        mem_free(&ctx->alloc, row);
+        return ctx_nomem(ctx);
+    }
+    memcpy(tmp, path, lp);
+    memcpy(tmp + lp, ".tmp.XXXXXX", 12);
+    pk_status st = PK_OK;
+    char why[256] = "";
+    int fd = mkstemp(tmp);
+    if (fd < 0) {
+        st = ctx_error(ctx, PK_ERR_IO, "%s: cannot create a temporary file beside it: %s", path, strerror(errno));
+        goto out;
+    }
+    (void)fchmod(fd, 0644);
+    FILE *f = fdopen(fd, "wb");
+    if (!f) {
+        close(fd);
+        unlink(tmp);
+        st = ctx_error(ctx, PK_ERR_IO, "%s: %s", path, strerror(errno));
+        goto out;
+    }
+    int rc = png ? write_png(f, img, row, why, sizeof why) : write_pfm(f, img, why, sizeof why);
+    if (rc == 0 && fflush(f) != 0) {
+        rc = -1;
+        snprintf(why, sizeof why, "write error: %s", strerror(errno));
+    }
+    if (rc == 0 && fsync(fileno(f)) != 0 && errno != EINVAL) {
+        rc = -1;
+        snprintf(why, sizeof why, "write error: %s", strerror(errno));
+    }
+    if (fclose(f) != 0 && rc == 0) {
+        rc = -1;
+        snprintf(why, sizeof why, "write error: %s", strerror(errno));
+    }
+    if (rc == 0 && rename(tmp, path) != 0) {
+        rc = -1;
+        snprintf(why, sizeof why, "cannot rename into place: %s", strerror(errno));
+    }
+    if (rc != 0) {
+        unlink(tmp);
+        st = ctx_error(ctx, PK_ERR_IO, "%s: %s", path, why);
+    }
+out:
+    mem_free(&ctx->alloc, tmp);
+    mem_free(&ctx->alloc, row);
+    return st;
+}
