@@ -75,6 +75,8 @@ PK_HIDDEN pk_status accel_midpoint_create(pk_context *ctx, const accel_input *in
 PK_HIDDEN pk_status accel_bvh_create(pk_context *ctx, const accel_input *in, accel **out);
 PK_HIDDEN pk_status accel_embree_create(pk_context *ctx, const accel_input *in, accel **out);
 PK_HIDDEN bool accel_embree_available(void);
+/* Invariant checkers (tests): false with a reason when the structure is broken. */
+PK_HIDDEN bool midpoint_check(const accel *a, char *why, size_t n);
 
 /* A copy of the primitives for the scalar accelerators (none, midpoint). */
 typedef struct prim_set {

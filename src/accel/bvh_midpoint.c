@@ -4,12 +4,13 @@
  * longest axis when every primitive lands on one side. Traversal visits the
  * nearer child first and skips nodes farther than the closest hit so far.
  *
- * Invariants (midpoint_check in the tests via the info counts):
+ * Invariants (midpoint_check tests them):
  *  1. a node's box contains its children's boxes and its primitives' boxes;
  *  2. every primitive that can be hit is in exactly one leaf.
  */
 #include "accel.h"
 
+#include <stdio.h>
 #include <string.h>
 
 #define MID_LEAF_MAX 4
@@ -247,4 +248,36 @@ out_fail:
     mem_free(al, b.centroids);
     mid_destroy(&m->base);
     return st;
+}
+
+bool midpoint_check(const accel *a, char *why, size_t n)
+{
+#define FAIL(...) do { snprintf(why, n, __VA_ARGS__); mem_free(a->alloc, seen); return false; } while (0)
+    const accel_mid *m = (const accel_mid *)a;
+    size_t total = (size_t)m->ps.ntris + m->ps.nspheres;
+    uint8_t *seen = total ? mem_calloc(a->alloc, total, 1) : NULL;
+    if (total && !seen) FAIL("out of memory");
+    for (uint32_t i = 0; i < m->nnodes; i++) {
+        const mid_node *nd = &m->nodes[i];
+        if (nd->count == 0) {
+            if (nd->first + 1 >= m->nnodes || nd->first <= i) FAIL("node %u: bad child index", i);
+            for (int k = 0; k < 2; k++)
+                if (!aabb_contains(nd->box, m->nodes[nd->first + k].box)) FAIL("node %u: child box outside", i);
+            continue;
+        }
+        for (uint32_t j = nd->first; j < nd->first + nd->count; j++) {
+            uint32_t id = m->ids[j];
+            aabb b;
+            if (id >= total || !prim_bounds(&m->ps, id, &b)) FAIL("node %u: bad primitive %u", i, id);
+            if (!aabb_contains(nd->box, b)) FAIL("node %u: primitive %u outside the box", i, id);
+            if (seen[id]++) FAIL("primitive %u in two leaves", id);
+        }
+    }
+    for (size_t id = 0; id < total; id++) {
+        aabb b;
+        if (!seen[id] && prim_bounds(&m->ps, (uint32_t)id, &b)) FAIL("primitive %zu in no leaf", id);
+    }
+    mem_free(a->alloc, seen);
+    return true;
+#undef FAIL
 }
