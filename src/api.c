@@ -202,14 +202,15 @@ void pk_scene_get_camera(const pk_scene *s, pk_camera *cam)
         *cam = s->camera;
         return;
     }
-    /* Frame the bounding sphere from +z with a 40 degree field of view. */
+    /* Look along -z at the centre of the bounds from just far enough that the
+     * front face of the box fills a 40 degree view (with a small margin). */
     aabb b = s->bounds;
     if (!v3_finite(b.lo) || !v3_finite(b.hi)) b.lo = b.hi = v3s(0.0f);
-    vec3 c = aabb_center(b);
-    float r = 0.5f * v3_len(aabb_extent(b));
-    if (!(r > 0.0f)) r = 1.0f;
+    vec3 c = aabb_center(b), e = aabb_extent(b);
     float fov = 40.0f;
-    float dist = r / sinf(0.5f * fov * PK_PI / 180.0f) * 1.05f;
+    float half = 0.5f * fmaxf(e.x, e.y) * 1.08f;
+    if (!(half > 0.0f)) half = fmaxf(0.5f * e.z, 1.0f);
+    float dist = half / tanf(0.5f * fov * PK_PI / 180.0f) + 0.5f * e.z;
     pk_camera k = {{c.x, c.y, c.z + dist}, {c.x, c.y, c.z}, {0.0f, 1.0f, 0.0f}, fov};
     *cam = k;
 }

@@ -195,13 +195,17 @@ vec3 whitted_shade(const integrator *in, thread_state *ts, const ray *r, const h
             float F = tir ? 1.0f : fresnel_dielectric(cos_i, eta_i, eta_t);
             vec3 wr = v3_reflect(dn, sf.ns);
             if (v3_dot(wr, sf.ng) <= 0.0f) wr = v3_reflect(dn, sf.ng);
+            /* Tf tints the light that enters: its hue, normalised to the brightest
+             * channel (exporters write grey Tf of any strength for clear glass) */
+            float tmax_c = v3_max_comp(m->tf);
+            vec3 tint = sf.front && tmax_c > 0.0f ? v3_scale(m->tf, 1.0f / tmax_c) : v3s(1.0f);
             vec3 kr, kt;
             if (in->fresnel) {
                 kr = v3s(F);
-                kt = tir ? v3s(0.0f) : v3_scale(sf.front ? m->tf : v3s(1.0f), 1.0f - F);
-            } else { /* the seed: fixed weights, Ks for reflection and Tf for refraction */
+                kt = tir ? v3s(0.0f) : v3_scale(tint, 1.0f - F);
+            } else { /* the seed: fixed weights, Ks for reflection and the tint for refraction */
                 kr = tir ? v3s(1.0f) : m->ks;
-                kt = tir ? v3s(0.0f) : (sf.front ? m->tf : v3s(1.0f));
+                kt = tir ? v3s(0.0f) : tint;
             }
             if (!is_black(kr)) {
                 ray rr = {offset_origin(in, sf.p, sf.ng), 0.0f, wr, INFINITY};

@@ -116,12 +116,16 @@ static inline void scene_tri_verts(const pk_scene *s, size_t k, vec3 *a, vec3 *b
     *c = s->positions[t->v[2]];
 }
 
-/* Triangles that can never be hit: a non-finite vertex or zero area. */
+/* Triangles that can never be hit: a non-finite vertex or zero area. The
+ * cross product is taken in double so that huge (1e30) and tiny (1e-30)
+ * triangles are not mistaken for degenerate ones by overflow or underflow. */
 static inline bool tri_is_degenerate(vec3 a, vec3 b, vec3 c)
 {
     if (!v3_finite(a) || !v3_finite(b) || !v3_finite(c)) return true;
-    vec3 n = v3_cross(v3_sub(b, a), v3_sub(c, a));
-    return !(v3_len2(n) > 0.0f) || !v3_finite(n);
+    double ex = (double)b.x - (double)a.x, ey = (double)b.y - (double)a.y, ez = (double)b.z - (double)a.z;
+    double fx = (double)c.x - (double)a.x, fy = (double)c.y - (double)a.y, fz = (double)c.z - (double)a.z;
+    double nx = ey * fz - ez * fy, ny = ez * fx - ex * fz, nz = ex * fy - ey * fx;
+    return nx == 0.0 && ny == 0.0 && nz == 0.0;
 }
 
 /* ---- loaders (io/) ----------------------------------------------------- */
