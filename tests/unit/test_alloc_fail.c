@@ -1,0 +1,104 @@
+/*
+ * test_alloc_fail.c - fault injection (as SQLite's test_malloc.c): an
+ * allocator that fails the Nth allocation, swept over N through a scene load
+ * and a small render. Every failure must come back as PK_ERR_NOMEM (or the
+ * load's own error) without a crash, and every block taken must be freed
+ * (the live-block count returns to zero; ASan builds check the rest).
+ */
+#include "test.h"
+
+#include "paprsek.h"
+
+typedef struct fail_alloc {
+    long calls, fail_at; /* fail the call numbered fail_at (1-based); 0 = never */
+    long live;           /* blocks currently allocated */
+    long failed;
+} fail_alloc;
+
+/* Blocks carry a 16-byte header with their size so that live blocks can be counted. */
+static void *hook(void *user, void *ptr, size_t size)
+{
+    fail_alloc *f = user;
+    if (size == 0) {
+        if (ptr) {
+            f->live--;
+            free((char *)ptr - 16);
+        }
+        return NULL;
+    }
+    f->calls++;
+    if (f->fail_at && f->calls == f->fail_at) {
+        f->failed++;
+        return NULL;
+    }
+    char *p = realloc(ptr ? (char *)ptr - 16 : NULL, size + 16);
+    if (!p) return NULL;
+    if (!ptr) f->live++;
+    return p + 16;
+}
+
+static const char *obj_text =
+    "mtllib none.mtl\n"
+    "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+    "vn 0 0 1\nvn 0 1 0\n"
+    "usemtl missing\n"
+    "f 1//1 2//1 3//1 4//1\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n"
+    "f 1 1 1\n";
+
+/* One run with the Nth allocation failing; returns the status of the first failing step. */
+static pk_status run(fail_alloc *f, int use_cornell)
+{
+    pk_allocator a = {hook, f};
+    pk_context *ctx = NULL;
+    pk_status st = pk_context_create(&a, &ctx);
+    if (st != PK_OK) return st;
+    pk_scene *s = NULL;
+    pk_image *img = NULL;
+    st = use_cornell ? pk_scene_create_cornell_box(ctx, &s)
+                     : pk_scene_load_obj_memory(ctx, obj_text, strlen(obj_text), "cube.obj", NULL, &s);
+    if (st == PK_OK) {
+        pk_render_options o;
+        pk_render_options_init(&o);
+        o.width = o.height = 8;
+        o.light_samples = 2;
+        o.threads = 2;
+        o.accel = use_cornell ? PK_ACCEL_BVH : PK_ACCEL_MIDPOINT;
+        pk_stats stats;
+        st = pk_render(ctx, s, &o, &img, &stats);
+        if (st == PK_OK) CHECK(img != NULL);
+        if (st != PK_OK) CHECK(img == NULL);
+    }
+    if (st != PK_OK) CHECKF(pk_context_error(ctx)[0] != '\0', "status %d without a message", (int)st);
+    pk_image_destroy(img);
+    pk_scene_destroy(s);
+    pk_context_destroy(ctx);
+    return st;
+}
+
+static void sweep(int use_cornell)
+{
+    fail_alloc f = {0, 0, 0, 0};
+    REQUIRE(run(&f, use_cornell) == PK_OK);
+    long total = f.calls;
+    CHECK(f.live == 0);
+    REQUIRE(total > 5);
+    long nomem = 0;
+    for (long n = 1; n <= total; n++) {
+        fail_alloc g = {0, n, 0, 0};
+        pk_status st = run(&g, use_cornell);
+        CHECKF(g.live == 0, "failing allocation %ld of %ld leaked %ld block(s)", n, total, g.live);
+        if (g.failed) {
+            CHECKF(st == PK_ERR_NOMEM, "failing allocation %ld of %ld gave status %d, not NOMEM", n, total, (int)st);
+            nomem++;
+        }
+    }
+    printf("%s: %ld allocations, each failed once: %ld reported out of memory, no leaks\n",
+           use_cornell ? "cornell box + bvh render" : "obj load + midpoint render", total, nomem);
+}
+
+int main(void)
+{
+    sweep(0);
+    sweep(1);
+    return test_done("test_alloc_fail");
+}
