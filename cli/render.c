@@ -183,6 +183,22 @@ static void print_table(const char *scene, const pk_render_options *ro, const pk
     printf("%-28s %.2f\n", "Mrays/s", st->render_s > 0 ? (double)rays / st->render_s / 1e6 : 0.0);
 }
 
+/* Writes s as a JSON string literal. */
+static void json_string(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (; *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\')
+            fprintf(f, "\\%c", c);
+        else if (c < 0x20)
+            fprintf(f, "\\u%04x", c);
+        else
+            fputc(c, f);
+    }
+    fputc('"', f);
+}
+
 static int write_stats_json(const char *path, const char *scene, const pk_render_options *ro, const pk_stats *st)
 {
     uint64_t rays = st->rays_camera + st->rays_shadow + st->rays_reflection + st->rays_refraction;
@@ -191,13 +207,15 @@ static int write_stats_json(const char *path, const char *scene, const pk_render
         perror(path);
         return 1;
     }
+    fputs("{\n  \"scene\": ", f);
+    json_string(f, scene);
     fprintf(f,
-            "{\n  \"scene\": \"%s\",\n  \"accel\": \"%s\",\n  \"width\": %d,\n  \"height\": %d,\n  \"spp\": %d,\n"
+            ",\n  \"accel\": \"%s\",\n  \"width\": %d,\n  \"height\": %d,\n  \"spp\": %d,\n"
             "  \"light_samples\": %d,\n  \"max_depth\": %d,\n  \"fresnel\": %s,\n  \"threads\": %d,\n"
             "  \"build_us\": %.1f,\n  \"render_s\": %.6f,\n  \"rays\": %llu,\n  \"rays_camera\": %llu,\n"
             "  \"rays_shadow\": %llu,\n  \"rays_reflection\": %llu,\n  \"rays_refraction\": %llu,\n"
             "  \"intersection_tests\": %llu,\n  \"nodes_visited\": %llu,\n  \"mrays_per_s\": %.3f\n}\n",
-            scene, pk_accel_kind_name(ro->accel), ro->width, ro->height, ro->spp, ro->light_samples, ro->max_depth,
+            pk_accel_kind_name(ro->accel), ro->width, ro->height, ro->spp, ro->light_samples, ro->max_depth,
             ro->fresnel ? "true" : "false", st->threads, st->build_us, st->render_s, (unsigned long long)rays,
             (unsigned long long)st->rays_camera, (unsigned long long)st->rays_shadow,
             (unsigned long long)st->rays_reflection, (unsigned long long)st->rays_refraction,
