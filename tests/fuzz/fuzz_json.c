@@ -1,0 +1,19 @@
+/* fuzz_json.c - the JSON scene parser through its (buffer, size) entry point;
+ * meshes are looked up in tests/data, so fuzzed scenes can name real files. */
+#include "fuzz.h"
+
+#include "scene/scene.h"
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    pk_context *ctx = NULL;
+    if (pk_context_create(NULL, &ctx) != PK_OK) return 0;
+    pk_scene *s = NULL;
+    if (scene_create(ctx, "fuzz.json", &s) == PK_OK) {
+        if (scene_json_parse(ctx, s, (const char *)data, size, "fuzz.json", PK_TEST_DATA) == PK_OK)
+            scene_commit(ctx, s);
+        scene_destroy(s);
+    }
+    pk_context_destroy(ctx);
+    return 0;
+}

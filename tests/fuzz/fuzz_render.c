@@ -1,0 +1,32 @@
+/* fuzz_render.c - loads a fuzzed scene (JSON when it starts with '{', OBJ
+ * otherwise) and renders it at 8x8 with every code path of the integrator. */
+#include "fuzz.h"
+
+#include "paprsek.h"
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    pk_context *ctx = NULL;
+    if (pk_context_create(NULL, &ctx) != PK_OK) return 0;
+    pk_scene *s = NULL;
+    const char *text = (const char *)data;
+    pk_status st = size && text[0] == '{'
+                       ? pk_scene_load_json_memory(ctx, text, size, "fuzz.json", PK_TEST_DATA, &s)
+                       : pk_scene_load_obj_memory(ctx, text, size, "fuzz.obj", NULL, &s);
+    if (st == PK_OK) {
+        pk_render_options o;
+        pk_scene_get_render_options(s, &o);
+        o.width = o.height = 8;
+        o.spp = 1;
+        o.light_samples = 2;
+        o.max_depth = 4;
+        o.threads = 1;
+        if (o.accel == PK_ACCEL_EMBREE) o.accel = PK_ACCEL_BVH;
+        pk_image *img = NULL;
+        pk_render(ctx, s, &o, &img, NULL);
+        pk_image_destroy(img);
+    }
+    pk_scene_destroy(s);
+    pk_context_destroy(ctx);
+    return 0;
+}
