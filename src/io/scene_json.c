@@ -1,0 +1,772 @@
+/*
+ * scene_json.c - JSON scene files: camera, film and render settings, meshes
+ * (OBJ files with optional transforms), materials, spheres, point lights and
+ * ambient light, parsed with cJSON into a pk_scene (docs/scene-format.md).
+ * Errors read "file:line: json.path: what is wrong". cJSON keeps no positions,
+ * so a line is found by a scan of the text that numbers values in the same
+ * pre-order as the parsed tree.
+ */
+#include "../scene/scene.h"
+
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#define JP_PATH_MAX 192
+#define JP_WARN_MAX 32
+#define JP_DEFAULT_FOV 45.0f
+
+/* One parse. warned[] holds the index-free paths ("spheres[].colour") of the
+ * unknown keys already reported, so that each is reported once. */
+typedef struct jp {
+    pk_context *ctx;
+    pk_scene *s;
+    const char *text;
+    size_t size;
+    const char *name;      /* file name for messages */
+    const char *base_dir;  /* meshes are read relative to it; NULL = as written */
+    const cJSON *root;
+    size_t named_limit;    /* materials findable by name (inline ones come after) */
+    size_t nwarned;        /* <= JP_WARN_MAX */
+    bool warn_full;        /* the "not reported" point was passed */
+    char warned[JP_WARN_MAX][JP_PATH_MAX];
+} jp;
+
+/* ---- positions ------------------------------------------------------------ */
+
+static bool is_ws(char c) { return (unsigned char)c <= 32; } /* cJSON's whitespace */
+
+static int line_at(const char *t, size_t off)
+{
+    int line = 1;
+    for (size_t i = 0; i < off; i++)
+        if (t[i] == '\n') line++;
+    return line;
+}
+
+/* Pre-order number of target under node (root = 0); false when absent. */
+static bool preorder_index(const cJSON *node, const cJSON *target, size_t *k)
+{
+    if (node == target) return true;
+    (*k)++;
+    for (const cJSON *c = node->child; c; c = c->next)
+        if (preorder_index(c, target, k)) return true;
+    return false;
+}
+
+/* Line where the k-th value (pre-order, keys not counted) of valid JSON text
+ * starts; 0 when there is none. */
+static int value_line(const char *t, size_t n, size_t k)
+{
+    int line = 1;
+    size_t count = 0, i = 0;
+    if (n >= 3 && memcmp(t, "\xEF\xBB\xBF", 3) == 0) i = 3;
+    while (i < n) {
+        char c = t[i];
+        if (c == '\n') {
+            line++;
+            i++;
+            continue;
+        }
+        if (is_ws(c) || c == ',' || c == ':' || c == '}' || c == ']') {
+            i++;
+            continue;
+        }
+        if (c == '"') {
+            int start = line;
+            size_t j = i + 1;
+            while (j < n && t[j] != '"') {
+                if (t[j] == '\\') j++;
+                if (j < n && t[j] == '\n') line++;
+                j++;
+            }
+            j++;
+            size_t m = j;
+            while (m < n && is_ws(t[m])) m++;
+            i = j;
+            if (m < n && t[m] == ':') continue; /* a key, not a value */
+            if (count++ == k) return start;
+            continue;
+        }
+        if (count++ == k) return line;
+        if (c == '{' || c == '[') {
+            i++;
+            continue;
+        }
+        while (i < n && !is_ws(t[i]) && t[i] != ',' && t[i] != ':' && t[i] != ']' && t[i] != '}') i++;
+    }
+    return 0;
+}
+
+static int item_line(const jp *p, const cJSON *item)
+{
+    size_t k = 0;
+    if (!item || !preorder_index(p->root, item, &k)) return 1;
+    int line = value_line(p->text, p->size, k);
+    return line > 0 ? line : 1;
+}
+
+/* ---- messages ------------------------------------------------------------- */
+
+static pk_status jfail(jp *p, pk_status st, const cJSON *at, const char *path, const char *fmt, ...)
+    PK_PRINTF(5, 6);
+
+static pk_status jfail(jp *p, pk_status st, const cJSON *at, const char *path, const char *fmt, ...)
+{
+    char msg[PK_ERRMSG_MAX];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    int line = item_line(p, at);
+    if (path[0]) return ctx_error(p->ctx, st, "%s:%d: %s: %s", p->name, line, path, msg);
+    return ctx_error(p->ctx, st, "%s:%d: %s", p->name, line, msg);
+}
+
+/* Copies in to out (n bytes) with control characters as '?', for messages. */
+static void sanitize(char *out, size_t n, const char *in)
+{
+    size_t i = 0;
+    for (; in[i] && i + 1 < n; i++) out[i] = ((unsigned char)in[i] < 32 || in[i] == 127) ? '?' : in[i];
+    out[i] = '\0';
+}
+
+/* out = base.key (or key at the top level); control characters become '?'. */
+static void path_key(char *out, const char *base, const char *key)
+{
+    size_t o = 0;
+    for (const char *c = base; *c && o + 1 < JP_PATH_MAX; c++) out[o++] = *c;
+    if (base[0] && o + 1 < JP_PATH_MAX) out[o++] = '.';
+    sanitize(out + o, JP_PATH_MAX - o, key ? key : "");
+}
+
+static void path_index(char *out, const char *base, int i) { snprintf(out, JP_PATH_MAX, "%s[%d]", base, i); }
+
+static void warn_unknown(jp *p, const cJSON *member, const char *path)
+{
+    char generic[JP_PATH_MAX];
+    size_t o = 0;
+    for (const char *c = path; *c && o + 1 < sizeof generic; c++) {
+        generic[o++] = *c;
+        if (*c == '[')
+            while (c[1] && c[1] != ']') c++;
+    }
+    generic[o] = '\0';
+    if (p->warn_full) return;
+    for (size_t i = 0; i < p->nwarned; i++)
+        if (strcmp(p->warned[i], generic) == 0) return;
+    if (p->nwarned == JP_WARN_MAX) {
+        /* finding a line scans the text: stop before that costs n^2 */
+        p->warn_full = true;
+        ctx_warn(p->ctx, "%s: more unknown keys ignored and not reported", p->name);
+        return;
+    }
+    memcpy(p->warned[p->nwarned++], generic, o + 1);
+    ctx_warn(p->ctx, "%s:%d: %s: unknown key ignored", p->name, item_line(p, member), path);
+}
+
+/* Checks that obj is an object and finds its known keys: fields[i] is the
+ * member named known[i] or NULL. Unknown keys are warned about; a known key
+ * given twice is an error. */
+static pk_status object_fields(jp *p, const cJSON *obj, const char *path, const char *const *known,
+                               size_t nknown, const cJSON **fields)
+{
+    if (!cJSON_IsObject(obj)) return jfail(p, PK_ERR_PARSE, obj, path, "must be an object");
+    for (size_t i = 0; i < nknown; i++) fields[i] = NULL;
+    for (const cJSON *m = obj->child; m; m = m->next) {
+        char mp[JP_PATH_MAX];
+        path_key(mp, path, m->string);
+        size_t i = 0;
+        while (i < nknown && (!m->string || strcmp(m->string, known[i]) != 0)) i++;
+        if (i == nknown) {
+            warn_unknown(p, m, mp);
+            continue;
+        }
+        if (fields[i]) return jfail(p, PK_ERR_PARSE, m, mp, "duplicate key");
+        fields[i] = m;
+    }
+    return PK_OK;
+}
+
+/* ---- values --------------------------------------------------------------- */
+
+static pk_status get_float(jp *p, const cJSON *it, const char *path, float *out)
+{
+    if (!cJSON_IsNumber(it)) return jfail(p, PK_ERR_PARSE, it, path, "must be a number");
+    float f = (float)it->valuedouble;
+    if (!isfinite(f)) return jfail(p, PK_ERR_PARSE, it, path, "must be a finite number");
+    *out = f;
+    return PK_OK;
+}
+
+static pk_status get_floats(jp *p, const cJSON *it, const char *path, float *out, int n)
+{
+    if (!cJSON_IsArray(it) || cJSON_GetArraySize(it) != n)
+        return jfail(p, PK_ERR_PARSE, it, path, "must be an array of %d numbers", n);
+    int i = 0;
+    for (const cJSON *e = it->child; e; e = e->next, i++) {
+        if (!cJSON_IsNumber(e)) return jfail(p, PK_ERR_PARSE, it, path, "must be an array of %d numbers", n);
+        out[i] = (float)e->valuedouble;
+        if (!isfinite(out[i])) return jfail(p, PK_ERR_PARSE, e, path, "numbers must be finite");
+    }
+    return PK_OK;
+}
+
+static pk_status get_vec3(jp *p, const cJSON *it, const char *path, vec3 *out)
+{
+    float f[3];
+    pk_status st = get_floats(p, it, path, f, 3);
+    if (st == PK_OK) *out = v3(f[0], f[1], f[2]);
+    return st;
+}
+
+static pk_status get_color(jp *p, const cJSON *it, const char *path, vec3 *out)
+{
+    pk_status st = get_vec3(p, it, path, out);
+    if (st == PK_OK && (out->x < 0.0f || out->y < 0.0f || out->z < 0.0f))
+        return jfail(p, PK_ERR_PARSE, it, path, "colour components must not be negative");
+    return st;
+}
+
+/* An integer in lo..hi; above hi is PK_ERR_LIMIT. */
+static pk_status get_int(jp *p, const cJSON *it, const char *path, int lo, int hi, int *out)
+{
+    if (!cJSON_IsNumber(it) || it->valuedouble != floor(it->valuedouble))
+        return jfail(p, PK_ERR_PARSE, it, path, "must be an integer");
+    double v = it->valuedouble;
+    if (v < (double)lo || v > (double)hi)
+        return jfail(p, v > (double)hi ? PK_ERR_LIMIT : PK_ERR_PARSE, it, path, "must be an integer in %d..%d",
+                     lo, hi);
+    *out = (int)v;
+    return PK_OK;
+}
+
+static pk_status get_array(jp *p, const cJSON *it, const char *path)
+{
+    return cJSON_IsArray(it) ? PK_OK : jfail(p, PK_ERR_PARSE, it, path, "must be an array");
+}
+
+/* ---- materials ------------------------------------------------------------ */
+
+enum { MF_NAME, MF_KD, MF_KS, MF_KE, MF_TF, MF_KA, MF_NS, MF_NI, MF_D, MF_ILLUM, MF_COUNT };
+static const char *const material_keys[MF_COUNT] = {"name", "kd", "ks", "ke", "tf", "ka", "ns", "ni", "d", "illum"};
+
+/* Reads a material object into *m (name not set). with_name: "name" is known. */
+static pk_status read_material(jp *p, const cJSON *obj, const char *path, bool with_name, material *m,
+                               const cJSON **name_item)
+{
+    const cJSON *f[MF_COUNT];
+    pk_status st = object_fields(p, obj, path, with_name ? material_keys : material_keys + 1,
+                                 with_name ? MF_COUNT : MF_COUNT - 1, with_name ? f : f + 1);
+    if (st) return st;
+    if (!with_name) f[MF_NAME] = NULL;
+    if (name_item) *name_item = f[MF_NAME];
+    material_init(m);
+    vec3 *colours[] = {NULL, &m->kd, &m->ks, &m->ke, &m->tf, &m->ka};
+    char fp[JP_PATH_MAX];
+    for (int i = MF_KD; i <= MF_KA; i++) {
+        if (!f[i]) continue;
+        path_key(fp, path, material_keys[i]);
+        if ((st = get_color(p, f[i], fp, colours[i]))) return st;
+    }
+    if (f[MF_NS]) {
+        path_key(fp, path, "ns");
+        if ((st = get_float(p, f[MF_NS], fp, &m->ns))) return st;
+        if (m->ns < 0.0f) return jfail(p, PK_ERR_PARSE, f[MF_NS], fp, "must not be negative");
+    }
+    if (f[MF_NI]) {
+        path_key(fp, path, "ni");
+        if ((st = get_float(p, f[MF_NI], fp, &m->ni))) return st;
+        if (!(m->ni > 0.0f)) return jfail(p, PK_ERR_PARSE, f[MF_NI], fp, "must be a positive number");
+    }
+    if (f[MF_D]) {
+        path_key(fp, path, "d");
+        if ((st = get_float(p, f[MF_D], fp, &m->d))) return st;
+        if (m->d < 0.0f || m->d > 1.0f) return jfail(p, PK_ERR_PARSE, f[MF_D], fp, "must be in 0..1");
+    }
+    if (f[MF_ILLUM]) {
+        path_key(fp, path, "illum");
+        if ((st = get_int(p, f[MF_ILLUM], fp, 0, 10, &m->illum))) return st;
+    }
+    return PK_OK;
+}
+
+static pk_status add_material(jp *p, const material *m, const char *name, uint32_t *index)
+{
+    uint32_t idx;
+    pk_status st = scene_add_material(p->ctx, p->s, name, &idx);
+    if (st) return st;
+    material *dst = &p->s->materials[idx];
+    char *owned = dst->name;
+    *dst = *m;
+    dst->name = owned;
+    if (index) *index = idx;
+    return PK_OK;
+}
+
+static pk_status parse_materials(jp *p, const cJSON *it)
+{
+    pk_status st;
+    material m;
+    char mp[JP_PATH_MAX];
+    if (cJSON_IsObject(it)) {
+        for (const cJSON *e = it->child; e; e = e->next) {
+            path_key(mp, "materials", e->string);
+            if (!e->string || !e->string[0]) return jfail(p, PK_ERR_PARSE, e, mp, "material name must not be empty");
+            if ((st = read_material(p, e, mp, false, &m, NULL))) return st;
+            if ((st = add_material(p, &m, e->string, NULL))) return st;
+        }
+        return PK_OK;
+    }
+    if (!cJSON_IsArray(it))
+        return jfail(p, PK_ERR_PARSE, it, "materials", "must be an object (name: material) or an array");
+    int i = 0;
+    for (const cJSON *e = it->child; e; e = e->next, i++) {
+        const cJSON *name = NULL;
+        path_index(mp, "materials", i);
+        if ((st = read_material(p, e, mp, true, &m, &name))) return st;
+        if (!name) return jfail(p, PK_ERR_PARSE, e, mp, "missing \"name\"");
+        char np[JP_PATH_MAX];
+        path_key(np, mp, "name");
+        if (!cJSON_IsString(name) || !name->valuestring[0])
+            return jfail(p, PK_ERR_PARSE, name, np, "must be a non-empty string");
+        if ((st = add_material(p, &m, name->valuestring, NULL))) return st;
+    }
+    return PK_OK;
+}
+
+/* ---- camera, film, render, ambient ---------------------------------------- */
+
+static pk_status parse_camera(jp *p, const cJSON *it)
+{
+    enum { C_FROM, C_AT, C_UP, C_FOV, C_COUNT };
+    static const char *const keys[C_COUNT] = {"look_from", "look_at", "up", "fov"};
+    const cJSON *f[C_COUNT];
+    pk_status st = object_fields(p, it, "camera", keys, C_COUNT, f);
+    if (st) return st;
+    if (!f[C_FROM]) return jfail(p, PK_ERR_PARSE, it, "camera", "missing \"look_from\"");
+    if (!f[C_AT]) return jfail(p, PK_ERR_PARSE, it, "camera", "missing \"look_at\"");
+    vec3 from, at, up = v3(0.0f, 1.0f, 0.0f);
+    float fov = JP_DEFAULT_FOV;
+    if ((st = get_vec3(p, f[C_FROM], "camera.look_from", &from))) return st;
+    if ((st = get_vec3(p, f[C_AT], "camera.look_at", &at))) return st;
+    if (f[C_UP] && (st = get_vec3(p, f[C_UP], "camera.up", &up))) return st;
+    if (f[C_FOV]) {
+        if ((st = get_float(p, f[C_FOV], "camera.fov", &fov))) return st;
+        if (!(fov > 0.0f && fov < 180.0f))
+            return jfail(p, PK_ERR_PARSE, f[C_FOV], "camera.fov", "must be between 0 and 180 degrees (exclusive)");
+    }
+    vec3 dir = v3_sub(at, from);
+    if (!(v3_len2(dir) > 0.0f) || !v3_finite(dir))
+        return jfail(p, PK_ERR_PARSE, f[C_AT], "camera.look_at", "must differ from look_from");
+    if (!(v3_len2(up) > 0.0f))
+        return jfail(p, PK_ERR_PARSE, f[C_UP], "camera.up", "must not be zero");
+    if (!(v3_len(v3_cross(v3_norm(dir), v3_norm(up))) > 1e-4f)) {
+        if (f[C_UP]) return jfail(p, PK_ERR_PARSE, f[C_UP], "camera.up", "is parallel to the view direction");
+        return jfail(p, PK_ERR_PARSE, it, "camera",
+                     "the default up [0, 1, 0] is parallel to the view direction; give \"up\"");
+    }
+    pk_camera *cam = &p->s->camera;
+    cam->look_from[0] = from.x, cam->look_from[1] = from.y, cam->look_from[2] = from.z;
+    cam->look_at[0] = at.x, cam->look_at[1] = at.y, cam->look_at[2] = at.z;
+    cam->up[0] = up.x, cam->up[1] = up.y, cam->up[2] = up.z;
+    cam->fov_deg = fov;
+    p->s->has_camera = true;
+    return PK_OK;
+}
+
+static pk_status parse_size(jp *p, const cJSON *wi, const cJSON *hi, const cJSON *obj, const char *path)
+{
+    scene_render_settings *r = &p->s->render;
+    char fp[JP_PATH_MAX];
+    pk_status st;
+    if (wi) {
+        path_key(fp, path, "width");
+        if ((st = get_int(p, wi, fp, 1, PK_MAX_IMAGE_SIDE, &r->opt.width))) return st;
+        r->has_width = true;
+    }
+    if (hi) {
+        path_key(fp, path, "height");
+        if ((st = get_int(p, hi, fp, 1, PK_MAX_IMAGE_SIDE, &r->opt.height))) return st;
+        r->has_height = true;
+    }
+    if ((uint64_t)r->opt.width * (uint64_t)r->opt.height > (uint64_t)PK_MAX_IMAGE_PIXELS)
+        return jfail(p, PK_ERR_LIMIT, obj, path, "%dx%d is more than %u pixels", r->opt.width, r->opt.height,
+                     (unsigned)PK_MAX_IMAGE_PIXELS);
+    return PK_OK;
+}
+
+static pk_status parse_film(jp *p, const cJSON *it)
+{
+    static const char *const keys[] = {"width", "height"};
+    const cJSON *f[2];
+    pk_status st = object_fields(p, it, "film", keys, 2, f);
+    if (st) return st;
+    return parse_size(p, f[0], f[1], it, "film");
+}
+
+static pk_status parse_render(jp *p, const cJSON *it)
+{
+    enum { R_W, R_H, R_SPP, R_LS, R_DEPTH, R_THREADS, R_ACCEL, R_FRESNEL, R_COUNT };
+    static const char *const keys[R_COUNT] = {"width",   "height", "spp",   "light_samples",
+                                              "max_depth", "threads", "accel", "fresnel"};
+    const cJSON *f[R_COUNT];
+    pk_status st = object_fields(p, it, "render", keys, R_COUNT, f);
+    if (st) return st;
+    scene_render_settings *r = &p->s->render;
+    if (f[R_SPP]) {
+        if ((st = get_int(p, f[R_SPP], "render.spp", 1, PK_MAX_SPP, &r->opt.spp))) return st;
+        r->has_spp = true;
+    }
+    if (f[R_LS]) {
+        if ((st = get_int(p, f[R_LS], "render.light_samples", 1, PK_MAX_LIGHT_SAMPLES, &r->opt.light_samples)))
+            return st;
+        r->has_light_samples = true;
+    }
+    if (f[R_DEPTH]) {
+        if ((st = get_int(p, f[R_DEPTH], "render.max_depth", 0, PK_MAX_DEPTH, &r->opt.max_depth))) return st;
+        r->has_max_depth = true;
+    }
+    if (f[R_THREADS]) {
+        if ((st = get_int(p, f[R_THREADS], "render.threads", 0, PK_MAX_THREADS, &r->opt.threads))) return st;
+        r->has_threads = true;
+    }
+    if (f[R_ACCEL]) {
+        pk_accel_kind kind;
+        if (!cJSON_IsString(f[R_ACCEL]) || pk_accel_kind_parse(f[R_ACCEL]->valuestring, &kind) != PK_OK)
+            return jfail(p, PK_ERR_PARSE, f[R_ACCEL], "render.accel",
+                         "must be one of \"none\", \"midpoint\", \"bvh\", \"embree\"");
+        r->opt.accel = kind;
+        r->has_accel = true;
+    }
+    if (f[R_FRESNEL]) {
+        if (!cJSON_IsBool(f[R_FRESNEL])) return jfail(p, PK_ERR_PARSE, f[R_FRESNEL], "render.fresnel", "must be true or false");
+        r->opt.fresnel = cJSON_IsTrue(f[R_FRESNEL]) ? 1 : 0;
+        r->has_fresnel = true;
+    }
+    return parse_size(p, f[R_W], f[R_H], it, "render");
+}
+
+/* ---- meshes ---------------------------------------------------------------- */
+
+static void mat_identity(float m[16])
+{
+    for (int i = 0; i < 16; i++) m[i] = (i % 5 == 0) ? 1.0f : 0.0f;
+}
+
+static void mat_mul(const float a[16], const float b[16], float out[16])
+{
+    float r[16];
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++) {
+            float sum = 0.0f;
+            for (int k = 0; k < 4; k++) sum += a[i * 4 + k] * b[k * 4 + j];
+            r[i * 4 + j] = sum;
+        }
+    memcpy(out, r, sizeof r);
+}
+
+/* A 4x4 row-major affine transform from 16 numbers or from
+ * {"translate", "scale", "rotate"} composed as T * R * S. */
+static pk_status parse_transform(jp *p, const cJSON *it, const char *path, float m[16])
+{
+    pk_status st;
+    char fp[JP_PATH_MAX];
+    if (cJSON_IsArray(it)) {
+        if ((st = get_floats(p, it, path, m, 16))) return st;
+        if (m[12] != 0.0f || m[13] != 0.0f || m[14] != 0.0f || m[15] != 1.0f)
+            return jfail(p, PK_ERR_PARSE, it, path, "the last row must be 0 0 0 1");
+    } else {
+        enum { T_TRANSLATE, T_SCALE, T_ROTATE, T_COUNT };
+        static const char *const keys[T_COUNT] = {"translate", "scale", "rotate"};
+        const cJSON *f[T_COUNT];
+        if (!cJSON_IsObject(it))
+            return jfail(p, PK_ERR_PARSE, it, path,
+                         "must be an array of 16 numbers or an object with translate, scale, rotate");
+        if ((st = object_fields(p, it, path, keys, T_COUNT, f))) return st;
+        float t[16], r[16], s[16];
+        mat_identity(t);
+        mat_identity(r);
+        mat_identity(s);
+        if (f[T_TRANSLATE]) {
+            vec3 v;
+            path_key(fp, path, "translate");
+            if ((st = get_vec3(p, f[T_TRANSLATE], fp, &v))) return st;
+            t[3] = v.x, t[7] = v.y, t[11] = v.z;
+        }
+        if (f[T_SCALE]) {
+            vec3 v;
+            path_key(fp, path, "scale");
+            if (cJSON_IsNumber(f[T_SCALE])) {
+                if ((st = get_float(p, f[T_SCALE], fp, &v.x))) return st;
+                v.y = v.z = v.x;
+            } else if (!cJSON_IsArray(f[T_SCALE])) {
+                return jfail(p, PK_ERR_PARSE, f[T_SCALE], fp, "must be a number or an array of 3 numbers");
+            } else if ((st = get_vec3(p, f[T_SCALE], fp, &v))) {
+                return st;
+            }
+            if (v.x == 0.0f || v.y == 0.0f || v.z == 0.0f)
+                return jfail(p, PK_ERR_PARSE, f[T_SCALE], fp, "must not be zero");
+            s[0] = v.x, s[5] = v.y, s[10] = v.z;
+        }
+        if (f[T_ROTATE]) {
+            float a[4];
+            path_key(fp, path, "rotate");
+            if ((st = get_floats(p, f[T_ROTATE], fp, a, 4))) return st;
+            vec3 ax = v3(a[1], a[2], a[3]);
+            if (!(v3_len2(ax) > 0.0f) || !isfinite(v3_len2(ax)))
+                return jfail(p, PK_ERR_PARSE, f[T_ROTATE], fp, "the axis must not be zero");
+            ax = v3_norm(ax);
+            float rad = a[0] * (PK_PI / 180.0f), c = cosf(rad), sn = sinf(rad), k = 1.0f - c;
+            r[0] = k * ax.x * ax.x + c, r[1] = k * ax.x * ax.y - sn * ax.z, r[2] = k * ax.x * ax.z + sn * ax.y;
+            r[4] = k * ax.x * ax.y + sn * ax.z, r[5] = k * ax.y * ax.y + c, r[6] = k * ax.y * ax.z - sn * ax.x;
+            r[8] = k * ax.x * ax.z - sn * ax.y, r[9] = k * ax.y * ax.z + sn * ax.x, r[10] = k * ax.z * ax.z + c;
+        }
+        mat_mul(r, s, m);
+        mat_mul(t, m, m);
+    }
+    double d[9];
+    for (int i = 0; i < 9; i++) d[i] = (double)m[(i / 3) * 4 + i % 3];
+    double det = d[0] * (d[4] * d[8] - d[5] * d[7]) - d[1] * (d[3] * d[8] - d[5] * d[6]) +
+                 d[2] * (d[3] * d[7] - d[4] * d[6]);
+    if (!(det != 0.0) || !isfinite(det)) return jfail(p, PK_ERR_PARSE, it, path, "the transform is singular");
+    for (int i = 0; i < 16; i++)
+        if (!isfinite(m[i])) return jfail(p, PK_ERR_PARSE, it, path, "the transform is not finite");
+    return PK_OK;
+}
+
+static pk_status parse_mesh(jp *p, const cJSON *it, const char *path)
+{
+    enum { M_OBJ, M_TRANSFORM, M_COUNT };
+    static const char *const keys[M_COUNT] = {"obj", "transform"};
+    const cJSON *f[M_COUNT];
+    char fp[JP_PATH_MAX];
+    float xf[16];
+    pk_status st = object_fields(p, it, path, keys, M_COUNT, f);
+    if (st) return st;
+    if (!f[M_OBJ]) return jfail(p, PK_ERR_PARSE, it, path, "missing \"obj\"");
+    path_key(fp, path, "obj");
+    if (!cJSON_IsString(f[M_OBJ]) || !f[M_OBJ]->valuestring[0])
+        return jfail(p, PK_ERR_PARSE, f[M_OBJ], fp, "must be a non-empty string (a path)");
+    if (f[M_TRANSFORM]) {
+        char tp[JP_PATH_MAX];
+        path_key(tp, path, "transform");
+        if ((st = parse_transform(p, f[M_TRANSFORM], tp, xf))) return st;
+    }
+
+    const pk_allocator *a = &p->ctx->alloc;
+    pk_context scratch;
+    char *data = NULL, *dir = NULL;
+    size_t size = 0;
+    char *full = path_join(a, p->base_dir, f[M_OBJ]->valuestring);
+    if (!full) {
+        st = ctx_nomem(p->ctx);
+        goto out;
+    }
+    dir = path_dirname(a, full);
+    if (!dir) {
+        st = ctx_nomem(p->ctx);
+        goto out;
+    }
+    /* Read through a scratch context so that the message can say where in the
+     * JSON file the path came from. */
+    scratch = *p->ctx;
+    scratch.status = PK_OK;
+    scratch.message[0] = '\0';
+    st = file_read_all(&scratch, full, &data, &size);
+    if (st) {
+        jfail(p, st, f[M_OBJ], fp, "%s", scratch.message);
+        goto out;
+    }
+    st = obj_parse(p->ctx, p->s, data, size, full, dir, f[M_TRANSFORM] ? xf : NULL);
+out:
+    mem_free(a, data);
+    mem_free(a, dir);
+    mem_free(a, full);
+    return st;
+}
+
+/* ---- spheres and lights ---------------------------------------------------- */
+
+/* Newest material named name among the first limit; -1 when absent. Inline
+ * sphere materials come after limit and are never found by name. */
+static int64_t find_material_below(const pk_scene *s, const char *name, size_t limit)
+{
+    for (size_t i = limit; i-- > 0;)
+        if (strcmp(s->materials[i].name, name) == 0) return (int64_t)i;
+    return -1;
+}
+
+static pk_status parse_sphere(jp *p, const cJSON *it, const char *path)
+{
+    enum { S_CENTER, S_RADIUS, S_MATERIAL, S_COUNT };
+    static const char *const keys[S_COUNT] = {"center", "radius", "material"};
+    const cJSON *f[S_COUNT];
+    char fp[JP_PATH_MAX];
+    pk_status st = object_fields(p, it, path, keys, S_COUNT, f);
+    if (st) return st;
+    if (!f[S_CENTER]) return jfail(p, PK_ERR_PARSE, it, path, "missing \"center\"");
+    if (!f[S_RADIUS]) return jfail(p, PK_ERR_PARSE, it, path, "missing \"radius\"");
+    sphere sp = {.material = 0};
+    path_key(fp, path, "center");
+    if ((st = get_vec3(p, f[S_CENTER], fp, &sp.center))) return st;
+    path_key(fp, path, "radius");
+    const cJSON *r = f[S_RADIUS];
+    sp.radius = cJSON_IsNumber(r) ? (float)r->valuedouble : 0.0f;
+    if (!(sp.radius > 0.0f) || !isfinite(sp.radius))
+        return jfail(p, PK_ERR_PARSE, r, fp, "must be a positive number");
+    const cJSON *mi = f[S_MATERIAL];
+    if (mi) {
+        path_key(fp, path, "material");
+        if (cJSON_IsString(mi)) {
+            int64_t idx = find_material_below(p->s, mi->valuestring, p->named_limit);
+            if (idx < 0) {
+                char shown[64];
+                sanitize(shown, sizeof shown, mi->valuestring);
+                return jfail(p, PK_ERR_PARSE, mi, fp, "unknown material \"%s\"", shown);
+            }
+            sp.material = (uint32_t)idx;
+        } else if (cJSON_IsObject(mi)) {
+            material m;
+            if ((st = read_material(p, mi, fp, false, &m, NULL))) return st;
+            if ((st = add_material(p, &m, fp, &sp.material))) return st;
+        } else {
+            return jfail(p, PK_ERR_PARSE, mi, fp, "must be a material name or a material object");
+        }
+    }
+    return scene_add_sphere(p->ctx, p->s, &sp);
+}
+
+static pk_status parse_light(jp *p, const cJSON *it, const char *path)
+{
+    enum { L_POSITION, L_INTENSITY, L_COLOR, L_COUNT };
+    static const char *const keys[L_COUNT] = {"position", "intensity", "color"};
+    const cJSON *f[L_COUNT];
+    char fp[JP_PATH_MAX];
+    pk_status st = object_fields(p, it, path, keys, L_COUNT, f);
+    if (st) return st;
+    if (!f[L_POSITION]) return jfail(p, PK_ERR_PARSE, it, path, "missing \"position\"");
+    point_light l;
+    vec3 intensity = v3s(1.0f), color = v3s(1.0f);
+    path_key(fp, path, "position");
+    if ((st = get_vec3(p, f[L_POSITION], fp, &l.position))) return st;
+    if (f[L_INTENSITY]) {
+        path_key(fp, path, "intensity");
+        if (cJSON_IsNumber(f[L_INTENSITY])) {
+            if ((st = get_float(p, f[L_INTENSITY], fp, &intensity.x))) return st;
+            intensity.y = intensity.z = intensity.x;
+        } else if (!cJSON_IsArray(f[L_INTENSITY])) {
+            return jfail(p, PK_ERR_PARSE, f[L_INTENSITY], fp, "must be a number or an array of 3 numbers");
+        } else if ((st = get_vec3(p, f[L_INTENSITY], fp, &intensity))) {
+            return st;
+        }
+        if (intensity.x < 0.0f || intensity.y < 0.0f || intensity.z < 0.0f)
+            return jfail(p, PK_ERR_PARSE, f[L_INTENSITY], fp, "must not be negative");
+    }
+    if (f[L_COLOR]) {
+        path_key(fp, path, "color");
+        if ((st = get_color(p, f[L_COLOR], fp, &color))) return st;
+    }
+    l.intensity = v3_mul(intensity, color);
+    if (!v3_finite(l.intensity))
+        return jfail(p, PK_ERR_PARSE, it, path, "intensity * color is not finite");
+    return scene_add_point_light(p->ctx, p->s, &l);
+}
+
+/* Calls fn on each element of the array at the top-level key. */
+static pk_status each_element(jp *p, const cJSON *arr, const char *key,
+                              pk_status (*fn)(jp *, const cJSON *, const char *))
+{
+    pk_status st = get_array(p, arr, key);
+    if (st) return st;
+    char ep[JP_PATH_MAX];
+    int i = 0;
+    for (const cJSON *e = arr->child; e; e = e->next, i++) {
+        path_index(ep, key, i);
+        if ((st = fn(p, e, ep))) return st;
+    }
+    return PK_OK;
+}
+
+/* ---- the document ---------------------------------------------------------- */
+
+static pk_status syntax_error(jp *p, const char *end)
+{
+    size_t first = 0, last = p->size;
+    while (first < p->size && is_ws(p->text[first])) first++;
+    if (first == p->size)
+        return ctx_error(p->ctx, PK_ERR_PARSE, "%s:1: empty document (expected a JSON object)", p->name);
+    while (last > 0 && is_ws(p->text[last - 1])) last--;
+    /* cJSON points at the last byte when the text ends too early, and
+     * sometimes just past the offending token: then back up to it. */
+    size_t off = end && end >= p->text && end <= p->text + p->size ? (size_t)(end - p->text) : 0;
+    if (off >= last)
+        return ctx_error(p->ctx, PK_ERR_PARSE, "%s:%d: invalid JSON: unexpected end of file", p->name,
+                         line_at(p->text, last - 1));
+    while (off > first && is_ws(p->text[off])) off--;
+    char near[24];
+    size_t n = 0;
+    while (n + 1 < sizeof near && off + n < p->size && p->text[off + n] >= 32 && p->text[off + n] < 127) {
+        near[n] = p->text[off + n];
+        n++;
+    }
+    near[n] = '\0';
+    return ctx_error(p->ctx, PK_ERR_PARSE, "%s:%d: invalid JSON near '%s'", p->name, line_at(p->text, off), near);
+}
+
+pk_status scene_json_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size, const char *name,
+                           const char *base_dir)
+{
+    enum { K_MATERIALS, K_CAMERA, K_FILM, K_RENDER, K_AMBIENT, K_MESHES, K_SPHERES, K_LIGHTS, K_COUNT };
+    static const char *const keys[K_COUNT] = {"materials", "camera", "film",    "render",
+                                              "ambient",   "meshes", "spheres", "lights"};
+    if (!ctx || !s) return PK_ERR_INVALID_ARGUMENT;
+    if (!data && size) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "scene_json_parse: no data");
+    jp *p = mem_calloc(&ctx->alloc, 1, sizeof *p);
+    if (!p) return ctx_nomem(ctx);
+    p->ctx = ctx;
+    p->s = s;
+    p->text = data ? data : "";
+    p->size = size;
+    p->name = name ? name : "scene.json";
+    p->base_dir = base_dir;
+
+    pk_status st;
+    const char *end = NULL;
+    cJSON *root = size ? cJSON_ParseWithLengthOpts(p->text, size, &end, 0) : NULL;
+    if (!root) {
+        st = syntax_error(p, end);
+        goto out;
+    }
+    p->root = root;
+    size_t rest = end && end >= p->text && end <= p->text + size ? (size_t)(end - p->text) : size;
+    while (rest < size && is_ws(p->text[rest])) rest++;
+    if (rest < size) {
+        st = ctx_error(ctx, PK_ERR_PARSE, "%s:%d: unexpected text after the JSON document", p->name,
+                       line_at(p->text, rest));
+        goto out;
+    }
+    if (!cJSON_IsObject(root)) {
+        st = jfail(p, PK_ERR_PARSE, root, "", "the top level must be a JSON object");
+        goto out;
+    }
+    const cJSON *f[K_COUNT];
+    if ((st = object_fields(p, root, "", keys, K_COUNT, f))) goto out;
+
+    /* Materials first: meshes (usemtl) and spheres refer to them by name. */
+    if (f[K_MATERIALS] && (st = parse_materials(p, f[K_MATERIALS]))) goto out;
+    if (f[K_CAMERA] && (st = parse_camera(p, f[K_CAMERA]))) goto out;
+    if (f[K_FILM] && (st = parse_film(p, f[K_FILM]))) goto out;
+    if (f[K_RENDER] && (st = parse_render(p, f[K_RENDER]))) goto out;
+    if (f[K_AMBIENT] && (st = get_color(p, f[K_AMBIENT], "ambient", &s->ambient))) goto out;
+    if (f[K_MESHES] && (st = each_element(p, f[K_MESHES], "meshes", parse_mesh))) goto out;
+    p->named_limit = s->nmaterials;
+    if (f[K_SPHERES] && (st = each_element(p, f[K_SPHERES], "spheres", parse_sphere))) goto out;
+    if (f[K_LIGHTS] && (st = each_element(p, f[K_LIGHTS], "lights", parse_light))) goto out;
+    st = PK_OK;
+out:
+    cJSON_Delete(root);
+    mem_free(&ctx->alloc, p);
+    return st;
+}
