@@ -1,0 +1,436 @@
+/*
+ * embree.c - Embree 3 as an accelerator (--accel embree), so that Paprsek's
+ * own structures can be timed and checked against it on the same rays. One
+ * triangle geometry holds every triangle (degenerate ones too, so Embree's
+ * primID is Paprsek's triangle number) and one sphere-point geometry the
+ * spheres. Without Embree (PK_HAVE_EMBREE 0) this file is a stub.
+ */
+#include "accel.h"
+
+#if defined(PK_HAVE_EMBREE) && PK_HAVE_EMBREE
+
+#include <embree3/rtcore.h>
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { GEOM_TRIS = 0, GEOM_SPHERES = 1 };
+
+/* Invariants:
+ *  1. scene is committed and never changed after accel_embree_create;
+ *  2. geometry GEOM_TRIS holds triangle k as primitive k (ntris of them),
+ *     geometry GEOM_SPHERES sphere k as primitive k (nspheres);
+ *  3. spheres is a copy of the input spheres (for u, v of sphere hits). */
+typedef struct embree_accel {
+    accel base;
+    pk_allocator alloc;       /* copy of the context's allocator */
+    RTCDevice device;
+    RTCScene scene;
+    accel_sphere *spheres;
+    int64_t device_bytes;     /* bytes Embree holds (memory monitor, atomic) */
+    unsigned packet_width;    /* 8 or 16: the widest native packet */
+    bool has_filter;          /* occlusion filters work: any-hit reports t */
+} embree_accel;
+
+/* The error callback's state while building. */
+typedef struct build_errors {
+    pk_context *ctx;
+    bool failed;
+} build_errors;
+
+/* An intersection context that carries where an occlusion filter writes the
+ * hit it accepts: out[ray id]. */
+typedef struct occ_context {
+    struct RTCIntersectContext base;
+    hit *out;
+} occ_context;
+
+bool accel_embree_available(void) { return true; }
+
+static const char *rtc_error_name(enum RTCError code)
+{
+    switch (code) {
+    case RTC_ERROR_NONE: return "no error";
+    case RTC_ERROR_INVALID_ARGUMENT: return "invalid argument";
+    case RTC_ERROR_INVALID_OPERATION: return "invalid operation";
+    case RTC_ERROR_OUT_OF_MEMORY: return "out of memory";
+    case RTC_ERROR_UNSUPPORTED_CPU: return "unsupported CPU";
+    case RTC_ERROR_CANCELLED: return "cancelled";
+    default: return "unknown error";
+    }
+}
+
+static pk_status rtc_error_status(enum RTCError code)
+{
+    switch (code) {
+    case RTC_ERROR_OUT_OF_MEMORY: return PK_ERR_NOMEM;
+    case RTC_ERROR_INVALID_ARGUMENT: return PK_ERR_INVALID_ARGUMENT;
+    case RTC_ERROR_CANCELLED: return PK_ERR_CANCELLED;
+    default: return PK_ERR_UNSUPPORTED;
+    }
+}
+
+static void on_build_error(void *user, enum RTCError code, const char *str)
+{
+    build_errors *be = user;
+    be->failed = true;
+    ctx_error(be->ctx, rtc_error_status(code), "embree: %s%s%s", rtc_error_name(code),
+              str && str[0] ? ": " : "", str ? str : "");
+}
+
+/* Counts what the device holds; Embree builds with several threads. */
+static bool on_memory(void *user, ssize_t bytes, bool post)
+{
+    (void)post;
+    embree_accel *e = user;
+    __atomic_fetch_add(&e->device_bytes, (int64_t)bytes, __ATOMIC_RELAXED);
+    return true;
+}
+
+static pk_status parse_quality(pk_context *ctx, enum RTCBuildQuality *q)
+{
+    const char *s = getenv("PAPRSEK_EMBREE_QUALITY");
+    if (!s || !s[0] || strcmp(s, "medium") == 0) *q = RTC_BUILD_QUALITY_MEDIUM;
+    else if (strcmp(s, "low") == 0) *q = RTC_BUILD_QUALITY_LOW;
+    else if (strcmp(s, "high") == 0) *q = RTC_BUILD_QUALITY_HIGH;
+    else
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT,
+                         "PAPRSEK_EMBREE_QUALITY=%s: expected low, medium or high", s);
+    return PK_OK;
+}
+
+/* u, v of a sphere hit, computed as sphere_intersect does (geom.h). */
+static void sphere_uv(const embree_accel *e, uint32_t k, vec3 o, vec3 d, float t, float *u, float *v)
+{
+    const accel_sphere *s = &e->spheres[k];
+    vec3 p = v3_scale(v3_sub(v3_add(o, v3_scale(d, t)), s->center), 1.0f / s->radius);
+    float phi = atan2f(p.z, p.x);
+    float theta = acosf(fminf(1.0f, fmaxf(-1.0f, p.y)));
+    *u = (phi + PK_PI) * (0.5f / PK_PI);
+    *v = theta * (1.0f / PK_PI);
+}
+
+/* Fills *h from Embree's answer for a ray from o along d. */
+static void set_hit(const embree_accel *e, vec3 o, vec3 d, float t, unsigned geom, unsigned prim,
+                    float u, float v, hit *h)
+{
+    h->t = t;
+    if (geom == GEOM_TRIS) {
+        h->prim = prim;
+        h->u = u;
+        h->v = v;
+    } else {
+        h->prim = (uint32_t)e->base.ntris + prim;
+        sphere_uv(e, prim, o, d, t, &h->u, &h->v);
+    }
+}
+
+static void init_ray1(struct RTCRay *rr, const ray *r)
+{
+    rr->org_x = r->o.x;
+    rr->org_y = r->o.y;
+    rr->org_z = r->o.z;
+    rr->tnear = r->tmin;
+    rr->dir_x = r->d.x;
+    rr->dir_y = r->d.y;
+    rr->dir_z = r->d.z;
+    rr->time = 0.0f;
+    rr->tfar = r->tmax;
+    rr->mask = 0xFFFFFFFFu;
+    rr->id = 0;
+    rr->flags = 0;
+}
+
+/* Occlusion filter: accepts the first hit and records it in out[ray id].
+ * Ray and hit are SoA blocks of N lanes (rtcore_ray.h, RTCRayN/RTCHitN). */
+static void occ_filter(const struct RTCFilterFunctionNArguments *args)
+{
+    const embree_accel *e = args->geometryUserPtr;
+    const occ_context *oc = (const occ_context *)args->context;
+    const unsigned n = args->N;
+    const float *rf = (const float *)args->ray;
+    const unsigned *ru = (const unsigned *)args->ray;
+    const float *hf = (const float *)args->hit;
+    const unsigned *hu = (const unsigned *)args->hit;
+    for (unsigned i = 0; i < n; i++) {
+        if (args->valid[i] != -1) continue;
+        vec3 o = v3(rf[0 * n + i], rf[1 * n + i], rf[2 * n + i]);
+        vec3 d = v3(rf[4 * n + i], rf[5 * n + i], rf[6 * n + i]);
+        set_hit(e, o, d, rf[8 * n + i], hu[6 * n + i], hu[5 * n + i], hf[3 * n + i], hf[4 * n + i],
+                &oc->out[ru[10 * n + i]]);
+    }
+}
+
+static bool emb_intersect(const accel *a, const ray *r, hit *h, accel_counters *c)
+{
+    (void)c;
+    const embree_accel *e = (const embree_accel *)a;
+    struct RTCIntersectContext ictx;
+    rtcInitIntersectContext(&ictx);
+    struct RTCRayHit rh;
+    init_ray1(&rh.ray, r);
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(e->scene, &ictx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+        hit_clear(h);
+        return false;
+    }
+    set_hit(e, r->o, r->d, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, h);
+    return true;
+}
+
+static bool emb_occluded(const accel *a, const ray *r, accel_counters *c)
+{
+    (void)c;
+    const embree_accel *e = (const embree_accel *)a;
+    hit scratch;
+    occ_context oc;
+    rtcInitIntersectContext(&oc.base);
+    oc.out = &scratch;
+    struct RTCRay rr;
+    init_ray1(&rr, r);
+    rtcOccluded1(e->scene, &oc.base, &rr);
+    return rr.tfar == -INFINITY;
+}
+
+/* Field indices in the SoA RTCRayHitN / RTCRayN layout (rtcore_ray.h). */
+enum {
+    F_ORG_X, F_ORG_Y, F_ORG_Z, F_TNEAR, F_DIR_X, F_DIR_Y, F_DIR_Z, F_TIME, F_TFAR, F_MASK, F_ID,
+    F_FLAGS, F_RAY_FIELDS,
+    /* hit fields follow the ray fields */
+    F_NG_X = F_RAY_FIELDS, F_NG_Y, F_NG_Z, F_U, F_V, F_PRIM, F_GEOM, F_INST
+};
+
+typedef union packet_buf {
+    struct RTCRayHit16 rh16;
+    struct RTCRayHit8 rh8;
+    struct RTCRay16 r16;
+    struct RTCRay8 r8;
+} packet_buf;
+
+/* Coherent groups of e->packet_width rays through rtcIntersect8/16 or
+ * rtcOccluded8/16; the last group has its unused lanes switched off. */
+static void emb_packets(const accel *a, const ray *r, hit *h, size_t n, bool any_hit,
+                        accel_counters *c)
+{
+    (void)c;
+    const embree_accel *e = (const embree_accel *)a;
+    const unsigned w = e->packet_width;
+    _Alignas(64) packet_buf buf;
+    _Alignas(64) int valid[16];
+    float *f = (float *)&buf;
+    unsigned *u = (unsigned *)&buf;
+
+    if (any_hit && !e->has_filter) {
+        /* No filter functions in this Embree: only the closest hit gives a t. */
+        for (size_t i = 0; i < n; i++) emb_intersect(a, &r[i], &h[i], NULL);
+        return;
+    }
+    memset(&buf, 0, sizeof buf);
+    for (size_t base = 0; base < n; base += w) {
+        const unsigned m = n - base < w ? (unsigned)(n - base) : w;
+        for (unsigned i = 0; i < w; i++) {
+            if (i >= m) {
+                valid[i] = 0;
+                continue;
+            }
+            const ray *ri = &r[base + i];
+            valid[i] = -1;
+            f[F_ORG_X * w + i] = ri->o.x;
+            f[F_ORG_Y * w + i] = ri->o.y;
+            f[F_ORG_Z * w + i] = ri->o.z;
+            f[F_TNEAR * w + i] = ri->tmin;
+            f[F_DIR_X * w + i] = ri->d.x;
+            f[F_DIR_Y * w + i] = ri->d.y;
+            f[F_DIR_Z * w + i] = ri->d.z;
+            f[F_TIME * w + i] = 0.0f;
+            f[F_TFAR * w + i] = ri->tmax;
+            u[F_MASK * w + i] = 0xFFFFFFFFu;
+            u[F_ID * w + i] = i;
+            u[F_FLAGS * w + i] = 0;
+            if (!any_hit) {
+                u[F_GEOM * w + i] = RTC_INVALID_GEOMETRY_ID;
+                u[F_INST * w + i] = RTC_INVALID_GEOMETRY_ID;
+            }
+        }
+        hit *out = h + base;
+        if (any_hit) {
+            occ_context oc;
+            rtcInitIntersectContext(&oc.base);
+            oc.base.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+            oc.out = out;
+            for (unsigned i = 0; i < m; i++) hit_clear(&out[i]);
+            if (w == 16) rtcOccluded16(valid, e->scene, &oc.base, &buf.r16);
+            else rtcOccluded8(valid, e->scene, &oc.base, &buf.r8);
+            for (unsigned i = 0; i < m; i++)
+                if (f[F_TFAR * w + i] != -INFINITY) hit_clear(&out[i]);
+        } else {
+            struct RTCIntersectContext ictx;
+            rtcInitIntersectContext(&ictx);
+            ictx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+            if (w == 16) rtcIntersect16(valid, e->scene, &ictx, &buf.rh16);
+            else rtcIntersect8(valid, e->scene, &ictx, &buf.rh8);
+            for (unsigned i = 0; i < m; i++) {
+                const ray *ri = &r[base + i];
+                if (u[F_GEOM * w + i] == RTC_INVALID_GEOMETRY_ID) hit_clear(&out[i]);
+                else
+                    set_hit(e, ri->o, ri->d, f[F_TFAR * w + i], u[F_GEOM * w + i],
+                            u[F_PRIM * w + i], f[F_U * w + i], f[F_V * w + i], &out[i]);
+            }
+        }
+    }
+}
+
+static void emb_destroy(accel *a)
+{
+    embree_accel *e = (embree_accel *)a;
+    if (!e) return;
+    pk_allocator al = e->alloc;
+    if (e->scene) rtcReleaseScene(e->scene);
+    if (e->device) rtcReleaseDevice(e->device);
+    mem_free(&al, e->spheres);
+    mem_free(&al, e);
+}
+
+static const accel_ops embree_ops = {
+    .destroy = emb_destroy,
+    .intersect = emb_intersect,
+    .occluded = emb_occluded,
+    .intersect_packet = emb_packets,
+};
+
+/* Adds the triangles as geometry GEOM_TRIS: vertices 3k..3k+2 are triangle k. */
+static void add_triangles(embree_accel *e, const accel_input *in, enum RTCBuildQuality q)
+{
+    RTCGeometry g = rtcNewGeometry(e->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    if (!g) return;
+    float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                        3 * sizeof(float), 3 * in->ntris);
+    unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                           3 * sizeof(unsigned), in->ntris);
+    if (vb && ib) {
+        for (size_t i = 0; i < 3 * in->ntris; i++) {
+            vb[3 * i + 0] = in->verts[i].x;
+            vb[3 * i + 1] = in->verts[i].y;
+            vb[3 * i + 2] = in->verts[i].z;
+            ib[i] = (unsigned)i;
+        }
+        rtcSetGeometryBuildQuality(g, q);
+        rtcSetGeometryUserData(g, e);
+        if (e->has_filter) rtcSetGeometryOccludedFilterFunction(g, occ_filter);
+        rtcCommitGeometry(g);
+        rtcAttachGeometryByID(e->scene, g, GEOM_TRIS);
+    }
+    rtcReleaseGeometry(g);
+}
+
+static void add_spheres(embree_accel *e, const accel_input *in, enum RTCBuildQuality q)
+{
+    RTCGeometry g = rtcNewGeometry(e->device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+    if (!g) return;
+    float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
+                                        4 * sizeof(float), in->nspheres);
+    if (vb) {
+        for (size_t i = 0; i < in->nspheres; i++) {
+            vb[4 * i + 0] = in->spheres[i].center.x;
+            vb[4 * i + 1] = in->spheres[i].center.y;
+            vb[4 * i + 2] = in->spheres[i].center.z;
+            vb[4 * i + 3] = in->spheres[i].radius;
+        }
+        rtcSetGeometryBuildQuality(g, q);
+        rtcSetGeometryUserData(g, e);
+        if (e->has_filter) rtcSetGeometryOccludedFilterFunction(g, occ_filter);
+        rtcCommitGeometry(g);
+        rtcAttachGeometryByID(e->scene, g, GEOM_SPHERES);
+    }
+    rtcReleaseGeometry(g);
+}
+
+pk_status accel_embree_create(pk_context *ctx, const accel_input *in, accel **out)
+{
+    *out = NULL;
+    enum RTCBuildQuality quality = RTC_BUILD_QUALITY_MEDIUM;
+    pk_status st = parse_quality(ctx, &quality);
+    if (st != PK_OK) return st;
+    if (in->ntris > UINT32_MAX / 3 || in->nspheres > UINT32_MAX ||
+        in->ntris + in->nspheres >= PK_NO_HIT)
+        return ctx_error(ctx, PK_ERR_LIMIT, "embree: %zu triangles and %zu spheres are too many",
+                         in->ntris, in->nspheres);
+
+    embree_accel *e = mem_calloc(&ctx->alloc, 1, sizeof *e);
+    if (!e) return ctx_nomem(ctx);
+    e->alloc = ctx->alloc;
+    e->base.ops = &embree_ops;
+    e->base.alloc = &e->alloc;
+    e->base.ntris = in->ntris;
+    e->base.nspheres = in->nspheres;
+    if (in->nspheres) {
+        e->spheres = mem_alloc(&e->alloc, in->nspheres * sizeof *e->spheres);
+        if (!e->spheres) {
+            emb_destroy(&e->base);
+            return ctx_nomem(ctx);
+        }
+        memcpy(e->spheres, in->spheres, in->nspheres * sizeof *e->spheres);
+    }
+
+    /* start_threads: the worker threads start here, outside build_ms */
+    char config[64];
+    snprintf(config, sizeof config, "threads=%d,start_threads=1,verbose=0", in->threads > 0 ? in->threads : 1);
+    e->device = rtcNewDevice(config);
+    if (!e->device) {
+        enum RTCError code = rtcGetDeviceError(NULL);
+        emb_destroy(&e->base);
+        return ctx_error(ctx, rtc_error_status(code), "embree: the device could not be created: %s",
+                         rtc_error_name(code));
+    }
+    build_errors be = {ctx, false};
+    rtcSetDeviceErrorFunction(e->device, on_build_error, &be);
+    rtcSetDeviceMemoryMonitorFunction(e->device, on_memory, e);
+    e->packet_width = rtcGetDeviceProperty(e->device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) ? 16 : 8;
+    e->has_filter = rtcGetDeviceProperty(e->device, RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED) != 0;
+
+    double t0 = time_now();
+    e->scene = rtcNewScene(e->device);
+    if (e->scene) {
+        rtcSetSceneFlags(e->scene, RTC_SCENE_FLAG_NONE);
+        rtcSetSceneBuildQuality(e->scene, quality);
+        if (in->ntris) add_triangles(e, in, quality);
+        if (in->nspheres) add_spheres(e, in, quality);
+        if (!be.failed) rtcCommitScene(e->scene);
+    }
+    double t1 = time_now();
+    if (be.failed || !e->scene || rtcGetDeviceError(e->device) != RTC_ERROR_NONE) {
+        if (!be.failed) ctx_error(ctx, PK_ERR_UNSUPPORTED, "embree: the scene could not be built");
+        st = pk_context_status(ctx);
+        rtcSetDeviceErrorFunction(e->device, NULL, NULL);
+        emb_destroy(&e->base);
+        return st != PK_OK ? st : PK_ERR_UNSUPPORTED;
+    }
+    /* Tracing has no context to report to, and cannot fail. */
+    rtcSetDeviceErrorFunction(e->device, NULL, NULL);
+
+    e->base.info.name = "embree";
+    e->base.info.build_ms = (t1 - t0) * 1e3;
+    e->base.info.primitives = in->ntris + in->nspheres;
+    int64_t bytes = __atomic_load_n(&e->device_bytes, __ATOMIC_RELAXED);
+    e->base.info.bytes = bytes > 0 ? (size_t)bytes : 0;
+    *out = &e->base;
+    return PK_OK;
+}
+
+#else /* no Embree */
+
+bool accel_embree_available(void) { return false; }
+
+pk_status accel_embree_create(pk_context *ctx, const accel_input *in, accel **out)
+{
+    (void)in;
+    *out = NULL;
+    return ctx_error(ctx, PK_ERR_UNSUPPORTED,
+                     "--accel embree: this build has no Embree (install libembree-dev and rebuild)");
+}
+
+#endif
