@@ -1,0 +1,99 @@
+/*
+ * io_util.h - what the OBJ and MTL parsers share: a line reader over a
+ * (data, size) buffer that is not NUL-terminated (CRLF, backslash
+ * continuation), blank/comment-aware tokens, a fast locale-independent float
+ * parser, overflow-checked integers and "file:line: ..." messages.
+ */
+#ifndef PK_IO_UTIL_H
+#define PK_IO_UTIL_H
+
+#include "../paprsek_internal.h"
+
+#define IO_WARN_KINDS 16     /* distinct unknown statement kinds remembered */
+#define IO_WARN_KIND_LEN 24  /* bytes of a kind that are compared */
+
+/* Invariants:
+ *  1. p <= end; every byte read lies in [start of data, end).
+ *  2. line is the number (1-based) of the first physical line of the
+ *     statement last returned by io_next_line; next_line that of the next one.
+ *  3. nkinds <= IO_WARN_KINDS; kinds[i] holds kind_len[i] bytes. */
+typedef struct io_reader {
+    pk_context *ctx;
+    const char *name;          /* file name for messages (borrowed) */
+    const char *p, *end;       /* input not yet read */
+    size_t line, next_line;
+    char *scratch;             /* joined continuation lines (owned) */
+    size_t scratch_cap;
+    char kinds[IO_WARN_KINDS][IO_WARN_KIND_LEN];
+    size_t kind_len[IO_WARN_KINDS];
+    int nkinds;
+    bool kinds_full;           /* the "no longer reported" point was passed */
+} io_reader;
+
+PK_HIDDEN void io_reader_init(io_reader *r, pk_context *ctx, const char *name, const char *data, size_t size);
+PK_HIDDEN void io_reader_free(io_reader *r);
+
+/* Next logical line as [*ls, *le): 1, or 0 at the end of the input, or -1
+ * when joining continuation lines ran out of memory (latched in ctx). */
+PK_HIDDEN int io_next_line(io_reader *r, const char **ls, const char **le);
+
+static inline bool io_is_blank(char c)
+{
+    return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+}
+
+static inline const char *io_skip_blanks(const char *p, const char *e)
+{
+    while (p < e && io_is_blank(*p)) p++;
+    return p;
+}
+
+static inline const char *io_token_end(const char *p, const char *e)
+{
+    while (p < e && !io_is_blank(*p)) p++;
+    return p;
+}
+
+/* True when only blanks or a '#' comment remain in [p, e). */
+static inline bool io_at_end(const char *p, const char *e)
+{
+    p = io_skip_blanks(p, e);
+    return p == e || *p == '#';
+}
+
+/* The rest of a statement (a name that may hold blanks): from the first
+ * non-blank to the last non-blank before a comment ('#' after a blank). */
+PK_HIDDEN void io_rest(const char *p, const char *e, const char **rs, const char **re);
+
+/* Parses a float at p (no leading blanks): [+-]digits[.digits][(e|E)[+-]digits],
+ * also ".5", "5." and nan/inf/infinity. Returns the end of what was read, or
+ * NULL when no number starts at p. Overflow gives +-inf, underflow 0. */
+PK_HIDDEN const char *io_parse_float(const char *p, const char *e, float *out);
+
+/* Parses [+-]digits; values beyond +-1e15 saturate (*out stays beyond that
+ * bound so range checks fail). NULL when no digits start at p. */
+PK_HIDDEN const char *io_parse_int(const char *p, const char *e, int64_t *out);
+
+/* Reads up to max blank-separated finite floats from *pp, stopping at the end
+ * of the statement or after max. *n receives the count. Errors (latched):
+ * "bad number 'x'" and "number 'x' is not a finite float". */
+PK_HIDDEN pk_status io_read_floats(io_reader *r, const char **pp, const char *e, float *out, int max, int *n);
+
+/* "name:line: " + fmt, latched in ctx; returns status. */
+PK_HIDDEN pk_status io_error(io_reader *r, pk_status status, const char *fmt, ...) PK_PRINTF(3, 4);
+/* "name:line: " + fmt as a warning. */
+PK_HIDDEN void io_warn(io_reader *r, const char *fmt, ...) PK_PRINTF(2, 3);
+/* Warns "name:line: unknown statement 'kw' ignored (further ones not
+ * reported)" the first time a kind is seen. */
+PK_HIDDEN void io_warn_unknown(io_reader *r, const char *kw, size_t len);
+/* Same, with a caller's text after the kind: "name:line: <what> ..." once per kind. */
+PK_HIDDEN void io_warn_once(io_reader *r, const char *kind, size_t len, const char *what);
+
+/* Printing width for a token in a message (long tokens are cut). */
+static inline int io_tok_len(const char *s, const char *e)
+{
+    size_t n = (size_t)(e - s);
+    return n > 40 ? 40 : (int)n;
+}
+
+#endif
