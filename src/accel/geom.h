@@ -5,7 +5,7 @@
  * Triangle test: watertight (Woop, Benthin and Wald, JCGT 2013): the ray is
  * sheared to +z, the edge functions are evaluated in 2D and recomputed in
  * double when one is exactly zero, so no hit is lost on a shared edge.
- * Closest-hit rule: t in [tmin, tmax]; among equal t the lower prim wins.
+ * Closest-hit rule: t in [tmin, tmax] and finite; among equal t the lower prim wins.
  * SIMD versions must perform the same float operations in the same order
  * (the build uses -ffp-contract=off), which keeps them bit-identical.
  */
@@ -103,7 +103,8 @@ static inline bool tri_intersect(const ray_pre *r, vec3 a, vec3 b, vec3 c, float
     const float T = U * az + V * bz + W * cz;
     const float rcp = 1.0f / det;
     const float t = T * rcp;
-    if (!(t >= r->tmin && t <= tmax)) return false;
+    /* t may overflow to +inf for huge coordinates: a hit at infinity is no hit */
+    if (!(t >= r->tmin && t <= tmax && t < INFINITY)) return false;
     *t_out = t;
     *u_out = V * rcp;
     *v_out = W * rcp;
@@ -134,9 +135,9 @@ static inline bool sphere_intersect(const ray_pre *r, vec3 center, float radius,
         t1 = tmp;
     }
     float t = t0;
-    if (!(t >= r->tmin && t <= tmax)) {
+    if (!(t >= r->tmin && t <= tmax && t < INFINITY)) {
         t = t1;
-        if (!(t >= r->tmin && t <= tmax)) return false;
+        if (!(t >= r->tmin && t <= tmax && t < INFINITY)) return false;
     }
     vec3 p = v3_scale(v3_sub(v3_add(r->o, v3_scale(r->d, t)), center), 1.0f / radius);
     float phi = atan2f(p.z, p.x);

@@ -104,11 +104,16 @@ static void test_degenerate(void)
     REQUIRE(s);
     compare("coincident triangles", s, PK_ACCEL_MIDPOINT);
     pk_scene_destroy(s);
-    /* huge and tiny coordinates */
-    s = scene_from("v -1e30 -1e30 0\nv 1e30 -1e30 0\nv 0 1e30 0\nv 0 0 1e-30\nv 1e-30 0 1e-30\nv 0 1e-30 1e-30\n"
-                   "f 1 2 3\nf 4 5 6\n");
+    /* huge and tiny coordinates (the edge-function products stay within float range) */
+    s = scene_from("v -1e15 -1e15 0\nv 1e15 -1e15 0\nv 0 1e15 0\nv -1e15 -1e15 1e15\nv 1e15 -1e15 1e15\n"
+                   "v 0 1e15 2e15\nf 1 2 3\nf 4 5 6\n");
     REQUIRE(s);
-    compare("huge and tiny", s, PK_ACCEL_MIDPOINT);
+    compare("huge coordinates", s, PK_ACCEL_MIDPOINT);
+    pk_scene_destroy(s);
+    s = scene_from("v -1e-12 -1e-12 0\nv 1e-12 -1e-12 0\nv 0 1e-12 0\nv -1e-12 -1e-12 1e-12\nv 1e-12 -1e-12 1e-12\n"
+                   "v 0 1e-12 2e-12\nf 1 2 3\nf 4 5 6\n");
+    REQUIRE(s);
+    compare("tiny coordinates", s, PK_ACCEL_MIDPOINT);
     pk_scene_destroy(s);
     /* all triangles at one point: nothing renderable, the loader refuses it */
     pk_scene *none = NULL;
