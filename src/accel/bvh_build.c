@@ -1,0 +1,604 @@
+/*
+ * bvh_build.c - builds the wide BVH: a binned-SAH binary tree (OpenMP tasks
+ * over the top levels), collapsed into BVH_WIDTH-wide SoA nodes with SoA
+ * triangle and sphere blocks in the leaves. Invariants: bvh.h; design and
+ * measurements: docs/bvh.md.
+ */
+#include "bvh.h"
+
+#include <immintrin.h>
+#include <omp.h>
+#include <string.h>
+
+#define NBINS 32
+#define TASK_MIN 2048      /* ranges below this are built by the task that holds them */
+#define SAH_DEPTH_MAX 48   /* binary levels split by SAH; deeper ones split at the median */
+#define COST_NODE 1.0f     /* SAH: cost of a node visit ... */
+#define COST_BLOCK 1.0f    /* ... relative to a primitive block test */
+
+/* A box in two SSE registers (lane 3 unused). */
+typedef struct sbox {
+    __m128 lo, hi;
+} sbox;
+
+static inline sbox sbox_empty(void)
+{
+    sbox b = {_mm_set1_ps(INFINITY), _mm_set1_ps(-INFINITY)};
+    return b;
+}
+static inline sbox sbox_union(sbox a, sbox b)
+{
+    a.lo = _mm_min_ps(a.lo, b.lo);
+    a.hi = _mm_max_ps(a.hi, b.hi);
+    return a;
+}
+static inline sbox sbox_grow(sbox a, __m128 p)
+{
+    a.lo = _mm_min_ps(a.lo, p);
+    a.hi = _mm_max_ps(a.hi, p);
+    return a;
+}
+static inline float sbox_half_area(sbox b)
+{
+    float e[4];
+    _mm_storeu_ps(e, _mm_sub_ps(b.hi, b.lo));
+    if (!(e[0] >= 0.0f && e[1] >= 0.0f && e[2] >= 0.0f)) return 0.0f;
+    return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
+}
+static inline aabb sbox_aabb(sbox b)
+{
+    float lo[4], hi[4];
+    _mm_storeu_ps(lo, b.lo);
+    _mm_storeu_ps(hi, b.hi);
+    aabb r = {{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}};
+    return r;
+}
+
+/* Binary node: inner when count == 0 (children first, first + 1), else a
+ * leaf over ids[first .. first + count). */
+typedef struct bnode {
+    sbox box;
+    uint32_t first, count;
+} bnode;
+
+typedef struct builder {
+    const sbox *pbox;       /* per primitive id */
+    uint32_t *ids;          /* primitive ids, partitioned in place */
+    bnode *nodes;
+    uint32_t nnodes;        /* allocated so far (atomic) */
+    uint32_t ntris;         /* ids >= ntris are spheres */
+    bool spheres;           /* any sphere present */
+} builder;
+
+static inline __m128 centroid2(const sbox *b) { return _mm_add_ps(b->lo, b->hi); }
+
+static uint32_t node_alloc2(builder *b)
+{
+    uint32_t k;
+#pragma omp atomic capture
+    {
+        k = b->nnodes;
+        b->nnodes += 2;
+    }
+    return k;
+}
+
+static inline float sah_blocks(uint32_t n) { return (float)((n + BVH_TRI_LANES - 1) / BVH_TRI_LANES); }
+
+typedef struct split {
+    int axis;
+    int bin;          /* left = bins < bin */
+    float cost;       /* sum of half areas * blocks */
+    sbox left, right;
+} split;
+
+typedef struct binner {
+    float lo[4], scale[4];
+} binner;
+
+static inline int bin_of(const binner *bn, __m128 c2, int axis)
+{
+    float c[4];
+    _mm_storeu_ps(c, c2);
+    int k = (int)((c[axis] - bn->lo[axis]) * bn->scale[axis]);
+    return k < 0 ? 0 : k >= NBINS ? NBINS - 1 : k;
+}
+
+/* Binned SAH over the doubled centroids in cb; false when every axis is flat. */
+static bool find_split(const builder *b, uint32_t begin, uint32_t end, sbox cb, binner *bn, split *best)
+{
+    float lo[4], hi[4];
+    _mm_storeu_ps(lo, cb.lo);
+    _mm_storeu_ps(hi, cb.hi);
+    bool any = false;
+    for (int ax = 0; ax < 3; ax++) {
+        float ext = hi[ax] - lo[ax];
+        bn->lo[ax] = lo[ax];
+        bn->scale[ax] = ext > 0.0f && isfinite(ext) ? (float)NBINS * 0.99999f / ext : 0.0f;
+        if (bn->scale[ax] > 0.0f && isfinite(bn->scale[ax])) any = true;
+        else bn->scale[ax] = 0.0f;
+    }
+    bn->lo[3] = 0.0f;
+    bn->scale[3] = 0.0f;
+    if (!any) return false;
+
+    sbox bins[3][NBINS];
+    uint32_t counts[3][NBINS];
+    for (int ax = 0; ax < 3; ax++)
+        for (int k = 0; k < NBINS; k++) {
+            bins[ax][k] = sbox_empty();
+            counts[ax][k] = 0;
+        }
+    const __m128 blo = _mm_loadu_ps(bn->lo), bsc = _mm_loadu_ps(bn->scale);
+    for (uint32_t i = begin; i < end; i++) {
+        const sbox *pb = &b->pbox[b->ids[i]];
+        __m128 k4 = _mm_mul_ps(_mm_sub_ps(centroid2(pb), blo), bsc);
+        __m128i ki = _mm_cvttps_epi32(k4);
+        ki = _mm_max_epi32(_mm_setzero_si128(), _mm_min_epi32(ki, _mm_set1_epi32(NBINS - 1)));
+        int k[4];
+        _mm_storeu_si128((__m128i *)k, ki);
+        for (int ax = 0; ax < 3; ax++) {
+            counts[ax][k[ax]]++;
+            bins[ax][k[ax]] = sbox_union(bins[ax][k[ax]], *pb);
+        }
+    }
+    bool found = false;
+    best->cost = INFINITY;
+    for (int ax = 0; ax < 3; ax++) {
+        if (bn->scale[ax] == 0.0f) continue;
+        float rarea[NBINS];
+        uint32_t rcount[NBINS];
+        sbox acc = sbox_empty();
+        uint32_t cnt = 0;
+        for (int k = NBINS - 1; k > 0; k--) {
+            acc = sbox_union(acc, bins[ax][k]);
+            cnt += counts[ax][k];
+            rarea[k] = sbox_half_area(acc);
+            rcount[k] = cnt;
+        }
+        acc = sbox_empty();
+        cnt = 0;
+        for (int k = 1; k < NBINS; k++) {
+            acc = sbox_union(acc, bins[ax][k - 1]);
+            cnt += counts[ax][k - 1];
+            if (cnt == 0 || rcount[k] == 0) continue;
+            float cost = sbox_half_area(acc) * sah_blocks(cnt) + rarea[k] * sah_blocks(rcount[k]);
+            if (cost < best->cost) {
+                best->cost = cost;
+                best->axis = ax;
+                best->bin = k;
+                found = true;
+            }
+        }
+    }
+    if (!found) return false;
+    best->left = sbox_empty();
+    best->right = sbox_empty();
+    for (int k = 0; k < NBINS; k++) {
+        if (k < best->bin) best->left = sbox_union(best->left, bins[best->axis][k]);
+        else best->right = sbox_union(best->right, bins[best->axis][k]);
+    }
+    return true;
+}
+
+static void range_bounds(const builder *b, uint32_t begin, uint32_t end, sbox *box, sbox *cb)
+{
+    sbox bx = sbox_empty(), c = sbox_empty();
+    for (uint32_t i = begin; i < end; i++) {
+        const sbox *pb = &b->pbox[b->ids[i]];
+        bx = sbox_union(bx, *pb);
+        c = sbox_grow(c, centroid2(pb));
+    }
+    *box = bx;
+    *cb = c;
+}
+
+/* Moves the triangles of [begin, end) before its spheres; returns the boundary. */
+static uint32_t partition_kind(builder *b, uint32_t begin, uint32_t end)
+{
+    uint32_t i = begin, j = end;
+    while (i < j) {
+        if (b->ids[i] < b->ntris) {
+            i++;
+        } else {
+            uint32_t t = b->ids[i];
+            b->ids[i] = b->ids[--j];
+            b->ids[j] = t;
+        }
+    }
+    return i;
+}
+
+static void build_node(builder *b, uint32_t ni, uint32_t begin, uint32_t end, sbox cb, int depth);
+
+static void build_children(builder *b, uint32_t ni, uint32_t begin, uint32_t mid, uint32_t end,
+                           sbox lbox, sbox lcb, sbox rbox, sbox rcb, int depth)
+{
+    uint32_t k = node_alloc2(b);
+    b->nodes[ni].first = k;
+    b->nodes[ni].count = 0;
+    b->nodes[k].box = lbox;
+    b->nodes[k + 1].box = rbox;
+    if (end - begin >= TASK_MIN) {
+#pragma omp task default(none) firstprivate(b, k, begin, mid, lcb, depth)
+        build_node(b, k, begin, mid, lcb, depth + 1);
+        build_node(b, k + 1, mid, end, rcb, depth + 1);
+    } else {
+        build_node(b, k, begin, mid, lcb, depth + 1);
+        build_node(b, k + 1, mid, end, rcb, depth + 1);
+    }
+}
+
+/* nodes[ni].box is set by the caller; cb bounds the doubled centroids. */
+static void build_node(builder *b, uint32_t ni, uint32_t begin, uint32_t end, sbox cb, int depth)
+{
+    uint32_t n = end - begin;
+    split s;
+    binner bn;
+    bool ok = n > 1 && depth < SAH_DEPTH_MAX && find_split(b, begin, end, cb, &bn, &s);
+
+    if (n <= BVH_LEAF_MAX) {
+        float area = sbox_half_area(b->nodes[ni].box);
+        bool leaf = !ok || COST_BLOCK * sah_blocks(n) * area <= COST_NODE * area + COST_BLOCK * s.cost;
+        if (leaf) {
+            uint32_t mid = b->spheres ? partition_kind(b, begin, end) : end;
+            if (mid == begin || mid == end) {
+                b->nodes[ni].first = begin;
+                b->nodes[ni].count = n;
+                return;
+            }
+            /* mixed triangles and spheres: one leaf of each */
+            sbox lbox, lcb, rbox, rcb;
+            range_bounds(b, begin, mid, &lbox, &lcb);
+            range_bounds(b, mid, end, &rbox, &rcb);
+            build_children(b, ni, begin, mid, end, lbox, lcb, rbox, rcb, depth);
+            return;
+        }
+    }
+
+    uint32_t mid;
+    sbox lbox, lcb, rbox, rcb;
+    if (ok) {
+        const int ax = s.axis, sb = s.bin;
+        uint32_t i = begin, j = end;
+        lcb = sbox_empty();
+        rcb = sbox_empty();
+        for (;;) {
+            while (i < j) {
+                __m128 c = centroid2(&b->pbox[b->ids[i]]);
+                if (bin_of(&bn, c, ax) >= sb) break;
+                lcb = sbox_grow(lcb, c);
+                i++;
+            }
+            while (i < j) {
+                __m128 c = centroid2(&b->pbox[b->ids[j - 1]]);
+                if (bin_of(&bn, c, ax) < sb) break;
+                rcb = sbox_grow(rcb, c);
+                j--;
+            }
+            if (i >= j) break;
+            uint32_t t = b->ids[i];
+            b->ids[i] = b->ids[j - 1];
+            b->ids[j - 1] = t;
+        }
+        mid = i;
+        lbox = s.left;
+        rbox = s.right;
+        PK_ASSERT(mid > begin && mid < end);
+    } else {
+        /* flat centroids or too deep: split in the middle of the range */
+        mid = begin + n / 2;
+        range_bounds(b, begin, mid, &lbox, &lcb);
+        range_bounds(b, mid, end, &rbox, &rcb);
+    }
+    build_children(b, ni, begin, mid, end, lbox, lcb, rbox, rcb, depth);
+}
+
+/* ---- collapse into the wide tree ---------------------------------------- */
+
+typedef struct collapser {
+    const builder *b;
+    const accel_input *in;
+    bvh_node *nodes;
+    size_t nnodes, cap_nodes;
+    bvh_tri_block *tris;
+    size_t ntri_blocks;
+    bvh_sphere_block *spheres;
+    size_t nsphere_blocks;
+    size_t leaves;
+    double sah;       /* sum of areas, normalised at the end */
+    int depth;
+} collapser;
+
+static uint32_t make_leaf(collapser *c, const bnode *bn)
+{
+    uint32_t ids[BVH_LEAF_MAX];
+    uint32_t n = bn->count;
+    memcpy(ids, c->b->ids + bn->first, n * sizeof *ids);
+    for (uint32_t i = 1; i < n; i++) {
+        uint32_t v = ids[i], j = i;
+        for (; j > 0 && ids[j - 1] > v; j--) ids[j] = ids[j - 1];
+        ids[j] = v;
+    }
+    c->leaves++;
+    c->sah += (double)n * (double)sbox_half_area(bn->box);
+    if (ids[0] >= c->b->ntris) {
+        uint32_t first = (uint32_t)c->nsphere_blocks;
+        uint32_t nb = (n + BVH_SPHERE_LANES - 1) / BVH_SPHERE_LANES;
+        for (uint32_t k = 0; k < nb; k++) {
+            bvh_sphere_block *blk = &c->spheres[c->nsphere_blocks++];
+            for (int l = 0; l < BVH_SPHERE_LANES; l++) {
+                uint32_t i = k * BVH_SPHERE_LANES + (uint32_t)l;
+                if (i < n) {
+                    const accel_sphere *sp = &c->in->spheres[ids[i] - c->b->ntris];
+                    blk->c[0][l] = sp->center.x;
+                    blk->c[1][l] = sp->center.y;
+                    blk->c[2][l] = sp->center.z;
+                    blk->r[l] = sp->radius;
+                    blk->prim[l] = ids[i];
+                } else {
+                    blk->c[0][l] = blk->c[1][l] = blk->c[2][l] = blk->r[l] = NAN;
+                    blk->prim[l] = PK_NO_HIT;
+                }
+            }
+        }
+        return bvh_leaf_ref(true, first, nb);
+    }
+    uint32_t first = (uint32_t)c->ntri_blocks;
+    uint32_t nb = (n + BVH_TRI_LANES - 1) / BVH_TRI_LANES;
+    for (uint32_t k = 0; k < nb; k++) {
+        bvh_tri_block *blk = &c->tris[c->ntri_blocks++];
+        for (int l = 0; l < BVH_TRI_LANES; l++) {
+            uint32_t i = k * BVH_TRI_LANES + (uint32_t)l;
+            if (i < n) {
+                const vec3 *p = c->in->verts + 3 * (size_t)ids[i];
+                for (int v = 0; v < 3; v++) {
+                    blk->v[v][0][l] = p[v].x;
+                    blk->v[v][1][l] = p[v].y;
+                    blk->v[v][2][l] = p[v].z;
+                }
+                blk->prim[l] = ids[i];
+            } else {
+                for (int v = 0; v < 3; v++) blk->v[v][0][l] = blk->v[v][1][l] = blk->v[v][2][l] = NAN;
+                blk->prim[l] = PK_NO_HIT;
+            }
+        }
+    }
+    return bvh_leaf_ref(false, first, nb);
+}
+
+static void set_slot_box(bvh_node *wn, int k, sbox box)
+{
+    aabb a = sbox_aabb(box);
+    wn->b[BVH_LO_X][k] = a.lo.x;
+    wn->b[BVH_HI_X][k] = a.hi.x;
+    wn->b[BVH_LO_Y][k] = a.lo.y;
+    wn->b[BVH_HI_Y][k] = a.hi.y;
+    wn->b[BVH_LO_Z][k] = a.lo.z;
+    wn->b[BVH_HI_Z][k] = a.hi.z;
+}
+
+static void init_node(bvh_node *wn)
+{
+    for (int k = 0; k < BVH_WIDTH; k++) {
+        wn->b[BVH_LO_X][k] = wn->b[BVH_LO_Y][k] = wn->b[BVH_LO_Z][k] = INFINITY;
+        wn->b[BVH_HI_X][k] = wn->b[BVH_HI_Y][k] = wn->b[BVH_HI_Z][k] = -INFINITY;
+        wn->child[k] = BVH_EMPTY;
+    }
+}
+
+/* Makes the wide node for binary inner node bi; returns its index. */
+static uint32_t collapse(collapser *c, uint32_t bi, int depth)
+{
+    const bnode *bn = c->b->nodes;
+    uint32_t wi = (uint32_t)c->nnodes++;
+    PK_ASSERT(wi < c->cap_nodes);
+    if (depth > c->depth) c->depth = depth;
+    c->sah += (double)sbox_half_area(bn[bi].box);
+
+    uint32_t kids[BVH_WIDTH];
+    int nk = 2;
+    kids[0] = bn[bi].first;
+    kids[1] = bn[bi].first + 1;
+    while (nk < BVH_WIDTH) {
+        int pick = -1;
+        float best = -1.0f;
+        for (int k = 0; k < nk; k++) {
+            const bnode *x = &bn[kids[k]];
+            if (x->count) continue;
+            float a = sbox_half_area(x->box);
+            if (a > best) {
+                best = a;
+                pick = k;
+            }
+        }
+        if (pick < 0) break;
+        uint32_t x = kids[pick];
+        kids[pick] = bn[x].first;
+        kids[nk++] = bn[x].first + 1;
+    }
+    init_node(&c->nodes[wi]);
+    for (int k = 0; k < nk; k++) {
+        const bnode *x = &bn[kids[k]];
+        uint32_t ref = x->count ? make_leaf(c, x) : collapse(c, kids[k], depth + 1);
+        bvh_node *wn = &c->nodes[wi]; /* index, not pointer, across recursion */
+        wn->child[k] = ref;
+        set_slot_box(wn, k, x->box);
+    }
+    return wi;
+}
+
+/* ---- the accelerator ---------------------------------------------------- */
+
+static void bvh_destroy(accel *a)
+{
+    if (!a) return;
+    bvh *t = (bvh *)a;
+    const pk_allocator *al = a->alloc;
+    mem_free_aligned(al, t->nodes);
+    mem_free_aligned(al, t->tris);
+    mem_free_aligned(al, t->spheres);
+    mem_free(al, t);
+}
+
+static const accel_ops bvh_ops = {bvh_destroy, bvh_intersect, bvh_occluded, bvh_intersect_packet};
+
+static void *copy_aligned(const pk_allocator *al, const void *src, size_t n, size_t size, bool *ok)
+{
+    if (n == 0) return NULL;
+    size_t total;
+    if (size_mul_overflows(n, size, &total)) {
+        *ok = false;
+        return NULL;
+    }
+    void *p = mem_alloc_aligned(al, total, 64);
+    if (!p) {
+        *ok = false;
+        return NULL;
+    }
+    memcpy(p, src, total);
+    return p;
+}
+
+pk_status accel_bvh_create(pk_context *ctx, const accel_input *in, accel **out)
+{
+    double t0 = time_now();
+    const pk_allocator *al = &ctx->alloc;
+    *out = NULL;
+    size_t nprim_in = in->ntris + in->nspheres;
+    if (nprim_in >= BVH_BLOCK_MASK || in->ntris > UINT32_MAX / 2) {
+        return ctx_error(ctx, PK_ERR_LIMIT, "too many primitives for the BVH (%zu)", nprim_in);
+    }
+    pk_status st = PK_OK;
+    bvh *t = mem_calloc(al, 1, sizeof *t);
+    sbox *pbox = mem_alloc_aligned(al, (nprim_in ? nprim_in : 1) * sizeof(sbox), 64);
+    uint32_t *ids = mem_alloc(al, (nprim_in ? nprim_in : 1) * sizeof(uint32_t));
+    bnode *bnodes = NULL;
+    collapser c = {0};
+    if (!t || !pbox || !ids) goto nomem;
+
+    /* primitive boxes; degenerate triangles and invalid spheres stay out */
+    uint32_t n = 0;
+    sbox root = sbox_empty(), rootc = sbox_empty();
+    for (size_t i = 0; i < in->ntris; i++) {
+        const vec3 *p = in->verts + 3 * i;
+        if (bvh_tri_degenerate(p[0], p[1], p[2])) continue;
+        sbox b;
+        b.lo = _mm_setr_ps(fminf(p[0].x, fminf(p[1].x, p[2].x)), fminf(p[0].y, fminf(p[1].y, p[2].y)),
+                           fminf(p[0].z, fminf(p[1].z, p[2].z)), 0.0f);
+        b.hi = _mm_setr_ps(fmaxf(p[0].x, fmaxf(p[1].x, p[2].x)), fmaxf(p[0].y, fmaxf(p[1].y, p[2].y)),
+                           fmaxf(p[0].z, fmaxf(p[1].z, p[2].z)), 0.0f);
+        pbox[i] = b;
+        ids[n++] = (uint32_t)i;
+        root = sbox_union(root, b);
+        rootc = sbox_grow(rootc, centroid2(&b));
+    }
+    bool any_sphere = false;
+    for (size_t i = 0; i < in->nspheres; i++) {
+        const accel_sphere *s = &in->spheres[i];
+        if (!bvh_sphere_valid(s)) continue;
+        sbox b;
+        b.lo = _mm_setr_ps(s->center.x - s->radius, s->center.y - s->radius, s->center.z - s->radius, 0.0f);
+        b.hi = _mm_setr_ps(s->center.x + s->radius, s->center.y + s->radius, s->center.z + s->radius, 0.0f);
+        pbox[in->ntris + i] = b;
+        ids[n++] = (uint32_t)(in->ntris + i);
+        root = sbox_union(root, b);
+        rootc = sbox_grow(rootc, centroid2(&b));
+        any_sphere = true;
+    }
+
+    builder b = {pbox, ids, NULL, 1, (uint32_t)in->ntris, any_sphere};
+    size_t cap_b = 2 * (size_t)n + 1;
+    bnodes = mem_alloc_aligned(al, cap_b * sizeof *bnodes, 64);
+    if (!bnodes) goto nomem;
+    b.nodes = bnodes;
+    bnodes[0].box = root;
+    bnodes[0].first = 0;
+    bnodes[0].count = 0;
+    if (n > 0) {
+        int threads = in->threads > 0 ? in->threads : 1;
+        if (n < 2 * TASK_MIN) threads = 1;
+#pragma omp parallel num_threads(threads) default(none) shared(b, n, rootc)
+#pragma omp single
+        build_node(&b, 0, 0, n, rootc, 1);
+    }
+
+    /* collapse: at most one wide node per binary inner node (+1 for a leaf root) */
+    size_t binner_count = (b.nnodes - 1) / 2 + 1;
+    c.b = &b;
+    c.in = in;
+    c.cap_nodes = binner_count + 1;
+    c.nodes = mem_alloc_aligned(al, c.cap_nodes * sizeof(bvh_node), 64);
+    size_t nbl = (b.nnodes + 1) / 2 + 1; /* binary leaves */
+    c.tris = mem_alloc_aligned(al, nbl * sizeof(bvh_tri_block), 64);
+    c.spheres = any_sphere ? mem_alloc_aligned(al, nbl * sizeof(bvh_sphere_block), 64) : NULL;
+    if (!c.nodes || !c.tris || (any_sphere && !c.spheres)) goto nomem;
+    if (n == 0) {
+        init_node(&c.nodes[0]);
+        c.nnodes = 1;
+        c.depth = 1;
+    } else if (bnodes[0].count) {
+        init_node(&c.nodes[0]);
+        c.nnodes = 1;
+        c.depth = 1;
+        c.sah += (double)sbox_half_area(bnodes[0].box);
+        c.nodes[0].child[0] = make_leaf(&c, &bnodes[0]);
+        set_slot_box(&c.nodes[0], 0, bnodes[0].box);
+    } else {
+        collapse(&c, 0, 1);
+    }
+
+    bool ok = true;
+    t->nodes = copy_aligned(al, c.nodes, c.nnodes, sizeof(bvh_node), &ok);
+    t->nnodes = c.nnodes;
+    t->tris = copy_aligned(al, c.tris, c.ntri_blocks, sizeof(bvh_tri_block), &ok);
+    t->ntri_blocks = c.ntri_blocks;
+    t->spheres = copy_aligned(al, c.spheres, c.nsphere_blocks, sizeof(bvh_sphere_block), &ok);
+    t->nsphere_blocks = c.nsphere_blocks;
+    if (!ok) goto nomem;
+    t->bounds = n ? sbox_aabb(root) : aabb_empty();
+    t->depth = c.depth;
+    if (t->depth > BVH_MAX_DEPTH) {
+        st = ctx_error(ctx, PK_ERR_LIMIT, "BVH deeper than %d levels", BVH_MAX_DEPTH);
+        goto fail;
+    }
+
+    t->base.ops = &bvh_ops;
+    t->base.alloc = al;
+    t->base.ntris = in->ntris;
+    t->base.nspheres = in->nspheres;
+    pk_accel_info *info = &t->base.info;
+    info->name = "bvh";
+    info->nodes = t->nnodes;
+    info->leaves = c.leaves;
+    info->primitives = n;
+    info->bytes = sizeof *t + t->nnodes * sizeof(bvh_node) + t->ntri_blocks * sizeof(bvh_tri_block) +
+                  t->nsphere_blocks * sizeof(bvh_sphere_block);
+    float ra = sbox_half_area(root);
+    info->sah_cost = ra > 0.0f ? c.sah / (double)ra : 0.0;
+
+    mem_free_aligned(al, c.nodes);
+    mem_free_aligned(al, c.tris);
+    mem_free_aligned(al, c.spheres);
+    mem_free_aligned(al, bnodes);
+    mem_free_aligned(al, pbox);
+    mem_free(al, ids);
+    info->build_ms = (time_now() - t0) * 1e3;
+    *out = &t->base;
+    return PK_OK;
+
+nomem:
+    st = ctx_nomem(ctx);
+fail:
+    mem_free_aligned(al, c.nodes);
+    mem_free_aligned(al, c.tris);
+    mem_free_aligned(al, c.spheres);
+    mem_free_aligned(al, bnodes);
+    mem_free_aligned(al, pbox);
+    mem_free(al, ids);
+    if (t) {
+        t->base.alloc = al;
+        bvh_destroy(&t->base);
+    }
+    return st;
+}
