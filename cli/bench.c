@@ -100,7 +100,7 @@ static int write_file_atomic(const char *path, const void *data, size_t size)
     snprintf(tmp, len, "%s.%ld.tmp", path, (long)getpid());
     FILE *f = fopen(tmp, "wb");
     if (!f) {
-        fprintf(stderr, "paprsek: %s: cannot create: %s\n", tmp, strerror(errno));
+        fprintf(stderr, "paprsek: %s: cannot create %s: %s\n", path, tmp, strerror(errno));
         free(tmp);
         return 1;
     }
@@ -233,6 +233,7 @@ static int bench_rays(int argc, char **argv)
     pk_scene_get_info(scene, &sinfo);
     double bytes_per_tri = sinfo.triangles ? (double)info.bytes / (double)sinfo.triangles : 0.0;
 
+    if (hits_path && write_file_atomic(hits_path, hits, n * sizeof *hits)) goto out;
     printf("rays=%zu accel=%s threads=%d build_ms=%.3f time_s=%.6f mrays_per_s=%.3f hits=%zu", n,
            info.name ? info.name : pk_accel_kind_name(kind), threads, info.build_ms, tmed,
            tmed > 0.0 ? (double)n / tmed / 1e6 : 0.0, nhits);
@@ -259,7 +260,6 @@ static int bench_rays(int argc, char **argv)
     }
     printf("\n");
     fflush(stdout);
-    if (hits_path && write_file_atomic(hits_path, hits, n * sizeof *hits)) goto out;
     rc = 0;
 out:
     free(times);
