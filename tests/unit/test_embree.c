@@ -11,6 +11,8 @@
 
 #include <stdint.h>
 
+#if PK_HAVE_EMBREE
+
 typedef struct rng {
     uint64_t s;
 } rng;
@@ -282,6 +284,8 @@ static void check_quality(pk_context *ctx)
     pk_context_clear_error(ctx);
     unsetenv("PAPRSEK_EMBREE_QUALITY");
 }
+
+#endif /* PK_HAVE_EMBREE */
 
 int main(void)
 {
