@@ -16,31 +16,30 @@
 #ifndef BVH_WIDTH
 #define BVH_WIDTH 8          /* children per node: 8 (AVX) or 4 (SSE) */
 #endif
-#define BVH_TRI_LANES 4      /* triangles per SoA block (one SSE test) */
-#define BVH_LEAF_MAX 4       /* primitives per leaf of the binary build */
+#ifndef BVH_TRI_LANES
+#define BVH_TRI_LANES 4      /* triangles per SoA block: 4 (SSE test) or 8 (AVX) */
+#endif
+#ifndef BVH_LEAF_MAX
+#define BVH_LEAF_MAX BVH_TRI_LANES /* primitives per leaf of the binary build */
+#endif
 #define BVH_SPHERE_LANES 4
 #define BVH_MAX_DEPTH 96     /* wide levels; the builder stays below it */
 #define BVH_STACK_SIZE (BVH_MAX_DEPTH * (BVH_WIDTH - 1) + 1)
 
-/* Child references (uint32):
- *   bit 31 clear: an inner node, the index into bvh.nodes;
- *   bit 31 set:   a leaf: bit 30 = sphere leaf, bits 27..29 = blocks - 1,
- *                 bits 0..26 = first block in bvh.tris (or bvh.spheres);
- *   BVH_EMPTY:    an unused slot (its box is empty: lo = +inf, hi = -inf). */
-#define BVH_LEAF 0x80000000u
-#define BVH_SPHERE_LEAF 0x40000000u
+/* Child references (uint32), byte offsets so that traversal needs one add:
+ *   bit 0 clear: an inner node at byte offset ref from bvh.nodes;
+ *   bit 0 set:   a leaf: bits 1..3 = blocks - 1, bit 4 = sphere leaf, and
+ *                ref & ~31 = byte offset of its first block from bvh.tris
+ *                (bvh.spheres); every node and block size is a multiple of 32;
+ *   BVH_EMPTY:   an unused slot (its box is empty: lo = +inf, hi = -inf). */
+#define BVH_LEAF 1u
+#define BVH_SPHERE_LEAF 16u
 #define BVH_EMPTY 0xFFFFFFFFu
-#define BVH_BLOCK_BITS 27
-#define BVH_BLOCK_MASK ((1u << BVH_BLOCK_BITS) - 1u)
 #define BVH_MAX_LEAF_BLOCKS 8u
 
 static inline bool bvh_is_leaf(uint32_t ref) { return (ref & BVH_LEAF) != 0; }
-static inline uint32_t bvh_leaf_first(uint32_t ref) { return ref & BVH_BLOCK_MASK; }
-static inline uint32_t bvh_leaf_blocks(uint32_t ref) { return ((ref >> BVH_BLOCK_BITS) & 7u) + 1u; }
-static inline uint32_t bvh_leaf_ref(bool sphere, uint32_t first, uint32_t blocks)
-{
-    return BVH_LEAF | (sphere ? BVH_SPHERE_LEAF : 0u) | ((blocks - 1u) << BVH_BLOCK_BITS) | first;
-}
+static inline size_t bvh_ref_offset(uint32_t ref) { return ref & ~(uint32_t)31; }
+static inline uint32_t bvh_leaf_blocks(uint32_t ref) { return ((ref >> 1) & 7u) + 1u; }
 
 /* Box planes in the order lo_x, hi_x, lo_y, hi_y, lo_z, hi_z, so that a
  * ray's near plane on an axis is b[2*axis + (d < 0)] and the far one the other. */
@@ -62,11 +61,28 @@ typedef struct bvh_sphere_block {
     float c[3][BVH_SPHERE_LANES];   /* centre [axis][lane], world space */
     float r[BVH_SPHERE_LANES];      /* radius; unused lanes: NaN */
     uint32_t prim[BVH_SPHERE_LANES];
+    uint32_t pad[4];                /* to a multiple of 32 bytes */
 } bvh_sphere_block;
+
+_Static_assert(sizeof(bvh_node) % 32 == 0 && sizeof(bvh_tri_block) % 32 == 0 &&
+                   sizeof(bvh_sphere_block) % 32 == 0, "32-byte multiples: refs keep flags in the low bits");
+
+static inline uint32_t bvh_node_ref(size_t index) { return (uint32_t)(index * sizeof(bvh_node)); }
+static inline size_t bvh_node_index(uint32_t ref) { return ref / sizeof(bvh_node); }
+static inline uint32_t bvh_leaf_ref(bool sphere, size_t first, uint32_t blocks)
+{
+    size_t off = first * (sphere ? sizeof(bvh_sphere_block) : sizeof(bvh_tri_block));
+    return (uint32_t)off | (sphere ? BVH_SPHERE_LEAF : 0u) | ((blocks - 1u) << 1) | BVH_LEAF;
+}
+/* Index of the leaf's first block in bvh.tris or bvh.spheres. */
+static inline size_t bvh_leaf_first(uint32_t ref)
+{
+    return bvh_ref_offset(ref) / ((ref & BVH_SPHERE_LEAF) ? sizeof(bvh_sphere_block) : sizeof(bvh_tri_block));
+}
 
 /* Invariants (bvh_check tests them):
  *  1. nodes[0] is the root and an inner node; every other node is the child
- *     of exactly one slot, and child indices are greater than the parent's
+ *     of exactly one slot, and children come after their parent in memory
  *     (no cycles); the tree is at most BVH_MAX_DEPTH levels deep (so the
  *     traversal stack, BVH_STACK_SIZE entries, cannot overflow).
  *  2. A slot's box contains the boxes in its child node, and a leaf slot's
@@ -83,6 +99,8 @@ typedef struct bvh_sphere_block {
  *  5. Every block is referenced by exactly one leaf. */
 typedef struct bvh {
     accel base;
+    void *mem;                  /* the one block holding nodes, tris, spheres */
+    size_t mem_bytes;           /* bytes of it in use */
     bvh_node *nodes;            /* 64-byte aligned */
     size_t nnodes;
     bvh_tri_block *tris;        /* 64-byte aligned */
@@ -123,17 +141,21 @@ static inline bool bvh_sphere_valid(const accel_sphere *s)
 
 #include <immintrin.h>
 
-/* The box test visits a slot when tnear <= tfar + |tfar| * BVH_BOX_SLACK,
- * where tfar already includes the current closest t: the slack (16 ulps)
- * covers the rounding of the slab distances and of the triangle's t, so a
- * box that holds a hit at the current distance is never skipped (ties go to
- * the lower prim, so equal distances must still be visited). */
+/* The box test must never skip a box that holds the closest hit (ties go
+ * to the lower prim, so boxes entered at exactly the current distance must
+ * still be visited). Far distances are computed with 1/d scaled up by
+ * 1 + BVH_BOX_SLACK and the current closest t is raised by the same
+ * relative amount (16 ulps): that covers the rounding of the slab distances
+ * (a few ulps, as in Ize's robust BVH traversal) and of the triangle's t. */
 #define BVH_BOX_SLACK 0x1p-20f
+
+static inline float bvh_cull_limit(float t) { return t + fabsf(t) * BVH_BOX_SLACK; }
 
 typedef struct bvh_ray {
     ray_pre pre;            /* geom.h's shear constants, for the exact tests */
     float org[3];           /* origin, world space */
     float rd[3];            /* 1/d per axis: +-inf for zero components */
+    float rdf[3];           /* rd * (1 + BVH_BOX_SLACK), for far planes */
     int near[3], far[3];    /* box plane rows: 2*axis + (rd < 0), and the other */
     int kx, ky, kz;         /* shear axes (rows of bvh_tri_block.v[vertex]) */
     float ox, oy, oz;       /* origin components along kx, ky, kz */
@@ -148,6 +170,7 @@ static inline void bvh_ray_init(bvh_ray *br, const ray *r)
     for (int k = 0; k < 3; k++) {
         br->org[k] = o[k];
         br->rd[k] = rd[k];
+        br->rdf[k] = rd[k] * (1.0f + BVH_BOX_SLACK);
         int neg = signbit(rd[k]) ? 1 : 0;
         br->near[k] = 2 * k + neg;
         br->far[k] = 2 * k + 1 - neg;
@@ -161,58 +184,102 @@ static inline void bvh_ray_init(bvh_ray *br, const ray *r)
     br->tmin = r->tmin;
 }
 
-/* Lanes of one triangle block that pass tri_intersect with limit tmax:
- * the same float operations in the same order as geom.h, four triangles at
- * a time (no FMA: the build has -ffp-contract=off and no fused intrinsics
- * are used here). Returns the lane mask; *t, *rcp, *V, *W hold the lanes. */
-static inline int bvh_tri4(const bvh_tri_block *blk, const bvh_ray *r, float tmax, __m128 *t_out,
-                           __m128 *rcp_out, __m128 *V_out, __m128 *W_out)
+/* SIMD vectors as wide as a triangle block. */
+#if BVH_TRI_LANES == 8
+typedef __m256 tvec;
+#define TV_LOAD _mm256_load_ps
+#define TV_LOADU _mm256_loadu_ps
+#define TV_STOREU _mm256_storeu_ps
+#define TV_SET1 _mm256_set1_ps
+#define TV_ZERO _mm256_setzero_ps
+#define TV_ADD _mm256_add_ps
+#define TV_SUB _mm256_sub_ps
+#define TV_MUL _mm256_mul_ps
+#define TV_DIV _mm256_div_ps
+#define TV_OR _mm256_or_ps
+#define TV_AND _mm256_and_ps
+#define TV_EQ(a, b) _mm256_cmp_ps(a, b, _CMP_EQ_OQ)
+#define TV_LT(a, b) _mm256_cmp_ps(a, b, _CMP_LT_OQ)
+#define TV_GT(a, b) _mm256_cmp_ps(a, b, _CMP_GT_OQ)
+#define TV_LE(a, b) _mm256_cmp_ps(a, b, _CMP_LE_OQ)
+#define TV_GE(a, b) _mm256_cmp_ps(a, b, _CMP_GE_OQ)
+#define TV_MASK _mm256_movemask_ps
+#elif BVH_TRI_LANES == 4
+typedef __m128 tvec;
+#define TV_LOAD _mm_load_ps
+#define TV_LOADU _mm_loadu_ps
+#define TV_STOREU _mm_storeu_ps
+#define TV_SET1 _mm_set1_ps
+#define TV_ZERO _mm_setzero_ps
+#define TV_ADD _mm_add_ps
+#define TV_SUB _mm_sub_ps
+#define TV_MUL _mm_mul_ps
+#define TV_DIV _mm_div_ps
+#define TV_OR _mm_or_ps
+#define TV_AND _mm_and_ps
+#define TV_EQ _mm_cmpeq_ps
+#define TV_LT _mm_cmplt_ps
+#define TV_GT _mm_cmpgt_ps
+#define TV_LE _mm_cmple_ps
+#define TV_GE _mm_cmpge_ps
+#define TV_MASK _mm_movemask_ps
+#else
+#error "BVH_TRI_LANES must be 4 or 8"
+#endif
+#define BVH_TRI_ALL ((1 << BVH_TRI_LANES) - 1)
+
+/* The lanes of one triangle block that pass tri_intersect with limit tmax:
+ * the same float operations in the same order as geom.h, a block at a time
+ * (no FMA: the build has -ffp-contract=off and no fused intrinsics are used
+ * here). Returns the lane mask; *t, *rcp, *V, *W hold the lanes. */
+static inline int bvh_tri_test(const bvh_tri_block *blk, const bvh_ray *r, float tmax, tvec *t_out,
+                               tvec *rcp_out, tvec *V_out, tvec *W_out)
 {
-    const __m128 ox = _mm_set1_ps(r->ox), oy = _mm_set1_ps(r->oy), oz = _mm_set1_ps(r->oz);
-    const __m128 sx = _mm_set1_ps(r->pre.sx), sy = _mm_set1_ps(r->pre.sy);
-    const __m128 ax0 = _mm_sub_ps(_mm_load_ps(blk->v[0][r->kx]), ox);
-    const __m128 ay0 = _mm_sub_ps(_mm_load_ps(blk->v[0][r->ky]), oy);
-    const __m128 az0 = _mm_sub_ps(_mm_load_ps(blk->v[0][r->kz]), oz);
-    const __m128 bx0 = _mm_sub_ps(_mm_load_ps(blk->v[1][r->kx]), ox);
-    const __m128 by0 = _mm_sub_ps(_mm_load_ps(blk->v[1][r->ky]), oy);
-    const __m128 bz0 = _mm_sub_ps(_mm_load_ps(blk->v[1][r->kz]), oz);
-    const __m128 cx0 = _mm_sub_ps(_mm_load_ps(blk->v[2][r->kx]), ox);
-    const __m128 cy0 = _mm_sub_ps(_mm_load_ps(blk->v[2][r->ky]), oy);
-    const __m128 cz0 = _mm_sub_ps(_mm_load_ps(blk->v[2][r->kz]), oz);
-    const __m128 ax = _mm_sub_ps(ax0, _mm_mul_ps(sx, az0)), ay = _mm_sub_ps(ay0, _mm_mul_ps(sy, az0));
-    const __m128 bx = _mm_sub_ps(bx0, _mm_mul_ps(sx, bz0)), by = _mm_sub_ps(by0, _mm_mul_ps(sy, bz0));
-    const __m128 cx = _mm_sub_ps(cx0, _mm_mul_ps(sx, cz0)), cy = _mm_sub_ps(cy0, _mm_mul_ps(sy, cz0));
-    __m128 U = _mm_sub_ps(_mm_mul_ps(cx, by), _mm_mul_ps(cy, bx));
-    __m128 V = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
-    __m128 W = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
-    const __m128 zero = _mm_setzero_ps();
-    int zm = _mm_movemask_ps(_mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(U, zero), _mm_cmpeq_ps(V, zero)),
-                                       _mm_cmpeq_ps(W, zero)));
+    const tvec ox = TV_SET1(r->ox), oy = TV_SET1(r->oy), oz = TV_SET1(r->oz);
+    const tvec sx = TV_SET1(r->pre.sx), sy = TV_SET1(r->pre.sy);
+    const tvec ax0 = TV_SUB(TV_LOAD(blk->v[0][r->kx]), ox);
+    const tvec ay0 = TV_SUB(TV_LOAD(blk->v[0][r->ky]), oy);
+    const tvec az0 = TV_SUB(TV_LOAD(blk->v[0][r->kz]), oz);
+    const tvec bx0 = TV_SUB(TV_LOAD(blk->v[1][r->kx]), ox);
+    const tvec by0 = TV_SUB(TV_LOAD(blk->v[1][r->ky]), oy);
+    const tvec bz0 = TV_SUB(TV_LOAD(blk->v[1][r->kz]), oz);
+    const tvec cx0 = TV_SUB(TV_LOAD(blk->v[2][r->kx]), ox);
+    const tvec cy0 = TV_SUB(TV_LOAD(blk->v[2][r->ky]), oy);
+    const tvec cz0 = TV_SUB(TV_LOAD(blk->v[2][r->kz]), oz);
+    const tvec ax = TV_SUB(ax0, TV_MUL(sx, az0)), ay = TV_SUB(ay0, TV_MUL(sy, az0));
+    const tvec bx = TV_SUB(bx0, TV_MUL(sx, bz0)), by = TV_SUB(by0, TV_MUL(sy, bz0));
+    const tvec cx = TV_SUB(cx0, TV_MUL(sx, cz0)), cy = TV_SUB(cy0, TV_MUL(sy, cz0));
+    tvec U = TV_SUB(TV_MUL(cx, by), TV_MUL(cy, bx));
+    tvec V = TV_SUB(TV_MUL(ax, cy), TV_MUL(ay, cx));
+    tvec W = TV_SUB(TV_MUL(bx, ay), TV_MUL(by, ax));
+    const tvec zero = TV_ZERO();
+    int zm = TV_MASK(TV_OR(TV_OR(TV_EQ(U, zero), TV_EQ(V, zero)), TV_EQ(W, zero)));
     if (PK_UNLIKELY(zm)) {
         /* an edge function is exactly 0: recompute that lane in double */
-        float fax[4], fay[4], fbx[4], fby[4], fcx[4], fcy[4], fu[4], fv[4], fw[4];
-        _mm_storeu_ps(fax, ax), _mm_storeu_ps(fay, ay), _mm_storeu_ps(fbx, bx);
-        _mm_storeu_ps(fby, by), _mm_storeu_ps(fcx, cx), _mm_storeu_ps(fcy, cy);
-        _mm_storeu_ps(fu, U), _mm_storeu_ps(fv, V), _mm_storeu_ps(fw, W);
-        for (int l = 0; l < 4; l++) {
+        float fax[BVH_TRI_LANES], fay[BVH_TRI_LANES], fbx[BVH_TRI_LANES], fby[BVH_TRI_LANES];
+        float fcx[BVH_TRI_LANES], fcy[BVH_TRI_LANES], fu[BVH_TRI_LANES], fv[BVH_TRI_LANES], fw[BVH_TRI_LANES];
+        TV_STOREU(fax, ax), TV_STOREU(fay, ay), TV_STOREU(fbx, bx), TV_STOREU(fby, by);
+        TV_STOREU(fcx, cx), TV_STOREU(fcy, cy), TV_STOREU(fu, U), TV_STOREU(fv, V), TV_STOREU(fw, W);
+        for (int l = 0; l < BVH_TRI_LANES; l++) {
             if (!(zm >> l & 1)) continue;
             fu[l] = (float)((double)fcx[l] * (double)fby[l] - (double)fcy[l] * (double)fbx[l]);
             fv[l] = (float)((double)fax[l] * (double)fcy[l] - (double)fay[l] * (double)fcx[l]);
             fw[l] = (float)((double)fbx[l] * (double)fay[l] - (double)fby[l] * (double)fax[l]);
         }
-        U = _mm_loadu_ps(fu), V = _mm_loadu_ps(fv), W = _mm_loadu_ps(fw);
+        U = TV_LOADU(fu), V = TV_LOADU(fv), W = TV_LOADU(fw);
     }
-    const __m128 neg = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(U, zero), _mm_cmplt_ps(V, zero)), _mm_cmplt_ps(W, zero));
-    const __m128 pos = _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(U, zero), _mm_cmpgt_ps(V, zero)), _mm_cmpgt_ps(W, zero));
-    const __m128 det = _mm_add_ps(_mm_add_ps(U, V), W);
-    int m = ~_mm_movemask_ps(_mm_or_ps(_mm_and_ps(neg, pos), _mm_cmpeq_ps(det, zero))) & 15;
+    const tvec neg = TV_OR(TV_OR(TV_LT(U, zero), TV_LT(V, zero)), TV_LT(W, zero));
+    const tvec pos = TV_OR(TV_OR(TV_GT(U, zero), TV_GT(V, zero)), TV_GT(W, zero));
+    const tvec det = TV_ADD(TV_ADD(U, V), W);
+    int m = ~TV_MASK(TV_OR(TV_AND(neg, pos), TV_EQ(det, zero))) & BVH_TRI_ALL;
     if (!m) return 0;
-    const __m128 sz = _mm_set1_ps(r->pre.sz);
-    const __m128 az = _mm_mul_ps(sz, az0), bz = _mm_mul_ps(sz, bz0), cz = _mm_mul_ps(sz, cz0);
-    const __m128 T = _mm_add_ps(_mm_add_ps(_mm_mul_ps(U, az), _mm_mul_ps(V, bz)), _mm_mul_ps(W, cz));
-    const __m128 rcp = _mm_div_ps(_mm_set1_ps(1.0f), det);
-    const __m128 t = _mm_mul_ps(T, rcp);
-    m &= _mm_movemask_ps(_mm_and_ps(_mm_cmpge_ps(t, _mm_set1_ps(r->tmin)), _mm_cmple_ps(t, _mm_set1_ps(tmax))));
+    const tvec sz = TV_SET1(r->pre.sz);
+    const tvec az = TV_MUL(sz, az0), bz = TV_MUL(sz, bz0), cz = TV_MUL(sz, cz0);
+    const tvec T = TV_ADD(TV_ADD(TV_MUL(U, az), TV_MUL(V, bz)), TV_MUL(W, cz));
+    const tvec rcp = TV_DIV(TV_SET1(1.0f), det);
+    const tvec t = TV_MUL(T, rcp);
+    /* t in [tmin, tmax] and finite (an overflowed t is no hit) */
+    m &= TV_MASK(TV_AND(TV_AND(TV_GE(t, TV_SET1(r->tmin)), TV_LE(t, TV_SET1(tmax))), TV_LT(t, TV_SET1(INFINITY))));
     *t_out = t;
     *rcp_out = rcp;
     *V_out = V;
@@ -221,13 +288,13 @@ static inline int bvh_tri4(const bvh_tri_block *blk, const bvh_ray *r, float tma
 }
 
 /* Closest-hit update from one triangle block; true when *h changed. */
-static inline bool bvh_tri4_closest(const bvh_tri_block *blk, const bvh_ray *r, hit *h)
+static inline bool bvh_tri_closest(const bvh_tri_block *blk, const bvh_ray *r, hit *h)
 {
-    __m128 t, rcp, V, W;
-    int m = bvh_tri4(blk, r, h->t, &t, &rcp, &V, &W);
+    tvec t, rcp, V, W;
+    int m = bvh_tri_test(blk, r, h->t, &t, &rcp, &V, &W);
     if (!m) return false;
-    float ft[4];
-    _mm_storeu_ps(ft, t);
+    float ft[BVH_TRI_LANES];
+    TV_STOREU(ft, t);
     /* lanes are sorted by prim: the first lane with the smallest t wins */
     int best = __builtin_ctz((unsigned)m);
     for (int mm = m & (m - 1); mm; mm &= mm - 1) {
@@ -236,14 +303,28 @@ static inline bool bvh_tri4_closest(const bvh_tri_block *blk, const bvh_ray *r, 
     }
     const uint32_t prim = blk->prim[best];
     if (!hit_better(ft[best], prim, h)) return false;
-    float fr[4], fv[4], fw[4];
-    _mm_storeu_ps(fr, rcp);
-    _mm_storeu_ps(fv, V);
-    _mm_storeu_ps(fw, W);
+    float fr[BVH_TRI_LANES], fv[BVH_TRI_LANES], fw[BVH_TRI_LANES];
+    TV_STOREU(fr, rcp);
+    TV_STOREU(fv, V);
+    TV_STOREU(fw, W);
     h->t = ft[best];
     h->prim = prim;
     h->u = fv[best] * fr[best];
     h->v = fw[best] * fr[best];
+    return true;
+}
+
+/* Any-hit: true (with h->t, h->prim of one hit) when a lane hits. */
+static inline bool bvh_tri_any(const bvh_tri_block *blk, const bvh_ray *r, hit *h)
+{
+    tvec t, rcp, V, W;
+    int m = bvh_tri_test(blk, r, h->t, &t, &rcp, &V, &W);
+    if (!m) return false;
+    float ft[BVH_TRI_LANES];
+    TV_STOREU(ft, t);
+    int l = __builtin_ctz((unsigned)m);
+    h->t = ft[l];
+    h->prim = blk->prim[l];
     return true;
 }
 

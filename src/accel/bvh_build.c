@@ -9,6 +9,9 @@
 #include <immintrin.h>
 #include <omp.h>
 #include <string.h>
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 #define NBINS 32
 #define TASK_MIN 2048      /* ranges below this are built by the task that holds them */
@@ -420,7 +423,7 @@ static uint32_t collapse(collapser *c, uint32_t bi, int depth)
     init_node(&c->nodes[wi]);
     for (int k = 0; k < nk; k++) {
         const bnode *x = &bn[kids[k]];
-        uint32_t ref = x->count ? make_leaf(c, x) : collapse(c, kids[k], depth + 1);
+        uint32_t ref = x->count ? make_leaf(c, x) : bvh_node_ref(collapse(c, kids[k], depth + 1));
         bvh_node *wn = &c->nodes[wi]; /* index, not pointer, across recursion */
         wn->child[k] = ref;
         set_slot_box(wn, k, x->box);
@@ -435,29 +438,45 @@ static void bvh_destroy(accel *a)
     if (!a) return;
     bvh *t = (bvh *)a;
     const pk_allocator *al = a->alloc;
-    mem_free_aligned(al, t->nodes);
-    mem_free_aligned(al, t->tris);
-    mem_free_aligned(al, t->spheres);
+    mem_free(al, t->mem);
     mem_free(al, t);
 }
 
 static const accel_ops bvh_ops = {bvh_destroy, bvh_intersect, bvh_occluded, bvh_intersect_packet};
 
-static void *copy_aligned(const pk_allocator *al, const void *src, size_t n, size_t size, bool *ok)
+/* Nodes, triangle and sphere blocks in one block of memory; large ones start
+ * on a 2 MiB boundary and ask for transparent huge pages, which saves TLB
+ * misses on incoherent rays. */
+#define HUGE_PAGE ((size_t)2 << 20)
+
+static size_t round_up(size_t x, size_t a) { return (x + a - 1) & ~(a - 1); }
+
+static bool place_arrays(const pk_allocator *al, bvh *t, const collapser *c)
 {
-    if (n == 0) return NULL;
-    size_t total;
-    if (size_mul_overflows(n, size, &total)) {
-        *ok = false;
-        return NULL;
-    }
-    void *p = mem_alloc_aligned(al, total, 64);
-    if (!p) {
-        *ok = false;
-        return NULL;
-    }
-    memcpy(p, src, total);
-    return p;
+    size_t bn = round_up(c->nnodes * sizeof(bvh_node), 64);
+    size_t bt = round_up(c->ntri_blocks * sizeof(bvh_tri_block), 64);
+    size_t bs = round_up(c->nsphere_blocks * sizeof(bvh_sphere_block), 64);
+    size_t total = bn + bt + bs;
+    bool huge = total >= HUGE_PAGE;
+    size_t align = huge ? HUGE_PAGE : 64;
+    unsigned char *raw = mem_alloc(al, total + align);
+    if (!raw) return false;
+    unsigned char *base = (unsigned char *)round_up((uintptr_t)raw, align);
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    if (huge) madvise(base, total & ~(HUGE_PAGE - 1), MADV_HUGEPAGE);
+#endif
+    t->mem = raw;
+    t->mem_bytes = total;
+    t->nodes = (bvh_node *)base;
+    t->tris = (bvh_tri_block *)(base + bn);
+    t->spheres = c->nsphere_blocks ? (bvh_sphere_block *)(base + bn + bt) : NULL;
+    memcpy(t->nodes, c->nodes, c->nnodes * sizeof(bvh_node));
+    if (c->ntri_blocks) memcpy(t->tris, c->tris, c->ntri_blocks * sizeof(bvh_tri_block));
+    if (c->nsphere_blocks) memcpy(t->spheres, c->spheres, c->nsphere_blocks * sizeof(bvh_sphere_block));
+    t->nnodes = c->nnodes;
+    t->ntri_blocks = c->ntri_blocks;
+    t->nsphere_blocks = c->nsphere_blocks;
+    return true;
 }
 
 pk_status accel_bvh_create(pk_context *ctx, const accel_input *in, accel **out)
@@ -466,7 +485,7 @@ pk_status accel_bvh_create(pk_context *ctx, const accel_input *in, accel **out)
     const pk_allocator *al = &ctx->alloc;
     *out = NULL;
     size_t nprim_in = in->ntris + in->nspheres;
-    if (nprim_in >= BVH_BLOCK_MASK || in->ntris > UINT32_MAX / 2) {
+    if (nprim_in >= UINT32_MAX / 2) {
         return ctx_error(ctx, PK_ERR_LIMIT, "too many primitives for the BVH (%zu)", nprim_in);
     }
     pk_status st = PK_OK;
@@ -523,6 +542,22 @@ pk_status accel_bvh_create(pk_context *ctx, const accel_input *in, accel **out)
         build_node(&b, 0, 0, n, rootc, 1);
     }
 
+    /* references are 32-bit byte offsets: the arrays must stay below 4 GiB */
+    {
+        size_t inner = 1, tblocks = 0, sblocks = 0;
+        for (uint32_t i = 0; i < b.nnodes; i++) {
+            const bnode *x = &bnodes[i];
+            if (!x->count) inner++;
+            else if (ids[x->first] < in->ntris) tblocks += (x->count + BVH_TRI_LANES - 1) / BVH_TRI_LANES;
+            else sblocks += (x->count + BVH_SPHERE_LANES - 1) / BVH_SPHERE_LANES;
+        }
+        if (inner > (size_t)UINT32_MAX / sizeof(bvh_node) || tblocks > (size_t)UINT32_MAX / sizeof(bvh_tri_block) ||
+            sblocks > (size_t)UINT32_MAX / sizeof(bvh_sphere_block)) {
+            st = ctx_error(ctx, PK_ERR_LIMIT, "scene too large for the BVH (%u primitives)", n);
+            goto fail;
+        }
+    }
+
     /* collapse: at most one wide node per binary inner node (+1 for a leaf root) */
     size_t binner_count = (b.nnodes - 1) / 2 + 1;
     c.b = &b;
@@ -548,13 +583,7 @@ pk_status accel_bvh_create(pk_context *ctx, const accel_input *in, accel **out)
         collapse(&c, 0, 1);
     }
 
-    bool ok = true;
-    t->nodes = copy_aligned(al, c.nodes, c.nnodes, sizeof(bvh_node), &ok);
-    t->nnodes = c.nnodes;
-    t->tris = copy_aligned(al, c.tris, c.ntri_blocks, sizeof(bvh_tri_block), &ok);
-    t->ntri_blocks = c.ntri_blocks;
-    t->spheres = copy_aligned(al, c.spheres, c.nsphere_blocks, sizeof(bvh_sphere_block), &ok);
-    t->nsphere_blocks = c.nsphere_blocks;
+    bool ok = place_arrays(al, t, &c);
     if (!ok) goto nomem;
     t->bounds = n ? sbox_aabb(root) : aabb_empty();
     t->depth = c.depth;
@@ -572,8 +601,7 @@ pk_status accel_bvh_create(pk_context *ctx, const accel_input *in, accel **out)
     info->nodes = t->nnodes;
     info->leaves = c.leaves;
     info->primitives = n;
-    info->bytes = sizeof *t + t->nnodes * sizeof(bvh_node) + t->ntri_blocks * sizeof(bvh_tri_block) +
-                  t->nsphere_blocks * sizeof(bvh_sphere_block);
+    info->bytes = sizeof *t + t->mem_bytes;
     float ra = sbox_half_area(root);
     info->sah_cost = ra > 0.0f ? c.sah / (double)ra : 0.0;
 

@@ -63,27 +63,30 @@ static bool check_prim(checker *k, uint32_t prim, uint32_t ni, int s)
 static bool check_leaf(checker *k, uint32_t ref, aabb box, uint32_t ni, int s)
 {
     const bvh *t = k->t;
-    const uint32_t first = bvh_leaf_first(ref), nb = bvh_leaf_blocks(ref);
+    const size_t first = bvh_leaf_first(ref);
+    const uint32_t nb = bvh_leaf_blocks(ref);
     const bool sph = (ref & BVH_SPHERE_LEAF) != 0;
     const size_t nblocks = sph ? t->nsphere_blocks : t->ntri_blocks;
     const int lanes = sph ? BVH_SPHERE_LANES : BVH_TRI_LANES;
-    if (nb > BVH_MAX_LEAF_BLOCKS || (size_t)first + nb > nblocks)
-        return fail(k, "node %u slot %d: leaf blocks %u+%u out of range (invariant 3)", ni, s, first, nb);
+    if ((ref & 14u) != ((nb - 1u) << 1) || (ref & ~(uint32_t)31) % (sph ? sizeof(bvh_sphere_block) : sizeof(bvh_tri_block)))
+        return fail(k, "node %u slot %d: malformed leaf reference %#x", ni, s, ref);
+    if (nb > BVH_MAX_LEAF_BLOCKS || first + nb > nblocks)
+        return fail(k, "node %u slot %d: leaf blocks %zu+%u out of range (invariant 3)", ni, s, first, nb);
     uint32_t count = 0;
     for (uint32_t b = 0; b < nb; b++) {
         uint8_t *seen = sph ? &k->sphere_seen[first + b] : &k->tri_seen[first + b];
-        if (*seen) return fail(k, "block %u referenced twice (invariant 5)", first + b);
+        if (*seen) return fail(k, "block %zu referenced twice (invariant 5)", first + b);
         *seen = 1;
         const uint32_t *prim = sph ? t->spheres[first + b].prim : t->tris[first + b].prim;
         int used = 0;
         while (used < lanes && prim[used] != PK_NO_HIT) used++;
         for (int l = used; l < lanes; l++)
-            if (prim[l] != PK_NO_HIT) return fail(k, "block %u: a used lane after padding (invariant 3)", first + b);
+            if (prim[l] != PK_NO_HIT) return fail(k, "block %zu: a used lane after padding (invariant 3)", first + b);
         if (used == 0 || (b + 1 < nb && used != lanes))
-            return fail(k, "block %u: %d lanes used in a leaf of %u blocks (invariant 3)", first + b, used, nb);
+            return fail(k, "block %zu: %d lanes used in a leaf of %u blocks (invariant 3)", first + b, used, nb);
         for (int l = 0; l < used; l++) {
             if (l > 0 && prim[l] <= prim[l - 1])
-                return fail(k, "block %u: lanes not sorted by prim (invariant 3)", first + b);
+                return fail(k, "block %zu: lanes not sorted by prim (invariant 3)", first + b);
             if (!check_prim(k, prim[l], ni, s)) return false;
             if (sph) {
                 const bvh_sphere_block *sb = &t->spheres[first + b];
@@ -132,9 +135,11 @@ static bool check_node(checker *k, uint32_t ni, int depth)
             if (!check_leaf(k, ref, box, ni, s)) return false;
             continue;
         }
-        if (ref <= ni) return fail(k, "node %u slot %d: child %u not after its parent (invariant 1)", ni, s, ref);
-        if (ref >= t->nnodes) return fail(k, "node %u slot %d: child %u out of range (invariant 1)", ni, s, ref);
-        const bvh_node *cn = &t->nodes[ref];
+        if (ref % sizeof(bvh_node)) return fail(k, "node %u slot %d: malformed node reference %#x", ni, s, ref);
+        const size_t ci = bvh_node_index(ref);
+        if (ci <= ni) return fail(k, "node %u slot %d: child %zu not after its parent (invariant 1)", ni, s, ci);
+        if (ci >= t->nnodes) return fail(k, "node %u slot %d: child %zu out of range (invariant 1)", ni, s, ci);
+        const bvh_node *cn = &t->nodes[ci];
         int used = 0;
         for (int q = 0; q < BVH_WIDTH; q++) {
             if (cn->child[q] == BVH_EMPTY) continue;
@@ -142,8 +147,8 @@ static bool check_node(checker *k, uint32_t ni, int depth)
             if (!aabb_contains(box, slot_box(cn, q)))
                 return fail(k, "node %u slot %d does not contain node %u slot %d (invariant 2)", ni, s, ref, q);
         }
-        if (used == 0) return fail(k, "node %u has no children (invariant 1)", ref);
-        if (!check_node(k, ref, depth + 1)) return false;
+        if (used == 0) return fail(k, "node %zu has no children (invariant 1)", ci);
+        if (!check_node(k, (uint32_t)ci, depth + 1)) return false;
     }
     return true;
 }

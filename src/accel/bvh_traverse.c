@@ -19,8 +19,6 @@ typedef __m256 vfloat;
 #define VF_MUL _mm256_mul_ps
 #define VF_MIN _mm256_min_ps
 #define VF_MAX _mm256_max_ps
-#define VF_FMADD _mm256_fmadd_ps
-#define VF_ABS(x) _mm256_andnot_ps(_mm256_set1_ps(-0.0f), x)
 #define VF_LE_MASK(a, b) _mm256_movemask_ps(_mm256_cmp_ps(a, b, _CMP_LE_OQ))
 #define VF_STORE _mm256_store_ps
 #elif BVH_WIDTH == 4
@@ -31,64 +29,108 @@ typedef __m128 vfloat;
 #define VF_MUL _mm_mul_ps
 #define VF_MIN _mm_min_ps
 #define VF_MAX _mm_max_ps
-#define VF_FMADD _mm_fmadd_ps
-#define VF_ABS(x) _mm_andnot_ps(_mm_set1_ps(-0.0f), x)
 #define VF_LE_MASK(a, b) _mm_movemask_ps(_mm_cmp_ps(a, b, _CMP_LE_OQ))
 #define VF_STORE _mm_store_ps
 #else
 #error "BVH_WIDTH must be 4 or 8"
 #endif
 
-/* Mask of the slots of n whose box the ray segment [tmin, tmax] touches;
- * *tn gets the entry distances. 0 * inf = NaN (a ray lying in a slab plane)
- * is the first operand of min/max, which then return the second: such a
- * plane does not limit the segment. */
-static inline int node_hits(const bvh_node *n, const bvh_ray *r, vfloat ox, vfloat oy, vfloat oz,
-                            vfloat rdx, vfloat rdy, vfloat rdz, vfloat tmin, float tmax, vfloat *tn)
+/* The ray as the node test wants it: broadcast origin and 1/d, and byte
+ * offsets of the near and far plane rows (chosen by the sign of 1/d). */
+typedef struct node_ray {
+    vfloat ox, oy, oz, rdx, rdy, rdz, rfx, rfy, rfz, tmin;
+    size_t nx, ny, nz, fx, fy, fz;
+} node_ray;
+
+static inline void node_ray_init(node_ray *nr, const bvh_ray *r)
 {
-    const vfloat tnx = VF_MUL(VF_SUB(VF_LOAD(n->b[r->near[0]]), ox), rdx);
-    const vfloat tny = VF_MUL(VF_SUB(VF_LOAD(n->b[r->near[1]]), oy), rdy);
-    const vfloat tnz = VF_MUL(VF_SUB(VF_LOAD(n->b[r->near[2]]), oz), rdz);
-    const vfloat tfx = VF_MUL(VF_SUB(VF_LOAD(n->b[r->far[0]]), ox), rdx);
-    const vfloat tfy = VF_MUL(VF_SUB(VF_LOAD(n->b[r->far[1]]), oy), rdy);
-    const vfloat tfz = VF_MUL(VF_SUB(VF_LOAD(n->b[r->far[2]]), oz), rdz);
-    const vfloat near = VF_MAX(tnx, VF_MAX(tny, VF_MAX(tnz, tmin)));
-    vfloat far = VF_MIN(tfx, VF_MIN(tfy, VF_MIN(tfz, VF_SET1(tmax))));
-    far = VF_FMADD(VF_ABS(far), VF_SET1(BVH_BOX_SLACK), far);
-    *tn = near;
-    return VF_LE_MASK(near, far);
+    nr->ox = VF_SET1(r->org[0]), nr->oy = VF_SET1(r->org[1]), nr->oz = VF_SET1(r->org[2]);
+    nr->rdx = VF_SET1(r->rd[0]), nr->rdy = VF_SET1(r->rd[1]), nr->rdz = VF_SET1(r->rd[2]);
+    nr->rfx = VF_SET1(r->rdf[0]), nr->rfy = VF_SET1(r->rdf[1]), nr->rfz = VF_SET1(r->rdf[2]);
+    nr->tmin = VF_SET1(r->tmin);
+    const size_t row = sizeof(float) * BVH_WIDTH;
+    nr->nx = (size_t)r->near[0] * row, nr->ny = (size_t)r->near[1] * row, nr->nz = (size_t)r->near[2] * row;
+    nr->fx = (size_t)r->far[0] * row, nr->fy = (size_t)r->far[1] * row, nr->fz = (size_t)r->far[2] * row;
 }
 
-static inline bool may_hit(float tn, float cur) { return tn <= cur + fabsf(cur) * BVH_BOX_SLACK; }
+/* Mask of the slots of node n whose box the segment [tmin, tcull] touches
+ * (tcull = bvh_cull_limit of the closest t); *tn gets the entry distances. 0 * inf = NaN (a ray lying in a slab plane)
+ * is the first operand of min/max, which then return the second: such a
+ * plane does not limit the segment. */
+static inline unsigned node_hits(const char *n, const node_ray *r, float tcull, vfloat *tn)
+{
+    const vfloat tnx = VF_MUL(VF_SUB(VF_LOAD((const float *)(n + r->nx)), r->ox), r->rdx);
+    const vfloat tny = VF_MUL(VF_SUB(VF_LOAD((const float *)(n + r->ny)), r->oy), r->rdy);
+    const vfloat tnz = VF_MUL(VF_SUB(VF_LOAD((const float *)(n + r->nz)), r->oz), r->rdz);
+    const vfloat tfx = VF_MUL(VF_SUB(VF_LOAD((const float *)(n + r->fx)), r->ox), r->rfx);
+    const vfloat tfy = VF_MUL(VF_SUB(VF_LOAD((const float *)(n + r->fy)), r->oy), r->rfy);
+    const vfloat tfz = VF_MUL(VF_SUB(VF_LOAD((const float *)(n + r->fz)), r->oz), r->rfz);
+    const vfloat near = VF_MAX(tnx, VF_MAX(tny, VF_MAX(tnz, r->tmin)));
+    const vfloat far = VF_MIN(tfx, VF_MIN(tfy, VF_MIN(tfz, VF_SET1(tcull))));
+    *tn = near;
+    return (unsigned)VF_LE_MASK(near, far);
+}
 
-static inline __attribute__((always_inline)) bool traverse(const bvh *t, const ray *rr, hit *h,
+/* Tests leaf ref; closest: updates *best; any: true on the first hit. */
+static inline __attribute__((always_inline)) bool leaf(const bvh *t, uint32_t ref, const bvh_ray *r, hit *best,
+                                                       uint64_t *tests, const bool any, const bool count)
+{
+    const uint32_t nb = bvh_leaf_blocks(ref);
+    const size_t off = bvh_ref_offset(ref);
+    bool found = false;
+    if (PK_LIKELY(!(ref & BVH_SPHERE_LEAF))) {
+        const bvh_tri_block *tb = (const bvh_tri_block *)((const char *)t->tris + off);
+        for (uint32_t b = 0; b < nb; b++) {
+            const bvh_tri_block *blk = tb + b;
+            if (count) *tests += bvh_tri_block_count(blk);
+            if (any) {
+                if (bvh_tri_any(blk, r, best)) return true;
+            } else {
+                found |= bvh_tri_closest(blk, r, best);
+            }
+        }
+    } else {
+        const bvh_sphere_block *sb = (const bvh_sphere_block *)((const char *)t->spheres + off);
+        for (uint32_t b = 0; b < nb; b++) {
+            const bvh_sphere_block *blk = sb + b;
+            if (count) *tests += bvh_sphere_block_count(blk);
+            if (bvh_sphere_block_closest(blk, r, best)) {
+                if (any) return true;
+                found = true;
+            }
+        }
+    }
+    return found;
+}
+
+static inline __attribute__((always_inline)) bool traverse(const bvh *t, const ray *rr, hit *out,
                                                            accel_counters *c, const bool any,
                                                            const bool count)
 {
     bvh_ray r;
     bvh_ray_init(&r, rr);
-    const vfloat ox = VF_SET1(r.org[0]), oy = VF_SET1(r.org[1]), oz = VF_SET1(r.org[2]);
-    const vfloat rdx = VF_SET1(r.rd[0]), rdy = VF_SET1(r.rd[1]), rdz = VF_SET1(r.rd[2]);
-    const vfloat tmin = VF_SET1(rr->tmin);
-    h->t = rr->tmax;
-    h->prim = PK_NO_HIT;
-    h->u = h->v = 0.0f;
+    node_ray nr;
+    node_ray_init(&nr, &r);
+    hit best = {rr->tmax, PK_NO_HIT, 0.0f, 0.0f};
+    float tcull = bvh_cull_limit(best.t);
+    const char *const nodes = (const char *)t->nodes;
 
     stack_entry stack[BVH_STACK_SIZE];
     int sp = 0;
     uint32_t ref = 0;
-    uint64_t nodes = 0, tests = 0;
+    uint64_t nvisit = 0, tests = 0;
     for (;;) {
         while (!bvh_is_leaf(ref)) {
-            const bvh_node *n = &t->nodes[ref];
-            if (count) nodes++;
+            const char *n = nodes + ref;
+            const uint32_t *child = ((const bvh_node *)n)->child;
+            if (count) nvisit++;
             vfloat tnv;
-            unsigned mask = (unsigned)node_hits(n, &r, ox, oy, oz, rdx, rdy, rdz, tmin, h->t, &tnv);
+            unsigned mask = node_hits(n, &nr, tcull, &tnv);
             if (!mask) goto pop;
             unsigned k0 = (unsigned)__builtin_ctz(mask);
             mask &= mask - 1;
             if (!mask) {
-                ref = n->child[k0];
+                ref = child[k0];
                 continue;
             }
             _Alignas(32) float tn[BVH_WIDTH];
@@ -96,23 +138,26 @@ static inline __attribute__((always_inline)) bool traverse(const bvh *t, const r
             unsigned k1 = (unsigned)__builtin_ctz(mask);
             mask &= mask - 1;
             if (!mask) {
+                uint32_t far;
                 if (tn[k0] <= tn[k1]) {
-                    stack[sp++] = (stack_entry){n->child[k1], tn[k1]};
-                    ref = n->child[k0];
+                    far = child[k1];
+                    stack[sp++] = (stack_entry){far, tn[k1]};
+                    ref = child[k0];
                 } else {
-                    stack[sp++] = (stack_entry){n->child[k0], tn[k0]};
-                    ref = n->child[k1];
+                    far = child[k0];
+                    stack[sp++] = (stack_entry){far, tn[k0]};
+                    ref = child[k1];
                 }
                 continue;
             }
             /* three or more: push all, sort the run far to near, take the top */
             const int base = sp;
-            stack[sp++] = (stack_entry){n->child[k0], tn[k0]};
-            stack[sp++] = (stack_entry){n->child[k1], tn[k1]};
+            stack[sp++] = (stack_entry){child[k0], tn[k0]};
+            stack[sp++] = (stack_entry){child[k1], tn[k1]};
             do {
                 unsigned k = (unsigned)__builtin_ctz(mask);
                 mask &= mask - 1;
-                stack[sp++] = (stack_entry){n->child[k], tn[k]};
+                stack[sp++] = (stack_entry){child[k], tn[k]};
             } while (mask);
             for (int i = base + 1; i < sp; i++) {
                 stack_entry e = stack[i];
@@ -123,61 +168,31 @@ static inline __attribute__((always_inline)) bool traverse(const bvh *t, const r
             ref = stack[--sp].ref;
         }
 
-        /* leaf */
-        if (count) nodes++;
-        {
-            const uint32_t first = bvh_leaf_first(ref), nb = bvh_leaf_blocks(ref);
-            if (!(ref & BVH_SPHERE_LEAF)) {
-                for (uint32_t b = 0; b < nb; b++) {
-                    const bvh_tri_block *blk = &t->tris[first + b];
-                    if (count) tests += bvh_tri_block_count(blk);
-                    if (any) {
-                        __m128 tt, rcp, V, W;
-                        int m = bvh_tri4(blk, &r, h->t, &tt, &rcp, &V, &W);
-                        if (m) {
-                            float ft[4];
-                            _mm_storeu_ps(ft, tt);
-                            h->t = ft[__builtin_ctz((unsigned)m)];
-                            h->prim = blk->prim[__builtin_ctz((unsigned)m)];
-                            goto found;
-                        }
-                    } else {
-                        bvh_tri4_closest(blk, &r, h);
-                    }
-                }
-            } else {
-                for (uint32_t b = 0; b < nb; b++) {
-                    const bvh_sphere_block *blk = &t->spheres[first + b];
-                    if (count) tests += bvh_sphere_block_count(blk);
-                    if (bvh_sphere_block_closest(blk, &r, h) && any) goto found;
-                }
-            }
+        if (count) nvisit++;
+        if (leaf(t, ref, &r, &best, &tests, any, count)) {
+            if (any) goto done;
+            tcull = bvh_cull_limit(best.t);
         }
     pop:
         for (;;) {
             if (sp == 0) goto done;
             --sp;
-            if (may_hit(stack[sp].t, h->t)) {
+            if (stack[sp].t <= tcull) {
                 ref = stack[sp].ref;
                 break;
             }
         }
     }
-found:
-    if (count) {
-        c->nodes += nodes;
-        c->tests += tests;
-    }
-    return true;
 done:
     if (count) {
-        c->nodes += nodes;
+        c->nodes += nvisit;
         c->tests += tests;
     }
-    if (h->prim == PK_NO_HIT) {
-        hit_clear(h);
+    if (best.prim == PK_NO_HIT) {
+        hit_clear(out);
         return false;
     }
+    *out = best;
     return true;
 }
 
