@@ -9,7 +9,7 @@ FUZZ_PKGS   = $(TEST_PKGS) clang libclang-rt-14-dev libomp-14-dev
 FUZZ_SECONDS ?= 60
 FUZZERS     = obj mtl json render
 
-.PHONY: all build demo test deps deps-test bench clean build-asan sanitize fuzz
+.PHONY: all build demo test deps deps-test bench clean build-asan sanitize fuzz fuzz-build fuzz-merge
 
 all: build
 
@@ -56,19 +56,47 @@ sanitize: build-asan
 	ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	  ctest --test-dir build-asan --output-on-failure -j $(JOBS)
 
-# libFuzzer harnesses (clang, ASan+UBSan), each run for FUZZ_SECONDS over its
-# corpus in tests/fuzz/corpus/<name>, seeded from tests/data and ../shared.
-# Crashers are written to build-fuzz/crashers/<name>/.
-fuzz:
+# libFuzzer harnesses (clang, ASan+UBSan), each run for FUZZ_SECONDS, one at
+# a time at the lowest priority, over a working corpus in build-fuzz/corpus/<name>
+# seeded from the committed corpus (tests/fuzz/corpus/<name>), the hand-made
+# fixtures (tests/data, fuzz_seed_* among them) and ../shared/scenes/cornell.
+# Crashers are written to build-fuzz/crashers/<name>/; once fixed, copy them
+# to tests/fuzz/crashers/<name>/ (ctest replays them). `make fuzz-merge`
+# minimises the working corpus into tests/fuzz/corpus/<name>.
+FUZZ_DIR   = build-fuzz
+FUZZ_FLAGS = -max_len=65536 -rss_limit_mb=2048 -timeout=10 -print_final_stats=1
+FUZZ_SEEDS = tests/data $(wildcard ../shared/scenes/cornell)
+
+$(FUZZ_DIR)/CMakeCache.txt:
+	CC=clang cmake -S . -B $(FUZZ_DIR) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPK_FUZZ=ON -DPK_WITH_EMBREE=OFF
+
+fuzz-build: $(FUZZ_DIR)/CMakeCache.txt
 	$(call ensure_pkgs,$(FUZZ_PKGS))
-	CC=clang cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPK_FUZZ=ON -DPK_WITH_EMBREE=OFF
-	cmake --build build-fuzz -j $(JOBS)
+	cmake --build $(FUZZ_DIR) -j $(JOBS)
+
+fuzz: fuzz-build
 	@for f in $(FUZZERS); do \
-	  mkdir -p tests/fuzz/corpus/$$f build-fuzz/crashers/$$f; \
+	  mkdir -p $(FUZZ_DIR)/corpus/$$f $(FUZZ_DIR)/crashers/$$f tests/fuzz/corpus/$$f; \
 	  echo "== fuzz_$$f for $(FUZZ_SECONDS) s"; \
-	  ./build-fuzz/tests/fuzz_$$f -max_total_time=$(FUZZ_SECONDS) -max_len=65536 -rss_limit_mb=2048 -timeout=10 \
-	    -artifact_prefix=build-fuzz/crashers/$$f/ -print_final_stats=1 \
-	    tests/fuzz/corpus/$$f tests/data ../shared/scenes/cornell 2>&1 | grep -E 'stat::|Done|ERROR|cov:' | tail -n 8; \
+	  ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+	  nice -n 19 ./$(FUZZ_DIR)/tests/fuzz_$$f -max_total_time=$(FUZZ_SECONDS) $(FUZZ_FLAGS) \
+	    -dict=tests/fuzz/$$f.dict -artifact_prefix=$(FUZZ_DIR)/crashers/$$f/ \
+	    $(FUZZ_DIR)/corpus/$$f tests/fuzz/corpus/$$f $(FUZZ_SEEDS) >$(FUZZ_DIR)/fuzz_$$f.log 2>&1; \
+	  status=$$?; \
+	  grep -E '^#[0-9]+.*(DONE|pulse)|stat::|ERROR|SUMMARY' $(FUZZ_DIR)/fuzz_$$f.log | tail -n 12; \
+	  if [ $$status -ne 0 ]; then echo "fuzz_$$f found a problem: see $(FUZZ_DIR)/fuzz_$$f.log and $(FUZZ_DIR)/crashers/$$f/"; exit 1; fi; \
+	done
+
+# The seeds are merged first and then removed, so that the committed corpus
+# holds only what adds coverage beyond them (ctest replays the seeds anyway).
+fuzz-merge: fuzz-build
+	@for f in $(FUZZERS); do \
+	  m=$(FUZZ_DIR)/merged/$$f; rm -rf $$m && mkdir -p $$m $(FUZZ_DIR)/corpus/$$f tests/fuzz/corpus/$$f; \
+	  for s in $(addsuffix /*,$(FUZZ_SEEDS)); do cp "$$s" "$$m/seed-$$(basename "$$s")"; done; \
+	  nice -n 19 ./$(FUZZ_DIR)/tests/fuzz_$$f -merge=1 $(FUZZ_FLAGS) $$m \
+	    tests/fuzz/corpus/$$f $(FUZZ_DIR)/corpus/$$f 2>&1 | grep -E 'MERGE-OUTER: [0-9]+ new files'; \
+	  rm -f $$m/seed-*; rm -rf tests/fuzz/corpus/$$f && cp -r $$m tests/fuzz/corpus/$$f; \
+	  echo "tests/fuzz/corpus/$$f: $$(ls tests/fuzz/corpus/$$f | wc -l) files, $$(du -sk tests/fuzz/corpus/$$f | cut -f1) KiB"; \
 	done
 
 bench: deps-test build
