@@ -77,6 +77,9 @@ PK_API const char *pk_status_string(pk_status status);
 #define PK_MAX_THREADS 1024
 #define PK_MAX_POLYGON_VERTICES 4096
 #define PK_MAX_FILE_BYTES ((size_t)1 << 31) /* 2 GiB */
+/* A JSON scene holds settings, materials, spheres and lights, not meshes; its
+ * parsed tree takes tens of bytes per byte of text, hence a smaller bound. */
+#define PK_MAX_JSON_BYTES ((size_t)64 << 20) /* 64 MiB */
 
 /* ---- camera, options, statistics ----------------------------------------- */
 

@@ -21,6 +21,9 @@ void io_reader_init(io_reader *r, pk_context *ctx, const char *name, const char 
     r->p = data ? data : "";
     r->end = data ? data + size : r->p;
     r->next_line = 1;
+    /* Windows editors start UTF-8 files with a byte order mark: without
+     * this, the first statement would be an unknown one (and be dropped). */
+    if (r->end - r->p >= 3 && memcmp(r->p, "\xEF\xBB\xBF", 3) == 0) r->p += 3;
 }
 
 void io_reader_free(io_reader *r) { mem_free(&r->ctx->alloc, r->scratch); r->scratch = NULL; }
@@ -38,15 +41,17 @@ static bool next_physical(io_reader *r, const char **ls, const char **le)
     return true;
 }
 
-/* The backslash that ends [s, e) (before trailing blanks), or NULL. Comment
- * lines never continue: "# C:\dir\" must not swallow the next statement. */
+/* The backslash that ends [s, e) (before trailing blanks), or NULL. Comments
+ * never continue: "# C:\dir\" (a whole line, or after a statement) must not
+ * swallow the next statement. A comment starts with a '#' at the start of a
+ * token, as io_rest reads it. */
 static const char *continuation(const char *s, const char *e)
 {
     const char *q = e;
     while (q > s && io_is_blank(q[-1])) q--;
     if (q == s || q[-1] != '\\') return NULL;
-    const char *f = io_skip_blanks(s, e);
-    if (*f == '#') return NULL;
+    for (const char *c = s; c < q - 1; c++)
+        if (*c == '#' && (c == s || io_is_blank(c[-1]))) return NULL;
     return q - 1;
 }
 

@@ -7,6 +7,7 @@
 #include "io_util.h"
 #include "../scene/scene.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -59,7 +60,13 @@ static pk_status parse_colour(mtl_state *st, const char *kw, size_t kn, const ch
     if ((n != 1 && n != 3) || !io_at_end(p, le))
         return io_error(&st->r, PK_ERR_PARSE, "%.*s needs 1 or 3 numbers, found %s%d", io_tok_len(kw, kw + kn), kw,
                         n == 3 ? "more than " : "", n);
-    *out = n == 1 ? v3s(c[0]) : v3(c[0], c[1], c[2]);
+    vec3 v = n == 1 ? v3s(c[0]) : v3(c[0], c[1], c[2]);
+    if (v.x < 0.0f || v.y < 0.0f || v.z < 0.0f) {
+        /* as JSON scenes, colours are not negative; MTL files are accepted */
+        io_warn(&st->r, "%.*s has a negative component; it is taken as 0", io_tok_len(kw, kw + kn), kw);
+        v = v3(fmaxf(v.x, 0.0f), fmaxf(v.y, 0.0f), fmaxf(v.z, 0.0f));
+    }
+    *out = v;
     return PK_OK;
 }
 
@@ -133,8 +140,22 @@ static pk_status parse_statement(mtl_state *st, const char *ls, const char *le)
         default: return parse_colour(st, kw, n, p, le, &m->ke);
         }
     case 'n':
-        if ((kw[1] | 0x20) == 's') return parse_scalar(st, kw, n, p, le, &m->ns);
-        return parse_scalar(st, kw, n, p, le, &m->ni);
+        rc = parse_scalar(st, kw, n, p, le, &f);
+        if (rc != PK_OK) return rc;
+        if ((kw[1] | 0x20) == 's') {
+            if (f < 0.0f) {
+                io_warn(r, "%.*s %g is negative; 0 is used", (int)n, kw, (double)f);
+                f = 0.0f;
+            }
+            m->ns = f;
+        } else {
+            if (!(f > 0.0f)) {
+                io_warn(r, "%.*s %g is not a positive index of refraction; 1 is used", (int)n, kw, (double)f);
+                f = 1.0f;
+            }
+            m->ni = f;
+        }
+        return PK_OK;
     case 'd': {
         const char *t = io_skip_blanks(p, le);
         const char *te = io_token_end(t, le);

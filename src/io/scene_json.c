@@ -723,6 +723,9 @@ pk_status scene_json_parse(pk_context *ctx, pk_scene *s, const char *data, size_
                                               "ambient",   "meshes", "spheres", "lights"};
     if (!ctx || !s) return PK_ERR_INVALID_ARGUMENT;
     if (!data && size) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "scene_json_parse: no data");
+    if (size > PK_MAX_JSON_BYTES)
+        return ctx_error(ctx, PK_ERR_LIMIT, "%s: a JSON scene may hold at most %zu bytes (meshes belong in OBJ files)",
+                         name ? name : "scene.json", (size_t)PK_MAX_JSON_BYTES);
     jp *p = mem_calloc(&ctx->alloc, 1, sizeof *p);
     if (!p) return ctx_nomem(ctx);
     p->ctx = ctx;

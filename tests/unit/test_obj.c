@@ -343,6 +343,60 @@ static void test_materials(void)
     pk_context_destroy(ctx);
 }
 
+/* ---- oddities of real files (issue 4) ---------------------------------- */
+
+static void test_oddities(void)
+{
+    warnings w;
+    pk_context *ctx = new_ctx(&w);
+
+    /* A UTF-8 byte order mark before the first statement is skipped, in OBJ
+     * and in MTL: the first vertex and the first material are not lost. */
+    pk_scene *s = new_scene(ctx);
+    CHECKF(parse_str(ctx, s, "\xEF\xBB\xBFv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "bom.obj") == PK_OK, "%s",
+           pk_context_error(ctx));
+    CHECK(s->npositions == 3 && s->ntris == 1 && w.count == 0);
+    const char *bm = "\xEF\xBB\xBFnewmtl first\nKd 0.5\n";
+    CHECK(mtl_parse(ctx, s, bm, strlen(bm), "bom.mtl") == PK_OK);
+    CHECK(scene_find_material(s, "first") == 1 && w.count == 0);
+    scene_destroy(s);
+
+    /* A backslash at the end of a comment does not continue it, whether the
+     * comment fills the line or follows a statement. */
+    s = new_scene(ctx);
+    CHECKF(parse_str(ctx, s, "v 0 0 0 # C:\\models\\\nv 1 0 \\\n 0\n# D:\\\nv 0 1 0\nf 1 2 3\n", "c.obj") == PK_OK,
+           "%s", pk_context_error(ctx));
+    CHECKF(s->npositions == 3 && s->ntris == 1, "%zu positions, %zu triangles", s->npositions, s->ntris);
+    CHECK(w.count == 0);
+    scene_destroy(s);
+
+    /* Values an MTL file may hold that make no sense are replaced, with a
+     * warning, so that the file still renders. */
+    memset(&w, 0, sizeof w);
+    s = new_scene(ctx);
+    const char *m = "newmtl odd\nKd -0.5 0.5 0.5\nKe -1\nNs -10\nNi 0\nNi -1.5\nKs -0 0 0\n";
+    CHECKF(mtl_parse(ctx, s, m, strlen(m), "odd.mtl") == PK_OK, "%s", pk_context_error(ctx));
+    const material *o = &s->materials[1];
+    CHECK(o->kd.x == 0.0f && o->kd.y == 0.5f && o->ke.x == 0.0f && o->ns == 0.0f && o->ni == 1.0f);
+    CHECKF(w.count == 5, "%d warnings:\n%s", w.count, w.all);
+    CHECKF(strstr(w.all, "odd.mtl:2: Kd has a negative component; it is taken as 0\n"), "%s", w.all);
+    CHECKF(strstr(w.all, "odd.mtl:3: Ke has a negative component; it is taken as 0\n"), "%s", w.all);
+    CHECKF(strstr(w.all, "odd.mtl:4: Ns -10 is negative; 0 is used\n"), "%s", w.all);
+    CHECKF(strstr(w.all, "odd.mtl:5: Ni 0 is not a positive index of refraction; 1 is used\n"), "%s", w.all);
+    CHECKF(strstr(w.all, "odd.mtl:6: Ni -1.5 is not a positive index of refraction; 1 is used\n"), "%s", w.all);
+    scene_destroy(s);
+
+    /* A JSON scene above PK_MAX_JSON_BYTES is refused before it is parsed
+     * (its tree would take tens of times its size); the text is not read. */
+    s = new_scene(ctx);
+    CHECK(scene_json_parse(ctx, s, "{}", PK_MAX_JSON_BYTES + 1, "big.json", NULL) == PK_ERR_LIMIT);
+    CHECKF(strcmp(pk_context_error(ctx), "big.json: a JSON scene may hold at most 67108864 bytes (meshes belong in "
+                                         "OBJ files)") == 0, "%s", pk_context_error(ctx));
+    pk_context_clear_error(ctx);
+    scene_destroy(s);
+    pk_context_destroy(ctx);
+}
+
 /* ---- errors -------------------------------------------------------------- */
 
 typedef struct err_case {
@@ -775,6 +829,7 @@ int main(void)
     test_unknown_statements();
     test_missing_mtl();
     test_materials();
+    test_oddities();
     test_errors();
     test_xform();
     test_float_parser();
