@@ -176,7 +176,13 @@ pk_status render_scene(pk_context *ctx, const pk_scene *s, const pk_camera *cam,
             int y1 = y0 + TILE < opt->height ? y0 + TILE : opt->height;
             int tw = x1 - x0, n = tw * (y1 - y0);
             memset(acc, 0, sizeof acc);
+            bool stopped = false;
             for (int smp = 0; smp < spp; smp++) {
+                /* also between passes: a tile at many samples may take long */
+                if (smp > 0 && cancel && *cancel) {
+                    stopped = true;
+                    break;
+                }
                 for (int i = 0; i < n; i++) {
                     int px = x0 + i % tw, py = y0 + i / tw;
                     float jx = 0.5f, jy = 0.5f;
@@ -193,11 +199,17 @@ pk_status render_scene(pk_context *ctx, const pk_scene *s, const pk_camera *cam,
                     if (hits[i].prim == PK_NO_HIT) continue;
                     int px = x0 + i % tw, py = y0 + i / tw;
                     me->rng = rng_seed(((uint64_t)py << 32) | (uint32_t)px, (uint64_t)smp * 2);
+                    me->ray_budget = WHITTED_RAY_BUDGET;
                     vec3 c = whitted_shade(&in, me, &rays[i], &hits[i], 0);
                     acc[3 * i] += c.x;
                     acc[3 * i + 1] += c.y;
                     acc[3 * i + 2] += c.z;
                 }
+            }
+            if (stopped) { /* an unfinished tile stays black */
+#pragma omp atomic write
+                cancelled = 1;
+                continue;
             }
             float inv = 1.0f / (float)spp;
             for (int i = 0; i < n; i++) {

@@ -90,7 +90,8 @@ static inline vec3 brdf_cos(const surface *sf, vec3 wo, vec3 wi)
 
 static vec3 trace(const integrator *in, thread_state *ts, const ray *r, int depth, int kind)
 {
-    if (depth > in->max_depth) return v3s(0.0f);
+    if (depth > in->max_depth || ts->ray_budget == 0) return v3s(0.0f);
+    ts->ray_budget--;
     ts->rays[kind]++;
     hit h;
     if (!accel_intersect(in->a, r, &h, ts->cp)) return v3s(0.0f);

@@ -8,6 +8,13 @@
 #include "render.h"
 #include "sampling.h"
 
+/* Secondary rays (reflection, refraction, dissolve) traced for one camera
+ * ray at most. The ray tree of a dielectric branches in two at every hit, so
+ * without it the work would grow as 2^max_depth (2^64 at PK_MAX_DEPTH) and a
+ * render could neither finish nor be cancelled; at the default depth (8) the
+ * tree has at most 2^9 - 2 = 510 rays and the budget never binds. */
+#define WHITTED_RAY_BUDGET 4096
+
 /* Ray kinds, for the statistics. */
 enum { RAY_CAMERA, RAY_SHADOW, RAY_REFLECTION, RAY_REFRACTION, RAY_KINDS };
 
@@ -32,12 +39,14 @@ typedef struct thread_state {
     hit *shadow_hits;
     vec3 *shadow_weight;
     rng rng;
+    uint32_t ray_budget; /* secondary rays left for the current camera ray */
 } thread_state;
 
 PK_HIDDEN pk_status integrator_init(pk_context *ctx, integrator *in, const pk_scene *s, const accel *a,
                                     const pk_render_options *opt);
 PK_HIDDEN void integrator_free(const pk_allocator *al, integrator *in);
-/* Radiance arriving along r that hit h (r traced already, depth 0 for camera rays). */
+/* Radiance arriving along r that hit h (r traced already, depth 0 for camera
+ * rays; set ts->ray_budget = WHITTED_RAY_BUDGET before each camera ray). */
 PK_HIDDEN vec3 whitted_shade(const integrator *in, thread_state *ts, const ray *r, const hit *h, int depth);
 
 #endif
