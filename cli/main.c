@@ -39,7 +39,6 @@ int main(int argc, char **argv)
         printf("paprsek %s\n", PK_VERSION_STRING);
         return 0;
     }
-    fprintf(stderr, "paprsek: unknown command '%s'\n", cmd);
-    usage(stderr);
+    fprintf(stderr, "paprsek: unknown command '%s' (see paprsek --help)\n", cmd);
     return 2;
 }

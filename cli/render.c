@@ -154,6 +154,19 @@ static int parse_args(int argc, char **argv, cli_opts *o)
     return 0;
 }
 
+/* True when path ends with ext (ASCII, any case). */
+static int ends_with_ci(const char *path, const char *ext)
+{
+    size_t lp = strlen(path), le = strlen(ext);
+    if (lp < le) return 0;
+    for (size_t i = 0; i < le; i++) {
+        char c = path[lp - le + i];
+        if (c >= 'A' && c <= 'Z') c = (char)(c - 'A' + 'a');
+        if (c != ext[i]) return 0;
+    }
+    return 1;
+}
+
 /* True when a and b name the same existing file. */
 static int same_file(const char *a, const char *b)
 {
@@ -249,8 +262,15 @@ int cli_render(int argc, char **argv)
     cli_opts o;
     int rc = parse_args(argc, argv, &o);
     if (rc) return rc < 0 ? 0 : rc;
+    /* Everything that would only fail after the render is checked first. */
+    if (!ends_with_ci(o.out, ".png") && !ends_with_ci(o.out, ".pfm"))
+        return cli_usage_error("%s: unknown image format (use .png or .pfm)", o.out);
     if (o.scene && same_file(o.scene, o.out))
         return cli_usage_error("render: refusing to write the image over the scene file '%s'", o.scene);
+    if (o.stats_json && o.scene && same_file(o.scene, o.stats_json))
+        return cli_usage_error("render: refusing to write the statistics over the scene file '%s'", o.scene);
+    if (o.stats_json && (strcmp(o.stats_json, o.out) == 0 || same_file(o.stats_json, o.out)))
+        return cli_usage_error("render: --stats-json and -o name the same file '%s'", o.out);
 
     pk_context *ctx = NULL;
     if (pk_context_create(NULL, &ctx) != PK_OK) {
