@@ -151,6 +151,54 @@ static inline bool bvh_sphere_valid(const accel_sphere *s)
 
 static inline float bvh_cull_limit(float t) { return t + fabsf(t) * BVH_BOX_SLACK; }
 
+/* SIMD vectors as wide as a triangle block. */
+#if BVH_TRI_LANES == 8
+typedef __m256 tvec;
+#define TV_LOAD _mm256_load_ps
+#define TV_LOADU _mm256_loadu_ps
+#define TV_STOREU _mm256_storeu_ps
+#define TV_SET1 _mm256_set1_ps
+#define TV_ZERO _mm256_setzero_ps
+#define TV_ADD _mm256_add_ps
+#define TV_SUB _mm256_sub_ps
+#define TV_MIN _mm256_min_ps
+#define TV_MAX _mm256_max_ps
+#define TV_MUL _mm256_mul_ps
+#define TV_DIV _mm256_div_ps
+#define TV_OR _mm256_or_ps
+#define TV_AND _mm256_and_ps
+#define TV_EQ(a, b) _mm256_cmp_ps(a, b, _CMP_EQ_OQ)
+#define TV_LT(a, b) _mm256_cmp_ps(a, b, _CMP_LT_OQ)
+#define TV_GT(a, b) _mm256_cmp_ps(a, b, _CMP_GT_OQ)
+#define TV_LE(a, b) _mm256_cmp_ps(a, b, _CMP_LE_OQ)
+#define TV_GE(a, b) _mm256_cmp_ps(a, b, _CMP_GE_OQ)
+#define TV_MASK _mm256_movemask_ps
+#elif BVH_TRI_LANES == 4
+typedef __m128 tvec;
+#define TV_LOAD _mm_load_ps
+#define TV_LOADU _mm_loadu_ps
+#define TV_STOREU _mm_storeu_ps
+#define TV_SET1 _mm_set1_ps
+#define TV_ZERO _mm_setzero_ps
+#define TV_ADD _mm_add_ps
+#define TV_SUB _mm_sub_ps
+#define TV_MIN _mm_min_ps
+#define TV_MAX _mm_max_ps
+#define TV_MUL _mm_mul_ps
+#define TV_DIV _mm_div_ps
+#define TV_OR _mm_or_ps
+#define TV_AND _mm_and_ps
+#define TV_EQ _mm_cmpeq_ps
+#define TV_LT _mm_cmplt_ps
+#define TV_GT _mm_cmpgt_ps
+#define TV_LE _mm_cmple_ps
+#define TV_GE _mm_cmpge_ps
+#define TV_MASK _mm_movemask_ps
+#else
+#error "BVH_TRI_LANES must be 4 or 8"
+#endif
+#define BVH_TRI_ALL ((1 << BVH_TRI_LANES) - 1)
+
 typedef struct bvh_ray {
     ray_pre pre;            /* geom.h's shear constants, for the exact tests */
     float org[3];           /* origin, world space */
@@ -160,6 +208,10 @@ typedef struct bvh_ray {
     int kx, ky, kz;         /* shear axes (rows of bvh_tri_block.v[vertex]) */
     float ox, oy, oz;       /* origin components along kx, ky, kz */
     float tmin;
+    /* the same, ready for the triangle test: byte offsets of rows kx, ky, kz
+     * of a vertex, and broadcast origin (sheared axes), shear and tmin */
+    size_t rowx, rowy, rowz;
+    tvec vox, voy, voz, vsx, vsy, vsz, vtmin;
 } bvh_ray;
 
 static inline void bvh_ray_init(bvh_ray *br, const ray *r)
@@ -182,70 +234,50 @@ static inline void bvh_ray_init(bvh_ray *br, const ray *r)
     br->oy = o[br->ky];
     br->oz = o[br->kz];
     br->tmin = r->tmin;
+    const size_t row = sizeof(float) * BVH_TRI_LANES;
+    br->rowx = (size_t)br->kx * row, br->rowy = (size_t)br->ky * row, br->rowz = (size_t)br->kz * row;
+    br->vox = TV_SET1(br->ox), br->voy = TV_SET1(br->oy), br->voz = TV_SET1(br->oz);
+    br->vsx = TV_SET1(br->pre.sx), br->vsy = TV_SET1(br->pre.sy), br->vsz = TV_SET1(br->pre.sz);
+    br->vtmin = TV_SET1(br->tmin);
 }
 
-/* SIMD vectors as wide as a triangle block. */
-#if BVH_TRI_LANES == 8
-typedef __m256 tvec;
-#define TV_LOAD _mm256_load_ps
-#define TV_LOADU _mm256_loadu_ps
-#define TV_STOREU _mm256_storeu_ps
-#define TV_SET1 _mm256_set1_ps
-#define TV_ZERO _mm256_setzero_ps
-#define TV_ADD _mm256_add_ps
-#define TV_SUB _mm256_sub_ps
-#define TV_MUL _mm256_mul_ps
-#define TV_DIV _mm256_div_ps
-#define TV_OR _mm256_or_ps
-#define TV_AND _mm256_and_ps
-#define TV_EQ(a, b) _mm256_cmp_ps(a, b, _CMP_EQ_OQ)
-#define TV_LT(a, b) _mm256_cmp_ps(a, b, _CMP_LT_OQ)
-#define TV_GT(a, b) _mm256_cmp_ps(a, b, _CMP_GT_OQ)
-#define TV_LE(a, b) _mm256_cmp_ps(a, b, _CMP_LE_OQ)
-#define TV_GE(a, b) _mm256_cmp_ps(a, b, _CMP_GE_OQ)
-#define TV_MASK _mm256_movemask_ps
-#elif BVH_TRI_LANES == 4
-typedef __m128 tvec;
-#define TV_LOAD _mm_load_ps
-#define TV_LOADU _mm_loadu_ps
-#define TV_STOREU _mm_storeu_ps
-#define TV_SET1 _mm_set1_ps
-#define TV_ZERO _mm_setzero_ps
-#define TV_ADD _mm_add_ps
-#define TV_SUB _mm_sub_ps
-#define TV_MUL _mm_mul_ps
-#define TV_DIV _mm_div_ps
-#define TV_OR _mm_or_ps
-#define TV_AND _mm_and_ps
-#define TV_EQ _mm_cmpeq_ps
-#define TV_LT _mm_cmplt_ps
-#define TV_GT _mm_cmpgt_ps
-#define TV_LE _mm_cmple_ps
-#define TV_GE _mm_cmpge_ps
-#define TV_MASK _mm_movemask_ps
-#else
-#error "BVH_TRI_LANES must be 4 or 8"
-#endif
-#define BVH_TRI_ALL ((1 << BVH_TRI_LANES) - 1)
 
 /* The lanes of one triangle block that pass tri_intersect with limit tmax:
  * the same float operations in the same order as geom.h, a block at a time
  * (no FMA: the build has -ffp-contract=off and no fused intrinsics are used
  * here). Returns the lane mask; *t, *rcp, *V, *W hold the lanes. */
+/* Lanes in zm have an edge function that is exactly 0: recompute U, V, W
+ * of those lanes in double, as tri_intersect does. */
+static __attribute__((noinline, cold)) void bvh_tri_recompute(int zm, tvec ax, tvec ay, tvec bx, tvec by, tvec cx,
+                                                            tvec cy, tvec *U, tvec *V, tvec *W)
+{
+    float fax[BVH_TRI_LANES], fay[BVH_TRI_LANES], fbx[BVH_TRI_LANES], fby[BVH_TRI_LANES];
+    float fcx[BVH_TRI_LANES], fcy[BVH_TRI_LANES], fu[BVH_TRI_LANES], fv[BVH_TRI_LANES], fw[BVH_TRI_LANES];
+    TV_STOREU(fax, ax), TV_STOREU(fay, ay), TV_STOREU(fbx, bx), TV_STOREU(fby, by);
+    TV_STOREU(fcx, cx), TV_STOREU(fcy, cy), TV_STOREU(fu, *U), TV_STOREU(fv, *V), TV_STOREU(fw, *W);
+    for (int l = 0; l < BVH_TRI_LANES; l++) {
+        if (!(zm >> l & 1)) continue;
+        fu[l] = (float)((double)fcx[l] * (double)fby[l] - (double)fcy[l] * (double)fbx[l]);
+        fv[l] = (float)((double)fax[l] * (double)fcy[l] - (double)fay[l] * (double)fcx[l]);
+        fw[l] = (float)((double)fbx[l] * (double)fay[l] - (double)fby[l] * (double)fax[l]);
+    }
+    *U = TV_LOADU(fu), *V = TV_LOADU(fv), *W = TV_LOADU(fw);
+}
+
 static inline int bvh_tri_test(const bvh_tri_block *blk, const bvh_ray *r, float tmax, tvec *t_out,
                                tvec *rcp_out, tvec *V_out, tvec *W_out)
 {
-    const tvec ox = TV_SET1(r->ox), oy = TV_SET1(r->oy), oz = TV_SET1(r->oz);
-    const tvec sx = TV_SET1(r->pre.sx), sy = TV_SET1(r->pre.sy);
-    const tvec ax0 = TV_SUB(TV_LOAD(blk->v[0][r->kx]), ox);
-    const tvec ay0 = TV_SUB(TV_LOAD(blk->v[0][r->ky]), oy);
-    const tvec az0 = TV_SUB(TV_LOAD(blk->v[0][r->kz]), oz);
-    const tvec bx0 = TV_SUB(TV_LOAD(blk->v[1][r->kx]), ox);
-    const tvec by0 = TV_SUB(TV_LOAD(blk->v[1][r->ky]), oy);
-    const tvec bz0 = TV_SUB(TV_LOAD(blk->v[1][r->kz]), oz);
-    const tvec cx0 = TV_SUB(TV_LOAD(blk->v[2][r->kx]), ox);
-    const tvec cy0 = TV_SUB(TV_LOAD(blk->v[2][r->ky]), oy);
-    const tvec cz0 = TV_SUB(TV_LOAD(blk->v[2][r->kz]), oz);
+    const char *va = (const char *)blk->v[0], *vb = (const char *)blk->v[1], *vc = (const char *)blk->v[2];
+    const tvec ax0 = TV_SUB(TV_LOAD((const float *)(va + r->rowx)), r->vox);
+    const tvec ay0 = TV_SUB(TV_LOAD((const float *)(va + r->rowy)), r->voy);
+    const tvec az0 = TV_SUB(TV_LOAD((const float *)(va + r->rowz)), r->voz);
+    const tvec bx0 = TV_SUB(TV_LOAD((const float *)(vb + r->rowx)), r->vox);
+    const tvec by0 = TV_SUB(TV_LOAD((const float *)(vb + r->rowy)), r->voy);
+    const tvec bz0 = TV_SUB(TV_LOAD((const float *)(vb + r->rowz)), r->voz);
+    const tvec cx0 = TV_SUB(TV_LOAD((const float *)(vc + r->rowx)), r->vox);
+    const tvec cy0 = TV_SUB(TV_LOAD((const float *)(vc + r->rowy)), r->voy);
+    const tvec cz0 = TV_SUB(TV_LOAD((const float *)(vc + r->rowz)), r->voz);
+    const tvec sx = r->vsx, sy = r->vsy;
     const tvec ax = TV_SUB(ax0, TV_MUL(sx, az0)), ay = TV_SUB(ay0, TV_MUL(sy, az0));
     const tvec bx = TV_SUB(bx0, TV_MUL(sx, bz0)), by = TV_SUB(by0, TV_MUL(sy, bz0));
     const tvec cx = TV_SUB(cx0, TV_MUL(sx, cz0)), cy = TV_SUB(cy0, TV_MUL(sy, cz0));
@@ -253,33 +285,22 @@ static inline int bvh_tri_test(const bvh_tri_block *blk, const bvh_ray *r, float
     tvec V = TV_SUB(TV_MUL(ax, cy), TV_MUL(ay, cx));
     tvec W = TV_SUB(TV_MUL(bx, ay), TV_MUL(by, ax));
     const tvec zero = TV_ZERO();
-    int zm = TV_MASK(TV_OR(TV_OR(TV_EQ(U, zero), TV_EQ(V, zero)), TV_EQ(W, zero)));
-    if (PK_UNLIKELY(zm)) {
-        /* an edge function is exactly 0: recompute that lane in double */
-        float fax[BVH_TRI_LANES], fay[BVH_TRI_LANES], fbx[BVH_TRI_LANES], fby[BVH_TRI_LANES];
-        float fcx[BVH_TRI_LANES], fcy[BVH_TRI_LANES], fu[BVH_TRI_LANES], fv[BVH_TRI_LANES], fw[BVH_TRI_LANES];
-        TV_STOREU(fax, ax), TV_STOREU(fay, ay), TV_STOREU(fbx, bx), TV_STOREU(fby, by);
-        TV_STOREU(fcx, cx), TV_STOREU(fcy, cy), TV_STOREU(fu, U), TV_STOREU(fv, V), TV_STOREU(fw, W);
-        for (int l = 0; l < BVH_TRI_LANES; l++) {
-            if (!(zm >> l & 1)) continue;
-            fu[l] = (float)((double)fcx[l] * (double)fby[l] - (double)fcy[l] * (double)fbx[l]);
-            fv[l] = (float)((double)fax[l] * (double)fcy[l] - (double)fay[l] * (double)fcx[l]);
-            fw[l] = (float)((double)fbx[l] * (double)fay[l] - (double)fby[l] * (double)fax[l]);
-        }
-        U = TV_LOADU(fu), V = TV_LOADU(fv), W = TV_LOADU(fw);
-    }
-    const tvec neg = TV_OR(TV_OR(TV_LT(U, zero), TV_LT(V, zero)), TV_LT(W, zero));
-    const tvec pos = TV_OR(TV_OR(TV_GT(U, zero), TV_GT(V, zero)), TV_GT(W, zero));
+    const int zm = TV_MASK(TV_OR(TV_OR(TV_EQ(U, zero), TV_EQ(V, zero)), TV_EQ(W, zero)));
+    if (PK_UNLIKELY(zm)) bvh_tri_recompute(zm, ax, ay, bx, by, cx, cy, &U, &V, &W);
+    /* reject mixed signs; a lane with a NaN edge function fails below
+     * anyway (det and t are NaN), so min/max may drop NaNs here */
+    const tvec neg = TV_LT(TV_MIN(TV_MIN(U, V), W), zero);
+    const tvec pos = TV_GT(TV_MAX(TV_MAX(U, V), W), zero);
     const tvec det = TV_ADD(TV_ADD(U, V), W);
     int m = ~TV_MASK(TV_OR(TV_AND(neg, pos), TV_EQ(det, zero))) & BVH_TRI_ALL;
     if (!m) return 0;
-    const tvec sz = TV_SET1(r->pre.sz);
+    const tvec sz = r->vsz;
     const tvec az = TV_MUL(sz, az0), bz = TV_MUL(sz, bz0), cz = TV_MUL(sz, cz0);
     const tvec T = TV_ADD(TV_ADD(TV_MUL(U, az), TV_MUL(V, bz)), TV_MUL(W, cz));
     const tvec rcp = TV_DIV(TV_SET1(1.0f), det);
     const tvec t = TV_MUL(T, rcp);
     /* t in [tmin, tmax] and finite (an overflowed t is no hit) */
-    m &= TV_MASK(TV_AND(TV_AND(TV_GE(t, TV_SET1(r->tmin)), TV_LE(t, TV_SET1(tmax))), TV_LT(t, TV_SET1(INFINITY))));
+    m &= TV_MASK(TV_AND(TV_AND(TV_GE(t, r->vtmin), TV_LE(t, TV_SET1(tmax))), TV_LT(t, TV_SET1(INFINITY))));
     *t_out = t;
     *rcp_out = rcp;
     *V_out = V;

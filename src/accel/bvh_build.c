@@ -543,8 +543,8 @@ pk_status accel_bvh_create(pk_context *ctx, const accel_input *in, accel **out)
     }
 
     /* references are 32-bit byte offsets: the arrays must stay below 4 GiB */
+    size_t inner = 1, tblocks = 0, sblocks = 0;
     {
-        size_t inner = 1, tblocks = 0, sblocks = 0;
         for (uint32_t i = 0; i < b.nnodes; i++) {
             const bnode *x = &bnodes[i];
             if (!x->count) inner++;
@@ -564,9 +564,8 @@ pk_status accel_bvh_create(pk_context *ctx, const accel_input *in, accel **out)
     c.in = in;
     c.cap_nodes = binner_count + 1;
     c.nodes = mem_alloc_aligned(al, c.cap_nodes * sizeof(bvh_node), 64);
-    size_t nbl = (b.nnodes + 1) / 2 + 1; /* binary leaves */
-    c.tris = mem_alloc_aligned(al, nbl * sizeof(bvh_tri_block), 64);
-    c.spheres = any_sphere ? mem_alloc_aligned(al, nbl * sizeof(bvh_sphere_block), 64) : NULL;
+    c.tris = mem_alloc_aligned(al, (tblocks + 1) * sizeof(bvh_tri_block), 64);
+    c.spheres = any_sphere ? mem_alloc_aligned(al, (sblocks + 1) * sizeof(bvh_sphere_block), 64) : NULL;
     if (!c.nodes || !c.tris || (any_sphere && !c.spheres)) goto nomem;
     if (n == 0) {
         init_node(&c.nodes[0]);

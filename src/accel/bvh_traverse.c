@@ -35,36 +35,41 @@ typedef __m128 vfloat;
 #error "BVH_WIDTH must be 4 or 8"
 #endif
 
-/* The ray as the node test wants it: broadcast origin and 1/d, and byte
- * offsets of the near and far plane rows (chosen by the sign of 1/d). */
+/* The ray as the node test wants it: broadcast origin and 1/d, and
+ * pointers to the near and far plane rows of node 0 (the rows are chosen by
+ * the sign of 1/d), so that a node's rows are these plus its reference. */
 typedef struct node_ray {
     vfloat ox, oy, oz, rdx, rdy, rdz, rfx, rfy, rfz, tmin;
-    size_t nx, ny, nz, fx, fy, fz;
+    const char *nx, *ny, *nz, *fx, *fy, *fz;
 } node_ray;
 
-static inline void node_ray_init(node_ray *nr, const bvh_ray *r)
+static inline void node_ray_init(node_ray *nr, const bvh_ray *r, const bvh *t)
 {
     nr->ox = VF_SET1(r->org[0]), nr->oy = VF_SET1(r->org[1]), nr->oz = VF_SET1(r->org[2]);
     nr->rdx = VF_SET1(r->rd[0]), nr->rdy = VF_SET1(r->rd[1]), nr->rdz = VF_SET1(r->rd[2]);
     nr->rfx = VF_SET1(r->rdf[0]), nr->rfy = VF_SET1(r->rdf[1]), nr->rfz = VF_SET1(r->rdf[2]);
     nr->tmin = VF_SET1(r->tmin);
+    const char *base = (const char *)t->nodes->b;
     const size_t row = sizeof(float) * BVH_WIDTH;
-    nr->nx = (size_t)r->near[0] * row, nr->ny = (size_t)r->near[1] * row, nr->nz = (size_t)r->near[2] * row;
-    nr->fx = (size_t)r->far[0] * row, nr->fy = (size_t)r->far[1] * row, nr->fz = (size_t)r->far[2] * row;
+    nr->nx = base + (size_t)r->near[0] * row, nr->ny = base + (size_t)r->near[1] * row;
+    nr->nz = base + (size_t)r->near[2] * row;
+    nr->fx = base + (size_t)r->far[0] * row, nr->fy = base + (size_t)r->far[1] * row;
+    nr->fz = base + (size_t)r->far[2] * row;
 }
 
-/* Mask of the slots of node n whose box the segment [tmin, tcull] touches
- * (tcull = bvh_cull_limit of the closest t); *tn gets the entry distances. 0 * inf = NaN (a ray lying in a slab plane)
- * is the first operand of min/max, which then return the second: such a
- * plane does not limit the segment. */
-static inline unsigned node_hits(const char *n, const node_ray *r, float tcull, vfloat *tn)
+/* Mask of the slots of the node at ref whose box the segment [tmin, tcull]
+ * touches (tcull = bvh_cull_limit of the closest t); *tn gets the entry
+ * distances. 0 * inf = NaN (a ray lying in a slab plane) is the first
+ * operand of min/max, which then return the second: such a plane does not
+ * limit the segment. */
+static inline unsigned node_hits(uint32_t ref, const node_ray *r, float tcull, vfloat *tn)
 {
-    const vfloat tnx = VF_MUL(VF_SUB(VF_LOAD((const float *)(n + r->nx)), r->ox), r->rdx);
-    const vfloat tny = VF_MUL(VF_SUB(VF_LOAD((const float *)(n + r->ny)), r->oy), r->rdy);
-    const vfloat tnz = VF_MUL(VF_SUB(VF_LOAD((const float *)(n + r->nz)), r->oz), r->rdz);
-    const vfloat tfx = VF_MUL(VF_SUB(VF_LOAD((const float *)(n + r->fx)), r->ox), r->rfx);
-    const vfloat tfy = VF_MUL(VF_SUB(VF_LOAD((const float *)(n + r->fy)), r->oy), r->rfy);
-    const vfloat tfz = VF_MUL(VF_SUB(VF_LOAD((const float *)(n + r->fz)), r->oz), r->rfz);
+    const vfloat tnx = VF_MUL(VF_SUB(VF_LOAD((const float *)(r->nx + ref)), r->ox), r->rdx);
+    const vfloat tny = VF_MUL(VF_SUB(VF_LOAD((const float *)(r->ny + ref)), r->oy), r->rdy);
+    const vfloat tnz = VF_MUL(VF_SUB(VF_LOAD((const float *)(r->nz + ref)), r->oz), r->rdz);
+    const vfloat tfx = VF_MUL(VF_SUB(VF_LOAD((const float *)(r->fx + ref)), r->ox), r->rfx);
+    const vfloat tfy = VF_MUL(VF_SUB(VF_LOAD((const float *)(r->fy + ref)), r->oy), r->rfy);
+    const vfloat tfz = VF_MUL(VF_SUB(VF_LOAD((const float *)(r->fz + ref)), r->oz), r->rfz);
     const vfloat near = VF_MAX(tnx, VF_MAX(tny, VF_MAX(tnz, r->tmin)));
     const vfloat far = VF_MIN(tfx, VF_MIN(tfy, VF_MIN(tfz, VF_SET1(tcull))));
     *tn = near;
@@ -72,7 +77,7 @@ static inline unsigned node_hits(const char *n, const node_ray *r, float tcull, 
 }
 
 /* Tests leaf ref; closest: updates *best; any: true on the first hit. */
-static inline __attribute__((always_inline)) bool leaf(const bvh *t, uint32_t ref, const bvh_ray *r, hit *best,
+static __attribute__((noinline)) bool leaf(const bvh *t, uint32_t ref, const bvh_ray *r, hit *best,
                                                        uint64_t *tests, const bool any, const bool count)
 {
     const uint32_t nb = bvh_leaf_blocks(ref);
@@ -110,22 +115,21 @@ static inline __attribute__((always_inline)) bool traverse(const bvh *t, const r
     bvh_ray r;
     bvh_ray_init(&r, rr);
     node_ray nr;
-    node_ray_init(&nr, &r);
+    node_ray_init(&nr, &r, t);
     hit best = {rr->tmax, PK_NO_HIT, 0.0f, 0.0f};
     float tcull = bvh_cull_limit(best.t);
-    const char *const nodes = (const char *)t->nodes;
+    const char *const children = (const char *)t->nodes->child;
 
     stack_entry stack[BVH_STACK_SIZE];
-    int sp = 0;
+    stack_entry *sp = stack;
     uint32_t ref = 0;
     uint64_t nvisit = 0, tests = 0;
     for (;;) {
         while (!bvh_is_leaf(ref)) {
-            const char *n = nodes + ref;
-            const uint32_t *child = ((const bvh_node *)n)->child;
+            const uint32_t *child = (const uint32_t *)(children + ref);
             if (count) nvisit++;
             vfloat tnv;
-            unsigned mask = node_hits(n, &nr, tcull, &tnv);
+            unsigned mask = node_hits(ref, &nr, tcull, &tnv);
             if (!mask) goto pop;
             unsigned k0 = (unsigned)__builtin_ctz(mask);
             mask &= mask - 1;
@@ -138,34 +142,30 @@ static inline __attribute__((always_inline)) bool traverse(const bvh *t, const r
             unsigned k1 = (unsigned)__builtin_ctz(mask);
             mask &= mask - 1;
             if (!mask) {
-                uint32_t far;
-                if (tn[k0] <= tn[k1]) {
-                    far = child[k1];
-                    stack[sp++] = (stack_entry){far, tn[k1]};
-                    ref = child[k0];
-                } else {
-                    far = child[k0];
-                    stack[sp++] = (stack_entry){far, tn[k0]};
-                    ref = child[k1];
-                }
+                const float t0 = tn[k0], t1 = tn[k1];
+                const uint32_t c0 = child[k0], c1 = child[k1];
+                const bool swap = t1 < t0;
+                sp->ref = swap ? c0 : c1;
+                sp->t = swap ? t0 : t1;
+                sp++;
+                ref = swap ? c1 : c0;
                 continue;
             }
             /* three or more: push all, sort the run far to near, take the top */
-            const int base = sp;
-            stack[sp++] = (stack_entry){child[k0], tn[k0]};
-            stack[sp++] = (stack_entry){child[k1], tn[k1]};
+            stack_entry *const base = sp;
+            *sp++ = (stack_entry){child[k0], tn[k0]};
+            *sp++ = (stack_entry){child[k1], tn[k1]};
             do {
                 unsigned k = (unsigned)__builtin_ctz(mask);
                 mask &= mask - 1;
-                stack[sp++] = (stack_entry){child[k], tn[k]};
+                *sp++ = (stack_entry){child[k], tn[k]};
             } while (mask);
-            for (int i = base + 1; i < sp; i++) {
-                stack_entry e = stack[i];
-                int j = i;
-                for (; j > base && stack[j - 1].t < e.t; j--) stack[j] = stack[j - 1];
-                stack[j] = e;
+            for (stack_entry *i = base + 1; i < sp; i++) {
+                stack_entry e = *i, *j = i;
+                for (; j > base && j[-1].t < e.t; j--) *j = j[-1];
+                *j = e;
             }
-            ref = stack[--sp].ref;
+            ref = (--sp)->ref;
         }
 
         if (count) nvisit++;
@@ -175,10 +175,10 @@ static inline __attribute__((always_inline)) bool traverse(const bvh *t, const r
         }
     pop:
         for (;;) {
-            if (sp == 0) goto done;
+            if (sp == stack) goto done;
             --sp;
-            if (stack[sp].t <= tcull) {
-                ref = stack[sp].ref;
+            if (sp->t <= tcull) {
+                ref = sp->ref;
                 break;
             }
         }
