@@ -56,7 +56,7 @@ pk_status prim_set_init(pk_context *ctx, const pk_allocator *a, const accel_inpu
 {
     memset(ps, 0, sizeof *ps);
     if (in->ntris) {
-        ps->verts = mem_realloc_array(a, NULL, in->ntris * 3, sizeof *ps->verts);
+        ps->verts = mem_realloc_array(a, NULL, in->ntris, 3 * sizeof *ps->verts); /* overflow-checked */
         if (!ps->verts) return ctx_nomem(ctx);
         memcpy(ps->verts, in->verts, in->ntris * 3 * sizeof *ps->verts);
     }

@@ -593,6 +593,9 @@ out:
  * sphere materials come after limit and are never found by name. */
 static int64_t find_material_below(const pk_scene *s, const char *name, size_t limit)
 {
+    int64_t newest = scene_find_material(s, name);
+    if (newest < (int64_t)limit) return newest;
+    /* an inline material's name ("spheres[2].material") hides a named one */
     for (size_t i = limit; i-- > 0;)
         if (strcmp(s->materials[i].name, name) == 0) return (int64_t)i;
     return -1;

@@ -21,7 +21,7 @@ pk_status render_build_accel(pk_context *ctx, const pk_scene *s, pk_accel_kind k
     vec3 *verts = NULL;
     accel_sphere *sph = NULL;
     if (s->ntris) {
-        verts = mem_realloc_array(&ctx->alloc, NULL, s->ntris * 3, sizeof *verts);
+        verts = mem_realloc_array(&ctx->alloc, NULL, s->ntris, 3 * sizeof *verts); /* overflow-checked */
         if (!verts) return ctx_nomem(ctx);
         for (size_t k = 0; k < s->ntris; k++) scene_tri_verts(s, k, &verts[3 * k], &verts[3 * k + 1], &verts[3 * k + 2]);
     }

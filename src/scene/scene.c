@@ -9,6 +9,7 @@
 #include <string.h>
 
 #define SCENE_MAX_PRIMS ((size_t)1 << 30) /* triangle numbers fit uint32 with room */
+#define SCENE_MAX_MATERIALS ((size_t)1 << 24)
 
 void material_init(material *m)
 {
@@ -46,6 +47,7 @@ void scene_destroy(pk_scene *s)
     const pk_allocator *a = &s->alloc;
     for (size_t i = 0; i < s->nmaterials; i++) mem_free(a, s->materials[i].name);
     mem_free(a, s->materials);
+    mem_free(a, s->mat_index);
     mem_free(a, s->positions);
     mem_free(a, s->normals);
     mem_free(a, s->tris);
@@ -58,11 +60,11 @@ void scene_destroy(pk_scene *s)
     mem_free(&copy, s);
 }
 
-#define APPEND(ctx, s, arr, n, cap, item, limit)                                          \
+#define APPEND(ctx, s, arr, n, cap, item, limit, what)                                    \
     do {                                                                                  \
         if ((s)->n >= (limit))                                                            \
-            return ctx_error(ctx, PK_ERR_LIMIT, "%s: more than %zu elements", (s)->name,  \
-                             (size_t)(limit));                                            \
+            return ctx_error(ctx, PK_ERR_LIMIT, "%s: more than %zu %s in one scene",      \
+                             (s)->name, (size_t)(limit), what);                           \
         if (!mem_grow(&(s)->alloc, (void **)&(s)->arr, &(s)->cap, (s)->n + 1, sizeof *(s)->arr)) \
             return ctx_nomem(ctx);                                                        \
         (s)->arr[(s)->n++] = (item);                                                      \
@@ -72,49 +74,86 @@ void scene_destroy(pk_scene *s)
 
 pk_status scene_add_position(pk_context *ctx, pk_scene *s, vec3 p)
 {
-    APPEND(ctx, s, positions, npositions, cap_positions, p, SCENE_MAX_PRIMS);
+    APPEND(ctx, s, positions, npositions, cap_positions, p, SCENE_MAX_PRIMS, "vertices");
 }
 
 pk_status scene_add_normal(pk_context *ctx, pk_scene *s, vec3 n)
 {
-    APPEND(ctx, s, normals, nnormals, cap_normals, n, SCENE_MAX_PRIMS);
+    APPEND(ctx, s, normals, nnormals, cap_normals, n, SCENE_MAX_PRIMS, "normals");
 }
 
 pk_status scene_add_triangle(pk_context *ctx, pk_scene *s, const triangle *t)
 {
-    APPEND(ctx, s, tris, ntris, cap_tris, *t, SCENE_MAX_PRIMS);
+    APPEND(ctx, s, tris, ntris, cap_tris, *t, SCENE_MAX_PRIMS, "triangles");
 }
 
 pk_status scene_add_sphere(pk_context *ctx, pk_scene *s, const sphere *sp)
 {
-    APPEND(ctx, s, spheres, nspheres, cap_spheres, *sp, SCENE_MAX_PRIMS);
+    APPEND(ctx, s, spheres, nspheres, cap_spheres, *sp, SCENE_MAX_PRIMS, "spheres");
 }
 
 pk_status scene_add_point_light(pk_context *ctx, pk_scene *s, const point_light *l)
 {
-    APPEND(ctx, s, lights, nlights, cap_lights, *l, SCENE_MAX_PRIMS);
+    APPEND(ctx, s, lights, nlights, cap_lights, *l, SCENE_MAX_PRIMS, "point lights");
+}
+
+/* FNV-1a */
+static size_t name_hash(const char *name)
+{
+    uint64_t h = 1469598103934665603u;
+    for (const unsigned char *c = (const unsigned char *)name; *c; c++) h = (h ^ *c) * 1099511628211u;
+    return (size_t)(h ^ (h >> 32));
+}
+
+/* Points index at material i: replaces an older material of the same name. */
+static void index_put(uint32_t *index, size_t slots, const material *mats, uint32_t i)
+{
+    size_t k = name_hash(mats[i].name) & (slots - 1);
+    while (index[k] && strcmp(mats[index[k] - 1].name, mats[i].name) != 0) k = (k + 1) & (slots - 1);
+    index[k] = i + 1;
+}
+
+/* Makes room in the index for one more material (rebuilt at twice the size
+ * when it would be more than half full). */
+static bool index_reserve(pk_scene *s)
+{
+    if (2 * (s->nmaterials + 1) < s->mat_slots) return true;
+    size_t slots = s->mat_slots ? 2 * s->mat_slots : 64;
+    uint32_t *index = mem_calloc(&s->alloc, slots, sizeof *index);
+    if (!index) return false;
+    for (size_t i = 0; i < s->nmaterials; i++) index_put(index, slots, s->materials, (uint32_t)i);
+    mem_free(&s->alloc, s->mat_index);
+    s->mat_index = index;
+    s->mat_slots = slots;
+    return true;
 }
 
 pk_status scene_add_material(pk_context *ctx, pk_scene *s, const char *name, uint32_t *index)
 {
+    if (s->nmaterials >= SCENE_MAX_MATERIALS)
+        return ctx_error(ctx, PK_ERR_LIMIT, "%s: more than %zu materials in one scene", s->name,
+                         (size_t)SCENE_MAX_MATERIALS);
     material m;
     material_init(&m);
     m.name = mem_strdup(&s->alloc, name);
     if (!m.name) return ctx_nomem(ctx);
-    if (s->nmaterials >= UINT32_MAX / 2 ||
-        !mem_grow(&s->alloc, (void **)&s->materials, &s->cap_materials, s->nmaterials + 1, sizeof m)) {
+    if (!mem_grow(&s->alloc, (void **)&s->materials, &s->cap_materials, s->nmaterials + 1, sizeof m) ||
+        !index_reserve(s)) {
         mem_free(&s->alloc, m.name);
         return ctx_nomem(ctx);
     }
     *index = (uint32_t)s->nmaterials;
     s->materials[s->nmaterials++] = m;
+    index_put(s->mat_index, s->mat_slots, s->materials, *index);
     return PK_OK;
 }
 
 int64_t scene_find_material(const pk_scene *s, const char *name)
 {
-    for (size_t i = s->nmaterials; i-- > 0;)
-        if (strcmp(s->materials[i].name, name) == 0) return (int64_t)i;
+    if (!s->mat_slots) return -1;
+    size_t k = name_hash(name) & (s->mat_slots - 1);
+    for (; s->mat_index[k]; k = (k + 1) & (s->mat_slots - 1))
+        if (strcmp(s->materials[s->mat_index[k] - 1].name, name) == 0) return (int64_t)s->mat_index[k] - 1;
     return -1;
 }
 
@@ -153,7 +192,7 @@ pk_status scene_commit(pk_context *ctx, pk_scene *s)
         s->bounds = aabb_grow(s->bounds, v3_add(sp->center, v3s(sp->radius)));
     }
     if (nemit) {
-        s->emissive = mem_alloc(&s->alloc, nemit * sizeof *s->emissive);
+        s->emissive = mem_realloc_array(&s->alloc, NULL, nemit, sizeof *s->emissive);
         if (!s->emissive) return ctx_nomem(ctx);
         for (size_t k = 0; k < s->ntris; k++)
             if (!s->degenerate[k] && material_emits(&s->materials[s->tris[k].material]))
@@ -175,6 +214,11 @@ bool scene_check(const pk_scene *s, char *why, size_t n)
 {
 #define FAIL(...) do { if (why) snprintf(why, n, __VA_ARGS__); return false; } while (0)
     if (s->nmaterials == 0) FAIL("no default material");
+    for (size_t i = 0; i < s->nmaterials; i++) {
+        int64_t j = scene_find_material(s, s->materials[i].name);
+        if (j < (int64_t)i || (size_t)j >= s->nmaterials || strcmp(s->materials[j].name, s->materials[i].name) != 0)
+            FAIL("material %zu is not found by its name", i);
+    }
     for (size_t i = 0; i < s->npositions; i++)
         if (!v3_finite(s->positions[i])) FAIL("position %zu is not finite", i);
     for (size_t i = 0; i < s->nnormals; i++)

@@ -57,7 +57,9 @@ typedef struct scene_render_settings {
  *  3. every sphere has a finite center and radius > 0, material < nmaterials;
  *  4. material 0 exists and is the neutral grey default;
  *  5. after commit, degenerate[k] says whether triangle k can never be hit,
- *     and emissive lists the triangles whose material has ke > 0 (non-degenerate). */
+ *     and emissive lists the triangles whose material has ke > 0 (non-degenerate);
+ *  6. the name index finds, for every material's name, a material of that name
+ *     that is not older (the newest, by construction). */
 struct pk_scene {
     pk_allocator alloc;
     char *name;             /* file name for messages and statistics */
@@ -67,6 +69,9 @@ struct pk_scene {
     triangle *tris;  size_t ntris, cap_tris;
     sphere *spheres; size_t nspheres, cap_spheres;
     material *materials; size_t nmaterials, cap_materials;
+    /* Name index: open addressing, mat_slots (a power of two, > 2 * nmaterials)
+     * slots holding 1 + the newest material of a name, 0 when empty. */
+    uint32_t *mat_index; size_t mat_slots;
     point_light *lights; size_t nlights, cap_lights;
 
     vec3 ambient;           /* ambient light; zero unless the scene asks */
@@ -97,7 +102,9 @@ PK_HIDDEN pk_status scene_add_point_light(pk_context *ctx, pk_scene *s, const po
  * illum 2) named name; *index receives its number. A later material of the same
  * name replaces the earlier one for scene_find_material. */
 PK_HIDDEN pk_status scene_add_material(pk_context *ctx, pk_scene *s, const char *name, uint32_t *index);
-/* Material number by name, searching from the newest; -1 when absent. */
+/* Number of the newest material named name; -1 when absent. Constant time
+ * (a hash index), so that files with many materials and usemtl statements
+ * do not take quadratic time. */
 PK_HIDDEN int64_t scene_find_material(const pk_scene *s, const char *name);
 PK_HIDDEN void material_init(material *m);
 

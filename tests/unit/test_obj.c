@@ -386,6 +386,27 @@ static void test_oddities(void)
     CHECKF(strstr(w.all, "odd.mtl:6: Ni -1.5 is not a positive index of refraction; 1 is used\n"), "%s", w.all);
     scene_destroy(s);
 
+    /* Many materials (the name index grows several times), names given
+     * twice: each name finds its newest material; usemtl over them all. */
+    s = new_scene(ctx);
+    size_t cap = 1 << 16, len = 0;
+    char *text = malloc(cap);
+    REQUIRE(text);
+    for (int i = 0; i < 3000; i++) len += (size_t)snprintf(text + len, cap - len, "newmtl m%d\n", i % 2000);
+    CHECK(mtl_parse(ctx, s, text, len, "many.mtl") == PK_OK);
+    CHECK(s->nmaterials == 3001);
+    for (int i = 0; i < 2000; i++) {
+        char name[16];
+        snprintf(name, sizeof name, "m%d", i);
+        int64_t want = i < 1000 ? 2001 + i : 1 + i;
+        CHECKF(scene_find_material(s, name) == want, "%s: %lld", name, (long long)scene_find_material(s, name));
+    }
+    CHECK(scene_find_material(s, "m2000") == -1 && scene_find_material(s, "default") == 0);
+    char why[256];
+    CHECKF(scene_check(s, why, sizeof why), "%s", why);
+    free(text);
+    scene_destroy(s);
+
     /* A JSON scene above PK_MAX_JSON_BYTES is refused before it is parsed
      * (its tree would take tens of times its size); the text is not read. */
     s = new_scene(ctx);
