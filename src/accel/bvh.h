@@ -17,10 +17,10 @@
 #define BVH_WIDTH 8          /* children per node: 8 (AVX) or 4 (SSE) */
 #endif
 #ifndef BVH_TRI_LANES
-#define BVH_TRI_LANES 4      /* triangles per SoA block: 4 (SSE test) or 8 (AVX) */
+#define BVH_TRI_LANES 8      /* triangles per SoA block: 4 (SSE test) or 8 (AVX) */
 #endif
 #ifndef BVH_LEAF_MAX
-#define BVH_LEAF_MAX BVH_TRI_LANES /* primitives per leaf of the binary build */
+#define BVH_LEAF_MAX 16      /* primitives per leaf (up to BVH_MAX_LEAF_BLOCKS blocks) */
 #endif
 #define BVH_SPHERE_LANES 4
 #define BVH_MAX_DEPTH 96     /* wide levels; the builder stays below it */

@@ -16,8 +16,11 @@
 #define NBINS 32
 #define TASK_MIN 2048      /* ranges below this are built by the task that holds them */
 #define SAH_DEPTH_MAX 48   /* binary levels split by SAH; deeper ones split at the median */
-#define COST_NODE 1.0f     /* SAH: cost of a node visit ... */
+#ifndef COST_NODE
+#define COST_NODE 2.0f     /* SAH: cost of a node visit ... */
+#endif
 #define COST_BLOCK 1.0f    /* ... relative to a primitive block test */
+#define BIN_LEAF_MAX 4     /* primitives per leaf of the binary tree */
 
 /* A box in two SSE registers (lane 3 unused). */
 typedef struct sbox {
@@ -58,10 +61,12 @@ static inline aabb sbox_aabb(sbox b)
 }
 
 /* Binary node: inner when count == 0 (children first, first + 1), else a
- * leaf over ids[first .. first + count). */
+ * leaf over ids[first .. first + count). Either way its subtree holds
+ * ids[begin .. begin + size). */
 typedef struct bnode {
     sbox box;
     uint32_t first, count;
+    uint32_t begin, size;
 } bnode;
 
 typedef struct builder {
@@ -86,7 +91,9 @@ static uint32_t node_alloc2(builder *b)
     return k;
 }
 
-static inline float sah_blocks(uint32_t n) { return (float)((n + BVH_TRI_LANES - 1) / BVH_TRI_LANES); }
+/* The binary tree's SAH counts primitives in groups of 4 (the collapse then
+ * packs leaves into blocks of BVH_TRI_LANES). */
+static inline float sah_blocks(uint32_t n) { return (float)((n + 3) / 4); }
 
 typedef struct split {
     int axis;
@@ -236,11 +243,13 @@ static void build_children(builder *b, uint32_t ni, uint32_t begin, uint32_t mid
 static void build_node(builder *b, uint32_t ni, uint32_t begin, uint32_t end, sbox cb, int depth)
 {
     uint32_t n = end - begin;
+    b->nodes[ni].begin = begin;
+    b->nodes[ni].size = n;
     split s;
     binner bn;
     bool ok = n > 1 && depth < SAH_DEPTH_MAX && find_split(b, begin, end, cb, &bn, &s);
 
-    if (n <= BVH_LEAF_MAX) {
+    if (n <= BIN_LEAF_MAX) {
         float area = sbox_half_area(b->nodes[ni].box);
         bool leaf = !ok || COST_BLOCK * sah_blocks(n) * area <= COST_NODE * area + COST_BLOCK * s.cost;
         if (leaf) {
@@ -316,8 +325,9 @@ typedef struct collapser {
 static uint32_t make_leaf(collapser *c, const bnode *bn)
 {
     uint32_t ids[BVH_LEAF_MAX];
-    uint32_t n = bn->count;
-    memcpy(ids, c->b->ids + bn->first, n * sizeof *ids);
+    uint32_t n = bn->size;
+    PK_ASSERT(n >= 1 && n <= BVH_LEAF_MAX);
+    memcpy(ids, c->b->ids + bn->begin, n * sizeof *ids);
     for (uint32_t i = 1; i < n; i++) {
         uint32_t v = ids[i], j = i;
         for (; j > 0 && ids[j - 1] > v; j--) ids[j] = ids[j - 1];
@@ -390,8 +400,89 @@ static void init_node(bvh_node *wn)
     }
 }
 
-/* Makes the wide node for binary inner node bi; returns its index. */
-static uint32_t collapse(collapser *c, uint32_t bi, int depth)
+/* The binary tree is collapsed into the wide one by dynamic programming
+ * (Ylitie, Karras and Laine 2017): for every binary node n and every
+ * i = 1..BVH_WIDTH, cost[i-1] is the least SAH cost of representing n's
+ * subtree by at most i slots of a wide node, each either a leaf (the whole
+ * subtree, up to BVH_LEAF_MAX primitives of one kind, COST_BLOCK per block)
+ * or a wide node (COST_NODE plus the best distribution of its children over
+ * BVH_WIDTH slots). Costs are areas times the per-visit cost; the root's is
+ * the tree's SAH cost in those units. */
+enum { DP_LEAF = 0, DP_NODE = 1, DP_FEWER = 0 };
+
+typedef struct dp_entry {
+    float cost[BVH_WIDTH];
+    uint8_t how[BVH_WIDTH];  /* [0]: DP_LEAF or DP_NODE; [i>0]: DP_FEWER or k, slots given to the left child */
+    uint8_t split;           /* as a wide node: slots given to the left child */
+    uint32_t spheres;        /* spheres in the subtree */
+} dp_entry;
+
+static void dp_solve(const builder *b, uint32_t nnodes, const uint32_t *ids, dp_entry *dp)
+{
+    for (uint32_t ii = nnodes; ii-- > 0;) {
+        const bnode *x = &b->nodes[ii];
+        dp_entry *e = &dp[ii];
+        const float area = sbox_half_area(x->box);
+        if (x->count) {
+            e->spheres = 0;
+            for (uint32_t k = 0; k < x->count; k++) e->spheres += ids[x->first + k] >= b->ntris;
+        } else {
+            e->spheres = dp[x->first].spheres + dp[x->first + 1].spheres;
+        }
+        const bool mixed = e->spheres != 0 && e->spheres != x->size;
+        const uint32_t lanes = e->spheres ? BVH_SPHERE_LANES : BVH_TRI_LANES;
+        const float leaf = x->size <= BVH_LEAF_MAX && !mixed
+                               ? COST_BLOCK * (float)((x->size + lanes - 1) / lanes) * area
+                               : INFINITY;
+        if (x->count) {
+            for (int i = 0; i < BVH_WIDTH; i++) {
+                e->cost[i] = leaf;
+                e->how[i] = i == 0 ? DP_LEAF : DP_FEWER;
+            }
+            e->split = 0;
+            continue;
+        }
+        const dp_entry *l = &dp[x->first], *r = &dp[x->first + 1];
+        float dist[BVH_WIDTH + 1];
+        uint8_t distk[BVH_WIDTH + 1];
+        for (int j = 2; j <= BVH_WIDTH; j++) {
+            dist[j] = INFINITY;
+            distk[j] = 1;
+            for (int k = 1; k < j; k++) {
+                float v = l->cost[k - 1] + r->cost[j - k - 1];
+                if (v < dist[j]) {
+                    dist[j] = v;
+                    distk[j] = (uint8_t)k;
+                }
+            }
+        }
+        const float node = COST_NODE * area + dist[BVH_WIDTH];
+        e->split = distk[BVH_WIDTH];
+        e->cost[0] = leaf <= node ? leaf : node;
+        e->how[0] = leaf <= node ? DP_LEAF : DP_NODE;
+        for (int j = 2; j <= BVH_WIDTH; j++) {
+            bool fewer = e->cost[j - 2] <= dist[j];
+            e->cost[j - 1] = fewer ? e->cost[j - 2] : dist[j];
+            e->how[j - 1] = fewer ? DP_FEWER : distk[j];
+        }
+    }
+}
+
+/* The binary nodes that fill at most j slots for node x. */
+static void dp_gather(const builder *b, const dp_entry *dp, uint32_t x, int j, uint32_t *out, int *n)
+{
+    while (j > 1 && dp[x].how[j - 1] == DP_FEWER) j--;
+    if (j == 1) {
+        out[(*n)++] = x;
+        return;
+    }
+    const int k = dp[x].how[j - 1];
+    dp_gather(b, dp, b->nodes[x].first, k, out, n);
+    dp_gather(b, dp, b->nodes[x].first + 1, j - k, out, n);
+}
+
+/* Makes the wide node for binary node bi (chosen as a node); returns its index. */
+static uint32_t collapse(collapser *c, const dp_entry *dp, uint32_t bi, int depth)
 {
     const bnode *bn = c->b->nodes;
     uint32_t wi = (uint32_t)c->nnodes++;
@@ -400,33 +491,18 @@ static uint32_t collapse(collapser *c, uint32_t bi, int depth)
     c->sah += (double)sbox_half_area(bn[bi].box);
 
     uint32_t kids[BVH_WIDTH];
-    int nk = 2;
-    kids[0] = bn[bi].first;
-    kids[1] = bn[bi].first + 1;
-    while (nk < BVH_WIDTH) {
-        int pick = -1;
-        float best = -1.0f;
-        for (int k = 0; k < nk; k++) {
-            const bnode *x = &bn[kids[k]];
-            if (x->count) continue;
-            float a = sbox_half_area(x->box);
-            if (a > best) {
-                best = a;
-                pick = k;
-            }
-        }
-        if (pick < 0) break;
-        uint32_t x = kids[pick];
-        kids[pick] = bn[x].first;
-        kids[nk++] = bn[x].first + 1;
-    }
+    int nk = 0;
+    const int k = dp[bi].split;
+    dp_gather(c->b, dp, bn[bi].first, k, kids, &nk);
+    dp_gather(c->b, dp, bn[bi].first + 1, BVH_WIDTH - k, kids, &nk);
     init_node(&c->nodes[wi]);
-    for (int k = 0; k < nk; k++) {
-        const bnode *x = &bn[kids[k]];
-        uint32_t ref = x->count ? make_leaf(c, x) : bvh_node_ref(collapse(c, kids[k], depth + 1));
+    for (int q = 0; q < nk; q++) {
+        const bnode *x = &bn[kids[q]];
+        uint32_t ref = dp[kids[q]].how[0] == DP_LEAF ? make_leaf(c, x)
+                                                     : bvh_node_ref(collapse(c, dp, kids[q], depth + 1));
         bvh_node *wn = &c->nodes[wi]; /* index, not pointer, across recursion */
-        wn->child[k] = ref;
-        set_slot_box(wn, k, x->box);
+        wn->child[q] = ref;
+        set_slot_box(wn, q, x->box);
     }
     return wi;
 }
@@ -493,6 +569,7 @@ pk_status accel_bvh_create(pk_context *ctx, const accel_input *in, accel **out)
     sbox *pbox = mem_alloc_aligned(al, (nprim_in ? nprim_in : 1) * sizeof(sbox), 64);
     uint32_t *ids = mem_alloc(al, (nprim_in ? nprim_in : 1) * sizeof(uint32_t));
     bnode *bnodes = NULL;
+    dp_entry *dp = NULL;
     collapser c = {0};
     if (!t || !pbox || !ids) goto nomem;
 
@@ -534,6 +611,8 @@ pk_status accel_bvh_create(pk_context *ctx, const accel_input *in, accel **out)
     bnodes[0].box = root;
     bnodes[0].first = 0;
     bnodes[0].count = 0;
+    bnodes[0].begin = 0;
+    bnodes[0].size = 0;
     if (n > 0) {
         int threads = in->threads > 0 ? in->threads : 1;
         if (n < 2 * TASK_MIN) threads = 1;
@@ -571,15 +650,20 @@ pk_status accel_bvh_create(pk_context *ctx, const accel_input *in, accel **out)
         init_node(&c.nodes[0]);
         c.nnodes = 1;
         c.depth = 1;
-    } else if (bnodes[0].count) {
-        init_node(&c.nodes[0]);
-        c.nnodes = 1;
-        c.depth = 1;
-        c.sah += (double)sbox_half_area(bnodes[0].box);
-        c.nodes[0].child[0] = make_leaf(&c, &bnodes[0]);
-        set_slot_box(&c.nodes[0], 0, bnodes[0].box);
     } else {
-        collapse(&c, 0, 1);
+        dp = mem_alloc(al, b.nnodes * sizeof *dp);
+        if (!dp) goto nomem;
+        dp_solve(&b, b.nnodes, ids, dp);
+        if (dp[0].how[0] == DP_LEAF) {
+            init_node(&c.nodes[0]);
+            c.nnodes = 1;
+            c.depth = 1;
+            c.sah += (double)sbox_half_area(bnodes[0].box);
+            c.nodes[0].child[0] = make_leaf(&c, &bnodes[0]);
+            set_slot_box(&c.nodes[0], 0, bnodes[0].box);
+        } else {
+            collapse(&c, dp, 0, 1);
+        }
     }
 
     bool ok = place_arrays(al, t, &c);
@@ -610,6 +694,7 @@ pk_status accel_bvh_create(pk_context *ctx, const accel_input *in, accel **out)
     mem_free_aligned(al, bnodes);
     mem_free_aligned(al, pbox);
     mem_free(al, ids);
+    mem_free(al, dp);
     info->build_ms = (time_now() - t0) * 1e3;
     *out = &t->base;
     return PK_OK;
@@ -617,6 +702,7 @@ pk_status accel_bvh_create(pk_context *ctx, const accel_input *in, accel **out)
 nomem:
     st = ctx_nomem(ctx);
 fail:
+    mem_free(al, dp);
     mem_free_aligned(al, c.nodes);
     mem_free_aligned(al, c.tris);
     mem_free_aligned(al, c.spheres);
