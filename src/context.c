@@ -5,11 +5,13 @@
 #include "paprsek_internal.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <time.h>
+#include <unistd.h>
 
 static void *default_realloc(void *user, void *ptr, size_t size)
 {
@@ -189,12 +191,19 @@ pk_status file_read_all(pk_context *ctx, const char *path, char **data, size_t *
 {
     *data = NULL;
     *size = 0;
-    FILE *f = fopen(path, "rb");
-    if (!f) return ctx_error(ctx, PK_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    /* O_NONBLOCK: opening a FIFO (mtllib /some/fifo) must not wait for a
+     * writer; it is refused below like any file that is not regular. */
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) return ctx_error(ctx, PK_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
     struct stat st;
-    if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
-        fclose(f);
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        close(fd);
         return ctx_error(ctx, PK_ERR_IO, "%s: not a regular file", path);
+    }
+    FILE *f = fdopen(fd, "rb");
+    if (!f) {
+        close(fd);
+        return ctx_nomem(ctx);
     }
     if ((unsigned long long)st.st_size > (unsigned long long)PK_MAX_FILE_BYTES) {
         fclose(f);
