@@ -12,7 +12,8 @@
 #include <sys/stat.h>
 
 static volatile sig_atomic_t g_stop; /* set by the signal handler only */
-static volatile int g_cancel;
+static volatile int g_cancel;        /* the render's cancel flag (an int in the API) */
+_Static_assert(sizeof(sig_atomic_t) == sizeof(int), "the cancel flag is written by a signal handler");
 
 static void on_signal(int sig)
 {
