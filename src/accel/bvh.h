@@ -199,19 +199,22 @@ typedef __m128 tvec;
 #endif
 #define BVH_TRI_ALL ((1 << BVH_TRI_LANES) - 1)
 
+/* What the triangle test needs of a ray: tri_intersect's constants. */
+typedef struct bvh_tri_ray {
+    float ox, oy, oz;          /* origin components along kx, ky, kz */
+    float sx, sy, sz;          /* shear constants (ray_prepare's) */
+    float tmin;
+    uint32_t rowx, rowy, rowz; /* byte offsets of rows kx, ky, kz of a vertex in a block */
+} bvh_tri_ray;
+
 typedef struct bvh_ray {
-    ray_pre pre;            /* geom.h's shear constants, for the exact tests */
+    ray_pre pre;            /* geom.h's, for the sphere test */
+    bvh_tri_ray tri;
     float org[3];           /* origin, world space */
     float rd[3];            /* 1/d per axis: +-inf for zero components */
     float rdf[3];           /* rd * (1 + BVH_BOX_SLACK), for far planes */
     int near[3], far[3];    /* box plane rows: 2*axis + (rd < 0), and the other */
-    int kx, ky, kz;         /* shear axes (rows of bvh_tri_block.v[vertex]) */
-    float ox, oy, oz;       /* origin components along kx, ky, kz */
     float tmin;
-    /* the same, ready for the triangle test: byte offsets of rows kx, ky, kz
-     * of a vertex, and broadcast origin (sheared axes), shear and tmin */
-    size_t rowx, rowy, rowz;
-    tvec vox, voy, voz, vsx, vsy, vsz, vtmin;
 } bvh_ray;
 
 static inline void bvh_ray_init(bvh_ray *br, const ray *r)
@@ -227,25 +230,15 @@ static inline void bvh_ray_init(bvh_ray *br, const ray *r)
         br->near[k] = 2 * k + neg;
         br->far[k] = 2 * k + 1 - neg;
     }
-    br->kx = br->pre.kx;
-    br->ky = br->pre.ky;
-    br->kz = br->pre.kz;
-    br->ox = o[br->kx];
-    br->oy = o[br->ky];
-    br->oz = o[br->kz];
     br->tmin = r->tmin;
-    const size_t row = sizeof(float) * BVH_TRI_LANES;
-    br->rowx = (size_t)br->kx * row, br->rowy = (size_t)br->ky * row, br->rowz = (size_t)br->kz * row;
-    br->vox = TV_SET1(br->ox), br->voy = TV_SET1(br->oy), br->voz = TV_SET1(br->oz);
-    br->vsx = TV_SET1(br->pre.sx), br->vsy = TV_SET1(br->pre.sy), br->vsz = TV_SET1(br->pre.sz);
-    br->vtmin = TV_SET1(br->tmin);
+    bvh_tri_ray *t = &br->tri;
+    t->ox = o[br->pre.kx], t->oy = o[br->pre.ky], t->oz = o[br->pre.kz];
+    t->sx = br->pre.sx, t->sy = br->pre.sy, t->sz = br->pre.sz;
+    t->tmin = r->tmin;
+    const uint32_t row = sizeof(float) * BVH_TRI_LANES;
+    t->rowx = (uint32_t)br->pre.kx * row, t->rowy = (uint32_t)br->pre.ky * row, t->rowz = (uint32_t)br->pre.kz * row;
 }
 
-
-/* The lanes of one triangle block that pass tri_intersect with limit tmax:
- * the same float operations in the same order as geom.h, a block at a time
- * (no FMA: the build has -ffp-contract=off and no fused intrinsics are used
- * here). Returns the lane mask; *t, *rcp, *V, *W hold the lanes. */
 /* Lanes in zm have an edge function that is exactly 0: recompute U, V, W
  * of those lanes in double, as tri_intersect does. */
 static __attribute__((noinline, cold)) void bvh_tri_recompute(int zm, tvec ax, tvec ay, tvec bx, tvec by, tvec cx,
@@ -264,20 +257,21 @@ static __attribute__((noinline, cold)) void bvh_tri_recompute(int zm, tvec ax, t
     *U = TV_LOADU(fu), *V = TV_LOADU(fv), *W = TV_LOADU(fw);
 }
 
-static inline int bvh_tri_test(const bvh_tri_block *blk, const bvh_ray *r, float tmax, tvec *t_out,
+static inline int bvh_tri_test(const bvh_tri_block *blk, const bvh_tri_ray *r, float tmax, tvec *t_out,
                                tvec *rcp_out, tvec *V_out, tvec *W_out)
 {
     const char *va = (const char *)blk->v[0], *vb = (const char *)blk->v[1], *vc = (const char *)blk->v[2];
-    const tvec ax0 = TV_SUB(TV_LOAD((const float *)(va + r->rowx)), r->vox);
-    const tvec ay0 = TV_SUB(TV_LOAD((const float *)(va + r->rowy)), r->voy);
-    const tvec az0 = TV_SUB(TV_LOAD((const float *)(va + r->rowz)), r->voz);
-    const tvec bx0 = TV_SUB(TV_LOAD((const float *)(vb + r->rowx)), r->vox);
-    const tvec by0 = TV_SUB(TV_LOAD((const float *)(vb + r->rowy)), r->voy);
-    const tvec bz0 = TV_SUB(TV_LOAD((const float *)(vb + r->rowz)), r->voz);
-    const tvec cx0 = TV_SUB(TV_LOAD((const float *)(vc + r->rowx)), r->vox);
-    const tvec cy0 = TV_SUB(TV_LOAD((const float *)(vc + r->rowy)), r->voy);
-    const tvec cz0 = TV_SUB(TV_LOAD((const float *)(vc + r->rowz)), r->voz);
-    const tvec sx = r->vsx, sy = r->vsy;
+    const tvec ox = TV_SET1(r->ox), oy = TV_SET1(r->oy), oz = TV_SET1(r->oz);
+    const tvec ax0 = TV_SUB(TV_LOAD((const float *)(va + r->rowx)), ox);
+    const tvec ay0 = TV_SUB(TV_LOAD((const float *)(va + r->rowy)), oy);
+    const tvec az0 = TV_SUB(TV_LOAD((const float *)(va + r->rowz)), oz);
+    const tvec bx0 = TV_SUB(TV_LOAD((const float *)(vb + r->rowx)), ox);
+    const tvec by0 = TV_SUB(TV_LOAD((const float *)(vb + r->rowy)), oy);
+    const tvec bz0 = TV_SUB(TV_LOAD((const float *)(vb + r->rowz)), oz);
+    const tvec cx0 = TV_SUB(TV_LOAD((const float *)(vc + r->rowx)), ox);
+    const tvec cy0 = TV_SUB(TV_LOAD((const float *)(vc + r->rowy)), oy);
+    const tvec cz0 = TV_SUB(TV_LOAD((const float *)(vc + r->rowz)), oz);
+    const tvec sx = TV_SET1(r->sx), sy = TV_SET1(r->sy);
     const tvec ax = TV_SUB(ax0, TV_MUL(sx, az0)), ay = TV_SUB(ay0, TV_MUL(sy, az0));
     const tvec bx = TV_SUB(bx0, TV_MUL(sx, bz0)), by = TV_SUB(by0, TV_MUL(sy, bz0));
     const tvec cx = TV_SUB(cx0, TV_MUL(sx, cz0)), cy = TV_SUB(cy0, TV_MUL(sy, cz0));
@@ -294,13 +288,13 @@ static inline int bvh_tri_test(const bvh_tri_block *blk, const bvh_ray *r, float
     const tvec det = TV_ADD(TV_ADD(U, V), W);
     int m = ~TV_MASK(TV_OR(TV_AND(neg, pos), TV_EQ(det, zero))) & BVH_TRI_ALL;
     if (!m) return 0;
-    const tvec sz = r->vsz;
+    const tvec sz = TV_SET1(r->sz);
     const tvec az = TV_MUL(sz, az0), bz = TV_MUL(sz, bz0), cz = TV_MUL(sz, cz0);
     const tvec T = TV_ADD(TV_ADD(TV_MUL(U, az), TV_MUL(V, bz)), TV_MUL(W, cz));
     const tvec rcp = TV_DIV(TV_SET1(1.0f), det);
     const tvec t = TV_MUL(T, rcp);
     /* t in [tmin, tmax] and finite (an overflowed t is no hit) */
-    m &= TV_MASK(TV_AND(TV_AND(TV_GE(t, r->vtmin), TV_LE(t, TV_SET1(tmax))), TV_LT(t, TV_SET1(INFINITY))));
+    m &= TV_MASK(TV_AND(TV_AND(TV_GE(t, TV_SET1(r->tmin)), TV_LE(t, TV_SET1(tmax))), TV_LT(t, TV_SET1(INFINITY))));
     *t_out = t;
     *rcp_out = rcp;
     *V_out = V;
@@ -309,7 +303,7 @@ static inline int bvh_tri_test(const bvh_tri_block *blk, const bvh_ray *r, float
 }
 
 /* Closest-hit update from one triangle block; true when *h changed. */
-static inline bool bvh_tri_closest(const bvh_tri_block *blk, const bvh_ray *r, hit *h)
+static inline bool bvh_tri_closest(const bvh_tri_block *blk, const bvh_tri_ray *r, hit *h)
 {
     tvec t, rcp, V, W;
     int m = bvh_tri_test(blk, r, h->t, &t, &rcp, &V, &W);
@@ -336,7 +330,7 @@ static inline bool bvh_tri_closest(const bvh_tri_block *blk, const bvh_ray *r, h
 }
 
 /* Any-hit: true (with h->t, h->prim of one hit) when a lane hits. */
-static inline bool bvh_tri_any(const bvh_tri_block *blk, const bvh_ray *r, hit *h)
+static inline bool bvh_tri_any(const bvh_tri_block *blk, const bvh_tri_ray *r, hit *h)
 {
     tvec t, rcp, V, W;
     int m = bvh_tri_test(blk, r, h->t, &t, &rcp, &V, &W);
@@ -349,13 +343,13 @@ static inline bool bvh_tri_any(const bvh_tri_block *blk, const bvh_ray *r, hit *
     return true;
 }
 
-static inline bool bvh_sphere_block_closest(const bvh_sphere_block *blk, const bvh_ray *r, hit *h)
+static inline bool bvh_sphere_block_closest(const bvh_sphere_block *blk, const ray_pre *r, hit *h)
 {
     bool any = false;
     for (int l = 0; l < BVH_SPHERE_LANES && blk->prim[l] != PK_NO_HIT; l++) {
         float t, u, v;
         vec3 c = v3(blk->c[0][l], blk->c[1][l], blk->c[2][l]);
-        if (sphere_intersect(&r->pre, c, blk->r[l], h->t, &t, &u, &v) && hit_better(t, blk->prim[l], h)) {
+        if (sphere_intersect(r, c, blk->r[l], h->t, &t, &u, &v) && hit_better(t, blk->prim[l], h)) {
             h->t = t;
             h->prim = blk->prim[l];
             h->u = u;

@@ -89,9 +89,9 @@ static __attribute__((noinline)) bool leaf(const bvh *t, uint32_t ref, const bvh
             const bvh_tri_block *blk = tb + b;
             if (count) *tests += bvh_tri_block_count(blk);
             if (any) {
-                if (bvh_tri_any(blk, r, best)) return true;
+                if (bvh_tri_any(blk, &r->tri, best)) return true;
             } else {
-                found |= bvh_tri_closest(blk, r, best);
+                found |= bvh_tri_closest(blk, &r->tri, best);
             }
         }
     } else {
@@ -99,7 +99,7 @@ static __attribute__((noinline)) bool leaf(const bvh *t, uint32_t ref, const bvh
         for (uint32_t b = 0; b < nb; b++) {
             const bvh_sphere_block *blk = sb + b;
             if (count) *tests += bvh_sphere_block_count(blk);
-            if (bvh_sphere_block_closest(blk, r, best)) {
+            if (bvh_sphere_block_closest(blk, &r->pre, best)) {
                 if (any) return true;
                 found = true;
             }
