@@ -46,10 +46,11 @@ static inline sbox sbox_grow(sbox a, __m128 p)
 }
 static inline float sbox_half_area(sbox b)
 {
-    float e[4];
-    _mm_storeu_ps(e, _mm_sub_ps(b.hi, b.lo));
-    if (!(e[0] >= 0.0f && e[1] >= 0.0f && e[2] >= 0.0f)) return 0.0f;
-    return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
+    const __m128 e = _mm_sub_ps(b.hi, b.lo);
+    /* empty (or NaN) on some axis: no area */
+    if ((_mm_movemask_ps(_mm_cmpge_ps(e, _mm_setzero_ps())) & 7) != 7) return 0.0f;
+    const __m128 p = _mm_mul_ps(e, _mm_shuffle_ps(e, e, _MM_SHUFFLE(3, 0, 2, 1))); /* xy, yz, zx */
+    return _mm_cvtss_f32(_mm_add_ss(_mm_add_ss(p, _mm_shuffle_ps(p, p, 1)), _mm_movehl_ps(p, p)));
 }
 static inline aabb sbox_aabb(sbox b)
 {
@@ -104,6 +105,7 @@ typedef struct split {
 
 typedef struct binner {
     float lo[4], scale[4];
+    int nbins;        /* NBINS, fewer for small ranges */
 } binner;
 
 static inline int bin_of(const binner *bn, __m128 c2, int axis)
@@ -111,7 +113,7 @@ static inline int bin_of(const binner *bn, __m128 c2, int axis)
     float c[4];
     _mm_storeu_ps(c, c2);
     int k = (int)((c[axis] - bn->lo[axis]) * bn->scale[axis]);
-    return k < 0 ? 0 : k >= NBINS ? NBINS - 1 : k;
+    return k < 0 ? 0 : k >= bn->nbins ? bn->nbins - 1 : k;
 }
 
 /* Binned SAH over the doubled centroids in cb; false when every axis is flat. */
@@ -120,11 +122,14 @@ static bool find_split(const builder *b, uint32_t begin, uint32_t end, sbox cb, 
     float lo[4], hi[4];
     _mm_storeu_ps(lo, cb.lo);
     _mm_storeu_ps(hi, cb.hi);
+    const uint32_t n = end - begin;
+    const int nb = n >= NBINS ? NBINS : n >= 8 ? (int)n : 8;
+    bn->nbins = nb;
     bool any = false;
     for (int ax = 0; ax < 3; ax++) {
         float ext = hi[ax] - lo[ax];
         bn->lo[ax] = lo[ax];
-        bn->scale[ax] = ext > 0.0f && isfinite(ext) ? (float)NBINS * 0.99999f / ext : 0.0f;
+        bn->scale[ax] = ext > 0.0f && isfinite(ext) ? (float)nb * 0.99999f / ext : 0.0f;
         if (bn->scale[ax] > 0.0f && isfinite(bn->scale[ax])) any = true;
         else bn->scale[ax] = 0.0f;
     }
@@ -135,7 +140,7 @@ static bool find_split(const builder *b, uint32_t begin, uint32_t end, sbox cb, 
     sbox bins[3][NBINS];
     uint32_t counts[3][NBINS];
     for (int ax = 0; ax < 3; ax++)
-        for (int k = 0; k < NBINS; k++) {
+        for (int k = 0; k < nb; k++) {
             bins[ax][k] = sbox_empty();
             counts[ax][k] = 0;
         }
@@ -144,7 +149,7 @@ static bool find_split(const builder *b, uint32_t begin, uint32_t end, sbox cb, 
         const sbox *pb = &b->pbox[b->ids[i]];
         __m128 k4 = _mm_mul_ps(_mm_sub_ps(centroid2(pb), blo), bsc);
         __m128i ki = _mm_cvttps_epi32(k4);
-        ki = _mm_max_epi32(_mm_setzero_si128(), _mm_min_epi32(ki, _mm_set1_epi32(NBINS - 1)));
+        ki = _mm_max_epi32(_mm_setzero_si128(), _mm_min_epi32(ki, _mm_set1_epi32(nb - 1)));
         int k[4];
         _mm_storeu_si128((__m128i *)k, ki);
         for (int ax = 0; ax < 3; ax++) {
@@ -160,7 +165,7 @@ static bool find_split(const builder *b, uint32_t begin, uint32_t end, sbox cb, 
         uint32_t rcount[NBINS];
         sbox acc = sbox_empty();
         uint32_t cnt = 0;
-        for (int k = NBINS - 1; k > 0; k--) {
+        for (int k = nb - 1; k > 0; k--) {
             acc = sbox_union(acc, bins[ax][k]);
             cnt += counts[ax][k];
             rarea[k] = sbox_half_area(acc);
@@ -168,7 +173,7 @@ static bool find_split(const builder *b, uint32_t begin, uint32_t end, sbox cb, 
         }
         acc = sbox_empty();
         cnt = 0;
-        for (int k = 1; k < NBINS; k++) {
+        for (int k = 1; k < nb; k++) {
             acc = sbox_union(acc, bins[ax][k - 1]);
             cnt += counts[ax][k - 1];
             if (cnt == 0 || rcount[k] == 0) continue;
@@ -184,7 +189,7 @@ static bool find_split(const builder *b, uint32_t begin, uint32_t end, sbox cb, 
     if (!found) return false;
     best->left = sbox_empty();
     best->right = sbox_empty();
-    for (int k = 0; k < NBINS; k++) {
+    for (int k = 0; k < nb; k++) {
         if (k < best->bin) best->left = sbox_union(best->left, bins[best->axis][k]);
         else best->right = sbox_union(best->right, bins[best->axis][k]);
     }
