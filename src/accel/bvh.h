@@ -12,6 +12,7 @@
 #define PK_BVH_H
 
 #include "accel.h"
+#include "../scene/scene.h"
 
 #ifndef BVH_WIDTH
 #define BVH_WIDTH 8          /* children per node: 8 (AVX) or 4 (SSE) */
@@ -69,10 +70,10 @@ _Static_assert(sizeof(bvh_node) % 32 == 0 && sizeof(bvh_tri_block) % 32 == 0 &&
 
 static inline uint32_t bvh_node_ref(size_t index) { return (uint32_t)(index * sizeof(bvh_node)); }
 static inline size_t bvh_node_index(uint32_t ref) { return ref / sizeof(bvh_node); }
-static inline uint32_t bvh_leaf_ref(bool sphere, size_t first, uint32_t blocks)
+static inline uint32_t bvh_leaf_ref(bool is_sphere, size_t first, uint32_t blocks)
 {
-    size_t off = first * (sphere ? sizeof(bvh_sphere_block) : sizeof(bvh_tri_block));
-    return (uint32_t)off | (sphere ? BVH_SPHERE_LEAF : 0u) | ((blocks - 1u) << 1) | BVH_LEAF;
+    size_t off = first * (is_sphere ? sizeof(bvh_sphere_block) : sizeof(bvh_tri_block));
+    return (uint32_t)off | (is_sphere ? BVH_SPHERE_LEAF : 0u) | ((blocks - 1u) << 1) | BVH_LEAF;
 }
 /* Index of the leaf's first block in bvh.tris or bvh.spheres. */
 static inline size_t bvh_leaf_first(uint32_t ref)
@@ -113,7 +114,7 @@ typedef struct bvh {
 
 /* Traversal entry points (bvh_traverse.c, bvh_packet.c). */
 PK_HIDDEN bool bvh_intersect(const accel *a, const ray *r, hit *h, accel_counters *c);
-PK_HIDDEN bool bvh_occluded(const accel *a, const ray *r, accel_counters *c);
+PK_HIDDEN bool bvh_occluded(const accel *a, const ray *r, hit *h, accel_counters *c);
 /* Occlusion that also reports the hit it found (t, prim; cleared on a miss). */
 PK_HIDDEN bool bvh_any_hit(const accel *a, const ray *r, hit *h, accel_counters *c);
 PK_HIDDEN void bvh_intersect_packet(const accel *a, const ray *r, hit *h, size_t n, bool any_hit,
@@ -122,19 +123,14 @@ PK_HIDDEN void bvh_intersect_packet(const accel *a, const ray *r, hit *h, size_t
 /* Tests the invariants above; false with a reason in why (may be NULL). */
 PK_HIDDEN bool bvh_check(const accel *a, char *why, size_t n);
 
-/* Triangles that can never be hit (same rule as scene.h's tri_is_degenerate). */
-static inline bool bvh_tri_degenerate(vec3 a, vec3 b, vec3 c)
-{
-    if (!v3_finite(a) || !v3_finite(b) || !v3_finite(c)) return true;
-    vec3 n = v3_cross(v3_sub(b, a), v3_sub(c, a));
-    return !(v3_len2(n) > 0.0f) || !v3_finite(n);
-}
+/* Triangles that can never be hit: scene.h's rule (non-finite vertex or zero
+ * area), shared with the other accelerators. */
+static inline bool bvh_tri_degenerate(vec3 a, vec3 b, vec3 c) { return tri_is_degenerate(a, b, c); }
 
-/* Spheres the structure holds: finite centre, finite radius > 0. */
+/* Spheres the structure holds (prim_bounds' rule): finite centre, finite radius > 0. */
 static inline bool bvh_sphere_valid(const accel_sphere *s)
 {
-    return v3_finite(s->center) && isfinite(s->radius) && s->radius > 0.0f &&
-           v3_finite(v3_add(s->center, v3s(s->radius))) && v3_finite(v3_sub(s->center, v3s(s->radius)));
+    return v3_finite(s->center) && isfinite(s->radius) && s->radius > 0.0f;
 }
 
 /* ---- per-ray kernels shared by the single-ray and packet traversals ---- */
