@@ -43,12 +43,10 @@ void accel_intersect_many(const accel *a, const ray *r, hit *h, size_t n, bool a
         return;
     }
     for (size_t i = 0; i < n; i++) {
-        if (any_hit) {
-            hit_clear(&h[i]);
-            if (a->ops->occluded(a, &r[i], c)) h[i].t = r[i].tmax;
-        } else {
+        if (any_hit)
+            a->ops->occluded(a, &r[i], &h[i], c);
+        else
             a->ops->intersect(a, &r[i], &h[i], c);
-        }
     }
 }
 

@@ -37,8 +37,9 @@ typedef struct accel_ops {
     void (*destroy)(accel *a);
     /* Closest hit in [r->tmin, r->tmax]; fills *h (cleared on a miss). */
     bool (*intersect)(const accel *a, const ray *r, hit *h, accel_counters *c);
-    /* Any hit in [r->tmin, r->tmax]? */
-    bool (*occluded)(const accel *a, const ray *r, accel_counters *c);
+    /* Any hit in [r->tmin, r->tmax]? h (may be NULL) receives the hit found
+     * (not necessarily the closest), or is cleared on a miss. */
+    bool (*occluded)(const accel *a, const ray *r, hit *h, accel_counters *c);
     /* Optional (may be NULL): n coherent rays at once; results as intersect.
      * any_hit: only occlusion (h[i].t finite on a hit). */
     void (*intersect_packet)(const accel *a, const ray *r, hit *h, size_t n, bool any_hit,
@@ -63,7 +64,7 @@ static inline bool accel_intersect(const accel *a, const ray *r, hit *h, accel_c
 }
 static inline bool accel_occluded(const accel *a, const ray *r, accel_counters *c)
 {
-    return a->ops->occluded(a, r, c);
+    return a->ops->occluded(a, r, NULL, c);
 }
 /* Packets when the accelerator has them, single rays otherwise. */
 PK_HIDDEN void accel_intersect_many(const accel *a, const ray *r, hit *h, size_t n, bool any_hit,

@@ -177,10 +177,11 @@ static bool mid_intersect(const accel *a, const ray *r, hit *h, accel_counters *
     return c ? mid_trace((const accel_mid *)a, r, h, false, c) : mid_trace((const accel_mid *)a, r, h, false, NULL);
 }
 
-static bool mid_occluded(const accel *a, const ray *r, accel_counters *c)
+static bool mid_occluded(const accel *a, const ray *r, hit *out, accel_counters *c)
 {
     hit h;
-    return c ? mid_trace((const accel_mid *)a, r, &h, true, c) : mid_trace((const accel_mid *)a, r, &h, true, NULL);
+    hit *hp = out ? out : &h;
+    return c ? mid_trace((const accel_mid *)a, r, hp, true, c) : mid_trace((const accel_mid *)a, r, hp, true, NULL);
 }
 
 static void mid_destroy(accel *a)

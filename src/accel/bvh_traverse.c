@@ -211,11 +211,12 @@ bool bvh_intersect(const accel *a, const ray *r, hit *h, accel_counters *c)
     return c ? intersect_counted(t, r, h, c) : intersect_plain(t, r, h);
 }
 
-bool bvh_occluded(const accel *a, const ray *r, accel_counters *c)
+bool bvh_occluded(const accel *a, const ray *r, hit *out, accel_counters *c)
 {
     const bvh *t = (const bvh *)a;
     hit h;
-    return c ? traverse(t, r, &h, c, true, true) : traverse(t, r, &h, NULL, true, false);
+    hit *hp = out ? out : &h;
+    return c ? traverse(t, r, hp, c, true, true) : traverse(t, r, hp, NULL, true, false);
 }
 
 bool bvh_any_hit(const accel *a, const ray *r, hit *h, accel_counters *c)

@@ -182,18 +182,23 @@ static bool emb_intersect(const accel *a, const ray *r, hit *h, accel_counters *
     return true;
 }
 
-static bool emb_occluded(const accel *a, const ray *r, accel_counters *c)
+static bool emb_occluded(const accel *a, const ray *r, hit *h, accel_counters *c)
 {
     (void)c;
     const embree_accel *e = (const embree_accel *)a;
     hit scratch;
     occ_context oc;
     rtcInitIntersectContext(&oc.base);
-    oc.out = &scratch;
+    oc.out = h ? h : &scratch;
+    hit_clear(oc.out);
     struct RTCRay rr;
     init_ray1(&rr, r);
     rtcOccluded1(e->scene, &oc.base, &rr);
-    return rr.tfar == -INFINITY;
+    if (rr.tfar != -INFINITY) {
+        hit_clear(oc.out);
+        return false;
+    }
+    return true;
 }
 
 /* Field indices in the SoA RTCRayHitN / RTCRayN layout (rtcore_ray.h). */

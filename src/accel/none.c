@@ -35,7 +35,7 @@ static bool none_intersect(const accel *a, const ray *r, hit *h, accel_counters 
     return true;
 }
 
-static bool none_occluded(const accel *a, const ray *r, accel_counters *c)
+static bool none_occluded(const accel *a, const ray *r, hit *out, accel_counters *c)
 {
     const accel_none *n = (const accel_none *)a;
     ray_pre rp = ray_prepare(r);
@@ -45,10 +45,12 @@ static bool none_occluded(const accel *a, const ray *r, accel_counters *c)
     for (uint32_t i = 0; i < n->nids; i++) {
         if (prim_test(&n->ps, n->ids[i], &rp, &h)) {
             if (c) c->tests += i + 1;
+            if (out) *out = h;
             return true;
         }
     }
     if (c) c->tests += n->nids;
+    if (out) hit_clear(out);
     return false;
 }
 

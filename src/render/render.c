@@ -61,10 +61,7 @@ void render_trace_rays(const accel *a, const ray *rays, hit *hits, size_t n, int
             if (coherent) {
                 accel_intersect_many(a, rays + lo, hits + lo, hi - lo, any, cp);
             } else if (any) {
-                for (size_t i = lo; i < hi; i++) {
-                    hit_clear(&hits[i]);
-                    if (a->ops->occluded(a, &rays[i], cp)) hits[i].t = rays[i].tmax;
-                }
+                for (size_t i = lo; i < hi; i++) a->ops->occluded(a, &rays[i], &hits[i], cp);
             } else {
                 for (size_t i = lo; i < hi; i++) a->ops->intersect(a, &rays[i], &hits[i], cp);
             }

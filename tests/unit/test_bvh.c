@@ -254,7 +254,7 @@ static void check_rays(const accel *a, const brute *b, const ray *rays, size_t n
         brute_intersect(b, &rays[i], &want[i]);
         bool hit1 = a->ops->intersect(a, &rays[i], &got[i], NULL);
         if (hit1 != (want[i].prim != PK_NO_HIT) || !same_hit(&got[i], &want[i])) bad_closest++;
-        bool occ = a->ops->occluded(a, &rays[i], NULL);
+        bool occ = a->ops->occluded(a, &rays[i], NULL, NULL);
         if (occ != hit1) bad_any++;
         accel_counters c = {0, 0};
         hit h2;
@@ -616,7 +616,7 @@ static void check_watertight(pk_context *ctx, const mesh *m, const char *name, f
     for (long i = 0; i < (long)nr; i++) {
         hit h, w;
         if (!a->ops->intersect(a, &rays[i], &h, NULL)) misses++;
-        if (!a->ops->occluded(a, &rays[i], NULL)) misses++;
+        if (!a->ops->occluded(a, &rays[i], NULL, NULL)) misses++;
         brute_intersect(&b, &rays[i], &w);
         if (!same_hit(&h, &w)) bad++;
     }
@@ -648,7 +648,7 @@ static void check_synthetic(pk_context *ctx)
         ray r = {{0, 0, 0}, 0.0f, {1, 0, 0}, INFINITY};
         hit h;
         CHECK(!a->ops->intersect(a, &r, &h, NULL) && h.prim == PK_NO_HIT && isinf(h.t));
-        CHECK(!a->ops->occluded(a, &r, NULL));
+        CHECK(!a->ops->occluded(a, &r, NULL, NULL));
         a->ops->intersect_packet(a, &r, &h, 1, false, NULL);
         CHECK(h.prim == PK_NO_HIT);
         CHECK(a->info.leaves == 0 && a->info.primitives == 0);
