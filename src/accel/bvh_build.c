@@ -436,9 +436,9 @@ static void dp_solve(const builder *b, uint32_t nnodes, const uint32_t *ids, dp_
         }
         const bool mixed = e->spheres != 0 && e->spheres != x->size;
         const uint32_t lanes = e->spheres ? BVH_SPHERE_LANES : BVH_TRI_LANES;
-        const float leaf = x->size <= BVH_LEAF_MAX && !mixed
-                               ? COST_BLOCK * (float)((x->size + lanes - 1) / lanes) * area
-                               : INFINITY;
+        /* a flag, not an infinite cost: areas overflow to inf in huge scenes */
+        const bool leaf_ok = x->size <= BVH_LEAF_MAX && !mixed;
+        const float leaf = leaf_ok ? COST_BLOCK * (float)((x->size + lanes - 1) / lanes) * area : INFINITY;
         if (x->count) {
             for (int i = 0; i < BVH_WIDTH; i++) {
                 e->cost[i] = leaf;
@@ -463,8 +463,9 @@ static void dp_solve(const builder *b, uint32_t nnodes, const uint32_t *ids, dp_
         }
         const float node = COST_NODE * area + dist[BVH_WIDTH];
         e->split = distk[BVH_WIDTH];
-        e->cost[0] = leaf <= node ? leaf : node;
-        e->how[0] = leaf <= node ? DP_LEAF : DP_NODE;
+        const bool as_leaf = leaf_ok && leaf <= node;
+        e->cost[0] = as_leaf ? leaf : node;
+        e->how[0] = as_leaf ? DP_LEAF : DP_NODE;
         for (int j = 2; j <= BVH_WIDTH; j++) {
             bool fewer = e->cost[j - 2] <= dist[j];
             e->cost[j - 1] = fewer ? e->cost[j - 2] : dist[j];
