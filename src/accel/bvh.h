@@ -49,6 +49,9 @@ enum { BVH_LO_X, BVH_HI_X, BVH_LO_Y, BVH_HI_Y, BVH_LO_Z, BVH_HI_Z };
 typedef struct bvh_node {
     float b[6][BVH_WIDTH];      /* children's boxes, world space, SoA */
     uint32_t child[BVH_WIDTH];  /* references as above */
+#if BVH_WIDTH == 4
+    uint32_t pad[4];            /* to a multiple of 32 bytes */
+#endif
 } bvh_node;
 
 /* Up to BVH_TRI_LANES triangles; unused lanes hold NaN vertices and
@@ -115,8 +118,6 @@ typedef struct bvh {
 /* Traversal entry points (bvh_traverse.c, bvh_packet.c). */
 PK_HIDDEN bool bvh_intersect(const accel *a, const ray *r, hit *h, accel_counters *c);
 PK_HIDDEN bool bvh_occluded(const accel *a, const ray *r, hit *h, accel_counters *c);
-/* Occlusion that also reports the hit it found (t, prim; cleared on a miss). */
-PK_HIDDEN bool bvh_any_hit(const accel *a, const ray *r, hit *h, accel_counters *c);
 PK_HIDDEN void bvh_intersect_packet(const accel *a, const ray *r, hit *h, size_t n, bool any_hit,
                                     accel_counters *c);
 

@@ -355,7 +355,7 @@ void bvh_intersect_packet(const accel *a, const ray *r, hit *h, size_t n, bool a
         while (oct < 8 && m < PACKET && i + (size_t)m < n && octant(&r[i + (size_t)m]) == oct) m++;
         if (m < PACKET_MIN) {
             for (int k = 0; k < m; k++) {
-                if (any_hit) bvh_any_hit(a, &r[i + (size_t)k], &h[i + (size_t)k], c);
+                if (any_hit) bvh_occluded(a, &r[i + (size_t)k], &h[i + (size_t)k], c);
                 else bvh_intersect(a, &r[i + (size_t)k], &h[i + (size_t)k], c);
             }
             i += (size_t)m;

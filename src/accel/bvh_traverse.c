@@ -218,9 +218,3 @@ bool bvh_occluded(const accel *a, const ray *r, hit *out, accel_counters *c)
     hit *hp = out ? out : &h;
     return c ? traverse(t, r, hp, c, true, true) : traverse(t, r, hp, NULL, true, false);
 }
-
-bool bvh_any_hit(const accel *a, const ray *r, hit *h, accel_counters *c)
-{
-    const bvh *t = (const bvh *)a;
-    return c ? traverse(t, r, h, c, true, true) : traverse(t, r, h, NULL, true, false);
-}
