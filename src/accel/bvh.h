@@ -89,17 +89,20 @@ static inline size_t bvh_leaf_first(uint32_t ref)
  *     of exactly one slot, and children come after their parent in memory
  *     (no cycles); the tree is at most BVH_MAX_DEPTH levels deep (so the
  *     traversal stack, BVH_STACK_SIZE entries, cannot overflow).
- *  2. A slot's box contains the boxes in its child node, and a leaf slot's
- *     box contains every vertex (sphere box) of its primitives; empty slots
- *     have empty boxes (lo = +inf, hi = -inf) and reference BVH_EMPTY.
+ *  2. A slot's box contains the boxes in its child node. A leaf slot's box
+ *     overlaps the box of each of its primitives, and every corner of a
+ *     primitive (vertex of a triangle, box corner of a sphere) lies in the
+ *     box of at least one leaf holding it: spatial splits cut a primitive
+ *     into pieces whose leaves' boxes together cover it. Empty slots have
+ *     empty boxes (lo = +inf, hi = -inf) and reference BVH_EMPTY.
  *  3. A leaf holds 1..BVH_LEAF_MAX primitives of one kind in
  *     1..BVH_MAX_LEAF_BLOCKS consecutive blocks; every block but the last is
- *     full; used lanes come first, sorted by prim, the rest are padding (NaN,
- *     PK_NO_HIT).
- *  4. Every primitive that can be hit is in exactly one leaf; no degenerate
- *     triangle (non-finite vertex or zero area) is in any; triangle ids are
- *     < ntris, sphere ids in [ntris, ntris + nspheres). info.primitives
- *     counts them.
+ *     full; used lanes come first, strictly increasing by prim, the rest are
+ *     padding (NaN, PK_NO_HIT).
+ *  4. Every primitive that can be hit is in at least one leaf (in several
+ *     when spatial splits cut it); no degenerate triangle (non-finite vertex
+ *     or zero area) is in any; triangle ids are < ntris, sphere ids in
+ *     [ntris, ntris + nspheres). info.primitives counts them.
  *  5. Every block is referenced by exactly one leaf. */
 typedef struct bvh {
     accel base;

@@ -1,8 +1,9 @@
 /*
- * bvh_build.c - builds the wide BVH: a binned-SAH binary tree (OpenMP tasks
- * over the top levels), collapsed into BVH_WIDTH-wide SoA nodes with SoA
- * triangle and sphere blocks in the leaves. Invariants: bvh.h; design and
- * measurements: docs/bvh.md.
+ * bvh_build.c - builds the wide BVH: a binned-SAH binary tree with spatial
+ * splits (OpenMP tasks over the top levels), collapsed by dynamic
+ * programming into BVH_WIDTH-wide SoA nodes with SoA triangle and sphere
+ * blocks in the leaves. Invariants: bvh.h; design and measurements:
+ * docs/bvh.md.
  */
 #include "bvh.h"
 
@@ -21,6 +22,11 @@
 #endif
 #define COST_BLOCK 1.0f    /* ... relative to a primitive block test */
 #define BIN_LEAF_MAX 4     /* primitives per leaf of the binary tree */
+#ifndef SPATIAL_EXTRA
+#define SPATIAL_EXTRA 0.25 /* spatial splits may add this many references per primitive */
+#endif
+#define SPATIAL_DEPTH_MAX 24
+#define SPATIAL_ALPHA 1e-5f /* ... where children overlap by this fraction of the root's area */
 
 /* A box in two SSE registers (lane 3 unused). */
 typedef struct sbox {
@@ -62,24 +68,46 @@ static inline aabb sbox_aabb(sbox b)
 }
 
 /* Binary node: inner when count == 0 (children first, first + 1), else a
- * leaf over ids[first .. first + count). Either way its subtree holds
- * ids[begin .. begin + size). */
+ * leaf over references [first, first + count). */
 typedef struct bnode {
     sbox box;
     uint32_t first, count;
-    uint32_t begin, size;
 } bnode;
 
+/* References: a primitive id and the box of the part of it this reference
+ * stands for (the whole primitive, or a piece cut by spatial splits). A
+ * node's references are contiguous; [end, cap) after them is room that
+ * spatial splits in its subtree may fill with duplicated references. */
 typedef struct builder {
-    const sbox *pbox;       /* per primitive id */
-    uint32_t *ids;          /* primitive ids, partitioned in place */
+    sbox *rbox;             /* reference boxes */
+    uint32_t *rid;          /* reference primitive ids */
+    const accel_input *in;  /* for clipping triangles */
     bnode *nodes;
     uint32_t nnodes;        /* allocated so far (atomic) */
     uint32_t ntris;         /* ids >= ntris are spheres */
     bool spheres;           /* any sphere present */
+    float min_overlap;      /* spatial splits are tried above this overlap (half area) */
 } builder;
 
 static inline __m128 centroid2(const sbox *b) { return _mm_add_ps(b->lo, b->hi); }
+
+static inline void ref_swap(builder *b, uint32_t i, uint32_t j)
+{
+    sbox t = b->rbox[i];
+    b->rbox[i] = b->rbox[j];
+    b->rbox[j] = t;
+    uint32_t u = b->rid[i];
+    b->rid[i] = b->rid[j];
+    b->rid[j] = u;
+}
+
+/* Moves references [from, from + n) to [to, to + n) (to >= from). */
+static void ref_move(builder *b, uint32_t to, uint32_t from, uint32_t n)
+{
+    if (to == from || n == 0) return;
+    memmove(b->rbox + to, b->rbox + from, n * sizeof *b->rbox);
+    memmove(b->rid + to, b->rid + from, n * sizeof *b->rid);
+}
 
 static uint32_t node_alloc2(builder *b)
 {
@@ -146,7 +174,7 @@ static bool find_split(const builder *b, uint32_t begin, uint32_t end, sbox cb, 
         }
     const __m128 blo = _mm_loadu_ps(bn->lo), bsc = _mm_loadu_ps(bn->scale);
     for (uint32_t i = begin; i < end; i++) {
-        const sbox *pb = &b->pbox[b->ids[i]];
+        const sbox *pb = &b->rbox[i];
         __m128 k4 = _mm_mul_ps(_mm_sub_ps(centroid2(pb), blo), bsc);
         __m128i ki = _mm_cvttps_epi32(k4);
         ki = _mm_max_epi32(_mm_setzero_si128(), _mm_min_epi32(ki, _mm_set1_epi32(nb - 1)));
@@ -196,11 +224,169 @@ static bool find_split(const builder *b, uint32_t begin, uint32_t end, sbox cb, 
     return true;
 }
 
+/* ---- spatial splits (Stich, Friedrich and Dietrich 2009) --------------- */
+
+static inline float sbox_get(__m128 v, int axis)
+{
+    float f[4];
+    _mm_storeu_ps(f, v);
+    return f[axis];
+}
+static inline __m128 vset(__m128 v, int axis, float x)
+{
+    float f[4];
+    _mm_storeu_ps(f, v);
+    f[axis] = x;
+    return _mm_loadu_ps(f);
+}
+
+/* Rounds a double box outward to floats. */
+static inline float down_f(double x)
+{
+    float f = (float)x;
+    return (double)f > x ? nextafterf(f, -INFINITY) : f;
+}
+static inline float up_f(double x)
+{
+    float f = (float)x;
+    return (double)f < x ? nextafterf(f, INFINITY) : f;
+}
+
+/* The box of the part of reference i (box rb) between planes a <= b on axis:
+ * a triangle is clipped exactly (in double, rounded outward), a sphere's box
+ * is cut. Empty when nothing of it lies there. */
+static sbox clip_ref(const builder *b, uint32_t id, sbox rb, int axis, float a, float bb)
+{
+    sbox slab = {vset(_mm_set1_ps(-INFINITY), axis, a), vset(_mm_set1_ps(INFINITY), axis, bb)};
+    sbox out;
+    if (id < b->ntris) {
+        const vec3 *v = b->in->verts + 3 * (size_t)id;
+        double p[3][3];
+        for (int k = 0; k < 3; k++) p[k][0] = v[k].x, p[k][1] = v[k].y, p[k][2] = v[k].z;
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        const double pa = a, pb = bb;
+        for (int e = 0; e < 3; e++) {
+            const double *P = p[e], *Q = p[(e + 1) % 3];
+            if (P[axis] >= pa && P[axis] <= pb)
+                for (int k = 0; k < 3; k++) lo[k] = fmin(lo[k], P[k]), hi[k] = fmax(hi[k], P[k]);
+            const double planes[2] = {pa, pb};
+            for (int q = 0; q < 2; q++) {
+                const double c = planes[q];
+                if ((P[axis] < c && Q[axis] > c) || (P[axis] > c && Q[axis] < c)) {
+                    const double t = (c - P[axis]) / (Q[axis] - P[axis]);
+                    for (int k = 0; k < 3; k++) {
+                        double x = k == axis ? c : P[k] + t * (Q[k] - P[k]);
+                        lo[k] = fmin(lo[k], x), hi[k] = fmax(hi[k], x);
+                    }
+                }
+            }
+        }
+        if (!(lo[0] <= hi[0])) return sbox_empty();
+        out.lo = _mm_setr_ps(down_f(lo[0]), down_f(lo[1]), down_f(lo[2]), 0.0f);
+        out.hi = _mm_setr_ps(up_f(hi[0]), up_f(hi[1]), up_f(hi[2]), 0.0f);
+    } else {
+        out = rb;
+    }
+    /* within the reference's box and the slab */
+    out.lo = _mm_max_ps(_mm_max_ps(out.lo, rb.lo), slab.lo);
+    out.hi = _mm_min_ps(_mm_min_ps(out.hi, rb.hi), slab.hi);
+    if ((_mm_movemask_ps(_mm_cmple_ps(out.lo, out.hi)) & 7) != 7) return sbox_empty();
+    return out;
+}
+
+#define SPATIAL_BINS 16
+
+typedef struct sp_split {
+    int axis;
+    float plane;
+    float cost;
+} sp_split;
+
+/* Best spatial split of [begin, end) within node box nb: references are
+ * binned by their boxes (cut, not clipped: cheap and conservative), each
+ * counted where it enters and where it leaves. */
+static bool find_spatial(const builder *b, uint32_t begin, uint32_t end, sbox nbox, sp_split *best)
+{
+    float lo[4], hi[4];
+    _mm_storeu_ps(lo, nbox.lo);
+    _mm_storeu_ps(hi, nbox.hi);
+    best->cost = INFINITY;
+    bool found = false;
+    float w[3], inv[3];
+    bool use[3];
+    /* bin k of axis a is the slab [plo[a][k], phi[a][k]], as boxes open on the other axes */
+    __m128 plo[3][SPATIAL_BINS], phi[3][SPATIAL_BINS];
+    sbox bins[3][SPATIAL_BINS];
+    uint32_t enter[3][SPATIAL_BINS], leave[3][SPATIAL_BINS];
+    for (int ax = 0; ax < 3; ax++) {
+        const float ext = hi[ax] - lo[ax];
+        use[ax] = ext > 0.0f && isfinite(ext);
+        w[ax] = ext / SPATIAL_BINS;
+        inv[ax] = use[ax] ? SPATIAL_BINS / ext : 0.0f;
+        for (int k = 0; k < SPATIAL_BINS; k++) {
+            plo[ax][k] = vset(_mm_set1_ps(-INFINITY), ax, lo[ax] + (float)k * w[ax]);
+            phi[ax][k] = vset(_mm_set1_ps(INFINITY), ax, lo[ax] + (float)(k + 1) * w[ax]);
+            bins[ax][k] = sbox_empty();
+            enter[ax][k] = leave[ax][k] = 0;
+        }
+    }
+    for (uint32_t i = begin; i < end; i++) {
+        const sbox *r = &b->rbox[i];
+        float rl[4], rh[4];
+        _mm_storeu_ps(rl, r->lo);
+        _mm_storeu_ps(rh, r->hi);
+        for (int ax = 0; ax < 3; ax++) {
+            if (!use[ax]) continue;
+            int k0 = (int)((rl[ax] - lo[ax]) * inv[ax]), k1 = (int)((rh[ax] - lo[ax]) * inv[ax]);
+            k0 = k0 < 0 ? 0 : k0 >= SPATIAL_BINS ? SPATIAL_BINS - 1 : k0;
+            k1 = k1 < k0 ? k0 : k1 >= SPATIAL_BINS ? SPATIAL_BINS - 1 : k1;
+            enter[ax][k0]++;
+            leave[ax][k1]++;
+            if (k0 == k1) {
+                bins[ax][k0] = sbox_union(bins[ax][k0], *r);
+                continue;
+            }
+            for (int k = k0; k <= k1; k++) {
+                sbox piece = {_mm_max_ps(r->lo, plo[ax][k]), _mm_min_ps(r->hi, phi[ax][k])};
+                bins[ax][k] = sbox_union(bins[ax][k], piece);
+            }
+        }
+    }
+    for (int ax = 0; ax < 3; ax++) {
+        if (!use[ax]) continue;
+        float rarea[SPATIAL_BINS];
+        uint32_t rcount[SPATIAL_BINS];
+        sbox acc = sbox_empty();
+        uint32_t cnt = 0;
+        for (int k = SPATIAL_BINS - 1; k > 0; k--) {
+            acc = sbox_union(acc, bins[ax][k]);
+            cnt += leave[ax][k];
+            rarea[k] = sbox_half_area(acc);
+            rcount[k] = cnt;
+        }
+        acc = sbox_empty();
+        cnt = 0;
+        for (int k = 1; k < SPATIAL_BINS; k++) {
+            acc = sbox_union(acc, bins[ax][k - 1]);
+            cnt += enter[ax][k - 1];
+            if (cnt == 0 || rcount[k] == 0) continue;
+            float cost = sbox_half_area(acc) * sah_blocks(cnt) + rarea[k] * sah_blocks(rcount[k]);
+            if (cost < best->cost) {
+                best->cost = cost;
+                best->axis = ax;
+                best->plane = lo[ax] + (float)k * w[ax];
+                found = true;
+            }
+        }
+    }
+    return found;
+}
+
 static void range_bounds(const builder *b, uint32_t begin, uint32_t end, sbox *box, sbox *cb)
 {
     sbox bx = sbox_empty(), c = sbox_empty();
     for (uint32_t i = begin; i < end; i++) {
-        const sbox *pb = &b->pbox[b->ids[i]];
+        const sbox *pb = &b->rbox[i];
         bx = sbox_union(bx, *pb);
         c = sbox_grow(c, centroid2(pb));
     }
@@ -208,54 +394,113 @@ static void range_bounds(const builder *b, uint32_t begin, uint32_t end, sbox *b
     *cb = c;
 }
 
+/* Splits [begin, end) at plane on axis into [begin, begin + nl) and
+ * [rbegin, rbegin + nr), cutting the references that straddle the plane in
+ * two; false (nothing changed) when that does not fit before cap. */
+static bool do_spatial(builder *b, uint32_t begin, uint32_t end, uint32_t cap, int axis, float plane,
+                       uint32_t *nl_out, uint32_t *rbegin_out, uint32_t *nr_out)
+{
+    /* three groups: left only | straddling | right only */
+    uint32_t i = begin, m = begin, j = end;
+    while (m < j) {
+        const float lo = sbox_get(b->rbox[m].lo, axis), hi = sbox_get(b->rbox[m].hi, axis);
+        if (hi <= plane) ref_swap(b, i++, m++);
+        else if (lo >= plane) ref_swap(b, m, --j);
+        else m++;
+    }
+    const uint32_t n0 = i - begin, ns = j - i, nr0 = end - j;
+    const uint32_t n = end - begin, nl = n0 + ns, nr = nr0 + ns;
+    if (ns == 0 || nl == 0 || nr == 0 || (size_t)nl + nr > (size_t)cap - begin) return false;
+    /* the room left over goes to the children in proportion to their sizes */
+    const uint32_t slack = cap - begin - nl - nr;
+    const uint32_t rbegin = begin + nl + (uint32_t)((uint64_t)slack * nl / (nl + nr));
+    ref_move(b, rbegin + ns, j, nr0);
+    for (uint32_t k = 0; k < ns; k++) {
+        const uint32_t at = i + k, id = b->rid[at];
+        const sbox rb = b->rbox[at];
+        sbox l = clip_ref(b, id, rb, axis, -INFINITY, plane);
+        sbox r = clip_ref(b, id, rb, axis, plane, INFINITY);
+        /* a piece lost to rounding keeps the cut box: still conservative */
+        if (!(sbox_half_area(l) > 0.0f || (_mm_movemask_ps(_mm_cmple_ps(l.lo, l.hi)) & 7) == 7)) {
+            l = rb;
+            l.hi = vset(l.hi, axis, plane);
+        }
+        if (!(sbox_half_area(r) > 0.0f || (_mm_movemask_ps(_mm_cmple_ps(r.lo, r.hi)) & 7) == 7)) {
+            r = rb;
+            r.lo = vset(r.lo, axis, plane);
+        }
+        b->rbox[at] = l;
+        b->rbox[rbegin + k] = r;
+        b->rid[rbegin + k] = id;
+    }
+    (void)n;
+    *nl_out = nl;
+    *rbegin_out = rbegin;
+    *nr_out = nr;
+    return true;
+}
+
 /* Moves the triangles of [begin, end) before its spheres; returns the boundary. */
 static uint32_t partition_kind(builder *b, uint32_t begin, uint32_t end)
 {
     uint32_t i = begin, j = end;
     while (i < j) {
-        if (b->ids[i] < b->ntris) {
-            i++;
-        } else {
-            uint32_t t = b->ids[i];
-            b->ids[i] = b->ids[--j];
-            b->ids[j] = t;
-        }
+        if (b->rid[i] < b->ntris) i++;
+        else ref_swap(b, i, --j);
     }
     return i;
 }
 
-static void build_node(builder *b, uint32_t ni, uint32_t begin, uint32_t end, sbox cb, int depth);
+static void build_node(builder *b, uint32_t ni, uint32_t begin, uint32_t end, uint32_t cap, sbox cb, int depth);
 
-static void build_children(builder *b, uint32_t ni, uint32_t begin, uint32_t mid, uint32_t end,
-                           sbox lbox, sbox lcb, sbox rbox, sbox rcb, int depth)
+/* Children over [begin, begin + nl) and [rbegin, rbegin + nr); the room up to
+ * cap is shared in proportion to their sizes (moving the right references). */
+static void build_children(builder *b, uint32_t ni, uint32_t begin, uint32_t nl, uint32_t rbegin, uint32_t nr,
+                           uint32_t cap, sbox lbox, sbox lcb, sbox rbox, sbox rcb, int depth)
 {
+    if (rbegin == begin + nl && cap > rbegin + nr) {
+        const uint32_t slack = cap - begin - nl - nr;
+        const uint32_t to = begin + nl + (uint32_t)((uint64_t)slack * nl / (nl + nr));
+        ref_move(b, to, rbegin, nr);
+        rbegin = to;
+    }
+    const uint32_t lcap = rbegin;
     uint32_t k = node_alloc2(b);
     b->nodes[ni].first = k;
     b->nodes[ni].count = 0;
     b->nodes[k].box = lbox;
     b->nodes[k + 1].box = rbox;
-    if (end - begin >= TASK_MIN) {
-#pragma omp task default(none) firstprivate(b, k, begin, mid, lcb, depth)
-        build_node(b, k, begin, mid, lcb, depth + 1);
-        build_node(b, k + 1, mid, end, rcb, depth + 1);
+    if (nl + nr >= TASK_MIN) {
+#pragma omp task default(none) firstprivate(b, k, begin, nl, lcap, lcb, depth)
+        build_node(b, k, begin, begin + nl, lcap, lcb, depth + 1);
+        build_node(b, k + 1, rbegin, rbegin + nr, cap, rcb, depth + 1);
     } else {
-        build_node(b, k, begin, mid, lcb, depth + 1);
-        build_node(b, k + 1, mid, end, rcb, depth + 1);
+        build_node(b, k, begin, begin + nl, lcap, lcb, depth + 1);
+        build_node(b, k + 1, rbegin, rbegin + nr, cap, rcb, depth + 1);
     }
 }
 
-/* nodes[ni].box is set by the caller; cb bounds the doubled centroids. */
-static void build_node(builder *b, uint32_t ni, uint32_t begin, uint32_t end, sbox cb, int depth)
+/* nodes[ni].box is set by the caller; cb bounds the doubled centroids;
+ * [end, cap) is free for duplicated references. */
+static void build_node(builder *b, uint32_t ni, uint32_t begin, uint32_t end, uint32_t cap, sbox cb, int depth)
 {
-    uint32_t n = end - begin;
-    b->nodes[ni].begin = begin;
-    b->nodes[ni].size = n;
-    split s;
-    binner bn;
+    const uint32_t n = end - begin;
+    split s = {0, 0, INFINITY, sbox_empty(), sbox_empty()};
+    binner bn = {{0.0f}, {0.0f}, 1};
     bool ok = n > 1 && depth < SAH_DEPTH_MAX && find_split(b, begin, end, cb, &bn, &s);
+    const float area = sbox_half_area(b->nodes[ni].box);
+
+    /* a spatial split when the object split's children overlap and there is room */
+    sp_split sp = {0, 0.0f, INFINITY};
+    bool spatial = false;
+    if (ok && cap > end && n > BIN_LEAF_MAX && depth < SPATIAL_DEPTH_MAX) {
+        sbox ov = {_mm_max_ps(s.left.lo, s.right.lo), _mm_min_ps(s.left.hi, s.right.hi)};
+        if (sbox_half_area(ov) > b->min_overlap && find_spatial(b, begin, end, b->nodes[ni].box, &sp) &&
+            sp.cost < s.cost)
+            spatial = true;
+    }
 
     if (n <= BIN_LEAF_MAX) {
-        float area = sbox_half_area(b->nodes[ni].box);
         bool leaf = !ok || COST_BLOCK * sah_blocks(n) * area <= COST_NODE * area + COST_BLOCK * s.cost;
         if (leaf) {
             uint32_t mid = b->spheres ? partition_kind(b, begin, end) : end;
@@ -268,13 +513,23 @@ static void build_node(builder *b, uint32_t ni, uint32_t begin, uint32_t end, sb
             sbox lbox, lcb, rbox, rcb;
             range_bounds(b, begin, mid, &lbox, &lcb);
             range_bounds(b, mid, end, &rbox, &rcb);
-            build_children(b, ni, begin, mid, end, lbox, lcb, rbox, rcb, depth);
+            build_children(b, ni, begin, mid - begin, mid, end - mid, cap, lbox, lcb, rbox, rcb, depth);
             return;
         }
     }
 
-    uint32_t mid;
     sbox lbox, lcb, rbox, rcb;
+    if (spatial) {
+        uint32_t nl, rbegin, nr;
+        if (do_spatial(b, begin, end, cap, sp.axis, sp.plane, &nl, &rbegin, &nr)) {
+            range_bounds(b, begin, begin + nl, &lbox, &lcb);
+            range_bounds(b, rbegin, rbegin + nr, &rbox, &rcb);
+            build_children(b, ni, begin, nl, rbegin, nr, cap, lbox, lcb, rbox, rcb, depth);
+            return;
+        }
+        /* did not fit: the object split (the order of references does not matter to it) */
+    }
+    uint32_t mid;
     if (ok) {
         const int ax = s.axis, sb = s.bin;
         uint32_t i = begin, j = end;
@@ -282,21 +537,19 @@ static void build_node(builder *b, uint32_t ni, uint32_t begin, uint32_t end, sb
         rcb = sbox_empty();
         for (;;) {
             while (i < j) {
-                __m128 c = centroid2(&b->pbox[b->ids[i]]);
+                __m128 c = centroid2(&b->rbox[i]);
                 if (bin_of(&bn, c, ax) >= sb) break;
                 lcb = sbox_grow(lcb, c);
                 i++;
             }
             while (i < j) {
-                __m128 c = centroid2(&b->pbox[b->ids[j - 1]]);
+                __m128 c = centroid2(&b->rbox[j - 1]);
                 if (bin_of(&bn, c, ax) < sb) break;
                 rcb = sbox_grow(rcb, c);
                 j--;
             }
             if (i >= j) break;
-            uint32_t t = b->ids[i];
-            b->ids[i] = b->ids[j - 1];
-            b->ids[j - 1] = t;
+            ref_swap(b, i, j - 1);
         }
         mid = i;
         lbox = s.left;
@@ -308,7 +561,7 @@ static void build_node(builder *b, uint32_t ni, uint32_t begin, uint32_t end, sb
         range_bounds(b, begin, mid, &lbox, &lcb);
         range_bounds(b, mid, end, &rbox, &rcb);
     }
-    build_children(b, ni, begin, mid, end, lbox, lcb, rbox, rcb, depth);
+    build_children(b, ni, begin, mid - begin, mid, end - mid, cap, lbox, lcb, rbox, rcb, depth);
 }
 
 /* ---- collapse into the wide tree ---------------------------------------- */
@@ -327,17 +580,35 @@ typedef struct collapser {
     int depth;
 } collapser;
 
-static uint32_t make_leaf(collapser *c, const bnode *bn)
+/* The primitives of binary subtree bi (at most BVH_LEAF_MAX references). */
+static uint32_t gather_ids(const builder *b, uint32_t bi, uint32_t *ids, uint32_t n)
 {
+    const bnode *x = &b->nodes[bi];
+    if (x->count) {
+        for (uint32_t k = 0; k < x->count && n < BVH_LEAF_MAX; k++) ids[n++] = b->rid[x->first + k];
+        return n;
+    }
+    n = gather_ids(b, x->first, ids, n);
+    return gather_ids(b, x->first + 1, ids, n);
+}
+
+/* A leaf of the references in binary subtree bi: their primitives sorted,
+ * pieces of one primitive (spatial splits) merged. */
+static uint32_t make_leaf(collapser *c, uint32_t bi)
+{
+    const bnode *bn = &c->b->nodes[bi];
     uint32_t ids[BVH_LEAF_MAX];
-    uint32_t n = bn->size;
+    uint32_t n = gather_ids(c->b, bi, ids, 0);
     PK_ASSERT(n >= 1 && n <= BVH_LEAF_MAX);
-    memcpy(ids, c->b->ids + bn->begin, n * sizeof *ids);
     for (uint32_t i = 1; i < n; i++) {
         uint32_t v = ids[i], j = i;
         for (; j > 0 && ids[j - 1] > v; j--) ids[j] = ids[j - 1];
         ids[j] = v;
     }
+    uint32_t u = 0;
+    for (uint32_t i = 0; i < n; i++)
+        if (u == 0 || ids[i] != ids[u - 1]) ids[u++] = ids[i];
+    n = u;
     c->leaves++;
     c->sah += (double)n * (double)sbox_half_area(bn->box);
     if (ids[0] >= c->b->ntris) {
@@ -419,10 +690,11 @@ typedef struct dp_entry {
     float cost[BVH_WIDTH];
     uint8_t how[BVH_WIDTH];  /* [0]: DP_LEAF or DP_NODE; [i>0]: DP_FEWER or k, slots given to the left child */
     uint8_t split;           /* as a wide node: slots given to the left child */
-    uint32_t spheres;        /* spheres in the subtree */
+    uint32_t spheres;        /* sphere references in the subtree */
+    uint32_t size;           /* references in the subtree */
 } dp_entry;
 
-static void dp_solve(const builder *b, uint32_t nnodes, const uint32_t *ids, dp_entry *dp)
+static void dp_solve(const builder *b, uint32_t nnodes, dp_entry *dp)
 {
     for (uint32_t ii = nnodes; ii-- > 0;) {
         const bnode *x = &b->nodes[ii];
@@ -430,15 +702,18 @@ static void dp_solve(const builder *b, uint32_t nnodes, const uint32_t *ids, dp_
         const float area = sbox_half_area(x->box);
         if (x->count) {
             e->spheres = 0;
-            for (uint32_t k = 0; k < x->count; k++) e->spheres += ids[x->first + k] >= b->ntris;
+            for (uint32_t k = 0; k < x->count; k++) e->spheres += b->rid[x->first + k] >= b->ntris;
+            e->size = x->count;
         } else {
             e->spheres = dp[x->first].spheres + dp[x->first + 1].spheres;
+            e->size = dp[x->first].size + dp[x->first + 1].size;
         }
-        const bool mixed = e->spheres != 0 && e->spheres != x->size;
+        const uint32_t size = e->size;
+        const bool mixed = e->spheres != 0 && e->spheres != size;
         const uint32_t lanes = e->spheres ? BVH_SPHERE_LANES : BVH_TRI_LANES;
         /* a flag, not an infinite cost: areas overflow to inf in huge scenes */
-        const bool leaf_ok = x->size <= BVH_LEAF_MAX && !mixed;
-        const float leaf = leaf_ok ? COST_BLOCK * (float)((x->size + lanes - 1) / lanes) * area : INFINITY;
+        const bool leaf_ok = size <= BVH_LEAF_MAX && !mixed;
+        const float leaf = leaf_ok ? COST_BLOCK * (float)((size + lanes - 1) / lanes) * area : INFINITY;
         if (x->count) {
             for (int i = 0; i < BVH_WIDTH; i++) {
                 e->cost[i] = leaf;
@@ -504,7 +779,7 @@ static uint32_t collapse(collapser *c, const dp_entry *dp, uint32_t bi, int dept
     init_node(&c->nodes[wi]);
     for (int q = 0; q < nk; q++) {
         const bnode *x = &bn[kids[q]];
-        uint32_t ref = dp[kids[q]].how[0] == DP_LEAF ? make_leaf(c, x)
+        uint32_t ref = dp[kids[q]].how[0] == DP_LEAF ? make_leaf(c, kids[q])
                                                      : bvh_node_ref(collapse(c, dp, kids[q], depth + 1));
         bvh_node *wn = &c->nodes[wi]; /* index, not pointer, across recursion */
         wn->child[q] = ref;
@@ -572,12 +847,14 @@ pk_status accel_bvh_create(pk_context *ctx, const accel_input *in, accel **out)
     }
     pk_status st = PK_OK;
     bvh *t = mem_calloc(al, 1, sizeof *t);
-    sbox *pbox = mem_alloc_aligned(al, (nprim_in ? nprim_in : 1) * sizeof(sbox), 64);
-    uint32_t *ids = mem_alloc(al, (nprim_in ? nprim_in : 1) * sizeof(uint32_t));
+    /* room for the references that spatial splits add */
+    const size_t cap_refs = nprim_in + (size_t)((double)nprim_in * SPATIAL_EXTRA) + 1;
+    sbox *rbox = mem_alloc_aligned(al, cap_refs * sizeof(sbox), 64);
+    uint32_t *rid = mem_alloc(al, cap_refs * sizeof(uint32_t));
     bnode *bnodes = NULL;
     dp_entry *dp = NULL;
     collapser c = {0};
-    if (!t || !pbox || !ids) goto nomem;
+    if (!t || !rbox || !rid) goto nomem;
 
     /* primitive boxes; degenerate triangles and invalid spheres stay out */
     uint32_t n = 0;
@@ -585,46 +862,46 @@ pk_status accel_bvh_create(pk_context *ctx, const accel_input *in, accel **out)
     for (size_t i = 0; i < in->ntris; i++) {
         const vec3 *p = in->verts + 3 * i;
         if (bvh_tri_degenerate(p[0], p[1], p[2])) continue;
-        sbox b;
-        b.lo = _mm_setr_ps(fminf(p[0].x, fminf(p[1].x, p[2].x)), fminf(p[0].y, fminf(p[1].y, p[2].y)),
-                           fminf(p[0].z, fminf(p[1].z, p[2].z)), 0.0f);
-        b.hi = _mm_setr_ps(fmaxf(p[0].x, fmaxf(p[1].x, p[2].x)), fmaxf(p[0].y, fmaxf(p[1].y, p[2].y)),
-                           fmaxf(p[0].z, fmaxf(p[1].z, p[2].z)), 0.0f);
-        pbox[i] = b;
-        ids[n++] = (uint32_t)i;
-        root = sbox_union(root, b);
-        rootc = sbox_grow(rootc, centroid2(&b));
+        sbox bx;
+        bx.lo = _mm_setr_ps(fminf(p[0].x, fminf(p[1].x, p[2].x)), fminf(p[0].y, fminf(p[1].y, p[2].y)),
+                            fminf(p[0].z, fminf(p[1].z, p[2].z)), 0.0f);
+        bx.hi = _mm_setr_ps(fmaxf(p[0].x, fmaxf(p[1].x, p[2].x)), fmaxf(p[0].y, fmaxf(p[1].y, p[2].y)),
+                            fmaxf(p[0].z, fmaxf(p[1].z, p[2].z)), 0.0f);
+        rbox[n] = bx;
+        rid[n++] = (uint32_t)i;
+        root = sbox_union(root, bx);
+        rootc = sbox_grow(rootc, centroid2(&bx));
     }
     bool any_sphere = false;
     for (size_t i = 0; i < in->nspheres; i++) {
-        const accel_sphere *s = &in->spheres[i];
-        if (!bvh_sphere_valid(s)) continue;
-        sbox b;
-        b.lo = _mm_setr_ps(s->center.x - s->radius, s->center.y - s->radius, s->center.z - s->radius, 0.0f);
-        b.hi = _mm_setr_ps(s->center.x + s->radius, s->center.y + s->radius, s->center.z + s->radius, 0.0f);
-        pbox[in->ntris + i] = b;
-        ids[n++] = (uint32_t)(in->ntris + i);
-        root = sbox_union(root, b);
-        rootc = sbox_grow(rootc, centroid2(&b));
+        const accel_sphere *sp = &in->spheres[i];
+        if (!bvh_sphere_valid(sp)) continue;
+        sbox bx;
+        bx.lo = _mm_setr_ps(sp->center.x - sp->radius, sp->center.y - sp->radius, sp->center.z - sp->radius, 0.0f);
+        bx.hi = _mm_setr_ps(sp->center.x + sp->radius, sp->center.y + sp->radius, sp->center.z + sp->radius, 0.0f);
+        rbox[n] = bx;
+        rid[n++] = (uint32_t)(in->ntris + i);
+        root = sbox_union(root, bx);
+        rootc = sbox_grow(rootc, centroid2(&bx));
         any_sphere = true;
     }
+    const uint32_t cap = n + (uint32_t)((double)n * SPATIAL_EXTRA);
 
-    builder b = {pbox, ids, NULL, 1, (uint32_t)in->ntris, any_sphere};
-    size_t cap_b = 2 * (size_t)n + 1;
+    builder b = {rbox, rid, in, NULL, 1, (uint32_t)in->ntris, any_sphere, 0.0f};
+    b.min_overlap = SPATIAL_ALPHA * sbox_half_area(root);
+    size_t cap_b = 2 * (size_t)cap + 1;
     bnodes = mem_alloc_aligned(al, cap_b * sizeof *bnodes, 64);
     if (!bnodes) goto nomem;
     b.nodes = bnodes;
     bnodes[0].box = root;
     bnodes[0].first = 0;
     bnodes[0].count = 0;
-    bnodes[0].begin = 0;
-    bnodes[0].size = 0;
     if (n > 0) {
         int threads = in->threads > 0 ? in->threads : 1;
         if (n < 2 * TASK_MIN) threads = 1;
-#pragma omp parallel num_threads(threads) default(none) shared(b, n, rootc)
+#pragma omp parallel num_threads(threads) default(none) shared(b, n, cap, rootc)
 #pragma omp single
-        build_node(&b, 0, 0, n, rootc, 1);
+        build_node(&b, 0, 0, n, cap, rootc, 1);
     }
 
     /* references are 32-bit byte offsets: the arrays must stay below 4 GiB */
@@ -633,7 +910,7 @@ pk_status accel_bvh_create(pk_context *ctx, const accel_input *in, accel **out)
         for (uint32_t i = 0; i < b.nnodes; i++) {
             const bnode *x = &bnodes[i];
             if (!x->count) inner++;
-            else if (ids[x->first] < in->ntris) tblocks += (x->count + BVH_TRI_LANES - 1) / BVH_TRI_LANES;
+            else if (rid[x->first] < in->ntris) tblocks += (x->count + BVH_TRI_LANES - 1) / BVH_TRI_LANES;
             else sblocks += (x->count + BVH_SPHERE_LANES - 1) / BVH_SPHERE_LANES;
         }
         if (inner > (size_t)UINT32_MAX / sizeof(bvh_node) || tblocks > (size_t)UINT32_MAX / sizeof(bvh_tri_block) ||
@@ -659,13 +936,13 @@ pk_status accel_bvh_create(pk_context *ctx, const accel_input *in, accel **out)
     } else {
         dp = mem_alloc(al, b.nnodes * sizeof *dp);
         if (!dp) goto nomem;
-        dp_solve(&b, b.nnodes, ids, dp);
+        dp_solve(&b, b.nnodes, dp);
         if (dp[0].how[0] == DP_LEAF) {
             init_node(&c.nodes[0]);
             c.nnodes = 1;
             c.depth = 1;
             c.sah += (double)sbox_half_area(bnodes[0].box);
-            c.nodes[0].child[0] = make_leaf(&c, &bnodes[0]);
+            c.nodes[0].child[0] = make_leaf(&c, 0);
             set_slot_box(&c.nodes[0], 0, bnodes[0].box);
         } else {
             collapse(&c, dp, 0, 1);
@@ -698,8 +975,8 @@ pk_status accel_bvh_create(pk_context *ctx, const accel_input *in, accel **out)
     mem_free_aligned(al, c.tris);
     mem_free_aligned(al, c.spheres);
     mem_free_aligned(al, bnodes);
-    mem_free_aligned(al, pbox);
-    mem_free(al, ids);
+    mem_free_aligned(al, rbox);
+    mem_free(al, rid);
     mem_free(al, dp);
     info->build_ms = (time_now() - t0) * 1e3;
     *out = &t->base;
@@ -713,8 +990,8 @@ fail:
     mem_free_aligned(al, c.tris);
     mem_free_aligned(al, c.spheres);
     mem_free_aligned(al, bnodes);
-    mem_free_aligned(al, pbox);
-    mem_free(al, ids);
+    mem_free_aligned(al, rbox);
+    mem_free(al, rid);
     if (t) {
         t->base.alloc = al;
         bvh_destroy(&t->base);

@@ -10,6 +10,7 @@
 typedef struct checker {
     const bvh *t;
     uint8_t *node_seen, *tri_seen, *sphere_seen, *prim_seen;
+    uint8_t *cover;   /* per primitive: which of its corners some leaf box holds */
     size_t prims;
     char *why;
     size_t n;
@@ -45,6 +46,11 @@ static bool box_is_empty_marker(aabb b)
            b.hi.y == -INFINITY && b.hi.z == -INFINITY;
 }
 
+static bool aabb_overlap(aabb b, vec3 lo, vec3 hi)
+{
+    return lo.x <= b.hi.x && lo.y <= b.hi.y && lo.z <= b.hi.z && hi.x >= b.lo.x && hi.y >= b.lo.y && hi.z >= b.lo.z;
+}
+
 static bool point_in(aabb b, vec3 p)
 {
     return p.x >= b.lo.x && p.y >= b.lo.y && p.z >= b.lo.z && p.x <= b.hi.x && p.y <= b.hi.y && p.z <= b.hi.z;
@@ -54,9 +60,8 @@ static bool check_prim(checker *k, uint32_t prim, uint32_t ni, int s)
 {
     const accel *a = &k->t->base;
     if (prim >= a->ntris + a->nspheres) return fail(k, "node %u slot %d: prim %u out of range", ni, s, prim);
-    if (k->prim_seen[prim]) return fail(k, "prim %u is in two leaves (invariant 4)", prim);
+    if (!k->prim_seen[prim]) k->prims++;
     k->prim_seen[prim] = 1;
-    k->prims++;
     return true;
 }
 
@@ -94,8 +99,10 @@ static bool check_leaf(checker *k, uint32_t ref, aabb box, uint32_t ni, int s)
                 vec3 c = v3(sb->c[0][l], sb->c[1][l], sb->c[2][l]);
                 accel_sphere sp = {c, sb->r[l]};
                 if (!bvh_sphere_valid(&sp)) return fail(k, "sphere %u is invalid (invariant 4)", prim[l]);
-                if (!point_in(box, v3_sub(c, v3s(sb->r[l]))) || !point_in(box, v3_add(c, v3s(sb->r[l]))))
-                    return fail(k, "sphere %u sticks out of its slot box (invariant 2)", prim[l]);
+                if (!aabb_overlap(box, v3_sub(c, v3s(sb->r[l])), v3_add(c, v3s(sb->r[l]))))
+                    return fail(k, "sphere %u is outside its slot box (invariant 2)", prim[l]);
+                k->cover[prim[l]] |= (uint8_t)(point_in(box, v3_sub(c, v3s(sb->r[l]))) |
+                                               point_in(box, v3_add(c, v3s(sb->r[l]))) << 1 | 4);
             } else {
                 const bvh_tri_block *tb = &t->tris[first + b];
                 if (prim[l] >= t->base.ntris) return fail(k, "triangle leaf holds sphere %u (invariant 3)", prim[l]);
@@ -103,9 +110,11 @@ static bool check_leaf(checker *k, uint32_t ref, aabb box, uint32_t ni, int s)
                 for (int j = 0; j < 3; j++) v[j] = v3(tb->v[j][0][l], tb->v[j][1][l], tb->v[j][2][l]);
                 if (bvh_tri_degenerate(v[0], v[1], v[2]))
                     return fail(k, "degenerate triangle %u is in a leaf (invariant 4)", prim[l]);
+                aabb vb = aabb_grow(aabb_grow(aabb_grow(aabb_empty(), v[0]), v[1]), v[2]);
+                if (!aabb_overlap(box, vb.lo, vb.hi))
+                    return fail(k, "triangle %u is outside node %u slot %d (invariant 2)", prim[l], ni, s);
                 for (int j = 0; j < 3; j++)
-                    if (!point_in(box, v[j]))
-                        return fail(k, "triangle %u sticks out of node %u slot %d (invariant 2)", prim[l], ni, s);
+                    if (point_in(box, v[j])) k->cover[prim[l]] |= (uint8_t)(1u << j);
             }
         }
         count += (uint32_t)used;
@@ -156,7 +165,7 @@ static bool check_node(checker *k, uint32_t ni, int depth)
 bool bvh_check(const accel *a, char *why, size_t n)
 {
     const bvh *t = (const bvh *)a;
-    checker k = {t, NULL, NULL, NULL, NULL, 0, why, n};
+    checker k = {t, NULL, NULL, NULL, NULL, NULL, 0, why, n};
     bool ok = false;
     if (why && n) why[0] = '\0';
     if (!t || !t->nodes || t->nnodes == 0) return fail(&k, "no root node (invariant 1)");
@@ -165,7 +174,8 @@ bool bvh_check(const accel *a, char *why, size_t n)
     k.tri_seen = mem_calloc(al, t->ntri_blocks + 1, 1);
     k.sphere_seen = mem_calloc(al, t->nsphere_blocks + 1, 1);
     k.prim_seen = mem_calloc(al, a->ntris + a->nspheres + 1, 1);
-    if (!k.node_seen || !k.tri_seen || !k.sphere_seen || !k.prim_seen) {
+    k.cover = mem_calloc(al, a->ntris + a->nspheres + 1, 1);
+    if (!k.node_seen || !k.tri_seen || !k.sphere_seen || !k.prim_seen || !k.cover) {
         fail(&k, "out of memory");
         goto out;
     }
@@ -185,6 +195,11 @@ bool bvh_check(const accel *a, char *why, size_t n)
             fail(&k, "sphere block %zu is in no leaf (invariant 5)", i);
             goto out;
         }
+    for (size_t i = 0; i < a->ntris + a->nspheres; i++)
+        if (k.prim_seen[i] && (k.cover[i] & (i < a->ntris ? 7 : 3)) != (i < a->ntris ? 7 : 3)) {
+            fail(&k, "primitive %zu: a corner lies in none of its leaves' boxes (invariant 2)", i);
+            goto out;
+        }
     if (k.prims != a->info.primitives) {
         fail(&k, "%zu primitives in leaves, info says %zu (invariant 4)", k.prims, a->info.primitives);
         goto out;
@@ -199,5 +214,6 @@ out:
     mem_free(al, k.tri_seen);
     mem_free(al, k.sphere_seen);
     mem_free(al, k.prim_seen);
+    mem_free(al, k.cover);
     return ok;
 }
