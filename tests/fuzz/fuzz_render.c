@@ -24,9 +24,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         if (o.max_depth > 4) o.max_depth = 4;
         o.threads = 1;
         if (o.accel == PK_ACCEL_EMBREE) o.accel = PK_ACCEL_BVH;
+        o.collect_stats = (int)(size & 1); /* both paths of the counters */
+        pk_stats stats;
         pk_image *img = NULL;
-        st = pk_render(ctx, s, &o, &img, NULL);
+        st = pk_render(ctx, s, &o, &img, &stats);
         fuzz_check_error(ctx, st);
+        if (st == PK_OK && o.collect_stats && stats.rays_camera != 8 * 8) {
+            fprintf(stderr, "fuzz: %llu camera rays for 8x8 pixels at 1 spp\n", (unsigned long long)stats.rays_camera);
+            abort();
+        }
         if (st == PK_OK) {
             const float *px = pk_image_pixels_const(img);
             for (int i = 0; i < 8 * 8 * 3; i++)
