@@ -261,20 +261,21 @@ static inline int bvh_tri_test(const bvh_tri_block *blk, const bvh_tri_ray *r, f
                                tvec *rcp_out, tvec *V_out, tvec *W_out)
 {
     const char *va = (const char *)blk->v[0], *vb = (const char *)blk->v[1], *vc = (const char *)blk->v[2];
-    const tvec ox = TV_SET1(r->ox), oy = TV_SET1(r->oy), oz = TV_SET1(r->oz);
-    const tvec ax0 = TV_SUB(TV_LOAD((const float *)(va + r->rowx)), ox);
-    const tvec ay0 = TV_SUB(TV_LOAD((const float *)(va + r->rowy)), oy);
-    const tvec az0 = TV_SUB(TV_LOAD((const float *)(va + r->rowz)), oz);
-    const tvec bx0 = TV_SUB(TV_LOAD((const float *)(vb + r->rowx)), ox);
-    const tvec by0 = TV_SUB(TV_LOAD((const float *)(vb + r->rowy)), oy);
-    const tvec bz0 = TV_SUB(TV_LOAD((const float *)(vb + r->rowz)), oz);
-    const tvec cx0 = TV_SUB(TV_LOAD((const float *)(vc + r->rowx)), ox);
-    const tvec cy0 = TV_SUB(TV_LOAD((const float *)(vc + r->rowy)), oy);
-    const tvec cz0 = TV_SUB(TV_LOAD((const float *)(vc + r->rowz)), oz);
+    const tvec ox = TV_SET1(r->ox), oy = TV_SET1(r->oy);
     const tvec sx = TV_SET1(r->sx), sy = TV_SET1(r->sy);
-    const tvec ax = TV_SUB(ax0, TV_MUL(sx, az0)), ay = TV_SUB(ay0, TV_MUL(sy, az0));
-    const tvec bx = TV_SUB(bx0, TV_MUL(sx, bz0)), by = TV_SUB(by0, TV_MUL(sy, bz0));
-    const tvec cx = TV_SUB(cx0, TV_MUL(sx, cz0)), cy = TV_SUB(cy0, TV_MUL(sy, cz0));
+    tvec ax, ay, bx, by, cx, cy;
+    {
+        const tvec oz = TV_SET1(r->oz);
+        const tvec az0 = TV_SUB(TV_LOAD((const float *)(va + r->rowz)), oz);
+        ax = TV_SUB(TV_SUB(TV_LOAD((const float *)(va + r->rowx)), ox), TV_MUL(sx, az0));
+        ay = TV_SUB(TV_SUB(TV_LOAD((const float *)(va + r->rowy)), oy), TV_MUL(sy, az0));
+        const tvec bz0 = TV_SUB(TV_LOAD((const float *)(vb + r->rowz)), oz);
+        bx = TV_SUB(TV_SUB(TV_LOAD((const float *)(vb + r->rowx)), ox), TV_MUL(sx, bz0));
+        by = TV_SUB(TV_SUB(TV_LOAD((const float *)(vb + r->rowy)), oy), TV_MUL(sy, bz0));
+        const tvec cz0 = TV_SUB(TV_LOAD((const float *)(vc + r->rowz)), oz);
+        cx = TV_SUB(TV_SUB(TV_LOAD((const float *)(vc + r->rowx)), ox), TV_MUL(sx, cz0));
+        cy = TV_SUB(TV_SUB(TV_LOAD((const float *)(vc + r->rowy)), oy), TV_MUL(sy, cz0));
+    }
     tvec U = TV_SUB(TV_MUL(cx, by), TV_MUL(cy, bx));
     tvec V = TV_SUB(TV_MUL(ax, cy), TV_MUL(ay, cx));
     tvec W = TV_SUB(TV_MUL(bx, ay), TV_MUL(by, ax));
@@ -288,8 +289,11 @@ static inline int bvh_tri_test(const bvh_tri_block *blk, const bvh_tri_ray *r, f
     const tvec det = TV_ADD(TV_ADD(U, V), W);
     int m = ~TV_MASK(TV_OR(TV_AND(neg, pos), TV_EQ(det, zero))) & BVH_TRI_ALL;
     if (!m) return 0;
-    const tvec sz = TV_SET1(r->sz);
-    const tvec az = TV_MUL(sz, az0), bz = TV_MUL(sz, bz0), cz = TV_MUL(sz, cz0);
+    /* the z differences again (recomputed rather than kept: fewer live registers) */
+    const tvec oz = TV_SET1(r->oz), sz = TV_SET1(r->sz);
+    const tvec az = TV_MUL(sz, TV_SUB(TV_LOAD((const float *)(va + r->rowz)), oz));
+    const tvec bz = TV_MUL(sz, TV_SUB(TV_LOAD((const float *)(vb + r->rowz)), oz));
+    const tvec cz = TV_MUL(sz, TV_SUB(TV_LOAD((const float *)(vc + r->rowz)), oz));
     const tvec T = TV_ADD(TV_ADD(TV_MUL(U, az), TV_MUL(V, bz)), TV_MUL(W, cz));
     const tvec rcp = TV_DIV(TV_SET1(1.0f), det);
     const tvec t = TV_MUL(T, rcp);
