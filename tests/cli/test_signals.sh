@@ -18,21 +18,32 @@ png_size() {
   od -An -tu1 -j16 -N8 "$1" | awk '{ print $1*16777216 + $2*65536 + $3*256 + $4, $5*16777216 + $6*65536 + $7*256 + $8 }'
 }
 
-# interrupt SIGNAL EXISTING: renders the built-in Cornell box for what would
-# be hours (65536 samples per pixel), sends SIGNAL after a second and checks
-# the outcome; EXISTING=1 puts a file at OUT first.
-interrupt() {
-  local sig=$1 existing=$2 name="SIG$1"
-  rm -rf "$tmp"/*
-  if [ "$existing" = 1 ]; then
-    printf 'an earlier image\n' >"$tmp/out.png"
-    name="$name over an existing image"
+# start_render ARGS...: starts paprsek render ARGS in the background (pid in
+# $pid) and returns once it has its signal handlers, that is, once it renders.
+start_render() {
+  "$bin" render "$@" >"$tmp/stdout" 2>"$tmp/stderr" &
+  pid=$!
+  # Before its handler is installed SIGTERM would kill paprsek and SIGINT,
+  # which a shell's background job ignores, would be lost. Without /proc, a
+  # second's wait.
+  local n=0 mask
+  if [ -r "/proc/$pid/status" ]; then
+    while [ $n -lt 600 ]; do
+      mask=$(awk '/^SigCgt:/ { print $2 }' "/proc/$pid/status" 2>/dev/null)
+      [ -n "$mask" ] && (((16#$mask >> 1) & 1)) && (((16#$mask >> 14) & 1)) && return
+      sleep 0.1
+      n=$((n + 1))
+    done
+  else
+    sleep 1
   fi
-  "$bin" render -o "$tmp/out.png" --width 96 --height 64 --spp 65536 --threads 2 >"$tmp/stdout" 2>"$tmp/stderr" &
-  local pid=$!
-  sleep 1
-  kill -s "$sig" "$pid"
-  local waited=0
+}
+
+# stop SIGNAL NAME: sends SIGNAL to $pid, waits up to 30 s for it to end and
+# sets $rc (empty when it had to be killed) and $waited (tenths of a second).
+stop() {
+  kill -s "$1" "$pid"
+  waited=0
   while kill -0 "$pid" 2>/dev/null && [ $waited -lt 300 ]; do
     sleep 0.1
     waited=$((waited + 1))
@@ -40,11 +51,28 @@ interrupt() {
   if kill -0 "$pid" 2>/dev/null; then
     kill -9 "$pid"
     wait "$pid"
-    bad "$name: still rendering 30 s after the signal"
+    bad "$2: still rendering 30 s after the signal"
+    rc=
     return
   fi
   wait "$pid"
-  local rc=$?
+  rc=$?
+}
+
+# interrupt SIGNAL EXISTING: renders the built-in Cornell box for what would
+# be hours (65536 samples per pixel), sends SIGNAL once the render runs and
+# checks the outcome; EXISTING=1 puts a file at OUT first.
+interrupt() {
+  local sig=$1 existing=$2 name="SIG$1"
+  rm -rf "$tmp"/*
+  if [ "$existing" = 1 ]; then
+    printf 'an earlier image\n' >"$tmp/out.png"
+    name="$name over an existing image"
+  fi
+  start_render -o "$tmp/out.png" --width 96 --height 64 --spp 65536 --threads 2
+  sleep 0.2
+  stop "$sig" "$name"
+  [ -n "$rc" ] || return
   local want="paprsek: interrupted; finished tiles written to $tmp/out.partial.png"
   [ "$rc" -eq 130 ] || bad "$name: exit $rc, wanted 130"
   [ "$(cat "$tmp/stderr")" = "$want" ] || bad "$name: stderr is '$(cat "$tmp/stderr")', wanted '$want'"
@@ -63,6 +91,29 @@ interrupt() {
 interrupt INT 1
 interrupt TERM 1
 interrupt INT 0
+
+# The .partial image holds the tiles finished before the signal, and the
+# others black: a PFM (raw floats) of 1024x1024 at 64 samples (minutes of
+# work) interrupted after two seconds has both lit and black pixels.
+rm -rf "$tmp"/*
+start_render -o "$tmp/out.pfm" --width 1024 --height 1024 --spp 64 --threads 2
+sleep 2
+stop INT "finished tiles"
+if [ -n "$rc" ]; then
+  part="$tmp/out.partial.pfm"
+  header=$(head -c 18 "$part" 2>/dev/null | tr '\n' ' ')
+  body=$((1024 * 1024 * 12))
+  lit=$(tail -c "$body" "$part" 2>/dev/null | tr -d '\000' | wc -c)
+  size=$(($(wc -c <"$part" 2>/dev/null || echo 0) - 18))
+  if [ "$rc" -ne 130 ] || [ "$header" != "PF 1024 1024 -1.0 " ] || [ "$size" -ne "$body" ]; then
+    bad "finished tiles: exit $rc, .partial header '$header', $size bytes of pixels"
+  elif [ "$lit" -eq 0 ] || [ "$lit" -gt $((body / 2)) ]; then
+    bad "finished tiles: $lit of $body bytes of pixels are not zero; wanted some, and many black"
+  else
+    echo "ok   finished tiles: $lit of $body pixel bytes of out.partial.pfm are not zero (a tile has 3072)"
+  fi
+  [ ! -e "$tmp/out.pfm" ] || bad "finished tiles: OUT was created"
+fi
 
 # A render that is not interrupted replaces OUT with the complete image.
 rm -rf "$tmp"/*
