@@ -11,6 +11,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #define OBJ_INLINE_CORNERS 64
 #define OBJ_MAX_UNDEFINED_WARNINGS 10
@@ -250,37 +251,67 @@ static const char *name_copy(pk_context *ctx, const char *s, const char *e, char
     return *heap;
 }
 
+/* Reads and parses the material library rel (relative to base_dir). One that
+ * cannot be read is warned about: its faces get the default material. */
+static pk_status read_library(obj_state *st, const char *rel)
+{
+    io_reader *r = &st->r;
+    char *path = path_join(&r->ctx->alloc, st->base_dir, rel);
+    if (!path) return ctx_nomem(r->ctx);
+    char *data = NULL;
+    size_t size = 0;
+    bool was_ok = r->ctx->status == PK_OK;
+    pk_status rc = file_read_all(r->ctx, path, &data, &size);
+    if (rc == PK_OK) {
+        rc = mtl_parse(r->ctx, st->s, data, size, rel);
+        mem_free(&r->ctx->alloc, data);
+    } else if (rc != PK_ERR_NOMEM && was_ok) {
+        char why[PK_ERRMSG_MAX];
+        snprintf(why, sizeof why, "%s", r->ctx->message);
+        pk_context_clear_error(r->ctx);
+        io_warn(r, "cannot read material library '%s' (%s); its materials are not defined", rel, why);
+        rc = PK_OK;
+    }
+    mem_free(&r->ctx->alloc, path);
+    return rc;
+}
+
+/* True when rel names a regular file in base_dir; false also when out of memory. */
+static bool library_exists(obj_state *st, const char *rel)
+{
+    char *path = path_join(&st->r.ctx->alloc, st->base_dir, rel);
+    struct stat sb;
+    bool ok = path && stat(path, &sb) == 0 && S_ISREG(sb.st_mode);
+    mem_free(&st->r.ctx->alloc, path);
+    return ok;
+}
+
 static pk_status parse_mtllib(obj_state *st, const char *p, const char *le)
 {
     io_reader *r = &st->r;
     if (!st->base_dir) return PK_OK;
+    char buf[256], *heap;
+    pk_status rc;
+    /* The statement lists file names separated by blanks, but exporters
+     * (Blender among them) write one name that holds blanks unquoted: when
+     * the whole rest of the line names a file, it is that file. */
+    const char *rs, *re;
+    io_rest(p, le, &rs, &re);
+    if (io_token_end(rs, re) != re) {
+        const char *whole = name_copy(r->ctx, rs, re, buf, sizeof buf, &heap);
+        if (!whole) return ctx_nomem(r->ctx);
+        bool found = library_exists(st, whole);
+        rc = found ? read_library(st, whole) : PK_OK;
+        mem_free(&r->ctx->alloc, heap);
+        if (found) return rc;
+    }
     for (;;) {
         p = io_skip_blanks(p, le);
         if (p == le || *p == '#') break;
         const char *te = io_token_end(p, le);
-        char buf[256], *heap;
         const char *rel = name_copy(r->ctx, p, te, buf, sizeof buf, &heap);
-        char *path = rel ? path_join(&r->ctx->alloc, st->base_dir, rel) : NULL;
-        if (!path) {
-            mem_free(&r->ctx->alloc, heap);
-            return ctx_nomem(r->ctx);
-        }
-        char *data = NULL;
-        size_t size = 0;
-        bool was_ok = r->ctx->status == PK_OK;
-        pk_status rc = file_read_all(r->ctx, path, &data, &size);
-        if (rc == PK_OK) {
-            rc = mtl_parse(r->ctx, st->s, data, size, rel);
-            mem_free(&r->ctx->alloc, data);
-        } else if (rc != PK_ERR_NOMEM && was_ok) {
-            /* A missing material library is not fatal: its faces get material 0. */
-            char why[PK_ERRMSG_MAX];
-            snprintf(why, sizeof why, "%s", r->ctx->message);
-            pk_context_clear_error(r->ctx);
-            io_warn(r, "cannot read material library '%s' (%s); its materials are not defined", rel, why);
-            rc = PK_OK;
-        }
-        mem_free(&r->ctx->alloc, path);
+        if (!rel) return ctx_nomem(r->ctx);
+        rc = read_library(st, rel);
         mem_free(&r->ctx->alloc, heap);
         if (rc != PK_OK) return rc;
         p = te;

@@ -48,6 +48,7 @@ renders odd_continuation.obj
 renders odd_bom.obj
 renders odd_bom.json
 renders odd_colours.obj
+renders odd_space.obj
 renders odd_w.obj
 renders odd_ngon.obj
 renders odd_unknown.obj \
