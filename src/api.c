@@ -226,9 +226,11 @@ pk_status camera_validate(pk_context *ctx, const pk_camera *cam, const char *wha
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: fov %g must be between 0 and 180 degrees (exclusive)",
                          what, (double)cam->fov_deg);
     vec3 dir = v3_sub(at, from);
-    if (!(v3_len(dir) > 0.0f) || !isfinite(v3_len(dir)))
+    if (!v3_finite(dir))
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: look_from and look_at are too far apart", what);
+    if (dir.x == 0.0f && dir.y == 0.0f && dir.z == 0.0f)
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: look_from and look_at are the same point", what);
-    vec3 x = v3_cross(v3_norm(dir), v3_norm(up));
+    vec3 x = v3_cross(v3_norm_scaled(dir), v3_norm_scaled(up));
     if (!(v3_len(x) > 1e-6f))
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: up vector is zero or parallel to the view direction", what);
     return PK_OK;
@@ -343,6 +345,9 @@ pk_status pk_render(pk_context *ctx, const pk_scene *scene, const pk_render_opti
     if (st != PK_OK) return st;
     pk_camera cam;
     pk_scene_get_camera(scene, &cam);
+    if (!scene->has_camera && camera_validate(NULL, &cam, "camera") != PK_OK)
+        return ctx_error(ctx, PK_ERR_LIMIT, "%s: the scene is too large to frame automatically; give it a camera",
+                         scene->name);
     st = camera_validate(ctx, &cam, "camera");
     if (st != PK_OK) return st;
     return render_scene(ctx, scene, &cam, &o, out, stats);

@@ -358,11 +358,11 @@ static pk_status parse_camera(jp *p, const cJSON *it)
             return jfail(p, PK_ERR_PARSE, f[C_FOV], "camera.fov", "must be between 0 and 180 degrees (exclusive)");
     }
     vec3 dir = v3_sub(at, from);
-    if (!(v3_len2(dir) > 0.0f) || !v3_finite(dir))
+    if ((dir.x == 0.0f && dir.y == 0.0f && dir.z == 0.0f) || !v3_finite(dir))
         return jfail(p, PK_ERR_PARSE, f[C_AT], "camera.look_at", "must differ from look_from");
-    if (!(v3_len2(up) > 0.0f))
+    if (up.x == 0.0f && up.y == 0.0f && up.z == 0.0f)
         return jfail(p, PK_ERR_PARSE, f[C_UP], "camera.up", "must not be zero");
-    if (!(v3_len(v3_cross(v3_norm(dir), v3_norm(up))) > 1e-4f)) {
+    if (!(v3_len(v3_cross(v3_norm_scaled(dir), v3_norm_scaled(up))) > 1e-4f)) {
         if (f[C_UP]) return jfail(p, PK_ERR_PARSE, f[C_UP], "camera.up", "is parallel to the view direction");
         return jfail(p, PK_ERR_PARSE, it, "camera",
                      "the default up [0, 1, 0] is parallel to the view direction; give \"up\"");

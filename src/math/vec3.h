@@ -34,6 +34,15 @@ static inline vec3 v3_norm(vec3 a)
     float l = v3_len(a);
     return l > 0.0f ? v3_scale(a, 1.0f / l) : a;
 }
+/* Unit vector for any finite a, however large (1e30) or small (1e-30) its
+ * components: a is divided by its largest |component| first, so that the
+ * squared length neither overflows nor underflows. Zero stays zero. */
+static inline vec3 v3_norm_scaled(vec3 a)
+{
+    float m = fmaxf(fabsf(a.x), fmaxf(fabsf(a.y), fabsf(a.z)));
+    if (!(m > 0.0f) || !isfinite(m)) return v3_norm(a);
+    return v3_norm(v3(a.x / m, a.y / m, a.z / m));
+}
 static inline vec3 v3_min(vec3 a, vec3 b) { return v3(fminf(a.x, b.x), fminf(a.y, b.y), fminf(a.z, b.z)); }
 static inline vec3 v3_max(vec3 a, vec3 b) { return v3(fmaxf(a.x, b.x), fmaxf(a.y, b.y), fmaxf(a.z, b.z)); }
 static inline float v3_get(vec3 a, int axis) { return axis == 0 ? a.x : axis == 1 ? a.y : a.z; }

@@ -88,8 +88,8 @@ static camera_frame camera_setup(const pk_camera *cam, int width, int height)
     vec3 at = v3(cam->look_at[0], cam->look_at[1], cam->look_at[2]);
     vec3 up = v3(cam->up[0], cam->up[1], cam->up[2]);
     f.origin = from;
-    f.w = v3_norm(v3_sub(from, at));
-    f.u = v3_norm(v3_cross(up, f.w));
+    f.w = v3_norm_scaled(v3_sub(from, at));
+    f.u = v3_norm(v3_cross(v3_norm_scaled(up), f.w));
     f.v = v3_cross(f.w, f.u);
     f.half_h = tanf(0.5f * cam->fov_deg * PK_PI / 180.0f);
     f.half_w = f.half_h * (float)width / (float)height;

@@ -18,6 +18,21 @@ typedef struct surface {
     const material *m;
 } surface;
 
+/* Unit normal of triangle abc (unnormalised orientation cross(b-a, c-a)),
+ * taken in double so that huge (1e30) and tiny (1e-30) triangles, which
+ * scene_commit keeps, do not get an overflowed or vanished normal. */
+static vec3 tri_normal(vec3 a, vec3 b, vec3 c)
+{
+    double ex = (double)b.x - (double)a.x, ey = (double)b.y - (double)a.y, ez = (double)b.z - (double)a.z;
+    double fx = (double)c.x - (double)a.x, fy = (double)c.y - (double)a.y, fz = (double)c.z - (double)a.z;
+    double nx = ey * fz - ez * fy, ny = ez * fx - ex * fz, nz = ex * fy - ey * fx;
+    double m = fmax(fabs(nx), fmax(fabs(ny), fabs(nz)));
+    if (!(m > 0.0)) return v3s(0.0f);
+    nx /= m, ny /= m, nz /= m;
+    double l = sqrt(nx * nx + ny * ny + nz * nz);
+    return v3((float)(nx / l), (float)(ny / l), (float)(nz / l));
+}
+
 static surface surface_at(const integrator *in, const ray *r, const hit *h)
 {
     const pk_scene *s = in->s;
@@ -29,7 +44,7 @@ static surface surface_at(const integrator *in, const ray *r, const hit *h)
         scene_tri_verts(s, h->prim, &a, &b, &c);
         float w = 1.0f - h->u - h->v;
         sf.p = v3_add(v3_add(v3_scale(a, w), v3_scale(b, h->u)), v3_scale(c, h->v));
-        ng = v3_norm(v3_cross(v3_sub(b, a), v3_sub(c, a)));
+        ng = tri_normal(a, b, c);
         ns = ng;
         if (t->n[0] >= 0 && t->n[1] >= 0 && t->n[2] >= 0) {
             vec3 n = v3_add(v3_add(v3_scale(s->normals[t->n[0]], w), v3_scale(s->normals[t->n[1]], h->u)),
@@ -44,7 +59,7 @@ static surface surface_at(const integrator *in, const ray *r, const hit *h)
     } else {
         const sphere *sp = &s->spheres[h->prim - s->ntris];
         vec3 p = v3_add(r->o, v3_scale(r->d, h->t));
-        ng = v3_norm(v3_sub(p, sp->center));
+        ng = v3_norm_scaled(v3_sub(p, sp->center));
         sf.p = v3_add(sp->center, v3_scale(ng, sp->radius));
         ns = ng;
         sf.m = &s->materials[sp->material];
@@ -150,7 +165,7 @@ static vec3 direct_light(const integrator *in, thread_state *ts, const surface *
             float dist2 = v3_len2(d);
             if (!(dist2 > 0.0f)) continue;
             vec3 wi = v3_scale(d, 1.0f / sqrtf(dist2));
-            vec3 nl = v3_norm(v3_cross(v3_sub(b, a), v3_sub(c, a)));
+            vec3 nl = tri_normal(a, b, c);
             float cos_l = fabsf(v3_dot(nl, wi)); /* emitters are two-sided */
             vec3 f = brdf_cos(sf, wo, wi);
             if (is_black(f) || cos_l <= 0.0f) continue;

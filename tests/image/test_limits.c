@@ -2,8 +2,9 @@
  * test_limits.c - the bounds of a render (issue 4): every option out of
  * range is refused with its exact message, the ray tree of a pathological
  * scene (glass inside a closed mirror, depth 64) stays within the ray budget,
- * a cancelled render returns its finished tiles, and an image write that
- * fails leaves the existing file and no temporary file.
+ * a cancelled render returns its finished tiles, cameras at the ends of the
+ * float range are handled, and an image write that fails leaves the
+ * existing file and no temporary file.
  */
 #include "test.h"
 
@@ -121,6 +122,36 @@ static void test_cancel(const pk_scene *s)
     pk_image_destroy(img);
 }
 
+/* Cameras and scenes at the ends of the float range: a camera 1e30 away is
+ * valid (its direction is normalised without overflow), one whose direction
+ * overflows is refused by name, and so is a scene too large to frame. */
+static void test_far(void)
+{
+    const char *huge = "v -3e38 0 0\nv 3e38 0 0\nv 0 3e38 0\nf 1 2 3\n";
+    pk_scene *s = NULL;
+    REQUIRE(pk_scene_load_obj_memory(ctx, huge, strlen(huge), "huge.obj", NULL, &s) == PK_OK);
+    pk_render_options o;
+    pk_render_options_init(&o);
+    o.width = o.height = 8;
+    pk_image *img = NULL;
+    CHECK(pk_render(ctx, s, &o, &img, NULL) == PK_ERR_LIMIT && img == NULL);
+    CHECKF(strcmp(pk_context_error(ctx), "huge.obj: the scene is too large to frame automatically; give it a camera") ==
+               0, "%s", pk_context_error(ctx));
+    pk_context_clear_error(ctx);
+    pk_camera far = {{0.0f, 1e30f, 1e30f}, {0.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, 40.0f};
+    CHECKF(pk_scene_set_camera(ctx, s, &far) == PK_OK, "%s", pk_context_error(ctx));
+    pk_camera apart = {{0.0f, 0.0f, 3e38f}, {0.0f, 0.0f, -3e38f}, {0.0f, 1.0f, 0.0f}, 40.0f};
+    CHECK(pk_scene_set_camera(ctx, s, &apart) == PK_ERR_INVALID_ARGUMENT);
+    CHECKF(strcmp(pk_context_error(ctx), "camera: look_from and look_at are too far apart") == 0, "%s",
+           pk_context_error(ctx));
+    pk_context_clear_error(ctx);
+    pk_camera tiny = {{0.0f, 0.0f, 1e-30f}, {0.0f, 0.0f, 0.0f}, {0.0f, 1e-30f, 0.0f}, 40.0f};
+    CHECKF(pk_scene_set_camera(ctx, s, &tiny) == PK_OK, "%s", pk_context_error(ctx));
+    CHECK(pk_render(ctx, s, &o, &img, NULL) == PK_OK);
+    pk_image_destroy(img);
+    pk_scene_destroy(s);
+}
+
 static int count_tmp(const char *dir)
 {
     int n = 0;
@@ -165,6 +196,7 @@ int main(void)
     test_options(s);
     test_cancel(s);
     test_ray_budget();
+    test_far();
     test_write();
     pk_scene_destroy(s);
     pk_context_destroy(ctx);
