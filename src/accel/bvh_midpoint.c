@@ -106,6 +106,12 @@ static pk_status build(build_state *b, uint32_t nprims)
     return PK_OK;
 }
 
+/* min/max that return b when a is NaN (0 * inf on a slab plane of a flat box):
+ * the slab value goes first, the running interval second. Plain compares,
+ * so they compile to minss/maxss instead of calls to fminf/fmaxf. */
+static inline float min_nan(float a, float b) { return a < b ? a : b; }
+static inline float max_nan(float a, float b) { return a > b ? a : b; }
+
 /* Slab test; tfar is scaled up by 1 + 2*gamma(3) so that rounding never culls
  * a box the ray touches (robust traversal, Ize 2013). */
 static inline bool box_hit(const aabb *b, const ray_pre *r, float tmax, float *tnear)
@@ -113,9 +119,13 @@ static inline bool box_hit(const aabb *b, const ray_pre *r, float tmax, float *t
     float tx0 = (b->lo.x - r->o.x) * r->inv_d.x, tx1 = (b->hi.x - r->o.x) * r->inv_d.x;
     float ty0 = (b->lo.y - r->o.y) * r->inv_d.y, ty1 = (b->hi.y - r->o.y) * r->inv_d.y;
     float tz0 = (b->lo.z - r->o.z) * r->inv_d.z, tz1 = (b->hi.z - r->o.z) * r->inv_d.z;
-    /* fminf/fmaxf drop the NaN of 0*inf (origin on a slab plane of a flat box) */
-    float t0 = fmaxf(fmaxf(fminf(tx0, tx1), fminf(ty0, ty1)), fmaxf(fminf(tz0, tz1), r->tmin));
-    float t1 = fminf(fminf(fmaxf(tx0, tx1), fmaxf(ty0, ty1)), fminf(fmaxf(tz0, tz1), tmax));
+    float t0 = r->tmin, t1 = tmax;
+    t0 = max_nan(min_nan(tx0, tx1), t0);
+    t1 = min_nan(max_nan(tx0, tx1), t1);
+    t0 = max_nan(min_nan(ty0, ty1), t0);
+    t1 = min_nan(max_nan(ty0, ty1), t1);
+    t0 = max_nan(min_nan(tz0, tz1), t0);
+    t1 = min_nan(max_nan(tz0, tz1), t1);
     t1 *= 1.0f + 2.0f * 3.0f * 0.5f * 1.1920929e-7f * 1.0001f;
     *tnear = t0;
     return t0 <= t1;
