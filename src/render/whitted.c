@@ -21,7 +21,7 @@ typedef struct surface {
 /* Unit normal of triangle abc (unnormalised orientation cross(b-a, c-a)),
  * taken in double so that huge (1e30) and tiny (1e-30) triangles, which
  * scene_commit keeps, do not get an overflowed or vanished normal. */
-static vec3 tri_normal(vec3 a, vec3 b, vec3 c)
+static vec3 tri_normal_double(vec3 a, vec3 b, vec3 c)
 {
     double ex = (double)b.x - (double)a.x, ey = (double)b.y - (double)a.y, ez = (double)b.z - (double)a.z;
     double fx = (double)c.x - (double)a.x, fy = (double)c.y - (double)a.y, fz = (double)c.z - (double)a.z;
@@ -31,6 +31,16 @@ static vec3 tri_normal(vec3 a, vec3 b, vec3 c)
     nx /= m, ny /= m, nz /= m;
     double l = sqrt(nx * nx + ny * ny + nz * nz);
     return v3((float)(nx / l), (float)(ny / l), (float)(nz / l));
+}
+
+/* The float cross product serves all but extreme triangles, whose squared
+ * length overflows or vanishes; those take the double path. */
+static inline vec3 tri_normal(vec3 a, vec3 b, vec3 c)
+{
+    vec3 n = v3_cross(v3_sub(b, a), v3_sub(c, a));
+    float l2 = v3_len2(n);
+    if (PK_LIKELY(l2 > 1e-30f && l2 < 1e30f)) return v3_scale(n, 1.0f / sqrtf(l2));
+    return tri_normal_double(a, b, c);
 }
 
 static surface surface_at(const integrator *in, const ray *r, const hit *h)
@@ -155,7 +165,8 @@ static vec3 direct_light(const integrator *in, thread_state *ts, const surface *
             size_t li = light_pick(in, u);
             float lo = li ? in->light_cdf[li - 1] : 0.0f;
             float p_tri = in->light_cdf[li] - lo;
-            float u1 = fminf(0x1.fffffep-1f, fmaxf(0.0f, (u - lo) / p_tri));
+            float u1 = (u - lo) / p_tri;
+            u1 = u1 > 0.0f ? (u1 < 0x1.fffffep-1f ? u1 : 0x1.fffffep-1f) : 0.0f;
             float u2 = rng_float(&ts->rng);
             uint32_t tri = s->emissive[li];
             vec3 a, b, c;
@@ -165,7 +176,7 @@ static vec3 direct_light(const integrator *in, thread_state *ts, const surface *
             float dist2 = v3_len2(d);
             if (!(dist2 > 0.0f)) continue;
             vec3 wi = v3_scale(d, 1.0f / sqrtf(dist2));
-            vec3 nl = tri_normal(a, b, c);
+            vec3 nl = in->light_normal[li];
             float cos_l = fabsf(v3_dot(nl, wi)); /* emitters are two-sided */
             vec3 f = brdf_cos(sf, wo, wi);
             if (is_black(f) || cos_l <= 0.0f) continue;
@@ -255,7 +266,8 @@ pk_status integrator_init(pk_context *ctx, integrator *in, const pk_scene *s, co
     if (s->nemissive == 0) return PK_OK;
     in->light_cdf = mem_realloc_array(&ctx->alloc, NULL, s->nemissive, sizeof(float));
     in->light_area = mem_realloc_array(&ctx->alloc, NULL, s->nemissive, sizeof(float));
-    if (!in->light_cdf || !in->light_area) {
+    in->light_normal = mem_realloc_array(&ctx->alloc, NULL, s->nemissive, sizeof(vec3));
+    if (!in->light_cdf || !in->light_area || !in->light_normal) {
         integrator_free(&ctx->alloc, in);
         return ctx_nomem(ctx);
     }
@@ -265,6 +277,7 @@ pk_status integrator_init(pk_context *ctx, integrator *in, const pk_scene *s, co
         scene_tri_verts(s, s->emissive[i], &a0, &b0, &c0);
         float area = 0.5f * v3_len(v3_cross(v3_sub(b0, a0), v3_sub(c0, a0)));
         in->light_area[i] = area;
+        in->light_normal[i] = tri_normal(a0, b0, c0);
         float lum = v3_luminance(s->materials[s->tris[s->emissive[i]].material].ke);
         total += (double)fmaxf(lum, 1e-6f) * (double)area;
         in->light_cdf[i] = (float)total;
@@ -279,5 +292,7 @@ void integrator_free(const pk_allocator *al, integrator *in)
 {
     mem_free(al, in->light_cdf);
     mem_free(al, in->light_area);
+    mem_free(al, in->light_normal);
     in->light_cdf = in->light_area = NULL;
+    in->light_normal = NULL;
 }

@@ -26,6 +26,7 @@ typedef struct integrator {
     bool fresnel;
     float *light_cdf;    /* nemissive entries, cumulative power, last = 1 */
     float *light_area;   /* area of each emissive triangle */
+    vec3 *light_normal;  /* unit geometric normal of each emissive triangle */
     float light_power;   /* total emitted power (luminance * area) */
     float eps;           /* base offset for spawned rays, world units */
 } integrator;
