@@ -9,6 +9,7 @@
 
 #include <immintrin.h>
 #include <omp.h>
+#include <stdlib.h>
 #include <string.h>
 #if defined(__linux__)
 #include <sys/mman.h>
@@ -26,7 +27,7 @@
 #define SPATIAL_EXTRA 0.25 /* spatial splits may add this many references per primitive */
 #endif
 #define SPATIAL_DEPTH_MAX 24
-#define SPATIAL_ALPHA 1e-5f /* ... where children overlap by this fraction of the root's area */
+#define SPATIAL_ALPHA 1e-2f /* ... where children overlap by this fraction of the root's area */
 
 /* A box in two SSE registers (lane 3 unused). */
 typedef struct sbox {
@@ -136,12 +137,13 @@ typedef struct binner {
     int nbins;        /* NBINS, fewer for small ranges */
 } binner;
 
-static inline int bin_of(const binner *bn, __m128 c2, int axis)
+/* The bin of a reference's doubled centroid on axis: find_split's vector
+ * binning, on scalars (the same IEEE operations, so the same bin). */
+static inline int part_bin(const sbox *r, int axis, float lo, float scale, int nbm1)
 {
-    float c[4];
-    _mm_storeu_ps(c, c2);
-    int k = (int)((c[axis] - bn->lo[axis]) * bn->scale[axis]);
-    return k < 0 ? 0 : k >= bn->nbins ? bn->nbins - 1 : k;
+    const float *pl = (const float *)&r->lo, *ph = (const float *)&r->hi;
+    int k = (int)(((pl[axis] + ph[axis]) - lo) * scale);
+    return k < 0 ? 0 : k > nbm1 ? nbm1 : k;
 }
 
 /* Binned SAH over the doubled centroids in cb; false when every axis is flat. */
@@ -532,19 +534,21 @@ static void build_node(builder *b, uint32_t ni, uint32_t begin, uint32_t end, ui
     uint32_t mid;
     if (ok) {
         const int ax = s.axis, sb = s.bin;
+        /* part_bin: the same bins as find_split's binning */
+        const float blo = bn.lo[ax], bsc = bn.scale[ax];
+        const int nbm1 = bn.nbins - 1;
         uint32_t i = begin, j = end;
         lcb = sbox_empty();
         rcb = sbox_empty();
         for (;;) {
             while (i < j) {
-                __m128 c = centroid2(&b->rbox[i]);
-                if (bin_of(&bn, c, ax) >= sb) break;
-                lcb = sbox_grow(lcb, c);
+                if (part_bin(&b->rbox[i], ax, blo, bsc, nbm1) >= sb) break;
+                lcb = sbox_grow(lcb, centroid2(&b->rbox[i]));
                 i++;
             }
             while (i < j) {
+                if (part_bin(&b->rbox[j - 1], ax, blo, bsc, nbm1) < sb) break;
                 __m128 c = centroid2(&b->rbox[j - 1]);
-                if (bin_of(&bn, c, ax) < sb) break;
                 rcb = sbox_grow(rcb, c);
                 j--;
             }
@@ -862,11 +866,10 @@ pk_status accel_bvh_create(pk_context *ctx, const accel_input *in, accel **out)
     for (size_t i = 0; i < in->ntris; i++) {
         const vec3 *p = in->verts + 3 * i;
         if (bvh_tri_degenerate(p[0], p[1], p[2])) continue;
-        sbox bx;
-        bx.lo = _mm_setr_ps(fminf(p[0].x, fminf(p[1].x, p[2].x)), fminf(p[0].y, fminf(p[1].y, p[2].y)),
-                            fminf(p[0].z, fminf(p[1].z, p[2].z)), 0.0f);
-        bx.hi = _mm_setr_ps(fmaxf(p[0].x, fmaxf(p[1].x, p[2].x)), fmaxf(p[0].y, fmaxf(p[1].y, p[2].y)),
-                            fmaxf(p[0].z, fmaxf(p[1].z, p[2].z)), 0.0f);
+        /* finite vertices (not degenerate): SSE min/max, not libm's fminf */
+        const __m128 a = _mm_setr_ps(p[0].x, p[0].y, p[0].z, 0.0f), b1 = _mm_setr_ps(p[1].x, p[1].y, p[1].z, 0.0f),
+                     c2 = _mm_setr_ps(p[2].x, p[2].y, p[2].z, 0.0f);
+        sbox bx = {_mm_min_ps(a, _mm_min_ps(b1, c2)), _mm_max_ps(a, _mm_max_ps(b1, c2))};
         rbox[n] = bx;
         rid[n++] = (uint32_t)i;
         root = sbox_union(root, bx);
@@ -885,7 +888,10 @@ pk_status accel_bvh_create(pk_context *ctx, const accel_input *in, accel **out)
         rootc = sbox_grow(rootc, centroid2(&bx));
         any_sphere = true;
     }
-    const uint32_t cap = n + (uint32_t)((double)n * SPATIAL_EXTRA);
+    /* PAPRSEK_BVH_QUALITY=fast: no spatial splits (no room for duplicates) */
+    const char *q = getenv("PAPRSEK_BVH_QUALITY");
+    const bool high = !(q && strcmp(q, "fast") == 0);
+    const uint32_t cap = n + (high ? (uint32_t)((double)n * SPATIAL_EXTRA) : 0);
 
     builder b = {rbox, rid, in, NULL, 1, (uint32_t)in->ntris, any_sphere, 0.0f};
     b.min_overlap = SPATIAL_ALPHA * sbox_half_area(root);
