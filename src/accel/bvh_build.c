@@ -147,6 +147,40 @@ static inline int part_bin(const sbox *r, int axis, float lo, float scale, int n
 }
 
 /* Binned SAH over the doubled centroids in cb; false when every axis is flat. */
+/* Sweeps the nb bins of one axis for the cheapest plane between bins k-1 and
+ * k: the left side takes the boxes and lcount of bins < k, the right side the
+ * boxes and rcount of bins >= k (object splits pass one count for both,
+ * spatial splits their entering and leaving counts). Returns the best k and
+ * lowers *cost, or returns 0 when no plane is cheaper than *cost. */
+#define SWEEP_MAX_BINS 32
+static int sah_sweep(const sbox *bins, const uint32_t *lcount, const uint32_t *rcount, int nb, float *cost)
+{
+    float rarea[SWEEP_MAX_BINS];
+    uint32_t rcnt[SWEEP_MAX_BINS];
+    sbox acc = sbox_empty();
+    uint32_t cnt = 0;
+    for (int k = nb - 1; k > 0; k--) {
+        acc = sbox_union(acc, bins[k]);
+        cnt += rcount[k];
+        rarea[k] = sbox_half_area(acc);
+        rcnt[k] = cnt;
+    }
+    acc = sbox_empty();
+    cnt = 0;
+    int best = 0;
+    for (int k = 1; k < nb; k++) {
+        acc = sbox_union(acc, bins[k - 1]);
+        cnt += lcount[k - 1];
+        if (cnt == 0 || rcnt[k] == 0) continue;
+        float c = sbox_half_area(acc) * sah_blocks(cnt) + rarea[k] * sah_blocks(rcnt[k]);
+        if (c < *cost) {
+            *cost = c;
+            best = k;
+        }
+    }
+    return best;
+}
+
 static bool find_split(const builder *b, uint32_t begin, uint32_t end, sbox cb, binner *bn, split *best)
 {
     float lo[4], hi[4];
@@ -191,29 +225,11 @@ static bool find_split(const builder *b, uint32_t begin, uint32_t end, sbox cb, 
     best->cost = INFINITY;
     for (int ax = 0; ax < 3; ax++) {
         if (bn->scale[ax] == 0.0f) continue;
-        float rarea[NBINS];
-        uint32_t rcount[NBINS];
-        sbox acc = sbox_empty();
-        uint32_t cnt = 0;
-        for (int k = nb - 1; k > 0; k--) {
-            acc = sbox_union(acc, bins[ax][k]);
-            cnt += counts[ax][k];
-            rarea[k] = sbox_half_area(acc);
-            rcount[k] = cnt;
-        }
-        acc = sbox_empty();
-        cnt = 0;
-        for (int k = 1; k < nb; k++) {
-            acc = sbox_union(acc, bins[ax][k - 1]);
-            cnt += counts[ax][k - 1];
-            if (cnt == 0 || rcount[k] == 0) continue;
-            float cost = sbox_half_area(acc) * sah_blocks(cnt) + rarea[k] * sah_blocks(rcount[k]);
-            if (cost < best->cost) {
-                best->cost = cost;
-                best->axis = ax;
-                best->bin = k;
-                found = true;
-            }
+        int k = sah_sweep(bins[ax], counts[ax], counts[ax], nb, &best->cost);
+        if (k) {
+            best->axis = ax;
+            best->bin = k;
+            found = true;
         }
     }
     if (!found) return false;
@@ -297,6 +313,7 @@ static sbox clip_ref(const builder *b, uint32_t id, sbox rb, int axis, float a, 
 }
 
 #define SPATIAL_BINS 16
+_Static_assert(NBINS <= SWEEP_MAX_BINS && SPATIAL_BINS <= SWEEP_MAX_BINS, "sweep buffers");
 
 typedef struct sp_split {
     int axis;
@@ -356,29 +373,11 @@ static bool find_spatial(const builder *b, uint32_t begin, uint32_t end, sbox nb
     }
     for (int ax = 0; ax < 3; ax++) {
         if (!use[ax]) continue;
-        float rarea[SPATIAL_BINS];
-        uint32_t rcount[SPATIAL_BINS];
-        sbox acc = sbox_empty();
-        uint32_t cnt = 0;
-        for (int k = SPATIAL_BINS - 1; k > 0; k--) {
-            acc = sbox_union(acc, bins[ax][k]);
-            cnt += leave[ax][k];
-            rarea[k] = sbox_half_area(acc);
-            rcount[k] = cnt;
-        }
-        acc = sbox_empty();
-        cnt = 0;
-        for (int k = 1; k < SPATIAL_BINS; k++) {
-            acc = sbox_union(acc, bins[ax][k - 1]);
-            cnt += enter[ax][k - 1];
-            if (cnt == 0 || rcount[k] == 0) continue;
-            float cost = sbox_half_area(acc) * sah_blocks(cnt) + rarea[k] * sah_blocks(rcount[k]);
-            if (cost < best->cost) {
-                best->cost = cost;
-                best->axis = ax;
-                best->plane = lo[ax] + (float)k * w[ax];
-                found = true;
-            }
+        int k = sah_sweep(bins[ax], enter[ax], leave[ax], SPATIAL_BINS, &best->cost);
+        if (k) {
+            best->axis = ax;
+            best->plane = lo[ax] + (float)k * w[ax];
+            found = true;
         }
     }
     return found;
