@@ -9,7 +9,7 @@ FUZZ_PKGS   = $(TEST_PKGS) clang libclang-rt-14-dev libomp-14-dev
 FUZZ_SECONDS ?= 60
 FUZZERS     = obj mtl json render
 
-.PHONY: all build demo test deps deps-test bench clean build-asan sanitize fuzz fuzz-build fuzz-merge
+.PHONY: all build demo test deps deps-test bench clean build-asan sanitize fuzz fuzz-build fuzz-seeds fuzz-merge
 
 all: build
 
@@ -66,22 +66,41 @@ sanitize: build-asan
 FUZZ_DIR   = build-fuzz
 FUZZ_FLAGS = -max_len=65536 -rss_limit_mb=2048 -timeout=10 -print_final_stats=1
 FUZZ_SEEDS = tests/data $(wildcard ../shared/scenes/cornell)
+# The public scenes of ../shared/scenes (when present) seed the fuzzers too,
+# by kind: $(FUZZ_DIR)/seeds/<name> holds links to every .obj (obj, render),
+# .mtl (mtl) and .json (json, render) file there; inputs beyond -max_len are
+# read truncated.
+SHARED_SCENES = ../shared/scenes
 
 $(FUZZ_DIR)/CMakeCache.txt:
+	$(call ensure_pkgs,$(FUZZ_PKGS))
 	CC=clang cmake -S . -B $(FUZZ_DIR) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPK_FUZZ=ON -DPK_WITH_EMBREE=OFF
 
 fuzz-build: $(FUZZ_DIR)/CMakeCache.txt
 	$(call ensure_pkgs,$(FUZZ_PKGS))
 	cmake --build $(FUZZ_DIR) -j $(JOBS)
 
-fuzz: fuzz-build
+fuzz-seeds:
+	@for f in $(FUZZERS); do rm -rf $(FUZZ_DIR)/seeds/$$f; mkdir -p $(FUZZ_DIR)/seeds/$$f; done
+	@if [ -d $(SHARED_SCENES) ]; then \
+	  find $(abspath $(SHARED_SCENES)) -type f \( -name '*.obj' -o -name '*.mtl' -o -name '*.json' \) | while read -r p; do \
+	    n=$$(echo "$${p#$(abspath $(SHARED_SCENES))/}" | tr '/' '_'); \
+	    case "$$p" in \
+	      *.obj) ln -sf "$$p" $(FUZZ_DIR)/seeds/obj/$$n; ln -sf "$$p" $(FUZZ_DIR)/seeds/render/$$n;; \
+	      *.mtl) ln -sf "$$p" $(FUZZ_DIR)/seeds/mtl/$$n;; \
+	      *.json) ln -sf "$$p" $(FUZZ_DIR)/seeds/json/$$n; ln -sf "$$p" $(FUZZ_DIR)/seeds/render/$$n;; \
+	    esac; \
+	  done; \
+	else echo "$(SHARED_SCENES) is absent: the fuzzers start from tests/data and the corpus only"; fi
+
+fuzz: fuzz-build fuzz-seeds
 	@for f in $(FUZZERS); do \
 	  mkdir -p $(FUZZ_DIR)/corpus/$$f $(FUZZ_DIR)/crashers/$$f tests/fuzz/corpus/$$f; \
 	  echo "== fuzz_$$f for $(FUZZ_SECONDS) s"; \
 	  ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  nice -n 19 ./$(FUZZ_DIR)/tests/fuzz_$$f -max_total_time=$(FUZZ_SECONDS) $(FUZZ_FLAGS) \
 	    -dict=tests/fuzz/$$f.dict -artifact_prefix=$(FUZZ_DIR)/crashers/$$f/ \
-	    $(FUZZ_DIR)/corpus/$$f tests/fuzz/corpus/$$f $(FUZZ_SEEDS) >$(FUZZ_DIR)/fuzz_$$f.log 2>&1; \
+	    $(FUZZ_DIR)/corpus/$$f tests/fuzz/corpus/$$f $(FUZZ_SEEDS) $(FUZZ_DIR)/seeds/$$f >$(FUZZ_DIR)/fuzz_$$f.log 2>&1; \
 	  status=$$?; \
 	  grep -E '^#[0-9]+.*(DONE|pulse)|stat::|ERROR|SUMMARY' $(FUZZ_DIR)/fuzz_$$f.log | tail -n 12; \
 	  if [ $$status -ne 0 ]; then echo "fuzz_$$f found a problem: see $(FUZZ_DIR)/fuzz_$$f.log and $(FUZZ_DIR)/crashers/$$f/"; exit 1; fi; \

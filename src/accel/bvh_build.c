@@ -139,11 +139,20 @@ typedef struct binner {
 
 /* The bin of a reference's doubled centroid on axis: find_split's vector
  * binning, on scalars (the same IEEE operations, so the same bin). */
+/* Bin index 0..nbm1 of a position t measured in bins. Clamped in float
+ * before the conversion, so that no NaN or out-of-range value is ever
+ * converted to int (undefined behaviour): NaN and negatives go to bin 0. */
+static inline int bin_clamp(float t, int nbm1)
+{
+    if (!(t > 0.0f)) return 0;
+    if (t >= (float)nbm1) return nbm1;
+    return (int)t;
+}
+
 static inline int part_bin(const sbox *r, int axis, float lo, float scale, int nbm1)
 {
     const float *pl = (const float *)&r->lo, *ph = (const float *)&r->hi;
-    int k = (int)(((pl[axis] + ph[axis]) - lo) * scale);
-    return k < 0 ? 0 : k > nbm1 ? nbm1 : k;
+    return bin_clamp(((pl[axis] + ph[axis]) - lo) * scale, nbm1);
 }
 
 /* Binned SAH over the doubled centroids in cb; false when every axis is flat. */
@@ -212,8 +221,10 @@ static bool find_split(const builder *b, uint32_t begin, uint32_t end, sbox cb, 
     for (uint32_t i = begin; i < end; i++) {
         const sbox *pb = &b->rbox[i];
         __m128 k4 = _mm_mul_ps(_mm_sub_ps(centroid2(pb), blo), bsc);
+        /* clamped in float as bin_clamp does (maxps returns its second operand
+         * for NaN, so NaN goes to 0), then truncated: always in 0..nb-1 */
+        k4 = _mm_min_ps(_mm_max_ps(k4, _mm_setzero_ps()), _mm_set1_ps((float)(nb - 1)));
         __m128i ki = _mm_cvttps_epi32(k4);
-        ki = _mm_max_epi32(_mm_setzero_si128(), _mm_min_epi32(ki, _mm_set1_epi32(nb - 1)));
         int k[4];
         _mm_storeu_si128((__m128i *)k, ki);
         for (int ax = 0; ax < 3; ax++) {
@@ -338,10 +349,18 @@ static bool find_spatial(const builder *b, uint32_t begin, uint32_t end, sbox nb
     sbox bins[3][SPATIAL_BINS];
     uint32_t enter[3][SPATIAL_BINS], leave[3][SPATIAL_BINS];
     for (int ax = 0; ax < 3; ax++) {
+        /* An axis is binned only when its bins have a width the arithmetic
+         * can resolve: a finite reciprocal and distinct planes. A box only
+         * denormals thick (ext 1e-38: SPATIAL_BINS / ext overflows to inf,
+         * and a reference on the box's face then gives 0 * inf = NaN as its
+         * bin) or too thin for its coordinates (lo + w == lo near 1e24) has no
+         * useful spatial split on that axis. */
         const float ext = hi[ax] - lo[ax];
-        use[ax] = ext > 0.0f && isfinite(ext);
         w[ax] = ext / SPATIAL_BINS;
-        inv[ax] = use[ax] ? SPATIAL_BINS / ext : 0.0f;
+        inv[ax] = SPATIAL_BINS / ext;
+        use[ax] = ext > 0.0f && isfinite(ext) && isfinite(inv[ax]) && lo[ax] + w[ax] > lo[ax] &&
+                  lo[ax] + (float)(SPATIAL_BINS - 1) * w[ax] < hi[ax];
+        if (!use[ax]) w[ax] = inv[ax] = 0.0f;
         for (int k = 0; k < SPATIAL_BINS; k++) {
             plo[ax][k] = vset(_mm_set1_ps(-INFINITY), ax, lo[ax] + (float)k * w[ax]);
             phi[ax][k] = vset(_mm_set1_ps(INFINITY), ax, lo[ax] + (float)(k + 1) * w[ax]);
@@ -356,9 +375,9 @@ static bool find_spatial(const builder *b, uint32_t begin, uint32_t end, sbox nb
         _mm_storeu_ps(rh, r->hi);
         for (int ax = 0; ax < 3; ax++) {
             if (!use[ax]) continue;
-            int k0 = (int)((rl[ax] - lo[ax]) * inv[ax]), k1 = (int)((rh[ax] - lo[ax]) * inv[ax]);
-            k0 = k0 < 0 ? 0 : k0 >= SPATIAL_BINS ? SPATIAL_BINS - 1 : k0;
-            k1 = k1 < k0 ? k0 : k1 >= SPATIAL_BINS ? SPATIAL_BINS - 1 : k1;
+            const int k0 = bin_clamp((rl[ax] - lo[ax]) * inv[ax], SPATIAL_BINS - 1);
+            int k1 = bin_clamp((rh[ax] - lo[ax]) * inv[ax], SPATIAL_BINS - 1);
+            if (k1 < k0) k1 = k0;
             enter[ax][k0]++;
             leave[ax][k1]++;
             if (k0 == k1) {

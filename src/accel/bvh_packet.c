@@ -335,10 +335,13 @@ done:
 }
 
 /* Direction signs; 8 for a ray that may not join a packet (a NaN or an
- * infinite origin would spoil the packet's bounds). */
+ * infinite origin would spoil the packet's bounds, and a direction component
+ * whose reciprocal overflows needs ray_rcp's NaN, which the packet's interval
+ * test does not take). */
 static inline unsigned octant(const ray *r)
 {
-    if (!v3_finite(r->o) || isnan(r->d.x) || isnan(r->d.y) || isnan(r->d.z) || isnan(r->tmin) || isnan(r->tmax))
+    if (!v3_finite(r->o) || isnan(r->d.x) || isnan(r->d.y) || isnan(r->d.z) || isnan(r->tmin) || isnan(r->tmax) ||
+        ray_dir_tiny(r->d))
         return 8;
     return (signbit(r->d.x) ? 1u : 0u) | (signbit(r->d.y) ? 2u : 0u) | (signbit(r->d.z) ? 4u : 0u);
 }

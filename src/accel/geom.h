@@ -45,11 +45,30 @@ static inline void hit_clear(hit *h)
 /* Ray data derived once per ray for traversal and the watertight test. */
 typedef struct ray_pre {
     vec3 o, d;
-    vec3 inv_d;        /* 1/d per axis (+-inf for zero components) */
+    vec3 inv_d;        /* ray_rcp(d) per axis */
     int kx, ky, kz;    /* shear axes: kz is the largest |d| component */
     float sx, sy, sz;  /* shear constants */
     float tmin;
 } ray_pre;
+
+/* 1/d for the slab tests: +-inf for a zero component (the ray never moves
+ * on that axis, exactly), NaN for a nonzero component whose reciprocal
+ * overflows (|d| <= 2^-128). inf there would be wrong: the ray does move, by
+ * |d| t, which matters for boxes only denormals apart; the slab tests take a
+ * NaN distance as "no limit on this axis" (conservative), and the triangle
+ * test decides exactly. */
+static inline float ray_rcp(float d)
+{
+    const float r = 1.0f / d;
+    return d != 0.0f && isinf(r) ? NAN : r;
+}
+
+/* true when a direction component is nonzero but too small for its
+ * reciprocal (or is NaN). */
+static inline bool ray_dir_tiny(vec3 d)
+{
+    return isnan(ray_rcp(d.x)) || isnan(ray_rcp(d.y)) || isnan(ray_rcp(d.z));
+}
 
 static inline ray_pre ray_prepare(const ray *r)
 {
@@ -57,7 +76,7 @@ static inline ray_pre ray_prepare(const ray *r)
     p.o = r->o;
     p.d = r->d;
     p.tmin = r->tmin;
-    p.inv_d = v3(1.0f / r->d.x, 1.0f / r->d.y, 1.0f / r->d.z);
+    p.inv_d = v3(ray_rcp(r->d.x), ray_rcp(r->d.y), ray_rcp(r->d.z));
     int kz = v3_max_axis_abs(r->d);
     int kx = kz + 1 == 3 ? 0 : kz + 1;
     int ky = kx + 1 == 3 ? 0 : kx + 1;

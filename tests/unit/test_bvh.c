@@ -753,6 +753,65 @@ static void check_synthetic(pk_context *ctx)
         check_input(ctx, &in2, 8000, false, 6, "tiny (1e-30)");
         free(big.v), free(tiny.v);
     }
+    /* coordinates near 1e24 mixed with denormal ones: nodes whose box is
+     * only denormals thick on one axis (1/extent overflows to inf) must not
+     * bin a reference lying on the box's face at 0 * inf = NaN (found by
+     * fuzzing; UndefinedBehaviorSanitizer fails the sanitize build there) */
+    {
+        const float thin[] = {0.0f, 0x1p-149f, 1.2e-45f, 1e-40f, 1.179435e-38f, -1e-45f};
+        const int nthin = (int)(sizeof thin / sizeof thin[0]);
+        mesh mix = {0};
+        for (int i = 0; i < 1500; i++) {
+            /* long slivers in an almost flat slab: overlapping children, so spatial splits are tried */
+            vec3 a = v3(rng_range(&g, -5, 5), rng_range(&g, -5, 5), thin[rng_u32(&g) % (unsigned)nthin]);
+            vec3 b = v3(a.x + rng_range(&g, -6, 6), a.y + rng_range(&g, -6, 6), thin[rng_u32(&g) % (unsigned)nthin]);
+            vec3 c = v3(0.5f * (a.x + b.x) + rng_range(&g, -0.1f, 0.1f), 0.5f * (a.y + b.y) + rng_range(&g, -0.1f, 0.1f),
+                        thin[rng_u32(&g) % (unsigned)nthin]);
+            mesh_tri(&mix, a, b, c);
+        }
+        accel_input flat = {mix.v, mix.ntris, NULL, 0, 2};
+        {
+            /* Two families of rays, each against brute force: rays from z = +-1
+             * through random points of the slab, and rays lying in the slab whose
+             * z direction is denormal (1/d overflows: the slab test must not
+             * take it as infinite). Rays that start inside the slab with a
+             * normal z direction are left out: their hits lie denormals away,
+             * below the resolution of the triangle test's arithmetic, which
+             * then disagrees with exact geometry by design. */
+            accel *a = build(ctx, &flat, "denormal-thin slab");
+            brute br;
+            brute_init(&br, &flat, false);
+            enum { NR = 20000 };
+            ray *rays = malloc(NR * sizeof *rays);
+            REQUIRE(rays);
+            for (int i = 0; i < NR; i++) {
+                vec3 target = v3(rng_range(&g, -6, 6), rng_range(&g, -6, 6), thin[rng_u32(&g) % (unsigned)nthin]);
+                if (i % 2 == 0) {
+                    vec3 o = v3(rng_range(&g, -8, 8), rng_range(&g, -8, 8), (rng_u32(&g) & 1) ? 1.0f : -1.0f);
+                    rays[i] = (ray){o, 0.0f, v3_sub(target, o), INFINITY};
+                } else {
+                    vec3 o = v3(rng_range(&g, -8, 8), rng_range(&g, -8, 8), thin[rng_u32(&g) % (unsigned)nthin]);
+                    vec3 d = v3_sub(target, o);
+                    d.z = (rng_u32(&g) & 1 ? 1.0f : -1.0f) * thin[1 + rng_u32(&g) % (unsigned)(nthin - 1)];
+                    rays[i] = (ray){o, 0.0f, d, INFINITY};
+                }
+            }
+            check_rays(a, &br, rays, NR, "denormal-thin slab");
+            free(rays);
+            brute_free(&br);
+            accel_destroy(a);
+        }
+        for (int i = 0; i < 600; i++) {
+            /* the same shapes scaled to 1e24 in x and y, some far off in z */
+            vec3 a = v3(rng_range(&g, -1e24f, 1e24f), rng_range(&g, -1e24f, 1e24f), thin[rng_u32(&g) % (unsigned)nthin]);
+            vec3 b = v3(a.x + rng_range(&g, -1e24f, 1e24f), a.y + 1e-40f, (i % 7 == 0) ? 1.2345e24f : thin[i % nthin]);
+            vec3 c = v3(a.x + 1e-45f, a.y + rng_range(&g, -1e24f, 1e24f), thin[rng_u32(&g) % (unsigned)nthin]);
+            mesh_tri(&mix, a, b, c);
+        }
+        accel_input both = {mix.v, mix.ntris, NULL, 0, 2};
+        check_input(ctx, &both, 20000, false, 9, "1e24 mixed with denormals");
+        free(mix.v);
+    }
     /* axis-parallel rays through an axis-aligned grid of quads, some lying in the planes */
     {
         mesh cube = {0};
