@@ -1,5 +1,5 @@
 /*
- * paprsek.h - the whole public interface of Paprsek, a Whitted ray tracer.
+ * paprsek.h - the whole public interface of Paprsek, a ray tracer.
  *
  * Everything a program may use is declared here; everything else is private.
  * Conventions: functions return pk_status (PK_OK == 0); fallible constructors
@@ -94,7 +94,7 @@ typedef struct pk_camera {
 typedef enum pk_accel_kind {
     PK_ACCEL_DEFAULT = 0,  /* the best built in (PK_ACCEL_BVH) */
     PK_ACCEL_NONE = 1,     /* every ray tests every primitive */
-    PK_ACCEL_MIDPOINT = 2, /* the seed's BVH: midpoint split, round-robin axis */
+    PK_ACCEL_MIDPOINT = 2, /* simple BVH (midpoint split), for comparison */
     PK_ACCEL_BVH = 3,      /* binned SAH, wide SIMD BVH */
     PK_ACCEL_EMBREE = 4    /* Embree 3, when built with it */
 } pk_accel_kind;
@@ -105,6 +105,12 @@ PK_API pk_status pk_accel_kind_parse(const char *name, pk_accel_kind *out);
 /* 1 when the accelerator is compiled in. */
 PK_API int pk_accel_available(pk_accel_kind kind);
 
+/* Progress of a render: done of total work units (tiles) finished, elapsed
+ * seconds since the render call began. Called from one thread, at most a few
+ * times per second, and once more at the end (done == total unless the render
+ * was cancelled). Returning non-zero cancels the render (PK_ERR_CANCELLED). */
+typedef int (*pk_progress_fn)(void *user, uint64_t done, uint64_t total, double elapsed_s);
+
 typedef struct pk_render_options {
     int width, height;   /* pixels */
     int spp;             /* samples per pixel, stratified jitter when > 1 */
@@ -112,16 +118,38 @@ typedef struct pk_render_options {
     int max_depth;       /* reflection/refraction recursion limit */
     int threads;         /* 0 = all cores */
     pk_accel_kind accel;
-    int fresnel;         /* 1 = exact dielectric Fresnel; 0 = the seed's fixed mix */
+    int fresnel;         /* 1 = exact dielectric Fresnel; 0 = fixed Ks/Tf weights */
     int collect_stats;   /* 1 = count rays, tests and nodes (small cost) */
     /* When non-NULL, the render stops soon after *cancel becomes non-zero and
      * returns PK_ERR_CANCELLED; the image then holds the finished tiles. */
     volatile const int *cancel;
+    pk_progress_fn progress; /* NULL: no progress reports */
+    void *progress_user;
 } pk_render_options;
 
 /* Defaults: 512x512, 1 spp, 32 light samples, depth 8, all threads, default
- * accelerator, Fresnel on, no statistics. */
+ * accelerator, Fresnel on, no statistics, no progress callback. */
 PK_API void pk_render_options_init(pk_render_options *opt);
+
+/* The integer render options and their ranges: one table serves the API
+ * (pk_render_options_check), JSON scenes (the "render" object) and the
+ * paprsek program (--name, with '_' written '-'). */
+typedef struct pk_int_option {
+    const char *name;    /* "width", "light_samples", ... */
+    const char *label;   /* as messages say it: "samples per pixel" */
+    const char *help;    /* one line for a user */
+    int min, max;        /* the accepted range, inclusive */
+    int default_value;
+    size_t offset;       /* offset of the int field in pk_render_options */
+} pk_int_option;
+
+/* The table (static storage); *count receives its length. */
+PK_API const pk_int_option *pk_int_options(size_t *count);
+/* The entry named name ("light_samples" or "light-samples"), or NULL. */
+PK_API const pk_int_option *pk_int_option_find(const char *name);
+/* Checks opt against the table, the pixel budget (PK_MAX_IMAGE_PIXELS) and
+ * the accelerators built in; latches "what is wrong" in ctx. */
+PK_API pk_status pk_render_options_check(pk_context *ctx, const pk_render_options *opt);
 
 typedef struct pk_stats {
     uint64_t rays_camera, rays_shadow, rays_reflection, rays_refraction;
@@ -130,6 +158,8 @@ typedef struct pk_stats {
     double build_us;             /* acceleration build, microseconds */
     double render_s;             /* rendering, seconds (wall clock) */
     int threads;                 /* threads used */
+    int accel_builds;            /* acceleration structures built (1 per renderer) */
+    uint64_t pixels;             /* pixels rendered (times the renders of a renderer) */
 } pk_stats;
 
 /* ---- scenes ------------------------------------------------------------ */
@@ -187,10 +217,69 @@ PK_API const float *pk_image_pixels_const(const pk_image *img);
  * existing file is only ever replaced by a complete image. */
 PK_API pk_status pk_image_write(pk_context *ctx, const pk_image *img, const char *path);
 
+/* ---- films: sums of samples, merged and resolved ------------------------ */
+
+/* A film holds, per pixel, the sum of the samples rendered there (linear RGB,
+ * 3 floats) and their count. Renders add into a film; films of the same size
+ * merge (from threads, processes or machines); resolving divides each sum by
+ * its count (pixels without samples are black). Merging films whose pixels
+ * come from one film each (disjoint regions, the usual case) is exact, so
+ * any order of merges gives the same bits. */
+typedef struct pk_film pk_film;
+
+PK_API pk_status pk_film_create(pk_context *ctx, int width, int height, pk_film **out);
+PK_API void pk_film_destroy(pk_film *film);
+PK_API int pk_film_width(const pk_film *film);
+PK_API int pk_film_height(const pk_film *film);
+/* Sets every sum and count to zero. */
+PK_API void pk_film_clear(pk_film *film);
+/* dst += src, pixel by pixel; PK_ERR_INVALID_ARGUMENT when sizes differ. */
+PK_API pk_status pk_film_merge(pk_context *ctx, pk_film *dst, const pk_film *src);
+/* The raw data, for moving films between processes: 3 floats (sum of R, G, B)
+ * and one uint32_t (sample count) per pixel, rows top to bottom. */
+PK_API float *pk_film_sums(pk_film *film);
+PK_API uint32_t *pk_film_counts(pk_film *film);
+/* A new image of the film's size: sum / count per pixel (0 where count is 0
+ * or the mean is not finite). */
+PK_API pk_status pk_film_resolve(pk_context *ctx, const pk_film *film, pk_image **out);
+
 /* ---- rendering --------------------------------------------------------- */
 
-/* Renders scene into a new image (*out, owned by the caller). stats may be NULL.
- * On PK_ERR_CANCELLED *out still holds the partial image. */
+/* A rectangle of the image in pixels: columns x .. x+width-1, rows y .. y+height-1. */
+typedef struct pk_region {
+    int x, y, width, height;
+} pk_region;
+
+/* A render session: the acceleration structure and the light tables are built
+ * once, in pk_renderer_create, and serve every render of the session (regions,
+ * passes, camera changes). The renderer borrows scene, which must stay alive
+ * and unchanged until pk_renderer_destroy; ctx must outlive it. */
+typedef struct pk_renderer pk_renderer;
+
+/* opt NULL: the scene's own settings (pk_scene_get_render_options). The
+ * camera is the scene's (pk_scene_get_camera). */
+PK_API pk_status pk_renderer_create(pk_context *ctx, const pk_scene *scene, const pk_render_options *opt,
+                                    pk_renderer **out);
+PK_API void pk_renderer_destroy(pk_renderer *r);
+/* The options the renderer was created with. */
+PK_API void pk_renderer_get_options(const pk_renderer *r, pk_render_options *opt);
+/* Changes the camera for later renders; nothing is rebuilt. */
+PK_API pk_status pk_renderer_set_camera(pk_renderer *r, const pk_camera *cam);
+PK_API void pk_renderer_get_camera(const pk_renderer *r, pk_camera *cam);
+/* Renders the n regions (NULL, 0: the whole image) into film, which must have
+ * the renderer's width and height: every pixel of the regions gets opt.spp
+ * samples added to its sum and count. A pixel's value depends only on the
+ * scene, the options and the pixel, never on the regions, their order or the
+ * threads, so that any tiling of the image, merged, equals one whole render
+ * bit for bit. On PK_ERR_CANCELLED the film holds the tiles that finished. */
+PK_API pk_status pk_renderer_render(pk_renderer *r, const pk_region *regions, size_t n, pk_film *film);
+/* Statistics since pk_renderer_create: the build once, the rays, tests,
+ * nodes, pixels and render time of every render added up. */
+PK_API void pk_renderer_get_stats(const pk_renderer *r, pk_stats *stats);
+
+/* One call: a renderer, a film of the whole image and its resolved image
+ * (*out, owned by the caller). opt NULL: the scene's settings. stats may be
+ * NULL. On PK_ERR_CANCELLED *out still holds the partial image. */
 PK_API pk_status pk_render(pk_context *ctx, const pk_scene *scene, const pk_render_options *opt,
                            pk_image **out, pk_stats *stats);
 

@@ -4,6 +4,8 @@
  */
 #include "paprsek_internal.h"
 
+#include "options.h"
+
 #include "accel/accel.h"
 #include "io/image.h"
 #include "render/render.h"
@@ -11,44 +13,7 @@
 
 #include <string.h>
 
-/* ---- options and names ---------------------------------------------------- */
-
-void pk_render_options_init(pk_render_options *opt)
-{
-    if (!opt) return;
-    memset(opt, 0, sizeof *opt);
-    opt->width = 512;
-    opt->height = 512;
-    opt->spp = 1;
-    opt->light_samples = 32;
-    opt->max_depth = 8;
-    opt->threads = 0;
-    opt->accel = PK_ACCEL_DEFAULT;
-    opt->fresnel = 1;
-}
-
-static const char *const accel_names[] = {"bvh", "none", "midpoint", "bvh", "embree"};
-
-const char *pk_accel_kind_name(pk_accel_kind kind)
-{
-    if ((unsigned)kind >= sizeof accel_names / sizeof accel_names[0]) return "unknown";
-    return accel_names[kind];
-}
-
-pk_status pk_accel_kind_parse(const char *name, pk_accel_kind *out)
-{
-    if (!name || !out) return PK_ERR_INVALID_ARGUMENT;
-    for (int k = PK_ACCEL_NONE; k <= PK_ACCEL_EMBREE; k++)
-        if (strcmp(name, accel_names[k]) == 0) {
-            *out = (pk_accel_kind)k;
-            return PK_OK;
-        }
-    if (strcmp(name, "default") == 0) {
-        *out = PK_ACCEL_DEFAULT;
-        return PK_OK;
-    }
-    return PK_ERR_INVALID_ARGUMENT;
-}
+/* ---- options ------------------------------------------------------------------ */
 
 int pk_accel_available(pk_accel_kind kind)
 {
@@ -309,25 +274,18 @@ pk_status pk_image_write(pk_context *ctx, const pk_image *img, const char *path)
 
 static pk_status check_options(pk_context *ctx, const pk_render_options *o)
 {
-#define RANGE(field, lo, hi, what)                                                                   \
-    if (o->field < (lo) || o->field > (hi))                                                          \
-        return ctx_error(ctx, PK_ERR_LIMIT, "%s %d is out of range (%d..%d)", what, o->field, (int)(lo), (int)(hi));
-    RANGE(width, 1, PK_MAX_IMAGE_SIDE, "width")
-    RANGE(height, 1, PK_MAX_IMAGE_SIDE, "height")
-    RANGE(spp, 1, PK_MAX_SPP, "samples per pixel")
-    RANGE(light_samples, 0, PK_MAX_LIGHT_SAMPLES, "light samples")
-    RANGE(max_depth, 0, PK_MAX_DEPTH, "max depth")
-    RANGE(threads, 0, PK_MAX_THREADS, "threads")
-#undef RANGE
-    if ((uint64_t)o->width * (uint64_t)o->height > PK_MAX_IMAGE_PIXELS)
-        return ctx_error(ctx, PK_ERR_LIMIT, "image of %dx%d pixels is larger than %u pixels", o->width, o->height,
-                         PK_MAX_IMAGE_PIXELS);
-    if ((unsigned)o->accel > PK_ACCEL_EMBREE)
-        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "unknown accelerator %d", (int)o->accel);
+    pk_status st = options_check(ctx, o);
+    if (st != PK_OK) return st;
     if (!pk_accel_available(o->accel))
         return ctx_error(ctx, PK_ERR_UNSUPPORTED, "accelerator '%s' is not available in this build",
                          pk_accel_kind_name(o->accel));
     return PK_OK;
+}
+
+pk_status pk_render_options_check(pk_context *ctx, const pk_render_options *opt)
+{
+    if (!ctx || !opt) return PK_ERR_INVALID_ARGUMENT;
+    return check_options(ctx, opt);
 }
 
 pk_status pk_render(pk_context *ctx, const pk_scene *scene, const pk_render_options *opt, pk_image **out,

@@ -6,6 +6,7 @@
  * so a line is found by a scan of the text that numbers values in the same
  * pre-order as the parsed tree.
  */
+#include "../options.h"
 #include "../scene/scene.h"
 
 #include <cjson/cJSON.h>
@@ -383,12 +384,14 @@ static pk_status parse_size(jp *p, const cJSON *wi, const cJSON *hi, const cJSON
     pk_status st;
     if (wi) {
         path_key(fp, path, "width");
-        if ((st = get_int(p, wi, fp, 1, PK_MAX_IMAGE_SIDE, &r->opt.width))) return st;
+        const pk_int_option *o = pk_int_option_find("width");
+        if ((st = get_int(p, wi, fp, o->min, o->max, &r->opt.width))) return st;
         r->has_width = true;
     }
     if (hi) {
         path_key(fp, path, "height");
-        if ((st = get_int(p, hi, fp, 1, PK_MAX_IMAGE_SIDE, &r->opt.height))) return st;
+        const pk_int_option *o = pk_int_option_find("height");
+        if ((st = get_int(p, hi, fp, o->min, o->max, &r->opt.height))) return st;
         r->has_height = true;
     }
     if ((uint64_t)r->opt.width * (uint64_t)r->opt.height > (uint64_t)PK_MAX_IMAGE_PIXELS)
@@ -415,22 +418,21 @@ static pk_status parse_render(jp *p, const cJSON *it)
     pk_status st = object_fields(p, it, "render", keys, R_COUNT, f);
     if (st) return st;
     scene_render_settings *r = &p->s->render;
-    if (f[R_SPP]) {
-        if ((st = get_int(p, f[R_SPP], "render.spp", 1, PK_MAX_SPP, &r->opt.spp))) return st;
-        r->has_spp = true;
-    }
-    if (f[R_LS]) {
-        if ((st = get_int(p, f[R_LS], "render.light_samples", 1, PK_MAX_LIGHT_SAMPLES, &r->opt.light_samples)))
+    /* ranges from the one option table (options.c), as the API and the CLI */
+    const struct {
+        int key;
+        const char *path;
+        bool *has;
+    } ints[] = {{R_SPP, "render.spp", &r->has_spp},
+                {R_LS, "render.light_samples", &r->has_light_samples},
+                {R_DEPTH, "render.max_depth", &r->has_max_depth},
+                {R_THREADS, "render.threads", &r->has_threads}};
+    for (size_t i = 0; i < sizeof ints / sizeof ints[0]; i++) {
+        if (!f[ints[i].key]) continue;
+        const pk_int_option *o = pk_int_option_find(keys[ints[i].key]);
+        if ((st = get_int(p, f[ints[i].key], ints[i].path, o->min, o->max, options_int_field(&r->opt, o))))
             return st;
-        r->has_light_samples = true;
-    }
-    if (f[R_DEPTH]) {
-        if ((st = get_int(p, f[R_DEPTH], "render.max_depth", 0, PK_MAX_DEPTH, &r->opt.max_depth))) return st;
-        r->has_max_depth = true;
-    }
-    if (f[R_THREADS]) {
-        if ((st = get_int(p, f[R_THREADS], "render.threads", 0, PK_MAX_THREADS, &r->opt.threads))) return st;
-        r->has_threads = true;
+        *ints[i].has = true;
     }
     if (f[R_ACCEL]) {
         pk_accel_kind kind;

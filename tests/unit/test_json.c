@@ -373,8 +373,11 @@ static void test_errors(void)
                  "scene.json:1: render.max_depth: must be an integer in 0..64");
     EXPECT_ERROR("{\"render\": {\"threads\": -1}}", PK_ERR_PARSE,
                  "scene.json:1: render.threads: must be an integer in 0..1024");
+    /* the same range as the API and the CLI (0 = point lights only) */
     EXPECT_ERROR("{\"render\": {\"light_samples\": 5000}}", PK_ERR_LIMIT,
-                 "scene.json:1: render.light_samples: must be an integer in 1..4096");
+                 "scene.json:1: render.light_samples: must be an integer in 0..4096");
+    EXPECT_ERROR("{\"render\": {\"light_samples\": -1}}", PK_ERR_PARSE,
+                 "scene.json:1: render.light_samples: must be an integer in 0..4096");
 
     /* materials */
     EXPECT_ERROR("{\"spheres\": [{\"center\": [0, 0, 0], \"radius\": 1,\n \"material\": \"gold\"}]}", PK_ERR_PARSE,

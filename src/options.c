@@ -1,0 +1,102 @@
+/*
+ * options.c - render-option defaults, the one table of integer option ranges
+ * (served to the API, JSON scenes and the paprsek program) and the
+ * accelerator name table. Depends on nothing but the public header and the
+ * context's error latch.
+ */
+#include "options.h"
+
+#include <stddef.h>
+#include <string.h>
+
+#define OPT(field, label, lo, hi, def, text) {#field, label, text, lo, hi, def, offsetof(pk_render_options, field)}
+
+static const pk_int_option table[] = {
+    OPT(width, "width", 1, PK_MAX_IMAGE_SIDE, 512, "image width in pixels"),
+    OPT(height, "height", 1, PK_MAX_IMAGE_SIDE, 512, "image height in pixels"),
+    OPT(spp, "samples per pixel", 1, PK_MAX_SPP, 1, "samples per pixel (stratified jitter; 1 = pixel centres)"),
+    OPT(light_samples, "light samples", 0, PK_MAX_LIGHT_SAMPLES, 32,
+        "shadow samples per shading point over the area lights (0 = point lights only)"),
+    OPT(max_depth, "max depth", 0, PK_MAX_DEPTH, 8, "reflection and refraction depth"),
+    OPT(threads, "threads", 0, PK_MAX_THREADS, 0, "worker threads (0 = all cores)"),
+};
+#undef OPT
+
+#define NOPTS (sizeof table / sizeof table[0])
+
+const pk_int_option *pk_int_options(size_t *count)
+{
+    if (count) *count = NOPTS;
+    return table;
+}
+
+/* name matches key with '-' taken as '_'. */
+static bool same_name(const char *name, const char *key)
+{
+    for (; *name && *key; name++, key++)
+        if (*name != *key && !(*name == '-' && *key == '_')) return false;
+    return *name == *key;
+}
+
+const pk_int_option *pk_int_option_find(const char *name)
+{
+    if (!name) return NULL;
+    for (size_t i = 0; i < NOPTS; i++)
+        if (same_name(name, table[i].name)) return &table[i];
+    return NULL;
+}
+
+int *options_int_field(pk_render_options *opt, const pk_int_option *o)
+{
+    return (int *)(void *)((char *)opt + o->offset);
+}
+
+void pk_render_options_init(pk_render_options *opt)
+{
+    if (!opt) return;
+    memset(opt, 0, sizeof *opt);
+    for (size_t i = 0; i < NOPTS; i++) *options_int_field(opt, &table[i]) = table[i].default_value;
+    opt->accel = PK_ACCEL_DEFAULT;
+    opt->fresnel = 1;
+}
+
+pk_status options_check(pk_context *ctx, const pk_render_options *o)
+{
+    for (size_t i = 0; i < NOPTS; i++) {
+        const int v = *(const int *)(const void *)((const char *)o + table[i].offset);
+        if (v < table[i].min || v > table[i].max)
+            return ctx_error(ctx, PK_ERR_LIMIT, "%s %d is out of range (%d..%d)", table[i].label, v, table[i].min,
+                             table[i].max);
+    }
+    if ((uint64_t)o->width * (uint64_t)o->height > PK_MAX_IMAGE_PIXELS)
+        return ctx_error(ctx, PK_ERR_LIMIT, "image of %dx%d pixels is larger than %u pixels", o->width, o->height,
+                         PK_MAX_IMAGE_PIXELS);
+    if ((unsigned)o->accel > PK_ACCEL_EMBREE)
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "unknown accelerator %d", (int)o->accel);
+    return PK_OK;
+}
+
+/* ---- accelerator names ----------------------------------------------------- */
+
+static const char *const accel_names[] = {"bvh", "none", "midpoint", "bvh", "embree"};
+
+const char *pk_accel_kind_name(pk_accel_kind kind)
+{
+    if ((unsigned)kind >= sizeof accel_names / sizeof accel_names[0]) return "unknown";
+    return accel_names[kind];
+}
+
+pk_status pk_accel_kind_parse(const char *name, pk_accel_kind *out)
+{
+    if (!name || !out) return PK_ERR_INVALID_ARGUMENT;
+    for (int k = PK_ACCEL_NONE; k <= PK_ACCEL_EMBREE; k++)
+        if (strcmp(name, accel_names[k]) == 0) {
+            *out = (pk_accel_kind)k;
+            return PK_OK;
+        }
+    if (strcmp(name, "default") == 0) {
+        *out = PK_ACCEL_DEFAULT;
+        return PK_OK;
+    }
+    return PK_ERR_INVALID_ARGUMENT;
+}
