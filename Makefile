@@ -4,7 +4,8 @@
 BUILD      ?= build
 JOBS       ?= $(shell nproc 2>/dev/null || echo 2)
 BUILD_PKGS  = gcc make cmake pkg-config libpng-dev libcjson-dev
-TEST_PKGS   = $(BUILD_PKGS) libembree-dev
+# g++: the install tests build a C++ program against the installed library
+TEST_PKGS   = $(BUILD_PKGS) libembree-dev g++
 PREFIX     ?= /usr/local
 FUZZ_PKGS   = $(TEST_PKGS) clang libclang-rt-14-dev libomp-14-dev
 FUZZ_SECONDS ?= 60
