@@ -7,8 +7,10 @@
 #include "options.h"
 
 #include "accel/accel.h"
+#include "image/image.h"
 #include "io/image.h"
 #include "render/render.h"
+#include "scene/camera.h"
 #include "scene/scene.h"
 
 #include <string.h>
@@ -163,42 +165,7 @@ pk_status pk_scene_get_triangle(const pk_scene *s, size_t k, float verts[9])
 void pk_scene_get_camera(const pk_scene *s, pk_camera *cam)
 {
     if (!s || !cam) return;
-    if (s->has_camera) {
-        *cam = s->camera;
-        return;
-    }
-    /* Look along -z at the centre of the bounds from just far enough that the
-     * front face of the box fills a 40 degree view (with a small margin). */
-    aabb b = s->bounds;
-    if (!v3_finite(b.lo) || !v3_finite(b.hi)) b.lo = b.hi = v3s(0.0f);
-    vec3 c = aabb_center(b), e = aabb_extent(b);
-    float fov = 40.0f;
-    float half = 0.5f * fmaxf(e.x, e.y) * 1.08f;
-    if (!(half > 0.0f)) half = fmaxf(0.5f * e.z, 1.0f);
-    float dist = half / tanf(0.5f * fov * PK_PI / 180.0f) + 0.5f * e.z;
-    pk_camera k = {{c.x, c.y, c.z + dist}, {c.x, c.y, c.z}, {0.0f, 1.0f, 0.0f}, fov};
-    *cam = k;
-}
-
-pk_status camera_validate(pk_context *ctx, const pk_camera *cam, const char *what)
-{
-    vec3 from = v3(cam->look_from[0], cam->look_from[1], cam->look_from[2]);
-    vec3 at = v3(cam->look_at[0], cam->look_at[1], cam->look_at[2]);
-    vec3 up = v3(cam->up[0], cam->up[1], cam->up[2]);
-    if (!v3_finite(from) || !v3_finite(at) || !v3_finite(up) || !isfinite(cam->fov_deg))
-        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: camera values must be finite numbers", what);
-    if (!(cam->fov_deg > 0.0f && cam->fov_deg < 180.0f))
-        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: fov %g must be between 0 and 180 degrees (exclusive)",
-                         what, (double)cam->fov_deg);
-    vec3 dir = v3_sub(at, from);
-    if (!v3_finite(dir))
-        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: look_from and look_at are too far apart", what);
-    if (dir.x == 0.0f && dir.y == 0.0f && dir.z == 0.0f)
-        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: look_from and look_at are the same point", what);
-    vec3 x = v3_cross(v3_norm_scaled(dir), v3_norm_scaled(up));
-    if (!(v3_len(x) > 1e-6f))
-        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: up vector is zero or parallel to the view direction", what);
-    return PK_OK;
+    scene_camera(s, cam);
 }
 
 pk_status pk_scene_set_camera(pk_context *ctx, pk_scene *s, const pk_camera *cam)
@@ -232,32 +199,10 @@ void pk_scene_get_render_options(const pk_scene *s, pk_render_options *opt)
 pk_status pk_image_create(pk_context *ctx, int width, int height, pk_image **out)
 {
     if (!ctx || !out) return PK_ERR_INVALID_ARGUMENT;
-    *out = NULL;
-    if (width < 1 || height < 1 || width > PK_MAX_IMAGE_SIDE || height > PK_MAX_IMAGE_SIDE ||
-        (uint64_t)width * (uint64_t)height > PK_MAX_IMAGE_PIXELS)
-        return ctx_error(ctx, PK_ERR_LIMIT, "image size %dx%d is out of range (1..%d per side, at most %u pixels)",
-                         width, height, PK_MAX_IMAGE_SIDE, PK_MAX_IMAGE_PIXELS);
-    pk_image *img = mem_calloc(&ctx->alloc, 1, sizeof *img);
-    if (!img) return ctx_nomem(ctx);
-    img->alloc = ctx->alloc;
-    img->width = width;
-    img->height = height;
-    img->pixels = mem_calloc(&ctx->alloc, (size_t)width * (size_t)height * 3, sizeof(float));
-    if (!img->pixels) {
-        mem_free(&ctx->alloc, img);
-        return ctx_nomem(ctx);
-    }
-    *out = img;
-    return PK_OK;
+    return image_create(ctx, width, height, out);
 }
 
-void pk_image_destroy(pk_image *img)
-{
-    if (!img) return;
-    pk_allocator a = img->alloc;
-    mem_free(&a, img->pixels);
-    mem_free(&a, img);
-}
+void pk_image_destroy(pk_image *img) { image_destroy(img); }
 
 int pk_image_width(const pk_image *img) { return img ? img->width : 0; }
 int pk_image_height(const pk_image *img) { return img ? img->height : 0; }
@@ -288,8 +233,18 @@ pk_status pk_render_options_check(pk_context *ctx, const pk_render_options *opt)
     return check_options(ctx, opt);
 }
 
-pk_status pk_render(pk_context *ctx, const pk_scene *scene, const pk_render_options *opt, pk_image **out,
-                    pk_stats *stats)
+/* The camera a render of scene uses, checked. */
+static pk_status render_camera(pk_context *ctx, const pk_scene *scene, pk_camera *cam)
+{
+    scene_camera(scene, cam);
+    if (!scene->has_camera && camera_check(cam) != CAMERA_OK)
+        return ctx_error(ctx, PK_ERR_LIMIT, "%s: the scene is too large to frame automatically; give it a camera",
+                         scene->name);
+    return camera_validate(ctx, cam, "camera");
+}
+
+pk_status pk_renderer_create(pk_context *ctx, const pk_scene *scene, const pk_render_options *opt,
+                             pk_renderer **out)
 {
     if (!ctx || !scene || !out) return PK_ERR_INVALID_ARGUMENT;
     *out = NULL;
@@ -302,13 +257,104 @@ pk_status pk_render(pk_context *ctx, const pk_scene *scene, const pk_render_opti
     pk_status st = check_options(ctx, &o);
     if (st != PK_OK) return st;
     pk_camera cam;
-    pk_scene_get_camera(scene, &cam);
-    if (!scene->has_camera && camera_validate(NULL, &cam, "camera") != PK_OK)
-        return ctx_error(ctx, PK_ERR_LIMIT, "%s: the scene is too large to frame automatically; give it a camera",
-                         scene->name);
-    st = camera_validate(ctx, &cam, "camera");
+    st = render_camera(ctx, scene, &cam);
     if (st != PK_OK) return st;
-    return render_scene(ctx, scene, &cam, &o, out, stats);
+    return renderer_create(ctx, scene, &o, &cam, out);
+}
+
+void pk_renderer_destroy(pk_renderer *r) { renderer_destroy(r); }
+
+void pk_renderer_get_options(const pk_renderer *r, pk_render_options *opt)
+{
+    if (r && opt) *opt = *renderer_options(r);
+}
+
+pk_status pk_renderer_set_camera(pk_renderer *r, const pk_camera *cam)
+{
+    if (!r || !cam) return PK_ERR_INVALID_ARGUMENT;
+    pk_status st = camera_validate(renderer_context(r), cam, "camera");
+    if (st == PK_OK) renderer_set_camera(r, cam);
+    return st;
+}
+
+void pk_renderer_get_camera(const pk_renderer *r, pk_camera *cam)
+{
+    if (r && cam) *cam = *renderer_camera(r);
+}
+
+pk_status pk_renderer_render(pk_renderer *r, const pk_region *regions, size_t n, pk_film *film)
+{
+    if (!r || !film || (!regions && n)) return PK_ERR_INVALID_ARGUMENT;
+    return renderer_render(r, regions, n, film);
+}
+
+void pk_renderer_get_stats(const pk_renderer *r, pk_stats *stats)
+{
+    if (r && stats) renderer_stats(r, stats);
+}
+
+pk_status pk_render(pk_context *ctx, const pk_scene *scene, const pk_render_options *opt, pk_image **out,
+                    pk_stats *stats)
+{
+    if (!ctx || !scene || !out) return PK_ERR_INVALID_ARGUMENT;
+    *out = NULL;
+    pk_renderer *r = NULL;
+    pk_film *film = NULL;
+    pk_image *img = NULL;
+    pk_status st = pk_renderer_create(ctx, scene, opt, &r);
+    if (st != PK_OK) return st;
+    const pk_render_options *o = renderer_options(r);
+    if ((st = film_create(ctx, o->width, o->height, &film)) != PK_OK) goto out;
+    if ((st = image_create(ctx, o->width, o->height, &img)) != PK_OK) goto out;
+    st = renderer_render(r, NULL, 0, film);
+    if (st == PK_OK || st == PK_ERR_CANCELLED) {
+        film_resolve_into(film, img);
+        *out = img;
+        img = NULL;
+    }
+    if (stats) renderer_stats(r, stats);
+out:
+    image_destroy(img);
+    film_destroy(film);
+    renderer_destroy(r);
+    return st;
+}
+
+/* ---- films ---------------------------------------------------------------------- */
+
+pk_status pk_film_create(pk_context *ctx, int width, int height, pk_film **out)
+{
+    if (!ctx || !out) return PK_ERR_INVALID_ARGUMENT;
+    return film_create(ctx, width, height, out);
+}
+
+void pk_film_destroy(pk_film *film) { film_destroy(film); }
+int pk_film_width(const pk_film *film) { return film ? film->width : 0; }
+int pk_film_height(const pk_film *film) { return film ? film->height : 0; }
+float *pk_film_sums(pk_film *film) { return film ? film->sums : NULL; }
+uint32_t *pk_film_counts(pk_film *film) { return film ? film->counts : NULL; }
+
+void pk_film_clear(pk_film *film)
+{
+    if (film) film_clear(film);
+}
+
+pk_status pk_film_merge(pk_context *ctx, pk_film *dst, const pk_film *src)
+{
+    if (!ctx || !dst || !src) return PK_ERR_INVALID_ARGUMENT;
+    if (dst->width != src->width || dst->height != src->height)
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "cannot merge a %dx%d film into a %dx%d film", src->width,
+                         src->height, dst->width, dst->height);
+    film_merge(dst, src); /* dst == src doubles every sum and count */
+    return PK_OK;
+}
+
+pk_status pk_film_resolve(pk_context *ctx, const pk_film *film, pk_image **out)
+{
+    if (!ctx || !film || !out) return PK_ERR_INVALID_ARGUMENT;
+    pk_status st = image_create(ctx, film->width, film->height, out);
+    if (st == PK_OK) film_resolve_into(film, *out);
+    return st;
 }
 
 /* ---- accelerators over scenes ---------------------------------------------------- */
@@ -322,8 +368,9 @@ pk_status pk_accel_create(pk_context *ctx, const pk_scene *scene, pk_accel_kind 
 {
     if (!ctx || !scene || !out) return PK_ERR_INVALID_ARGUMENT;
     *out = NULL;
-    if (threads < 0 || threads > PK_MAX_THREADS)
-        return ctx_error(ctx, PK_ERR_LIMIT, "threads %d is out of range (0..%d)", threads, PK_MAX_THREADS);
+    const pk_int_option *th = pk_int_option_find("threads");
+    if (threads < th->min || threads > th->max)
+        return ctx_error(ctx, PK_ERR_LIMIT, "threads %d is out of range (%d..%d)", threads, th->min, th->max);
     if ((unsigned)kind > PK_ACCEL_EMBREE)
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "unknown accelerator %d", (int)kind);
     if (!pk_accel_available(kind))
@@ -332,7 +379,7 @@ pk_status pk_accel_create(pk_context *ctx, const pk_scene *scene, pk_accel_kind 
     pk_accel *pa = mem_calloc(&ctx->alloc, 1, sizeof *pa);
     if (!pa) return ctx_nomem(ctx);
     pa->ctx = ctx;
-    pk_status st = render_build_accel(ctx, scene, kind, threads, &pa->a);
+    pk_status st = frame_build_accel(ctx, scene, kind, threads, &pa->a);
     if (st != PK_OK) {
         mem_free(&ctx->alloc, pa);
         return st;
@@ -358,5 +405,5 @@ void pk_accel_trace(const pk_accel *pa, const pk_ray *rays, pk_hit *hits, size_t
                     pk_trace_counters *counters)
 {
     if (!pa || !rays || !hits || n == 0) return;
-    render_trace_rays(pa->a, (const ray *)rays, (hit *)hits, n, threads, flags, counters);
+    accel_trace_batch(pa->a, (const ray *)rays, (hit *)hits, n, threads, flags, counters);
 }

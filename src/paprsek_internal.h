@@ -45,16 +45,6 @@ struct pk_context {
     void *warn_user;
 };
 
-/* Linear RGB image. Invariant: pixels holds 3*width*height floats, rows top first. */
-struct pk_image {
-    pk_allocator alloc;
-    int width, height;
-    float *pixels;
-};
-
-/* Validates a camera; on failure latches "what: ..." in ctx. */
-PK_HIDDEN pk_status camera_validate(pk_context *ctx, const pk_camera *cam, const char *what);
-
 /* ---- allocation: every library allocation goes through the context's hook */
 
 /* NULL on failure or on size 0. */

@@ -4,7 +4,7 @@
  */
 #include "accel.h"
 
-#include "../scene/scene.h"
+#include "../math/tri.h"
 
 #include <string.h>
 

@@ -70,6 +70,11 @@ static inline bool accel_occluded(const accel *a, const ray *r, accel_counters *
 PK_HIDDEN void accel_intersect_many(const accel *a, const ray *r, hit *h, size_t n, bool any_hit,
                                     accel_counters *c);
 
+/* Traces n rays in parallel with up to threads threads (0 = all); flags as
+ * PK_TRACE_* (any-hit, coherent packets); counters may be NULL (trace.c). */
+PK_HIDDEN void accel_trace_batch(const accel *a, const ray *rays, hit *hits, size_t n, int threads,
+                                 unsigned flags, pk_trace_counters *counters);
+
 /* Constructors, one per file (builders latch their own errors). */
 PK_HIDDEN pk_status accel_none_create(pk_context *ctx, const accel_input *in, accel **out);
 PK_HIDDEN pk_status accel_midpoint_create(pk_context *ctx, const accel_input *in, accel **out);

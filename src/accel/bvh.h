@@ -12,7 +12,7 @@
 #define PK_BVH_H
 
 #include "accel.h"
-#include "../scene/scene.h"
+#include "../math/tri.h"
 
 #ifndef BVH_WIDTH
 #define BVH_WIDTH 8          /* children per node: 8 (AVX) or 4 (SSE) */

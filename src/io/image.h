@@ -5,7 +5,7 @@
 #ifndef PK_IMAGE_H
 #define PK_IMAGE_H
 
-#include "../paprsek_internal.h"
+#include "../image/image.h"
 
 /* Writes img by the extension of path (.png, .pfm). */
 PK_HIDDEN pk_status image_write(pk_context *ctx, const pk_image *img, const char *path);

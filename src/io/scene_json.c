@@ -7,6 +7,7 @@
  * pre-order as the parsed tree.
  */
 #include "../options.h"
+#include "../scene/camera.h"
 #include "../scene/scene.h"
 
 #include <cjson/cJSON.h>
@@ -353,26 +354,24 @@ static pk_status parse_camera(jp *p, const cJSON *it)
     if ((st = get_vec3(p, f[C_FROM], "camera.look_from", &from))) return st;
     if ((st = get_vec3(p, f[C_AT], "camera.look_at", &at))) return st;
     if (f[C_UP] && (st = get_vec3(p, f[C_UP], "camera.up", &up))) return st;
-    if (f[C_FOV]) {
-        if ((st = get_float(p, f[C_FOV], "camera.fov", &fov))) return st;
-        if (!(fov > 0.0f && fov < 180.0f))
-            return jfail(p, PK_ERR_PARSE, f[C_FOV], "camera.fov", "must be between 0 and 180 degrees (exclusive)");
-    }
-    vec3 dir = v3_sub(at, from);
-    if ((dir.x == 0.0f && dir.y == 0.0f && dir.z == 0.0f) || !v3_finite(dir))
-        return jfail(p, PK_ERR_PARSE, f[C_AT], "camera.look_at", "must differ from look_from");
-    if (up.x == 0.0f && up.y == 0.0f && up.z == 0.0f)
-        return jfail(p, PK_ERR_PARSE, f[C_UP], "camera.up", "must not be zero");
-    if (!(v3_len(v3_cross(v3_norm_scaled(dir), v3_norm_scaled(up))) > 1e-4f)) {
+    if (f[C_FOV] && (st = get_float(p, f[C_FOV], "camera.fov", &fov))) return st;
+    pk_camera cam = {{from.x, from.y, from.z}, {at.x, at.y, at.z}, {up.x, up.y, up.z}, fov};
+    /* the one camera rule (scene/camera.c), with the messages of this format */
+    switch (camera_check(&cam)) {
+    case CAMERA_OK: break;
+    case CAMERA_NOT_FINITE: /* get_vec3 and get_float refuse non-finite numbers */
+    case CAMERA_FOV:
+        return jfail(p, PK_ERR_PARSE, f[C_FOV] ? f[C_FOV] : it, "camera.fov",
+                     "must be between 0 and 180 degrees (exclusive)");
+    case CAMERA_TOO_FAR:
+    case CAMERA_SAME_POINT: return jfail(p, PK_ERR_PARSE, f[C_AT], "camera.look_at", "must differ from look_from");
+    case CAMERA_UP_ZERO: return jfail(p, PK_ERR_PARSE, f[C_UP], "camera.up", "must not be zero");
+    case CAMERA_UP_PARALLEL:
         if (f[C_UP]) return jfail(p, PK_ERR_PARSE, f[C_UP], "camera.up", "is parallel to the view direction");
         return jfail(p, PK_ERR_PARSE, it, "camera",
                      "the default up [0, 1, 0] is parallel to the view direction; give \"up\"");
     }
-    pk_camera *cam = &p->s->camera;
-    cam->look_from[0] = from.x, cam->look_from[1] = from.y, cam->look_from[2] = from.z;
-    cam->look_at[0] = at.x, cam->look_at[1] = at.y, cam->look_at[2] = at.z;
-    cam->up[0] = up.x, cam->up[1] = up.y, cam->up[2] = up.z;
-    cam->fov_deg = fov;
+    p->s->camera = cam;
     p->s->has_camera = true;
     return PK_OK;
 }

@@ -1,21 +1,26 @@
 /*
- * render.h - the renderer's interface to api.c: building an accelerator over
- * a scene, rendering a frame with the Whitted integrator, tracing ray batches.
+ * render.h - render sessions, the renderer's interface to api.c: a frame
+ * built once (accelerator, lights), a camera that may change, and renders of
+ * any set of regions into a film, in parallel over 16x16 tiles.
  */
 #ifndef PK_RENDER_H
 #define PK_RENDER_H
 
-#include "../accel/accel.h"
-#include "../scene/scene.h"
+#include "../image/image.h"
+#include "frame.h"
 
-/* Renders the committed scene through cam with options opt (already checked). */
-PK_HIDDEN pk_status render_scene(pk_context *ctx, const pk_scene *s, const pk_camera *cam,
-                                 const pk_render_options *opt, pk_image **out, pk_stats *stats);
-/* Builds an accelerator of kind over the scene's triangles and spheres. */
-PK_HIDDEN pk_status render_build_accel(pk_context *ctx, const pk_scene *s, pk_accel_kind kind, int threads,
-                                       accel **out);
-/* Traces n rays in parallel (threads 0 = all); flags as PK_TRACE_*. */
-PK_HIDDEN void render_trace_rays(const accel *a, const ray *rays, hit *hits, size_t n, int threads,
-                                 unsigned flags, pk_trace_counters *counters);
+/* opt has passed pk_render_options_check and cam camera_validate. */
+PK_HIDDEN pk_status renderer_create(pk_context *ctx, const pk_scene *s, const pk_render_options *opt,
+                                    const pk_camera *cam, pk_renderer **out);
+PK_HIDDEN void renderer_destroy(pk_renderer *r);
+PK_HIDDEN pk_context *renderer_context(const pk_renderer *r);
+PK_HIDDEN const pk_render_options *renderer_options(const pk_renderer *r);
+/* cam has passed camera_validate. */
+PK_HIDDEN void renderer_set_camera(pk_renderer *r, const pk_camera *cam);
+PK_HIDDEN const pk_camera *renderer_camera(const pk_renderer *r);
+/* regions NULL: the whole image; film has the renderer's size. Regions are
+ * checked here (inside the image, not empty, not overlapping). */
+PK_HIDDEN pk_status renderer_render(pk_renderer *r, const pk_region *regions, size_t n, pk_film *film);
+PK_HIDDEN void renderer_stats(const pk_renderer *r, pk_stats *stats);
 
 #endif

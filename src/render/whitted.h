@@ -1,11 +1,13 @@
 /*
- * whitted.h - the Whitted integrator's state, shared by render.c (frame loop)
- * and whitted.c (shading). Private to render/.
+ * whitted.h - the Whitted integrator: direct light from point lights and
+ * area lights with shadow rays, Lambert + Phong, recursive mirror reflection
+ * and refraction. Built on the frame (accelerator, light table), surface.h
+ * and bsdf.h, which a second integrator shares.
  */
 #ifndef PK_WHITTED_H
 #define PK_WHITTED_H
 
-#include "render.h"
+#include "frame.h"
 #include "sampling.h"
 
 /* Secondary rays (reflection, refraction, dissolve) traced for one camera
@@ -19,35 +21,28 @@
 enum { RAY_CAMERA, RAY_SHADOW, RAY_REFLECTION, RAY_REFRACTION, RAY_KINDS };
 
 /* Read-only during a render. */
-typedef struct integrator {
-    const pk_scene *s;
-    const accel *a;
+typedef struct whitted {
+    const frame *f;
     int light_samples, max_depth;
     bool fresnel;
-    float *light_cdf;    /* nemissive entries, cumulative power, last = 1 */
-    float *light_area;   /* area of each emissive triangle */
-    vec3 *light_normal;  /* unit geometric normal of each emissive triangle */
-    float light_power;   /* total emitted power (luminance * area) */
-    float eps;           /* base offset for spawned rays, world units */
-} integrator;
+} whitted;
 
-/* Per-thread scratch, allocated once per render. */
-typedef struct thread_state {
+/* Per-thread scratch, allocated once per renderer. */
+typedef struct whitted_thread {
     uint64_t rays[RAY_KINDS];
     accel_counters counters;
     accel_counters *cp;  /* &counters when statistics are on, else NULL */
-    ray *shadow_rays;    /* light_samples + nlights entries */
+    ray *shadow_rays;    /* light_samples + point lights entries */
     hit *shadow_hits;
     vec3 *shadow_weight;
     rng rng;
     uint32_t ray_budget; /* secondary rays left for the current camera ray */
-} thread_state;
+} whitted_thread;
 
-PK_HIDDEN pk_status integrator_init(pk_context *ctx, integrator *in, const pk_scene *s, const accel *a,
-                                    const pk_render_options *opt);
-PK_HIDDEN void integrator_free(const pk_allocator *al, integrator *in);
+PK_HIDDEN pk_status whitted_thread_init(pk_context *ctx, const whitted *w, whitted_thread *t, bool stats);
+PK_HIDDEN void whitted_thread_free(const pk_allocator *al, whitted_thread *t);
 /* Radiance arriving along r that hit h (r traced already, depth 0 for camera
- * rays; set ts->ray_budget = WHITTED_RAY_BUDGET before each camera ray). */
-PK_HIDDEN vec3 whitted_shade(const integrator *in, thread_state *ts, const ray *r, const hit *h, int depth);
+ * rays; set t->ray_budget = WHITTED_RAY_BUDGET before each camera ray). */
+PK_HIDDEN vec3 whitted_shade(const whitted *w, whitted_thread *t, const ray *r, const hit *h, int depth);
 
 #endif

@@ -7,6 +7,7 @@
 #ifndef PK_SCENE_H
 #define PK_SCENE_H
 
+#include "../math/tri.h"
 #include "../math/vec3.h"
 #include "../paprsek_internal.h"
 
@@ -121,18 +122,6 @@ static inline void scene_tri_verts(const pk_scene *s, size_t k, vec3 *a, vec3 *b
     *a = s->positions[t->v[0]];
     *b = s->positions[t->v[1]];
     *c = s->positions[t->v[2]];
-}
-
-/* Triangles that can never be hit: a non-finite vertex or zero area. The
- * cross product is taken in double so that huge (1e30) and tiny (1e-30)
- * triangles are not mistaken for degenerate ones by overflow or underflow. */
-static inline bool tri_is_degenerate(vec3 a, vec3 b, vec3 c)
-{
-    if (!v3_finite(a) || !v3_finite(b) || !v3_finite(c)) return true;
-    double ex = (double)b.x - (double)a.x, ey = (double)b.y - (double)a.y, ez = (double)b.z - (double)a.z;
-    double fx = (double)c.x - (double)a.x, fy = (double)c.y - (double)a.y, fz = (double)c.z - (double)a.z;
-    double nx = ey * fz - ez * fy, ny = ez * fx - ex * fz, nz = ex * fy - ey * fx;
-    return nx == 0.0 && ny == 0.0 && nz == 0.0;
 }
 
 /* ---- loaders (io/) ----------------------------------------------------- */

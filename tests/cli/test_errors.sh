@@ -106,7 +106,8 @@ put bad.mtl 'newmtl\n'
 render "MTL material without a name" 1 "bad.mtl:1: newmtl needs a name" badmtl.obj
 rm -f "$tmp/bad.mtl"
 mkfifo "$tmp/bad.mtl" 2>/dev/null &&
-  render "MTL library that is a FIFO" 0 "warning: badmtl.obj:1: cannot read material library 'bad.mtl' ($tmp/bad.mtl: not a regular file); its materials are not defined" badmtl.obj
+  render "MTL library that is a FIFO" 0 "warning: badmtl.obj:1: cannot read material library 'bad.mtl' ($tmp/bad.mtl: not a regular file); its materials are not defined
+paprsek: warning: badmtl.obj: the scene has no light (no emissive triangle or sphere, no point light): the image will be black" badmtl.obj
 
 # ---- JSON
 put bad.json '{ "camera": { "fov": 40,\n  "look_from": [0,0,5] \n'
@@ -193,6 +194,7 @@ expect "statistics over the image" 2 "render: --stats-json and -o name the same 
   render "$tmp/tri.obj" -o "$tmp/out.png" --stats-json "$tmp/out.png"
 cmp -s "$tmp/tri.obj" "$tmp/tri.orig" || { echo "FAIL: the scene file was changed"; fail=1; }
 rm -f "$tmp/link.png"
+# checked before the scene is read: no render, so no warning about its light
 expect "folder that does not exist" 1 "$tmp/no/such/dir/out.png: folder '$tmp/no/such/dir' does not exist" \
   render "$tmp/tri.obj" -o "$tmp/no/such/dir/out.png" --width 8 --height 8
 ls "$tmp"/no 2>/dev/null && { echo "FAIL: a folder was created"; fail=1; }

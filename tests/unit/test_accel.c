@@ -6,7 +6,7 @@
  */
 #include "test.h"
 
-#include "render/render.h"
+#include "render/frame.h"
 #include "render/sampling.h"
 
 #include <dirent.h>
@@ -45,17 +45,17 @@ static void make_rays(const pk_scene *s, ray *rays, size_t n, uint64_t seed)
 static void compare(const char *name, const pk_scene *s, pk_accel_kind kind)
 {
     accel *ref = NULL, *acc = NULL;
-    REQUIRE(render_build_accel(ctx, s, PK_ACCEL_NONE, 2, &ref) == PK_OK);
-    REQUIRE(render_build_accel(ctx, s, kind, 2, &acc) == PK_OK);
+    REQUIRE(frame_build_accel(ctx, s, PK_ACCEL_NONE, 2, &ref) == PK_OK);
+    REQUIRE(frame_build_accel(ctx, s, kind, 2, &acc) == PK_OK);
     char why[256] = "";
     if (kind == PK_ACCEL_MIDPOINT) CHECKF(midpoint_check(acc, why, sizeof why), "%s: %s", name, why);
     ray *rays = malloc(NRAYS * sizeof *rays);
     hit *h0 = malloc(NRAYS * sizeof *h0), *h1 = malloc(NRAYS * sizeof *h1), *o1 = malloc(NRAYS * sizeof *o1);
     REQUIRE(rays && h0 && h1 && o1);
     make_rays(s, rays, NRAYS, 1234);
-    render_trace_rays(ref, rays, h0, NRAYS, 2, 0, NULL);
-    render_trace_rays(acc, rays, h1, NRAYS, 2, 0, NULL);
-    render_trace_rays(acc, rays, o1, NRAYS, 2, PK_TRACE_ANY_HIT, NULL);
+    accel_trace_batch(ref, rays, h0, NRAYS, 2, 0, NULL);
+    accel_trace_batch(acc, rays, h1, NRAYS, 2, 0, NULL);
+    accel_trace_batch(acc, rays, o1, NRAYS, 2, PK_TRACE_ANY_HIT, NULL);
     size_t bad = 0, hits = 0, bad_any = 0;
     for (size_t i = 0; i < NRAYS; i++) {
         hits += h0[i].prim != PK_NO_HIT;

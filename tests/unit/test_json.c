@@ -497,7 +497,7 @@ static void test_alloc_failures(void)
 
 /* ---- the Cornell box --------------------------------------------------------------- */
 
-static vec3 tri_normal(const pk_scene *s, size_t k)
+static vec3 scene_tri_normal(const pk_scene *s, size_t k)
 {
     vec3 a, b, c;
     scene_tri_verts(s, k, &a, &b, &c);
@@ -529,7 +529,7 @@ static void test_cornell(void)
     for (size_t k = 0; k < s->ntris; k++) {
         vec3 a, b, c;
         scene_tri_verts(s, k, &a, &b, &c);
-        CHECKF(!tri_is_degenerate(a, b, c) && v3_len(tri_normal(s, k)) > 1e-4f, "triangle %zu", k);
+        CHECKF(!tri_is_degenerate(a, b, c) && v3_len(scene_tri_normal(s, k)) > 1e-4f, "triangle %zu", k);
     }
 
     /* the camera: in front of the open side (z < 0), looking in */
@@ -556,7 +556,7 @@ static void test_cornell(void)
     int nred = 0, ngreen = 0, nlight = 0;
     for (size_t k = 0; k < s->ntris; k++) {
         uint32_t m = s->tris[k].material;
-        vec3 cen = tri_centroid(s, k), n = tri_normal(s, k);
+        vec3 cen = tri_centroid(s, k), n = scene_tri_normal(s, k);
         float side = v3_dot(v3_sub(cen, from), right); /* < 0: left of the camera */
         if (m == red) {
             nred++;

@@ -1,0 +1,44 @@
+/*
+ * image.h - pixel storage behind pk_image (linear RGB floats) and pk_film
+ * (per-pixel sums of samples and their counts: merged, then resolved into an
+ * image). Depends only on the context.
+ */
+#ifndef PK_IMAGE_STORAGE_H
+#define PK_IMAGE_STORAGE_H
+
+#include "../paprsek_internal.h"
+
+/* Linear RGB image. Invariant: pixels holds 3*width*height floats, rows top first. */
+struct pk_image {
+    pk_allocator alloc;
+    int width, height;
+    float *pixels;
+};
+
+/* Invariants: sums holds 3*width*height floats and counts width*height
+ * sample counts, rows top first; a pixel with count 0 has zero sums. */
+struct pk_film {
+    pk_allocator alloc;
+    int width, height;
+    float *sums;
+    uint32_t *counts;
+};
+
+/* Checks the size against PK_MAX_IMAGE_SIDE and PK_MAX_IMAGE_PIXELS;
+ * latches "what WxH is out of range (...)". */
+PK_HIDDEN pk_status image_check_size(pk_context *ctx, const char *what, int width, int height);
+/* Zeroed storage of the given size (checked). */
+PK_HIDDEN pk_status image_create(pk_context *ctx, int width, int height, pk_image **out);
+PK_HIDDEN void image_destroy(pk_image *img);
+PK_HIDDEN pk_status film_create(pk_context *ctx, int width, int height, pk_film **out);
+PK_HIDDEN void film_destroy(pk_film *film);
+PK_HIDDEN void film_clear(pk_film *film);
+/* dst += src (same size, checked by the caller). */
+PK_HIDDEN void film_merge(pk_film *dst, const pk_film *src);
+/* Adds a block of w x h pixels at (x, y): rgb holds 3 floats per pixel, row
+ * after row, each the sum of spp samples. */
+PK_HIDDEN void film_add_block(pk_film *film, int x, int y, int w, int h, const float *rgb, uint32_t spp);
+/* img (same size) = sums / counts, 0 where there is no sample or the mean is not finite. */
+PK_HIDDEN void film_resolve_into(const pk_film *film, pk_image *img);
+
+#endif

@@ -1,0 +1,60 @@
+/*
+ * frame.c - building a frame (see frame.h).
+ */
+#include "frame.h"
+
+#include <omp.h>
+#include <string.h>
+
+pk_status frame_build_accel(pk_context *ctx, const pk_scene *s, pk_accel_kind kind, int threads, accel **out)
+{
+    *out = NULL;
+    vec3 *verts = NULL;
+    accel_sphere *sph = NULL;
+    if (s->ntris) {
+        verts = mem_realloc_array(&ctx->alloc, NULL, s->ntris, 3 * sizeof *verts); /* overflow-checked */
+        if (!verts) return ctx_nomem(ctx);
+        for (size_t k = 0; k < s->ntris; k++) scene_tri_verts(s, k, &verts[3 * k], &verts[3 * k + 1], &verts[3 * k + 2]);
+    }
+    if (s->nspheres) {
+        sph = mem_realloc_array(&ctx->alloc, NULL, s->nspheres, sizeof *sph);
+        if (!sph) {
+            mem_free(&ctx->alloc, verts);
+            return ctx_nomem(ctx);
+        }
+        for (size_t i = 0; i < s->nspheres; i++) {
+            sph[i].center = s->spheres[i].center;
+            sph[i].radius = s->spheres[i].radius;
+        }
+    }
+    accel_input in = {verts, s->ntris, sph, s->nspheres, threads > 0 ? threads : omp_get_max_threads()};
+    pk_status st = accel_create(ctx, kind, &in, out);
+    mem_free(&ctx->alloc, verts);
+    mem_free(&ctx->alloc, sph);
+    return st;
+}
+
+pk_status frame_init(pk_context *ctx, frame *f, const pk_scene *s, pk_accel_kind kind, int threads)
+{
+    memset(f, 0, sizeof *f);
+    f->s = s;
+    double t0 = time_now();
+    pk_status st = frame_build_accel(ctx, s, kind, threads, &f->a);
+    if (st != PK_OK) return st;
+    f->build_s = f->a->info.build_ms > 0.0 ? f->a->info.build_ms * 1e-3 : time_now() - t0;
+    vec3 ext = aabb_extent(s->bounds);
+    f->eps = 1e-5f * fmaxf(v3_max_comp(ext), 1e-6f);
+    st = lights_build(ctx, s, &f->lights);
+    if (st != PK_OK) {
+        frame_free(&ctx->alloc, f);
+        return st;
+    }
+    return PK_OK;
+}
+
+void frame_free(const pk_allocator *al, frame *f)
+{
+    lights_free(al, &f->lights);
+    accel_destroy(f->a);
+    f->a = NULL;
+}

@@ -1,0 +1,27 @@
+/*
+ * frame.h - what a renderer builds once for a scene and then only reads:
+ * the acceleration structure, the light table and the ray offset scale.
+ */
+#ifndef PK_FRAME_H
+#define PK_FRAME_H
+
+#include "../accel/accel.h"
+#include "lights.h"
+
+typedef struct frame {
+    const pk_scene *s;
+    accel *a;
+    light_table lights;
+    float eps;           /* base offset for spawned rays, world units */
+    double build_s;      /* acceleration build, seconds */
+} frame;
+
+/* Builds an accelerator of kind over the scene's triangles and spheres with
+ * up to threads threads (0 = all). */
+PK_HIDDEN pk_status frame_build_accel(pk_context *ctx, const pk_scene *s, pk_accel_kind kind, int threads,
+                                      accel **out);
+/* The accelerator, the light table and eps. */
+PK_HIDDEN pk_status frame_init(pk_context *ctx, frame *f, const pk_scene *s, pk_accel_kind kind, int threads);
+PK_HIDDEN void frame_free(const pk_allocator *al, frame *f);
+
+#endif

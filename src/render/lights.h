@@ -1,0 +1,36 @@
+/*
+ * lights.h - the light table of a frame: the emissive triangles with their
+ * areas, unit normals and a CDF over emitted power (luminance x area), built
+ * once per renderer and shared by the integrators.
+ */
+#ifndef PK_LIGHTS_H
+#define PK_LIGHTS_H
+
+#include "../scene/scene.h"
+
+typedef struct light_table {
+    size_t n;            /* the scene's emissive triangles (s->emissive) */
+    float *cdf;          /* n entries, cumulative power, last = 1 */
+    float *area;         /* area of each emissive triangle */
+    vec3 *normal;        /* unit geometric normal of each emissive triangle */
+    float power;         /* total emitted power (luminance * area) */
+} light_table;
+
+PK_HIDDEN pk_status lights_build(pk_context *ctx, const pk_scene *s, light_table *lt);
+PK_HIDDEN void lights_free(const pk_allocator *al, light_table *lt);
+
+/* The light whose CDF interval holds u in [0, 1) (lt->n > 0). */
+static inline size_t light_pick(const light_table *lt, float u)
+{
+    size_t lo = 0, hi = lt->n - 1;
+    while (lo < hi) {
+        size_t mid = (lo + hi) / 2;
+        if (u < lt->cdf[mid])
+            hi = mid;
+        else
+            lo = mid + 1;
+    }
+    return lo;
+}
+
+#endif

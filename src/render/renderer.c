@@ -1,0 +1,287 @@
+/*
+ * renderer.c - render sessions: the frame is built once; each render splits
+ * its regions into 16x16 tiles rendered in parallel (OpenMP, dynamic
+ * scheduling), generates camera rays through pixel centres (stratified
+ * jitter for spp > 1) in coherent batches, shades them with the Whitted
+ * integrator and adds each finished tile to the film. Every pixel sample
+ * seeds its own random numbers from (pixel, sample), so a pixel's value does
+ * not depend on the threads, the tiles or the regions.
+ */
+#include "render.h"
+
+#include "camera.h"
+#include "whitted.h"
+
+#include <omp.h>
+#include <stdatomic.h>
+#include <string.h>
+
+#define TILE 16
+#define BATCH (TILE * TILE)
+#define PROGRESS_INTERVAL_S 0.25 /* at most 4 progress reports a second */
+
+struct pk_renderer {
+    pk_context *ctx;
+    pk_render_options opt;
+    int nt;                 /* threads */
+    frame fr;
+    whitted w;
+    whitted_thread *ts;     /* nt entries */
+    pk_camera cam;
+    pk_stats total;         /* since creation */
+};
+
+/* Warnings about scenes that the Whitted integrator will render black or
+ * lit differently from what the file suggests. */
+static void warn_lighting(pk_context *ctx, const pk_scene *s)
+{
+    size_t emissive_spheres = 0;
+    for (size_t i = 0; i < s->nspheres; i++) {
+        vec3 ke = s->materials[s->spheres[i].material].ke;
+        if (ke.x > 0.0f || ke.y > 0.0f || ke.z > 0.0f) emissive_spheres++;
+    }
+    bool ambient = s->ambient.x > 0.0f || s->ambient.y > 0.0f || s->ambient.z > 0.0f;
+    if (s->nemissive == 0 && s->nlights == 0 && emissive_spheres == 0 && !ambient)
+        ctx_warn(ctx, "%s: the scene has no light (no emissive triangle or sphere, no point light): the image will be black",
+                 s->name);
+    if (emissive_spheres)
+        ctx_warn(ctx, "%s: %zu emissive sphere%s visible but light%s nothing: the Whitted integrator lights the scene "
+                 "only from emissive triangles and point lights", s->name, emissive_spheres,
+                 emissive_spheres == 1 ? " is" : "s are", emissive_spheres == 1 ? "s" : "");
+}
+
+pk_status renderer_create(pk_context *ctx, const pk_scene *s, const pk_render_options *opt, const pk_camera *cam,
+                          pk_renderer **out)
+{
+    *out = NULL;
+    pk_renderer *r = mem_calloc(&ctx->alloc, 1, sizeof *r);
+    if (!r) return ctx_nomem(ctx);
+    r->ctx = ctx;
+    r->opt = *opt;
+    r->cam = *cam;
+    r->nt = opt->threads > 0 ? opt->threads : omp_get_max_threads();
+    pk_status st = frame_init(ctx, &r->fr, s, opt->accel, r->nt);
+    if (st != PK_OK) {
+        mem_free(&ctx->alloc, r);
+        return st;
+    }
+    r->w = (whitted){&r->fr, opt->light_samples, opt->max_depth, opt->fresnel != 0};
+    r->ts = mem_calloc(&ctx->alloc, (size_t)r->nt, sizeof *r->ts);
+    if (!r->ts) {
+        renderer_destroy(r);
+        return ctx_nomem(ctx);
+    }
+    for (int t = 0; t < r->nt; t++)
+        if ((st = whitted_thread_init(ctx, &r->w, &r->ts[t], opt->collect_stats != 0)) != PK_OK) {
+            renderer_destroy(r);
+            return st;
+        }
+    r->total.build_us = r->fr.build_s * 1e6;
+    r->total.threads = r->nt;
+    r->total.accel_builds = 1;
+    warn_lighting(ctx, s);
+    *out = r;
+    return PK_OK;
+}
+
+void renderer_destroy(pk_renderer *r)
+{
+    if (!r) return;
+    const pk_allocator *al = &r->ctx->alloc;
+    if (r->ts)
+        for (int t = 0; t < r->nt; t++) whitted_thread_free(al, &r->ts[t]);
+    mem_free(al, r->ts);
+    frame_free(al, &r->fr);
+    mem_free(al, r);
+}
+
+pk_context *renderer_context(const pk_renderer *r) { return r->ctx; }
+const pk_render_options *renderer_options(const pk_renderer *r) { return &r->opt; }
+void renderer_set_camera(pk_renderer *r, const pk_camera *cam) { r->cam = *cam; }
+const pk_camera *renderer_camera(const pk_renderer *r) { return &r->cam; }
+void renderer_stats(const pk_renderer *r, pk_stats *stats) { *stats = r->total; }
+
+typedef struct tile {
+    int x, y, w, h;
+} tile;
+
+static bool regions_overlap(const pk_region *a, const pk_region *b)
+{
+    return a->x < b->x + b->width && b->x < a->x + a->width && a->y < b->y + b->height && b->y < a->y + a->height;
+}
+
+/* Checks the regions and counts their tiles. */
+static pk_status check_regions(pk_context *ctx, const pk_region *reg, size_t n, int width, int height,
+                               size_t *ntiles)
+{
+    size_t count = 0;
+    for (size_t i = 0; i < n; i++) {
+        const pk_region *g = &reg[i];
+        if (g->width < 1 || g->height < 1 || g->x < 0 || g->y < 0 || g->x > width - g->width ||
+            g->y > height - g->height)
+            return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT,
+                             "region %zu (%d,%d %dx%d) is empty or not inside the %dx%d image", i, g->x, g->y,
+                             g->width, g->height, width, height);
+        count += (size_t)((g->width + TILE - 1) / TILE) * (size_t)((g->height + TILE - 1) / TILE);
+    }
+    /* overlapping regions would add samples twice, from two threads at once */
+    if (n <= 4096) {
+        for (size_t i = 0; i < n; i++)
+            for (size_t j = i + 1; j < n; j++)
+                if (regions_overlap(&reg[i], &reg[j]))
+                    return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "regions %zu and %zu overlap", i, j);
+    } else {
+        uint8_t *seen = mem_calloc(&ctx->alloc, (size_t)width * (size_t)height, 1);
+        if (!seen) return ctx_nomem(ctx);
+        pk_status st = PK_OK;
+        for (size_t i = 0; i < n && st == PK_OK; i++)
+            for (int y = reg[i].y; y < reg[i].y + reg[i].height && st == PK_OK; y++)
+                for (int x = reg[i].x; x < reg[i].x + reg[i].width; x++) {
+                    uint8_t *p = &seen[(size_t)y * (size_t)width + (size_t)x];
+                    if (*p) {
+                        st = ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "region %zu overlaps an earlier region", i);
+                        break;
+                    }
+                    *p = 1;
+                }
+        mem_free(&ctx->alloc, seen);
+        if (st != PK_OK) return st;
+    }
+    *ntiles = count;
+    return PK_OK;
+}
+
+/* Renders one tile into acc (3 floats per pixel, the sums of spp samples);
+ * false when the render was cancelled before the tile finished. */
+static bool render_tile(const pk_renderer *r, whitted_thread *me, const camera_frame *cf, const tile *tl,
+                        float *acc, volatile const int *cancel, atomic_int *stop)
+{
+    const whitted *w = &r->w;
+    const int spp = r->opt.spp;
+    const int sx = (int)ceilf(sqrtf((float)spp)), sy = (spp + sx - 1) / sx;
+    const int tw = tl->w, n = tl->w * tl->h;
+    ray rays[BATCH];
+    hit hits[BATCH];
+    memset(acc, 0, sizeof(float) * 3 * (size_t)n);
+    for (int smp = 0; smp < spp; smp++) {
+        /* also between passes: a tile at many samples may take long */
+        if (smp > 0 && ((cancel && *cancel) || atomic_load_explicit(stop, memory_order_relaxed))) return false;
+        for (int i = 0; i < n; i++) {
+            int px = tl->x + i % tw, py = tl->y + i / tw;
+            float jx = 0.5f, jy = 0.5f;
+            if (spp > 1) {
+                rng jr = rng_seed(((uint64_t)py << 32) | (uint32_t)px, (uint64_t)smp * 2 + 1);
+                jx = ((float)(smp % sx) + rng_float(&jr)) / (float)sx;
+                jy = ((float)(smp / sx) + rng_float(&jr)) / (float)sy;
+            }
+            rays[i] = camera_ray(cf, (float)px + jx, (float)py + jy);
+        }
+        me->rays[RAY_CAMERA] += (uint64_t)n;
+        accel_intersect_many(w->f->a, rays, hits, (size_t)n, false, me->cp);
+        for (int i = 0; i < n; i++) {
+            if (hits[i].prim == PK_NO_HIT) continue;
+            int px = tl->x + i % tw, py = tl->y + i / tw;
+            me->rng = rng_seed(((uint64_t)py << 32) | (uint32_t)px, (uint64_t)smp * 2);
+            me->ray_budget = WHITTED_RAY_BUDGET;
+            vec3 c = whitted_shade(w, me, &rays[i], &hits[i], 0);
+            acc[3 * i] += c.x;
+            acc[3 * i + 1] += c.y;
+            acc[3 * i + 2] += c.z;
+        }
+    }
+    return true;
+}
+
+pk_status renderer_render(pk_renderer *r, const pk_region *regions, size_t nregions, pk_film *film)
+{
+    pk_context *ctx = r->ctx;
+    const pk_render_options *opt = &r->opt;
+    if (film->width != opt->width || film->height != opt->height)
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "the film is %dx%d but the renderer makes %dx%d images",
+                         film->width, film->height, opt->width, opt->height);
+    const pk_region whole = {0, 0, opt->width, opt->height};
+    if (!regions) {
+        regions = &whole;
+        nregions = 1;
+    }
+    size_t ntiles = 0;
+    pk_status st = check_regions(ctx, regions, nregions, opt->width, opt->height, &ntiles);
+    if (st != PK_OK) return st;
+    if (ntiles > (size_t)INT32_MAX) return ctx_error(ctx, PK_ERR_LIMIT, "too many regions (%zu tiles)", ntiles);
+    tile *tiles = mem_realloc_array(&ctx->alloc, NULL, ntiles ? ntiles : 1, sizeof *tiles);
+    if (!tiles) return ctx_nomem(ctx);
+    size_t k = 0;
+    uint64_t pixels = 0;
+    for (size_t i = 0; i < nregions; i++) {
+        const pk_region *g = &regions[i];
+        pixels += (uint64_t)g->width * (uint64_t)g->height;
+        for (int y = g->y; y < g->y + g->height; y += TILE)
+            for (int x = g->x; x < g->x + g->width; x += TILE) {
+                int x1 = x + TILE < g->x + g->width ? x + TILE : g->x + g->width;
+                int y1 = y + TILE < g->y + g->height ? y + TILE : g->y + g->height;
+                tiles[k++] = (tile){x, y, x1 - x, y1 - y};
+            }
+    }
+
+    for (int t = 0; t < r->nt; t++) {
+        memset(r->ts[t].rays, 0, sizeof r->ts[t].rays);
+        r->ts[t].counters = (accel_counters){0, 0};
+    }
+    const camera_frame cf = camera_setup(&r->cam, opt->width, opt->height);
+    volatile const int *cancel = opt->cancel;
+    atomic_int stop = 0;      /* set when the progress callback asks to stop */
+    atomic_long done = 0;     /* finished tiles */
+    int cancelled = 0;
+    const int nt_total = (int)ntiles;
+    const double t1 = time_now();
+    double last_report = t1;
+    if (opt->progress && opt->progress(opt->progress_user, 0, (uint64_t)ntiles, 0.0) != 0) stop = 1;
+#pragma omp parallel num_threads(r->nt)
+    {
+        const int tid = omp_get_thread_num();
+        whitted_thread *me = &r->ts[tid];
+        float acc[BATCH * 3];
+#pragma omp for schedule(dynamic, 1)
+        for (int ti = 0; ti < nt_total; ti++) {
+            if ((cancel && *cancel) || atomic_load_explicit(&stop, memory_order_relaxed)) {
+#pragma omp atomic write
+                cancelled = 1;
+                continue;
+            }
+            const tile *tl = &tiles[ti];
+            if (!render_tile(r, me, &cf, tl, acc, cancel, &stop)) { /* an unfinished tile stays black */
+#pragma omp atomic write
+                cancelled = 1;
+                continue;
+            }
+            film_add_block(film, tl->x, tl->y, tl->w, tl->h, acc, (uint32_t)opt->spp);
+            const long d = atomic_fetch_add_explicit(&done, 1, memory_order_relaxed) + 1;
+            /* progress reports come from the calling thread only (OpenMP thread 0) */
+            if (tid == 0 && opt->progress) {
+                const double now = time_now();
+                if (now - last_report >= PROGRESS_INTERVAL_S) {
+                    last_report = now;
+                    if (opt->progress(opt->progress_user, (uint64_t)d, (uint64_t)ntiles, now - t1) != 0)
+                        atomic_store(&stop, 1);
+                }
+            }
+        }
+    }
+    const double render_s = time_now() - t1;
+    if (opt->progress) opt->progress(opt->progress_user, (uint64_t)atomic_load(&done), (uint64_t)ntiles, render_s);
+    mem_free(&ctx->alloc, tiles);
+
+    pk_stats *s = &r->total;
+    for (int t = 0; t < r->nt; t++) {
+        s->rays_camera += r->ts[t].rays[RAY_CAMERA];
+        s->rays_shadow += r->ts[t].rays[RAY_SHADOW];
+        s->rays_reflection += r->ts[t].rays[RAY_REFLECTION];
+        s->rays_refraction += r->ts[t].rays[RAY_REFRACTION];
+        s->intersection_tests += r->ts[t].counters.tests;
+        s->nodes_visited += r->ts[t].counters.nodes;
+    }
+    s->render_s += render_s;
+    s->pixels += pixels;
+    if (cancelled || atomic_load(&stop)) return ctx_error(ctx, PK_ERR_CANCELLED, "render cancelled");
+    return PK_OK;
+}
