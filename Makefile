@@ -37,8 +37,11 @@ $(BUILD)/CMakeCache.txt:
 build: deps $(BUILD)/CMakeCache.txt
 	cmake --build $(BUILD) -j $(JOBS)
 
-demo: build
-	./$(BUILD)/paprsek render -o cornell.png --stats
+# Only the program (target paprsek_cli and the library it links), not the
+# tests and fuzz replays that `make build` and `make test` compile.
+demo: deps $(BUILD)/CMakeCache.txt
+	cmake --build $(BUILD) -j $(JOBS) --target paprsek_cli
+	$(BUILD)/paprsek render -o cornell.png --stats
 
 test: deps-test
 	@# (re)configure so that a newly installed Embree is found
