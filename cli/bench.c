@@ -40,8 +40,8 @@ enum {
 
 static cli_option rays_opts[] = {
     OPT_STR("accel", B_ACCEL, "NAME", "the acceleration structure: " ACCEL_HELP),
-    {.name = "threads", .id = B_THREADS}, /* from the library's table: bench_options() */
-    {.name = "reps", .id = B_REPS, .kind = CLI_INT, .arg = "K", .help = "timed repetitions; the median is reported",
+    {.name = "threads", .id = B_THREADS}, /* the library's entry, put here by bench_options() */
+    {.name = "reps", .id = B_REPS, .kind = CLI_INT, .arg = "K", .help = "timed repetitions (the median is reported)",
      .min = 1, .max = MAX_REPS, .default_value = 5},
     OPT_STR("hits", B_HITS, "FILE", "write the hits of the last repetition (16 bytes per ray)"),
     OPT_FLAG("any-hit", B_ANY_HIT, "occlusion rays: any hit, not the closest"),
@@ -83,8 +83,10 @@ static void bench_options(void)
     if (!t) return;
     cli_option o = cli_option_from_render(t, name, sizeof name);
     o.id = B_THREADS;
-    rays_opts[1] = o;
-    gen_opts[10] = o;
+    for (size_t i = 0; i < COUNT(rays_opts); i++)
+        if (rays_opts[i].id == B_THREADS) rays_opts[i] = o;
+    for (size_t i = 0; i < COUNT(gen_opts); i++)
+        if (gen_opts[i].id == B_THREADS) gen_opts[i] = o;
 }
 
 void cli_bench_help(FILE *f)
