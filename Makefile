@@ -4,12 +4,14 @@
 BUILD      ?= build
 JOBS       ?= $(shell nproc 2>/dev/null || echo 2)
 BUILD_PKGS  = gcc make cmake pkg-config libpng-dev libcjson-dev
-TEST_PKGS   = $(BUILD_PKGS) libembree-dev
+# g++: the install tests build a C++ program against the installed library
+TEST_PKGS   = $(BUILD_PKGS) libembree-dev g++
+PREFIX     ?= /usr/local
 FUZZ_PKGS   = $(TEST_PKGS) clang libclang-rt-14-dev libomp-14-dev
 FUZZ_SECONDS ?= 60
 FUZZERS     = obj mtl json render
 
-.PHONY: all build demo test deps deps-test bench clean build-asan sanitize fuzz fuzz-build fuzz-seeds fuzz-merge
+.PHONY: all build demo test deps deps-test install bench clean build-asan sanitize fuzz fuzz-build fuzz-seeds fuzz-merge
 
 all: build
 
@@ -42,6 +44,15 @@ build: deps $(BUILD)/CMakeCache.txt
 demo: deps $(BUILD)/CMakeCache.txt
 	cmake --build $(BUILD) -j $(JOBS) --target paprsek_cli
 	$(BUILD)/paprsek render -o cornell.png --stats
+
+# Installs the program, the header, the shared and static libraries, paprsek.pc
+# and the CMake package under PREFIX (docs/install.md); DESTDIR=/stage puts
+# them under /stage/PREFIX instead. As root, ldconfig then refreshes the
+# dynamic linker's cache, so that programs find libpaprsek.so.0 in
+# /usr/local/lib.
+install: build
+	DESTDIR="$(DESTDIR)" cmake --install $(BUILD) --prefix "$(PREFIX)"
+	@if [ -z "$(DESTDIR)" ] && [ "$$(id -u)" = 0 ] && command -v ldconfig >/dev/null; then ldconfig; fi
 
 test: deps-test
 	@# (re)configure so that a newly installed Embree is found

@@ -23,6 +23,14 @@ int pk_accel_available(pk_accel_kind kind)
     return (unsigned)kind <= PK_ACCEL_BVH;
 }
 
+/* Latches why kind cannot be used (Embree says which library did not load). */
+static pk_status accel_unavailable(pk_context *ctx, pk_accel_kind kind)
+{
+    if (kind == PK_ACCEL_EMBREE) return accel_embree_unavailable(ctx);
+    return ctx_error(ctx, PK_ERR_UNSUPPORTED, "accelerator '%s' is not available in this build",
+                     pk_accel_kind_name(kind));
+}
+
 /* ---- scenes ----------------------------------------------------------------- */
 
 static const char *base_name(const char *path)
@@ -221,9 +229,7 @@ static pk_status check_options(pk_context *ctx, const pk_render_options *o)
 {
     pk_status st = options_check(ctx, o);
     if (st != PK_OK) return st;
-    if (!pk_accel_available(o->accel))
-        return ctx_error(ctx, PK_ERR_UNSUPPORTED, "accelerator '%s' is not available in this build",
-                         pk_accel_kind_name(o->accel));
+    if (!pk_accel_available(o->accel)) return accel_unavailable(ctx, o->accel);
     return PK_OK;
 }
 
@@ -373,9 +379,7 @@ pk_status pk_accel_create(pk_context *ctx, const pk_scene *scene, pk_accel_kind 
         return ctx_error(ctx, PK_ERR_LIMIT, "threads %d is out of range (%d..%d)", threads, th->min, th->max);
     if ((unsigned)kind > PK_ACCEL_EMBREE)
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "unknown accelerator %d", (int)kind);
-    if (!pk_accel_available(kind))
-        return ctx_error(ctx, PK_ERR_UNSUPPORTED, "accelerator '%s' is not available in this build",
-                         pk_accel_kind_name(kind));
+    if (!pk_accel_available(kind)) return accel_unavailable(ctx, kind);
     pk_accel *pa = mem_calloc(&ctx->alloc, 1, sizeof *pa);
     if (!pa) return ctx_nomem(ctx);
     pa->ctx = ctx;

@@ -81,6 +81,8 @@ PK_HIDDEN pk_status accel_midpoint_create(pk_context *ctx, const accel_input *in
 PK_HIDDEN pk_status accel_bvh_create(pk_context *ctx, const accel_input *in, accel **out);
 PK_HIDDEN pk_status accel_embree_create(pk_context *ctx, const accel_input *in, accel **out);
 PK_HIDDEN bool accel_embree_available(void);
+/* When Embree is not available: latches why (PK_ERR_UNSUPPORTED) and returns it. */
+PK_HIDDEN pk_status accel_embree_unavailable(pk_context *ctx);
 /* Invariant checkers (tests): false with a reason when the structure is broken. */
 PK_HIDDEN bool midpoint_check(const accel *a, char *why, size_t n);
 

@@ -1,5 +1,5 @@
 /*
- * bvh_midpoint.c - the seed's BVH: a binary tree split at the midpoint of the
+ * bvh_midpoint.c - a simple BVH, kept for comparison: a binary tree split at the midpoint of the
  * centroid bounds on round-robin axes (x, y, z, x, ...), falling back to the
  * longest axis when every primitive lands on one side. Traversal visits the
  * nearer child first and skips nodes farther than the closest hit so far.

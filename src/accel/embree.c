@@ -3,7 +3,16 @@
  * own structures can be timed and checked against it on the same rays. One
  * triangle geometry holds every triangle (degenerate ones too, so Embree's
  * primID is Paprsek's triangle number) and one sphere-point geometry the
- * spheres. Without Embree (PK_HAVE_EMBREE 0) this file is a stub.
+ * spheres. Without Embree's headers at build time (PK_HAVE_EMBREE 0) this
+ * file is a stub.
+ *
+ * Embree is not linked: the library is compiled against Embree's headers and
+ * loads libembree3.so.3 with dlopen the first time the Embree accelerator is
+ * asked for (pk_accel_available or pk_accel_create), so that a program that
+ * never uses it neither needs Embree installed nor pays for loading it. Every
+ * rtc* function is called through the table rtc, filled with dlsym; the
+ * header's prototypes give the pointer types (__typeof__), so a call that
+ * does not match Embree's declarations does not compile.
  */
 #include "accel.h"
 
@@ -11,9 +20,74 @@
 
 #include <embree3/rtcore.h>
 
+#include <dlfcn.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* The soname of Embree 3's runtime (Debian: libembree3-3). */
+#define EMBREE_LIBRARY "libembree3.so.3"
+
+/* Every Embree function this file calls. */
+#define RTC_FUNCTIONS(X)                                                                 \
+    X(NewDevice) X(ReleaseDevice) X(GetDeviceError) X(GetDeviceProperty)                 \
+    X(SetDeviceErrorFunction) X(SetDeviceMemoryMonitorFunction)                          \
+    X(NewScene) X(ReleaseScene) X(SetSceneFlags) X(SetSceneBuildQuality) X(CommitScene)  \
+    X(NewGeometry) X(ReleaseGeometry) X(SetNewGeometryBuffer) X(SetGeometryBuildQuality) \
+    X(SetGeometryUserData) X(SetGeometryOccludedFilterFunction) X(CommitGeometry)        \
+    X(AttachGeometryByID)                                                                \
+    X(Intersect1) X(Occluded1) X(Intersect8) X(Occluded8) X(Intersect16) X(Occluded16)
+
+/* rtc.Name points to Embree's rtcName once load_embree has succeeded. */
+static struct rtc_table {
+#define RTC_FIELD(name) __typeof__(&rtc##name) name;
+    RTC_FUNCTIONS(RTC_FIELD)
+#undef RTC_FIELD
+} rtc;
+
+/* Invariant: after load_once has run, loaded says whether every field of rtc
+ * is set; when it is false, load_error says why (for messages). The handle is
+ * never closed: Embree keeps threads of its own and the table stays valid for
+ * the life of the process. */
+static pthread_once_t load_once = PTHREAD_ONCE_INIT;
+static bool loaded;
+static char load_error[256];
+
+static void load_embree(void)
+{
+    /* PAPRSEK_EMBREE_LIBRARY names another file to load (a path or a soname):
+     * an Embree 3 build of one's own, or a missing file to try the fallback. */
+    const char *name = getenv("PAPRSEK_EMBREE_LIBRARY");
+    if (!name || !name[0]) name = EMBREE_LIBRARY;
+    void *h = dlopen(name, RTLD_NOW | RTLD_LOCAL);
+    if (!h) {
+        const char *why = dlerror();
+        snprintf(load_error, sizeof load_error, "%s could not be loaded (%s)", name,
+                 why ? why : "no reason given");
+        return;
+    }
+    struct rtc_table t;
+    void *sym;
+#define RTC_LOAD(fn)                                                                              \
+    sym = dlsym(h, "rtc" #fn);                                                                    \
+    if (!sym) {                                                                                   \
+        snprintf(load_error, sizeof load_error, "%s has no rtc" #fn " (not Embree 3?)", name);    \
+        dlclose(h);                                                                               \
+        return;                                                                                   \
+    }                                                                                             \
+    memcpy(&t.fn, &sym, sizeof sym);
+    RTC_FUNCTIONS(RTC_LOAD)
+#undef RTC_LOAD
+    rtc = t;
+    loaded = true;
+}
+
+/* Loads Embree once per process; true when its functions are in rtc. */
+static bool embree_loaded(void)
+{
+    return pthread_once(&load_once, load_embree) == 0 && loaded;
+}
 
 enum { GEOM_TRIS = 0, GEOM_SPHERES = 1 };
 
@@ -46,7 +120,15 @@ typedef struct occ_context {
     hit *out;
 } occ_context;
 
-bool accel_embree_available(void) { return true; }
+bool accel_embree_available(void) { return embree_loaded(); }
+
+pk_status accel_embree_unavailable(pk_context *ctx)
+{
+    bool ok = embree_loaded();
+    return ctx_error(ctx, PK_ERR_UNSUPPORTED,
+                     "accelerator 'embree' is not available: %s (Debian: install libembree3-3)",
+                     !ok && load_error[0] ? load_error : EMBREE_LIBRARY " could not be loaded");
+}
 
 static const char *rtc_error_name(enum RTCError code)
 {
@@ -173,7 +255,7 @@ static bool emb_intersect(const accel *a, const ray *r, hit *h, accel_counters *
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(e->scene, &ictx, &rh);
+    rtc.Intersect1(e->scene, &ictx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
         hit_clear(h);
         return false;
@@ -193,7 +275,7 @@ static bool emb_occluded(const accel *a, const ray *r, hit *h, accel_counters *c
     hit_clear(oc.out);
     struct RTCRay rr;
     init_ray1(&rr, r);
-    rtcOccluded1(e->scene, &oc.base, &rr);
+    rtc.Occluded1(e->scene, &oc.base, &rr);
     if (rr.tfar != -INFINITY) {
         hit_clear(oc.out);
         return false;
@@ -268,16 +350,16 @@ static void emb_packets(const accel *a, const ray *r, hit *h, size_t n, bool any
             oc.base.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
             oc.out = out;
             for (unsigned i = 0; i < m; i++) hit_clear(&out[i]);
-            if (w == 16) rtcOccluded16(valid, e->scene, &oc.base, &buf.r16);
-            else rtcOccluded8(valid, e->scene, &oc.base, &buf.r8);
+            if (w == 16) rtc.Occluded16(valid, e->scene, &oc.base, &buf.r16);
+            else rtc.Occluded8(valid, e->scene, &oc.base, &buf.r8);
             for (unsigned i = 0; i < m; i++)
                 if (f[F_TFAR * w + i] != -INFINITY) hit_clear(&out[i]);
         } else {
             struct RTCIntersectContext ictx;
             rtcInitIntersectContext(&ictx);
             ictx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-            if (w == 16) rtcIntersect16(valid, e->scene, &ictx, &buf.rh16);
-            else rtcIntersect8(valid, e->scene, &ictx, &buf.rh8);
+            if (w == 16) rtc.Intersect16(valid, e->scene, &ictx, &buf.rh16);
+            else rtc.Intersect8(valid, e->scene, &ictx, &buf.rh8);
             for (unsigned i = 0; i < m; i++) {
                 const ray *ri = &r[base + i];
                 if (u[F_GEOM * w + i] == RTC_INVALID_GEOMETRY_ID) hit_clear(&out[i]);
@@ -294,8 +376,8 @@ static void emb_destroy(accel *a)
     embree_accel *e = (embree_accel *)a;
     if (!e) return;
     pk_allocator al = e->alloc;
-    if (e->scene) rtcReleaseScene(e->scene);
-    if (e->device) rtcReleaseDevice(e->device);
+    if (e->scene) rtc.ReleaseScene(e->scene);
+    if (e->device) rtc.ReleaseDevice(e->device);
     mem_free(&al, e->spheres);
     mem_free(&al, e);
 }
@@ -310,11 +392,11 @@ static const accel_ops embree_ops = {
 /* Adds the triangles as geometry GEOM_TRIS: vertices 3k..3k+2 are triangle k. */
 static void add_triangles(embree_accel *e, const accel_input *in, enum RTCBuildQuality q)
 {
-    RTCGeometry g = rtcNewGeometry(e->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    RTCGeometry g = rtc.NewGeometry(e->device, RTC_GEOMETRY_TYPE_TRIANGLE);
     if (!g) return;
-    float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+    float *vb = rtc.SetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                         3 * sizeof(float), 3 * in->ntris);
-    unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+    unsigned *ib = rtc.SetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                            3 * sizeof(unsigned), in->ntris);
     if (vb && ib) {
         for (size_t i = 0; i < 3 * in->ntris; i++) {
@@ -323,20 +405,20 @@ static void add_triangles(embree_accel *e, const accel_input *in, enum RTCBuildQ
             vb[3 * i + 2] = in->verts[i].z;
             ib[i] = (unsigned)i;
         }
-        rtcSetGeometryBuildQuality(g, q);
-        rtcSetGeometryUserData(g, e);
-        if (e->has_filter) rtcSetGeometryOccludedFilterFunction(g, occ_filter);
-        rtcCommitGeometry(g);
-        rtcAttachGeometryByID(e->scene, g, GEOM_TRIS);
+        rtc.SetGeometryBuildQuality(g, q);
+        rtc.SetGeometryUserData(g, e);
+        if (e->has_filter) rtc.SetGeometryOccludedFilterFunction(g, occ_filter);
+        rtc.CommitGeometry(g);
+        rtc.AttachGeometryByID(e->scene, g, GEOM_TRIS);
     }
-    rtcReleaseGeometry(g);
+    rtc.ReleaseGeometry(g);
 }
 
 static void add_spheres(embree_accel *e, const accel_input *in, enum RTCBuildQuality q)
 {
-    RTCGeometry g = rtcNewGeometry(e->device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+    RTCGeometry g = rtc.NewGeometry(e->device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
     if (!g) return;
-    float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
+    float *vb = rtc.SetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
                                         4 * sizeof(float), in->nspheres);
     if (vb) {
         for (size_t i = 0; i < in->nspheres; i++) {
@@ -345,18 +427,19 @@ static void add_spheres(embree_accel *e, const accel_input *in, enum RTCBuildQua
             vb[4 * i + 2] = in->spheres[i].center.z;
             vb[4 * i + 3] = in->spheres[i].radius;
         }
-        rtcSetGeometryBuildQuality(g, q);
-        rtcSetGeometryUserData(g, e);
-        if (e->has_filter) rtcSetGeometryOccludedFilterFunction(g, occ_filter);
-        rtcCommitGeometry(g);
-        rtcAttachGeometryByID(e->scene, g, GEOM_SPHERES);
+        rtc.SetGeometryBuildQuality(g, q);
+        rtc.SetGeometryUserData(g, e);
+        if (e->has_filter) rtc.SetGeometryOccludedFilterFunction(g, occ_filter);
+        rtc.CommitGeometry(g);
+        rtc.AttachGeometryByID(e->scene, g, GEOM_SPHERES);
     }
-    rtcReleaseGeometry(g);
+    rtc.ReleaseGeometry(g);
 }
 
 pk_status accel_embree_create(pk_context *ctx, const accel_input *in, accel **out)
 {
     *out = NULL;
+    if (!embree_loaded()) return accel_embree_unavailable(ctx);
     enum RTCBuildQuality quality = RTC_BUILD_QUALITY_MEDIUM;
     pk_status st = parse_quality(ctx, &quality);
     if (st != PK_OK) return st;
@@ -384,38 +467,38 @@ pk_status accel_embree_create(pk_context *ctx, const accel_input *in, accel **ou
     /* start_threads: the worker threads start here, outside build_ms */
     char config[64];
     snprintf(config, sizeof config, "threads=%d,start_threads=1,verbose=0", in->threads > 0 ? in->threads : 1);
-    e->device = rtcNewDevice(config);
+    e->device = rtc.NewDevice(config);
     if (!e->device) {
-        enum RTCError code = rtcGetDeviceError(NULL);
+        enum RTCError code = rtc.GetDeviceError(NULL);
         emb_destroy(&e->base);
         return ctx_error(ctx, rtc_error_status(code), "embree: the device could not be created: %s",
                          rtc_error_name(code));
     }
     build_errors be = {ctx, false};
-    rtcSetDeviceErrorFunction(e->device, on_build_error, &be);
-    rtcSetDeviceMemoryMonitorFunction(e->device, on_memory, e);
-    e->packet_width = rtcGetDeviceProperty(e->device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) ? 16 : 8;
-    e->has_filter = rtcGetDeviceProperty(e->device, RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED) != 0;
+    rtc.SetDeviceErrorFunction(e->device, on_build_error, &be);
+    rtc.SetDeviceMemoryMonitorFunction(e->device, on_memory, e);
+    e->packet_width = rtc.GetDeviceProperty(e->device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) ? 16 : 8;
+    e->has_filter = rtc.GetDeviceProperty(e->device, RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED) != 0;
 
     double t0 = time_now();
-    e->scene = rtcNewScene(e->device);
+    e->scene = rtc.NewScene(e->device);
     if (e->scene) {
-        rtcSetSceneFlags(e->scene, RTC_SCENE_FLAG_NONE);
-        rtcSetSceneBuildQuality(e->scene, quality);
+        rtc.SetSceneFlags(e->scene, RTC_SCENE_FLAG_NONE);
+        rtc.SetSceneBuildQuality(e->scene, quality);
         if (in->ntris) add_triangles(e, in, quality);
         if (in->nspheres) add_spheres(e, in, quality);
-        if (!be.failed) rtcCommitScene(e->scene);
+        if (!be.failed) rtc.CommitScene(e->scene);
     }
     double t1 = time_now();
-    if (be.failed || !e->scene || rtcGetDeviceError(e->device) != RTC_ERROR_NONE) {
+    if (be.failed || !e->scene || rtc.GetDeviceError(e->device) != RTC_ERROR_NONE) {
         if (!be.failed) ctx_error(ctx, PK_ERR_UNSUPPORTED, "embree: the scene could not be built");
         st = pk_context_status(ctx);
-        rtcSetDeviceErrorFunction(e->device, NULL, NULL);
+        rtc.SetDeviceErrorFunction(e->device, NULL, NULL);
         emb_destroy(&e->base);
         return st != PK_OK ? st : PK_ERR_UNSUPPORTED;
     }
     /* Tracing has no context to report to, and cannot fail. */
-    rtcSetDeviceErrorFunction(e->device, NULL, NULL);
+    rtc.SetDeviceErrorFunction(e->device, NULL, NULL);
 
     e->base.info.name = "embree";
     e->base.info.build_ms = (t1 - t0) * 1e3;
@@ -430,12 +513,17 @@ pk_status accel_embree_create(pk_context *ctx, const accel_input *in, accel **ou
 
 bool accel_embree_available(void) { return false; }
 
+pk_status accel_embree_unavailable(pk_context *ctx)
+{
+    return ctx_error(ctx, PK_ERR_UNSUPPORTED,
+                     "--accel embree: this build has no Embree (install libembree-dev and rebuild)");
+}
+
 pk_status accel_embree_create(pk_context *ctx, const accel_input *in, accel **out)
 {
     (void)in;
     *out = NULL;
-    return ctx_error(ctx, PK_ERR_UNSUPPORTED,
-                     "--accel embree: this build has no Embree (install libembree-dev and rebuild)");
+    return accel_embree_unavailable(ctx);
 }
 
 #endif

@@ -1,0 +1,76 @@
+# install.cmake - what `cmake --install` puts under the prefix:
+#   bin/paprsek, include/paprsek.h, lib/libpaprsek.so.0.1.0 (+ .so.0, .so),
+#   lib/libpaprsek.a, lib/pkgconfig/paprsek.pc and lib/cmake/paprsek/
+#   (paprsekConfig.cmake, its version file, the exported targets
+#   paprsek::paprsek and paprsek::paprsek_static).
+include(CMakePackageConfigHelpers)
+
+set(PK_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/paprsek)
+
+install(TARGETS paprsek_cli RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+install(TARGETS paprsek_shared paprsek_static EXPORT paprsekTargets
+  LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+  RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+install(FILES include/paprsek.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+
+install(EXPORT paprsekTargets NAMESPACE paprsek:: DESTINATION ${PK_CMAKE_DIR})
+configure_package_config_file(cmake/paprsekConfig.cmake.in
+  ${CMAKE_CURRENT_BINARY_DIR}/paprsekConfig.cmake INSTALL_DESTINATION ${PK_CMAKE_DIR})
+# libpaprsek.so.0 keeps its ABI for every 0.x release.
+write_basic_package_version_file(${CMAKE_CURRENT_BINARY_DIR}/paprsekConfigVersion.cmake
+  COMPATIBILITY SameMajorVersion)
+install(FILES ${CMAKE_CURRENT_BINARY_DIR}/paprsekConfig.cmake
+  ${CMAKE_CURRENT_BINARY_DIR}/paprsekConfigVersion.cmake DESTINATION ${PK_CMAKE_DIR})
+
+# paprsek.pc. Static linking (pkg-config --static) needs what the library
+# links: libpng and cJSON through their own .pc files where they have one,
+# the OpenMP flag, libm (and libdl, the thread library where the C library
+# lacks them). Embree is not listed: it is loaded at run time.
+set(PK_PC_REQUIRES_PRIVATE)
+set(PK_PC_LIBS_PRIVATE ${OpenMP_C_FLAGS})
+find_package(PkgConfig QUIET)
+if(PKG_CONFIG_FOUND)
+  pkg_check_modules(PK_PC_LIBPNG QUIET libpng)
+  pkg_check_modules(PK_PC_LIBCJSON QUIET libcjson)
+endif()
+if(PK_PC_LIBPNG_FOUND)
+  list(APPEND PK_PC_REQUIRES_PRIVATE libpng)
+else()
+  foreach(lib ${PNG_LIBRARIES})
+    get_filename_component(name ${lib} NAME_WE)
+    string(REGEX REPLACE "^lib" "" name ${name})
+    list(APPEND PK_PC_LIBS_PRIVATE -l${name})
+  endforeach()
+endif()
+if(PK_PC_LIBCJSON_FOUND)
+  list(APPEND PK_PC_REQUIRES_PRIVATE libcjson)
+else()
+  list(APPEND PK_PC_LIBS_PRIVATE -lcjson)
+endif()
+list(APPEND PK_PC_LIBS_PRIVATE -lm ${CMAKE_THREAD_LIBS_INIT})
+foreach(lib ${PK_DL_LIBS})
+  list(APPEND PK_PC_LIBS_PRIVATE -l${lib})
+endforeach()
+list(REMOVE_DUPLICATES PK_PC_LIBS_PRIVATE)
+list(JOIN PK_PC_REQUIRES_PRIVATE ", " PK_PC_REQUIRES_PRIVATE)
+list(JOIN PK_PC_LIBS_PRIVATE " " PK_PC_LIBS_PRIVATE)
+if(IS_ABSOLUTE "${CMAKE_INSTALL_LIBDIR}")
+  set(PK_PC_LIBDIR "${CMAKE_INSTALL_LIBDIR}")
+else()
+  set(PK_PC_LIBDIR "\${prefix}/${CMAKE_INSTALL_LIBDIR}")
+endif()
+if(IS_ABSOLUTE "${CMAKE_INSTALL_INCLUDEDIR}")
+  set(PK_PC_INCLUDEDIR "${CMAKE_INSTALL_INCLUDEDIR}")
+else()
+  set(PK_PC_INCLUDEDIR "\${prefix}/${CMAKE_INSTALL_INCLUDEDIR}")
+endif()
+# The prefix is only known when installing (cmake --install --prefix P), so
+# the file is written in two steps: everything else now, the prefix then.
+set(PK_PC_PREFIX "@PK_PC_PREFIX@")
+configure_file(cmake/paprsek.pc.in ${CMAKE_CURRENT_BINARY_DIR}/paprsek.pc.in @ONLY)
+install(CODE "
+  get_filename_component(PK_PC_PREFIX \"\${CMAKE_INSTALL_PREFIX}\" ABSOLUTE)
+  configure_file(\"${CMAKE_CURRENT_BINARY_DIR}/paprsek.pc.in\" \"${CMAKE_CURRENT_BINARY_DIR}/paprsek.pc\" @ONLY)
+")
+install(FILES ${CMAKE_CURRENT_BINARY_DIR}/paprsek.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
