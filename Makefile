@@ -39,8 +39,11 @@ $(BUILD)/CMakeCache.txt:
 build: deps $(BUILD)/CMakeCache.txt
 	cmake --build $(BUILD) -j $(JOBS)
 
-demo: build
-	./$(BUILD)/paprsek render -o cornell.png --stats
+# Only the program (target paprsek_cli and the library it links), not the
+# tests and fuzz replays that `make build` and `make test` compile.
+demo: deps $(BUILD)/CMakeCache.txt
+	cmake --build $(BUILD) -j $(JOBS) --target paprsek_cli
+	$(BUILD)/paprsek render -o cornell.png --stats
 
 # Installs the program, the header, the shared and static libraries, paprsek.pc
 # and the CMake package under PREFIX (docs/install.md); DESTDIR=/stage puts

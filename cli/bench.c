@@ -27,11 +27,80 @@ static const char usage_text[] =
     "                          [--size N] [--kind primary|diffuse] [--seed S] [--accel NAME] [--threads N]\n"
     "       paprsek bench compare A.hits B.hits [--any-hit] [--rays RAYS.rays]";
 
-static double now_s(void)
+/* ---- the options of each subcommand ---------------------------------------- */
+
+enum {
+    B_ACCEL = 1, B_THREADS, B_REPS, B_HITS, B_ANY_HIT, B_PACKETS, B_STATS, B_HELP,
+    B_OUTPUT, B_LOOK_FROM, B_LOOK_AT, B_FOV, B_SIZE, B_KIND, B_SEED, B_WORKLOAD, B_SHARED, B_RAYS
+};
+
+#define ACCEL_HELP "none, midpoint, bvh (default) or embree"
+#define OPT_FLAG(n, i, h) {.name = n, .id = i, .kind = CLI_FLAG, .help = h}
+#define OPT_STR(n, i, a, h) {.name = n, .id = i, .kind = CLI_STRING, .arg = a, .help = h}
+
+static cli_option rays_opts[] = {
+    OPT_STR("accel", B_ACCEL, "NAME", "the acceleration structure: " ACCEL_HELP),
+    {.name = "threads", .id = B_THREADS}, /* the library's entry, put here by bench_options() */
+    {.name = "reps", .id = B_REPS, .kind = CLI_INT, .arg = "K", .help = "timed repetitions (the median is reported)",
+     .min = 1, .max = MAX_REPS, .default_value = 5},
+    OPT_STR("hits", B_HITS, "FILE", "write the hits of the last repetition (16 bytes per ray)"),
+    OPT_FLAG("any-hit", B_ANY_HIT, "occlusion rays: any hit, not the closest"),
+    OPT_FLAG("packets", B_PACKETS, "trace coherent groups of rays as packets"),
+    OPT_FLAG("stats", B_STATS, "count nodes and tests per ray in one more, untimed pass"),
+    {.name = "help", .short_name = 'h', .id = B_HELP, .kind = CLI_FLAG, .help = "this text"},
+};
+
+static cli_option gen_opts[] = {
+    {.name = "output", .short_name = 'o', .id = B_OUTPUT, .kind = CLI_STRING, .arg = "FILE",
+     .help = "the ray file to write (required)"},
+    OPT_STR("look-from", B_LOOK_FROM, "X,Y,Z", "camera position"),
+    OPT_STR("look-at", B_LOOK_AT, "X,Y,Z", "camera target"),
+    OPT_STR("fov", B_FOV, "DEG", "vertical field of view in degrees, between 0 and 180"),
+    {.name = "size", .id = B_SIZE, .kind = CLI_INT, .arg = "N", .help = "N x N primary rays",
+     .min = 1, .max = PK_MAX_IMAGE_SIDE, .default_value = 1024},
+    OPT_STR("kind", B_KIND, "KIND", "primary (default) or diffuse (one bounce from each hit)"),
+    OPT_STR("seed", B_SEED, "S", "random seed of the diffuse directions (default 1)"),
+    OPT_STR("workload", B_WORKLOAD, "NAME", "a standard workload's scene and camera: cornell-sphere, bunny, sponza"),
+    OPT_STR("shared", B_SHARED, "DIR", "where the workloads' scenes are (default ../shared)"),
+    OPT_STR("accel", B_ACCEL, "NAME", "the acceleration structure for diffuse rays: " ACCEL_HELP),
+    {.name = "threads", .id = B_THREADS},
+    {.name = "help", .short_name = 'h', .id = B_HELP, .kind = CLI_FLAG, .help = "this text"},
+};
+
+static cli_option compare_opts[] = {
+    OPT_FLAG("any-hit", B_ANY_HIT, "compare hit or miss only, not distances"),
+    OPT_STR("rays", B_RAYS, "FILE", "the rays of the hit files, to excuse hits at a ray's origin"),
+    {.name = "help", .short_name = 'h', .id = B_HELP, .kind = CLI_FLAG, .help = "this text"},
+};
+
+#define COUNT(a) (sizeof a / sizeof a[0])
+
+/* Fills in --threads from the library's table of render options. */
+static void bench_options(void)
 {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+    static char name[64];
+    const pk_int_option *t = pk_int_option_find("threads");
+    if (!t) return;
+    cli_option o = cli_option_from_render(t, name, sizeof name);
+    o.id = B_THREADS;
+    for (size_t i = 0; i < COUNT(rays_opts); i++)
+        if (rays_opts[i].id == B_THREADS) rays_opts[i] = o;
+    for (size_t i = 0; i < COUNT(gen_opts); i++)
+        if (gen_opts[i].id == B_THREADS) gen_opts[i] = o;
+}
+
+void cli_bench_help(FILE *f)
+{
+    bench_options();
+    fprintf(f, "%s\n\noptions of bench rays:\n", usage_text);
+    cli_print_options(f, rays_opts, COUNT(rays_opts));
+    fputs("\noptions of bench gen-rays:\n", f);
+    cli_print_options(f, gen_opts, COUNT(gen_opts));
+    fputs("\noptions of bench compare:\n", f);
+    cli_print_options(f, compare_opts, COUNT(compare_opts));
+    fputs("\nexit status: 0 success (compare: the files agree); 1 a runtime failure (a file\n"
+          "that cannot be read or written; compare: the files disagree); 2 a usage error.\n",
+          f);
 }
 
 static int online_cpus(void)
@@ -141,16 +210,6 @@ static pk_context *new_context(void)
     return ctx;
 }
 
-/* The value after argv[*i], or NULL (with a message) when there is none. */
-static const char *next_arg(int argc, char **argv, int *i)
-{
-    if (*i + 1 >= argc) {
-        cli_usage_error("%s needs a value", argv[*i]);
-        return NULL;
-    }
-    return argv[++*i];
-}
-
 /* ---- bench rays ------------------------------------------------------------ */
 
 static int bench_rays(int argc, char **argv)
@@ -158,40 +217,39 @@ static int bench_rays(int argc, char **argv)
     const char *scene_path = NULL, *rays_path = NULL, *hits_path = NULL;
     pk_accel_kind kind = PK_ACCEL_DEFAULT;
     int threads = 0, reps = 5, any_hit = 0, packets = 0, stats = 0;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *v;
-        if (strcmp(a, "--accel") == 0) {
-            if (!(v = next_arg(argc, argv, &i))) return 2;
+    bench_options();
+    cli_parser p;
+    cli_parser_init(&p, "bench rays", rays_opts, COUNT(rays_opts), argc, argv);
+    int r;
+    while ((r = cli_next(&p)) != CLI_END) {
+        if (r == CLI_ERROR) return 2;
+        const char *v = p.value;
+        if (r == CLI_ARGUMENT) {
+            if (!scene_path)
+                scene_path = v;
+            else if (!rays_path)
+                rays_path = v;
+            else
+                return cli_usage_error("bench rays: unexpected argument %s\n%s", v, usage_text);
+            continue;
+        }
+        switch (rays_opts[p.index].id) {
+        case B_ACCEL:
             if (pk_accel_kind_parse(v, &kind) != PK_OK)
                 return cli_usage_error("--accel %s: expected none, midpoint, bvh or embree", v);
-        } else if (strcmp(a, "--threads") == 0) {
-            if (!(v = next_arg(argc, argv, &i))) return 2;
-            if (!cli_parse_int(v, 0, PK_MAX_THREADS, &threads))
-                return cli_usage_error("--threads %s: expected 0..%d", v, PK_MAX_THREADS);
-        } else if (strcmp(a, "--reps") == 0) {
-            if (!(v = next_arg(argc, argv, &i))) return 2;
-            if (!cli_parse_int(v, 1, MAX_REPS, &reps))
-                return cli_usage_error("--reps %s: expected 1..%d", v, MAX_REPS);
-        } else if (strcmp(a, "--hits") == 0) {
-            if (!(hits_path = next_arg(argc, argv, &i))) return 2;
-        } else if (strcmp(a, "--any-hit") == 0) {
-            any_hit = 1;
-        } else if (strcmp(a, "--packets") == 0) {
-            packets = 1;
-        } else if (strcmp(a, "--stats") == 0) {
-            stats = 1;
-        } else if (a[0] == '-' && a[1]) {
-            return cli_usage_error("bench rays: unknown option %s\n%s", a, usage_text);
-        } else if (!scene_path) {
-            scene_path = a;
-        } else if (!rays_path) {
-            rays_path = a;
-        } else {
-            return cli_usage_error("bench rays: unexpected argument %s\n%s", a, usage_text);
+            break;
+        case B_THREADS: threads = p.int_value; break;
+        case B_REPS: reps = p.int_value; break;
+        case B_HITS: hits_path = v; break;
+        case B_ANY_HIT: any_hit = 1; break;
+        case B_PACKETS: packets = 1; break;
+        case B_STATS: stats = 1; break;
+        case B_HELP: cli_bench_help(stdout); return 0;
         }
     }
     if (!scene_path || !rays_path)
         return cli_usage_error("bench rays needs SCENE.obj and RAYS.rays\n%s", usage_text);
+    if (hits_path && cli_check_output(hits_path, 1)) return 1;
     if (threads == 0) threads = online_cpus();
 
     int rc = 1;
@@ -218,10 +276,10 @@ static int bench_rays(int argc, char **argv)
     }
     unsigned flags = (any_hit ? PK_TRACE_ANY_HIT : 0u) | (packets ? PK_TRACE_COHERENT : 0u);
     pk_accel_trace(accel, rays, hits, n, threads, flags, NULL); /* warm-up */
-    for (int r = 0; r < reps; r++) {
-        double t0 = now_s();
+    for (int k = 0; k < reps; k++) {
+        double t0 = cli_now();
         pk_accel_trace(accel, rays, hits, n, threads, flags, NULL);
-        times[r] = now_s() - t0;
+        times[k] = cli_now() - t0;
     }
     double tmed = median(times, reps), tmin = times[0];
     size_t nhits = 0;
@@ -420,18 +478,28 @@ static int bench_gen_rays(int argc, char **argv)
     int has_from = 0, has_at = 0, has_fov = 0, size = 1024, threads = 0;
     long long seed = 1;
     pk_accel_kind accel_kind = PK_ACCEL_DEFAULT;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *v;
-        if (strcmp(a, "--look-from") == 0) {
-            if (!(v = next_arg(argc, argv, &i))) return 2;
+    bench_options();
+    cli_parser p;
+    cli_parser_init(&p, "bench gen-rays", gen_opts, COUNT(gen_opts), argc, argv);
+    int r;
+    while ((r = cli_next(&p)) != CLI_END) {
+        if (r == CLI_ERROR) return 2;
+        const char *v = p.value;
+        if (r == CLI_ARGUMENT) {
+            if (scene_arg) return cli_usage_error("bench gen-rays: unexpected argument %s\n%s", v, usage_text);
+            scene_arg = v;
+            continue;
+        }
+        switch (gen_opts[p.index].id) {
+        case B_LOOK_FROM:
             if (!cli_parse_vec3(v, from)) return cli_usage_error("--look-from %s: expected x,y,z", v);
             has_from = 1;
-        } else if (strcmp(a, "--look-at") == 0) {
-            if (!(v = next_arg(argc, argv, &i))) return 2;
+            break;
+        case B_LOOK_AT:
             if (!cli_parse_vec3(v, at)) return cli_usage_error("--look-at %s: expected x,y,z", v);
             has_at = 1;
-        } else if (strcmp(a, "--fov") == 0) {
-            if (!(v = next_arg(argc, argv, &i))) return 2;
+            break;
+        case B_FOV: {
             char *end;
             errno = 0;
             double f = strtod(v, &end);
@@ -439,45 +507,36 @@ static int bench_gen_rays(int argc, char **argv)
                 return cli_usage_error("--fov %s: expected degrees in (0, 180)", v);
             fov = (float)f;
             has_fov = 1;
-        } else if (strcmp(a, "--size") == 0) {
-            if (!(v = next_arg(argc, argv, &i))) return 2;
-            if (!cli_parse_int(v, 1, PK_MAX_IMAGE_SIDE, &size))
-                return cli_usage_error("--size %s: expected 1..%d", v, PK_MAX_IMAGE_SIDE);
-        } else if (strcmp(a, "--kind") == 0) {
-            if (!(kind_name = next_arg(argc, argv, &i))) return 2;
+            break;
+        }
+        case B_SIZE: size = p.int_value; break;
+        case B_KIND:
+            kind_name = v;
             if (strcmp(kind_name, "primary") != 0 && strcmp(kind_name, "diffuse") != 0)
                 return cli_usage_error("--kind %s: expected primary or diffuse", kind_name);
-        } else if (strcmp(a, "--seed") == 0) {
-            if (!(v = next_arg(argc, argv, &i))) return 2;
+            break;
+        case B_SEED: {
             char *end;
             errno = 0;
             seed = strtoll(v, &end, 10);
             if (end == v || *end || errno || seed < 0)
                 return cli_usage_error("--seed %s: expected a non-negative integer", v);
-        } else if (strcmp(a, "--workload") == 0) {
-            if (!(v = next_arg(argc, argv, &i))) return 2;
+            break;
+        }
+        case B_WORKLOAD:
             wl = NULL;
             for (size_t k = 0; k < sizeof workloads / sizeof workloads[0]; k++)
                 if (strcmp(v, workloads[k].name) == 0) wl = &workloads[k];
             if (!wl) return cli_usage_error("--workload %s: expected cornell-sphere, bunny or sponza", v);
-        } else if (strcmp(a, "--shared") == 0) {
-            if (!(shared = next_arg(argc, argv, &i))) return 2;
-        } else if (strcmp(a, "--accel") == 0) {
-            if (!(v = next_arg(argc, argv, &i))) return 2;
+            break;
+        case B_SHARED: shared = v; break;
+        case B_ACCEL:
             if (pk_accel_kind_parse(v, &accel_kind) != PK_OK)
                 return cli_usage_error("--accel %s: expected none, midpoint, bvh or embree", v);
-        } else if (strcmp(a, "--threads") == 0) {
-            if (!(v = next_arg(argc, argv, &i))) return 2;
-            if (!cli_parse_int(v, 0, PK_MAX_THREADS, &threads))
-                return cli_usage_error("--threads %s: expected 0..%d", v, PK_MAX_THREADS);
-        } else if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {
-            if (!(out_path = next_arg(argc, argv, &i))) return 2;
-        } else if (a[0] == '-' && a[1]) {
-            return cli_usage_error("bench gen-rays: unknown option %s\n%s", a, usage_text);
-        } else if (!scene_arg) {
-            scene_arg = a;
-        } else {
-            return cli_usage_error("bench gen-rays: unexpected argument %s\n%s", a, usage_text);
+            break;
+        case B_THREADS: threads = p.int_value; break;
+        case B_OUTPUT: out_path = v; break;
+        case B_HELP: cli_bench_help(stdout); return 0;
         }
     }
     if (!out_path) return cli_usage_error("bench gen-rays needs -o OUT.rays\n%s", usage_text);
@@ -496,6 +555,7 @@ static int bench_gen_rays(int argc, char **argv)
     if (!scene_path) return cli_usage_error("bench gen-rays needs SCENE.obj or --workload\n%s", usage_text);
     if (!has_from || !has_at || !has_fov)
         return cli_usage_error("bench gen-rays needs --look-from, --look-at and --fov (or --workload)");
+    if (cli_check_output(out_path, 1)) return 1;
     if (threads == 0) threads = online_cpus();
     const int diffuse = strcmp(kind_name, "diffuse") == 0;
 
@@ -582,20 +642,25 @@ static int bench_compare(int argc, char **argv)
 {
     const char *pa = NULL, *pb = NULL, *prays = NULL;
     int any_hit = 0;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        if (strcmp(a, "--any-hit") == 0) {
-            any_hit = 1;
-        } else if (strcmp(a, "--rays") == 0) {
-            if (!(prays = next_arg(argc, argv, &i))) return 2;
-        } else if (a[0] == '-' && a[1]) {
-            return cli_usage_error("bench compare: unknown option %s\n%s", a, usage_text);
-        } else if (!pa) {
-            pa = a;
-        } else if (!pb) {
-            pb = a;
-        } else {
-            return cli_usage_error("bench compare: unexpected argument %s\n%s", a, usage_text);
+    cli_parser p;
+    cli_parser_init(&p, "bench compare", compare_opts, COUNT(compare_opts), argc, argv);
+    int r;
+    while ((r = cli_next(&p)) != CLI_END) {
+        if (r == CLI_ERROR) return 2;
+        const char *v = p.value;
+        if (r == CLI_ARGUMENT) {
+            if (!pa)
+                pa = v;
+            else if (!pb)
+                pb = v;
+            else
+                return cli_usage_error("bench compare: unexpected argument %s\n%s", v, usage_text);
+            continue;
+        }
+        switch (compare_opts[p.index].id) {
+        case B_ANY_HIT: any_hit = 1; break;
+        case B_RAYS: prays = v; break;
+        case B_HELP: cli_bench_help(stdout); return 0;
         }
     }
     if (!pa || !pb) return cli_usage_error("bench compare needs A.hits and B.hits\n%s", usage_text);
@@ -660,9 +725,12 @@ int cli_bench(int argc, char **argv)
     if (strcmp(sub, "rays") == 0) return bench_rays(argc - 1, argv + 1);
     if (strcmp(sub, "gen-rays") == 0) return bench_gen_rays(argc - 1, argv + 1);
     if (strcmp(sub, "compare") == 0) return bench_compare(argc - 1, argv + 1);
-    if (strcmp(sub, "--help") == 0 || strcmp(sub, "-h") == 0) {
-        puts(usage_text);
+    if (strcmp(sub, "--help") == 0 || strcmp(sub, "-h") == 0 || strcmp(sub, "help") == 0) {
+        cli_bench_help(stdout);
         return 0;
     }
+    static const char *const subs[] = {"rays", "gen-rays", "compare"};
+    const char *near = cli_nearest(sub, strlen(sub), subs, COUNT(subs));
+    if (near) return cli_usage_error("bench %s: unknown subcommand; did you mean bench %s?", sub, near);
     return cli_usage_error("bench %s: unknown subcommand (rays, gen-rays, compare)\n%s", sub, usage_text);
 }

@@ -1,26 +1,128 @@
 /*
  * cli.h - the pieces of the paprsek program, built on include/paprsek.h alone.
+ *
+ * Exit statuses, the same for every command: 0 success, 1 a runtime failure
+ * (a file that cannot be read or written, a malformed scene, a scene beyond
+ * the limits), 2 a usage error (unknown option, bad value, unknown image
+ * format), 128 + the signal's number when a render is interrupted (130 for
+ * SIGINT, 143 for SIGTERM).
  */
 #ifndef PK_CLI_H
 #define PK_CLI_H
 
 #include "paprsek.h"
 
+#include <stdint.h>
+#include <stdio.h>
+
+enum { CLI_EXIT_OK = 0, CLI_EXIT_FAILURE = 1, CLI_EXIT_USAGE = 2 };
+
 /* `paprsek render ...` (cli/render.c). argv[0] is "render". Returns the exit status. */
 int cli_render(int argc, char **argv);
-/* `paprsek bench rays|gen-rays ...` (cli/bench.c). argv[0] is "bench". */
+void cli_render_help(FILE *f);
+/* `paprsek bench rays|gen-rays|compare ...` (cli/bench.c). argv[0] is "bench". */
 int cli_bench(int argc, char **argv);
+void cli_bench_help(FILE *f);
 
-/* Shared helpers (cli/util.c). */
+/* ---- options (cli/options.c) ----------------------------------------------
+ * One table per command serves parsing (getopt_long: --name VALUE,
+ * --name=VALUE, unique abbreviations, -o VALUE), the range checks of its
+ * integer options and its --help text. */
+
+typedef enum cli_kind {
+    CLI_FLAG,   /* no value */
+    CLI_STRING, /* a value, checked by the command */
+    CLI_INT     /* a whole number in min..max, checked by the parser */
+} cli_kind;
+
+typedef struct cli_option {
+    const char *name;  /* long name without "--" */
+    int short_name;    /* 'o', or 0 */
+    int id;            /* the command's own number for it */
+    cli_kind kind;
+    const char *arg;   /* the value's name in --help ("FILE"); NULL for flags */
+    const char *help;  /* one sentence; --help wraps it */
+    int min, max, default_value; /* CLI_INT: range and default, shown by --help */
+    const pk_int_option *render; /* the library's entry when it is a render option */
+} cli_option;
+
+/* An integer render option of the library's table (pk_int_options) as a
+ * command-line option: --light-samples for light_samples. name_buf holds
+ * the name (at least 64 bytes) and must live as long as the option. */
+cli_option cli_option_from_render(const pk_int_option *o, char *name_buf, size_t cap);
+
+/* cli_next's answers */
+enum { CLI_END = 0, CLI_OPTION, CLI_ARGUMENT, CLI_ERROR };
+
+typedef struct cli_parser {
+    const char *cmd; /* "render", "bench rays": in messages */
+    const cli_option *opts;
+    size_t n;
+    int argc;
+    char **argv;
+    int rest;        /* after "--": the next argument to return */
+    /* the answer of the last cli_next */
+    int index;         /* CLI_OPTION: opts[index] */
+    const char *value; /* CLI_OPTION: its value (NULL for flags); CLI_ARGUMENT: the argument */
+    int int_value;     /* CLI_OPTION of kind CLI_INT: the checked number */
+} cli_parser;
+
+/* argv[0] is the command's own name and is skipped. At most 64 options. */
+void cli_parser_init(cli_parser *p, const char *cmd, const cli_option *opts, size_t n, int argc, char **argv);
+/* The next option or argument, in command-line order; CLI_ERROR after a
+ * message on stderr (a usage error: exit status 2); CLI_END at the end. */
+int cli_next(cli_parser *p);
+/* The option list of --help: one entry per option, the help wrapped to 80
+ * columns, the range and default of integer options appended. */
+void cli_print_options(FILE *f, const cli_option *opts, size_t n);
+/* The entry of names[0..n-1] nearest to word[0..len-1] by edit distance
+ * (a swap of two neighbours counts one), or NULL when none is near enough
+ * to be a likely typing mistake. */
+const char *cli_nearest(const char *word, size_t len, const char *const *names, size_t n);
+
+/* ---- the progress bar (cli/progress.c) --------------------------------- */
+
+typedef struct cli_progress {
+    FILE *f;          /* stderr */
+    int enabled;      /* f is a terminal and --quiet is not given */
+    int drawn;        /* characters of the bar now on the line (0: none) */
+    int last_permille;
+    double last_elapsed;
+} cli_progress;
+
+/* enabled when f is a terminal (isatty) and quiet is 0. */
+void cli_progress_init(cli_progress *p, FILE *f, int quiet);
+/* A pk_progress_fn (user is the cli_progress): redraws the bar in place. */
+int cli_progress_update(void *user, uint64_t done, uint64_t total, double elapsed_s);
+/* Erases the bar, so that the next message starts a clean line. */
+void cli_progress_clear(cli_progress *p);
+/* The bar's text for a line of cols columns, without '\r': for the
+ * terminal and for tests. Returns its length. */
+int cli_progress_format(char *buf, size_t cap, int cols, uint64_t done, uint64_t total, double elapsed_s);
+/* "0.42 s", "12.3 s", "4:05", "1:02:03" */
+void cli_format_duration(char *buf, size_t cap, double s);
+
+/* ---- shared helpers (cli/util.c) ------------------------------------------ */
+
 /* Prints "paprsek: <ctx error>" to stderr and returns 1. */
 int cli_fail_ctx(pk_context *ctx);
 /* Prints "paprsek: <fmt>" to stderr and returns 2 (usage errors). */
 int cli_usage_error(const char *fmt, ...);
+/* Prints "paprsek: <fmt>" to stderr and returns 1 (runtime failures). */
+int cli_failure(const char *fmt, ...);
 /* Parses an int in [lo, hi]; false on junk or out of range. */
 int cli_parse_int(const char *s, long lo, long hi, int *out);
 /* Parses "x,y,z"; false on junk or non-finite values. */
 int cli_parse_vec3(const char *s, float out[3]);
 /* Prints warnings from the library to stderr as "paprsek: warning: ...". */
 void cli_print_warning(void *user, const char *message);
+/* Checks, before any work, that a file can be written at path: path is not
+ * a folder, its folder exists and is one, and this process may create files
+ * there (access W_OK). With replace_by_rename 0 (a file opened for writing
+ * in place), an existing path that is writable is enough. Creates nothing.
+ * Prints "paprsek: path: why" and returns 1 when it cannot; else 0. */
+int cli_check_output(const char *path, int replace_by_rename);
+/* Seconds on a monotonic clock. */
+double cli_now(void);
 
 #endif

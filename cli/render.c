@@ -1,10 +1,12 @@
 /*
  * render.c - `paprsek render`: loads a scene (or the built-in Cornell box),
- * applies the command-line overrides, renders, writes the image and prints
- * the seed's statistics table. SIGINT/SIGTERM stop the render cleanly.
+ * applies the command-line overrides, checks that the outputs can be
+ * written, renders with a progress bar on a terminal, writes the image and
+ * prints the statistics table. SIGINT/SIGTERM stop the render cleanly.
  */
 #include "cli.h"
 
+#include <errno.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -21,134 +23,191 @@ static void on_signal(int sig)
     g_cancel = 1;
 }
 
-static void help(void)
+/* Warnings of the library, on a line of their own (the bar, if drawn, is
+ * erased first and redrawn by its next report). */
+static void print_warning(void *user, const char *message)
 {
-    printf("usage: paprsek render [SCENE] -o OUT [options]\n"
-           "\n"
-           "SCENE is a Wavefront .obj (materials from its .mtl files) or a .json scene\n"
-           "(docs/scene-format.md); without it the built-in Cornell box is rendered.\n"
-           "OUT is written by extension: .png (8-bit sRGB) or .pfm (linear float RGB),\n"
-           "through a temporary file that is renamed into place.\n"
-           "\n"
-           "options (they override the scene's own \"render\" settings):\n"
-           "  -o, --output FILE      the image to write (required)\n"
-           "  --width W, --height H  image size in pixels (default 512x512)\n"
-           "  --spp N                samples per pixel, stratified jitter (default 1: pixel centres)\n"
-           "  --light-samples N      shadow samples per shading point over the area lights\n"
-           "                         (emissive triangles, chosen by power; default 32)\n"
-           "  --max-depth N          reflection/refraction depth (default 8)\n"
-           "  --threads N            worker threads (default: all cores)\n"
-           "  --accel NAME           bvh (default), midpoint (the seed's BVH), none, embree\n"
-           "  --fresnel on|off       exact dielectric Fresnel (default on); off = fixed Ks/Tf mix\n"
-           "  --look-from x,y,z      camera position\n"
-           "  --look-at x,y,z        camera target\n"
-           "  --up x,y,z             camera up vector (default 0,1,0)\n"
-           "  --fov DEG              vertical field of view in degrees\n"
-           "  --stats                print the statistics table (rays, tests, nodes, times)\n"
-           "  --stats-json FILE      write the statistics as JSON\n"
-           "  --quiet                do not print warnings\n"
-           "  -h, --help             this text\n"
-           "\n"
-           "On SIGINT or SIGTERM the render stops, the finished tiles are written to\n"
-           "OUT with '.partial' before the extension, OUT itself is left untouched and\n"
-           "the exit status is 130.\n");
+    cli_progress_clear(user);
+    cli_print_warning(NULL, message);
+}
+
+/* ---- the options: one table for parsing, ranges and --help ---------------- */
+
+enum {
+    OPT_OUTPUT = 1,
+    OPT_INT, /* an integer render option of the library's table */
+    OPT_ACCEL,
+    OPT_FRESNEL,
+    OPT_LOOK_FROM,
+    OPT_LOOK_AT,
+    OPT_UP,
+    OPT_FOV,
+    OPT_STATS,
+    OPT_STATS_JSON,
+    OPT_QUIET,
+    OPT_HELP
+};
+
+#define MAX_RENDER_OPTIONS 48
+static cli_option g_opts[MAX_RENDER_OPTIONS];
+static char g_int_names[MAX_RENDER_OPTIONS][64];
+static size_t g_nopts;
+
+static void add(cli_option o)
+{
+    if (g_nopts < MAX_RENDER_OPTIONS) g_opts[g_nopts++] = o;
+}
+
+/* The table: -o first, the library's integer options (pk_int_options) in
+ * its order, then the rest. Built once. */
+static const cli_option *render_options(size_t *n)
+{
+    if (g_nopts == 0) {
+        add((cli_option){.name = "output", .short_name = 'o', .id = OPT_OUTPUT, .kind = CLI_STRING, .arg = "FILE",
+                         .help = "the image to write (required): .png (8-bit sRGB) or .pfm (linear float RGB)"});
+        size_t count = 0;
+        const pk_int_option *ints = pk_int_options(&count);
+        for (size_t i = 0; i < count && g_nopts < MAX_RENDER_OPTIONS; i++) {
+            cli_option o = cli_option_from_render(&ints[i], g_int_names[g_nopts], sizeof g_int_names[0]);
+            o.id = OPT_INT;
+            add(o);
+        }
+        add((cli_option){.name = "accel", .id = OPT_ACCEL, .kind = CLI_STRING, .arg = "NAME",
+                         .help = "the acceleration structure: bvh (default: binned SAH, wide SIMD BVH), midpoint "
+                                 "(simple BVH, for comparison), none (every ray tests every primitive), embree "
+                                 "(Embree 3, when built with it); all give the same image"});
+        add((cli_option){.name = "fresnel", .id = OPT_FRESNEL, .kind = CLI_STRING, .arg = "on|off",
+                         .help = "on: exact dielectric Fresnel (default); off: fixed Ks/Tf weights"});
+        add((cli_option){.name = "look-from", .id = OPT_LOOK_FROM, .kind = CLI_STRING, .arg = "X,Y,Z",
+                         .help = "camera position"});
+        add((cli_option){.name = "look-at", .id = OPT_LOOK_AT, .kind = CLI_STRING, .arg = "X,Y,Z",
+                         .help = "camera target"});
+        add((cli_option){.name = "up", .id = OPT_UP, .kind = CLI_STRING, .arg = "X,Y,Z",
+                         .help = "camera up vector (default 0,1,0)"});
+        add((cli_option){.name = "fov", .id = OPT_FOV, .kind = CLI_STRING, .arg = "DEG",
+                         .help = "vertical field of view in degrees, between 0 and 180"});
+        add((cli_option){.name = "stats", .id = OPT_STATS, .kind = CLI_FLAG,
+                         .help = "print the statistics table on standard output (rays, intersection tests, "
+                                 "nodes, build and render time)"});
+        add((cli_option){.name = "stats-json", .id = OPT_STATS_JSON, .kind = CLI_STRING, .arg = "FILE",
+                         .help = "write the statistics as JSON to FILE; - writes them to standard output"});
+        add((cli_option){.name = "quiet", .short_name = 'q', .id = OPT_QUIET, .kind = CLI_FLAG,
+                         .help = "no progress bar, no 'wrote' line, no warnings (errors are still printed)"});
+        add((cli_option){.name = "help", .short_name = 'h', .id = OPT_HELP, .kind = CLI_FLAG, .help = "this text"});
+    }
+    *n = g_nopts;
+    return g_opts;
+}
+
+void cli_render_help(FILE *f)
+{
+    size_t n;
+    const cli_option *opts = render_options(&n);
+    fputs("usage: paprsek render [SCENE] -o OUT [options]\n"
+          "\n"
+          "SCENE is a Wavefront .obj (materials from its .mtl files) or a .json scene\n"
+          "(docs/scene-format.md); without it the built-in Cornell box is rendered.\n"
+          "OUT is written by extension: .png (8-bit sRGB) or .pfm (linear float RGB),\n"
+          "through a temporary file that is renamed into place. Its folder is checked\n"
+          "before the scene is read: it must exist and be writable.\n"
+          "\n"
+          "options (they override the scene's own \"render\" settings; --name VALUE and\n"
+          "--name=VALUE are the same, and a unique beginning of a name is enough):\n",
+          f);
+    cli_print_options(f, opts, n);
+    fputs("\n"
+          "When stderr is a terminal, a progress bar (percentage, elapsed time, ETA)\n"
+          "is redrawn there, and at the end one line says what was written, e.g.\n"
+          "\"wrote cornell.png (512x512, 1.2 s)\" (the time from start to finish).\n"
+          "Otherwise, and with --quiet, stderr carries only warnings and errors.\n"
+          "\n"
+          "exit status:\n"
+          "  0    the image was written\n"
+          "  1    a runtime failure: a file that cannot be read or written, a malformed\n"
+          "       scene, a scene beyond the limits\n"
+          "  2    a usage error: unknown option, bad value, unknown image format\n"
+          "  130  interrupted by SIGINT (Ctrl-C)\n"
+          "  143  interrupted by SIGTERM\n"
+          "On SIGINT or SIGTERM the render stops, the finished tiles are written to\n"
+          "OUT with '.partial' before the extension, and OUT itself is left untouched.\n",
+          f);
 }
 
 typedef struct cli_opts {
     const char *scene, *out, *stats_json;
     int stats, quiet;
-    int width, height, spp, light_samples, max_depth, threads, fresnel;
+    int int_set[MAX_RENDER_OPTIONS]; /* per table entry: given on the command line */
+    int int_value[MAX_RENDER_OPTIONS];
+    int fresnel;
     int has_accel;
     pk_accel_kind accel;
     int has_from, has_at, has_up, has_fov;
     float from[3], at[3], up[3], fov;
 } cli_opts;
 
-static int need_arg(int i, int argc, const char *opt)
-{
-    if (i + 1 >= argc) {
-        cli_usage_error("%s needs a value", opt);
-        return 0;
-    }
-    return 1;
-}
-
+/* Returns 0 to go on, -1 after --help (exit 0), or an exit status. */
 static int parse_args(int argc, char **argv, cli_opts *o)
 {
     memset(o, 0, sizeof *o);
-    o->width = o->height = o->spp = o->light_samples = o->max_depth = o->threads = o->fresnel = -1;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-#define INT_OPT(name, field, lo, hi)                                                          \
-    if (strcmp(a, name) == 0) {                                                               \
-        if (!need_arg(i, argc, a)) return 2;                                                  \
-        if (!cli_parse_int(argv[++i], lo, hi, &o->field))                                     \
-            return cli_usage_error("%s: '%s' is not a whole number in %ld..%ld", name, argv[i], \
-                                   (long)(lo), (long)(hi));                                   \
-        continue;                                                                             \
-    }
-#define VEC_OPT(name, field, flag)                                                            \
-    if (strcmp(a, name) == 0) {                                                               \
-        if (!need_arg(i, argc, a)) return 2;                                                  \
-        if (!cli_parse_vec3(argv[++i], o->field))                                             \
-            return cli_usage_error("%s: '%s' is not x,y,z (three finite numbers)", name, argv[i]); \
-        o->flag = 1;                                                                          \
-        continue;                                                                             \
-    }
-        INT_OPT("--width", width, 1, PK_MAX_IMAGE_SIDE)
-        INT_OPT("--height", height, 1, PK_MAX_IMAGE_SIDE)
-        INT_OPT("--spp", spp, 1, PK_MAX_SPP)
-        INT_OPT("--light-samples", light_samples, 0, PK_MAX_LIGHT_SAMPLES)
-        INT_OPT("--max-depth", max_depth, 0, PK_MAX_DEPTH)
-        INT_OPT("--threads", threads, 1, PK_MAX_THREADS)
-        VEC_OPT("--look-from", from, has_from)
-        VEC_OPT("--look-at", at, has_at)
-        VEC_OPT("--up", up, has_up)
-#undef INT_OPT
-#undef VEC_OPT
-        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
-            help();
-            return -1;
-        } else if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {
-            if (!need_arg(i, argc, a)) return 2;
-            o->out = argv[++i];
-        } else if (strcmp(a, "--stats-json") == 0) {
-            if (!need_arg(i, argc, a)) return 2;
-            o->stats_json = argv[++i];
-        } else if (strcmp(a, "--stats") == 0) {
-            o->stats = 1;
-        } else if (strcmp(a, "--quiet") == 0) {
-            o->quiet = 1;
-        } else if (strcmp(a, "--accel") == 0) {
-            if (!need_arg(i, argc, a)) return 2;
-            if (pk_accel_kind_parse(argv[++i], &o->accel) != PK_OK)
-                return cli_usage_error("--accel: unknown accelerator '%s' (none, midpoint, bvh, embree)", argv[i]);
+    o->fresnel = -1;
+    size_t n;
+    const cli_option *opts = render_options(&n);
+    cli_parser p;
+    cli_parser_init(&p, "render", opts, n, argc, argv);
+    int r;
+    while ((r = cli_next(&p)) != CLI_END) {
+        if (r == CLI_ERROR) return 2;
+        const char *v = p.value;
+        if (r == CLI_ARGUMENT) {
+            if (o->scene) return cli_usage_error("render: more than one scene given ('%s' and '%s')", o->scene, v);
+            o->scene = v;
+            continue;
+        }
+        const char *name = opts[p.index].name;
+        switch (opts[p.index].id) {
+        case OPT_OUTPUT: o->out = v; break;
+        case OPT_INT:
+            o->int_set[p.index] = 1;
+            o->int_value[p.index] = p.int_value;
+            break;
+        case OPT_ACCEL:
+            if (pk_accel_kind_parse(v, &o->accel) != PK_OK)
+                return cli_usage_error("--accel: unknown accelerator '%s' (none, midpoint, bvh, embree)", v);
             if (!pk_accel_available(o->accel))
                 return cli_usage_error("--accel %s: not available in this build (install libembree-dev and rebuild)",
-                                       argv[i]);
+                                       v);
             o->has_accel = 1;
-        } else if (strcmp(a, "--fresnel") == 0) {
-            if (!need_arg(i, argc, a)) return 2;
-            const char *v = argv[++i];
+            break;
+        case OPT_FRESNEL:
             if (strcmp(v, "on") == 0)
                 o->fresnel = 1;
             else if (strcmp(v, "off") == 0)
                 o->fresnel = 0;
             else
                 return cli_usage_error("--fresnel: expected on or off, not '%s'", v);
-        } else if (strcmp(a, "--fov") == 0) {
-            if (!need_arg(i, argc, a)) return 2;
+            break;
+        case OPT_LOOK_FROM:
+        case OPT_LOOK_AT:
+        case OPT_UP: {
+            int id = opts[p.index].id;
+            float *dst = id == OPT_LOOK_FROM ? o->from : id == OPT_LOOK_AT ? o->at : o->up;
+            if (!cli_parse_vec3(v, dst))
+                return cli_usage_error("--%s: '%s' is not x,y,z (three finite numbers)", name, v);
+            *(id == OPT_LOOK_FROM ? &o->has_from : id == OPT_LOOK_AT ? &o->has_at : &o->has_up) = 1;
+            break;
+        }
+        case OPT_FOV: {
             char *end;
-            o->fov = strtof(argv[++i], &end);
-            if (*end || end == argv[i] || !(o->fov > 0.0f && o->fov < 180.0f))
-                return cli_usage_error("--fov: '%s' must be a number of degrees between 0 and 180", argv[i]);
+            o->fov = strtof(v, &end);
+            if (*end || end == v || !(o->fov > 0.0f && o->fov < 180.0f))
+                return cli_usage_error("--fov: '%s' must be a number of degrees between 0 and 180", v);
             o->has_fov = 1;
-        } else if (a[0] == '-' && a[1] != '\0') {
-            return cli_usage_error("render: unknown option '%s' (see paprsek render --help)", a);
-        } else if (!o->scene) {
-            o->scene = a;
-        } else {
-            return cli_usage_error("render: more than one scene given ('%s' and '%s')", o->scene, a);
+            break;
+        }
+        case OPT_STATS: o->stats = 1; break;
+        case OPT_STATS_JSON: o->stats_json = v; break;
+        case OPT_QUIET: o->quiet = 1; break;
+        case OPT_HELP: cli_render_help(stdout); return -1;
         }
     }
     if (!o->out) return cli_usage_error("render: no output file (-o OUT.png)");
@@ -213,14 +272,13 @@ static void json_string(FILE *f, const char *s)
     fputc('"', f);
 }
 
+/* path "-": standard output. */
 static int write_stats_json(const char *path, const char *scene, const pk_render_options *ro, const pk_stats *st)
 {
     uint64_t rays = st->rays_camera + st->rays_shadow + st->rays_reflection + st->rays_refraction;
-    FILE *f = fopen(path, "w");
-    if (!f) {
-        perror(path);
-        return 1;
-    }
+    const int to_stdout = strcmp(path, "-") == 0;
+    FILE *f = to_stdout ? stdout : fopen(path, "w");
+    if (!f) return cli_failure("%s: cannot write: %s", path, strerror(errno));
     fputs("{\n  \"scene\": ", f);
     json_string(f, scene);
     fprintf(f,
@@ -235,10 +293,8 @@ static int write_stats_json(const char *path, const char *scene, const pk_render
             (unsigned long long)st->rays_reflection, (unsigned long long)st->rays_refraction,
             (unsigned long long)st->intersection_tests, (unsigned long long)st->nodes_visited,
             st->render_s > 0 ? (double)rays / st->render_s / 1e6 : 0.0);
-    if (fclose(f) != 0) {
-        perror(path);
-        return 1;
-    }
+    if (to_stdout ? fflush(f) != 0 || ferror(f) : fclose(f) != 0)
+        return cli_failure("%s: cannot write: %s", to_stdout ? "standard output" : path, strerror(errno));
     return 0;
 }
 
@@ -260,43 +316,54 @@ static char *partial_name(const char *out)
 
 int cli_render(int argc, char **argv)
 {
+    const double t0 = cli_now();
     cli_opts o;
     int rc = parse_args(argc, argv, &o);
     if (rc) return rc < 0 ? 0 : rc;
     /* Everything that would only fail after the render is checked first. */
+    struct stat sb;
+    if (stat(o.out, &sb) == 0 && S_ISDIR(sb.st_mode)) return cli_failure("%s: is a folder; name a file in it", o.out);
     if (!ends_with_ci(o.out, ".png") && !ends_with_ci(o.out, ".pfm"))
         return cli_usage_error("%s: unknown image format (use .png or .pfm)", o.out);
     if (o.scene && same_file(o.scene, o.out))
         return cli_usage_error("render: refusing to write the image over the scene file '%s'", o.scene);
-    if (o.stats_json && o.scene && same_file(o.scene, o.stats_json))
+    const int json_stdout = o.stats_json && strcmp(o.stats_json, "-") == 0;
+    if (json_stdout && o.stats)
+        return cli_usage_error("render: --stats and --stats-json - both write to standard output; choose one");
+    if (o.stats_json && !json_stdout && o.scene && same_file(o.scene, o.stats_json))
         return cli_usage_error("render: refusing to write the statistics over the scene file '%s'", o.scene);
-    if (o.stats_json && (strcmp(o.stats_json, o.out) == 0 || same_file(o.stats_json, o.out)))
+    if (o.stats_json && !json_stdout && (strcmp(o.stats_json, o.out) == 0 || same_file(o.stats_json, o.out)))
         return cli_usage_error("render: --stats-json and -o name the same file '%s'", o.out);
+    if (cli_check_output(o.out, 1)) return 1;
+    if (o.stats_json && !json_stdout && cli_check_output(o.stats_json, 0)) return 1;
 
     pk_context *ctx = NULL;
     if (pk_context_create(NULL, &ctx) != PK_OK) {
         fprintf(stderr, "paprsek: out of memory\n");
         return 1;
     }
-    if (!o.quiet) pk_context_set_warning_handler(ctx, cli_print_warning, NULL);
     pk_scene *scene = NULL;
     pk_image *img = NULL;
+    cli_progress bar;
+    cli_progress_init(&bar, stderr, o.quiet);
+    if (!o.quiet) pk_context_set_warning_handler(ctx, print_warning, &bar);
     rc = 1;
     pk_status st = o.scene ? pk_scene_load_file(ctx, o.scene, &scene) : pk_scene_create_cornell_box(ctx, &scene);
     if (st != PK_OK) goto fail;
 
     pk_render_options ro;
     pk_scene_get_render_options(scene, &ro);
-    if (o.width > 0) ro.width = o.width;
-    if (o.height > 0) ro.height = o.height;
-    if (o.spp > 0) ro.spp = o.spp;
-    if (o.light_samples >= 0) ro.light_samples = o.light_samples;
-    if (o.max_depth >= 0) ro.max_depth = o.max_depth;
-    if (o.threads > 0) ro.threads = o.threads;
+    size_t nopts;
+    const cli_option *opts = render_options(&nopts);
+    for (size_t i = 0; i < nopts; i++)
+        if (o.int_set[i]) *(int *)(void *)((char *)&ro + opts[i].render->offset) = o.int_value[i];
     if (o.fresnel >= 0) ro.fresnel = o.fresnel;
     if (o.has_accel) ro.accel = o.accel;
     ro.collect_stats = o.stats || o.stats_json;
     ro.cancel = &g_cancel;
+    ro.progress = cli_progress_update;
+    ro.progress_user = &bar;
+    if (pk_render_options_check(ctx, &ro) != PK_OK) goto fail;
 
     if (o.has_from || o.has_at || o.has_up || o.has_fov) {
         pk_camera cam;
@@ -316,6 +383,7 @@ int cli_render(int argc, char **argv)
 
     pk_stats stats;
     st = pk_render(ctx, scene, &ro, &img, &stats);
+    cli_progress_clear(&bar);
     if (st == PK_ERR_CANCELLED) {
         char *partial = partial_name(o.out);
         if (partial && img && pk_image_write(ctx, img, partial) == PK_OK)
@@ -323,17 +391,24 @@ int cli_render(int argc, char **argv)
         else
             fprintf(stderr, "paprsek: interrupted\n");
         free(partial);
-        rc = 130;
+        /* 128 + the signal, as a shell reports a process the signal ended */
+        rc = 128 + (g_stop ? (int)g_stop : SIGINT);
         goto out;
     }
     if (st != PK_OK) goto fail;
     if (pk_image_write(ctx, img, o.out) != PK_OK) goto fail;
+    if (bar.enabled) {
+        char took[32];
+        cli_format_duration(took, sizeof took, cli_now() - t0);
+        fprintf(stderr, "wrote %s (%dx%d, %s)\n", o.out, ro.width, ro.height, took);
+    }
     const char *name = o.scene ? o.scene : "cornell-box (built in)";
     if (o.stats) print_table(name, &ro, &stats);
     if (o.stats_json && write_stats_json(o.stats_json, name, &ro, &stats) != 0) goto out;
     rc = 0;
     goto out;
 fail:
+    cli_progress_clear(&bar);
     rc = cli_fail_ctx(ctx);
 out:
     pk_image_destroy(img);

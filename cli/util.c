@@ -1,6 +1,6 @@
 /*
- * util.c - small helpers shared by the paprsek subcommands: messages and
- * strict number parsing.
+ * util.c - small helpers shared by the paprsek subcommands: messages, strict
+ * number parsing and the check that an output file can be written.
  */
 #include "cli.h"
 
@@ -9,6 +9,10 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
 
 int cli_fail_ctx(pk_context *ctx)
 {
@@ -26,6 +30,17 @@ int cli_usage_error(const char *fmt, ...)
     fputs("\n", stderr);
     va_end(ap);
     return 2;
+}
+
+int cli_failure(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fputs("paprsek: ", stderr);
+    vfprintf(stderr, fmt, ap);
+    fputs("\n", stderr);
+    va_end(ap);
+    return 1;
 }
 
 int cli_parse_int(const char *s, long lo, long hi, int *out)
@@ -62,4 +77,53 @@ void cli_print_warning(void *user, const char *message)
 {
     (void)user;
     fprintf(stderr, "paprsek: warning: %s\n", message);
+}
+
+double cli_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+int cli_check_output(const char *path, int replace_by_rename)
+{
+    struct stat sb;
+    if (stat(path, &sb) == 0) {
+        if (S_ISDIR(sb.st_mode)) return cli_failure("%s: is a folder; name a file in it", path);
+        if (!replace_by_rename) {
+            if (access(path, W_OK) == 0) return 0;
+            return cli_failure("%s: cannot write: %s", path, strerror(errno));
+        }
+    }
+    /* The folder: what is before the last '/' (without trailing slashes),
+     * "/" for a file at the root, "." for a bare name. */
+    size_t n = strlen(path);
+    char *dir = malloc(n + 2);
+    if (!dir) return cli_failure("%s: out of memory", path);
+    const char *slash = strrchr(path, '/');
+    if (!slash) {
+        strcpy(dir, ".");
+    } else {
+        size_t k = (size_t)(slash - path);
+        while (k > 0 && path[k - 1] == '/') k--;
+        if (k == 0) k = 1; /* the root */
+        memcpy(dir, path, k);
+        dir[k] = '\0';
+    }
+    int rc = 0;
+    if (stat(dir, &sb) != 0) {
+        if (errno == ENOENT)
+            rc = cli_failure("%s: folder '%s' does not exist", path, dir);
+        else if (errno == ENOTDIR)
+            rc = cli_failure("%s: folder '%s' does not exist (part of its path is a file)", path, dir);
+        else
+            rc = cli_failure("%s: folder '%s': %s", path, dir, strerror(errno));
+    } else if (!S_ISDIR(sb.st_mode)) {
+        rc = cli_failure("%s: '%s' is not a folder", path, dir);
+    } else if (access(dir, W_OK) != 0) {
+        rc = cli_failure("%s: cannot write in folder '%s': %s", path, dir, strerror(errno));
+    }
+    free(dir);
+    return rc;
 }

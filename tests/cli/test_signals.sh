@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # SIGINT and SIGTERM during a render: the render stops within seconds, exit
-# status 130, the finished tiles go to OUT with ".partial" before the
-# extension, an existing OUT is left untouched (and a missing one is not
+# status 128 + the signal (130 for SIGINT, 143 for SIGTERM, as a shell
+# reports a process the signal ended), the finished tiles go to OUT with
+# ".partial" before the extension, an existing OUT is left untouched (and a missing one is not
 # created), and no temporary file is left behind.
 # usage: test_signals.sh PAPRSEK SHARED_DIR DATA_DIR
 set -u
@@ -63,7 +64,8 @@ stop() {
 # be hours (65536 samples per pixel), sends SIGNAL once the render runs and
 # checks the outcome; EXISTING=1 puts a file at OUT first.
 interrupt() {
-  local sig=$1 existing=$2 name="SIG$1"
+  local sig=$1 existing=$2 name="SIG$1" want_rc
+  case $sig in INT) want_rc=130 ;; TERM) want_rc=143 ;; esac
   rm -rf "$tmp"/*
   if [ "$existing" = 1 ]; then
     printf 'an earlier image\n' >"$tmp/out.png"
@@ -74,7 +76,7 @@ interrupt() {
   stop "$sig" "$name"
   [ -n "$rc" ] || return
   local want="paprsek: interrupted; finished tiles written to $tmp/out.partial.png"
-  [ "$rc" -eq 130 ] || bad "$name: exit $rc, wanted 130"
+  [ "$rc" -eq "$want_rc" ] || bad "$name: exit $rc, wanted $want_rc"
   [ "$(cat "$tmp/stderr")" = "$want" ] || bad "$name: stderr is '$(cat "$tmp/stderr")', wanted '$want'"
   if [ "$existing" = 1 ]; then
     [ "$(cat "$tmp/out.png")" = "an earlier image" ] || bad "$name: the existing OUT was changed"
@@ -85,12 +87,13 @@ interrupt() {
   local left
   left=$(ls "$tmp" | grep -F '.tmp.')
   [ -z "$left" ] || bad "$name: temporary files left: $left"
-  [ $fail -ne 0 ] || echo "ok   $name: exit 130 after $((waited / 10)).$((waited % 10)) s, $(cat "$tmp/stderr")"
+  [ $fail -ne 0 ] || echo "ok   $name: exit $rc after $((waited / 10)).$((waited % 10)) s, $(cat "$tmp/stderr")"
 }
 
 interrupt INT 1
 interrupt TERM 1
 interrupt INT 0
+interrupt TERM 0
 
 # The .partial image holds the tiles finished before the signal, and the
 # others black: a PFM (raw floats) of 1024x1024 at 64 samples (minutes of
