@@ -1,0 +1,151 @@
+/*
+ * test_options.c - the one table of integer render options serves the API,
+ * JSON scenes and the paprsek program alike: for every entry, each of the
+ * three accepts the bounds and refuses one past them, with the same range in
+ * its message.
+ */
+#include "test.h"
+
+#include "paprsek.h"
+
+#include <stdbool.h>
+#include <sys/wait.h>
+
+static pk_context *ctx;
+
+/* The value of option e set to v (the other image side 1, so that the pixel
+ * budget never decides). */
+static void set_value(pk_render_options *o, const pk_int_option *e, int v)
+{
+    pk_render_options_init(o);
+    if (strcmp(e->name, "width") == 0) o->height = 1;
+    if (strcmp(e->name, "height") == 0) o->width = 1;
+    *(int *)(void *)((char *)o + e->offset) = v;
+}
+
+static void check_api(const pk_int_option *e, int v, bool ok)
+{
+    pk_render_options o;
+    set_value(&o, e, v);
+    pk_status st = pk_render_options_check(ctx, &o);
+    if (ok) {
+        CHECKF(st == PK_OK, "API: %s = %d refused: %s", e->name, v, pk_context_error(ctx));
+    } else {
+        char want[256];
+        snprintf(want, sizeof want, "%s %d is out of range (%d..%d)", e->label, v, e->min, e->max);
+        CHECKF(st == PK_ERR_LIMIT && strcmp(pk_context_error(ctx), want) == 0, "API: %s = %d: status %d, '%s'",
+               e->name, v, (int)st, pk_context_error(ctx));
+    }
+    pk_context_clear_error(ctx);
+}
+
+static void check_json(const pk_int_option *e, int v, bool ok)
+{
+    char text[512];
+    snprintf(text, sizeof text,
+             "{\"render\": {\"%s\": %d%s}, \"spheres\": [{\"center\": [0, 0, 0], \"radius\": 1}]}", e->name, v,
+             strcmp(e->name, "width") == 0 ? ", \"height\": 1" : strcmp(e->name, "height") == 0 ? ", \"width\": 1" : "");
+    pk_scene *s = NULL;
+    pk_status st = pk_scene_load_json_memory(ctx, text, strlen(text), "o.json", ".", &s);
+    if (ok) {
+        CHECKF(st == PK_OK, "JSON: %s = %d refused: %s", e->name, v, pk_context_error(ctx));
+        if (st == PK_OK) {
+            pk_render_options o;
+            pk_scene_get_render_options(s, &o);
+            CHECKF(*(int *)(void *)((char *)&o + e->offset) == v, "JSON: %s = %d not taken", e->name, v);
+            CHECK(pk_render_options_check(ctx, &o) == PK_OK); /* and the API agrees */
+        }
+    } else {
+        char want[256];
+        snprintf(want, sizeof want, "o.json:1: render.%s: must be an integer in %d..%d", e->name, e->min, e->max);
+        CHECKF(st != PK_OK && strcmp(pk_context_error(ctx), want) == 0, "JSON: %s = %d: status %d, '%s'", e->name,
+               v, (int)st, pk_context_error(ctx));
+    }
+    pk_scene_destroy(s);
+    pk_context_clear_error(ctx);
+}
+
+/* Runs the program; returns its exit status. */
+static int run_cli(const char *args)
+{
+    char cmd[1024];
+    snprintf(cmd, sizeof cmd, "'%s' render %s -o options_test.png --quiet >options_test.out 2>&1", PK_CLI, args);
+    int rc = system(cmd);
+    return WIFEXITED(rc) ? WEXITSTATUS(rc) : 128 + WTERMSIG(rc);
+}
+
+static void check_cli(const pk_int_option *e, int v, bool ok)
+{
+    char opt[64], args[256];
+    snprintf(opt, sizeof opt, "%s", e->name);
+    for (char *c = opt; *c; c++)
+        if (*c == '_') *c = '-';
+    /* a 1x1 image (the other side 1 for width and height) keeps every accepted value fast */
+    snprintf(args, sizeof args, "--%s=%d %s --light-samples 1", opt, v,
+             strcmp(e->name, "width") == 0    ? "--height 1"
+             : strcmp(e->name, "height") == 0 ? "--width 1"
+                                              : "--width 1 --height 1");
+    if (strcmp(e->name, "light_samples") == 0)
+        snprintf(args, sizeof args, "--%s=%d --width 1 --height 1", opt, v);
+    remove("options_test.png");
+    int rc = run_cli(args);
+    if (ok) {
+        CHECKF(rc == 0 && access("options_test.png", F_OK) == 0, "CLI: --%s=%d: exit %d", opt, v, rc);
+    } else {
+        CHECKF(rc == 2 && access("options_test.png", F_OK) != 0, "CLI: --%s=%d: exit %d (wanted 2)", opt, v, rc);
+        /* the message names the table's range */
+        char range[64], line[512] = "";
+        snprintf(range, sizeof range, "%d..%d", e->min, e->max);
+        FILE *f = fopen("options_test.out", "r");
+        if (f) {
+            if (!fgets(line, sizeof line, f)) line[0] = '\0';
+            fclose(f);
+        }
+        CHECKF(strstr(line, range) != NULL, "CLI: --%s=%d: message without the range %s: %s", opt, v, range, line);
+    }
+}
+
+int main(void)
+{
+    REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
+    size_t n = 0;
+    const pk_int_option *t = pk_int_options(&n);
+    REQUIRE(t && n >= 6);
+    const char *expected[] = {"width", "height", "spp", "light_samples", "max_depth", "threads"};
+    for (size_t k = 0; k < sizeof expected / sizeof *expected; k++) {
+        const pk_int_option *e = pk_int_option_find(expected[k]);
+        CHECKF(e != NULL, "no table entry %s", expected[k]);
+    }
+    CHECK(pk_int_option_find("light-samples") == pk_int_option_find("light_samples"));
+    CHECK(pk_int_option_find("light") == NULL && pk_int_option_find("") == NULL && pk_int_option_find(NULL) == NULL);
+    /* the defaults are the table's */
+    pk_render_options d;
+    pk_render_options_init(&d);
+    for (size_t i = 0; i < n; i++) {
+        const pk_int_option *e = &t[i];
+        CHECKF(e->min <= e->default_value && e->default_value <= e->max, "%s default outside its range", e->name);
+        CHECKF(*(const int *)(const void *)((const char *)&d + e->offset) == e->default_value, "%s default", e->name);
+        CHECK(e->label && e->label[0] && e->help && e->help[0]);
+    }
+    CHECK(pk_render_options_check(ctx, &d) == PK_OK);
+    const bool cli = access(PK_CLI, X_OK) == 0;
+    if (!cli) printf("note: %s is not built; the program's part is not checked\n", PK_CLI);
+    for (size_t i = 0; i < n; i++) {
+        const pk_int_option *e = &t[i];
+        const int ok[2] = {e->min, e->max}, bad[2] = {e->min - 1, e->max + 1};
+        for (int k = 0; k < 2; k++) {
+            check_api(e, ok[k], true);
+            check_api(e, bad[k], false);
+            check_json(e, ok[k], true);
+            check_json(e, bad[k], false);
+            if (cli) {
+                check_cli(e, ok[k], true);
+                check_cli(e, bad[k], false);
+            }
+        }
+    }
+    remove("options_test.png");
+    remove("options_test.out");
+    pk_context_destroy(ctx);
+    return test_done("test_options");
+}
