@@ -120,18 +120,23 @@ fuzz: fuzz-build fuzz-seeds
 	  if [ $$status -ne 0 ]; then echo "fuzz_$$f found a problem: see $(FUZZ_DIR)/fuzz_$$f.log and $(FUZZ_DIR)/crashers/$$f/"; exit 1; fi; \
 	done
 
-# The seeds are merged first and then removed, so that the committed corpus
-# holds only what adds coverage beyond them (ctest replays the seeds anyway).
+# The seeds that ctest replays anyway (tests/data, the Cornell scenes) are
+# merged first and then removed, so that the committed corpus holds only what
+# adds coverage beyond them; a public scene's own text (its first 8 KiB, as
+# the merge cuts inputs, named by its SHA-1 as libFuzzer names them) is
+# removed too: the corpus holds no copy of a scene file.
 # Edges only (no hit counters) and inputs cut at 8 KiB keep it to a few
 # hundred KiB; a fuzzing session finds the finer features again in minutes.
 FUZZ_MERGE_FLAGS = -use_counters=0 -max_len=8192 -rss_limit_mb=2048 -timeout=10
-fuzz-merge: fuzz-build
+fuzz-merge: fuzz-build fuzz-seeds
 	@for f in $(FUZZERS); do \
 	  m=$(FUZZ_DIR)/merged/$$f; rm -rf $$m && mkdir -p $$m $(FUZZ_DIR)/corpus/$$f tests/fuzz/corpus/$$f; \
 	  for s in $(addsuffix /*,$(FUZZ_SEEDS)); do cp "$$s" "$$m/seed-$$(basename "$$s")"; done; \
 	  nice -n 19 ./$(FUZZ_DIR)/tests/fuzz_$$f -merge=1 $(FUZZ_MERGE_FLAGS) $$m \
 	    tests/fuzz/corpus/$$f $(FUZZ_DIR)/corpus/$$f 2>&1 | grep -E 'MERGE-OUTER: [0-9]+ new files'; \
-	  rm -f $$m/seed-*; rm -rf tests/fuzz/corpus/$$f && cp -r $$m tests/fuzz/corpus/$$f; \
+	  rm -f $$m/seed-*; \
+	  for s in $(FUZZ_DIR)/seeds/$$f/*; do [ -f "$$s" ] && rm -f "$$m/$$(head -c 8192 "$$s" | sha1sum | cut -c1-40)"; done; \
+	  rm -rf tests/fuzz/corpus/$$f && cp -r $$m tests/fuzz/corpus/$$f; \
 	  echo "tests/fuzz/corpus/$$f: $$(ls tests/fuzz/corpus/$$f | wc -l) files, $$(cat tests/fuzz/corpus/$$f/* | wc -c) bytes"; \
 	done
 
