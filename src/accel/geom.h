@@ -64,10 +64,13 @@ static inline float ray_rcp(float d)
 }
 
 /* true when a direction component is nonzero but too small for its
- * reciprocal (or is NaN). */
+ * reciprocal: 1/d rounds to inf exactly when 0 < |d| <= 2^-128 (the next
+ * float above 2^-128 has a finite reciprocal). Compares only: it runs once
+ * per ray of every packet. */
 static inline bool ray_dir_tiny(vec3 d)
 {
-    return isnan(ray_rcp(d.x)) || isnan(ray_rcp(d.y)) || isnan(ray_rcp(d.z));
+    return (fabsf(d.x) <= 0x1p-128f && d.x != 0.0f) || (fabsf(d.y) <= 0x1p-128f && d.y != 0.0f) ||
+           (fabsf(d.z) <= 0x1p-128f && d.z != 0.0f);
 }
 
 static inline ray_pre ray_prepare(const ray *r)
