@@ -37,6 +37,7 @@ enum {
     OPT_OUTPUT = 1,
     OPT_INT, /* an integer render option of the library's table */
     OPT_ACCEL,
+    OPT_INTEGRATOR,
     OPT_FRESNEL,
     OPT_LOOK_FROM,
     OPT_LOOK_AT,
@@ -76,6 +77,9 @@ static const cli_option *render_options(size_t *n)
                          .help = "the acceleration structure: bvh (default: binned SAH, wide SIMD BVH), midpoint "
                                  "(simple BVH, for comparison), none (every ray tests every primitive), embree "
                                  "(Embree 3, when built with it); all give the same image"});
+        add((cli_option){.name = "integrator", .id = OPT_INTEGRATOR, .kind = CLI_STRING, .arg = "NAME",
+                         .help = "whitted (default: direct light, mirrors and glass) or path (path tracing: "
+                                 "global illumination, one-sided area lights)"});
         add((cli_option){.name = "fresnel", .id = OPT_FRESNEL, .kind = CLI_STRING, .arg = "on|off",
                          .help = "on: exact dielectric Fresnel (default); off: fixed Ks/Tf weights"});
         add((cli_option){.name = "look-from", .id = OPT_LOOK_FROM, .kind = CLI_STRING, .arg = "X,Y,Z",
@@ -141,6 +145,8 @@ typedef struct cli_opts {
     int fresnel;
     int has_accel;
     pk_accel_kind accel;
+    int has_integrator;
+    pk_integrator_kind integrator;
     int has_from, has_at, has_up, has_fov;
     float from[3], at[3], up[3], fov;
 } cli_opts;
@@ -177,6 +183,11 @@ static int parse_args(int argc, char **argv, cli_opts *o)
                 return cli_usage_error("--accel %s: not available in this build (install libembree-dev and rebuild)",
                                        v);
             o->has_accel = 1;
+            break;
+        case OPT_INTEGRATOR:
+            if (pk_integrator_parse(v, &o->integrator) != PK_OK)
+                return cli_usage_error("--integrator: unknown integrator '%s' (whitted, path)", v);
+            o->has_integrator = 1;
             break;
         case OPT_FRESNEL:
             if (strcmp(v, "on") == 0)
@@ -237,17 +248,26 @@ static int same_file(const char *a, const char *b)
 
 static void print_table(const char *scene, const pk_render_options *ro, const pk_stats *st)
 {
-    uint64_t rays = st->rays_camera + st->rays_shadow + st->rays_reflection + st->rays_refraction;
+    uint64_t rays = st->rays_camera + st->rays_shadow + st->rays_reflection + st->rays_refraction + st->rays_bounce;
     double r = rays ? (double)rays : 1.0;
+    const int path = ro->integrator == PK_INTEGRATOR_PATH;
     printf("%-28s %s\n", "scene", scene);
     printf("%-28s %s, %d thread%s, %dx%d, %d spp, %d light samples, depth %d, fresnel %s\n", "settings",
            pk_accel_kind_name(ro->accel), st->threads, st->threads == 1 ? "" : "s", ro->width, ro->height, ro->spp,
            ro->light_samples, ro->max_depth, ro->fresnel ? "on" : "off");
     printf("%-28s %.0f\n", "build [us]", st->build_us);
     printf("%-28s %.3f\n", "render [s]", st->render_s);
-    printf("%-28s %llu (camera %llu, shadow %llu, reflection %llu, refraction %llu)\n", "rays",
-           (unsigned long long)rays, (unsigned long long)st->rays_camera, (unsigned long long)st->rays_shadow,
-           (unsigned long long)st->rays_reflection, (unsigned long long)st->rays_refraction);
+    if (path) {
+        printf("%-28s path tracing, seed %d\n", "integrator", ro->seed);
+        printf("%-28s %llu (camera %llu, bounce %llu, shadow %llu)\n", "rays", (unsigned long long)rays,
+               (unsigned long long)st->rays_camera, (unsigned long long)st->rays_bounce,
+               (unsigned long long)st->rays_shadow);
+        printf("%-28s %.0f\n", "samples/s", st->render_s > 0 ? (double)st->pixels * ro->spp / st->render_s : 0.0);
+    } else {
+        printf("%-28s %llu (camera %llu, shadow %llu, reflection %llu, refraction %llu)\n", "rays",
+               (unsigned long long)rays, (unsigned long long)st->rays_camera, (unsigned long long)st->rays_shadow,
+               (unsigned long long)st->rays_reflection, (unsigned long long)st->rays_refraction);
+    }
     printf("%-28s %llu\n", "intersection tests", (unsigned long long)st->intersection_tests);
     printf("%-28s %llu\n", "nodes traversed", (unsigned long long)st->nodes_visited);
     printf("%-28s %.2f\n", "tests/ray", (double)st->intersection_tests / r);
@@ -275,7 +295,7 @@ static void json_string(FILE *f, const char *s)
 /* path "-": standard output. */
 static int write_stats_json(const char *path, const char *scene, const pk_render_options *ro, const pk_stats *st)
 {
-    uint64_t rays = st->rays_camera + st->rays_shadow + st->rays_reflection + st->rays_refraction;
+    uint64_t rays = st->rays_camera + st->rays_shadow + st->rays_reflection + st->rays_refraction + st->rays_bounce;
     const int to_stdout = strcmp(path, "-") == 0;
     FILE *f = to_stdout ? stdout : fopen(path, "w");
     if (!f) return cli_failure("%s: cannot write: %s", path, strerror(errno));
@@ -286,13 +306,16 @@ static int write_stats_json(const char *path, const char *scene, const pk_render
             "  \"light_samples\": %d,\n  \"max_depth\": %d,\n  \"fresnel\": %s,\n  \"threads\": %d,\n"
             "  \"build_us\": %.1f,\n  \"render_s\": %.6f,\n  \"rays\": %llu,\n  \"rays_camera\": %llu,\n"
             "  \"rays_shadow\": %llu,\n  \"rays_reflection\": %llu,\n  \"rays_refraction\": %llu,\n"
-            "  \"intersection_tests\": %llu,\n  \"nodes_visited\": %llu,\n  \"mrays_per_s\": %.3f\n}\n",
+            "  \"intersection_tests\": %llu,\n  \"nodes_visited\": %llu,\n  \"mrays_per_s\": %.3f,\n"
+            "  \"integrator\": \"%s\",\n  \"seed\": %d,\n  \"rays_bounce\": %llu,\n  \"samples_per_s\": %.1f\n}\n",
             pk_accel_kind_name(ro->accel), ro->width, ro->height, ro->spp, ro->light_samples, ro->max_depth,
             ro->fresnel ? "true" : "false", st->threads, st->build_us, st->render_s, (unsigned long long)rays,
             (unsigned long long)st->rays_camera, (unsigned long long)st->rays_shadow,
             (unsigned long long)st->rays_reflection, (unsigned long long)st->rays_refraction,
             (unsigned long long)st->intersection_tests, (unsigned long long)st->nodes_visited,
-            st->render_s > 0 ? (double)rays / st->render_s / 1e6 : 0.0);
+            st->render_s > 0 ? (double)rays / st->render_s / 1e6 : 0.0, pk_integrator_name(ro->integrator), ro->seed,
+            (unsigned long long)st->rays_bounce,
+            st->render_s > 0 ? (double)st->pixels * ro->spp / st->render_s : 0.0);
     if (to_stdout ? fflush(f) != 0 || ferror(f) : fclose(f) != 0)
         return cli_failure("%s: cannot write: %s", to_stdout ? "standard output" : path, strerror(errno));
     return 0;
@@ -359,6 +382,7 @@ int cli_render(int argc, char **argv)
         if (o.int_set[i]) *(int *)(void *)((char *)&ro + opts[i].render->offset) = o.int_value[i];
     if (o.fresnel >= 0) ro.fresnel = o.fresnel;
     if (o.has_accel) ro.accel = o.accel;
+    if (o.has_integrator) ro.integrator = o.integrator;
     ro.collect_stats = o.stats || o.stats_json;
     ro.cancel = &g_cancel;
     ro.progress = cli_progress_update;

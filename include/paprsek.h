@@ -105,6 +105,16 @@ PK_API pk_status pk_accel_kind_parse(const char *name, pk_accel_kind *out);
 /* 1 when the accelerator is compiled in. */
 PK_API int pk_accel_available(pk_accel_kind kind);
 
+typedef enum pk_integrator_kind {
+    PK_INTEGRATOR_DEFAULT = 0, /* the Whitted integrator, for now */
+    PK_INTEGRATOR_WHITTED = 1, /* direct light, mirror reflection and refraction */
+    PK_INTEGRATOR_PATH = 2     /* path tracing: global illumination, multiple importance sampling */
+} pk_integrator_kind;
+
+PK_API const char *pk_integrator_name(pk_integrator_kind kind);
+/* Returns PK_OK and sets *out for "whitted", "path", "default". */
+PK_API pk_status pk_integrator_parse(const char *name, pk_integrator_kind *out);
+
 /* Progress of a render: done of total work units (tiles) finished, elapsed
  * seconds since the render call began. Called from one thread, at most a few
  * times per second, and once more at the end (done == total unless the render
@@ -125,6 +135,8 @@ typedef struct pk_render_options {
     volatile const int *cancel;
     pk_progress_fn progress; /* NULL: no progress reports */
     void *progress_user;
+    pk_integrator_kind integrator;
+    int seed;            /* the path tracer's noise pattern (0..2^31-1) */
 } pk_render_options;
 
 /* Defaults: 512x512, 1 spp, 32 light samples, depth 8, all threads, default
@@ -153,6 +165,7 @@ PK_API pk_status pk_render_options_check(pk_context *ctx, const pk_render_option
 
 typedef struct pk_stats {
     uint64_t rays_camera, rays_shadow, rays_reflection, rays_refraction;
+    uint64_t rays_bounce;        /* the path tracer's continuation rays */
     uint64_t intersection_tests; /* ray-primitive tests */
     uint64_t nodes_visited;      /* acceleration-structure nodes */
     double build_us;             /* acceleration build, microseconds */

@@ -19,6 +19,7 @@ static const pk_int_option table[] = {
         "shadow samples per shading point over the area lights (0 = point lights only)"),
     OPT(max_depth, "max depth", 0, PK_MAX_DEPTH, 8, "reflection and refraction depth"),
     OPT(threads, "threads", 0, PK_MAX_THREADS, 0, "worker threads (0 = all cores)"),
+    OPT(seed, "seed", 0, 2147483647, 0, "the path tracer's noise pattern (another seed, other noise)"),
 };
 #undef OPT
 
@@ -73,6 +74,28 @@ pk_status options_check(pk_context *ctx, const pk_render_options *o)
                          PK_MAX_IMAGE_PIXELS);
     if ((unsigned)o->accel > PK_ACCEL_EMBREE)
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "unknown accelerator %d", (int)o->accel);
+    if ((unsigned)o->integrator > PK_INTEGRATOR_PATH)
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "unknown integrator %d", (int)o->integrator);
+    return PK_OK;
+}
+
+/* ---- integrator names ------------------------------------------------------ */
+
+static const char *const integrator_names[] = {"whitted", "whitted", "path"};
+
+const char *pk_integrator_name(pk_integrator_kind kind)
+{
+    if ((unsigned)kind >= sizeof integrator_names / sizeof integrator_names[0]) return "unknown";
+    return integrator_names[kind];
+}
+
+pk_status pk_integrator_parse(const char *name, pk_integrator_kind *out)
+{
+    if (!name || !out) return PK_ERR_INVALID_ARGUMENT;
+    if (strcmp(name, "whitted") == 0) *out = PK_INTEGRATOR_WHITTED;
+    else if (strcmp(name, "path") == 0) *out = PK_INTEGRATOR_PATH;
+    else if (strcmp(name, "default") == 0) *out = PK_INTEGRATOR_DEFAULT;
+    else return PK_ERR_INVALID_ARGUMENT;
     return PK_OK;
 }
 

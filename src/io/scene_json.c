@@ -251,8 +251,9 @@ static pk_status get_array(jp *p, const cJSON *it, const char *path)
 
 /* ---- materials ------------------------------------------------------------ */
 
-enum { MF_NAME, MF_KD, MF_KS, MF_KE, MF_TF, MF_KA, MF_NS, MF_NI, MF_D, MF_ILLUM, MF_COUNT };
-static const char *const material_keys[MF_COUNT] = {"name", "kd", "ks", "ke", "tf", "ka", "ns", "ni", "d", "illum"};
+enum { MF_NAME, MF_KD, MF_KS, MF_KE, MF_TF, MF_KA, MF_NS, MF_NI, MF_D, MF_ILLUM, MF_TWO_SIDED, MF_COUNT };
+static const char *const material_keys[MF_COUNT] = {"name", "kd", "ks", "ke", "tf", "ka",
+                                                    "ns", "ni", "d",  "illum", "two_sided"};
 
 /* Reads a material object into *m (name not set). with_name: "name" is known. */
 static pk_status read_material(jp *p, const cJSON *obj, const char *path, bool with_name, material *m,
@@ -290,6 +291,11 @@ static pk_status read_material(jp *p, const cJSON *obj, const char *path, bool w
     if (f[MF_ILLUM]) {
         path_key(fp, path, "illum");
         if ((st = get_int(p, f[MF_ILLUM], fp, 0, 10, &m->illum))) return st;
+    }
+    if (f[MF_TWO_SIDED]) {
+        path_key(fp, path, "two_sided");
+        if (!cJSON_IsBool(f[MF_TWO_SIDED])) return jfail(p, PK_ERR_PARSE, f[MF_TWO_SIDED], fp, "must be true or false");
+        m->two_sided = cJSON_IsTrue(f[MF_TWO_SIDED]);
     }
     return PK_OK;
 }
@@ -410,9 +416,9 @@ static pk_status parse_film(jp *p, const cJSON *it)
 
 static pk_status parse_render(jp *p, const cJSON *it)
 {
-    enum { R_W, R_H, R_SPP, R_LS, R_DEPTH, R_THREADS, R_ACCEL, R_FRESNEL, R_COUNT };
-    static const char *const keys[R_COUNT] = {"width",   "height", "spp",   "light_samples",
-                                              "max_depth", "threads", "accel", "fresnel"};
+    enum { R_W, R_H, R_SPP, R_LS, R_DEPTH, R_THREADS, R_SEED, R_ACCEL, R_FRESNEL, R_INTEGRATOR, R_COUNT };
+    static const char *const keys[R_COUNT] = {"width",   "height", "spp",   "light_samples", "max_depth",
+                                              "threads", "seed",   "accel", "fresnel",       "integrator"};
     const cJSON *f[R_COUNT];
     pk_status st = object_fields(p, it, "render", keys, R_COUNT, f);
     if (st) return st;
@@ -425,7 +431,8 @@ static pk_status parse_render(jp *p, const cJSON *it)
     } ints[] = {{R_SPP, "render.spp", &r->has_spp},
                 {R_LS, "render.light_samples", &r->has_light_samples},
                 {R_DEPTH, "render.max_depth", &r->has_max_depth},
-                {R_THREADS, "render.threads", &r->has_threads}};
+                {R_THREADS, "render.threads", &r->has_threads},
+                {R_SEED, "render.seed", &r->has_seed}};
     for (size_t i = 0; i < sizeof ints / sizeof ints[0]; i++) {
         if (!f[ints[i].key]) continue;
         const pk_int_option *o = pk_int_option_find(keys[ints[i].key]);
@@ -440,6 +447,13 @@ static pk_status parse_render(jp *p, const cJSON *it)
                          "must be one of \"none\", \"midpoint\", \"bvh\", \"embree\"");
         r->opt.accel = kind;
         r->has_accel = true;
+    }
+    if (f[R_INTEGRATOR]) {
+        pk_integrator_kind kind;
+        if (!cJSON_IsString(f[R_INTEGRATOR]) || pk_integrator_parse(f[R_INTEGRATOR]->valuestring, &kind) != PK_OK)
+            return jfail(p, PK_ERR_PARSE, f[R_INTEGRATOR], "render.integrator", "must be \"path\" or \"whitted\"");
+        r->opt.integrator = kind;
+        r->has_integrator = true;
     }
     if (f[R_FRESNEL]) {
         if (!cJSON_IsBool(f[R_FRESNEL])) return jfail(p, PK_ERR_PARSE, f[R_FRESNEL], "render.fresnel", "must be true or false");

@@ -41,3 +41,89 @@ void lights_free(const pk_allocator *al, light_table *lt)
     mem_free(al, lt->normal);
     memset(lt, 0, sizeof *lt);
 }
+
+static bool emits(vec3 ke) { return ke.x > 0.0f || ke.y > 0.0f || ke.z > 0.0f; }
+
+pk_status light_set_build(pk_context *ctx, const pk_scene *s, light_set *ls)
+{
+    memset(ls, 0, sizeof *ls);
+    const pk_allocator *al = &ctx->alloc;
+    size_t nsph = 0;
+    for (size_t i = 0; i < s->nspheres; i++) nsph += emits(s->materials[s->spheres[i].material].ke);
+    const size_t n = s->nemissive + nsph + s->nlights;
+    ls->of_prim = mem_realloc_array(al, NULL, s->ntris + s->nspheres + 1, sizeof(int32_t));
+    if (!ls->of_prim) return ctx_nomem(ctx);
+    for (size_t i = 0; i < s->ntris + s->nspheres; i++) ls->of_prim[i] = -1;
+    if (n == 0) return PK_OK;
+    ls->lights = mem_realloc_array(al, NULL, n, sizeof(light));
+    ls->cdf = mem_realloc_array(al, NULL, n, sizeof(float));
+    ls->pmf = mem_realloc_array(al, NULL, n, sizeof(float));
+    double *power = mem_realloc_array(al, NULL, n, sizeof(double));
+    if (!ls->lights || !ls->cdf || !ls->pmf || !power) {
+        mem_free(al, power);
+        light_set_free(al, ls);
+        return ctx_nomem(ctx);
+    }
+    size_t k = 0;
+    /* emitted flux (luminance): pi * L * area per emitting side; 4 pi I for points */
+    for (size_t i = 0; i < s->nemissive; i++) {
+        const uint32_t t = s->emissive[i];
+        vec3 a, b, c;
+        scene_tri_verts(s, t, &a, &b, &c);
+        const material *m = &s->materials[s->tris[t].material];
+        light *l = &ls->lights[k];
+        l->kind = LIGHT_TRIANGLE;
+        l->index = t;
+        l->area = 0.5f * v3_len(v3_cross(v3_sub(b, a), v3_sub(c, a)));
+        l->normal = tri_normal(a, b, c);
+        power[k] = (double)fmaxf(v3_luminance(m->ke), 1e-6f) * (double)l->area * (double)PK_PI * (m->two_sided ? 2.0 : 1.0);
+        ls->of_prim[t] = (int32_t)k;
+        k++;
+    }
+    for (size_t i = 0; i < s->nspheres; i++) {
+        const sphere *sp = &s->spheres[i];
+        const material *m = &s->materials[sp->material];
+        if (!emits(m->ke)) continue;
+        light *l = &ls->lights[k];
+        l->kind = LIGHT_SPHERE;
+        l->index = (uint32_t)i;
+        l->area = 4.0f * PK_PI * sp->radius * sp->radius;
+        l->normal = v3s(0.0f);
+        power[k] = (double)fmaxf(v3_luminance(m->ke), 1e-6f) * (double)l->area * (double)PK_PI * (m->two_sided ? 2.0 : 1.0);
+        ls->of_prim[s->ntris + i] = (int32_t)k;
+        k++;
+    }
+    for (size_t i = 0; i < s->nlights; i++) {
+        light *l = &ls->lights[k];
+        l->kind = LIGHT_POINT;
+        l->index = (uint32_t)i;
+        l->area = 0.0f;
+        l->normal = v3s(0.0f);
+        power[k] = (double)fmaxf(v3_luminance(s->lights[i].intensity), 1e-6f) * 4.0 * (double)PK_PI;
+        k++;
+    }
+    double total = 0.0;
+    for (size_t i = 0; i < n; i++) total += isfinite(power[i]) ? power[i] : 0.0;
+    double acc = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        /* lights of infinite power (overflowing areas) share what is left equally */
+        const double p = total > 0.0 && isfinite(total) ? (isfinite(power[i]) ? power[i] / total : 0.0) : 1.0 / (double)n;
+        ls->pmf[i] = (float)p;
+        acc += p;
+        ls->cdf[i] = (float)acc;
+    }
+    ls->cdf[n - 1] = 1.0f;
+    ls->n = n;
+    ls->power = total;
+    mem_free(al, power);
+    return PK_OK;
+}
+
+void light_set_free(const pk_allocator *al, light_set *ls)
+{
+    mem_free(al, ls->lights);
+    mem_free(al, ls->cdf);
+    mem_free(al, ls->pmf);
+    mem_free(al, ls->of_prim);
+    memset(ls, 0, sizeof *ls);
+}

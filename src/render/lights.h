@@ -33,4 +33,43 @@ static inline size_t light_pick(const light_table *lt, float u)
     return lo;
 }
 
+
+/* ---- every light, for the path tracer ------------------------------------ */
+
+enum { LIGHT_TRIANGLE, LIGHT_SPHERE, LIGHT_POINT };
+
+typedef struct light {
+    uint32_t kind;       /* LIGHT_* */
+    uint32_t index;      /* triangle number, sphere number or point light number */
+    float area;          /* triangles and spheres */
+    vec3 normal;         /* triangles: unit winding normal */
+} light;
+
+/* Emissive triangles, emissive spheres and point lights, chosen in proportion
+ * to their emitted power. */
+typedef struct light_set {
+    size_t n;
+    light *lights;
+    float *cdf;          /* n entries, last = 1 */
+    float *pmf;          /* probability of choosing each light */
+    int32_t *of_prim;    /* ntris + nspheres entries: the light a primitive is, or -1 */
+    double power;
+} light_set;
+
+PK_HIDDEN pk_status light_set_build(pk_context *ctx, const pk_scene *s, light_set *ls);
+PK_HIDDEN void light_set_free(const pk_allocator *al, light_set *ls);
+
+static inline size_t light_set_pick(const light_set *ls, float u)
+{
+    size_t lo = 0, hi = ls->n - 1;
+    while (lo < hi) {
+        size_t mid = (lo + hi) / 2;
+        if (u < ls->cdf[mid])
+            hi = mid;
+        else
+            lo = mid + 1;
+    }
+    return lo;
+}
+
 #endif

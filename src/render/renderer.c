@@ -10,6 +10,7 @@
 #include "render.h"
 
 #include "camera.h"
+#include "path.h"
 #include "whitted.h"
 
 #include <omp.h>
@@ -25,15 +26,18 @@ struct pk_renderer {
     pk_render_options opt;
     int nt;                 /* threads */
     frame fr;
+    bool path;              /* the path tracer, else the Whitted integrator */
     whitted w;
     whitted_thread *ts;     /* nt entries */
+    path_tracer pt;
+    path_thread *pts;       /* nt entries */
     pk_camera cam;
     pk_stats total;         /* since creation */
 };
 
 /* Warnings about scenes that the Whitted integrator will render black or
  * lit differently from what the file suggests. */
-static void warn_lighting(pk_context *ctx, const pk_scene *s)
+static void warn_lighting(pk_context *ctx, const pk_scene *s, bool path)
 {
     size_t emissive_spheres = 0;
     for (size_t i = 0; i < s->nspheres; i++) {
@@ -44,7 +48,7 @@ static void warn_lighting(pk_context *ctx, const pk_scene *s)
     if (s->nemissive == 0 && s->nlights == 0 && emissive_spheres == 0 && !ambient)
         ctx_warn(ctx, "%s: the scene has no light (no emissive triangle or sphere, no point light): the image will be black",
                  s->name);
-    if (emissive_spheres)
+    if (emissive_spheres && !path)
         ctx_warn(ctx, "%s: %zu emissive sphere%s visible but light%s nothing: the Whitted integrator lights the scene "
                  "only from emissive triangles and point lights", s->name, emissive_spheres,
                  emissive_spheres == 1 ? " is" : "s are", emissive_spheres == 1 ? "s" : "");
@@ -65,21 +69,31 @@ pk_status renderer_create(pk_context *ctx, const pk_scene *s, const pk_render_op
         mem_free(&ctx->alloc, r);
         return st;
     }
+    r->path = opt->integrator == PK_INTEGRATOR_PATH;
     r->w = (whitted){&r->fr, opt->light_samples, opt->max_depth, opt->fresnel != 0};
     r->ts = mem_calloc(&ctx->alloc, (size_t)r->nt, sizeof *r->ts);
-    if (!r->ts) {
+    r->pts = mem_calloc(&ctx->alloc, (size_t)r->nt, sizeof *r->pts);
+    if (!r->ts || !r->pts) {
         renderer_destroy(r);
         return ctx_nomem(ctx);
     }
-    for (int t = 0; t < r->nt; t++)
-        if ((st = whitted_thread_init(ctx, &r->w, &r->ts[t], opt->collect_stats != 0)) != PK_OK) {
+    if (r->path) {
+        if ((st = path_init(ctx, &r->pt, &r->fr, opt)) != PK_OK) {
             renderer_destroy(r);
             return st;
         }
+        for (int t = 0; t < r->nt; t++) r->pts[t].cp = opt->collect_stats ? &r->pts[t].counters : NULL;
+    } else {
+        for (int t = 0; t < r->nt; t++)
+            if ((st = whitted_thread_init(ctx, &r->w, &r->ts[t], opt->collect_stats != 0)) != PK_OK) {
+                renderer_destroy(r);
+                return st;
+            }
+    }
     r->total.build_us = r->fr.build_s * 1e6;
     r->total.threads = r->nt;
     r->total.accel_builds = 1;
-    warn_lighting(ctx, s);
+    warn_lighting(ctx, s, r->path);
     *out = r;
     return PK_OK;
 }
@@ -91,6 +105,8 @@ void renderer_destroy(pk_renderer *r)
     if (r->ts)
         for (int t = 0; t < r->nt; t++) whitted_thread_free(al, &r->ts[t]);
     mem_free(al, r->ts);
+    mem_free(al, r->pts);
+    path_free(al, &r->pt);
     frame_free(al, &r->fr);
     mem_free(al, r);
 }
@@ -153,6 +169,42 @@ static pk_status check_regions(pk_context *ctx, const pk_region *reg, size_t n, 
 
 /* Renders one tile into acc (3 floats per pixel, the sums of spp samples);
  * false when the render was cancelled before the tile finished. */
+/* The path tracer's version of render_tile: the pixel position of each
+ * sample comes from its sampler (the first two dimensions). */
+static bool render_tile_path(const pk_renderer *r, path_thread *me, const camera_frame *cf, const tile *tl,
+                             float *acc, volatile const int *cancel, atomic_int *stop)
+{
+    const int spp = r->opt.spp;
+    const int tw = tl->w, n = tl->w * tl->h;
+    ray rays[BATCH];
+    hit hits[BATCH];
+    memset(acc, 0, sizeof(float) * 3 * (size_t)n);
+    for (int smp = 0; smp < spp; smp++) {
+        if (smp > 0 && ((cancel && *cancel) || atomic_load_explicit(stop, memory_order_relaxed))) return false;
+        for (int i = 0; i < n; i++) {
+            int px = tl->x + i % tw, py = tl->y + i / tw;
+            sampler sm = sampler_start((uint32_t)px, (uint32_t)py, (uint32_t)smp, r->pt.seed);
+            float jx, jy;
+            sampler_2d(&sm, &jx, &jy);
+            rays[i] = camera_ray(cf, (float)px + jx, (float)py + jy);
+        }
+        me->rays_camera += (uint64_t)n;
+        accel_intersect_many(r->fr.a, rays, hits, (size_t)n, false, me->cp);
+        for (int i = 0; i < n; i++) {
+            if (hits[i].prim == PK_NO_HIT) continue;
+            int px = tl->x + i % tw, py = tl->y + i / tw;
+            sampler sm = sampler_start((uint32_t)px, (uint32_t)py, (uint32_t)smp, r->pt.seed);
+            sm.dim = 2; /* the pixel position */
+            vec3 c = path_radiance(&r->pt, me, &sm, &rays[i], &hits[i]);
+            if (!v3_finite(c)) continue; /* a lost sample, not a poisoned pixel */
+            acc[3 * i] += c.x;
+            acc[3 * i + 1] += c.y;
+            acc[3 * i + 2] += c.z;
+        }
+    }
+    return true;
+}
+
 static bool render_tile(const pk_renderer *r, whitted_thread *me, const camera_frame *cf, const tile *tl,
                         float *acc, volatile const int *cancel, atomic_int *stop)
 {
@@ -226,6 +278,9 @@ pk_status renderer_render(pk_renderer *r, const pk_region *regions, size_t nregi
     for (int t = 0; t < r->nt; t++) {
         memset(r->ts[t].rays, 0, sizeof r->ts[t].rays);
         r->ts[t].counters = (accel_counters){0, 0};
+        accel_counters *cp = r->pts[t].cp;
+        memset(&r->pts[t], 0, sizeof r->pts[t]);
+        r->pts[t].cp = cp;
     }
     const camera_frame cf = camera_setup(&r->cam, opt->width, opt->height);
     volatile const int *cancel = opt->cancel;
@@ -240,6 +295,7 @@ pk_status renderer_render(pk_renderer *r, const pk_region *regions, size_t nregi
     {
         const int tid = omp_get_thread_num();
         whitted_thread *me = &r->ts[tid];
+        path_thread *pme = &r->pts[tid];
         float acc[BATCH * 3];
 #pragma omp for schedule(dynamic, 1)
         for (int ti = 0; ti < nt_total; ti++) {
@@ -249,7 +305,9 @@ pk_status renderer_render(pk_renderer *r, const pk_region *regions, size_t nregi
                 continue;
             }
             const tile *tl = &tiles[ti];
-            if (!render_tile(r, me, &cf, tl, acc, cancel, &stop)) { /* an unfinished tile stays black */
+            const bool finished = r->path ? render_tile_path(r, pme, &cf, tl, acc, cancel, &stop)
+                                           : render_tile(r, me, &cf, tl, acc, cancel, &stop);
+            if (!finished) { /* an unfinished tile stays black */
 #pragma omp atomic write
                 cancelled = 1;
                 continue;
@@ -279,6 +337,11 @@ pk_status renderer_render(pk_renderer *r, const pk_region *regions, size_t nregi
         s->rays_refraction += r->ts[t].rays[RAY_REFRACTION];
         s->intersection_tests += r->ts[t].counters.tests;
         s->nodes_visited += r->ts[t].counters.nodes;
+        s->rays_camera += r->pts[t].rays_camera;
+        s->rays_bounce += r->pts[t].rays_bounce;
+        s->rays_shadow += r->pts[t].rays_shadow;
+        s->intersection_tests += r->pts[t].counters.tests;
+        s->nodes_visited += r->pts[t].counters.nodes;
     }
     s->render_s += render_s;
     s->pixels += pixels;

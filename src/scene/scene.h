@@ -25,6 +25,11 @@ typedef struct material {
     float ni;      /* index of refraction */
     float d;       /* dissolve, 1 = opaque (Tr = 1 - d) */
     int illum;
+    /* Emission on both sides (the path tracer; area lights are one-sided by
+     * default, emitting on the side of the winding normal, counter-clockwise
+     * v0 v1 v2, and of a sphere's outward normal). The Whitted integrator
+     * treats every emitter as two-sided. */
+    bool two_sided;
 } material;
 
 /* Triangle k is the k-th triangle the file produced (fan order). */
@@ -49,7 +54,7 @@ typedef struct point_light {
 typedef struct scene_render_settings {
     pk_render_options opt;
     bool has_width, has_height, has_spp, has_light_samples, has_max_depth, has_threads,
-        has_accel, has_fresnel;
+        has_accel, has_fresnel, has_seed, has_integrator;
 } scene_render_settings;
 
 /* Invariants (scene_check tests them after commit):

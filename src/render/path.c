@@ -1,0 +1,336 @@
+/*
+ * path.c - the path tracer (see path.h and docs/integrators.md).
+ *
+ * Materials are the MTL models: Lambertian Kd; mirrors (illum 3, 5) add an
+ * ideal reflection weighted by Ks; dielectrics (illum 4, 6, 7) reflect and
+ * refract with exact Fresnel, tinted by Tf on the way in; dissolve d < 1 lets
+ * a fraction of the light pass straight through. A surface's lobes are chosen
+ * in proportion to their weights; only the diffuse lobe is seen by light
+ * sampling (the others are delta lobes).
+ */
+#include "path.h"
+
+#include "optics.h"
+#include "sampling.h"
+#include "surface.h"
+
+#include <string.h>
+
+#define RR_START 3            /* Russian roulette from this bounce on */
+#define SHADOW_SHORTEN 1e-3f  /* shadow rays stop this fraction short of the light */
+
+pk_status path_init(pk_context *ctx, path_tracer *pt, const frame *f, const pk_render_options *opt)
+{
+    memset(pt, 0, sizeof *pt);
+    pt->f = f;
+    pt->max_depth = opt->max_depth;
+    pt->seed = (uint32_t)opt->seed;
+    return light_set_build(ctx, f->s, &pt->lights);
+}
+
+void path_free(const pk_allocator *al, path_tracer *pt) { light_set_free(al, &pt->lights); }
+
+static inline bool black(vec3 c) { return !(c.x > 0.0f || c.y > 0.0f || c.z > 0.0f); }
+static inline float power_heuristic(float a, float b)
+{
+    a *= a, b *= b;
+    return a + b > 0.0f ? a / (a + b) : 0.0f;
+}
+
+/* Radiance a surface emits toward wo (unit, pointing away from it). */
+static inline vec3 emitted(const surface *sf) { return sf->front || sf->m->two_sided ? sf->m->ke : v3s(0.0f); }
+
+/* ---- the material's lobes ----------------------------------------------------- */
+
+typedef struct lobes {
+    vec3 kd;             /* diffuse albedo */
+    vec3 ks;             /* mirror weight (illum 3, 5) */
+    float w_diffuse, w_mirror, w_glass, w_pass; /* selection probabilities, summing to 1 (or all 0) */
+} lobes;
+
+static lobes lobes_of(const material *m)
+{
+    lobes l = {v3s(0.0f), v3s(0.0f), 0.0f, 0.0f, 0.0f, 0.0f};
+    const bool glass = m->illum == 4 || m->illum == 6 || m->illum == 7;
+    const bool mirror = m->illum == 3 || m->illum == 5;
+    float opaque = glass ? 1.0f : fminf(fmaxf(m->d, 0.0f), 1.0f);
+    float wd = 0.0f, wm = 0.0f, wg = 0.0f;
+    if (glass) {
+        wg = 1.0f;
+    } else {
+        l.kd = m->kd;
+        if (mirror) l.ks = m->ks;
+        wd = v3_max_comp(l.kd);
+        wm = v3_max_comp(l.ks);
+    }
+    float total = wd + wm + wg;
+    if (total > 0.0f) {
+        l.w_diffuse = opaque * wd / total;
+        l.w_mirror = opaque * wm / total;
+        l.w_glass = opaque * wg / total;
+    }
+    l.w_pass = 1.0f - opaque;
+    return l;
+}
+
+/* f * cos for the diffuse lobe, and its pdf (with the lobe's selection). */
+static inline vec3 diffuse_eval(const surface *sf, const lobes *lb, vec3 wi, float *pdf)
+{
+    float cos_i = v3_dot(sf->ns, wi);
+    if (cos_i <= 0.0f || v3_dot(sf->ng, wi) <= 0.0f || lb->w_diffuse <= 0.0f) {
+        *pdf = 0.0f;
+        return v3s(0.0f);
+    }
+    *pdf = lb->w_diffuse * cos_i / PK_PI;
+    return v3_scale(lb->kd, cos_i / PK_PI);
+}
+
+/* Samples a lobe and a direction. Returns false when the path ends. Sets *wi,
+ * *weight (f cos / pdf, the lobe's selection included), *pdf (0 for delta
+ * lobes), *delta. */
+static bool sample_lobes(const surface *sf, const lobes *lb, vec3 wo, float u0, float u1, float u2, vec3 *wi,
+                         vec3 *weight, float *pdf, bool *delta)
+{
+    float u = u0;
+    if (u < lb->w_diffuse) {
+        vec3 d = sample_cosine(sf->ns, u1, u2);
+        if (v3_dot(d, sf->ng) <= 0.0f) return false; /* below the geometric surface */
+        float p;
+        vec3 f = diffuse_eval(sf, lb, d, &p);
+        if (!(p > 0.0f)) return false;
+        *wi = d;
+        *weight = v3_scale(f, 1.0f / p);
+        *pdf = p;
+        *delta = false;
+        return true;
+    }
+    u -= lb->w_diffuse;
+    *pdf = 0.0f;
+    *delta = true;
+    const vec3 dn = v3_neg(wo); /* incident direction */
+    if (u < lb->w_mirror) {
+        vec3 r = v3_reflect(dn, sf->ns);
+        if (v3_dot(r, sf->ng) <= 0.0f) r = v3_reflect(dn, sf->ng);
+        *wi = r;
+        *weight = v3_scale(lb->ks, 1.0f / lb->w_mirror);
+        return true;
+    }
+    u -= lb->w_mirror;
+    if (u < lb->w_glass) {
+        const material *m = sf->m;
+        float eta_i = sf->front ? 1.0f : m->ni, eta_t = sf->front ? m->ni : 1.0f;
+        float cos_i = fminf(1.0f, v3_dot(wo, sf->ns));
+        vec3 wt;
+        bool tir = !refract_dir(dn, sf->ns, eta_i / eta_t, &wt) || v3_dot(wt, sf->ng) >= 0.0f;
+        float F = tir ? 1.0f : fresnel_dielectric(cos_i, eta_i, eta_t);
+        /* reflect with probability F, else refract: the weight is then 1 (times the tint) */
+        if (u2 < F) {
+            vec3 r = v3_reflect(dn, sf->ns);
+            if (v3_dot(r, sf->ng) <= 0.0f) r = v3_reflect(dn, sf->ng);
+            *wi = r;
+            *weight = v3s(1.0f / lb->w_glass);
+        } else {
+            float tmax_c = v3_max_comp(m->tf);
+            vec3 tint = sf->front && tmax_c > 0.0f ? v3_scale(m->tf, 1.0f / tmax_c) : v3s(1.0f);
+            *wi = wt;
+            *weight = v3_scale(tint, 1.0f / lb->w_glass);
+        }
+        return true;
+    }
+    if (lb->w_pass > 0.0f) { /* straight through (dissolve) */
+        *wi = dn;
+        *weight = v3s(1.0f);
+        return true;
+    }
+    return false;
+}
+
+/* ---- lights ------------------------------------------------------------------- */
+
+/* Solid-angle pdf of sampling the point q (normal nq, on light l) from p by
+ * light sampling, the choice of the light excluded. */
+static float light_pdf_dir(const path_tracer *pt, const light *l, vec3 p, vec3 q, vec3 nq)
+{
+    const pk_scene *s = pt->f->s;
+    vec3 d = v3_sub(q, p);
+    float dist2 = v3_len2(d);
+    if (!(dist2 > 0.0f)) return 0.0f;
+    if (l->kind == LIGHT_SPHERE) {
+        const sphere *sp = &s->spheres[l->index];
+        float dc2 = v3_len2(v3_sub(sp->center, p)), r2 = sp->radius * sp->radius;
+        if (dc2 > r2 * 1.0001f) { /* outside: uniform in the cone of the sphere */
+            float sin2 = r2 / dc2, cos_max = sqrtf(fmaxf(0.0f, 1.0f - sin2));
+            float one_minus = sin2 / (1.0f + cos_max);
+            return 1.0f / (2.0f * PK_PI * one_minus);
+        }
+    }
+    /* uniform by area, converted to solid angle */
+    float cos_l = fabsf(v3_dot(nq, v3_scale(d, 1.0f / sqrtf(dist2))));
+    if (!(cos_l > 0.0f) || !(l->area > 0.0f)) return 0.0f;
+    return dist2 / (cos_l * l->area);
+}
+
+typedef struct light_sample {
+    vec3 wi;       /* unit direction from p to the light */
+    vec3 le;       /* radiance (or intensity / dist^2 for point lights) arriving at p */
+    float pdf;     /* solid angle, the light's choice included; 1 for point lights */
+    bool delta;
+    ray shadow;
+} light_sample;
+
+static bool sample_light(const path_tracer *pt, vec3 o, vec3 p, float u0, float u1, float u2, light_sample *ls)
+{
+    const light_set *set = &pt->lights;
+    const pk_scene *s = pt->f->s;
+    if (set->n == 0) return false;
+    size_t li = light_set_pick(set, u0);
+    const light *l = &set->lights[li];
+    const float psel = set->pmf[li];
+    if (!(psel > 0.0f)) return false;
+    vec3 q, nq, le;
+    float pdf;
+    if (l->kind == LIGHT_POINT) {
+        const point_light *pl = &s->lights[l->index];
+        vec3 d = v3_sub(pl->position, o);
+        float dist2 = v3_len2(d);
+        if (!(dist2 > 0.0f)) return false;
+        ls->wi = v3_scale(d, 1.0f / sqrtf(dist2));
+        ls->le = v3_scale(pl->intensity, 1.0f / dist2);
+        ls->pdf = psel;
+        ls->delta = true;
+        ls->shadow = (ray){o, 0.0f, d, 1.0f};
+        return true;
+    }
+    const material *m;
+    if (l->kind == LIGHT_TRIANGLE) {
+        vec3 a, b, c;
+        scene_tri_verts(s, l->index, &a, &b, &c);
+        q = sample_triangle(a, b, c, u1, u2);
+        nq = l->normal;
+        m = &s->materials[s->tris[l->index].material];
+        vec3 toward = v3_sub(p, q);
+        bool front = v3_dot(nq, toward) > 0.0f;
+        if (!front && !m->two_sided) return false;
+    } else {
+        const sphere *sp = &s->spheres[l->index];
+        m = &s->materials[sp->material];
+        vec3 dc = v3_sub(sp->center, p);
+        float dc2 = v3_len2(dc), r2 = sp->radius * sp->radius;
+        if (dc2 > r2 * 1.0001f) {
+            /* a direction uniform in the cone, then the point where it meets the sphere */
+            float dcl = sqrtf(dc2), sin2 = r2 / dc2, cos_max = sqrtf(fmaxf(0.0f, 1.0f - sin2));
+            float one_minus = sin2 / (1.0f + cos_max);
+            float cos_t = 1.0f - u1 * one_minus, sin_t = sqrtf(fmaxf(0.0f, 1.0f - cos_t * cos_t));
+            float phi = 2.0f * PK_PI * u2;
+            vec3 w = v3_scale(dc, 1.0f / dcl);
+            vec3 t = fabsf(w.x) > 0.5f ? v3(-w.y, w.x, 0.0f) : v3(0.0f, -w.z, w.y);
+            t = v3_norm(t);
+            vec3 bb = v3_cross(w, t);
+            vec3 dir = v3_add(v3_add(v3_scale(t, sin_t * cosf(phi)), v3_scale(bb, sin_t * sinf(phi))), v3_scale(w, cos_t));
+            /* nearest intersection of p + s dir with the sphere */
+            float bq = v3_dot(dir, dc), disc = bq * bq - (dc2 - r2);
+            float sdist = bq - sqrtf(fmaxf(0.0f, disc));
+            q = v3_add(p, v3_scale(dir, sdist));
+            nq = v3_norm_scaled(v3_sub(q, sp->center)); /* seen from outside: the emitting side */
+        } else {
+            /* inside: uniform on the sphere, seen from within (its back) */
+            float z = 1.0f - 2.0f * u1, rr = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = 2.0f * PK_PI * u2;
+            nq = v3(rr * cosf(phi), rr * sinf(phi), z);
+            q = v3_add(sp->center, v3_scale(nq, sp->radius));
+            if (!m->two_sided) return false;
+        }
+    }
+    le = m->ke;
+    pdf = light_pdf_dir(pt, l, p, q, nq);
+    if (!(pdf > 0.0f) || !isfinite(pdf)) return false;
+    vec3 d = v3_sub(q, o);
+    float dist2 = v3_len2(d);
+    if (!(dist2 > 0.0f)) return false;
+    ls->wi = v3_scale(d, 1.0f / sqrtf(dist2));
+    ls->le = le;
+    ls->pdf = psel * pdf;
+    ls->delta = false;
+    ls->shadow = (ray){o, 0.0f, d, 1.0f - SHADOW_SHORTEN};
+    return true;
+}
+
+/* ---- the path ------------------------------------------------------------------ */
+
+vec3 path_radiance(const path_tracer *pt, path_thread *t, sampler *smp, const ray *r0, const hit *h0)
+{
+    const frame *fr = pt->f;
+    const pk_scene *s = fr->s;
+    vec3 L = v3s(0.0f), beta = v3s(1.0f);
+    ray r = *r0;
+    hit h = *h0;
+    bool prev_delta = true; /* the camera: emission is counted in full */
+    float prev_pdf = 0.0f;
+    vec3 prev_p = r.o;
+    for (int depth = 0;; depth++) {
+        surface sf = surface_at(s, &r, &h);
+        const vec3 wo = v3_neg(v3_norm(r.d));
+        /* emission reached by the path */
+        vec3 le = emitted(&sf);
+        if (!black(le)) {
+            float w = 1.0f;
+            if (!prev_delta) {
+                int32_t li = pt->lights.of_prim[h.prim];
+                if (li >= 0) {
+                    const light *l = &pt->lights.lights[li];
+                    float pl = pt->lights.pmf[li] * light_pdf_dir(pt, l, prev_p, sf.p,
+                                                                   l->kind == LIGHT_TRIANGLE ? l->normal : sf.ng);
+                    w = power_heuristic(prev_pdf, pl);
+                }
+            }
+            L = v3_add(L, v3_mul(beta, v3_scale(le, w)));
+        }
+        if (depth >= pt->max_depth) break;
+        const lobes lb = lobes_of(sf.m);
+        float u0, u1, u2, u3, u4, u5;
+        sampler_2d(smp, &u0, &u1);
+        sampler_2d(smp, &u2, &u3);
+        sampler_2d(smp, &u4, &u5);
+        /* next-event estimation: one light, chosen by power */
+        if (lb.w_diffuse > 0.0f && pt->lights.n) {
+            light_sample ls;
+            vec3 o = offset_origin(fr->eps, sf.p, sf.ng);
+            if (sample_light(pt, o, sf.p, u0, u1, u2, &ls)) {
+                float pb;
+                vec3 f = diffuse_eval(&sf, &lb, ls.wi, &pb);
+                if (!black(f)) {
+                    hit sh;
+                    t->rays_shadow++;
+                    if (!fr->a->ops->occluded(fr->a, &ls.shadow, &sh, t->cp)) {
+                        float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, pb);
+                        L = v3_add(L, v3_mul(beta, v3_scale(v3_mul(f, ls.le), w / ls.pdf)));
+                    }
+                }
+            }
+        }
+        /* the next direction, from the material */
+        vec3 wi, weight;
+        float pdf;
+        bool delta;
+        if (!sample_lobes(&sf, &lb, wo, u3, u4, u5, &wi, &weight, &pdf, &delta)) break;
+        beta = v3_mul(beta, weight);
+        if (black(beta) || !v3_finite(beta)) break;
+        /* Russian roulette on the throughput: a path carrying less than 1
+         * survives with probability max(beta) and is weighted up by its
+         * inverse (unbiased) */
+        if (depth + 1 >= RR_START) {
+            float q = v3_max_comp(beta);
+            if (q < 1.0f) {
+                if (sampler_1d(smp) >= q) break;
+                beta = v3_scale(beta, 1.0f / q);
+            }
+        }
+        const bool below = v3_dot(wi, sf.ng) < 0.0f;
+        r = (ray){offset_origin(fr->eps, sf.p, below ? v3_neg(sf.ng) : sf.ng), 0.0f, wi, INFINITY};
+        prev_delta = delta;
+        prev_pdf = pdf;
+        prev_p = sf.p;
+        t->rays_bounce++;
+        if (!fr->a->ops->intersect(fr->a, &r, &h, t->cp)) break; /* no environment light yet */
+    }
+    return L;
+}
