@@ -273,7 +273,8 @@ vec3 path_radiance(const path_tracer *pt, path_thread *t, sampler *smp, const ra
         vec3 le = emitted(&sf);
         if (!black(le)) {
             float w = 1.0f;
-            if (!prev_delta) {
+            if (!prev_delta && pt->strategy == PATH_LIGHTS_ONLY) w = 0.0f; /* light sampling found it */
+            if (!prev_delta && pt->strategy == PATH_MIS) {
                 int32_t li = pt->lights.of_prim[h.prim];
                 if (li >= 0) {
                     const light *l = &pt->lights.lights[li];
@@ -291,7 +292,7 @@ vec3 path_radiance(const path_tracer *pt, path_thread *t, sampler *smp, const ra
         sampler_2d(smp, &u2, &u3);
         sampler_2d(smp, &u4, &u5);
         /* next-event estimation: one light, chosen by power */
-        if (lb.w_diffuse > 0.0f && pt->lights.n) {
+        if (lb.w_diffuse > 0.0f && pt->lights.n && pt->strategy != PATH_BSDF_ONLY) {
             light_sample ls;
             vec3 o = offset_origin(fr->eps, sf.p, sf.ng);
             if (sample_light(pt, o, sf.p, u0, u1, u2, &ls)) {
@@ -301,7 +302,7 @@ vec3 path_radiance(const path_tracer *pt, path_thread *t, sampler *smp, const ra
                     hit sh;
                     t->rays_shadow++;
                     if (!fr->a->ops->occluded(fr->a, &ls.shadow, &sh, t->cp)) {
-                        float w = ls.delta ? 1.0f : power_heuristic(ls.pdf, pb);
+                        float w = ls.delta || pt->strategy == PATH_LIGHTS_ONLY ? 1.0f : power_heuristic(ls.pdf, pb);
                         L = v3_add(L, v3_mul(beta, v3_scale(v3_mul(f, ls.le), w / ls.pdf)));
                     }
                 }

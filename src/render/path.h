@@ -11,12 +11,17 @@
 #include "frame.h"
 #include "sampler.h"
 
+/* How direct light is found: both strategies weighted by MIS (the renderer's
+ * choice), or one alone (tests: all three converge to the same image). */
+enum { PATH_MIS, PATH_LIGHTS_ONLY, PATH_BSDF_ONLY };
+
 /* Read-only during a render. */
 typedef struct path_tracer {
     const frame *f;
     light_set lights;
     int max_depth;       /* bounces after the camera ray */
     uint32_t seed;
+    int strategy;        /* PATH_* */
 } path_tracer;
 
 typedef struct path_thread {

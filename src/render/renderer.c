@@ -116,6 +116,7 @@ const pk_render_options *renderer_options(const pk_renderer *r) { return &r->opt
 void renderer_set_camera(pk_renderer *r, const pk_camera *cam) { r->cam = *cam; }
 const pk_camera *renderer_camera(const pk_renderer *r) { return &r->cam; }
 void renderer_stats(const pk_renderer *r, pk_stats *stats) { *stats = r->total; }
+void renderer_set_path_strategy(pk_renderer *r, int strategy) { r->pt.strategy = strategy; }
 
 typedef struct tile {
     int x, y, w, h;
