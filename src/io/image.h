@@ -21,7 +21,9 @@ PK_HIDDEN unsigned char srgb_encode(float linear);
 
 /* The compression of .exr files: ZIP (zlib over 16-scanline blocks), lossless.
  * (Measured on a 512x512 render in docs/design.md, against PIZ.) */
+#ifndef PK_EXR_COMPRESSION /* (-D for measurements) */
 #define PK_EXR_COMPRESSION EXR_COMPRESSION_ZIP
+#endif
 /* At most this many channels in one file. */
 #define PK_EXR_MAX_CHANNELS 64
 
