@@ -257,6 +257,15 @@ static void test_exr_layers(void)
         CHECKF(bad == 0, "%s: %ld samples differ", r.names[k], bad);
     }
     free_read(&r);
+    /* a device that takes nothing: the write callback's error comes back */
+    fd = open("/dev/full", O_WRONLY);
+    if (fd >= 0) {
+        why[0] = '\0';
+        CHECK(exr_write_channels(fd, w, h, ch, n, why, sizeof why) == -1);
+        CHECKF(strncmp(why, "write error: ", 13) == 0, "%s", why);
+        printf("/dev/full: %s\n", why);
+        close(fd);
+    }
     /* refused: no channels */
     CHECK(exr_write_channels(-1, w, h, ch, 0, why, sizeof why) == -1 && why[0]);
     remove(path);
