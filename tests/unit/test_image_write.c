@@ -153,7 +153,8 @@ static pk_image *test_image(int w, int h)
         px[i] = (float)(s >> 8) / (float)(1 << 24) * 4.0f;
     }
     const float special[] = {-0.0f, 1e-40f, from_bits(1), 65504.0f, 1e30f, -3.5f, INFINITY, from_bits(0x7fc01234)};
-    for (size_t i = 0; i < sizeof special / sizeof special[0] && i < (size_t)(3 * w * h); i++) px[i * 7] = special[i];
+    for (size_t i = 0; i < sizeof special / sizeof special[0] && i * 7 < (size_t)(3 * w * h); i++)
+        px[i * 7] = special[i];
     return img;
 }
 
