@@ -13,7 +13,7 @@ static void usage(FILE *f)
           "\n"
           "commands:\n"
           "  render [SCENE] -o OUT     render a scene (.obj or .json; the built-in Cornell box\n"
-          "                            when SCENE is omitted) to OUT (.png or .pfm)\n"
+          "                            when SCENE is omitted) to OUT (.png, .pfm or .exr)\n"
           "  bench rays SCENE RAYS     time an accelerator on a ray file\n"
           "  bench gen-rays SCENE ...  make the standard ray files\n"
           "  bench compare A B         check that two hit files agree\n"

@@ -35,6 +35,7 @@ static void print_warning(void *user, const char *message)
 
 enum {
     OPT_OUTPUT = 1,
+    OPT_EXPOSURE,
     OPT_INT, /* an integer render option of the library's table */
     OPT_ACCEL,
     OPT_INTEGRATOR,
@@ -65,7 +66,11 @@ static const cli_option *render_options(size_t *n)
 {
     if (g_nopts == 0) {
         add((cli_option){.name = "output", .short_name = 'o', .id = OPT_OUTPUT, .kind = CLI_STRING, .arg = "FILE",
-                         .help = "the image to write (required): .png (8-bit sRGB) or .pfm (linear float RGB)"});
+                         .help = "the image to write (required): .png (8-bit sRGB), .pfm or .exr (linear "
+                                 "float RGB)"});
+        add((cli_option){.name = "exposure", .id = OPT_EXPOSURE, .kind = CLI_STRING, .arg = "EV",
+                         .help = "PNG only: multiply the linear values by 2^EV before the tone curve; a number "
+                                 "in -20..20, default 0 (.pfm and .exr are written unscaled)"});
         size_t count = 0;
         const pk_int_option *ints = pk_int_options(&count);
         for (size_t i = 0; i < count && g_nopts < MAX_RENDER_OPTIONS; i++) {
@@ -111,9 +116,16 @@ void cli_render_help(FILE *f)
           "\n"
           "SCENE is a Wavefront .obj (materials from its .mtl files) or a .json scene\n"
           "(docs/scene-format.md); without it the built-in Cornell box is rendered.\n"
-          "OUT is written by extension: .png (8-bit sRGB) or .pfm (linear float RGB),\n"
-          "through a temporary file that is renamed into place. Its folder is checked\n"
-          "before the scene is read: it must exist and be writable.\n"
+          "OUT is written by extension, through a temporary file that is renamed into\n"
+          "place. Its folder is checked before the scene is read: it must exist and be\n"
+          "writable. The formats:\n"
+          "  .png  8-bit sRGB. Tone curve (clamp): each linear value v becomes\n"
+          "        x = v * 2^EV (--exposure, default 0); x <= 0 gives 0, x >= 1 gives\n"
+          "        255, else the sRGB curve s = 12.92 x (x <= 0.0031308) or\n"
+          "        1.055 x^(1/2.4) - 0.055, stored as floor(255 s + 0.5).\n"
+          "  .pfm  linear 32-bit float RGB, the rendered values unchanged.\n"
+          "  .exr  OpenEXR, linear 32-bit float channels R, G, B, the rendered values\n"
+          "        unchanged (scanlines, lossless ZIP compression).\n"
           "\n"
           "options (they override the scene's own \"render\" settings; --name VALUE and\n"
           "--name=VALUE are the same, and a unique beginning of a name is enough):\n",
@@ -139,6 +151,8 @@ void cli_render_help(FILE *f)
 
 typedef struct cli_opts {
     const char *scene, *out, *stats_json;
+    int has_exposure;
+    float exposure;
     int stats, quiet;
     int int_set[MAX_RENDER_OPTIONS]; /* per table entry: given on the command line */
     int int_value[MAX_RENDER_OPTIONS];
@@ -172,6 +186,16 @@ static int parse_args(int argc, char **argv, cli_opts *o)
         const char *name = opts[p.index].name;
         switch (opts[p.index].id) {
         case OPT_OUTPUT: o->out = v; break;
+        case OPT_EXPOSURE: {
+            char *end;
+            double ev = strtod(v, &end);
+            if (*end || end == v || !(ev >= -PK_MAX_EXPOSURE_EV && ev <= PK_MAX_EXPOSURE_EV))
+                return cli_usage_error("--exposure: '%s' must be a number of stops in %d..%d", v,
+                                       -PK_MAX_EXPOSURE_EV, PK_MAX_EXPOSURE_EV);
+            o->exposure = (float)ev;
+            o->has_exposure = 1;
+            break;
+        }
         case OPT_INT:
             o->int_set[p.index] = 1;
             o->int_value[p.index] = p.int_value;
@@ -346,8 +370,14 @@ int cli_render(int argc, char **argv)
     /* Everything that would only fail after the render is checked first. */
     struct stat sb;
     if (stat(o.out, &sb) == 0 && S_ISDIR(sb.st_mode)) return cli_failure("%s: is a folder; name a file in it", o.out);
-    if (!ends_with_ci(o.out, ".png") && !ends_with_ci(o.out, ".pfm"))
-        return cli_usage_error("%s: unknown image format (use .png or .pfm)", o.out);
+    const int png = ends_with_ci(o.out, ".png");
+    if (!png && !ends_with_ci(o.out, ".pfm") && !ends_with_ci(o.out, ".exr"))
+        return cli_usage_error("%s: unknown image format (use .png, .pfm or .exr)", o.out);
+    pk_write_options wo;
+    pk_write_options_init(&wo);
+    if (o.has_exposure) wo.exposure_ev = o.exposure;
+    if (o.has_exposure && o.exposure != 0.0f && !png && !o.quiet)
+        cli_print_warning(NULL, "--exposure applies to PNG only; the HDR image is written unscaled");
     if (o.scene && same_file(o.scene, o.out))
         return cli_usage_error("render: refusing to write the image over the scene file '%s'", o.scene);
     const int json_stdout = o.stats_json && strcmp(o.stats_json, "-") == 0;
@@ -410,7 +440,7 @@ int cli_render(int argc, char **argv)
     cli_progress_clear(&bar);
     if (st == PK_ERR_CANCELLED) {
         char *partial = partial_name(o.out);
-        if (partial && img && pk_image_write(ctx, img, partial) == PK_OK)
+        if (partial && img && pk_image_write_ex(ctx, img, partial, &wo) == PK_OK)
             fprintf(stderr, "paprsek: interrupted; finished tiles written to %s\n", partial);
         else
             fprintf(stderr, "paprsek: interrupted\n");
@@ -420,7 +450,7 @@ int cli_render(int argc, char **argv)
         goto out;
     }
     if (st != PK_OK) goto fail;
-    if (pk_image_write(ctx, img, o.out) != PK_OK) goto fail;
+    if (pk_image_write_ex(ctx, img, o.out, &wo) != PK_OK) goto fail;
     if (bar.enabled) {
         char took[32];
         cli_format_duration(took, sizeof took, cli_now() - t0);

@@ -225,10 +225,40 @@ PK_API int pk_image_height(const pk_image *img);
 /* 3 floats per pixel; owned by img. */
 PK_API float *pk_image_pixels(pk_image *img);
 PK_API const float *pk_image_pixels_const(const pk_image *img);
-/* Writes by extension: .png (8-bit sRGB) or .pfm (linear float). The image goes
- * to a temporary file in the same folder that is renamed into place, so an
- * existing file is only ever replaced by a complete image. */
+/* Writes by extension (any case):
+ *   .png  8-bit sRGB, through the tone curve below;
+ *   .pfm  linear float RGB, the values as they are;
+ *   .exr  OpenEXR: linear 32-bit float channels R, G, B, the values as they
+ *         are (bit for bit), scanlines, ZIP compression.
+ * The image goes to a temporary file in the same folder that is renamed into
+ * place, so an existing file is only ever replaced by a complete image, and
+ * no temporary file is left behind when the write fails. Errors are latched
+ * as "path: what is wrong". Same as pk_image_write_ex with wo NULL. */
 PK_API pk_status pk_image_write(pk_context *ctx, const pk_image *img, const char *path);
+
+/* Options of pk_image_write_ex; pk_write_options_init sets the defaults.
+ *
+ * exposure_ev: PNG only. Each linear value v becomes v * 2^exposure_ev
+ * before the tone curve; 0 (the default) leaves it unchanged, +1 doubles,
+ * -1 halves. A finite number in [-PK_MAX_EXPOSURE_EV, PK_MAX_EXPOSURE_EV].
+ * HDR outputs (.pfm, .exr) hold the renderer's linear values unscaled,
+ * whatever the exposure, as pbrt and Mitsuba write theirs: exposure is a
+ * choice made when viewing or converting them.
+ *
+ * The PNG tone curve ("clamp"): x = v * 2^exposure_ev (in float); x <= 0
+ * or NaN gives 0, x >= 1 gives 255; otherwise the sRGB transfer function
+ * s = 12.92 x (x <= 0.0031308) or 1.055 x^(1/2.4) - 0.055, and the byte is
+ * floor(255 s + 0.5). Values above 1 are clipped, not compressed. */
+#define PK_MAX_EXPOSURE_EV 20
+typedef struct pk_write_options {
+    float exposure_ev;
+} pk_write_options;
+
+PK_API void pk_write_options_init(pk_write_options *wo);
+/* pk_image_write with options; wo NULL means the defaults. An exposure out
+ * of range is PK_ERR_INVALID_ARGUMENT (nothing is written). */
+PK_API pk_status pk_image_write_ex(pk_context *ctx, const pk_image *img, const char *path,
+                                   const pk_write_options *wo);
 
 /* ---- films: sums of samples, merged and resolved ------------------------ */
 

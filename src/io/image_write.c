@@ -1,7 +1,8 @@
 /*
- * image_write.c - PNG (8-bit sRGB through libpng) and PFM (linear float RGB)
- * writers. Each writes to a temporary file beside the target and renames it
- * into place, so an existing image is only ever replaced by a complete one.
+ * image_write.c - PNG (8-bit sRGB through libpng, after exposure), PFM
+ * (linear float RGB) and OpenEXR (linear float RGB, exr.c) writers. Each
+ * writes to a temporary file beside the target and renames it into place,
+ * so an existing image is only ever replaced by a complete one.
  */
 #include "image.h"
 
@@ -54,7 +55,7 @@ static void png_warn_fn(png_structp png, png_const_charp msg)
 
 /* Returns 0 on success, or -1 with why filled. The row buffer is allocated
  * before setjmp so that a longjmp cannot leak it. */
-static int write_png(FILE *f, const pk_image *img, unsigned char *row, char *why, size_t nwhy)
+static int write_png(FILE *f, const pk_image *img, float scale, unsigned char *row, char *why, size_t nwhy)
 {
     png_err err = {{0}};
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &err, png_error_fn, png_warn_fn);
@@ -80,7 +81,7 @@ static int write_png(FILE *f, const pk_image *img, unsigned char *row, char *why
     png_write_info(png, info);
     for (int y = 0; y < img->height; y++) {
         const float *src = img->pixels + (size_t)y * (size_t)img->width * 3;
-        for (int i = 0; i < img->width * 3; i++) row[i] = srgb_encode(src[i]);
+        for (int i = 0; i < img->width * 3; i++) row[i] = srgb_encode(src[i] * scale);
         png_write_row(png, row);
     }
     png_write_end(png, info);
@@ -102,11 +103,52 @@ fail:
     return -1;
 }
 
+/* The image's R, G, B as three channels of one OpenEXR part. */
+static int write_exr(FILE *f, const pk_image *img, char *why, size_t nwhy)
+{
+    const size_t row = (size_t)img->width * 3;
+    const exr_channel rgb[3] = {
+        {"R", img->pixels + 0, 3, row},
+        {"G", img->pixels + 1, 3, row},
+        {"B", img->pixels + 2, 3, row},
+    };
+    return exr_write_channels(fileno(f), img->width, img->height, rgb, 3, why, nwhy);
+}
+
+void pk_write_options_init(pk_write_options *wo)
+{
+    if (!wo) return;
+    memset(wo, 0, sizeof *wo);
+    wo->exposure_ev = 0.0f;
+}
+
+pk_status pk_image_write_ex(pk_context *ctx, const pk_image *img, const char *path, const pk_write_options *wo)
+{
+    if (!ctx || !img || !path) return PK_ERR_INVALID_ARGUMENT;
+    return image_write_ex(ctx, img, path, wo);
+}
+
 pk_status image_write(pk_context *ctx, const pk_image *img, const char *path)
 {
-    bool png = ends_with(path, ".png"), pfm = ends_with(path, ".pfm");
-    if (!png && !pfm)
-        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: unknown image format (use .png or .pfm)", path);
+    return image_write_ex(ctx, img, path, NULL);
+}
+
+pk_status image_write_ex(pk_context *ctx, const pk_image *img, const char *path, const pk_write_options *wo)
+{
+    pk_write_options defaults;
+    if (!wo) {
+        pk_write_options_init(&defaults);
+        wo = &defaults;
+    }
+    if (!(wo->exposure_ev >= -(float)PK_MAX_EXPOSURE_EV && wo->exposure_ev <= (float)PK_MAX_EXPOSURE_EV))
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: exposure %g EV is not a number in %d..%d", path,
+                         (double)wo->exposure_ev, -PK_MAX_EXPOSURE_EV, PK_MAX_EXPOSURE_EV);
+    /* exact for whole EVs (a power of two); 1 at the default, so that PNG
+     * output without exposure is what it was before the option existed */
+    const float scale = exp2f(wo->exposure_ev);
+    bool png = ends_with(path, ".png"), pfm = ends_with(path, ".pfm"), exr = ends_with(path, ".exr");
+    if (!png && !pfm && !exr)
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: unknown image format (use .png, .pfm or .exr)", path);
     size_t lp = strlen(path);
     char *tmp = mem_alloc(&ctx->alloc, lp + 16);
     unsigned char *row = png ? mem_alloc(&ctx->alloc, (size_t)img->width * 3) : NULL;
@@ -132,7 +174,9 @@ pk_status image_write(pk_context *ctx, const pk_image *img, const char *path)
         st = ctx_error(ctx, PK_ERR_IO, "%s: %s", path, strerror(errno));
         goto out;
     }
-    int rc = png ? write_png(f, img, row, why, sizeof why) : write_pfm(f, img, why, sizeof why);
+    int rc = png   ? write_png(f, img, scale, row, why, sizeof why)
+             : exr ? write_exr(f, img, why, sizeof why)
+                   : write_pfm(f, img, why, sizeof why);
     if (rc == 0 && fflush(f) != 0) {
         rc = -1;
         snprintf(why, sizeof why, "write error: %s", strerror(errno));

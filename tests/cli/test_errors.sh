@@ -179,12 +179,12 @@ expect "option without its value" 2 "--width needs a value" render "$tmp/tri.obj
 expect "two scenes" 2 "render: more than one scene given ('$tmp/tri.obj' and '$tmp/flat.obj')" \
   render "$tmp/tri.obj" "$tmp/flat.obj" -o "$tmp/out.png"
 expect "no output" 2 "render: no output file (-o OUT.png)" render "$tmp/tri.obj"
-expect "unknown image format" 2 "$tmp/out.bmp: unknown image format (use .png or .pfm)" \
+expect "unknown image format" 2 "$tmp/out.bmp: unknown image format (use .png, .pfm or .exr)" \
   render "$tmp/tri.obj" -o "$tmp/out.bmp" --width 8 --height 8
 expect "unknown command" 2 "unknown command 'draw' (see paprsek --help)" draw
 cp "$tmp/tri.obj" "$tmp/tri.orig"
 ln -s tri.obj "$tmp/link.png"
-expect "output over the scene" 2 "$tmp/tri.obj: unknown image format (use .png or .pfm)" \
+expect "output over the scene" 2 "$tmp/tri.obj: unknown image format (use .png, .pfm or .exr)" \
   render "$tmp/tri.obj" -o "$tmp/tri.obj"
 expect "output over the scene through a link" 2 "render: refusing to write the image over the scene file '$tmp/tri.obj'" \
   render "$tmp/tri.obj" -o "$tmp/link.png"
