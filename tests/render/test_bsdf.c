@@ -10,20 +10,15 @@
 
 #include "math/frame.h"
 #include "render/pbsdf.h"
+#include "render/sampling.h"
 
 #include <stdint.h>
 
-/* ---- random numbers: splitmix64, 24-bit floats in [0, 1) ------------------ */
+/* ---- random numbers: the renderer's PCG32 (render/sampling.h) ----------- */
 
-typedef struct { uint64_t s; } prng;
-static uint64_t prng_u64(prng *r)
-{
-    uint64_t z = (r->s += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
-static float prng_f(prng *r) { return (float)(prng_u64(r) >> 40) * (1.0f / 16777216.0f); }
+typedef rng prng;
+static prng prng_make(uint64_t seed) { return rng_seed(seed, 0x5eed); }
+static float prng_f(prng *r) { return rng_float(r); }
 
 /* ---- the chi-square distribution: regularised incomplete gamma ---------- */
 
@@ -171,7 +166,7 @@ static result chi2_test(const pbsdf *b, vec3 wo, uint64_t seed)
     static double expct[N_CELLS + 1];
     result r = {0};
     memset(obs, 0, sizeof obs);
-    prng g = {seed};
+    prng g = prng_make(seed);
     long nondelta = 0;
     for (long s = 0; s < N_SAMPLES; s++) {
         float u[3] = {prng_f(&g), prng_f(&g), prng_f(&g)};
@@ -269,7 +264,7 @@ static furnace white_furnace(const pbsdf *b, vec3 wo, uint64_t seed)
     furnace f;
     memset(&f, 0, sizeof f);
     double s[3] = {0}, s2[3] = {0}, n1[3] = {0}, n2[3] = {0};
-    prng g = {seed};
+    prng g = prng_make(seed);
     for (long i = 0; i < N_FURNACE; i++) {
         float u[3] = {prng_f(&g), prng_f(&g), prng_f(&g)};
         vec3 wi, w;
@@ -302,7 +297,7 @@ static furnace white_furnace(const pbsdf *b, vec3 wo, uint64_t seed)
 
 static void test_reciprocity(const bcase *bc, uint64_t seed)
 {
-    prng g = {seed};
+    prng g = prng_make(seed);
     int bad = 0;
     double worst = 0.0;
     for (int i = 0; i < 20000; i++) {
@@ -369,7 +364,7 @@ static void build_cases(void)
 
 static void test_frame(void)
 {
-    prng g = {7};
+    prng g = prng_make(7);
     for (int i = 0; i < 10000; i++) {
         vec3 n;
         if (i < 4) {
