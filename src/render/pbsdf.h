@@ -1,0 +1,557 @@
+/*
+ * pbsdf.h - physically based BSDFs for the path tracer: Lambert, GGX
+ * conductors, smooth and rough dielectrics (Walter et al. 2007), plastic (a
+ * diffuse base under a dielectric coating) and the MTL "glossy over diffuse"
+ * model. Plain static inline C over one plain struct: no context, no
+ * allocation, no function pointers, so that nvcc can compile the same code.
+ * docs/materials.md describes the models, their parameters and conventions.
+ *
+ * Conventions (all functions):
+ *  - Directions are unit vectors in the LOCAL shading frame (z = shading
+ *    normal; math/frame.h converts), both pointing AWAY from the surface.
+ *  - pbsdf_eval returns f(wo, wi) * |cos theta_i| (cos theta_i = wi.z), the
+ *    non-delta part only; pbsdf_pdf is the solid-angle density of sampling wi
+ *    (non-delta part only, 0 for directions only a delta lobe reaches).
+ *  - Reflection-only types (diffuse, conductor, plastic, glossy) are one-sided:
+ *    they scatter only for wo.z > 0 and wi.z > 0. A two-sided material is
+ *    the caller's business (flip the frame so that wo.z > 0).
+ *  - Dielectrics are two-sided: wo.z < 0 means wo is inside (the side with
+ *    index `ior`), and wi may lie on either side.
+ *  - Transmitted light is not scaled by 1/eta^2 (the radiance compression at
+ *    a refracting boundary), so that a lossless smooth dielectric has
+ *    R + T = 1; for light that enters and leaves a closed object the factors
+ *    cancel. An integrator that needs it can apply it.
+ *  - Colours are linear RGB.
+ */
+#ifndef PK_PBSDF_H
+#define PK_PBSDF_H
+
+#include "../math/vec3.h"
+
+#include <stdbool.h>
+
+typedef enum pbsdf_type {
+    PBSDF_DIFFUSE = 0,  /* Lambert: albedo */
+    PBSDF_CONDUCTOR,    /* GGX metal: eta, k (or specular with PBSDF_SCHLICK), alpha */
+    PBSDF_DIELECTRIC,   /* glass: ior, alpha, transmittance */
+    PBSDF_PLASTIC,      /* diffuse albedo under a dielectric coating: ior, alpha */
+    PBSDF_GLOSSY,       /* MTL Kd + Ks + Ns: albedo (kd) + specular (ks), alpha; no Fresnel */
+    PBSDF_TYPE_COUNT
+} pbsdf_type;
+
+/* flags */
+#define PBSDF_SCHLICK 1u /* conductor: Schlick's Fresnel with F0 = specular, not eta/k */
+
+/* Below this roughness a microfacet lobe is treated as perfectly smooth (a
+ * delta lobe): the GGX density would exceed float range long before 0. */
+#define PBSDF_ALPHA_SMOOTH 1e-3f
+
+/* One BSDF instance. Fields a type does not use are ignored.
+ * Valid ranges (the constructors below do not clamp; the scene's material
+ * mapping must):
+ *   albedo        [0, 1] per channel       diffuse, plastic; glossy (kd)
+ *   specular      [0, 1] per channel       glossy (ks, with albedo + specular <= 1
+ *                                          per channel), conductor F0 with PBSDF_SCHLICK
+ *   eta, k        eta > 0, k >= 0          conductor: complex index of the metal
+ *                                          relative to the outside medium, per channel
+ *   transmittance [0, 1] per channel       dielectric: tint of refracted light (MTL Tf)
+ *   alpha         [0, 1]                   GGX roughness (alpha = perceptual roughness^2);
+ *                                          < PBSDF_ALPHA_SMOOTH: smooth (delta lobes)
+ *   ior           > 0, != 1 for dielectric dielectric, plastic: inside / outside index */
+typedef struct pbsdf {
+    int type;            /* pbsdf_type */
+    unsigned flags;      /* PBSDF_SCHLICK */
+    vec3 albedo;
+    vec3 specular;
+    vec3 eta, k;
+    vec3 transmittance;
+    float alpha;
+    float ior;
+} pbsdf;
+
+/* ---- constructors ------------------------------------------------------- */
+
+static inline pbsdf pbsdf__blank(int type)
+{
+    pbsdf b;
+    b.type = type;
+    b.flags = 0;
+    b.albedo = b.specular = b.transmittance = v3s(0.0f);
+    b.eta = v3s(1.0f);
+    b.k = v3s(0.0f);
+    b.alpha = 0.0f;
+    b.ior = 1.5f;
+    return b;
+}
+static inline pbsdf pbsdf_diffuse(vec3 albedo)
+{
+    pbsdf b = pbsdf__blank(PBSDF_DIFFUSE);
+    b.albedo = albedo;
+    return b;
+}
+static inline pbsdf pbsdf_conductor(vec3 eta, vec3 k, float alpha)
+{
+    pbsdf b = pbsdf__blank(PBSDF_CONDUCTOR);
+    b.eta = eta;
+    b.k = k;
+    b.alpha = alpha;
+    return b;
+}
+static inline pbsdf pbsdf_conductor_schlick(vec3 f0, float alpha)
+{
+    pbsdf b = pbsdf__blank(PBSDF_CONDUCTOR);
+    b.flags = PBSDF_SCHLICK;
+    b.specular = f0;
+    b.alpha = alpha;
+    return b;
+}
+static inline pbsdf pbsdf_dielectric(float ior, float alpha, vec3 transmittance)
+{
+    pbsdf b = pbsdf__blank(PBSDF_DIELECTRIC);
+    b.ior = ior;
+    b.alpha = alpha;
+    b.transmittance = transmittance;
+    return b;
+}
+static inline pbsdf pbsdf_plastic(vec3 albedo, float ior, float alpha)
+{
+    pbsdf b = pbsdf__blank(PBSDF_PLASTIC);
+    b.albedo = albedo;
+    b.ior = ior;
+    b.alpha = alpha;
+    return b;
+}
+static inline pbsdf pbsdf_glossy(vec3 kd, vec3 ks, float alpha)
+{
+    pbsdf b = pbsdf__blank(PBSDF_GLOSSY);
+    b.albedo = kd;
+    b.specular = ks;
+    b.alpha = alpha;
+    return b;
+}
+/* GGX roughness for an MTL Phong exponent: alpha = sqrt(2 / (Ns + 2)). */
+static inline float pbsdf_alpha_from_ns(float ns)
+{
+    return sqrtf(2.0f / (fmaxf(ns, 0.0f) + 2.0f));
+}
+/* MTL Kd, Ks, Ns -> glossy over diffuse. Where Kd + Ks > 1 in a channel both
+ * are scaled down in that channel so that the pair conserves energy. */
+static inline pbsdf pbsdf_glossy_mtl(vec3 kd, vec3 ks, float ns)
+{
+    float *d[3] = {&kd.x, &kd.y, &kd.z}, *s[3] = {&ks.x, &ks.y, &ks.z};
+    for (int c = 0; c < 3; c++) {
+        float sum = *d[c] + *s[c];
+        if (sum > 1.0f) {
+            *d[c] /= sum;
+            *s[c] /= sum;
+        }
+    }
+    return pbsdf_glossy(kd, ks, pbsdf_alpha_from_ns(ns));
+}
+
+/* ---- Fresnel ------------------------------------------------------------ */
+
+/* Unpolarised Fresnel reflectance of a dielectric boundary; cos_i is the
+ * cosine to the normal on the side wo is on: cos_i >= 0 means outside
+ * (relative index eta = inside / outside), cos_i < 0 inside. 1 under total
+ * internal reflection. */
+static inline float pbsdf_fresnel_dielectric(float cos_i, float eta)
+{
+    cos_i = fminf(1.0f, fmaxf(-1.0f, cos_i));
+    if (cos_i < 0.0f) {
+        eta = 1.0f / eta;
+        cos_i = -cos_i;
+    }
+    float sin2_t = (1.0f - cos_i * cos_i) / (eta * eta);
+    if (sin2_t >= 1.0f) return 1.0f;
+    float cos_t = sqrtf(fmaxf(0.0f, 1.0f - sin2_t));
+    float rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    float rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    return 0.5f * (rs * rs + rp * rp);
+}
+
+/* Fresnel reflectance of a conductor with complex index eta + i k (relative
+ * to the outside), unpolarised, one channel; cos_i in [0, 1]. */
+static inline float pbsdf__fresnel_conductor1(float cos_i, float eta, float k)
+{
+    cos_i = fminf(1.0f, fmaxf(0.0f, cos_i));
+    float cos2 = cos_i * cos_i, sin2 = 1.0f - cos2;
+    float eta2 = eta * eta, k2 = k * k;
+    float t0 = eta2 - k2 - sin2;
+    float a2b2 = sqrtf(fmaxf(0.0f, t0 * t0 + 4.0f * eta2 * k2));
+    float t1 = a2b2 + cos2;
+    float a = sqrtf(fmaxf(0.0f, 0.5f * (a2b2 + t0)));
+    float t2 = 2.0f * cos_i * a;
+    float rs = (t1 - t2) / (t1 + t2);
+    float t3 = cos2 * a2b2 + sin2 * sin2;
+    float t4 = t2 * sin2;
+    float rp = rs * (t3 - t4) / (t3 + t4);
+    return 0.5f * (rp + rs);
+}
+
+static inline vec3 pbsdf__fresnel_conductor(const pbsdf *b, float cos_i)
+{
+    if (b->flags & PBSDF_SCHLICK) {
+        float m = 1.0f - fminf(1.0f, fmaxf(0.0f, cos_i));
+        float m5 = m * m * m * m * m;
+        return v3_add(b->specular, v3_scale(v3_sub(v3s(1.0f), b->specular), m5));
+    }
+    return v3(pbsdf__fresnel_conductor1(cos_i, b->eta.x, b->k.x),
+              pbsdf__fresnel_conductor1(cos_i, b->eta.y, b->k.y),
+              pbsdf__fresnel_conductor1(cos_i, b->eta.z, b->k.z));
+}
+
+/* ---- GGX (Trowbridge-Reitz), isotropic, local frame ---------------------- */
+
+/* Normal distribution D(m) for m.z > 0. */
+static inline float pbsdf_ggx_d(float alpha, vec3 m)
+{
+    if (m.z <= 0.0f) return 0.0f;
+    float a2 = alpha * alpha;
+    float t = m.z * m.z * (a2 - 1.0f) + 1.0f;
+    return a2 / (PK_PI * t * t);
+}
+
+/* Smith's Lambda(w); G1(w) = 1 / (1 + Lambda(w)). */
+static inline float pbsdf_ggx_lambda(float alpha, vec3 w)
+{
+    float z2 = w.z * w.z;
+    if (z2 <= 0.0f) return INFINITY;
+    float t2 = alpha * alpha * (w.x * w.x + w.y * w.y) / z2;
+    return 0.5f * (sqrtf(1.0f + t2) - 1.0f);
+}
+static inline float pbsdf_ggx_g1(float alpha, vec3 w) { return 1.0f / (1.0f + pbsdf_ggx_lambda(alpha, w)); }
+/* Height-correlated masking-shadowing (Heitz 2014), used (as pbrt-v4 does)
+ * for reflection and transmission alike. Symmetric in wo, wi. */
+static inline float pbsdf_ggx_g2(float alpha, vec3 wo, vec3 wi)
+{
+    return 1.0f / (1.0f + pbsdf_ggx_lambda(alpha, wo) + pbsdf_ggx_lambda(alpha, wi));
+}
+
+/* Density of the visible normals seen from w (either hemisphere; it is
+ * mirrored to +z): G1(w) max(0, w.m) D(m) / |w.z|, per unit solid angle of m. */
+static inline float pbsdf_ggx_vndf_pdf(float alpha, vec3 w, vec3 m)
+{
+    if (w.z < 0.0f) w = v3_neg(w);
+    float wm = v3_dot(w, m);
+    if (wm <= 0.0f || w.z <= 0.0f) return 0.0f;
+    return pbsdf_ggx_g1(alpha, w) * wm * pbsdf_ggx_d(alpha, m) / w.z;
+}
+
+/* Samples a visible normal from w (either hemisphere; mirrored to +z),
+ * Heitz 2018, "Sampling the GGX Distribution of Visible Normals". */
+static inline vec3 pbsdf_ggx_vndf_sample(float alpha, vec3 w, float u1, float u2)
+{
+    if (w.z < 0.0f) w = v3_neg(w);
+    vec3 vh = v3_norm(v3(alpha * w.x, alpha * w.y, w.z));
+    float lensq = vh.x * vh.x + vh.y * vh.y;
+    vec3 t1 = lensq > 0.0f ? v3_scale(v3(-vh.y, vh.x, 0.0f), 1.0f / sqrtf(lensq)) : v3(1.0f, 0.0f, 0.0f);
+    vec3 t2 = v3_cross(vh, t1);
+    float r = sqrtf(u1), phi = 2.0f * PK_PI * u2;
+    float p1 = r * cosf(phi), p2 = r * sinf(phi);
+    float s = 0.5f * (1.0f + vh.z);
+    p2 = (1.0f - s) * sqrtf(fmaxf(0.0f, 1.0f - p1 * p1)) + s * p2;
+    vec3 nh = v3_add(v3_add(v3_scale(t1, p1), v3_scale(t2, p2)),
+                     v3_scale(vh, sqrtf(fmaxf(0.0f, 1.0f - p1 * p1 - p2 * p2))));
+    return v3_norm(v3(alpha * nh.x, alpha * nh.y, fmaxf(1e-7f, nh.z)));
+}
+
+/* ---- lobes (local frame, wo.z > 0 and wi.z > 0 checked by the caller) -- */
+
+static inline bool pbsdf__smooth(const pbsdf *b) { return b->alpha < PBSDF_ALPHA_SMOOTH; }
+static inline float pbsdf__mean(vec3 c) { return (c.x + c.y + c.z) * (1.0f / 3.0f); }
+static inline vec3 pbsdf__mirror(vec3 w) { return v3(-w.x, -w.y, w.z); }
+
+/* GGX reflection without Fresnel: D G2 / (4 cos_o cos_i) * cos_i. */
+static inline float pbsdf__ggx_refl_cos(float alpha, vec3 wo, vec3 wi, vec3 *h_out)
+{
+    vec3 h = v3_add(wo, wi);
+    if (v3_len2(h) <= 0.0f) return 0.0f;
+    h = v3_norm(h);
+    *h_out = h;
+    return pbsdf_ggx_d(alpha, h) * pbsdf_ggx_g2(alpha, wo, wi) / (4.0f * wo.z);
+}
+/* Density of wi for a VNDF-sampled half vector reflected about it. */
+static inline float pbsdf__ggx_refl_pdf(float alpha, vec3 wo, vec3 wi)
+{
+    vec3 h = v3_add(wo, wi);
+    if (v3_len2(h) <= 0.0f) return 0.0f;
+    h = v3_norm(h);
+    float oh = v3_dot(wo, h);
+    if (oh <= 0.0f) return 0.0f;
+    return pbsdf_ggx_vndf_pdf(alpha, wo, h) / (4.0f * oh);
+}
+
+/* Probability of choosing the specular lobe over the diffuse one, from
+ * estimates of their albedos. */
+static inline float pbsdf__spec_prob(const pbsdf *b, vec3 wo)
+{
+    float es, ed;
+    if (b->type == PBSDF_PLASTIC) {
+        float f = pbsdf_fresnel_dielectric(wo.z, b->ior);
+        es = f;
+        ed = (1.0f - f) * pbsdf__mean(b->albedo);
+    } else { /* glossy */
+        es = pbsdf__mean(b->specular);
+        ed = pbsdf__mean(b->albedo);
+    }
+    if (!(es + ed > 0.0f)) return 0.5f;
+    return es / (es + ed);
+}
+
+/* Plastic's diffuse base: albedo / pi, through the coating twice. */
+static inline vec3 pbsdf__plastic_diffuse_cos(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    float t = (1.0f - pbsdf_fresnel_dielectric(wo.z, b->ior)) * (1.0f - pbsdf_fresnel_dielectric(wi.z, b->ior));
+    return v3_scale(b->albedo, t * wi.z / PK_PI);
+}
+
+/* ---- dielectric ------------------------------------------------------------ */
+
+/* Generalised half vector of a rough dielectric (Walter 2007), facing +z;
+ * *etap = relative index across the boundary as seen from wo (1 for
+ * reflection). False where no microfacet connects wo and wi. */
+static inline bool pbsdf__dielectric_half(const pbsdf *b, vec3 wo, vec3 wi, vec3 *m, float *etap)
+{
+    bool reflect = wo.z * wi.z > 0.0f;
+    float e = 1.0f;
+    if (!reflect) e = wo.z > 0.0f ? b->ior : 1.0f / b->ior;
+    vec3 h = v3_add(v3_scale(wi, e), wo);
+    if (wo.z == 0.0f || wi.z == 0.0f || v3_len2(h) <= 0.0f) return false;
+    h = v3_norm(h);
+    if (h.z < 0.0f) h = v3_neg(h);
+    /* microfacets seen from behind by either direction do not count */
+    if (v3_dot(h, wi) * wi.z < 0.0f || v3_dot(h, wo) * wo.z < 0.0f) return false;
+    *m = h;
+    *etap = e;
+    return true;
+}
+
+static inline vec3 pbsdf__dielectric_eval(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    vec3 m;
+    float e;
+    if (pbsdf__smooth(b) || !pbsdf__dielectric_half(b, wo, wi, &m, &e)) return v3s(0.0f);
+    float a = b->alpha;
+    float f = pbsdf_fresnel_dielectric(v3_dot(wo, m), b->ior);
+    float dg = pbsdf_ggx_d(a, m) * pbsdf_ggx_g2(a, wo, wi);
+    if (wo.z * wi.z > 0.0f) return v3s(dg * f / (4.0f * fabsf(wo.z)));
+    float im = v3_dot(wi, m), om = v3_dot(wo, m);
+    float den = im + om / e;
+    den *= den;
+    /* f_t |cos_i| = D G (1 - F) |i.m| |o.m| / (den |cos_o|) */
+    float t = dg * (1.0f - f) * fabsf(im * om) / (den * fabsf(wo.z));
+    return v3_scale(b->transmittance, t);
+}
+
+static inline float pbsdf__dielectric_pdf(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    vec3 m;
+    float e;
+    if (pbsdf__smooth(b) || !pbsdf__dielectric_half(b, wo, wi, &m, &e)) return 0.0f;
+    float a = b->alpha;
+    float om = v3_dot(wo, m);
+    float r = pbsdf_fresnel_dielectric(om, b->ior);
+    float pm = pbsdf_ggx_vndf_pdf(a, wo, m);
+    if (wo.z * wi.z > 0.0f) return pm / (4.0f * fabsf(om)) * r;
+    float im = v3_dot(wi, m);
+    float den = im + om / e;
+    return pm * fabsf(im) / (den * den) * (1.0f - r);
+}
+
+/* Refracts w (pointing away, either side) through the facet m (m.z > 0,
+ * ior = inside / outside). False on total internal reflection. */
+static inline bool pbsdf__refract(vec3 w, vec3 m, float ior, vec3 *out)
+{
+    float c = v3_dot(w, m), eta = ior;
+    if (c < 0.0f) {
+        eta = 1.0f / eta;
+        c = -c;
+        m = v3_neg(m);
+    }
+    float s2t = fmaxf(0.0f, 1.0f - c * c) / (eta * eta);
+    if (s2t >= 1.0f) return false;
+    float ct = sqrtf(1.0f - s2t);
+    *out = v3_norm(v3_add(v3_scale(v3_neg(w), 1.0f / eta), v3_scale(m, c / eta - ct)));
+    return true;
+}
+
+/* ---- the interface --------------------------------------------------------- */
+
+/* True if the BSDF has a non-delta part, i.e. light sampling and MIS can
+ * reach it (eval and pdf are not identically 0). */
+static inline bool pbsdf_has_nondelta(const pbsdf *b)
+{
+    switch (b->type) {
+    case PBSDF_DIFFUSE: case PBSDF_PLASTIC: case PBSDF_GLOSSY: return true;
+    default: return !pbsdf__smooth(b);
+    }
+}
+
+/* f(wo, wi) * |wi.z| of the non-delta part. Local frame, unit vectors. */
+static inline vec3 pbsdf_eval(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    if (b->type == PBSDF_DIELECTRIC) return pbsdf__dielectric_eval(b, wo, wi);
+    if (!(wo.z > 0.0f && wi.z > 0.0f)) return v3s(0.0f);
+    vec3 h;
+    switch (b->type) {
+    case PBSDF_DIFFUSE:
+        return v3_scale(b->albedo, wi.z / PK_PI);
+    case PBSDF_CONDUCTOR: {
+        if (pbsdf__smooth(b)) return v3s(0.0f);
+        float s = pbsdf__ggx_refl_cos(b->alpha, wo, wi, &h);
+        if (s <= 0.0f) return v3s(0.0f);
+        return v3_scale(pbsdf__fresnel_conductor(b, v3_dot(wo, h)), s);
+    }
+    case PBSDF_PLASTIC: {
+        vec3 r = pbsdf__plastic_diffuse_cos(b, wo, wi);
+        if (!pbsdf__smooth(b)) {
+            float s = pbsdf__ggx_refl_cos(b->alpha, wo, wi, &h);
+            if (s > 0.0f) r = v3_add(r, v3s(s * pbsdf_fresnel_dielectric(v3_dot(wo, h), b->ior)));
+        }
+        return r;
+    }
+    case PBSDF_GLOSSY: {
+        vec3 r = v3_scale(b->albedo, wi.z / PK_PI);
+        if (!pbsdf__smooth(b)) {
+            float s = pbsdf__ggx_refl_cos(b->alpha, wo, wi, &h);
+            if (s > 0.0f) r = v3_add(r, v3_scale(b->specular, s));
+        }
+        return r;
+    }
+    default:
+        return v3s(0.0f);
+    }
+}
+
+/* Solid-angle density with which pbsdf_sample returns wi as a non-delta
+ * sample (the lobe choice included). */
+static inline float pbsdf_pdf(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    if (b->type == PBSDF_DIELECTRIC) return pbsdf__dielectric_pdf(b, wo, wi);
+    if (!(wo.z > 0.0f && wi.z > 0.0f)) return 0.0f;
+    switch (b->type) {
+    case PBSDF_DIFFUSE:
+        return wi.z / PK_PI;
+    case PBSDF_CONDUCTOR:
+        return pbsdf__smooth(b) ? 0.0f : pbsdf__ggx_refl_pdf(b->alpha, wo, wi);
+    case PBSDF_PLASTIC:
+    case PBSDF_GLOSSY: {
+        float ps = pbsdf__spec_prob(b, wo);
+        float p = (1.0f - ps) * wi.z / PK_PI;
+        if (!pbsdf__smooth(b)) p += ps * pbsdf__ggx_refl_pdf(b->alpha, wo, wi);
+        return p;
+    }
+    default:
+        return 0.0f;
+    }
+}
+
+/* Samples wi for wo from u (three numbers in [0, 1): u[0] picks the lobe,
+ * u[1], u[2] the direction). On success: *wi, *weight = f |cos theta_i| / pdf
+ * (the throughput factor), *pdf and *is_delta. For a non-delta sample *pdf
+ * equals pbsdf_pdf(b, wo, *wi) and *weight pbsdf_eval / pbsdf_pdf; for a delta
+ * sample *pdf is the discrete probability of having chosen that lobe (the
+ * weight already contains it). False when no direction was produced (wo
+ * below a one-sided surface, a reflection below the horizon, ...): the path
+ * ends there, and those samples count as weight 0 in every estimate. */
+static inline bool pbsdf_sample(const pbsdf *b, vec3 wo, const float u[3], vec3 *wi, vec3 *weight, float *pdf,
+                                bool *is_delta)
+{
+    *is_delta = false;
+    if (b->type == PBSDF_DIELECTRIC) {
+        if (wo.z == 0.0f) return false;
+        if (pbsdf__smooth(b)) {
+            float r = pbsdf_fresnel_dielectric(wo.z, b->ior);
+            *is_delta = true;
+            if (u[0] < r) {
+                *wi = pbsdf__mirror(wo);
+                *weight = v3s(1.0f);
+                *pdf = r;
+                return true;
+            }
+            if (!pbsdf__refract(wo, v3(0.0f, 0.0f, 1.0f), b->ior, wi)) return false;
+            *weight = b->transmittance;
+            *pdf = 1.0f - r;
+            return true;
+        }
+        vec3 m = pbsdf_ggx_vndf_sample(b->alpha, wo, u[1], u[2]);
+        float r = pbsdf_fresnel_dielectric(v3_dot(wo, m), b->ior);
+        vec3 w;
+        if (u[0] < r) {
+            w = v3_sub(v3_scale(m, 2.0f * v3_dot(wo, m)), wo);
+            if (!(w.z * wo.z > 0.0f)) return false;
+        } else {
+            if (!pbsdf__refract(wo, m, b->ior, &w) || !(w.z * wo.z < 0.0f)) return false;
+        }
+        float p = pbsdf__dielectric_pdf(b, wo, w);
+        if (!(p > 0.0f)) return false;
+        *wi = w;
+        *pdf = p;
+        *weight = v3_scale(pbsdf__dielectric_eval(b, wo, w), 1.0f / p);
+        return true;
+    }
+    if (!(wo.z > 0.0f)) return false;
+    vec3 w;
+    switch (b->type) {
+    case PBSDF_DIFFUSE: {
+        float r = sqrtf(u[1]), phi = 2.0f * PK_PI * u[2];
+        w = v3(r * cosf(phi), r * sinf(phi), sqrtf(fmaxf(0.0f, 1.0f - u[1])));
+        if (!(w.z > 0.0f)) return false;
+        *wi = w;
+        *pdf = w.z / PK_PI;
+        *weight = b->albedo;
+        return true;
+    }
+    case PBSDF_CONDUCTOR: {
+        if (pbsdf__smooth(b)) {
+            *wi = pbsdf__mirror(wo);
+            *weight = pbsdf__fresnel_conductor(b, wo.z);
+            *pdf = 1.0f;
+            *is_delta = true;
+            return true;
+        }
+        vec3 m = pbsdf_ggx_vndf_sample(b->alpha, wo, u[1], u[2]);
+        float om = v3_dot(wo, m);
+        w = v3_sub(v3_scale(m, 2.0f * om), wo);
+        if (!(w.z > 0.0f) || !(om > 0.0f)) return false;
+        *wi = w;
+        *pdf = pbsdf__ggx_refl_pdf(b->alpha, wo, w);
+        if (!(*pdf > 0.0f)) return false;
+        /* f cos / pdf = F D G2 / (4 cos_o) / (G1(wo) D / (4 cos_o)) = F G2 / G1(wo) */
+        *weight = v3_scale(pbsdf__fresnel_conductor(b, om),
+                           pbsdf_ggx_g2(b->alpha, wo, w) / pbsdf_ggx_g1(b->alpha, wo));
+        return true;
+    }
+    case PBSDF_PLASTIC:
+    case PBSDF_GLOSSY: {
+        float ps = pbsdf__spec_prob(b, wo);
+        if (u[0] < ps) {
+            if (pbsdf__smooth(b)) {
+                *wi = pbsdf__mirror(wo);
+                vec3 s = b->type == PBSDF_PLASTIC ? v3s(pbsdf_fresnel_dielectric(wo.z, b->ior)) : b->specular;
+                *weight = v3_scale(s, 1.0f / ps);
+                *pdf = ps;
+                *is_delta = true;
+                return true;
+            }
+            vec3 m = pbsdf_ggx_vndf_sample(b->alpha, wo, u[1], u[2]);
+            w = v3_sub(v3_scale(m, 2.0f * v3_dot(wo, m)), wo);
+        } else {
+            float r = sqrtf(u[1]), phi = 2.0f * PK_PI * u[2];
+            w = v3(r * cosf(phi), r * sinf(phi), sqrtf(fmaxf(0.0f, 1.0f - u[1])));
+        }
+        if (!(w.z > 0.0f)) return false;
+        float p = pbsdf_pdf(b, wo, w);
+        if (!(p > 0.0f)) return false;
+        *wi = w;
+        *pdf = p;
+        *weight = v3_scale(pbsdf_eval(b, wo, w), 1.0f / p);
+        return true;
+    }
+    default:
+        return false;
+    }
+}
+
+#endif

@@ -1,0 +1,496 @@
+/*
+ * test_bsdf.c - statistical tests of the path tracer's BSDFs (render/pbsdf.h)
+ * for every type, several roughnesses and incident angles (grazing among
+ * them), as Mitsuba and pbrt test theirs: a chi-square goodness-of-fit of the
+ * sampled directions against the pdf, the pdf's integral over the sphere,
+ * eval/pdf == sample weight, reciprocity, and white-furnace energy bounds.
+ * Fixed seeds: the results are the same on every run.
+ */
+#include "test.h"
+
+#include "math/frame.h"
+#include "render/pbsdf.h"
+#include "render/sampling.h"
+
+#include <stdint.h>
+
+/* ---- random numbers: the renderer's PCG32 (render/sampling.h) ----------- */
+
+typedef rng prng;
+static prng prng_make(uint64_t seed) { return rng_seed(seed, 0x5eed); }
+static float prng_f(prng *r) { return rng_float(r); }
+
+/* ---- the chi-square distribution: regularised incomplete gamma ---------- */
+
+/* Q(a, x) = Gamma(a, x) / Gamma(a), the upper tail (Numerical Recipes 6.2:
+ * the series for x < a + 1, Lentz's continued fraction otherwise). */
+static double gamma_q(double a, double x)
+{
+    if (x <= 0.0) return 1.0;
+    double lg = lgamma(a);
+    if (x < a + 1.0) {
+        double ap = a, sum = 1.0 / a, del = sum;
+        for (int n = 0; n < 10000; n++) {
+            ap += 1.0;
+            del *= x / ap;
+            sum += del;
+            if (fabs(del) < fabs(sum) * 1e-15) break;
+        }
+        return 1.0 - sum * exp(-x + a * log(x) - lg);
+    }
+    double b = x + 1.0 - a, c = 1.0 / 1e-300, d = 1.0 / b, h = d;
+    for (int i = 1; i < 10000; i++) {
+        double an = -i * (i - a);
+        b += 2.0;
+        d = an * d + b;
+        if (fabs(d) < 1e-300) d = 1e-300;
+        c = b + an / c;
+        if (fabs(c) < 1e-300) c = 1e-300;
+        d = 1.0 / d;
+        double del = d * c;
+        h *= del;
+        if (fabs(del - 1.0) < 1e-15) break;
+    }
+    return exp(-x + a * log(x) - lg) * h;
+}
+/* P(X >= chi2) for X ~ chi-square with dof degrees of freedom. */
+static double chi2_pvalue(double chi2, int dof) { return gamma_q(0.5 * dof, 0.5 * chi2); }
+
+/* ---- the cases -------------------------------------------------------------- */
+
+#define N_THETA 10 /* cells in cos(theta) over [-1, 1] */
+#define N_PHI 20   /* cells in phi over [0, 2 pi) */
+#define N_CELLS (N_THETA * N_PHI)
+#define N_SAMPLES 400000
+#define N_FURNACE 200000
+#define MIN_EXPECTED 5.0
+
+static const float roughs[] = {0.05f, 0.2f, 0.5f, 1.0f};
+/* incident angles in degrees; > 90 means from inside (dielectrics only) */
+static const float angles_out[] = {3.0f, 35.0f, 65.0f, 87.0f};
+static const float angles_in[] = {145.0f, 125.0f, 93.0f}; /* 125: beyond the critical angle of 1.5 */
+
+typedef struct bcase {
+    char name[64];
+    pbsdf b;
+    bool lossless; /* white furnace == 1 exactly (every sample weighs 1) */
+} bcase;
+
+static vec3 dir_from(float theta_deg, float phi)
+{
+    float t = theta_deg * PK_PI / 180.0f;
+    return v3(sinf(t) * cosf(phi), sinf(t) * sinf(phi), cosf(t));
+}
+
+/* ---- numerical integration of pdf (and eval) over one cell --------------- */
+
+typedef struct cell_int {
+    double pdf, eval[3];
+    double err;                /* estimate of the pdf integral's error */
+    long eval_without_pdf;     /* points where eval > 0 but pdf == 0 */
+} cell_int;
+
+/* Composite Simpson in (theta, phi) with n x n intervals over the cell
+ * theta in [t0, t1] (dw = sin theta dtheta dphi), phi in [p0, p1]. */
+static cell_int simpson_cell(const pbsdf *b, vec3 wo, double t0, double t1, double p0, double p1, int n)
+{
+    bool upper = t0 + t1 < M_PI;
+    cell_int r = {0};
+    double ht = (t1 - t0) / n, hp = (p1 - p0) / n;
+    for (int i = 0; i <= n; i++) {
+        double t = t0 + i * ht, wt = (i == 0 || i == n) ? 1.0 : (i & 1) ? 4.0 : 2.0;
+        double st = sin(t), ct = cos(t);
+        /* keep the horizon row on the cell's own side: cos(acos(0)) is 6e-17 */
+        if (upper ? ct < 0.0 : ct > 0.0) ct = 0.0;
+        for (int j = 0; j <= n; j++) {
+            double p = p0 + j * hp, wp = (j == 0 || j == n) ? 1.0 : (j & 1) ? 4.0 : 2.0;
+            vec3 wi = v3((float)(st * cos(p)), (float)(st * sin(p)), upper ? (float)ct : -(float)fabs(ct));
+            float pdf = pbsdf_pdf(b, wo, wi);
+            vec3 e = pbsdf_eval(b, wo, wi);
+            double w = wt * wp * st;
+            r.pdf += w * (double)pdf;
+            r.eval[0] += w * (double)e.x;
+            r.eval[1] += w * (double)e.y;
+            r.eval[2] += w * (double)e.z;
+            if (!(pdf > 0.0f) && (e.x > 0.0f || e.y > 0.0f || e.z > 0.0f)) r.eval_without_pdf++;
+        }
+    }
+    double s = ht * hp / 9.0;
+    r.pdf *= s;
+    for (int c = 0; c < 3; c++) r.eval[c] *= s;
+    return r;
+}
+
+/* Doubles the resolution until two successive estimates of the cell's
+ * probability agree to within tol (or 512 x 512 intervals). */
+static cell_int integrate_cell(const pbsdf *b, vec3 wo, int ci, int pi, double n_samples)
+{
+    double c0 = -1.0 + 2.0 * ci / N_THETA, c1 = -1.0 + 2.0 * (ci + 1) / N_THETA;
+    double t0 = acos(c1), t1 = acos(c0);
+    double p0 = 2.0 * M_PI * pi / N_PHI, p1 = 2.0 * M_PI * (pi + 1) / N_PHI;
+    cell_int lo = simpson_cell(b, wo, t0, t1, p0, p1, 8), hi = lo;
+    for (int n = 16; n <= 512; n *= 2) {
+        hi = simpson_cell(b, wo, t0, t1, p0, p1, n);
+        hi.eval_without_pdf += lo.eval_without_pdf;
+        double err = fabs(hi.pdf - lo.pdf);
+        /* an expected-count error of 0.05 standard deviations at most */
+        double tol = 0.05 * sqrt(fmax(MIN_EXPECTED, n_samples * hi.pdf)) / n_samples;
+        hi.err = err;
+        if (err < tol) break;
+        lo = hi;
+    }
+    return hi;
+}
+
+/* ---- one chi-square test ------------------------------------------------- */
+
+typedef struct result {
+    double chi2, pvalue;
+    int dof;
+    bool zero_cell_hit;        /* samples where the pdf integrates to 0 */
+    double pdf_integral, pdf_err, eval_integral[3];
+    double nondelta_frac;      /* sampled non-delta directions / all attempts */
+    long weight_mismatch, pdf_mismatch, eval_without_pdf;
+    double max_weight_rel;
+} result;
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static result chi2_test(const pbsdf *b, vec3 wo, uint64_t seed)
+{
+    static long obs[N_CELLS + 1];
+    static double expct[N_CELLS + 1];
+    result r = {0};
+    memset(obs, 0, sizeof obs);
+    prng g = prng_make(seed);
+    long nondelta = 0;
+    for (long s = 0; s < N_SAMPLES; s++) {
+        float u[3] = {prng_f(&g), prng_f(&g), prng_f(&g)};
+        vec3 wi, w;
+        float pdf;
+        bool delta;
+        if (!pbsdf_sample(b, wo, u, &wi, &w, &pdf, &delta) || delta) continue;
+        nondelta++;
+        float z = fminf(1.0f, fmaxf(-1.0f, wi.z));
+        int ci = (int)((z + 1.0f) * 0.5f * N_THETA);
+        if (ci >= N_THETA) ci = N_THETA - 1;
+        double phi = atan2(wi.y, wi.x);
+        if (phi < 0.0) phi += 2.0 * M_PI;
+        int pi = (int)(phi / (2.0 * M_PI) * N_PHI);
+        if (pi >= N_PHI) pi = N_PHI - 1;
+        obs[ci * N_PHI + pi]++;
+        /* the sample's own pdf and weight against pdf() and eval()/pdf() */
+        float p2 = pbsdf_pdf(b, wo, wi);
+        vec3 e = pbsdf_eval(b, wo, wi);
+        if (!(fabsf(p2 - pdf) <= 1e-3f * fmaxf(p2, pdf) + 1e-6f)) r.pdf_mismatch++;
+        float we[3] = {e.x / p2, e.y / p2, e.z / p2}, ws[3] = {w.x, w.y, w.z};
+        for (int c = 0; c < 3; c++) {
+            double rel = fabs((double)we[c] - (double)ws[c]) / fmax(1e-6, fabs((double)we[c]));
+            if (rel > r.max_weight_rel) r.max_weight_rel = rel;
+            if (!(fabsf(we[c] - ws[c]) <= 1e-3f * fabsf(we[c]) + 1e-6f)) {
+                r.weight_mismatch++;
+                break;
+            }
+        }
+    }
+    r.nondelta_frac = (double)nondelta / N_SAMPLES;
+    obs[N_CELLS] = N_SAMPLES - nondelta;
+
+    double total = 0.0, err = 0.0, ev[3] = {0, 0, 0};
+    for (int ci = 0; ci < N_THETA; ci++)
+        for (int pi = 0; pi < N_PHI; pi++) {
+            cell_int c = integrate_cell(b, wo, ci, pi, N_SAMPLES);
+            expct[ci * N_PHI + pi] = c.pdf * N_SAMPLES;
+            total += c.pdf;
+            err += c.err;
+            for (int k = 0; k < 3; k++) ev[k] += c.eval[k];
+            r.eval_without_pdf += c.eval_without_pdf;
+        }
+    r.pdf_integral = total;
+    r.pdf_err = err;
+    for (int k = 0; k < 3; k++) r.eval_integral[k] = ev[k];
+    /* the last category: delta samples and failed ones */
+    expct[N_CELLS] = fmax(0.0, 1.0 - total) * N_SAMPLES;
+
+    /* Pool the cells with expected counts below MIN_EXPECTED, smallest first
+     * (Mitsuba's chi2 test). */
+    int idx[N_CELLS + 1];
+    double key[N_CELLS + 1][2];
+    for (int i = 0; i <= N_CELLS; i++) {
+        key[i][0] = expct[i];
+        key[i][1] = i;
+    }
+    qsort(key, N_CELLS + 1, sizeof key[0], cmp_double);
+    for (int i = 0; i <= N_CELLS; i++) idx[i] = (int)key[i][1];
+    double chi2 = 0.0, pool_exp = 0.0, pool_obs = 0.0;
+    int dof = 0;
+    for (int k = 0; k <= N_CELLS; k++) {
+        int i = idx[k];
+        if (expct[i] == 0.0 && obs[i] > 0) r.zero_cell_hit = true;
+        if (expct[i] < MIN_EXPECTED || (pool_exp > 0.0 && pool_exp < MIN_EXPECTED)) {
+            pool_exp += expct[i];
+            pool_obs += obs[i];
+        } else {
+            double d = obs[i] - expct[i];
+            chi2 += d * d / expct[i];
+            dof++;
+        }
+    }
+    if (pool_exp > 0.0) {
+        double d = pool_obs - pool_exp;
+        chi2 += d * d / pool_exp;
+        dof++;
+    }
+    dof -= 1;
+    r.chi2 = chi2;
+    r.dof = dof;
+    r.pvalue = dof > 0 ? chi2_pvalue(chi2, dof) : 1.0;
+    return r;
+}
+
+/* ---- white furnace: mean and standard error of the sample weights ------- */
+
+typedef struct furnace {
+    double mean[3], se[3];
+    double nondelta_mean[3], nondelta_se[3];
+} furnace;
+
+static furnace white_furnace(const pbsdf *b, vec3 wo, uint64_t seed)
+{
+    furnace f;
+    memset(&f, 0, sizeof f);
+    double s[3] = {0}, s2[3] = {0}, n1[3] = {0}, n2[3] = {0};
+    prng g = prng_make(seed);
+    for (long i = 0; i < N_FURNACE; i++) {
+        float u[3] = {prng_f(&g), prng_f(&g), prng_f(&g)};
+        vec3 wi, w;
+        float pdf;
+        bool delta;
+        if (!pbsdf_sample(b, wo, u, &wi, &w, &pdf, &delta)) continue;
+        double v[3] = {w.x, w.y, w.z};
+        for (int c = 0; c < 3; c++) {
+            s[c] += v[c];
+            s2[c] += v[c] * v[c];
+            if (!delta) {
+                n1[c] += v[c];
+                n2[c] += v[c] * v[c];
+            }
+        }
+    }
+    for (int c = 0; c < 3; c++) {
+        double m = s[c] / N_FURNACE, var = fmax(0.0, s2[c] / N_FURNACE - m * m);
+        f.mean[c] = m;
+        f.se[c] = sqrt(var / (N_FURNACE - 1));
+        m = n1[c] / N_FURNACE;
+        var = fmax(0.0, n2[c] / N_FURNACE - m * m);
+        f.nondelta_mean[c] = m;
+        f.nondelta_se[c] = sqrt(var / (N_FURNACE - 1));
+    }
+    return f;
+}
+
+/* ---- reciprocity: f(wo, wi) == f(wi, wo) for reflection ----------------- */
+
+static void test_reciprocity(const bcase *bc, uint64_t seed)
+{
+    prng g = prng_make(seed);
+    int bad = 0;
+    double worst = 0.0;
+    for (int i = 0; i < 20000; i++) {
+        /* uniform directions on the upper hemisphere; dielectrics: both sides */
+        float sgn = (bc->b.type == PBSDF_DIELECTRIC && (i & 1)) ? -1.0f : 1.0f;
+        vec3 d[2];
+        for (int k = 0; k < 2; k++) {
+            float z = fmaxf(1e-3f, prng_f(&g)), phi = 2.0f * PK_PI * prng_f(&g), r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+            d[k] = v3(r * cosf(phi), r * sinf(phi), sgn * z);
+        }
+        vec3 a = pbsdf_eval(&bc->b, d[0], d[1]), b = pbsdf_eval(&bc->b, d[1], d[0]);
+        float fa[3] = {a.x / fabsf(d[1].z), a.y / fabsf(d[1].z), a.z / fabsf(d[1].z)};
+        float fb[3] = {b.x / fabsf(d[0].z), b.y / fabsf(d[0].z), b.z / fabsf(d[0].z)};
+        for (int c = 0; c < 3; c++) {
+            double diff = fabs((double)fa[c] - (double)fb[c]), scale = fmax(fabs((double)fa[c]), fabs((double)fb[c]));
+            if (scale > 0.0 && diff / scale > worst) worst = diff / scale;
+            if (diff > 2e-4 * scale + 1e-7) bad++;
+        }
+    }
+    CHECKF(bad == 0, "%s: reciprocity fails for %d channel values (worst relative difference %.3g)", bc->name, bad,
+           worst);
+}
+
+/* ---- driver ------------------------------------------------------------------ */
+
+#define MAX_CASES 64
+static bcase cases[MAX_CASES];
+static int n_cases;
+
+static void add_case(const char *name, float alpha, pbsdf b, bool lossless)
+{
+    REQUIRE(n_cases < MAX_CASES);
+    bcase *c = &cases[n_cases++];
+    if (alpha >= 0.0f)
+        snprintf(c->name, sizeof c->name, "%s a=%.2f", name, (double)alpha);
+    else
+        snprintf(c->name, sizeof c->name, "%s", name);
+    c->b = b;
+    c->lossless = lossless;
+}
+
+static void build_cases(void)
+{
+    vec3 white = v3s(1.0f);
+    add_case("diffuse white", -1.0f, pbsdf_diffuse(white), true);
+    add_case("diffuse coloured", -1.0f, pbsdf_diffuse(v3(0.8f, 0.4f, 0.1f)), false);
+    add_case("conductor smooth white", 0.0f, pbsdf_conductor_schlick(white, 0.0f), true);
+    add_case("conductor smooth gold", 0.0f, pbsdf_conductor(v3(0.143f, 0.374f, 1.442f), v3(3.983f, 2.385f, 1.603f), 0.0f),
+             false);
+    add_case("dielectric smooth 1.5", 0.0f, pbsdf_dielectric(1.5f, 0.0f, white), true);
+    add_case("plastic smooth", 0.0f, pbsdf_plastic(white, 1.5f, 0.0f), false);
+    add_case("glossy smooth", 0.0f, pbsdf_glossy(v3s(0.5f), v3s(0.5f), 0.0f), false);
+    for (int r = 0; r < 4; r++) {
+        float a = roughs[r];
+        add_case("conductor gold", a, pbsdf_conductor(v3(0.143f, 0.374f, 1.442f), v3(3.983f, 2.385f, 1.603f), a), false);
+        add_case("conductor schlick white", a, pbsdf_conductor_schlick(white, a), false);
+        add_case("dielectric 1.5", a, pbsdf_dielectric(1.5f, a, white), false);
+        add_case("plastic white", a, pbsdf_plastic(white, 1.5f, a), false);
+        add_case("glossy kd.5 ks.5", a, pbsdf_glossy(v3s(0.5f), v3s(0.5f), a), false);
+    }
+    /* MTL-style glossy with kd + ks = 1 in one channel, from an Ns */
+    add_case("glossy mtl Ns=100", -1.0f, pbsdf_glossy_mtl(v3(0.7f, 0.2f, 0.1f), v3(0.3f, 0.3f, 0.3f), 100.0f), false);
+}
+
+static void test_frame(void)
+{
+    prng g = prng_make(7);
+    for (int i = 0; i < 10000; i++) {
+        vec3 n;
+        if (i < 4) {
+            n = i == 0 ? v3(0, 0, 1) : i == 1 ? v3(0, 0, -1) : i == 2 ? v3(1, 0, 0) : v3(0, -1, 0);
+        } else {
+            float z = 2.0f * prng_f(&g) - 1.0f, phi = 2.0f * PK_PI * prng_f(&g), r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+            n = v3(r * cosf(phi), r * sinf(phi), z);
+        }
+        onb f = onb_from_normal(n);
+        CHECK(fabsf(v3_len(f.s) - 1.0f) < 1e-5f && fabsf(v3_len(f.t) - 1.0f) < 1e-5f);
+        CHECK(fabsf(v3_dot(f.s, f.t)) < 1e-5f && fabsf(v3_dot(f.s, n)) < 1e-5f && fabsf(v3_dot(f.t, n)) < 1e-5f);
+        CHECK(v3_len(v3_sub(v3_cross(f.s, f.t), n)) < 1e-5f);
+        vec3 v = v3(prng_f(&g) - 0.5f, prng_f(&g) - 0.5f, prng_f(&g) - 0.5f);
+        vec3 back = onb_to_world(f, onb_to_local(f, v));
+        CHECK(v3_len(v3_sub(back, v)) < 1e-5f);
+        CHECK(fabsf(onb_to_local(f, n).z - 1.0f) < 1e-5f);
+    }
+}
+
+static void test_fresnel(void)
+{
+    /* normal incidence: ((n - 1) / (n + 1))^2, the same from both sides */
+    CHECK_NEAR(pbsdf_fresnel_dielectric(1.0f, 1.5f), 0.04, 1e-6);
+    CHECK_NEAR(pbsdf_fresnel_dielectric(-1.0f, 1.5f), 0.04, 1e-6);
+    CHECK(pbsdf_fresnel_dielectric(-0.5f, 1.5f) == 1.0f); /* 60 degrees inside: beyond critical */
+    CHECK_NEAR(pbsdf_fresnel_dielectric(0.0f, 1.5f), 1.0, 1e-6);
+    /* conductor at normal incidence: ((n - 1)^2 + k^2) / ((n + 1)^2 + k^2) */
+    pbsdf g = pbsdf_conductor(v3(0.2f, 1.0f, 2.0f), v3(3.0f, 0.0f, 1.0f), 0.0f);
+    vec3 f = pbsdf__fresnel_conductor(&g, 1.0f);
+    CHECK_NEAR(f.x, (0.64 + 9.0) / (1.44 + 9.0), 1e-5);
+    CHECK_NEAR(f.y, 0.0, 1e-6);
+    CHECK_NEAR(f.z, (1.0 + 1.0) / (9.0 + 1.0), 1e-5);
+    /* conductor with k = 0 is a dielectric */
+    for (float c = 0.05f; c < 1.0f; c += 0.1f)
+        CHECK_NEAR(pbsdf__fresnel_conductor1(c, 1.5f, 0.0f), pbsdf_fresnel_dielectric(c, 1.5f), 1e-5);
+    CHECK_NEAR(pbsdf_alpha_from_ns(0.0f), 1.0, 1e-6);
+    CHECK_NEAR(pbsdf_alpha_from_ns(98.0f), sqrt(0.02), 1e-6);
+}
+
+int main(void)
+{
+    test_frame();
+    test_fresnel();
+    build_cases();
+
+    /* how many chi-square tests: the Sidak correction needs it up front */
+    int n_tests = 0;
+    for (int i = 0; i < n_cases; i++) {
+        if (!pbsdf_has_nondelta(&cases[i].b)) continue;
+        n_tests += 4 + (cases[i].b.type == PBSDF_DIELECTRIC ? 3 : 0);
+    }
+    const double alpha_sig = 0.01;
+    double threshold = 1.0 - pow(1.0 - alpha_sig, 1.0 / n_tests);
+    printf("%d chi-square tests, %d samples each; per-test significance %.3g (Sidak, overall %.2f)\n", n_tests,
+           N_SAMPLES, threshold, alpha_sig);
+
+    double min_p = 1.0, sum_p = 0.0;
+    int below_05 = 0, runs = 0;
+    uint64_t seed = 1;
+    for (int i = 0; i < n_cases; i++) {
+        const bcase *bc = &cases[i];
+        test_reciprocity(bc, 1000 + (uint64_t)i);
+        int na = 4 + (bc->b.type == PBSDF_DIELECTRIC ? 3 : 0);
+        for (int k = 0; k < na; k++) {
+            float th = k < 4 ? angles_out[k] : angles_in[k - 4];
+            vec3 wo = dir_from(th, 0.7f);
+            seed++;
+
+            /* white furnace (non-white cases: each channel still <= 1) */
+            furnace f = white_furnace(&bc->b, wo, seed * 7919u);
+            for (int c = 0; c < 3; c++) {
+                CHECKF(f.mean[c] <= 1.0 + 4.0 * f.se[c] + 1e-6, "%s theta_o=%g: furnace[%d] = %.6f +- %.2g > 1",
+                       bc->name, (double)th, c, f.mean[c], f.se[c]);
+                if (bc->lossless)
+                    CHECKF(fabs(f.mean[c] - 1.0) <= 4.0 * f.se[c] + 1e-6,
+                           "%s theta_o=%g: lossless furnace[%d] = %.6f +- %.2g", bc->name, (double)th, c,
+                           f.mean[c], f.se[c]);
+            }
+            if (!pbsdf_has_nondelta(&bc->b)) {
+                printf("  %-28s theta_o=%5.1f  furnace %.4f %.4f %.4f (delta only)\n", bc->name, (double)th,
+                       f.mean[0], f.mean[1], f.mean[2]);
+                continue;
+            }
+
+            result r = chi2_test(&bc->b, wo, seed);
+            runs++;
+            sum_p += r.pvalue;
+            if (r.pvalue < min_p) min_p = r.pvalue;
+            if (r.pvalue < 0.05) below_05++;
+            printf("  %-28s theta_o=%5.1f  chi2=%8.2f dof=%3d p=%.4f  int pdf=%.5f (+-%.1e, sampled %.5f)"
+                   "  furnace %.4f %.4f %.4f\n",
+                   bc->name, (double)th, r.chi2, r.dof, r.pvalue, r.pdf_integral, r.pdf_err, r.nondelta_frac,
+                   f.mean[0], f.mean[1], f.mean[2]);
+            CHECKF(r.pvalue >= threshold, "%s theta_o=%g: chi2 %.2f, dof %d, p = %.3g < %.3g", bc->name, (double)th,
+                   r.chi2, r.dof, r.pvalue, threshold);
+            CHECKF(!r.zero_cell_hit, "%s theta_o=%g: samples in a cell where the pdf is 0", bc->name, (double)th);
+            CHECKF(r.pdf_mismatch == 0, "%s theta_o=%g: %ld sampled pdfs differ from pdf()", bc->name, (double)th,
+                   r.pdf_mismatch);
+            CHECKF(r.weight_mismatch == 0, "%s theta_o=%g: %ld weights differ from eval/pdf (worst rel %.3g)",
+                   bc->name, (double)th, r.weight_mismatch, r.max_weight_rel);
+            CHECKF(r.eval_without_pdf == 0, "%s theta_o=%g: eval > 0 where pdf == 0 at %ld points", bc->name,
+                   (double)th, r.eval_without_pdf);
+            /* the pdf integrates to the share of non-delta samples (1 when
+             * there are neither delta lobes nor failed samples) */
+            double se = sqrt(fmax(r.nondelta_frac * (1.0 - r.nondelta_frac), 1e-12) / N_SAMPLES);
+            double itol = 2.0 * r.pdf_err + 1e-4;
+            CHECKF(fabs(r.pdf_integral - r.nondelta_frac) <= 4.0 * se + itol,
+                   "%s theta_o=%g: pdf integrates to %.6f (+-%.2g), sampled non-delta share %.6f", bc->name,
+                   (double)th, r.pdf_integral, itol, r.nondelta_frac);
+            CHECKF(r.pdf_integral <= 1.0 + itol, "%s theta_o=%g: pdf integrates to %.6f > 1", bc->name, (double)th,
+                   r.pdf_integral);
+            if (bc->b.type == PBSDF_DIFFUSE)
+                CHECKF(fabs(r.pdf_integral - 1.0) <= itol, "%s: pdf integrates to %.6f", bc->name, r.pdf_integral);
+            /* energy by quadrature of eval (independent of the sampler), and
+             * its agreement with the non-delta sample weights */
+            for (int c = 0; c < 3; c++) {
+                double qtol = 4.0 * f.nondelta_se[c] + 2e-3 * fmax(1.0, r.eval_integral[c]) + 1e-4;
+                CHECKF(r.eval_integral[c] <= 1.0 + 2e-3, "%s theta_o=%g: integral of f cos [%d] = %.6f > 1",
+                       bc->name, (double)th, c, r.eval_integral[c]);
+                CHECKF(fabs(r.eval_integral[c] - f.nondelta_mean[c]) <= qtol,
+                       "%s theta_o=%g: integral of f cos [%d] = %.6f, sampled %.6f +- %.2g", bc->name, (double)th,
+                       c, r.eval_integral[c], f.nondelta_mean[c], f.nondelta_se[c]);
+            }
+        }
+    }
+    printf("%d chi-square tests: min p = %.4g, mean p = %.3f, %d below 0.05 (expected about %.1f)\n", runs, min_p,
+           sum_p / runs, below_05, 0.05 * runs);
+    return test_done("test_bsdf");
+}
