@@ -1,16 +1,16 @@
 /*
  * path.c - the path tracer (see path.h and docs/integrators.md).
  *
- * Materials are the MTL models: Lambertian Kd; mirrors (illum 3, 5) add an
- * ideal reflection weighted by Ks; dielectrics (illum 4, 6, 7) reflect and
- * refract with exact Fresnel, tinted by Tf on the way in; dissolve d < 1 lets
- * a fraction of the light pass straight through. A surface's lobes are chosen
- * in proportion to their weights; only the diffuse lobe is seen by light
- * sampling (the others are delta lobes).
+ * Materials are the MTL models mapped to pbsdf.h (docs/materials.md): Kd
+ * diffuse; Ks with Ns a GGX lobe over it (illum 2); illum 3 an ideal mirror
+ * weighted by Ks over the diffuse part, illum 5 a mirror with Fresnel;
+ * illum 4, 6, 7 smooth dielectrics (Ni, Tf) with exact Fresnel; dissolve
+ * d < 1 lets a fraction of the light pass straight through.
  */
 #include "path.h"
 
-#include "optics.h"
+#include "../math/frame.h"
+#include "pbsdf.h"
 #include "sampling.h"
 #include "surface.h"
 
@@ -40,109 +40,84 @@ static inline float power_heuristic(float a, float b)
 /* Radiance a surface emits toward wo (unit, pointing away from it). */
 static inline vec3 emitted(const surface *sf) { return sf->front || sf->m->two_sided ? sf->m->ke : v3s(0.0f); }
 
-/* ---- the material's lobes ----------------------------------------------------- */
+/* ---- materials: the MTL models as physically based BSDFs (pbsdf.h) ----------- */
 
-typedef struct lobes {
-    vec3 kd;             /* diffuse albedo */
-    vec3 ks;             /* mirror weight (illum 3, 5) */
-    float w_diffuse, w_mirror, w_glass, w_pass; /* selection probabilities, summing to 1 (or all 0) */
-} lobes;
+/* The BSDF at a surface, its frame, and the dissolve: with probability
+ * 1 - opaque the path passes straight through (a delta lobe of its own). */
+typedef struct shading {
+    pbsdf b;
+    onb frame;           /* z = the shading normal; for dielectrics the outward one */
+    float opaque;
+    bool nondelta;       /* the BSDF has a part that light sampling can reach */
+} shading;
 
-static lobes lobes_of(const material *m)
+static shading shading_at(const surface *sf)
 {
-    lobes l = {v3s(0.0f), v3s(0.0f), 0.0f, 0.0f, 0.0f, 0.0f};
+    const material *m = sf->m;
+    shading sh;
     const bool glass = m->illum == 4 || m->illum == 6 || m->illum == 7;
-    const bool mirror = m->illum == 3 || m->illum == 5;
-    float opaque = glass ? 1.0f : fminf(fmaxf(m->d, 0.0f), 1.0f);
-    float wd = 0.0f, wm = 0.0f, wg = 0.0f;
+    sh.opaque = glass ? 1.0f : fminf(fmaxf(m->d, 0.0f), 1.0f);
+    vec3 n = sf->ns;
     if (glass) {
-        wg = 1.0f;
+        /* Tf: the hue of what enters, normalised to the brightest channel
+         * (exporters write grey Tf of any strength for clear glass) */
+        float tmax_c = v3_max_comp(m->tf);
+        vec3 tint = tmax_c > 0.0f ? v3_scale(m->tf, 1.0f / tmax_c) : v3s(1.0f);
+        sh.b = pbsdf_dielectric(m->ni, 0.0f, sf->front ? tint : v3s(1.0f));
+        if (!sf->front) n = v3_neg(n); /* the outward normal: wo.z < 0 inside */
+    } else if (m->illum == 5) {
+        sh.b = pbsdf_conductor_schlick(m->ks, 0.0f); /* a mirror with Fresnel */
+    } else if (m->illum == 3) {
+        sh.b = pbsdf_glossy(m->kd, m->ks, 0.0f); /* diffuse + an ideal mirror weighted by Ks */
+    } else if (m->illum == 2 && (m->ks.x > 0.0f || m->ks.y > 0.0f || m->ks.z > 0.0f)) {
+        sh.b = pbsdf_glossy_mtl(m->kd, m->ks, m->ns);
     } else {
-        l.kd = m->kd;
-        if (mirror) l.ks = m->ks;
-        wd = v3_max_comp(l.kd);
-        wm = v3_max_comp(l.ks);
+        sh.b = pbsdf_diffuse(m->kd);
     }
-    float total = wd + wm + wg;
-    if (total > 0.0f) {
-        l.w_diffuse = opaque * wd / total;
-        l.w_mirror = opaque * wm / total;
-        l.w_glass = opaque * wg / total;
-    }
-    l.w_pass = 1.0f - opaque;
-    return l;
+    sh.frame = onb_from_normal(n);
+    sh.nondelta = sh.opaque > 0.0f && pbsdf_has_nondelta(&sh.b) &&
+                  (sh.b.type != PBSDF_DIFFUSE || !black(sh.b.albedo));
+    return sh;
 }
 
-/* f * cos for the diffuse lobe, and its pdf (with the lobe's selection). */
-static inline vec3 diffuse_eval(const surface *sf, const lobes *lb, vec3 wi, float *pdf)
+/* f * cos toward wi (world, unit) and its pdf, the dissolve included; zero
+ * where the geometric normal says the light comes through the surface. */
+static inline vec3 shading_eval(const surface *sf, const shading *sh, vec3 wo, vec3 wi, float *pdf)
 {
-    float cos_i = v3_dot(sf->ns, wi);
-    if (cos_i <= 0.0f || v3_dot(sf->ng, wi) <= 0.0f || lb->w_diffuse <= 0.0f) {
-        *pdf = 0.0f;
-        return v3s(0.0f);
-    }
-    *pdf = lb->w_diffuse * cos_i / PK_PI;
-    return v3_scale(lb->kd, cos_i / PK_PI);
-}
-
-/* Samples a lobe and a direction. Returns false when the path ends. Sets *wi,
- * *weight (f cos / pdf, the lobe's selection included), *pdf (0 for delta
- * lobes), *delta. */
-static bool sample_lobes(const surface *sf, const lobes *lb, vec3 wo, float u0, float u1, float u2, vec3 *wi,
-                         vec3 *weight, float *pdf, bool *delta)
-{
-    float u = u0;
-    if (u < lb->w_diffuse) {
-        vec3 d = sample_cosine(sf->ns, u1, u2);
-        if (v3_dot(d, sf->ng) <= 0.0f) return false; /* below the geometric surface */
-        float p;
-        vec3 f = diffuse_eval(sf, lb, d, &p);
-        if (!(p > 0.0f)) return false;
-        *wi = d;
-        *weight = v3_scale(f, 1.0f / p);
-        *pdf = p;
-        *delta = false;
-        return true;
-    }
-    u -= lb->w_diffuse;
     *pdf = 0.0f;
-    *delta = true;
-    const vec3 dn = v3_neg(wo); /* incident direction */
-    if (u < lb->w_mirror) {
-        vec3 r = v3_reflect(dn, sf->ns);
-        if (v3_dot(r, sf->ng) <= 0.0f) r = v3_reflect(dn, sf->ng);
-        *wi = r;
-        *weight = v3_scale(lb->ks, 1.0f / lb->w_mirror);
-        return true;
-    }
-    u -= lb->w_mirror;
-    if (u < lb->w_glass) {
-        const material *m = sf->m;
-        float eta_i = sf->front ? 1.0f : m->ni, eta_t = sf->front ? m->ni : 1.0f;
-        float cos_i = fminf(1.0f, v3_dot(wo, sf->ns));
-        vec3 wt;
-        bool tir = !refract_dir(dn, sf->ns, eta_i / eta_t, &wt) || v3_dot(wt, sf->ng) >= 0.0f;
-        float F = tir ? 1.0f : fresnel_dielectric(cos_i, eta_i, eta_t);
-        /* reflect with probability F, else refract: the weight is then 1 (times the tint) */
-        if (u2 < F) {
-            vec3 r = v3_reflect(dn, sf->ns);
-            if (v3_dot(r, sf->ng) <= 0.0f) r = v3_reflect(dn, sf->ng);
-            *wi = r;
-            *weight = v3s(1.0f / lb->w_glass);
-        } else {
-            float tmax_c = v3_max_comp(m->tf);
-            vec3 tint = sf->front && tmax_c > 0.0f ? v3_scale(m->tf, 1.0f / tmax_c) : v3s(1.0f);
-            *wi = wt;
-            *weight = v3_scale(tint, 1.0f / lb->w_glass);
-        }
-        return true;
-    }
-    if (lb->w_pass > 0.0f) { /* straight through (dissolve) */
-        *wi = dn;
+    const float side = v3_dot(wi, sf->ng), shade = v3_dot(wi, sf->ns);
+    if (sh->b.type != PBSDF_DIELECTRIC && (side <= 0.0f || shade <= 0.0f)) return v3s(0.0f);
+    vec3 lo = onb_to_local(sh->frame, wo), li = onb_to_local(sh->frame, wi);
+    *pdf = sh->opaque * pbsdf_pdf(&sh->b, lo, li);
+    return v3_scale(pbsdf_eval(&sh->b, lo, li), sh->opaque);
+}
+
+/* Samples the next direction. Returns false when the path ends. */
+static bool shading_sample(const surface *sf, const shading *sh, vec3 wo, float u0, float u1, float u2, vec3 *wi,
+                           vec3 *weight, float *pdf, bool *delta)
+{
+    if (u0 >= sh->opaque) { /* straight through (dissolve) */
+        *wi = v3_neg(wo);
         *weight = v3s(1.0f);
+        *pdf = 0.0f;
+        *delta = true;
         return true;
     }
-    return false;
+    const float u[3] = {u0 / sh->opaque, u1, u2};
+    vec3 lo = onb_to_local(sh->frame, wo), li, w;
+    float p;
+    bool d;
+    if (!pbsdf_sample(&sh->b, lo, u, &li, &w, &p, &d)) return false;
+    vec3 out = v3_norm(onb_to_world(sh->frame, li));
+    /* reflection stays on the side of the incoming ray, transmission crosses:
+     * by the geometric normal, so that shading normals never leak light */
+    const bool transmit = li.z * lo.z < 0.0f;
+    if (transmit ? v3_dot(out, sf->ng) >= 0.0f : v3_dot(out, sf->ng) <= 0.0f) return false;
+    *wi = out;
+    *weight = w;
+    *pdf = d ? 0.0f : p * sh->opaque;
+    *delta = d;
+    return true;
 }
 
 /* ---- lights ------------------------------------------------------------------- */
@@ -286,22 +261,22 @@ vec3 path_radiance(const path_tracer *pt, path_thread *t, sampler *smp, const ra
             L = v3_add(L, v3_mul(beta, v3_scale(le, w)));
         }
         if (depth >= pt->max_depth) break;
-        const lobes lb = lobes_of(sf.m);
+        const shading sh = shading_at(&sf);
         float u0, u1, u2, u3, u4, u5;
         sampler_2d(smp, &u0, &u1);
         sampler_2d(smp, &u2, &u3);
         sampler_2d(smp, &u4, &u5);
         /* next-event estimation: one light, chosen by power */
-        if (lb.w_diffuse > 0.0f && pt->lights.n && pt->strategy != PATH_BSDF_ONLY) {
+        if (sh.nondelta && pt->lights.n && pt->strategy != PATH_BSDF_ONLY) {
             light_sample ls;
             vec3 o = offset_origin(fr->eps, sf.p, sf.ng);
             if (sample_light(pt, o, sf.p, u0, u1, u2, &ls)) {
                 float pb;
-                vec3 f = diffuse_eval(&sf, &lb, ls.wi, &pb);
+                vec3 f = shading_eval(&sf, &sh, wo, ls.wi, &pb);
                 if (!black(f)) {
-                    hit sh;
+                    hit blocker;
                     t->rays_shadow++;
-                    if (!fr->a->ops->occluded(fr->a, &ls.shadow, &sh, t->cp)) {
+                    if (!fr->a->ops->occluded(fr->a, &ls.shadow, &blocker, t->cp)) {
                         float w = ls.delta || pt->strategy == PATH_LIGHTS_ONLY ? 1.0f : power_heuristic(ls.pdf, pb);
                         L = v3_add(L, v3_mul(beta, v3_scale(v3_mul(f, ls.le), w / ls.pdf)));
                     }
@@ -312,7 +287,7 @@ vec3 path_radiance(const path_tracer *pt, path_thread *t, sampler *smp, const ra
         vec3 wi, weight;
         float pdf;
         bool delta;
-        if (!sample_lobes(&sf, &lb, wo, u3, u4, u5, &wi, &weight, &pdf, &delta)) break;
+        if (!shading_sample(&sf, &sh, wo, u3, u4, u5, &wi, &weight, &pdf, &delta)) break;
         beta = v3_mul(beta, weight);
         if (black(beta) || !v3_finite(beta)) break;
         /* Russian roulette on the throughput: a path carrying less than 1
