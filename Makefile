@@ -43,7 +43,7 @@ build: deps $(BUILD)/CMakeCache.txt
 # tests and fuzz replays that `make build` and `make test` compile.
 demo: deps $(BUILD)/CMakeCache.txt
 	cmake --build $(BUILD) -j $(JOBS) --target paprsek_cli
-	$(BUILD)/paprsek render -o cornell.png --stats
+	$(BUILD)/paprsek render -o cornell.png --spp 64 --stats
 
 # Installs the program, the header, the shared and static libraries, paprsek.pc
 # and the CMake package under PREFIX (docs/install.md); DESTDIR=/stage puts

@@ -18,7 +18,7 @@ for scene in Original Sphere; do
   for fresnel in on off; do
     [ "$scene" = Original ] && [ "$fresnel" = off ] && continue  # no dielectrics: identical
     for accel in $accels; do
-      "$bin" render "$shared/scenes/cornell/CornellBox-$scene.obj" -o "$tmp/img.png" --quiet \
+      "$bin" render "$shared/scenes/cornell/CornellBox-$scene.obj" -o "$tmp/img.png" --quiet --integrator whitted \
         --width "$size" --height "$size" --light-samples 32 --accel "$accel" --fresnel "$fresnel" \
         --stats-json "$tmp/s.json" >/dev/null
       python3 - "$tmp/s.json" "$scene" "$fresnel" "$accel" <<'PY'

@@ -83,8 +83,8 @@ static const cli_option *render_options(size_t *n)
                                  "(simple BVH, for comparison), none (every ray tests every primitive), embree "
                                  "(Embree 3, when built with it); all give the same image"});
         add((cli_option){.name = "integrator", .id = OPT_INTEGRATOR, .kind = CLI_STRING, .arg = "NAME",
-                         .help = "whitted (default: direct light, mirrors and glass) or path (path tracing: "
-                                 "global illumination, one-sided area lights)"});
+                         .help = "path (default: path tracing, global illumination, one-sided area lights) or "
+                                 "whitted (direct light, mirrors and glass; emitters two-sided)"});
         add((cli_option){.name = "fresnel", .id = OPT_FRESNEL, .kind = CLI_STRING, .arg = "on|off",
                          .help = "on: exact dielectric Fresnel (default); off: fixed Ks/Tf weights"});
         add((cli_option){.name = "look-from", .id = OPT_LOOK_FROM, .kind = CLI_STRING, .arg = "X,Y,Z",
@@ -274,7 +274,7 @@ static void print_table(const char *scene, const pk_render_options *ro, const pk
 {
     uint64_t rays = st->rays_camera + st->rays_shadow + st->rays_reflection + st->rays_refraction + st->rays_bounce;
     double r = rays ? (double)rays : 1.0;
-    const int path = ro->integrator == PK_INTEGRATOR_PATH;
+    const int path = ro->integrator != PK_INTEGRATOR_WHITTED;
     printf("%-28s %s\n", "scene", scene);
     printf("%-28s %s, %d thread%s, %dx%d, %d spp, %d light samples, depth %d, fresnel %s\n", "settings",
            pk_accel_kind_name(ro->accel), st->threads, st->threads == 1 ? "" : "s", ro->width, ro->height, ro->spp,

@@ -106,7 +106,7 @@ PK_API pk_status pk_accel_kind_parse(const char *name, pk_accel_kind *out);
 PK_API int pk_accel_available(pk_accel_kind kind);
 
 typedef enum pk_integrator_kind {
-    PK_INTEGRATOR_DEFAULT = 0, /* the Whitted integrator, for now */
+    PK_INTEGRATOR_DEFAULT = 0, /* the path tracer */
     PK_INTEGRATOR_WHITTED = 1, /* direct light, mirror reflection and refraction */
     PK_INTEGRATOR_PATH = 2     /* path tracing: global illumination, multiple importance sampling */
 } pk_integrator_kind;

@@ -81,7 +81,7 @@ pk_status options_check(pk_context *ctx, const pk_render_options *o)
 
 /* ---- integrator names ------------------------------------------------------ */
 
-static const char *const integrator_names[] = {"whitted", "whitted", "path"};
+static const char *const integrator_names[] = {"path", "whitted", "path"};
 
 const char *pk_integrator_name(pk_integrator_kind kind)
 {

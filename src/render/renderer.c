@@ -69,7 +69,7 @@ pk_status renderer_create(pk_context *ctx, const pk_scene *s, const pk_render_op
         mem_free(&ctx->alloc, r);
         return st;
     }
-    r->path = opt->integrator == PK_INTEGRATOR_PATH;
+    r->path = opt->integrator != PK_INTEGRATOR_WHITTED;
     r->w = (whitted){&r->fr, opt->light_samples, opt->max_depth, opt->fresnel != 0};
     r->ts = mem_calloc(&ctx->alloc, (size_t)r->nt, sizeof *r->ts);
     r->pts = mem_calloc(&ctx->alloc, (size_t)r->nt, sizeof *r->pts);

@@ -79,6 +79,7 @@ static void test_ray_budget(void)
             PK_OK);
     pk_render_options o;
     pk_render_options_init(&o);
+    o.integrator = PK_INTEGRATOR_WHITTED; /* its ray tree is what the budget bounds */
     o.width = o.height = 8;
     o.threads = 1;
     o.collect_stats = 1;
