@@ -11,6 +11,7 @@
 
 #include "camera.h"
 #include "path.h"
+#include "sampling.h"
 #include "whitted.h"
 
 #include <omp.h>
@@ -44,7 +45,8 @@ static void warn_lighting(pk_context *ctx, const pk_scene *s, bool path)
         vec3 ke = s->materials[s->spheres[i].material].ke;
         if (ke.x > 0.0f || ke.y > 0.0f || ke.z > 0.0f) emissive_spheres++;
     }
-    bool ambient = s->ambient.x > 0.0f || s->ambient.y > 0.0f || s->ambient.z > 0.0f;
+    /* the path tracer has no ambient term */
+    bool ambient = !path && (s->ambient.x > 0.0f || s->ambient.y > 0.0f || s->ambient.z > 0.0f);
     if (s->nemissive == 0 && s->nlights == 0 && emissive_spheres == 0 && !ambient)
         ctx_warn(ctx, "%s: the scene has no light (no emissive triangle or sphere, no point light): the image will be black",
                  s->name);
@@ -52,6 +54,47 @@ static void warn_lighting(pk_context *ctx, const pk_scene *s, bool path)
         ctx_warn(ctx, "%s: %zu emissive sphere%s visible but light%s nothing: the Whitted integrator lights the scene "
                  "only from emissive triangles and point lights", s->name, emissive_spheres,
                  emissive_spheres == 1 ? " is" : "s are", emissive_spheres == 1 ? "s" : "");
+}
+
+/* The path tracer's area lights are one-sided. When a scene's only lights are
+ * one-sided triangles and none of them sees the scene on its emitting side
+ * while some see it behind them, they are almost surely wound the wrong way:
+ * say so. Eight probe rays a side from up to 256 emitters. */
+static void warn_facing(pk_context *ctx, const pk_scene *s, const accel *a)
+{
+    if (s->nemissive == 0 || s->nlights != 0) return;
+    for (size_t i = 0; i < s->nspheres; i++) {
+        vec3 ke = s->materials[s->spheres[i].material].ke;
+        if (ke.x > 0.0f || ke.y > 0.0f || ke.z > 0.0f) return;
+    }
+    const size_t step = s->nemissive > 256 ? s->nemissive / 256 : 1;
+    size_t front = 0, back = 0;
+    vec3 ext = aabb_extent(s->bounds);
+    const float eps = 1e-5f * fmaxf(v3_max_comp(ext), 1e-6f), reach = v3_len(ext);
+    for (size_t k = 0; k < s->nemissive; k += step) {
+        const uint32_t t = s->emissive[k];
+        if (s->materials[s->tris[t].material].two_sided) return;
+        vec3 va, vb, vc;
+        scene_tri_verts(s, t, &va, &vb, &vc);
+        vec3 n = tri_normal(va, vb, vc), c = v3_scale(v3_add(v3_add(va, vb), vc), 1.0f / 3.0f);
+        for (int side = 0; side < 2; side++) {
+            vec3 ns = side ? v3_neg(n) : n;
+            for (int j = 0; j < 8; j++) {
+                vec3 d = sample_cosine(ns, ((float)j + 0.5f) / 8.0f, (float)((j * 5) % 8) / 8.0f);
+                ray r = {v3_add(c, v3_scale(ns, eps + 4e-6f * v3_max_comp(v3(fabsf(c.x), fabsf(c.y), fabsf(c.z))))),
+                         0.0f, d, INFINITY};
+                hit h;
+                /* a hit less than 1% of the scene's size in front of the light (along its
+                 * normal) is the surface the light is
+                 * mounted on (a ceiling a centimetre above), not the scene */
+                if (accel_intersect(a, &r, &h, NULL) && h.t * v3_dot(d, ns) > 0.01f * reach) *(side ? &back : &front) += 1;
+            }
+        }
+    }
+    if (front == 0 && back > 0)
+        ctx_warn(ctx, "%s: every area light faces away from the scene (a triangle emits on the side its "
+                 "counter-clockwise winding faces): wound the wrong way? Reverse the faces, or give the "
+                 "material \"two_sided\": true in a JSON scene", s->name);
 }
 
 pk_status renderer_create(pk_context *ctx, const pk_scene *s, const pk_render_options *opt, const pk_camera *cam,
@@ -94,6 +137,7 @@ pk_status renderer_create(pk_context *ctx, const pk_scene *s, const pk_render_op
     r->total.threads = r->nt;
     r->total.accel_builds = 1;
     warn_lighting(ctx, s, r->path);
+    if (r->path) warn_facing(ctx, s, r->fr.a);
     *out = r;
     return PK_OK;
 }

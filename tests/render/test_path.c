@@ -172,6 +172,45 @@ static void check_determinism(void)
     pk_scene_destroy(s);
 }
 
+static int g_facing_warnings;
+static void count_facing(void *user, const char *message)
+{
+    (void)user;
+    if (strstr(message, "every area light faces away from the scene")) g_facing_warnings++;
+}
+
+/* A floor under a light quad: wound to face the floor, no warning; wound to
+ * face the sky, the warning that it faces away from the scene. */
+static void check_facing_warning(const char *dir)
+{
+    const char *mtl = "newmtl floor\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\n";
+    char path[600];
+    snprintf(path, sizeof path, "%s/lamp.mtl", dir);
+    write_file(path, mtl);
+    for (int up = 0; up < 2; up++) {
+        char text[1024];
+        snprintf(text, sizeof text,
+                 "mtllib lamp.mtl\nv -2 0 -2\nv 2 0 -2\nv 2 0 2\nv -2 0 2\n"
+                 "v -0.5 1 -0.5\nv 0.5 1 -0.5\nv 0.5 1 0.5\nv -0.5 1 0.5\n"
+                 "usemtl floor\nf 1 4 3 2\nusemtl lamp\n%s\n",
+                 up ? "f 5 8 7 6" : "f 5 6 7 8");
+        snprintf(path, sizeof path, "%s/lamp.obj", dir);
+        write_file(path, text);
+        pk_scene *s = NULL;
+        REQUIRE(pk_scene_load_file(ctx, path, &s) == PK_OK);
+        g_facing_warnings = 0;
+        pk_context_set_warning_handler(ctx, count_facing, NULL);
+        pk_image *img = render_path(s, 8, 1, 1, 0);
+        pk_context_set_warning_handler(ctx, NULL, NULL);
+        CHECKF(g_facing_warnings == up, "lamp wound to face %s: %d warnings", up ? "up" : "down", g_facing_warnings);
+        pk_image_destroy(img);
+        pk_scene_destroy(s);
+        remove(path);
+    }
+    snprintf(path, sizeof path, "%s/lamp.mtl", dir);
+    remove(path);
+}
+
 int main(void)
 {
     REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
@@ -186,6 +225,7 @@ int main(void)
         check_furnace("sphere furnace", sph, albedo[k], 0.5f);
         pk_scene_destroy(sph);
     }
+    check_facing_warning(dir);
     char path[600];
     snprintf(path, sizeof path, "%s/furnace.obj", dir);
     remove(path);
