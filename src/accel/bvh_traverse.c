@@ -112,6 +112,11 @@ static inline __attribute__((always_inline)) bool traverse(const bvh *t, const r
                                                            accel_counters *c, const bool any,
                                                            const bool count)
 {
+    if (!ray_traceable(rr)) { /* rejected at the root */
+        if (count) c->nodes++;
+        hit_clear(out);
+        return false;
+    }
     bvh_ray r;
     bvh_ray_init(&r, rr);
     node_ray nr;

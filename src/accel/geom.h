@@ -73,6 +73,16 @@ static inline bool ray_dir_tiny(vec3 d)
            (fabsf(d.z) <= 0x1p-128f && d.z != 0.0f);
 }
 
+/* A ray that can hit something: a finite origin, no NaN in its direction or
+ * interval. Others hit nothing (the triangle and sphere tests say so too),
+ * and must not reach a slab test: there NaN means "no limit on this axis",
+ * which would let them into empty child slots (boxes of +inf..-inf). */
+static inline bool ray_traceable(const ray *r)
+{
+    return v3_finite(r->o) && !isnan(r->d.x) && !isnan(r->d.y) && !isnan(r->d.z) && !isnan(r->tmin) &&
+           !isnan(r->tmax);
+}
+
 static inline ray_pre ray_prepare(const ray *r)
 {
     ray_pre p;

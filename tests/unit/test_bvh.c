@@ -715,6 +715,31 @@ static void check_synthetic(pk_context *ctx)
         accel_input in2 = {NULL, 0, sph, 200, 1};
         check_input(ctx, &in2, 20000, false, 4, "spheres only");
     }
+    /* rays with a non-finite origin or a NaN direction or interval hit
+     * nothing, by every entry point (the render fuzz corpus holds the scene
+     * where such a ray once reached an empty child slot and crashed) */
+    {
+        accel_input in = {m.v, 60, sph, 5, 2};
+        accel *a = build(ctx, &in, "non-finite rays");
+        const float bad[] = {NAN, INFINITY, -INFINITY};
+        int hits = 0;
+        for (int k = 0; k < 3; k++)
+            for (int w = 0; w < 7; w++) {
+                ray r = {v3(0.1f, 0.2f, 0.3f), 0.0f, v3(0.3f, -0.5f, 0.8f), INFINITY};
+                float *f = w < 3 ? &r.o.x + w : w < 6 ? &r.d.x + (w - 3) : &r.tmax;
+                if (w >= 3 && k > 0 && w < 6) continue; /* infinite directions are legitimate */
+                if (w == 6 && k > 0) continue;          /* tmax = inf is the usual case */
+                *f = bad[k];
+                hit h;
+                accel_counters c = {0, 0};
+                hits += a->ops->intersect(a, &r, &h, NULL) + a->ops->intersect(a, &r, &h, &c);
+                hits += a->ops->occluded(a, &r, NULL, NULL);
+                a->ops->intersect_packet(a, &r, &h, 1, false, NULL);
+                hits += h.prim != PK_NO_HIT;
+            }
+        CHECKF(hits == 0, "non-finite rays: %d hits", hits);
+        accel_destroy(a);
+    }
     /* long slivers crossing the scene in every direction: spatial splits cut
      * them into pieces held by several leaves */
     {
