@@ -88,6 +88,7 @@ typedef struct cli_progress {
     int drawn;        /* characters of the bar now on the line (0: none) */
     int last_permille;
     double last_elapsed;
+    char note[32];    /* shown after the times ("pass 12"), empty by default */
 } cli_progress;
 
 /* enabled when f is a terminal (isatty) and quiet is 0. */

@@ -94,7 +94,9 @@ int cli_progress_update(void *user, uint64_t done, uint64_t total, double elapse
     p->last_permille = permille;
     p->last_elapsed = elapsed_s;
     char line[256];
-    int len = cli_progress_format(line, sizeof line, terminal_columns(p->f), done, total, elapsed_s);
+    const int cols = terminal_columns(p->f), nl = p->note[0] ? (int)strlen(p->note) + 2 : 0;
+    int len = cli_progress_format(line, sizeof line, cols - nl, done, total, elapsed_s);
+    if (nl && len + nl < (int)sizeof line) len += snprintf(line + len, sizeof line - (size_t)len, ", %s", p->note);
     /* Spaces cover what is left of a longer earlier line. */
     int pad = p->drawn > len ? p->drawn - len : 0;
     fprintf(p->f, "\r%s%*s", line, pad, "");

@@ -44,6 +44,7 @@ enum {
     OPT_LOOK_AT,
     OPT_UP,
     OPT_FOV,
+    OPT_TIME,
     OPT_STATS,
     OPT_STATS_JSON,
     OPT_QUIET,
@@ -93,6 +94,9 @@ static const cli_option *render_options(size_t *n)
                          .help = "camera target"});
         add((cli_option){.name = "up", .id = OPT_UP, .kind = CLI_STRING, .arg = "X,Y,Z",
                          .help = "camera up vector (default 0,1,0)"});
+        add((cli_option){.name = "time", .id = OPT_TIME, .kind = CLI_STRING, .arg = "SECONDS",
+                         .help = "render passes of --spp samples per pixel until SECONDS have passed (at least "
+                                 "one pass); the image is the mean of all passes"});
         add((cli_option){.name = "fov", .id = OPT_FOV, .kind = CLI_STRING, .arg = "DEG",
                          .help = "vertical field of view in degrees, between 0 and 180"});
         add((cli_option){.name = "stats", .id = OPT_STATS, .kind = CLI_FLAG,
@@ -161,6 +165,7 @@ typedef struct cli_opts {
     pk_accel_kind accel;
     int has_integrator;
     pk_integrator_kind integrator;
+    double time;         /* --time: seconds of passes, 0 when not given */
     int has_from, has_at, has_up, has_fov;
     float from[3], at[3], up[3], fov;
 } cli_opts;
@@ -237,6 +242,13 @@ static int parse_args(int argc, char **argv, cli_opts *o)
             if (*end || end == v || !(o->fov > 0.0f && o->fov < 180.0f))
                 return cli_usage_error("--fov: '%s' must be a number of degrees between 0 and 180", v);
             o->has_fov = 1;
+            break;
+        }
+        case OPT_TIME: {
+            char *end;
+            o->time = strtod(v, &end);
+            if (*end || end == v || !(o->time > 0.0 && o->time <= 1e7))
+                return cli_usage_error("--time: '%s' must be a number of seconds in (0, 10000000]", v);
             break;
         }
         case OPT_STATS: o->stats = 1; break;
@@ -361,6 +373,41 @@ static char *partial_name(const char *out)
     return p;
 }
 
+/* --time: passes of ro->spp samples into one film until seconds have
+ * passed; the bar shows the time spent and the passes done. */
+static pk_status render_passes(pk_context *ctx, const pk_scene *scene, pk_render_options *ro, double seconds,
+                               cli_progress *bar, pk_image **img, pk_stats *stats, uint32_t *passes)
+{
+    ro->progress = NULL; /* the bar follows the passes, not the tiles */
+    pk_renderer *r = NULL;
+    pk_film *film = NULL;
+    *img = NULL;
+    pk_status st = pk_renderer_create(ctx, scene, ro, &r);
+    if (st == PK_OK) st = pk_film_create(ctx, ro->width, ro->height, &film);
+    const double t0 = cli_now();
+    uint32_t k = 0;
+    while (st == PK_OK) {
+        pk_renderer_set_pass(r, k);
+        st = pk_renderer_render(r, NULL, 0, film);
+        if (st != PK_OK) break;
+        k++;
+        const double el = cli_now() - t0;
+        snprintf(bar->note, sizeof bar->note, "pass %u", k);
+        cli_progress_update(bar, (uint64_t)(el < seconds ? el * 1000.0 : seconds * 1000.0),
+                            (uint64_t)(seconds * 1000.0), el);
+        if (el >= seconds || k == UINT32_MAX / (uint32_t)ro->spp) break;
+    }
+    *passes = k;
+    if ((st == PK_OK || st == PK_ERR_CANCELLED) && film) {
+        pk_status rs = pk_film_resolve(ctx, film, img);
+        if (rs != PK_OK) st = rs;
+    }
+    if (r) pk_renderer_get_stats(r, stats);
+    pk_film_destroy(film);
+    pk_renderer_destroy(r);
+    return st;
+}
+
 int cli_render(int argc, char **argv)
 {
     const double t0 = cli_now();
@@ -436,7 +483,11 @@ int cli_render(int argc, char **argv)
     sigaction(SIGTERM, &sa, NULL);
 
     pk_stats stats;
-    st = pk_render(ctx, scene, &ro, &img, &stats);
+    uint32_t passes = 1;
+    if (o.time > 0.0)
+        st = render_passes(ctx, scene, &ro, o.time, &bar, &img, &stats, &passes);
+    else
+        st = pk_render(ctx, scene, &ro, &img, &stats);
     cli_progress_clear(&bar);
     if (st == PK_ERR_CANCELLED) {
         char *partial = partial_name(o.out);
@@ -454,7 +505,11 @@ int cli_render(int argc, char **argv)
     if (bar.enabled) {
         char took[32];
         cli_format_duration(took, sizeof took, cli_now() - t0);
-        fprintf(stderr, "wrote %s (%dx%d, %s)\n", o.out, ro.width, ro.height, took);
+        if (o.time > 0.0)
+            fprintf(stderr, "wrote %s (%dx%d, %u passes of %d spp, %s)\n", o.out, ro.width, ro.height, passes, ro.spp,
+                    took);
+        else
+            fprintf(stderr, "wrote %s (%dx%d, %s)\n", o.out, ro.width, ro.height, took);
     }
     const char *name = o.scene ? o.scene : "cornell-box (built in)";
     if (o.stats) print_table(name, &ro, &stats);

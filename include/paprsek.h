@@ -316,6 +316,12 @@ PK_API void pk_renderer_get_camera(const pk_renderer *r, pk_camera *cam);
  * threads, so that any tiling of the image, merged, equals one whole render
  * bit for bit. On PK_ERR_CANCELLED the film holds the tiles that finished. */
 PK_API pk_status pk_renderer_render(pk_renderer *r, const pk_region *regions, size_t n, pk_film *film);
+/* Progressive rendering: later renders take the samples of pass `pass`,
+ * sample numbers pass * spp .. pass * spp + spp - 1 of every pixel (default 0),
+ * so that rendering passes 0..k-1 into one film equals one render of k * spp
+ * samples' worth of independent samples (the path tracer's sampler, the
+ * Whitted integrator's random numbers), and any pass can be rendered anywhere. */
+PK_API void pk_renderer_set_pass(pk_renderer *r, uint32_t pass);
 /* Statistics since pk_renderer_create: the build once, the rays, tests,
  * nodes, pixels and render time of every render added up. */
 PK_API void pk_renderer_get_stats(const pk_renderer *r, pk_stats *stats);

@@ -296,6 +296,11 @@ pk_status pk_renderer_render(pk_renderer *r, const pk_region *regions, size_t n,
     return renderer_render(r, regions, n, film);
 }
 
+void pk_renderer_set_pass(pk_renderer *r, uint32_t pass)
+{
+    if (r) renderer_set_pass(r, pass);
+}
+
 void pk_renderer_get_stats(const pk_renderer *r, pk_stats *stats)
 {
     if (r && stats) renderer_stats(r, stats);

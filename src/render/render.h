@@ -22,6 +22,7 @@ PK_HIDDEN const pk_camera *renderer_camera(const pk_renderer *r);
  * checked here (inside the image, not empty, not overlapping). */
 PK_HIDDEN pk_status renderer_render(pk_renderer *r, const pk_region *regions, size_t n, pk_film *film);
 PK_HIDDEN void renderer_stats(const pk_renderer *r, pk_stats *stats);
+PK_HIDDEN void renderer_set_pass(pk_renderer *r, uint32_t pass);
 /* Tests: the path tracer's direct-light strategy (PATH_* of path.h). */
 PK_HIDDEN void renderer_set_path_strategy(pk_renderer *r, int strategy);
 

@@ -33,6 +33,7 @@ struct pk_renderer {
     path_tracer pt;
     path_thread *pts;       /* nt entries */
     pk_camera cam;
+    uint32_t pass;          /* sample numbers start at pass * spp */
     pk_stats total;         /* since creation */
 };
 
@@ -161,6 +162,7 @@ void renderer_set_camera(pk_renderer *r, const pk_camera *cam) { r->cam = *cam; 
 const pk_camera *renderer_camera(const pk_renderer *r) { return &r->cam; }
 void renderer_stats(const pk_renderer *r, pk_stats *stats) { *stats = r->total; }
 void renderer_set_path_strategy(pk_renderer *r, int strategy) { r->pt.strategy = strategy; }
+void renderer_set_pass(pk_renderer *r, uint32_t pass) { r->pass = pass; }
 
 typedef struct tile {
     int x, y, w, h;
@@ -220,6 +222,7 @@ static bool render_tile_path(const pk_renderer *r, path_thread *me, const camera
                              float *acc, volatile const int *cancel, atomic_int *stop)
 {
     const int spp = r->opt.spp;
+    const uint32_t first = r->pass * (uint32_t)spp; /* the pass's first sample number */
     const int tw = tl->w, n = tl->w * tl->h;
     ray rays[BATCH];
     hit hits[BATCH];
@@ -228,7 +231,7 @@ static bool render_tile_path(const pk_renderer *r, path_thread *me, const camera
         if (smp > 0 && ((cancel && *cancel) || atomic_load_explicit(stop, memory_order_relaxed))) return false;
         for (int i = 0; i < n; i++) {
             int px = tl->x + i % tw, py = tl->y + i / tw;
-            sampler sm = sampler_start((uint32_t)px, (uint32_t)py, (uint32_t)smp, r->pt.seed);
+            sampler sm = sampler_start((uint32_t)px, (uint32_t)py, first + (uint32_t)smp, r->pt.seed);
             float jx, jy;
             sampler_2d(&sm, &jx, &jy);
             rays[i] = camera_ray(cf, (float)px + jx, (float)py + jy);
@@ -238,7 +241,7 @@ static bool render_tile_path(const pk_renderer *r, path_thread *me, const camera
         for (int i = 0; i < n; i++) {
             if (hits[i].prim == PK_NO_HIT) continue;
             int px = tl->x + i % tw, py = tl->y + i / tw;
-            sampler sm = sampler_start((uint32_t)px, (uint32_t)py, (uint32_t)smp, r->pt.seed);
+            sampler sm = sampler_start((uint32_t)px, (uint32_t)py, first + (uint32_t)smp, r->pt.seed);
             sm.dim = 2; /* the pixel position */
             vec3 c = path_radiance(&r->pt, me, &sm, &rays[i], &hits[i]);
             if (!v3_finite(c)) continue; /* a lost sample, not a poisoned pixel */
@@ -255,6 +258,7 @@ static bool render_tile(const pk_renderer *r, whitted_thread *me, const camera_f
 {
     const whitted *w = &r->w;
     const int spp = r->opt.spp;
+    const uint64_t first = (uint64_t)r->pass * (uint64_t)spp; /* the pass's first sample number */
     const int sx = (int)ceilf(sqrtf((float)spp)), sy = (spp + sx - 1) / sx;
     const int tw = tl->w, n = tl->w * tl->h;
     ray rays[BATCH];
@@ -267,7 +271,7 @@ static bool render_tile(const pk_renderer *r, whitted_thread *me, const camera_f
             int px = tl->x + i % tw, py = tl->y + i / tw;
             float jx = 0.5f, jy = 0.5f;
             if (spp > 1) {
-                rng jr = rng_seed(((uint64_t)py << 32) | (uint32_t)px, (uint64_t)smp * 2 + 1);
+                rng jr = rng_seed(((uint64_t)py << 32) | (uint32_t)px, (first + (uint64_t)smp) * 2 + 1);
                 jx = ((float)(smp % sx) + rng_float(&jr)) / (float)sx;
                 jy = ((float)(smp / sx) + rng_float(&jr)) / (float)sy;
             }
@@ -278,7 +282,7 @@ static bool render_tile(const pk_renderer *r, whitted_thread *me, const camera_f
         for (int i = 0; i < n; i++) {
             if (hits[i].prim == PK_NO_HIT) continue;
             int px = tl->x + i % tw, py = tl->y + i / tw;
-            me->rng = rng_seed(((uint64_t)py << 32) | (uint32_t)px, (uint64_t)smp * 2);
+            me->rng = rng_seed(((uint64_t)py << 32) | (uint32_t)px, (first + (uint64_t)smp) * 2);
             me->ray_budget = WHITTED_RAY_BUDGET;
             vec3 c = whitted_shade(w, me, &rays[i], &hits[i], 0);
             acc[3 * i] += c.x;
