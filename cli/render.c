@@ -8,6 +8,7 @@
 
 #include <errno.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -282,6 +283,17 @@ static int same_file(const char *a, const char *b)
     return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
 }
 
+/* pk_film: 3 float sums and a uint32 count per pixel (include/paprsek.h). */
+#define FILM_BYTES_PER_PIXEL ((int)(3 * sizeof(float) + sizeof(uint32_t)))
+
+/* The process's peak resident memory so far (getrusage: kilobytes on Linux). */
+static double peak_rss_mib(void)
+{
+    struct rusage ru;
+    if (getrusage(RUSAGE_SELF, &ru) != 0) return 0.0;
+    return (double)ru.ru_maxrss / 1024.0;
+}
+
 static void print_table(const char *scene, const pk_render_options *ro, const pk_stats *st)
 {
     uint64_t rays = st->rays_camera + st->rays_shadow + st->rays_reflection + st->rays_refraction + st->rays_bounce;
@@ -310,6 +322,8 @@ static void print_table(const char *scene, const pk_render_options *ro, const pk
     printf("%-28s %.2f\n", "nodes/ray", (double)st->nodes_visited / r);
     printf("%-28s %.4f\n", "traversal time/ray [us]", st->render_s * st->threads / r * 1e6);
     printf("%-28s %.2f\n", "Mrays/s", st->render_s > 0 ? (double)rays / st->render_s / 1e6 : 0.0);
+    printf("%-28s %d per pixel (film: 3 float sums + a count), peak resident %.1f MiB\n", "memory [bytes]",
+           FILM_BYTES_PER_PIXEL, peak_rss_mib());
 }
 
 /* Writes s as a JSON string literal. */
@@ -343,7 +357,8 @@ static int write_stats_json(const char *path, const char *scene, const pk_render
             "  \"build_us\": %.1f,\n  \"render_s\": %.6f,\n  \"rays\": %llu,\n  \"rays_camera\": %llu,\n"
             "  \"rays_shadow\": %llu,\n  \"rays_reflection\": %llu,\n  \"rays_refraction\": %llu,\n"
             "  \"intersection_tests\": %llu,\n  \"nodes_visited\": %llu,\n  \"mrays_per_s\": %.3f,\n"
-            "  \"integrator\": \"%s\",\n  \"seed\": %d,\n  \"rays_bounce\": %llu,\n  \"samples_per_s\": %.1f\n}\n",
+            "  \"integrator\": \"%s\",\n  \"seed\": %d,\n  \"rays_bounce\": %llu,\n  \"samples_per_s\": %.1f,\n"
+            "  \"film_bytes_per_pixel\": %d,\n  \"peak_rss_mib\": %.1f\n}\n",
             pk_accel_kind_name(ro->accel), ro->width, ro->height, ro->spp, ro->light_samples, ro->max_depth,
             ro->fresnel ? "true" : "false", st->threads, st->build_us, st->render_s, (unsigned long long)rays,
             (unsigned long long)st->rays_camera, (unsigned long long)st->rays_shadow,
@@ -351,7 +366,8 @@ static int write_stats_json(const char *path, const char *scene, const pk_render
             (unsigned long long)st->intersection_tests, (unsigned long long)st->nodes_visited,
             st->render_s > 0 ? (double)rays / st->render_s / 1e6 : 0.0, pk_integrator_name(ro->integrator), ro->seed,
             (unsigned long long)st->rays_bounce,
-            st->render_s > 0 ? (double)st->pixels * ro->spp / st->render_s : 0.0);
+            st->render_s > 0 ? (double)st->pixels * ro->spp / st->render_s : 0.0, FILM_BYTES_PER_PIXEL,
+            peak_rss_mib());
     if (to_stdout ? fflush(f) != 0 || ferror(f) : fclose(f) != 0)
         return cli_failure("%s: cannot write: %s", to_stdout ? "standard output" : path, strerror(errno));
     return 0;
