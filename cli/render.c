@@ -7,6 +7,7 @@
 #include "cli.h"
 
 #include <errno.h>
+#include <math.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <stdio.h>
@@ -46,6 +47,7 @@ enum {
     OPT_UP,
     OPT_FOV,
     OPT_TIME,
+    OPT_AOV,
     OPT_STATS,
     OPT_STATS_JSON,
     OPT_QUIET,
@@ -98,6 +100,10 @@ static const cli_option *render_options(size_t *n)
         add((cli_option){.name = "time", .id = OPT_TIME, .kind = CLI_STRING, .arg = "SECONDS",
                          .help = "render passes of --spp samples per pixel until SECONDS have passed (at least "
                                  "one pass); the image is the mean of all passes"});
+        add((cli_option){.name = "aov", .id = OPT_AOV, .kind = CLI_STRING, .arg = "LIST",
+                         .help = "also write these outputs beside OUT as NAME.AOV.EXT, from the camera rays: "
+                                 "albedo, normal, depth, heatmap (nodes visited + primitives tested per camera "
+                                 "ray), comma-separated"});
         add((cli_option){.name = "fov", .id = OPT_FOV, .kind = CLI_STRING, .arg = "DEG",
                          .help = "vertical field of view in degrees, between 0 and 180"});
         add((cli_option){.name = "stats", .id = OPT_STATS, .kind = CLI_FLAG,
@@ -167,6 +173,7 @@ typedef struct cli_opts {
     int has_integrator;
     pk_integrator_kind integrator;
     double time;         /* --time: seconds of passes, 0 when not given */
+    unsigned aovs;       /* --aov: PK_AOV_* */
     int has_from, has_at, has_up, has_fov;
     float from[3], at[3], up[3], fov;
 } cli_opts;
@@ -250,6 +257,17 @@ static int parse_args(int argc, char **argv, cli_opts *o)
             o->time = strtod(v, &end);
             if (*end || end == v || !(o->time > 0.0 && o->time <= 1e7))
                 return cli_usage_error("--time: '%s' must be a number of seconds in (0, 10000000]", v);
+            break;
+        }
+        case OPT_AOV: {
+            char buf[128];
+            snprintf(buf, sizeof buf, "%s", v);
+            for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
+                unsigned a = pk_aov_parse(tok);
+                if (!a) return cli_usage_error("--aov: unknown output '%s' (albedo, normal, depth, heatmap)", tok);
+                o->aovs |= a;
+            }
+            if (!o->aovs) return cli_usage_error("--aov: no output named (albedo, normal, depth, heatmap)");
             break;
         }
         case OPT_STATS: o->stats = 1; break;
@@ -392,14 +410,15 @@ static char *partial_name(const char *out)
 /* --time: passes of ro->spp samples into one film until seconds have
  * passed; the bar shows the time spent and the passes done. */
 static pk_status render_passes(pk_context *ctx, const pk_scene *scene, pk_render_options *ro, double seconds,
-                               cli_progress *bar, pk_image **img, pk_stats *stats, uint32_t *passes)
+                               unsigned aovs, cli_progress *bar, pk_image **img, pk_film **film_out,
+                               pk_stats *stats, uint32_t *passes)
 {
-    ro->progress = NULL; /* the bar follows the passes, not the tiles */
+    if (seconds > 0.0) ro->progress = NULL; /* the bar follows the passes, not the tiles */
     pk_renderer *r = NULL;
     pk_film *film = NULL;
     *img = NULL;
     pk_status st = pk_renderer_create(ctx, scene, ro, &r);
-    if (st == PK_OK) st = pk_film_create(ctx, ro->width, ro->height, &film);
+    if (st == PK_OK) st = pk_film_create_aovs(ctx, ro->width, ro->height, aovs, &film);
     const double t0 = cli_now();
     uint32_t k = 0;
     while (st == PK_OK) {
@@ -407,6 +426,7 @@ static pk_status render_passes(pk_context *ctx, const pk_scene *scene, pk_render
         st = pk_renderer_render(r, NULL, 0, film);
         if (st != PK_OK) break;
         k++;
+        if (seconds <= 0.0) break; /* one pass */
         const double el = cli_now() - t0;
         snprintf(bar->note, sizeof bar->note, "pass %u", k);
         cli_progress_update(bar, (uint64_t)(el < seconds ? el * 1000.0 : seconds * 1000.0),
@@ -419,9 +439,60 @@ static pk_status render_passes(pk_context *ctx, const pk_scene *scene, pk_render
         if (rs != PK_OK) st = rs;
     }
     if (r) pk_renderer_get_stats(r, stats);
-    pk_film_destroy(film);
+    *film_out = film;
     pk_renderer_destroy(r);
     return st;
+}
+
+/* "dir/name.png" + "depth" -> "dir/name.depth.png" */
+static char *aov_name(const char *out, const char *aov)
+{
+    size_t n = strlen(out);
+    const char *dot = strrchr(out, '.');
+    const char *slash = strrchr(out, '/');
+    if (!dot || (slash && dot < slash)) dot = out + n;
+    char *p = malloc(n + strlen(aov) + 2);
+    if (!p) return NULL;
+    size_t head = (size_t)(dot - out);
+    memcpy(p, out, head);
+    p[head] = '.';
+    strcpy(p + head + 1, aov);
+    strcat(p, dot);
+    return p;
+}
+
+/* For 8-bit PNG only: normals from [-1, 1] to [0, 1], depth divided by its
+ * largest value, the heatmap on a blue-green-red scale between its smallest
+ * and largest value (the range is printed). HDR files keep the raw values. */
+static void aov_for_png(pk_image *img, unsigned aov, int quiet)
+{
+    float *px = pk_image_pixels(img);
+    const size_t n = (size_t)pk_image_width(img) * (size_t)pk_image_height(img);
+    if (aov == PK_AOV_NORMAL) {
+        for (size_t i = 0; i < 3 * n; i++) px[i] = px[i] * 0.5f + 0.5f;
+        return;
+    }
+    if (aov != PK_AOV_DEPTH && aov != PK_AOV_HEATMAP) return;
+    float lo = INFINITY, hi = 0.0f;
+    for (size_t i = 0; i < n; i++) {
+        lo = px[3 * i] < lo ? px[3 * i] : lo;
+        hi = px[3 * i] > hi ? px[3 * i] : hi;
+    }
+    if (aov == PK_AOV_DEPTH) {
+        for (size_t i = 0; i < 3 * n; i++) px[i] = hi > 0.0f ? px[i] / hi : 0.0f;
+        if (!quiet) fprintf(stderr, "depth: black 0 to white %g (scene units)\n", (double)hi);
+        return;
+    }
+    for (size_t i = 0; i < n; i++) {
+        float t = hi > lo ? (px[3 * i] - lo) / (hi - lo) : 0.0f;
+        /* blue (few) -> green -> red (many), linear values for the sRGB encoding */
+        px[3 * i] = t > 0.5f ? 2.0f * t - 1.0f : 0.0f;
+        px[3 * i + 1] = t < 0.5f ? 2.0f * t : 2.0f - 2.0f * t;
+        px[3 * i + 2] = t < 0.5f ? 1.0f - 2.0f * t : 0.0f;
+    }
+    if (!quiet)
+        fprintf(stderr, "heatmap: blue %g to red %g nodes visited + primitives tested per camera ray\n", (double)lo,
+                (double)hi);
 }
 
 int cli_render(int argc, char **argv)
@@ -460,6 +531,7 @@ int cli_render(int argc, char **argv)
     }
     pk_scene *scene = NULL;
     pk_image *img = NULL;
+    pk_film *film = NULL; /* --time and --aov render into a film of their own */
     cli_progress bar;
     cli_progress_init(&bar, stderr, o.quiet);
     if (!o.quiet) pk_context_set_warning_handler(ctx, print_warning, &bar);
@@ -500,8 +572,8 @@ int cli_render(int argc, char **argv)
 
     pk_stats stats;
     uint32_t passes = 1;
-    if (o.time > 0.0)
-        st = render_passes(ctx, scene, &ro, o.time, &bar, &img, &stats, &passes);
+    if (o.time > 0.0 || o.aovs)
+        st = render_passes(ctx, scene, &ro, o.time, o.aovs, &bar, &img, &film, &stats, &passes);
     else
         st = pk_render(ctx, scene, &ro, &img, &stats);
     cli_progress_clear(&bar);
@@ -518,6 +590,22 @@ int cli_render(int argc, char **argv)
     }
     if (st != PK_OK) goto fail;
     if (pk_image_write_ex(ctx, img, o.out, &wo) != PK_OK) goto fail;
+    for (unsigned a = 1; a <= PK_AOV_HEATMAP; a <<= 1) {
+        if (!(o.aovs & a)) continue;
+        pk_image *ai = NULL;
+        char *name = aov_name(o.out, pk_aov_name(a));
+        if (!name || pk_film_resolve_aov(ctx, film, a, &ai) != PK_OK) {
+            free(name);
+            goto fail;
+        }
+        if (ends_with_ci(o.out, ".png")) aov_for_png(ai, a, o.quiet);
+        pk_write_options aw;
+        pk_write_options_init(&aw); /* no exposure: these are data, not pictures */
+        pk_status ws = pk_image_write_ex(ctx, ai, name, &aw);
+        pk_image_destroy(ai);
+        free(name);
+        if (ws != PK_OK) goto fail;
+    }
     if (bar.enabled) {
         char took[32];
         cli_format_duration(took, sizeof took, cli_now() - t0);
@@ -536,6 +624,7 @@ fail:
     cli_progress_clear(&bar);
     rc = cli_fail_ctx(ctx);
 out:
+    pk_film_destroy(film);
     pk_image_destroy(img);
     pk_scene_destroy(scene);
     pk_context_destroy(ctx);

@@ -139,6 +139,19 @@ typedef struct pk_render_options {
     int seed;            /* the path tracer's noise pattern (0..2^31-1) */
 } pk_render_options;
 
+/* Arbitrary output variables: what the camera ray of each sample found,
+ * averaged over the pixel like the image. A film holds those it was created
+ * with (pk_film_create_aovs); renders fill them. */
+enum {
+    PK_AOV_ALBEDO = 1u,  /* the material's diffuse reflectance (0 where nothing is hit) */
+    PK_AOV_NORMAL = 2u,  /* the shading normal, world space, facing the camera */
+    PK_AOV_DEPTH = 4u,   /* distance from the camera to the hit (0 where nothing is hit) */
+    PK_AOV_HEATMAP = 8u  /* acceleration-structure nodes visited + primitives tested by the camera ray */
+};
+/* "albedo", "normal", "depth", "heatmap" -> PK_AOV_*, 0 when unknown. */
+PK_API unsigned pk_aov_parse(const char *name);
+PK_API const char *pk_aov_name(unsigned aov);
+
 /* Defaults: 512x512, 1 spp, 32 light samples, depth 8, all threads, default
  * accelerator, Fresnel on, no statistics, no progress callback. */
 PK_API void pk_render_options_init(pk_render_options *opt);
@@ -271,6 +284,12 @@ PK_API pk_status pk_image_write_ex(pk_context *ctx, const pk_image *img, const c
 typedef struct pk_film pk_film;
 
 PK_API pk_status pk_film_create(pk_context *ctx, int width, int height, pk_film **out);
+/* A film that also holds the AOVs of the mask aovs (PK_AOV_*). */
+PK_API pk_status pk_film_create_aovs(pk_context *ctx, int width, int height, unsigned aovs, pk_film **out);
+PK_API unsigned pk_film_aovs(const pk_film *film);
+/* The AOV (one PK_AOV_* the film holds) as a new image: per-pixel means;
+ * depth and heatmap in all three channels. */
+PK_API pk_status pk_film_resolve_aov(pk_context *ctx, const pk_film *film, unsigned aov, pk_image **out);
 PK_API void pk_film_destroy(pk_film *film);
 PK_API int pk_film_width(const pk_film *film);
 PK_API int pk_film_height(const pk_film *film);

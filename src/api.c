@@ -317,7 +317,7 @@ pk_status pk_render(pk_context *ctx, const pk_scene *scene, const pk_render_opti
     pk_status st = pk_renderer_create(ctx, scene, opt, &r);
     if (st != PK_OK) return st;
     const pk_render_options *o = renderer_options(r);
-    if ((st = film_create(ctx, o->width, o->height, &film)) != PK_OK) goto out;
+    if ((st = film_create(ctx, o->width, o->height, 0, &film)) != PK_OK) goto out;
     if ((st = image_create(ctx, o->width, o->height, &img)) != PK_OK) goto out;
     st = renderer_render(r, NULL, 0, film);
     if (st == PK_OK || st == PK_ERR_CANCELLED) {
@@ -338,7 +338,49 @@ out:
 pk_status pk_film_create(pk_context *ctx, int width, int height, pk_film **out)
 {
     if (!ctx || !out) return PK_ERR_INVALID_ARGUMENT;
-    return film_create(ctx, width, height, out);
+    return film_create(ctx, width, height, 0, out);
+}
+
+pk_status pk_film_create_aovs(pk_context *ctx, int width, int height, unsigned aovs, pk_film **out)
+{
+    if (!ctx || !out) return PK_ERR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (aovs & ~(PK_AOV_ALBEDO | PK_AOV_NORMAL | PK_AOV_DEPTH | PK_AOV_HEATMAP))
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "unknown AOV bits 0x%x", aovs);
+    return film_create(ctx, width, height, aovs, out);
+}
+
+unsigned pk_film_aovs(const pk_film *film) { return film ? film->aovs : 0; }
+
+static const char *const aov_names[FILM_AOVS] = {"albedo", "normal", "depth", "heatmap"};
+
+unsigned pk_aov_parse(const char *name)
+{
+    if (!name) return 0;
+    for (int k = 0; k < FILM_AOVS; k++)
+        if (strcmp(name, aov_names[k]) == 0) return 1u << k;
+    return 0;
+}
+
+const char *pk_aov_name(unsigned aov)
+{
+    for (int k = 0; k < FILM_AOVS; k++)
+        if (aov == 1u << k) return aov_names[k];
+    return "unknown";
+}
+
+pk_status pk_film_resolve_aov(pk_context *ctx, const pk_film *film, unsigned aov, pk_image **out)
+{
+    if (!ctx || !film || !out) return PK_ERR_INVALID_ARGUMENT;
+    *out = NULL;
+    int k = -1;
+    for (int i = 0; i < FILM_AOVS; i++)
+        if (aov == 1u << i) k = i;
+    if (k < 0 || !(film->aovs & aov))
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "the film holds no AOV '%s'", pk_aov_name(aov));
+    pk_status st = image_create(ctx, film->width, film->height, out);
+    if (st == PK_OK) film_resolve_aov_into(film, k, *out);
+    return st;
 }
 
 void pk_film_destroy(pk_film *film) { film_destroy(film); }

@@ -17,11 +17,15 @@ struct pk_image {
 
 /* Invariants: sums holds 3*width*height floats and counts width*height
  * sample counts, rows top first; a pixel with count 0 has zero sums. */
+#define FILM_AOVS 4 /* albedo, normal, depth, heatmap: bit k of the mask is aov[k] */
+
 struct pk_film {
     pk_allocator alloc;
     int width, height;
     float *sums;
     uint32_t *counts;
+    unsigned aovs;              /* PK_AOV_* held */
+    float *aov[FILM_AOVS];      /* 3 floats per pixel each (sums), NULL when not held */
 };
 
 /* Checks the size against PK_MAX_IMAGE_SIDE and PK_MAX_IMAGE_PIXELS;
@@ -30,7 +34,7 @@ PK_HIDDEN pk_status image_check_size(pk_context *ctx, const char *what, int widt
 /* Zeroed storage of the given size (checked). */
 PK_HIDDEN pk_status image_create(pk_context *ctx, int width, int height, pk_image **out);
 PK_HIDDEN void image_destroy(pk_image *img);
-PK_HIDDEN pk_status film_create(pk_context *ctx, int width, int height, pk_film **out);
+PK_HIDDEN pk_status film_create(pk_context *ctx, int width, int height, unsigned aovs, pk_film **out);
 PK_HIDDEN void film_destroy(pk_film *film);
 PK_HIDDEN void film_clear(pk_film *film);
 /* dst += src (same size, checked by the caller). */
@@ -38,6 +42,10 @@ PK_HIDDEN void film_merge(pk_film *dst, const pk_film *src);
 /* Adds a block of w x h pixels at (x, y): rgb holds 3 floats per pixel, row
  * after row, each the sum of spp samples. */
 PK_HIDDEN void film_add_block(pk_film *film, int x, int y, int w, int h, const float *rgb, uint32_t spp);
+/* Adds AOV k's block (3 floats per pixel, sums over the same samples). */
+PK_HIDDEN void film_add_aov_block(pk_film *film, int k, int x, int y, int w, int h, const float *v);
+/* img = AOV k's sums / counts. */
+PK_HIDDEN void film_resolve_aov_into(const pk_film *film, int k, pk_image *img);
 /* img (same size) = sums / counts, 0 where there is no sample or the mean is not finite. */
 PK_HIDDEN void film_resolve_into(const pk_film *film, pk_image *img);
 

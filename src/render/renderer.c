@@ -12,6 +12,7 @@
 #include "camera.h"
 #include "path.h"
 #include "sampling.h"
+#include "surface.h"
 #include "whitted.h"
 
 #include <omp.h>
@@ -216,6 +217,27 @@ static pk_status check_regions(pk_context *ctx, const pk_region *reg, size_t n, 
 
 /* Renders one tile into acc (3 floats per pixel, the sums of spp samples);
  * false when the render was cancelled before the tile finished. */
+/* The camera ray of sample smp (0..spp-1 of the current pass) of pixel
+ * (px, py): the path tracer's from its sampler's first two dimensions, the
+ * Whitted integrator's through the pixel centre at 1 spp and jittered in
+ * sx x sy strata above. Both tile loops and the AOVs take their rays here. */
+static inline ray sample_camera_ray(const pk_renderer *r, const camera_frame *cf, int px, int py, int smp)
+{
+    const int spp = r->opt.spp;
+    float jx = 0.5f, jy = 0.5f;
+    if (r->path) {
+        sampler sm = sampler_start((uint32_t)px, (uint32_t)py, r->pass * (uint32_t)spp + (uint32_t)smp, r->pt.seed);
+        sampler_2d(&sm, &jx, &jy);
+    } else if (spp > 1) {
+        const int sx = (int)ceilf(sqrtf((float)spp)), sy = (spp + sx - 1) / sx;
+        const uint64_t first = (uint64_t)r->pass * (uint64_t)spp;
+        rng jr = rng_seed(((uint64_t)py << 32) | (uint32_t)px, (first + (uint64_t)smp) * 2 + 1);
+        jx = ((float)(smp % sx) + rng_float(&jr)) / (float)sx;
+        jy = ((float)(smp / sx) + rng_float(&jr)) / (float)sy;
+    }
+    return camera_ray(cf, (float)px + jx, (float)py + jy);
+}
+
 /* The path tracer's version of render_tile: the pixel position of each
  * sample comes from its sampler (the first two dimensions). */
 static bool render_tile_path(const pk_renderer *r, path_thread *me, const camera_frame *cf, const tile *tl,
@@ -229,13 +251,7 @@ static bool render_tile_path(const pk_renderer *r, path_thread *me, const camera
     memset(acc, 0, sizeof(float) * 3 * (size_t)n);
     for (int smp = 0; smp < spp; smp++) {
         if (smp > 0 && ((cancel && *cancel) || atomic_load_explicit(stop, memory_order_relaxed))) return false;
-        for (int i = 0; i < n; i++) {
-            int px = tl->x + i % tw, py = tl->y + i / tw;
-            sampler sm = sampler_start((uint32_t)px, (uint32_t)py, first + (uint32_t)smp, r->pt.seed);
-            float jx, jy;
-            sampler_2d(&sm, &jx, &jy);
-            rays[i] = camera_ray(cf, (float)px + jx, (float)py + jy);
-        }
+        for (int i = 0; i < n; i++) rays[i] = sample_camera_ray(r, cf, tl->x + i % tw, tl->y + i / tw, smp);
         me->rays_camera += (uint64_t)n;
         accel_intersect_many(r->fr.a, rays, hits, (size_t)n, false, me->cp);
         for (int i = 0; i < n; i++) {
@@ -259,7 +275,6 @@ static bool render_tile(const pk_renderer *r, whitted_thread *me, const camera_f
     const whitted *w = &r->w;
     const int spp = r->opt.spp;
     const uint64_t first = (uint64_t)r->pass * (uint64_t)spp; /* the pass's first sample number */
-    const int sx = (int)ceilf(sqrtf((float)spp)), sy = (spp + sx - 1) / sx;
     const int tw = tl->w, n = tl->w * tl->h;
     ray rays[BATCH];
     hit hits[BATCH];
@@ -267,16 +282,7 @@ static bool render_tile(const pk_renderer *r, whitted_thread *me, const camera_f
     for (int smp = 0; smp < spp; smp++) {
         /* also between passes: a tile at many samples may take long */
         if (smp > 0 && ((cancel && *cancel) || atomic_load_explicit(stop, memory_order_relaxed))) return false;
-        for (int i = 0; i < n; i++) {
-            int px = tl->x + i % tw, py = tl->y + i / tw;
-            float jx = 0.5f, jy = 0.5f;
-            if (spp > 1) {
-                rng jr = rng_seed(((uint64_t)py << 32) | (uint32_t)px, (first + (uint64_t)smp) * 2 + 1);
-                jx = ((float)(smp % sx) + rng_float(&jr)) / (float)sx;
-                jy = ((float)(smp / sx) + rng_float(&jr)) / (float)sy;
-            }
-            rays[i] = camera_ray(cf, (float)px + jx, (float)py + jy);
-        }
+        for (int i = 0; i < n; i++) rays[i] = sample_camera_ray(r, cf, tl->x + i % tw, tl->y + i / tw, smp);
         me->rays[RAY_CAMERA] += (uint64_t)n;
         accel_intersect_many(w->f->a, rays, hits, (size_t)n, false, me->cp);
         for (int i = 0; i < n; i++) {
@@ -291,6 +297,34 @@ static bool render_tile(const pk_renderer *r, whitted_thread *me, const camera_f
         }
     }
     return true;
+}
+
+/* The AOVs of a finished tile, from the camera rays of its samples (traced
+ * again, one at a time, so that each ray's nodes and tests are its own). */
+static void render_tile_aovs(const pk_renderer *r, const camera_frame *cf, const tile *tl, pk_film *film)
+{
+    const pk_scene *s = r->fr.s;
+    const int tw = tl->w, n = tl->w * tl->h;
+    float v[FILM_AOVS][BATCH * 3];
+    memset(v, 0, sizeof v);
+    for (int smp = 0; smp < r->opt.spp; smp++)
+        for (int i = 0; i < n; i++) {
+            ray cr = sample_camera_ray(r, cf, tl->x + i % tw, tl->y + i / tw, smp);
+            accel_counters c = {0, 0};
+            hit h;
+            const bool got = r->fr.a->ops->intersect(r->fr.a, &cr, &h, (film->aovs & PK_AOV_HEATMAP) ? &c : NULL);
+            float *a = &v[0][3 * i], *nn = &v[1][3 * i], *d = &v[2][3 * i], *hm = &v[3][3 * i];
+            const float heat = (float)(c.nodes + c.tests);
+            hm[0] += heat, hm[1] += heat, hm[2] += heat;
+            if (!got) continue;
+            surface sf = surface_at(s, &cr, &h);
+            a[0] += sf.m->kd.x, a[1] += sf.m->kd.y, a[2] += sf.m->kd.z;
+            nn[0] += sf.ns.x, nn[1] += sf.ns.y, nn[2] += sf.ns.z;
+            const float dist = h.t * v3_len(cr.d);
+            d[0] += dist, d[1] += dist, d[2] += dist;
+        }
+    for (int k = 0; k < FILM_AOVS; k++)
+        if (film->aovs & (1u << k)) film_add_aov_block(film, k, tl->x, tl->y, tl->w, tl->h, v[k]);
 }
 
 pk_status renderer_render(pk_renderer *r, const pk_region *regions, size_t nregions, pk_film *film)
@@ -362,6 +396,7 @@ pk_status renderer_render(pk_renderer *r, const pk_region *regions, size_t nregi
                 continue;
             }
             film_add_block(film, tl->x, tl->y, tl->w, tl->h, acc, (uint32_t)opt->spp);
+            if (film->aovs) render_tile_aovs(r, &cf, tl, film);
             const long d = atomic_fetch_add_explicit(&done, 1, memory_order_relaxed) + 1;
             /* progress reports come from the calling thread only (OpenMP thread 0) */
             if (tid == 0 && opt->progress) {
