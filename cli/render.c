@@ -101,9 +101,9 @@ static const cli_option *render_options(size_t *n)
                          .help = "render passes of --spp samples per pixel until SECONDS have passed (at least "
                                  "one pass); the image is the mean of all passes"});
         add((cli_option){.name = "aov", .id = OPT_AOV, .kind = CLI_STRING, .arg = "LIST",
-                         .help = "also write these outputs beside OUT as NAME.AOV.EXT, from the camera rays: "
-                                 "albedo, normal, depth, heatmap (nodes visited + primitives tested per camera "
-                                 "ray), comma-separated"});
+                         .help = "also write these outputs, from the camera rays: albedo, normal, depth, "
+                                 "heatmap (nodes visited + primitives tested per camera ray), comma-separated; "
+                                 "layers NAME.R/G/B of an .exr OUT, else files beside OUT as NAME.AOV.EXT"});
         add((cli_option){.name = "fov", .id = OPT_FOV, .kind = CLI_STRING, .arg = "DEG",
                          .help = "vertical field of view in degrees, between 0 and 180"});
         add((cli_option){.name = "stats", .id = OPT_STATS, .kind = CLI_FLAG,
@@ -589,9 +589,30 @@ int cli_render(int argc, char **argv)
         goto out;
     }
     if (st != PK_OK) goto fail;
-    if (pk_image_write_ex(ctx, img, o.out, &wo) != PK_OK) goto fail;
+    if (o.aovs && ends_with_ci(o.out, ".exr")) {
+        /* one file: the AOVs as layers */
+        pk_image *li[4] = {NULL, NULL, NULL, NULL};
+        const char *ln[4];
+        size_t nl = 0;
+        pk_status ls = PK_OK;
+        for (unsigned a = 1; a <= PK_AOV_HEATMAP && ls == PK_OK; a <<= 1)
+            if (o.aovs & a) {
+                ln[nl] = pk_aov_name(a);
+                ls = pk_film_resolve_aov(ctx, film, a, &li[nl++]);
+            }
+        if (ls == PK_OK) {
+            wo.nlayers = nl;
+            wo.layers = (const pk_image *const *)li;
+            wo.layer_names = ln;
+            ls = pk_image_write_ex(ctx, img, o.out, &wo);
+        }
+        for (size_t l = 0; l < 4; l++) pk_image_destroy(li[l]);
+        if (ls != PK_OK) goto fail;
+    } else if (pk_image_write_ex(ctx, img, o.out, &wo) != PK_OK) {
+        goto fail;
+    }
     for (unsigned a = 1; a <= PK_AOV_HEATMAP; a <<= 1) {
-        if (!(o.aovs & a)) continue;
+        if (!(o.aovs & a) || ends_with_ci(o.out, ".exr")) continue;
         pk_image *ai = NULL;
         char *name = aov_name(o.out, pk_aov_name(a));
         if (!name || pk_film_resolve_aov(ctx, film, a, &ai) != PK_OK) {

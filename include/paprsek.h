@@ -265,6 +265,12 @@ PK_API pk_status pk_image_write(pk_context *ctx, const pk_image *img, const char
 #define PK_MAX_EXPOSURE_EV 20
 typedef struct pk_write_options {
     float exposure_ev;
+    /* .exr only: more images of the same size written into the same file as
+     * layers, channels "NAME.R", "NAME.G", "NAME.B" (the AOVs). Other formats
+     * refuse layers. */
+    size_t nlayers;
+    const pk_image *const *layers;
+    const char *const *layer_names;
 } pk_write_options;
 
 PK_API void pk_write_options_init(pk_write_options *wo);

@@ -103,16 +103,25 @@ fail:
     return -1;
 }
 
-/* The image's R, G, B as three channels of one OpenEXR part. */
-static int write_exr(FILE *f, const pk_image *img, char *why, size_t nwhy)
+#define EXR_MAX_LAYERS ((PK_EXR_MAX_CHANNELS - 3) / 3)
+
+/* The image's R, G, B as three channels of one OpenEXR part, and each layer's
+ * as "NAME.R", "NAME.G", "NAME.B" (checked by the caller). */
+static int write_exr(FILE *f, const pk_image *img, const pk_write_options *wo, char *why, size_t nwhy)
 {
     const size_t row = (size_t)img->width * 3;
-    const exr_channel rgb[3] = {
-        {"R", img->pixels + 0, 3, row},
-        {"G", img->pixels + 1, 3, row},
-        {"B", img->pixels + 2, 3, row},
-    };
-    return exr_write_channels(fileno(f), img->width, img->height, rgb, 3, why, nwhy);
+    exr_channel ch[PK_EXR_MAX_CHANNELS];
+    char names[EXR_MAX_LAYERS][3][72];
+    int n = 0;
+    ch[n++] = (exr_channel){"R", img->pixels + 0, 3, row};
+    ch[n++] = (exr_channel){"G", img->pixels + 1, 3, row};
+    ch[n++] = (exr_channel){"B", img->pixels + 2, 3, row};
+    for (size_t l = 0; l < wo->nlayers; l++)
+        for (int c = 0; c < 3; c++) {
+            snprintf(names[l][c], sizeof names[l][c], "%s.%c", wo->layer_names[l], "RGB"[c]);
+            ch[n++] = (exr_channel){names[l][c], wo->layers[l]->pixels + c, 3, row};
+        }
+    return exr_write_channels(fileno(f), img->width, img->height, ch, n, why, nwhy);
 }
 
 void pk_write_options_init(pk_write_options *wo)
@@ -149,6 +158,25 @@ pk_status image_write_ex(pk_context *ctx, const pk_image *img, const char *path,
     bool png = ends_with(path, ".png"), pfm = ends_with(path, ".pfm"), exr = ends_with(path, ".exr");
     if (!png && !pfm && !exr)
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: unknown image format (use .png, .pfm or .exr)", path);
+    if (wo->nlayers) {
+        if (!exr) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: layers are written to .exr files only", path);
+        if (wo->nlayers > EXR_MAX_LAYERS || !wo->layers || !wo->layer_names)
+            return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: at most %d layers, each with an image and a name", path,
+                             (int)EXR_MAX_LAYERS);
+        for (size_t l = 0; l < wo->nlayers; l++) {
+            const pk_image *li = wo->layers[l];
+            const char *nm = wo->layer_names[l];
+            if (!li || li->width != img->width || li->height != img->height)
+                return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: layer %zu is not a %dx%d image", path, l,
+                                 img->width, img->height);
+            if (!nm || !nm[0] || strlen(nm) > 64 || strchr(nm, '.'))
+                return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: layer %zu needs a name of 1..64 characters without '.'",
+                                 path, l);
+            for (size_t m = 0; m < l; m++)
+                if (strcmp(nm, wo->layer_names[m]) == 0)
+                    return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: two layers named '%s'", path, nm);
+        }
+    }
     size_t lp = strlen(path);
     char *tmp = mem_alloc(&ctx->alloc, lp + 16);
     unsigned char *row = png ? mem_alloc(&ctx->alloc, (size_t)img->width * 3) : NULL;
@@ -175,7 +203,7 @@ pk_status image_write_ex(pk_context *ctx, const pk_image *img, const char *path,
         goto out;
     }
     int rc = png   ? write_png(f, img, scale, row, why, sizeof why)
-             : exr ? write_exr(f, img, why, sizeof why)
+             : exr ? write_exr(f, img, wo, why, sizeof why)
                    : write_pfm(f, img, why, sizeof why);
     if (rc == 0 && fflush(f) != 0) {
         rc = -1;

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# --aov: the outputs beside OUT as NAME.AOV.EXT, for PNG and PFM; an unknown
+# --aov: the outputs beside OUT as NAME.AOV.EXT for PNG and PFM, layers of an
+# .exr OUT; an unknown
 # name is a usage error (exit 2) and nothing is written.
 # usage: test_aov.sh PAPRSEK SHARED_DIR DATA_DIR
 set -u
@@ -22,6 +23,9 @@ grep -q "^heatmap: blue [0-9.e+]* to red [0-9.e+]* nodes visited" "$tmp/err" && 
 "$bin" render -o "$tmp/d.pfm" --width 24 --height 16 --aov depth --quiet
 [ "$(head -c 2 "$tmp/d.depth.pfm")" = PF ] && ok "d.depth.pfm is a colour PFM" || bad "d.depth.pfm"
 [ ! -e "$tmp/d.albedo.pfm" ] && ok "only the AOVs asked for" || bad "an AOV not asked for was written"
+"$bin" render -o "$tmp/x.exr" --width 24 --height 16 --aov depth,albedo --quiet
+[ -s "$tmp/x.exr" ] && [ ! -e "$tmp/x.depth.exr" ] && grep -aq 'depth\.R' "$tmp/x.exr" && grep -aq 'albedo\.B' "$tmp/x.exr" &&
+  ok "an .exr holds the AOVs as layers" || bad "AOV layers in .exr"
 "$bin" render -o "$tmp/e.png" --aov depth,colour 2>"$tmp/err"
 rc=$?
 [ $rc -eq 2 ] && grep -q "unknown output 'colour'" "$tmp/err" && [ ! -e "$tmp/e.png" ] &&

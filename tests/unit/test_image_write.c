@@ -372,12 +372,70 @@ static void test_png_exposure(void)
     pk_image_destroy(img);
 }
 
+/* pk_image_write_ex with layers: the image's R, G, B and each layer's
+ * NAME.R/G/B, bit for bit; layers are refused for other formats, for another
+ * size and for a repeated name, and nothing is written then. */
+static void test_write_layers(void)
+{
+    pk_image *img = NULL, *lay = NULL, *small = NULL;
+    REQUIRE(pk_image_create(ctx, 5, 3, &img) == PK_OK && pk_image_create(ctx, 5, 3, &lay) == PK_OK &&
+            pk_image_create(ctx, 4, 3, &small) == PK_OK);
+    for (int i = 0; i < 45; i++) {
+        pk_image_pixels(img)[i] = (float)i + 0.5f;
+        pk_image_pixels(lay)[i] = -1.0f / (float)(i + 1);
+    }
+    char path[256];
+    snprintf(path, sizeof path, "%s/with_layers.exr", dir);
+    const pk_image *layers[2] = {lay, lay};
+    const char *names[2] = {"normal", "normal"};
+    pk_write_options wo;
+    pk_write_options_init(&wo);
+    wo.nlayers = 1;
+    wo.layers = layers;
+    wo.layer_names = names;
+    REQUIRE(pk_image_write_ex(ctx, img, path, &wo) == PK_OK);
+    exr_read r;
+    REQUIRE(read_exr(path, &r) == 0);
+    const char *sorted[] = {"B", "G", "R", "normal.B", "normal.G", "normal.R"};
+    CHECK(r.nch == 6);
+    for (int k = 0; k < r.nch && k < 6; k++) {
+        CHECKF(strcmp(r.names[k], sorted[k]) == 0, "channel %d is %s", k, r.names[k]);
+        const pk_image *src = k < 3 ? img : lay;
+        const int c = 2 - k % 3; /* B, G, R */
+        long bad = 0;
+        for (int i = 0; i < 15; i++)
+            if (bits(pk_image_pixels_const(src)[3 * i + c]) != bits(r.planes[k][i])) bad++;
+        CHECKF(bad == 0, "%s: %ld samples differ", r.names[k], bad);
+    }
+    free_read(&r);
+    remove(path);
+    /* refusals */
+    const int before = count_files();
+    snprintf(path, sizeof path, "%s/layers.png", dir);
+    CHECK(pk_image_write_ex(ctx, img, path, &wo) == PK_ERR_INVALID_ARGUMENT);
+    CHECK(strstr(pk_context_error(ctx), "layers are written to .exr files only") != NULL);
+    pk_context_clear_error(ctx);
+    snprintf(path, sizeof path, "%s/bad.exr", dir);
+    wo.nlayers = 2;
+    CHECK(pk_image_write_ex(ctx, img, path, &wo) == PK_ERR_INVALID_ARGUMENT);
+    CHECK(strstr(pk_context_error(ctx), "two layers named 'normal'") != NULL);
+    pk_context_clear_error(ctx);
+    layers[1] = small;
+    names[1] = "depth";
+    CHECK(pk_image_write_ex(ctx, img, path, &wo) == PK_ERR_INVALID_ARGUMENT);
+    CHECK(strstr(pk_context_error(ctx), "layer 1 is not a 5x3 image") != NULL);
+    pk_context_clear_error(ctx);
+    CHECK(count_files() == before);
+    pk_image_destroy(img), pk_image_destroy(lay), pk_image_destroy(small);
+}
+
 int main(void)
 {
     REQUIRE(mkdtemp(dir));
     REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
     test_exr_round_trip();
     test_exr_layers();
+    test_write_layers();
     test_exr_missing_folder();
     test_png_exposure();
     pk_context_destroy(ctx);
