@@ -255,10 +255,185 @@ enum { MF_NAME, MF_KD, MF_KS, MF_KE, MF_TF, MF_KA, MF_NS, MF_NI, MF_D, MF_ILLUM,
 static const char *const material_keys[MF_COUNT] = {"name", "kd", "ks", "ke", "tf", "ka",
                                                     "ns", "ni", "d",  "illum", "two_sided"};
 
+/* A reflectance: three finite numbers in 0..1. */
+static pk_status get_reflectance(jp *p, const cJSON *it, const char *path, vec3 *out)
+{
+    pk_status st = get_vec3(p, it, path, out);
+    if (st == PK_OK && !(out->x >= 0.0f && out->y >= 0.0f && out->z >= 0.0f && out->x <= 1.0f &&
+                         out->y <= 1.0f && out->z <= 1.0f))
+        return jfail(p, PK_ERR_PARSE, it, path, "components must be in 0..1");
+    return st;
+}
+
+/* A number in 0..1 (roughness, alpha). */
+static pk_status get_unit(jp *p, const cJSON *it, const char *path, float *out)
+{
+    pk_status st = get_float(p, it, path, out);
+    if (st == PK_OK && !(*out >= 0.0f && *out <= 1.0f)) return jfail(p, PK_ERR_PARSE, it, path, "must be in 0..1");
+    return st;
+}
+
+/* Fresnel reflectance at normal incidence from a dielectric of index ior. */
+static float f0_dielectric(float ior)
+{
+    float r = (ior - 1.0f) / (ior + 1.0f);
+    return r * r;
+}
+
+/* The MTL Phong exponent whose path tracer alpha (sqrt(2/(Ns+2))) is alpha. */
+static float ns_from_alpha(float alpha) { return alpha < 1e-3f ? 1000.0f : fmaxf(2.0f / (alpha * alpha) - 2.0f, 0.0f); }
+
+/* The physically based material types (docs/materials.md). The keys of each:
+ * the common ones ("type", "two_sided") and the type's parameters. */
+enum { TP_ALBEDO, TP_SPECULAR, TP_ETA, TP_K, TP_ROUGHNESS, TP_ALPHA, TP_IOR, TP_TRANSMITTANCE, TP_RADIANCE, TP_COUNT };
+static const char *const tp_keys[TP_COUNT] = {"albedo", "specular", "eta",           "k",       "roughness",
+                                              "alpha",  "ior",      "transmittance", "radiance"};
+typedef struct mat_type_def {
+    const char *name;
+    int nparams;
+    int params[5];
+} mat_type_def;
+static const mat_type_def mat_types[] = {
+    {"diffuse", 1, {TP_ALBEDO}},
+    {"conductor", 5, {TP_ETA, TP_K, TP_SPECULAR, TP_ROUGHNESS, TP_ALPHA}},
+    {"dielectric", 3, {TP_IOR, TP_ROUGHNESS, TP_TRANSMITTANCE}},
+    {"plastic", 3, {TP_ALBEDO, TP_IOR, TP_ROUGHNESS}},
+    {"emitter", 1, {TP_RADIANCE}},
+};
+#define N_MAT_TYPES (sizeof mat_types / sizeof mat_types[0])
+
+/* Reads a material object with a "type" (type_item) into *m. */
+static pk_status read_typed_material(jp *p, const cJSON *obj, const cJSON *type_item, const char *path,
+                                     bool with_name, material *m, const cJSON **name_item)
+{
+    char fp[JP_PATH_MAX];
+    path_key(fp, path, "type");
+    size_t t = 0;
+    if (cJSON_IsString(type_item))
+        while (t < N_MAT_TYPES && strcmp(type_item->valuestring, mat_types[t].name) != 0) t++;
+    if (!cJSON_IsString(type_item) || t == N_MAT_TYPES)
+        return jfail(p, PK_ERR_PARSE, type_item, fp,
+                     "must be one of \"diffuse\", \"conductor\", \"dielectric\", \"plastic\", \"emitter\"");
+    const mat_type_def *def = &mat_types[t];
+    /* the known keys: "type", "two_sided", the type's parameters, and "name"
+     * where materials are listed in an array */
+    const char *keys[8];
+    const cJSON *f[8];
+    size_t nk = 0;
+    keys[nk++] = "type", keys[nk++] = "two_sided";
+    for (int i = 0; i < def->nparams; i++) keys[nk++] = tp_keys[def->params[i]];
+    if (with_name) keys[nk++] = "name";
+    pk_status st = object_fields(p, obj, path, keys, nk, f);
+    if (st) return st;
+    const cJSON *pv[TP_COUNT] = {NULL}; /* the parameters by their TP_ number */
+    for (int i = 0; i < def->nparams; i++) pv[def->params[i]] = f[2 + i];
+    const cJSON *two_sided = f[1];
+    if (name_item) *name_item = with_name ? f[nk - 1] : NULL;
+
+    material_init(m);
+    char pp[TP_COUNT][JP_PATH_MAX];
+    for (int i = 0; i < TP_COUNT; i++)
+        if (pv[i]) path_key(pp[i], path, tp_keys[i]);
+    float roughness = 0.0f, alpha = 0.0f, ior = 1.5f;
+    vec3 albedo = v3s(0.5f), transmittance = v3s(1.0f);
+    if (pv[TP_ALBEDO] && (st = get_reflectance(p, pv[TP_ALBEDO], pp[TP_ALBEDO], &albedo))) return st;
+    if (pv[TP_TRANSMITTANCE] &&
+        (st = get_reflectance(p, pv[TP_TRANSMITTANCE], pp[TP_TRANSMITTANCE], &transmittance)))
+        return st;
+    if (pv[TP_ROUGHNESS]) {
+        if ((st = get_unit(p, pv[TP_ROUGHNESS], pp[TP_ROUGHNESS], &roughness))) return st;
+        alpha = roughness * roughness;
+    }
+    if (pv[TP_ALPHA]) {
+        if (pv[TP_ROUGHNESS])
+            return jfail(p, PK_ERR_PARSE, pv[TP_ALPHA], pp[TP_ALPHA], "give \"roughness\" or \"alpha\", not both");
+        if ((st = get_unit(p, pv[TP_ALPHA], pp[TP_ALPHA], &alpha))) return st;
+    }
+    if (pv[TP_IOR]) {
+        if ((st = get_float(p, pv[TP_IOR], pp[TP_IOR], &ior))) return st;
+        if (!(ior > 0.0f)) return jfail(p, PK_ERR_PARSE, pv[TP_IOR], pp[TP_IOR], "must be a positive number");
+        if (ior == 1.0f && alpha > 0.0f)
+            return jfail(p, PK_ERR_PARSE, pv[TP_IOR], pp[TP_IOR], "must not be 1 on a rough surface (roughness > 0)");
+    }
+    m->alpha = alpha;
+    /* the MTL fields: what the Whitted integrator renders of each type */
+    switch (t) {
+    case 0: /* diffuse */
+        m->type = MAT_DIFFUSE;
+        m->kd = albedo;
+        break;
+    case 1: { /* conductor */
+        m->type = MAT_CONDUCTOR;
+        m->eta = v3(0.2f, 0.92f, 1.1f), m->k = v3(3.9f, 2.45f, 2.14f); /* copper, as pbrt */
+        vec3 f0;
+        if (pv[TP_SPECULAR]) {
+            const cJSON *other = pv[TP_ETA] ? pv[TP_ETA] : pv[TP_K];
+            if (other) {
+                char op[JP_PATH_MAX];
+                path_key(op, path, pv[TP_ETA] ? "eta" : "k");
+                return jfail(p, PK_ERR_PARSE, other, op, "give \"eta\" and \"k\" or \"specular\", not both");
+            }
+            if ((st = get_reflectance(p, pv[TP_SPECULAR], pp[TP_SPECULAR], &f0))) return st;
+            m->schlick = true;
+        } else {
+            if (pv[TP_ETA]) {
+                if ((st = get_vec3(p, pv[TP_ETA], pp[TP_ETA], &m->eta))) return st;
+                if (!(m->eta.x > 0.0f && m->eta.y > 0.0f && m->eta.z > 0.0f))
+                    return jfail(p, PK_ERR_PARSE, pv[TP_ETA], pp[TP_ETA], "components must be positive");
+            }
+            if (pv[TP_K]) {
+                if ((st = get_vec3(p, pv[TP_K], pp[TP_K], &m->k))) return st;
+                if (!(m->k.x >= 0.0f && m->k.y >= 0.0f && m->k.z >= 0.0f))
+                    return jfail(p, PK_ERR_PARSE, pv[TP_K], pp[TP_K], "components must not be negative");
+            }
+            /* normal incidence: ((eta - 1)^2 + k^2) / ((eta + 1)^2 + k^2) */
+            const float e[3] = {m->eta.x, m->eta.y, m->eta.z}, k[3] = {m->k.x, m->k.y, m->k.z};
+            float r[3];
+            for (int c = 0; c < 3; c++)
+                r[c] = ((e[c] - 1.0f) * (e[c] - 1.0f) + k[c] * k[c]) / ((e[c] + 1.0f) * (e[c] + 1.0f) + k[c] * k[c]);
+            f0 = v3(r[0], r[1], r[2]);
+        }
+        m->kd = v3s(0.0f), m->ks = f0;
+        if (alpha < 1e-3f) m->illum = 3; /* a mirror weighted by the normal reflectance */
+        else m->ns = ns_from_alpha(alpha);
+        break;
+    }
+    case 2: /* dielectric */
+        m->type = MAT_DIELECTRIC;
+        m->ni = ior, m->tf = transmittance;
+        m->kd = v3s(0.0f), m->ks = v3s(f0_dielectric(ior));
+        m->illum = 7;
+        break;
+    case 3: /* plastic */
+        m->type = MAT_PLASTIC;
+        m->ni = ior, m->kd = albedo, m->ks = v3s(f0_dielectric(ior));
+        if (alpha < 1e-3f) m->illum = 3;
+        else m->ns = ns_from_alpha(alpha);
+        break;
+    default: /* emitter: black diffuse */
+        m->type = MAT_DIFFUSE;
+        m->kd = v3s(0.0f);
+        m->ke = v3s(1.0f);
+        if (pv[TP_RADIANCE]) {
+            path_key(fp, path, "radiance");
+            if ((st = get_color(p, pv[TP_RADIANCE], fp, &m->ke))) return st;
+        }
+        break;
+    }
+    if (two_sided) {
+        path_key(fp, path, "two_sided");
+        if (!cJSON_IsBool(two_sided)) return jfail(p, PK_ERR_PARSE, two_sided, fp, "must be true or false");
+        m->two_sided = cJSON_IsTrue(two_sided);
+    }
+    return PK_OK;
+}
+
 /* Reads a material object into *m (name not set). with_name: "name" is known. */
 static pk_status read_material(jp *p, const cJSON *obj, const char *path, bool with_name, material *m,
                                const cJSON **name_item)
 {
+    const cJSON *type_item = cJSON_IsObject(obj) ? cJSON_GetObjectItemCaseSensitive(obj, "type") : NULL;
+    if (type_item) return read_typed_material(p, obj, type_item, path, with_name, m, name_item);
     const cJSON *f[MF_COUNT];
     pk_status st = object_fields(p, obj, path, with_name ? material_keys : material_keys + 1,
                                  with_name ? MF_COUNT : MF_COUNT - 1, with_name ? f : f + 1);

@@ -5,7 +5,9 @@
  * diffuse; Ks with Ns a GGX lobe over it (illum 2); illum 3 an ideal mirror
  * weighted by Ks over the diffuse part, illum 5 a mirror with Fresnel;
  * illum 4, 6, 7 smooth dielectrics (Ni, Tf) with exact Fresnel; dissolve
- * d < 1 lets a fraction of the light pass straight through.
+ * d < 1 lets a fraction of the light pass straight through. The JSON
+ * material types (diffuse, conductor, dielectric, plastic) map to their
+ * pbsdf directly.
  */
 #include "path.h"
 
@@ -55,10 +57,22 @@ static shading shading_at(const surface *sf)
 {
     const material *m = sf->m;
     shading sh;
-    const bool glass = m->illum == 4 || m->illum == 6 || m->illum == 7;
-    sh.opaque = glass ? 1.0f : fminf(fmaxf(m->d, 0.0f), 1.0f);
+    const bool glass = m->type == MAT_MTL && (m->illum == 4 || m->illum == 6 || m->illum == 7);
+    sh.opaque = glass || m->type == MAT_DIELECTRIC ? 1.0f : fminf(fmaxf(m->d, 0.0f), 1.0f);
     vec3 n = sf->ns;
-    if (glass) {
+    if (m->type != MAT_MTL) { /* the physically based types of JSON scenes */
+        switch (m->type) {
+        case MAT_CONDUCTOR:
+            sh.b = m->schlick ? pbsdf_conductor_schlick(m->ks, m->alpha) : pbsdf_conductor(m->eta, m->k, m->alpha);
+            break;
+        case MAT_DIELECTRIC:
+            sh.b = pbsdf_dielectric(m->ni, m->alpha, sf->front ? m->tf : v3s(1.0f));
+            if (!sf->front) n = v3_neg(n); /* the outward normal: wo.z < 0 inside */
+            break;
+        case MAT_PLASTIC: sh.b = pbsdf_plastic(m->kd, m->ni, m->alpha); break;
+        default: sh.b = pbsdf_diffuse(m->kd); break;
+        }
+    } else if (glass) {
         /* Tf: the hue of what enters, normalised to the brightest channel
          * (exporters write grey Tf of any strength for clear glass) */
         float tmax_c = v3_max_comp(m->tf);

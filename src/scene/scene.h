@@ -30,7 +30,22 @@ typedef struct material {
      * v0 v1 v2, and of a sphere's outward normal). The Whitted integrator
      * treats every emitter as two-sided. */
     bool two_sided;
+    /* The physically based types of JSON scenes (docs/materials.md). MAT_MTL
+     * (material_init's default, every MTL material) is the MTL model of the
+     * fields above. The others are for the path tracer: MAT_DIFFUSE has the
+     * albedo kd; MAT_CONDUCTOR the complex index eta + i k, or with
+     * schlick the normal-incidence reflectance ks (Schlick's Fresnel);
+     * MAT_DIELECTRIC the index ni and the transmittance tf; MAT_PLASTIC the
+     * albedo kd under a coating of index ni. alpha is the GGX roughness of
+     * the conductor, dielectric and plastic (0 = smooth). The JSON reader
+     * also sets the MTL fields to a Whitted approximation of each type. */
+    int type;      /* material_type */
+    float alpha;
+    vec3 eta, k;
+    bool schlick;
 } material;
+
+typedef enum material_type { MAT_MTL, MAT_DIFFUSE, MAT_CONDUCTOR, MAT_DIELECTRIC, MAT_PLASTIC } material_type;
 
 /* Triangle k is the k-th triangle the file produced (fan order). */
 typedef struct triangle {

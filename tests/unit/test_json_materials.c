@@ -1,0 +1,258 @@
+/*
+ * test_json_materials.c - the physically based JSON material types
+ * (docs/materials.md, docs/scene-format.md): each type with its defaults and
+ * with explicit values, the MTL fields each sets for the Whitted integrator,
+ * keys that do not belong to a type, and the exact text of each refusal.
+ */
+#include "test.h"
+
+#include "scene/scene.h"
+
+#define NAME "scene.json"
+
+static char warnings[16][PK_ERRMSG_MAX];
+static int nwarnings;
+
+static void on_warning(void *user, const char *message)
+{
+    (void)user;
+    if (nwarnings < 16) snprintf(warnings[nwarnings], sizeof warnings[0], "%s", message);
+    nwarnings++;
+}
+
+static pk_context *new_ctx(void)
+{
+    pk_context *ctx = NULL;
+    REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
+    pk_context_set_warning_handler(ctx, on_warning, NULL);
+    nwarnings = 0;
+    return ctx;
+}
+
+static pk_status parse(pk_context *ctx, const char *json, pk_scene **out)
+{
+    REQUIRE(scene_create(ctx, NAME, out) == PK_OK);
+    return scene_json_parse(ctx, *out, json, strlen(json), NAME, PK_TEST_DATA);
+}
+
+static bool near3(vec3 a, float x, float y, float z, float tol)
+{
+    return fabsf(a.x - x) <= tol && fabsf(a.y - y) <= tol && fabsf(a.z - z) <= tol;
+}
+
+/* Parses {"materials": {"m": <body>}} and returns a copy of material m. */
+static material one(const char *body)
+{
+    char json[1024];
+    snprintf(json, sizeof json, "{\"materials\": {\"m\": %s}}", body);
+    pk_context *ctx = new_ctx();
+    pk_scene *s;
+    pk_status st = parse(ctx, json, &s);
+    CHECKF(st == PK_OK, "%s: %s", body, pk_context_error(ctx));
+    material m;
+    material_init(&m);
+    int64_t i = scene_find_material(s, "m");
+    CHECKF(i >= 0, "%s: no material m", body);
+    if (i >= 0) m = s->materials[i];
+    m.name = NULL;
+    scene_destroy(s);
+    pk_context_destroy(ctx);
+    return m;
+}
+
+static void test_defaults(void)
+{
+    material m = one("{\"kd\": [0.2, 0.3, 0.4]}"); /* no type: the MTL fields */
+    CHECK(m.type == MAT_MTL && near3(m.kd, 0.2f, 0.3f, 0.4f, 0) && m.illum == 2 && m.alpha == 0.0f);
+
+    m = one("{\"type\": \"diffuse\"}");
+    CHECK(m.type == MAT_DIFFUSE && near3(m.kd, 0.5f, 0.5f, 0.5f, 0) && near3(m.ks, 0, 0, 0, 0) && m.illum == 2);
+    CHECK(near3(m.ke, 0, 0, 0, 0) && !m.two_sided);
+
+    m = one("{\"type\": \"conductor\"}"); /* copper, smooth */
+    CHECK(m.type == MAT_CONDUCTOR && !m.schlick && m.alpha == 0.0f);
+    CHECK(near3(m.eta, 0.2f, 0.92f, 1.1f, 0) && near3(m.k, 3.9f, 2.45f, 2.14f, 0));
+    /* Whitted: a mirror weighted by the normal-incidence reflectance */
+    CHECK(m.illum == 3 && near3(m.kd, 0, 0, 0, 0));
+    CHECKF(near3(m.ks, (0.64f + 15.21f) / (1.44f + 15.21f), (0.0064f + 6.0025f) / (3.6864f + 6.0025f),
+                 (0.01f + 4.5796f) / (4.41f + 4.5796f), 1e-5f),
+           "%g %g %g", (double)m.ks.x, (double)m.ks.y, (double)m.ks.z);
+
+    m = one("{\"type\": \"dielectric\"}");
+    CHECK(m.type == MAT_DIELECTRIC && m.ni == 1.5f && m.alpha == 0.0f && near3(m.tf, 1, 1, 1, 0));
+    CHECK(m.illum == 7 && near3(m.ks, 0.04f, 0.04f, 0.04f, 1e-6f) && near3(m.kd, 0, 0, 0, 0));
+
+    m = one("{\"type\": \"plastic\"}");
+    CHECK(m.type == MAT_PLASTIC && m.ni == 1.5f && m.alpha == 0.0f && near3(m.kd, 0.5f, 0.5f, 0.5f, 0));
+    CHECK(m.illum == 3 && near3(m.ks, 0.04f, 0.04f, 0.04f, 1e-6f));
+
+    m = one("{\"type\": \"emitter\"}");
+    CHECK(m.type == MAT_DIFFUSE && near3(m.ke, 1, 1, 1, 0) && near3(m.kd, 0, 0, 0, 0));
+}
+
+static void test_explicit(void)
+{
+    material m = one("{\"type\": \"diffuse\", \"albedo\": [0.1, 0.2, 1], \"two_sided\": true}");
+    CHECK(m.type == MAT_DIFFUSE && near3(m.kd, 0.1f, 0.2f, 1, 0) && m.two_sided);
+
+    m = one("{\"type\": \"conductor\", \"eta\": [1.5, 1, 0.5], \"k\": [0, 1, 2], \"roughness\": 0.5}");
+    CHECK(m.type == MAT_CONDUCTOR && !m.schlick && m.alpha == 0.25f);
+    CHECK(near3(m.eta, 1.5f, 1, 0.5f, 0) && near3(m.k, 0, 1, 2, 0));
+    CHECK(m.illum == 2 && fabsf(m.ns - 30.0f) < 1e-4f); /* alpha = sqrt(2 / (Ns + 2)) */
+    CHECK(near3(m.ks, 0.04f, 0.2f, 4.25f / 6.25f, 1e-6f));
+
+    m = one("{\"type\": \"conductor\", \"specular\": [1, 0.8, 0.3], \"alpha\": 0.3}");
+    CHECK(m.type == MAT_CONDUCTOR && m.schlick && m.alpha == 0.3f && near3(m.ks, 1, 0.8f, 0.3f, 0));
+
+    m = one("{\"type\": \"dielectric\", \"ior\": 1.33, \"roughness\": 0.2, \"transmittance\": [1, 0.5, 0]}");
+    CHECK(m.type == MAT_DIELECTRIC && m.ni == 1.33f && fabsf(m.alpha - 0.04f) < 1e-7f);
+    CHECK(near3(m.tf, 1, 0.5f, 0, 0));
+
+    /* a smooth ior 1 dielectric is allowed: light passes straight through */
+    m = one("{\"type\": \"dielectric\", \"ior\": 1}");
+    CHECK(m.type == MAT_DIELECTRIC && m.ni == 1.0f);
+
+    m = one("{\"type\": \"plastic\", \"albedo\": [0.9, 0, 0], \"ior\": 2, \"roughness\": 1}");
+    CHECK(m.type == MAT_PLASTIC && m.ni == 2.0f && m.alpha == 1.0f && near3(m.kd, 0.9f, 0, 0, 0));
+    CHECK(m.illum == 2 && m.ns == 0.0f && near3(m.ks, 1.0f / 9.0f, 1.0f / 9.0f, 1.0f / 9.0f, 1e-6f));
+
+    m = one("{\"type\": \"emitter\", \"radiance\": [10, 5, 0], \"two_sided\": true}");
+    CHECK(near3(m.ke, 10, 5, 0, 0) && m.two_sided && near3(m.kd, 0, 0, 0, 0));
+
+    /* the array form (with "name") and an inline sphere material */
+    pk_context *ctx = new_ctx();
+    pk_scene *s;
+    pk_status st = parse(ctx,
+                         "{\"materials\": [{\"name\": \"gold\", \"type\": \"conductor\", \"specular\": [1, 0.8, 0.3]}],"
+                         " \"spheres\": [{\"center\": [0, 0, 0], \"radius\": 1,"
+                         "   \"material\": {\"type\": \"plastic\", \"roughness\": 0.1}},"
+                         "  {\"center\": [3, 0, 0], \"radius\": 1, \"material\": \"gold\"}]}",
+                         &s);
+    CHECKF(st == PK_OK, "%s", pk_context_error(ctx));
+    CHECK(nwarnings == 0);
+    REQUIRE(s->nspheres == 2);
+    const material *a = &s->materials[s->spheres[0].material], *b = &s->materials[s->spheres[1].material];
+    CHECK(a->type == MAT_PLASTIC && fabsf(a->alpha - 0.01f) < 1e-7f);
+    CHECK(b->type == MAT_CONDUCTOR && b->schlick && strcmp(b->name, "gold") == 0);
+    scene_destroy(s);
+    pk_context_destroy(ctx);
+}
+
+/* Keys that do not belong to a type are reported like other unknown keys. */
+static void test_foreign_keys(void)
+{
+    pk_context *ctx = new_ctx();
+    pk_scene *s;
+    pk_status st = parse(ctx,
+                         "{\"materials\": {\n"
+                         " \"gold\": {\"type\": \"conductor\", \"kd\": [1, 0, 0],\n"
+                         "  \"albedo\": [1, 1, 1]},\n"
+                         " \"glass\": {\"type\": \"dielectric\", \"alpha\": 0.5}}}",
+                         &s);
+    CHECKF(st == PK_OK, "%s", pk_context_error(ctx));
+    CHECK(nwarnings == 3);
+    CHECKF(strcmp(warnings[0], "scene.json:2: materials.gold.kd: unknown key ignored") == 0, "%s", warnings[0]);
+    CHECKF(strcmp(warnings[1], "scene.json:3: materials.gold.albedo: unknown key ignored") == 0, "%s", warnings[1]);
+    CHECKF(strcmp(warnings[2], "scene.json:4: materials.glass.alpha: unknown key ignored") == 0, "%s", warnings[2]);
+    const material *g = &s->materials[scene_find_material(s, "glass")];
+    CHECK(g->type == MAT_DIELECTRIC && g->alpha == 0.0f);
+    scene_destroy(s);
+    pk_context_destroy(ctx);
+}
+
+static void expect_error(int line, const char *json, const char *message)
+{
+    pk_context *ctx = new_ctx();
+    pk_scene *s;
+    pk_status st = parse(ctx, json, &s);
+    if (st != PK_ERR_PARSE || strcmp(pk_context_error(ctx), message) != 0) {
+        fprintf(stderr, "%s:%d: expected \"%s\"\n    got %d \"%s\"\n", __FILE__, line, message, (int)st,
+                pk_context_error(ctx));
+        test_failures++;
+    }
+    scene_destroy(s);
+    pk_context_destroy(ctx);
+}
+
+#define EXPECT_ERROR(json, message) expect_error(__LINE__, json, message)
+#define MAT(body) "{\"materials\": {\"gold\": " body "}}"
+
+static void test_errors(void)
+{
+    const char *types = "must be one of \"diffuse\", \"conductor\", \"dielectric\", \"plastic\", \"emitter\"";
+    char want[512];
+    snprintf(want, sizeof want, "scene.json:1: materials.gold.type: %s", types);
+    EXPECT_ERROR(MAT("{\"type\": \"metal\"}"), want);
+    EXPECT_ERROR(MAT("{\"type\": 3}"), want);
+    snprintf(want, sizeof want, "scene.json:2: spheres[0].material.type: %s", types);
+    EXPECT_ERROR("{\"spheres\": [{\"center\": [0, 0, 0], \"radius\": 1,\n \"material\": {\"type\": \"Diffuse\"}}]}",
+                 want);
+    EXPECT_ERROR(MAT("{\"type\": \"diffuse\", \"type\": \"plastic\"}"), "scene.json:1: materials.gold.type: duplicate key");
+
+    /* roughness and alpha */
+    EXPECT_ERROR("{\"materials\": {\n\n \"gold\": {\"type\": \"conductor\", \"roughness\": 1.5}}}",
+                 "scene.json:3: materials.gold.roughness: must be in 0..1");
+    EXPECT_ERROR(MAT("{\"type\": \"conductor\", \"roughness\": -0.1}"),
+                 "scene.json:1: materials.gold.roughness: must be in 0..1");
+    EXPECT_ERROR(MAT("{\"type\": \"plastic\", \"roughness\": \"high\"}"),
+                 "scene.json:1: materials.gold.roughness: must be a number");
+    EXPECT_ERROR(MAT("{\"type\": \"dielectric\", \"roughness\": 1e999}"),
+                 "scene.json:1: materials.gold.roughness: must be a finite number");
+    EXPECT_ERROR(MAT("{\"type\": \"conductor\", \"alpha\": 2}"), "scene.json:1: materials.gold.alpha: must be in 0..1");
+    EXPECT_ERROR(MAT("{\"type\": \"conductor\", \"roughness\": 0.5, \"alpha\": 0.25}"),
+                 "scene.json:1: materials.gold.alpha: give \"roughness\" or \"alpha\", not both");
+
+    /* ior */
+    EXPECT_ERROR(MAT("{\"type\": \"dielectric\", \"ior\": 0}"), "scene.json:1: materials.gold.ior: must be a positive number");
+    EXPECT_ERROR(MAT("{\"type\": \"plastic\", \"ior\": -1.5}"), "scene.json:1: materials.gold.ior: must be a positive number");
+    EXPECT_ERROR(MAT("{\"type\": \"dielectric\", \"ior\": 1, \"roughness\": 0.1}"),
+                 "scene.json:1: materials.gold.ior: must not be 1 on a rough surface (roughness > 0)");
+    EXPECT_ERROR(MAT("{\"type\": \"plastic\", \"ior\": 1e999}"),
+                 "scene.json:1: materials.gold.ior: must be a finite number");
+
+    /* reflectances */
+    EXPECT_ERROR(MAT("{\"type\": \"diffuse\", \"albedo\": [0.5, 1.01, 0]}"),
+                 "scene.json:1: materials.gold.albedo: components must be in 0..1");
+    EXPECT_ERROR(MAT("{\"type\": \"plastic\", \"albedo\": [-0.1, 0, 0]}"),
+                 "scene.json:1: materials.gold.albedo: components must be in 0..1");
+    EXPECT_ERROR(MAT("{\"type\": \"diffuse\", \"albedo\": [0.5, 1e999, 0]}"),
+                 "scene.json:1: materials.gold.albedo: numbers must be finite");
+    EXPECT_ERROR(MAT("{\"type\": \"diffuse\", \"albedo\": 0.5}"),
+                 "scene.json:1: materials.gold.albedo: must be an array of 3 numbers");
+    EXPECT_ERROR(MAT("{\"type\": \"conductor\", \"specular\": [2, 1, 1]}"),
+                 "scene.json:1: materials.gold.specular: components must be in 0..1");
+    EXPECT_ERROR(MAT("{\"type\": \"dielectric\", \"transmittance\": [1, 1, 1.5]}"),
+                 "scene.json:1: materials.gold.transmittance: components must be in 0..1");
+
+    /* conductor indices */
+    EXPECT_ERROR(MAT("{\"type\": \"conductor\", \"eta\": [0, 1, 1]}"),
+                 "scene.json:1: materials.gold.eta: components must be positive");
+    EXPECT_ERROR(MAT("{\"type\": \"conductor\", \"k\": [1, -1, 1]}"),
+                 "scene.json:1: materials.gold.k: components must not be negative");
+    EXPECT_ERROR(MAT("{\"type\": \"conductor\", \"k\": [1, 1e999, 1]}"), "scene.json:1: materials.gold.k: numbers must be finite");
+    EXPECT_ERROR(MAT("{\"type\": \"conductor\", \"eta\": [1, 1, 1], \"specular\": [1, 1, 1]}"),
+                 "scene.json:1: materials.gold.eta: give \"eta\" and \"k\" or \"specular\", not both");
+    EXPECT_ERROR(MAT("{\"type\": \"conductor\", \"specular\": [1, 1, 1], \"k\": [1, 1, 1]}"),
+                 "scene.json:1: materials.gold.k: give \"eta\" and \"k\" or \"specular\", not both");
+
+    /* emitter */
+    EXPECT_ERROR(MAT("{\"type\": \"emitter\", \"radiance\": [1, -1, 1]}"),
+                 "scene.json:1: materials.gold.radiance: colour components must not be negative");
+    EXPECT_ERROR(MAT("{\"type\": \"emitter\", \"radiance\": [1, 1, 1e999]}"),
+                 "scene.json:1: materials.gold.radiance: numbers must be finite");
+    EXPECT_ERROR(MAT("{\"type\": \"emitter\", \"two_sided\": 1}"),
+                 "scene.json:1: materials.gold.two_sided: must be true or false");
+
+    /* the array form still needs a name */
+    EXPECT_ERROR("{\"materials\": [{\"type\": \"diffuse\"}]}", "scene.json:1: materials[0]: missing \"name\"");
+    EXPECT_ERROR("{\"materials\": {\"gold\": [1]}}", "scene.json:1: materials.gold: must be an object");
+}
+
+int main(void)
+{
+    test_defaults();
+    test_explicit();
+    test_foreign_keys();
+    test_errors();
+    return test_done("test_json_materials");
+}
