@@ -318,9 +318,13 @@ static void print_table(const char *scene, const pk_render_options *ro, const pk
     double r = rays ? (double)rays : 1.0;
     const int path = ro->integrator != PK_INTEGRATOR_WHITTED;
     printf("%-28s %s\n", "scene", scene);
-    printf("%-28s %s, %d thread%s, %dx%d, %d spp, %d light samples, depth %d, fresnel %s\n", "settings",
-           pk_accel_kind_name(ro->accel), st->threads, st->threads == 1 ? "" : "s", ro->width, ro->height, ro->spp,
-           ro->light_samples, ro->max_depth, ro->fresnel ? "on" : "off");
+    if (path) /* light samples and the Fresnel switch are the Whitted integrator's */
+        printf("%-28s %s, %d thread%s, %dx%d, %d spp, depth %d\n", "settings", pk_accel_kind_name(ro->accel),
+               st->threads, st->threads == 1 ? "" : "s", ro->width, ro->height, ro->spp, ro->max_depth);
+    else
+        printf("%-28s %s, %d thread%s, %dx%d, %d spp, %d light samples, depth %d, fresnel %s\n", "settings",
+               pk_accel_kind_name(ro->accel), st->threads, st->threads == 1 ? "" : "s", ro->width, ro->height, ro->spp,
+               ro->light_samples, ro->max_depth, ro->fresnel ? "on" : "off");
     printf("%-28s %.0f\n", "build [us]", st->build_us);
     printf("%-28s %.3f\n", "render [s]", st->render_s);
     if (path) {
