@@ -19,13 +19,13 @@ typedef struct light_table {
 PK_HIDDEN pk_status lights_build(pk_context *ctx, const pk_scene *s, light_table *lt);
 PK_HIDDEN void lights_free(const pk_allocator *al, light_table *lt);
 
-/* The light whose CDF interval holds u in [0, 1) (lt->n > 0). */
-static inline size_t light_pick(const light_table *lt, float u)
+/* The index i of a CDF of n > 0 entries (last = 1) with cdf[i-1] <= u < cdf[i]. */
+static inline size_t cdf_pick(const float *cdf, size_t n, float u)
 {
-    size_t lo = 0, hi = lt->n - 1;
+    size_t lo = 0, hi = n - 1;
     while (lo < hi) {
         size_t mid = (lo + hi) / 2;
-        if (u < lt->cdf[mid])
+        if (u < cdf[mid])
             hi = mid;
         else
             lo = mid + 1;
@@ -33,6 +33,8 @@ static inline size_t light_pick(const light_table *lt, float u)
     return lo;
 }
 
+/* The light whose CDF interval holds u in [0, 1) (lt->n > 0). */
+static inline size_t light_pick(const light_table *lt, float u) { return cdf_pick(lt->cdf, lt->n, u); }
 
 /* ---- every light, for the path tracer ------------------------------------ */
 
@@ -59,17 +61,6 @@ typedef struct light_set {
 PK_HIDDEN pk_status light_set_build(pk_context *ctx, const pk_scene *s, light_set *ls);
 PK_HIDDEN void light_set_free(const pk_allocator *al, light_set *ls);
 
-static inline size_t light_set_pick(const light_set *ls, float u)
-{
-    size_t lo = 0, hi = ls->n - 1;
-    while (lo < hi) {
-        size_t mid = (lo + hi) / 2;
-        if (u < ls->cdf[mid])
-            hi = mid;
-        else
-            lo = mid + 1;
-    }
-    return lo;
-}
+static inline size_t light_set_pick(const light_set *ls, float u) { return cdf_pick(ls->cdf, ls->n, u); }
 
 #endif

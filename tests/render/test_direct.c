@@ -4,25 +4,22 @@
  * recursion estimate the same image on a diffuse scene: every block mean must
  * agree within its confidence interval. Each integrator renders twice with
  * independent random numbers (another seed, another pass), and the pixel
- * differences measure each block mean's variance (as in test_mis.c).
+ * differences measure each block mean's variance (block_stats.h).
  */
 #include "test.h"
 
 #include "paprsek.h"
 
+#include "block_stats.h"
+
 #define SIZE 48
 #define BLOCK 16
-#define NB (SIZE / BLOCK)
 /* two-sided p = 1e-3 over 9 blocks x 3 channels: Phi^-1(1 - 0.001 / 54) */
 #define Z_CRIT 4.12
 
 static pk_context *ctx;
 
-typedef struct estimate {
-    double mean[NB][NB][3], var[NB][NB][3];
-} estimate;
-
-static void render_twice(const pk_scene *s, pk_integrator_kind kind, estimate *e)
+static void render_twice(const pk_scene *s, pk_integrator_kind kind, block_estimate *e)
 {
     pk_render_options o;
     pk_render_options_init(&o);
@@ -50,44 +47,22 @@ static void render_twice(const pk_scene *s, pk_integrator_kind kind, estimate *e
         pk_film_destroy(f);
         pk_renderer_destroy(r);
     }
-    const float *a = pk_image_pixels_const(img[0]), *b = pk_image_pixels_const(img[1]);
-    const double n = BLOCK * BLOCK;
-    memset(e, 0, sizeof *e);
-    for (int y = 0; y < SIZE; y++)
-        for (int x = 0; x < SIZE; x++)
-            for (int c = 0; c < 3; c++) {
-                size_t i = 3 * ((size_t)y * SIZE + (size_t)x) + (size_t)c;
-                double va = (double)a[i], vb = (double)b[i];
-                e->mean[y / BLOCK][x / BLOCK][c] += 0.5 * (va + vb) / n;
-                e->var[y / BLOCK][x / BLOCK][c] += (va - vb) * (va - vb) / 2.0 / (2.0 * n * n);
-            }
+    block_estimate_from(img[0], img[1], BLOCK, e);
     pk_image_destroy(img[0]);
     pk_image_destroy(img[1]);
 }
 
 static void check(const char *name, const pk_scene *s)
 {
-    static estimate p, w;
+    static block_estimate p, w;
     render_twice(s, PK_INTEGRATOR_PATH, &p);
     render_twice(s, PK_INTEGRATOR_WHITTED, &w);
-    double worst = 0.0, sum = 0.0;
-    int bad = 0;
-    for (int by = 0; by < NB; by++)
-        for (int bx = 0; bx < NB; bx++)
-            for (int c = 0; c < 3; c++) {
-                double d = p.mean[by][bx][c] - w.mean[by][bx][c], sd = sqrt(p.var[by][bx][c] + w.var[by][bx][c]);
-                double z = sd > 0.0 ? fabs(d) / sd : (d == 0.0 ? 0.0 : 1e9);
-                sum += w.mean[by][bx][c];
-                if (z > worst) worst = z;
-                if (z > Z_CRIT) {
-                    bad++;
-                    fprintf(stderr, "%s: block (%d, %d) channel %d: path %.5f, Whitted %.5f, z = %.2f\n", name, bx, by,
-                            c, p.mean[by][bx][c], w.mean[by][bx][c], z);
-                }
-            }
-    printf("%s: largest |z| over %d block means %.2f (bound %.2f)\n", name, NB * NB * 3, worst, Z_CRIT);
+    double sum = 0.0;
+    for (int by = 0; by < w.nb; by++)
+        for (int bx = 0; bx < w.nb; bx++)
+            for (int c = 0; c < 3; c++) sum += w.mean[by][bx][c];
     CHECKF(sum > 0.0, "%s: black", name);
-    CHECKF(bad == 0, "%s: %d block means of the one-bounce path tracer and Whitted disagree", name, bad);
+    block_compare(name, "one-bounce path tracer vs Whitted", &p, &w, Z_CRIT);
 }
 
 int main(void)

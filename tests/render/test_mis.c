@@ -2,14 +2,8 @@
  * test_mis.c - light sampling alone, material (BSDF) sampling alone and both
  * weighted by multiple importance sampling are three estimators of the same
  * image: on a scene with a small and a large light (and on the Cornell box),
- * their block means must agree within confidence intervals.
- *
- * The variance of a block mean is measured, not assumed: each strategy
- * renders the image twice with different seeds; for every pixel the
- * difference of the two renders has mean 0 and variance 2 sigma_p^2, so
- * sum_p (a_p - b_p)^2 / 2 estimates sum_p sigma_p^2 without bias, and the
- * mean of the two renders over a block of n pixels has variance
- * sum_p sigma_p^2 / (2 n^2).
+ * their block means must agree within confidence intervals, each block's
+ * variance measured from two renders with different seeds (block_stats.h).
  */
 #include "test.h"
 
@@ -17,20 +11,17 @@
 #include "render/path.h"
 #include "render/render.h"
 
+#include "block_stats.h"
+
 #define SIZE 32
 #define BLOCK 8
-#define NB (SIZE / BLOCK)
 /* two-sided p = 1e-3 over 16 blocks x 3 channels x 2 comparisons x 2 scenes:
  * Phi^-1(1 - 0.001 / 384) */
 #define Z_CRIT 4.56
 
 static pk_context *ctx;
 
-typedef struct estimate {
-    double mean[NB][NB][3], var[NB][NB][3];
-} estimate;
-
-static void render_strategy(const pk_scene *s, int strategy, int spp, estimate *e)
+static void render_strategy(const pk_scene *s, int strategy, int spp, block_estimate *e)
 {
     pk_render_options o;
     pk_render_options_init(&o);
@@ -52,55 +43,24 @@ static void render_strategy(const pk_scene *s, int strategy, int spp, estimate *
         pk_film_destroy(f);
         pk_renderer_destroy(r);
     }
-    const float *a = pk_image_pixels_const(img[0]), *b = pk_image_pixels_const(img[1]);
-    const double n = BLOCK * BLOCK;
-    memset(e, 0, sizeof *e);
-    for (int y = 0; y < SIZE; y++)
-        for (int x = 0; x < SIZE; x++)
-            for (int c = 0; c < 3; c++) {
-                size_t i = 3 * ((size_t)y * SIZE + (size_t)x) + (size_t)c;
-                double va = (double)a[i], vb = (double)b[i];
-                e->mean[y / BLOCK][x / BLOCK][c] += 0.5 * (va + vb) / n;
-                e->var[y / BLOCK][x / BLOCK][c] += (va - vb) * (va - vb) / 2.0 / (2.0 * n * n);
-            }
+    block_estimate_from(img[0], img[1], BLOCK, e);
     pk_image_destroy(img[0]);
     pk_image_destroy(img[1]);
 }
 
-static void compare(const char *scene, const char *what, const estimate *p, const estimate *q)
-{
-    double worst = 0.0;
-    int bad = 0;
-    for (int by = 0; by < NB; by++)
-        for (int bx = 0; bx < NB; bx++)
-            for (int c = 0; c < 3; c++) {
-                double d = p->mean[by][bx][c] - q->mean[by][bx][c];
-                double sd = sqrt(p->var[by][bx][c] + q->var[by][bx][c]);
-                double z = sd > 0.0 ? fabs(d) / sd : (d == 0.0 ? 0.0 : (double)INFINITY);
-                if (z > worst) worst = z;
-                if (z > Z_CRIT) {
-                    bad++;
-                    fprintf(stderr, "%s: %s: block (%d, %d) channel %d: %.5f vs %.5f, z = %.2f\n", scene, what, bx, by,
-                            c, p->mean[by][bx][c], q->mean[by][bx][c], z);
-                }
-            }
-    printf("%s: %s: largest |z| over %d block means %.2f (bound %.2f)\n", scene, what, NB * NB * 3, worst, Z_CRIT);
-    CHECKF(bad == 0, "%s: %s: %d block means outside their confidence intervals", scene, what, bad);
-}
-
 static void check_scene(const char *name, const pk_scene *s, int spp)
 {
-    static estimate mis, lights, bsdf;
+    static block_estimate mis, lights, bsdf;
     render_strategy(s, PATH_MIS, spp, &mis);
     render_strategy(s, PATH_LIGHTS_ONLY, spp, &lights);
     /* material sampling alone finds small lights rarely: its pixel means are
      * the most skewed, so it gets more samples to be near normal */
     render_strategy(s, PATH_BSDF_ONLY, 4 * spp, &bsdf);
-    compare(name, "MIS vs light sampling", &mis, &lights);
-    compare(name, "MIS vs BSDF sampling", &mis, &bsdf);
+    block_compare(name, "MIS vs light sampling", &mis, &lights, Z_CRIT);
+    block_compare(name, "MIS vs BSDF sampling", &mis, &bsdf, Z_CRIT);
     double vm = 0.0, vl = 0.0, vb = 0.0;
-    for (int by = 0; by < NB; by++)
-        for (int bx = 0; bx < NB; bx++)
+    for (int by = 0; by < mis.nb; by++)
+        for (int bx = 0; bx < mis.nb; bx++)
             for (int c = 0; c < 3; c++) vm += mis.var[by][bx][c], vl += lights.var[by][bx][c], vb += bsdf.var[by][bx][c];
     printf("%s: summed block variances: MIS %.3g, lights %.3g, BSDF %.3g (at 4x the samples)\n", name, vm, vl, vb);
 }
