@@ -22,6 +22,17 @@ void material_init(material *m)
     m->illum = 2;
 }
 
+void scene_env_init(scene_environment *env)
+{
+    memset(env, 0, sizeof *env);
+    env->map_scale = 1.0f;
+    env->to_world[0] = env->to_world[4] = env->to_world[8] = 1.0f;
+    env->sun_dir = (vec3){0.0f, 1.0f, 0.0f};
+    env->sun_angle = 0.53f;
+    env->sky_turbidity = 3.0f;
+    env->sky_scale = 1.0f;
+}
+
 pk_status scene_create(pk_context *ctx, const char *name, pk_scene **out)
 {
     *out = NULL;
@@ -30,6 +41,7 @@ pk_status scene_create(pk_context *ctx, const char *name, pk_scene **out)
     s->alloc = ctx->alloc;
     s->bounds = aabb_empty();
     pk_render_options_init(&s->render.opt);
+    scene_env_init(&s->env);
     s->name = mem_strdup(&s->alloc, name ? name : "scene");
     uint32_t idx;
     if (!s->name || scene_add_material(ctx, s, "default", &idx) != PK_OK) {
@@ -55,6 +67,7 @@ void scene_destroy(pk_scene *s)
     mem_free(a, s->lights);
     mem_free(a, s->degenerate);
     mem_free(a, s->emissive);
+    mem_free(a, s->env.map);
     mem_free(a, s->name);
     pk_allocator copy = *a;
     mem_free(&copy, s);

@@ -65,6 +65,27 @@ typedef struct point_light {
     vec3 intensity;  /* radiant intensity, linear RGB (W/sr per channel) */
 } point_light;
 
+/* Light from the surroundings (docs/scene-format.md, "environment"): what a
+ * ray that leaves the scene sees. Every part is optional and they add up.
+ * Directions are world space; a lat-long map is looked up through
+ * to_world (row-major 3x3 rotation; identity by default) so that a map's
+ * +y is up. set says the scene file described its environment (even as
+ * none): without it, a scene with no light at all gets a uniform white one. */
+typedef struct scene_environment {
+    bool set;
+    vec3 radiance;        /* constant radiance, zero = none */
+    char *map;            /* lat-long HDR image file (owned; NULL = none), resolved path */
+    float map_scale;      /* multiplies the map (1) */
+    float to_world[9];    /* the map's rotation into the world */
+    bool has_sun;
+    vec3 sun_dir;         /* unit, toward the sun */
+    vec3 sun_radiance;    /* radiance of the sun's disc */
+    float sun_angle;      /* angular diameter in degrees (0.53) */
+    bool has_sky;         /* an analytic daylight sky for the sun's direction */
+    float sky_turbidity;  /* 2 .. 10 (3) */
+    float sky_scale;      /* multiplies the sky (1) */
+} scene_environment;
+
 /* Render settings a scene file may carry; a field is set when its has_ flag is. */
 typedef struct scene_render_settings {
     pk_render_options opt;
@@ -96,6 +117,7 @@ struct pk_scene {
     point_light *lights; size_t nlights, cap_lights;
 
     vec3 ambient;           /* ambient light; zero unless the scene asks */
+    scene_environment env;  /* the surroundings; nothing unless the scene asks */
     bool has_camera;
     pk_camera camera;
     scene_render_settings render;
@@ -128,6 +150,8 @@ PK_HIDDEN pk_status scene_add_material(pk_context *ctx, pk_scene *s, const char 
  * do not take quadratic time. */
 PK_HIDDEN int64_t scene_find_material(const pk_scene *s, const char *name);
 PK_HIDDEN void material_init(material *m);
+/* The empty environment (nothing set, identity rotation, scales 1, sun 0.53 degrees). */
+PK_HIDDEN void scene_env_init(scene_environment *env);
 
 /* Validates and derives (degenerate flags, emissive list, bounds).
  * PK_ERR_EMPTY_SCENE when nothing can be hit. Warns about degenerate triangles. */
