@@ -320,11 +320,11 @@ static void print_table(const char *scene, const pk_render_options *ro, const pk
     printf("%-28s %s\n", "scene", scene);
     if (path) /* light samples and the Fresnel switch are the Whitted integrator's */
         printf("%-28s %s, %d thread%s, %dx%d, %d spp, depth %d\n", "settings", pk_accel_kind_name(ro->accel),
-               st->threads, st->threads == 1 ? "" : "s", ro->width, ro->height, ro->spp, ro->max_depth);
+               st->threads, st->threads == 1 ? "" : "s", ro->width, ro->height, ro->spp, pk_render_options_max_depth(ro));
     else
         printf("%-28s %s, %d thread%s, %dx%d, %d spp, %d light samples, depth %d, fresnel %s\n", "settings",
                pk_accel_kind_name(ro->accel), st->threads, st->threads == 1 ? "" : "s", ro->width, ro->height, ro->spp,
-               ro->light_samples, ro->max_depth, ro->fresnel ? "on" : "off");
+               ro->light_samples, pk_render_options_max_depth(ro), ro->fresnel ? "on" : "off");
     printf("%-28s %.0f\n", "build [us]", st->build_us);
     printf("%-28s %.3f\n", "render [s]", st->render_s);
     if (path) {
@@ -381,7 +381,7 @@ static int write_stats_json(const char *path, const char *scene, const pk_render
             "  \"intersection_tests\": %llu,\n  \"nodes_visited\": %llu,\n  \"mrays_per_s\": %.3f,\n"
             "  \"integrator\": \"%s\",\n  \"seed\": %d,\n  \"rays_bounce\": %llu,\n  \"samples_per_s\": %.1f,\n"
             "  \"film_bytes_per_pixel\": %d,\n  \"peak_rss_mib\": %.1f\n}\n",
-            pk_accel_kind_name(ro->accel), ro->width, ro->height, ro->spp, ro->light_samples, ro->max_depth,
+            pk_accel_kind_name(ro->accel), ro->width, ro->height, ro->spp, ro->light_samples, pk_render_options_max_depth(ro),
             ro->fresnel ? "true" : "false", st->threads, st->build_us, st->render_s, (unsigned long long)rays,
             (unsigned long long)st->rays_camera, (unsigned long long)st->rays_shadow,
             (unsigned long long)st->rays_reflection, (unsigned long long)st->rays_refraction,

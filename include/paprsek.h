@@ -74,6 +74,8 @@ PK_API const char *pk_status_string(pk_status status);
 #define PK_MAX_SPP 65536
 #define PK_MAX_LIGHT_SAMPLES 4096
 #define PK_MAX_DEPTH 64
+#define PK_DEFAULT_DEPTH_PATH 64    /* enough for a closed box to converge */
+#define PK_DEFAULT_DEPTH_WHITTED 8
 #define PK_MAX_THREADS 1024
 #define PK_MAX_POLYGON_VERTICES 4096
 #define PK_MAX_FILE_BYTES ((size_t)1 << 31) /* 2 GiB */
@@ -125,7 +127,8 @@ typedef struct pk_render_options {
     int width, height;   /* pixels */
     int spp;             /* samples per pixel, stratified jitter when > 1 */
     int light_samples;   /* shadow samples per shading point for area lights */
-    int max_depth;       /* reflection/refraction recursion limit */
+    int max_depth;       /* bounces (path) or reflection/refraction depth (whitted);
+                            -1 = the integrator's default (pk_render_options_max_depth) */
     int threads;         /* 0 = all cores */
     pk_accel_kind accel;
     int fresnel;         /* 1 = exact dielectric Fresnel; 0 = fixed Ks/Tf weights */
@@ -174,6 +177,9 @@ PK_API const pk_int_option *pk_int_options(size_t *count);
 PK_API const pk_int_option *pk_int_option_find(const char *name);
 /* Checks opt against the table, the pixel budget (PK_MAX_IMAGE_PIXELS) and
  * the accelerators built in; latches "what is wrong" in ctx. */
+/* The depth a render with these options uses: max_depth, or when it is -1 the
+ * integrator's default, PK_DEFAULT_DEPTH_PATH or PK_DEFAULT_DEPTH_WHITTED. */
+PK_API int pk_render_options_max_depth(const pk_render_options *opt);
 PK_API pk_status pk_render_options_check(pk_context *ctx, const pk_render_options *opt);
 
 typedef struct pk_stats {

@@ -17,7 +17,9 @@ static const pk_int_option table[] = {
     OPT(spp, "samples per pixel", 1, PK_MAX_SPP, 1, "samples per pixel (stratified jitter; 1 = pixel centres)"),
     OPT(light_samples, "light samples", 0, PK_MAX_LIGHT_SAMPLES, 32,
         "shadow samples per shading point over the area lights (0 = point lights only)"),
-    OPT(max_depth, "max depth", 0, PK_MAX_DEPTH, 8, "reflection and refraction depth"),
+    OPT(max_depth, "max depth", -1, PK_MAX_DEPTH, -1,
+        "path length in bounces (path) or reflection and refraction depth (whitted); -1 = the integrator's "
+        "default, 64 for path and 8 for whitted"),
     OPT(threads, "threads", 0, PK_MAX_THREADS, 0, "worker threads (0 = all cores)"),
     OPT(seed, "seed", 0, 2147483647, 0, "the path tracer's noise pattern (another seed, other noise)"),
 };
@@ -50,6 +52,13 @@ const pk_int_option *pk_int_option_find(const char *name)
 int *options_int_field(pk_render_options *opt, const pk_int_option *o)
 {
     return (int *)(void *)((char *)opt + o->offset);
+}
+
+int pk_render_options_max_depth(const pk_render_options *opt)
+{
+    if (!opt) return PK_DEFAULT_DEPTH_PATH;
+    if (opt->max_depth >= 0) return opt->max_depth;
+    return opt->integrator == PK_INTEGRATOR_WHITTED ? PK_DEFAULT_DEPTH_WHITTED : PK_DEFAULT_DEPTH_PATH;
 }
 
 void pk_render_options_init(pk_render_options *opt)

@@ -285,9 +285,9 @@ static float ns_from_alpha(float alpha) { return alpha < 1e-3f ? 1000.0f : fmaxf
 
 /* The physically based material types (docs/materials.md). The keys of each:
  * the common ones ("type", "two_sided") and the type's parameters. */
-enum { TP_ALBEDO, TP_SPECULAR, TP_ETA, TP_K, TP_ROUGHNESS, TP_ALPHA, TP_IOR, TP_TRANSMITTANCE, TP_RADIANCE, TP_COUNT };
+enum { TP_ALBEDO, TP_SPECULAR, TP_ETA, TP_K, TP_ROUGHNESS, TP_ALPHA, TP_IOR, TP_TRANSMITTANCE, TP_RADIANCE, TP_BSDF, TP_COUNT };
 static const char *const tp_keys[TP_COUNT] = {"albedo", "specular", "eta",           "k",       "roughness",
-                                              "alpha",  "ior",      "transmittance", "radiance"};
+                                              "alpha",  "ior",      "transmittance", "radiance", "bsdf"};
 typedef struct mat_type_def {
     const char *name;
     int nparams;
@@ -298,7 +298,8 @@ static const mat_type_def mat_types[] = {
     {"conductor", 5, {TP_ETA, TP_K, TP_SPECULAR, TP_ROUGHNESS, TP_ALPHA}},
     {"dielectric", 3, {TP_IOR, TP_ROUGHNESS, TP_TRANSMITTANCE}},
     {"plastic", 3, {TP_ALBEDO, TP_IOR, TP_ROUGHNESS}},
-    {"emitter", 1, {TP_RADIANCE}},
+    {"emitter", 2, {TP_RADIANCE, TP_BSDF}},
+    {"two_sided", 1, {TP_BSDF}},
 };
 #define N_MAT_TYPES (sizeof mat_types / sizeof mat_types[0])
 
@@ -313,7 +314,8 @@ static pk_status read_typed_material(jp *p, const cJSON *obj, const cJSON *type_
         while (t < N_MAT_TYPES && strcmp(type_item->valuestring, mat_types[t].name) != 0) t++;
     if (!cJSON_IsString(type_item) || t == N_MAT_TYPES)
         return jfail(p, PK_ERR_PARSE, type_item, fp,
-                     "must be one of \"diffuse\", \"conductor\", \"dielectric\", \"plastic\", \"emitter\"");
+                     "must be one of \"diffuse\", \"conductor\", \"dielectric\", \"plastic\", \"emitter\", "
+                     "\"two_sided\"");
     const mat_type_def *def = &mat_types[t];
     /* the known keys: "type", "two_sided", the type's parameters, and "name"
      * where materials are listed in an array */
@@ -356,6 +358,24 @@ static pk_status read_typed_material(jp *p, const cJSON *obj, const cJSON *type_
             return jfail(p, PK_ERR_PARSE, pv[TP_IOR], pp[TP_IOR], "must not be 1 on a rough surface (roughness > 0)");
     }
     m->alpha = alpha;
+    if (t == 5) { /* two_sided: the nested material, reflecting and emitting on both sides */
+        const cJSON *in = pv[TP_BSDF];
+        const cJSON *bt = cJSON_IsObject(in) ? cJSON_GetObjectItemCaseSensitive(in, "type") : NULL;
+        if (!bt)
+            return jfail(p, PK_ERR_PARSE, in ? in : obj, in ? pp[TP_BSDF] : path,
+                         "a two_sided material needs a \"bsdf\": a material object with a \"type\"");
+        char bp[JP_PATH_MAX];
+        path_key(bp, pp[TP_BSDF], "type");
+        if (cJSON_IsString(bt) && (strcmp(bt->valuestring, "dielectric") == 0 || strcmp(bt->valuestring, "two_sided") == 0))
+            return jfail(p, PK_ERR_PARSE, bt, bp, "is two-sided already");
+        if ((st = read_typed_material(p, in, bt, pp[TP_BSDF], false, m, NULL))) return st;
+        m->two_sided = true;
+        if (two_sided) {
+            path_key(fp, path, "two_sided");
+            return jfail(p, PK_ERR_PARSE, two_sided, fp, "a two_sided material is two-sided by its type");
+        }
+        return PK_OK;
+    }
     /* the MTL fields: what the Whitted integrator renders of each type */
     switch (t) {
     case 0: /* diffuse */
@@ -410,15 +430,28 @@ static pk_status read_typed_material(jp *p, const cJSON *obj, const cJSON *type_
         if (alpha < 1e-3f) m->illum = 3;
         else m->ns = ns_from_alpha(alpha);
         break;
-    default: /* emitter: black diffuse */
-        m->type = MAT_DIFFUSE;
-        m->kd = v3s(0.0f);
-        m->ke = v3s(1.0f);
-        if (pv[TP_RADIANCE]) {
-            path_key(fp, path, "radiance");
-            if ((st = get_color(p, pv[TP_RADIANCE], fp, &m->ke))) return st;
+    default: { /* emitter: black diffuse, or the surface its "bsdf" describes */
+        vec3 ke = v3s(1.0f);
+        if (pv[TP_RADIANCE] && (st = get_color(p, pv[TP_RADIANCE], pp[TP_RADIANCE], &ke))) return st;
+        if (pv[TP_BSDF]) {
+            const cJSON *bt =
+                cJSON_IsObject(pv[TP_BSDF]) ? cJSON_GetObjectItemCaseSensitive(pv[TP_BSDF], "type") : NULL;
+            if (!bt)
+                return jfail(p, PK_ERR_PARSE, pv[TP_BSDF], pp[TP_BSDF],
+                             "must be a material object with a \"type\" (the emitting surface's reflection)");
+            if (cJSON_IsString(bt) && strcmp(bt->valuestring, "emitter") == 0) {
+                char bp[JP_PATH_MAX];
+                path_key(bp, pp[TP_BSDF], "type");
+                return jfail(p, PK_ERR_PARSE, bt, bp, "an emitter's bsdf cannot be another emitter");
+            }
+            if ((st = read_typed_material(p, pv[TP_BSDF], bt, pp[TP_BSDF], false, m, NULL))) return st;
+        } else {
+            m->type = MAT_DIFFUSE;
+            m->kd = v3s(0.0f);
         }
+        m->ke = ke;
         break;
+    }
     }
     if (two_sided) {
         path_key(fp, path, "two_sided");

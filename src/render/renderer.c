@@ -115,7 +115,7 @@ pk_status renderer_create(pk_context *ctx, const pk_scene *s, const pk_render_op
         return st;
     }
     r->path = opt->integrator != PK_INTEGRATOR_WHITTED;
-    r->w = (whitted){&r->fr, opt->light_samples, opt->max_depth, opt->fresnel != 0};
+    r->w = (whitted){&r->fr, opt->light_samples, pk_render_options_max_depth(opt), opt->fresnel != 0};
     r->ts = mem_calloc(&ctx->alloc, (size_t)r->nt, sizeof *r->ts);
     r->pts = mem_calloc(&ctx->alloc, (size_t)r->nt, sizeof *r->pts);
     if (!r->ts || !r->pts) {

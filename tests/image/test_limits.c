@@ -37,7 +37,7 @@ static void spp_big(pk_render_options *o) { o->spp = PK_MAX_SPP + 1; }
 static void spp0(pk_render_options *o) { o->spp = 0; }
 static void ls_big(pk_render_options *o) { o->light_samples = PK_MAX_LIGHT_SAMPLES + 1; }
 static void depth_big(pk_render_options *o) { o->max_depth = PK_MAX_DEPTH + 1; }
-static void depth_neg(pk_render_options *o) { o->max_depth = -1; }
+static void depth_neg(pk_render_options *o) { o->max_depth = -2; }
 static void threads_big(pk_render_options *o) { o->threads = PK_MAX_THREADS + 1; }
 static void accel_bad(pk_render_options *o) { o->accel = (pk_accel_kind)99; }
 
@@ -49,8 +49,8 @@ static void test_options(const pk_scene *s)
     expect_refused(s, spp_big, PK_ERR_LIMIT, "samples per pixel 65537 is out of range (1..65536)");
     expect_refused(s, spp0, PK_ERR_LIMIT, "samples per pixel 0 is out of range (1..65536)");
     expect_refused(s, ls_big, PK_ERR_LIMIT, "light samples 4097 is out of range (0..4096)");
-    expect_refused(s, depth_big, PK_ERR_LIMIT, "max depth 65 is out of range (0..64)");
-    expect_refused(s, depth_neg, PK_ERR_LIMIT, "max depth -1 is out of range (0..64)");
+    expect_refused(s, depth_big, PK_ERR_LIMIT, "max depth 65 is out of range (-1..64)");
+    expect_refused(s, depth_neg, PK_ERR_LIMIT, "max depth -2 is out of range (-1..64)");
     expect_refused(s, threads_big, PK_ERR_LIMIT, "threads 1025 is out of range (0..1024)");
     expect_refused(s, accel_bad, PK_ERR_INVALID_ARGUMENT, "unknown accelerator 99");
 

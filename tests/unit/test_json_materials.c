@@ -119,6 +119,18 @@ static void test_explicit(void)
     m = one("{\"type\": \"emitter\", \"radiance\": [10, 5, 0], \"two_sided\": true}");
     CHECK(near3(m.ke, 10, 5, 0, 0) && m.two_sided && near3(m.kd, 0, 0, 0, 0));
 
+    /* an emitter over a reflecting surface */
+    m = one("{\"type\": \"emitter\", \"radiance\": [2, 3, 4], \"bsdf\": {\"type\": \"plastic\", \"albedo\": [0.7, 0.7, 0.7]}}");
+    CHECK(m.type == MAT_PLASTIC && near3(m.ke, 2, 3, 4, 0) && near3(m.kd, 0.7f, 0.7f, 0.7f, 0) && !m.two_sided);
+    m = one("{\"type\": \"emitter\", \"bsdf\": {\"type\": \"diffuse\"}, \"two_sided\": true}");
+    CHECK(m.type == MAT_DIFFUSE && near3(m.ke, 1, 1, 1, 0) && near3(m.kd, 0.5f, 0.5f, 0.5f, 0) && m.two_sided);
+
+    /* the two_sided wrapper: its material, reflecting and emitting on both sides */
+    m = one("{\"type\": \"two_sided\", \"bsdf\": {\"type\": \"conductor\", \"specular\": [1, 0.5, 0.25]}}");
+    CHECK(m.type == MAT_CONDUCTOR && m.schlick && near3(m.ks, 1, 0.5f, 0.25f, 0) && m.two_sided);
+    m = one("{\"type\": \"two_sided\", \"bsdf\": {\"type\": \"emitter\", \"radiance\": [5, 5, 5]}}");
+    CHECK(near3(m.ke, 5, 5, 5, 0) && m.two_sided);
+
     /* the array form (with "name") and an inline sphere material */
     pk_context *ctx = new_ctx();
     pk_scene *s;
@@ -179,7 +191,8 @@ static void expect_error(int line, const char *json, const char *message)
 
 static void test_errors(void)
 {
-    const char *types = "must be one of \"diffuse\", \"conductor\", \"dielectric\", \"plastic\", \"emitter\"";
+    const char *types =
+        "must be one of \"diffuse\", \"conductor\", \"dielectric\", \"plastic\", \"emitter\", \"two_sided\"";
     char want[512];
     snprintf(want, sizeof want, "scene.json:1: materials.gold.type: %s", types);
     EXPECT_ERROR(MAT("{\"type\": \"metal\"}"), want);
@@ -242,6 +255,22 @@ static void test_errors(void)
                  "scene.json:1: materials.gold.radiance: numbers must be finite");
     EXPECT_ERROR(MAT("{\"type\": \"emitter\", \"two_sided\": 1}"),
                  "scene.json:1: materials.gold.two_sided: must be true or false");
+    EXPECT_ERROR(MAT("{\"type\": \"emitter\", \"bsdf\": [1]}"),
+                 "scene.json:1: materials.gold.bsdf: must be a material object with a \"type\" (the emitting "
+                 "surface's reflection)");
+    EXPECT_ERROR(MAT("{\"type\": \"emitter\", \"bsdf\": {\"type\": \"emitter\"}}"),
+                 "scene.json:1: materials.gold.bsdf.type: an emitter's bsdf cannot be another emitter");
+    EXPECT_ERROR(MAT("{\"type\": \"emitter\", \"bsdf\": {\"type\": \"diffuse\", \"albedo\": [2, 0, 0]}}"),
+                 "scene.json:1: materials.gold.bsdf.albedo: components must be in 0..1");
+
+    /* two_sided */
+    EXPECT_ERROR(MAT("{\"type\": \"two_sided\"}"),
+                 "scene.json:1: materials.gold: a two_sided material needs a \"bsdf\": a material object with a "
+                 "\"type\"");
+    EXPECT_ERROR(MAT("{\"type\": \"two_sided\", \"bsdf\": {\"type\": \"dielectric\"}}"),
+                 "scene.json:1: materials.gold.bsdf.type: is two-sided already");
+    EXPECT_ERROR(MAT("{\"type\": \"two_sided\", \"bsdf\": {\"type\": \"diffuse\"}, \"two_sided\": false}"),
+                 "scene.json:1: materials.gold.two_sided: a two_sided material is two-sided by its type");
 
     /* the array form still needs a name */
     EXPECT_ERROR("{\"materials\": [{\"type\": \"diffuse\"}]}", "scene.json:1: materials[0]: missing \"name\"");
