@@ -25,7 +25,7 @@ install(FILES ${CMAKE_CURRENT_BINARY_DIR}/paprsekConfig.cmake
 
 # paprsek.pc. Static linking (pkg-config --static) needs what the library
 # links: libpng and cJSON through their own .pc files where they have one,
-# OpenEXRCore, the OpenMP flag, libm (and libdl, the thread library where the C library
+# libjpeg, OpenEXRCore, the OpenMP flag, libm (and libdl, the thread library where the C library
 # lacks them). Embree is not listed: it is loaded at run time.
 set(PK_PC_REQUIRES_PRIVATE)
 set(PK_PC_LIBS_PRIVATE ${OpenMP_C_FLAGS})
@@ -51,7 +51,7 @@ endif()
 # OpenEXR: the C library OpenEXRCore alone, by name. Its OpenEXR.pc would
 # link the C++ libraries too (OpenEXR, Iex, IlmThread) and add Imath's
 # headers, none of which the library uses.
-list(APPEND PK_PC_LIBS_PRIVATE -l${PK_OPENEXR_LINK_NAME})
+list(APPEND PK_PC_LIBS_PRIVATE -ljpeg -l${PK_OPENEXR_LINK_NAME})
 list(APPEND PK_PC_LIBS_PRIVATE -lm ${CMAKE_THREAD_LIBS_INIT})
 foreach(lib ${PK_DL_LIBS})
   list(APPEND PK_PC_LIBS_PRIVATE -l${lib})

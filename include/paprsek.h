@@ -82,6 +82,15 @@ PK_API const char *pk_status_string(pk_status status);
 /* A JSON scene holds settings, materials, spheres and lights, not meshes; its
  * parsed tree takes tens of bytes per byte of text, hence a smaller bound. */
 #define PK_MAX_JSON_BYTES ((size_t)64 << 20) /* 64 MiB */
+/* Image textures and environment maps: each side at most PK_MAX_TEXTURE_SIDE
+ * pixels and at most PK_MAX_TEXTURE_PIXELS pixels per image (checked before
+ * a file is decoded, so that a small compressed file cannot ask for
+ * gigabytes); all the textures of a scene together, their mipmaps included,
+ * at most PK_MAX_TEXTURE_BYTES. A texture past a bound is left out with a
+ * warning, and its material keeps its constant values. */
+#define PK_MAX_TEXTURE_SIDE 32768
+#define PK_MAX_TEXTURE_PIXELS (128u * 1024u * 1024u)
+#define PK_MAX_TEXTURE_BYTES ((size_t)4 << 30) /* 4 GiB */
 
 /* ---- camera, options, statistics ----------------------------------------- */
 

@@ -1,0 +1,688 @@
+/*
+ * image_read.c - the image readers (see image_read.h): PNG through libpng's
+ * simplified API, JPEG through libjpeg (errors caught with setjmp/longjmp,
+ * messages kept instead of printed), OpenEXR through OpenEXRCore reading
+ * from memory, and Radiance .hdr and PFM parsed here.
+ */
+#include "image_read.h"
+
+#include <limits.h>
+#include <math.h>
+#include <setjmp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <jpeglib.h>
+#include <openexr.h>
+#include <png.h>
+
+const float image_srgb_to_linear[256] = {
+    0.000000000e+00f, 3.035269835e-04f, 6.070539671e-04f, 9.105809506e-04f, 1.214107934e-03f, 1.517634918e-03f,
+    1.821161901e-03f, 2.124688885e-03f, 2.428215868e-03f, 2.731742852e-03f, 3.035269835e-03f, 3.346535764e-03f,
+    3.676507324e-03f, 4.024717018e-03f, 4.391442037e-03f, 4.776953481e-03f, 5.181516702e-03f, 5.605391624e-03f,
+    6.048833023e-03f, 6.512090793e-03f, 6.995410187e-03f, 7.499032043e-03f, 8.023192985e-03f, 8.568125618e-03f,
+    9.134058702e-03f, 9.721217320e-03f, 1.032982303e-02f, 1.096009401e-02f, 1.161224518e-02f, 1.228648836e-02f,
+    1.298303234e-02f, 1.370208305e-02f, 1.444384360e-02f, 1.520851442e-02f, 1.599629337e-02f, 1.680737575e-02f,
+    1.764195449e-02f, 1.850022013e-02f, 1.938236096e-02f, 2.028856306e-02f, 2.121901038e-02f, 2.217388479e-02f,
+    2.315336618e-02f, 2.415763245e-02f, 2.518685963e-02f, 2.624122189e-02f, 2.732089164e-02f, 2.842603950e-02f,
+    2.955683444e-02f, 3.071344373e-02f, 3.189603307e-02f, 3.310476657e-02f, 3.433980681e-02f, 3.560131488e-02f,
+    3.688945040e-02f, 3.820437160e-02f, 3.954623528e-02f, 4.091519691e-02f, 4.231141062e-02f, 4.373502926e-02f,
+    4.518620439e-02f, 4.666508634e-02f, 4.817182423e-02f, 4.970656598e-02f, 5.126945837e-02f, 5.286064702e-02f,
+    5.448027644e-02f, 5.612849005e-02f, 5.780543019e-02f, 5.951123816e-02f, 6.124605423e-02f, 6.301001765e-02f,
+    6.480326669e-02f, 6.662593864e-02f, 6.847816984e-02f, 7.036009570e-02f, 7.227185068e-02f, 7.421356838e-02f,
+    7.618538148e-02f, 7.818742181e-02f, 8.021982031e-02f, 8.228270713e-02f, 8.437621154e-02f, 8.650046204e-02f,
+    8.865558629e-02f, 9.084171118e-02f, 9.305896285e-02f, 9.530746663e-02f, 9.758734714e-02f, 9.989872825e-02f,
+    1.022417331e-01f, 1.046164841e-01f, 1.070231030e-01f, 1.094617108e-01f, 1.119324278e-01f, 1.144353738e-01f,
+    1.169706678e-01f, 1.195384280e-01f, 1.221387722e-01f, 1.247718176e-01f, 1.274376804e-01f, 1.301364767e-01f,
+    1.328683216e-01f, 1.356333297e-01f, 1.384316150e-01f, 1.412632911e-01f, 1.441284709e-01f, 1.470272665e-01f,
+    1.499597898e-01f, 1.529261520e-01f, 1.559264637e-01f, 1.589608351e-01f, 1.620293756e-01f, 1.651321945e-01f,
+    1.682694002e-01f, 1.714411007e-01f, 1.746474037e-01f, 1.778884160e-01f, 1.811642442e-01f, 1.844749945e-01f,
+    1.878207723e-01f, 1.912016827e-01f, 1.946178304e-01f, 1.980693196e-01f, 2.015562538e-01f, 2.050787364e-01f,
+    2.086368701e-01f, 2.122307574e-01f, 2.158605001e-01f, 2.195261997e-01f, 2.232279573e-01f, 2.269658735e-01f,
+    2.307400485e-01f, 2.345505822e-01f, 2.383975738e-01f, 2.422811225e-01f, 2.462013267e-01f, 2.501582847e-01f,
+    2.541520943e-01f, 2.581828529e-01f, 2.622506575e-01f, 2.663556048e-01f, 2.704977910e-01f, 2.746773121e-01f,
+    2.788942635e-01f, 2.831487404e-01f, 2.874408377e-01f, 2.917706498e-01f, 2.961382708e-01f, 3.005437944e-01f,
+    3.049873141e-01f, 3.094689228e-01f, 3.139887134e-01f, 3.185467781e-01f, 3.231432091e-01f, 3.277780981e-01f,
+    3.324515363e-01f, 3.371636150e-01f, 3.419144249e-01f, 3.467040564e-01f, 3.515325995e-01f, 3.564001441e-01f,
+    3.613067798e-01f, 3.662525956e-01f, 3.712376805e-01f, 3.762621230e-01f, 3.813260114e-01f, 3.864294338e-01f,
+    3.915724777e-01f, 3.967552307e-01f, 4.019777798e-01f, 4.072402119e-01f, 4.125426135e-01f, 4.178850708e-01f,
+    4.232676700e-01f, 4.286904966e-01f, 4.341536362e-01f, 4.396571738e-01f, 4.452011945e-01f, 4.507857828e-01f,
+    4.564110232e-01f, 4.620769997e-01f, 4.677837961e-01f, 4.735314961e-01f, 4.793201831e-01f, 4.851499401e-01f,
+    4.910208498e-01f, 4.969329951e-01f, 5.028864580e-01f, 5.088813209e-01f, 5.149176654e-01f, 5.209955732e-01f,
+    5.271151257e-01f, 5.332764040e-01f, 5.394794890e-01f, 5.457244614e-01f, 5.520114015e-01f, 5.583403896e-01f,
+    5.647115057e-01f, 5.711248295e-01f, 5.775804404e-01f, 5.840784179e-01f, 5.906188409e-01f, 5.972017884e-01f,
+    6.038273389e-01f, 6.104955708e-01f, 6.172065624e-01f, 6.239603917e-01f, 6.307571363e-01f, 6.375968740e-01f,
+    6.444796820e-01f, 6.514056374e-01f, 6.583748173e-01f, 6.653872983e-01f, 6.724431570e-01f, 6.795424696e-01f,
+    6.866853124e-01f, 6.938717613e-01f, 7.011018919e-01f, 7.083757799e-01f, 7.156935005e-01f, 7.230551289e-01f,
+    7.304607401e-01f, 7.379104088e-01f, 7.454042095e-01f, 7.529422168e-01f, 7.605245047e-01f, 7.681511472e-01f,
+    7.758222183e-01f, 7.835377915e-01f, 7.912979403e-01f, 7.991027380e-01f, 8.069522577e-01f, 8.148465722e-01f,
+    8.227857544e-01f, 8.307698768e-01f, 8.387990117e-01f, 8.468732315e-01f, 8.549926081e-01f, 8.631572135e-01f,
+    8.713671192e-01f, 8.796223969e-01f, 8.879231179e-01f, 8.962693534e-01f, 9.046611744e-01f, 9.130986518e-01f,
+    9.215818563e-01f, 9.301108584e-01f, 9.386857285e-01f, 9.473065367e-01f, 9.559733532e-01f, 9.646862479e-01f,
+    9.734452904e-01f, 9.822505503e-01f, 9.911020971e-01f, 1.000000000e+00f,
+};
+
+void image_buf_free(const pk_allocator *a, image_buf *img)
+{
+    mem_free(a, img->px8);
+    mem_free(a, img->pxf);
+    memset(img, 0, sizeof *img);
+}
+
+/* Checks a size against the bounds; latches PK_ERR_LIMIT or PK_ERR_PARSE. */
+static pk_status check_size(pk_context *ctx, const char *name, int64_t w, int64_t h)
+{
+    if (w <= 0 || h <= 0) return ctx_error(ctx, PK_ERR_PARSE, "%s: image size %lldx%lld is empty", name, (long long)w, (long long)h);
+    if (w > PK_MAX_TEXTURE_SIDE || h > PK_MAX_TEXTURE_SIDE || (uint64_t)w * (uint64_t)h > PK_MAX_TEXTURE_PIXELS)
+        return ctx_error(ctx, PK_ERR_LIMIT, "%s: image size %lldx%lld is beyond the limits (%d pixels a side, %u pixels)",
+                         name, (long long)w, (long long)h, PK_MAX_TEXTURE_SIDE, PK_MAX_TEXTURE_PIXELS);
+    return PK_OK;
+}
+
+/* Allocates out's samples (8-bit or float) for w x h x nc. */
+static pk_status alloc_buf(pk_context *ctx, image_buf *out, int w, int h, int nc, bool hdr)
+{
+    memset(out, 0, sizeof *out);
+    size_t n = (size_t)w * (size_t)h * (size_t)nc; /* bounded by check_size */
+    if (hdr) out->pxf = mem_realloc_array(&ctx->alloc, NULL, n, sizeof(float));
+    else out->px8 = mem_alloc(&ctx->alloc, n);
+    if (!out->pxf && !out->px8) return ctx_nomem(ctx);
+    out->w = w;
+    out->h = h;
+    out->nc = nc;
+    return PK_OK;
+}
+
+/* Non-finite samples (NaN, inf) become 0: lookups must stay finite. */
+static void sanitize_floats(float *p, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (!isfinite(p[i])) p[i] = 0.0f;
+}
+
+image_format image_sniff(const void *data, size_t size)
+{
+    const unsigned char *b = data;
+    if (size >= 8 && memcmp(b, "\x89PNG\r\n\x1a\n", 8) == 0) return IMAGE_PNG;
+    if (size >= 3 && b[0] == 0xFF && b[1] == 0xD8 && b[2] == 0xFF) return IMAGE_JPEG;
+    if (size >= 4 && b[0] == 0x76 && b[1] == 0x2F && b[2] == 0x31 && b[3] == 0x01) return IMAGE_EXR;
+    if (size >= 2 && b[0] == '#' && b[1] == '?') return IMAGE_HDR;
+    if (size >= 3 && b[0] == 'P' && (b[1] == 'F' || b[1] == 'f') && (b[2] == '\n' || b[2] == ' ' || b[2] == '\r' || b[2] == '\t'))
+        return IMAGE_PFM;
+    return IMAGE_UNKNOWN;
+}
+
+pk_status image_decode(pk_context *ctx, const void *data, size_t size, const char *name, image_buf *out)
+{
+    memset(out, 0, sizeof *out);
+    switch (image_sniff(data, size)) {
+    case IMAGE_PNG: return image_decode_png(ctx, data, size, name, out);
+    case IMAGE_JPEG: return image_decode_jpeg(ctx, data, size, name, out);
+    case IMAGE_EXR: return image_decode_exr(ctx, data, size, name, out);
+    case IMAGE_HDR: return image_decode_hdr(ctx, data, size, name, out);
+    case IMAGE_PFM: return image_decode_pfm(ctx, data, size, name, out);
+    default: break;
+    }
+    return ctx_error(ctx, PK_ERR_UNSUPPORTED, "%s: not a PNG, JPEG, OpenEXR, Radiance HDR or PFM image", name);
+}
+
+/* ---- PNG ------------------------------------------------------------------ */
+
+pk_status image_decode_png(pk_context *ctx, const void *data, size_t size, const char *name, image_buf *out)
+{
+    memset(out, 0, sizeof *out);
+    png_image im;
+    memset(&im, 0, sizeof im);
+    im.version = PNG_IMAGE_VERSION;
+    if (!png_image_begin_read_from_memory(&im, data, size)) {
+        pk_status st = ctx_error(ctx, PK_ERR_PARSE, "%s: bad PNG: %s", name, im.message);
+        png_image_free(&im);
+        return st;
+    }
+    pk_status st = check_size(ctx, name, im.width, im.height);
+    if (st != PK_OK) {
+        png_image_free(&im);
+        return st;
+    }
+    int nc = (im.format & PNG_FORMAT_FLAG_COLOR) ? 3 : 1;
+    if (im.format & PNG_FORMAT_FLAG_ALPHA) nc++;
+    static const png_uint_32 formats[5] = {0, PNG_FORMAT_GRAY, PNG_FORMAT_GA, PNG_FORMAT_RGB, PNG_FORMAT_RGBA};
+    im.format = formats[nc];
+    st = alloc_buf(ctx, out, (int)im.width, (int)im.height, nc, false);
+    if (st != PK_OK) {
+        png_image_free(&im);
+        return st;
+    }
+    if (!png_image_finish_read(&im, NULL, out->px8, 0, NULL)) {
+        st = ctx_error(ctx, PK_ERR_PARSE, "%s: bad PNG: %s", name, im.message);
+        png_image_free(&im);
+        image_buf_free(&ctx->alloc, out);
+        return st;
+    }
+    png_image_free(&im);
+    return PK_OK;
+}
+
+/* ---- JPEG ------------------------------------------------------------------ */
+
+#define JPEG_MAX_SCANS 1000                 /* a progressive file with more is refused */
+#define JPEG_MAX_MEMORY ((long)1 << 30)     /* libjpeg's working memory */
+
+typedef struct jpeg_err {
+    struct jpeg_error_mgr pub;
+    jmp_buf jb;
+    char msg[JMSG_LENGTH_MAX];
+} jpeg_err;
+
+static void jpeg_on_error(j_common_ptr c)
+{
+    jpeg_err *e = (jpeg_err *)c->err;
+    c->err->format_message(c, e->msg);
+    longjmp(e->jb, 1);
+}
+
+static void jpeg_on_message(j_common_ptr c) { (void)c; } /* warnings: not printed */
+
+static void jpeg_on_progress(j_common_ptr c)
+{
+    j_decompress_ptr d = (j_decompress_ptr)c;
+    if (d->input_scan_number > JPEG_MAX_SCANS) {
+        jpeg_err *e = (jpeg_err *)c->err;
+        snprintf(e->msg, sizeof e->msg, "more than %d scans", JPEG_MAX_SCANS);
+        longjmp(e->jb, 1);
+    }
+}
+
+typedef struct jpeg_job {
+    struct jpeg_decompress_struct d;
+    jpeg_err err;
+    struct jpeg_progress_mgr progress;
+    image_buf img;
+} jpeg_job;
+
+pk_status image_decode_jpeg(pk_context *ctx, const void *data, size_t size, const char *name, image_buf *out)
+{
+    memset(out, 0, sizeof *out);
+    if (size > ULONG_MAX) return ctx_error(ctx, PK_ERR_LIMIT, "%s: JPEG too large", name);
+    /* on the heap: what longjmp returns to must not live in registers */
+    jpeg_job *volatile job = mem_calloc(&ctx->alloc, 1, sizeof *job);
+    if (!job) return ctx_nomem(ctx);
+    job->d.err = jpeg_std_error(&job->err.pub);
+    job->err.pub.error_exit = jpeg_on_error;
+    job->err.pub.output_message = jpeg_on_message;
+    pk_status st = PK_OK;
+    if (setjmp(job->err.jb)) {
+        if (ctx->status == PK_OK) st = ctx_error(ctx, PK_ERR_PARSE, "%s: bad JPEG: %s", name, job->err.msg);
+        else st = ctx->status;
+        goto done;
+    }
+    jpeg_create_decompress(&job->d);
+    job->d.mem->max_memory_to_use = JPEG_MAX_MEMORY;
+    job->progress.progress_monitor = jpeg_on_progress;
+    job->d.progress = &job->progress;
+    jpeg_mem_src(&job->d, (const unsigned char *)data, (unsigned long)size);
+    jpeg_read_header(&job->d, TRUE);
+    int nc;
+    switch (job->d.jpeg_color_space) {
+    case JCS_GRAYSCALE: job->d.out_color_space = JCS_GRAYSCALE; nc = 1; break;
+    case JCS_CMYK:
+    case JCS_YCCK:
+        st = ctx_error(ctx, PK_ERR_UNSUPPORTED, "%s: CMYK JPEG images are not supported", name);
+        goto done;
+    default: job->d.out_color_space = JCS_RGB; nc = 3; break;
+    }
+    st = check_size(ctx, name, job->d.image_width, job->d.image_height);
+    if (st != PK_OK) goto done;
+    jpeg_start_decompress(&job->d);
+    if ((int)job->d.output_components != nc || job->d.output_width != job->d.image_width ||
+        job->d.output_height != job->d.image_height) {
+        st = ctx_error(ctx, PK_ERR_PARSE, "%s: bad JPEG: unexpected output layout", name);
+        goto done;
+    }
+    st = alloc_buf(ctx, &job->img, (int)job->d.output_width, (int)job->d.output_height, nc, false);
+    if (st != PK_OK) goto done;
+    while (job->d.output_scanline < job->d.output_height) {
+        JSAMPROW row = job->img.px8 + (size_t)job->d.output_scanline * (size_t)job->img.w * (size_t)nc;
+        if (jpeg_read_scanlines(&job->d, &row, 1) != 1) {
+            st = ctx_error(ctx, PK_ERR_PARSE, "%s: bad JPEG: truncated", name);
+            goto done;
+        }
+    }
+    jpeg_finish_decompress(&job->d);
+    *out = job->img;
+    memset(&job->img, 0, sizeof job->img);
+done:
+    jpeg_destroy_decompress(&job->d);
+    image_buf_free(&ctx->alloc, &job->img);
+    mem_free(&ctx->alloc, job);
+    return st;
+}
+
+/* ---- OpenEXR ------------------------------------------------------------------ */
+
+typedef struct exr_src {
+    const unsigned char *data;
+    size_t size;
+    char msg[200];
+} exr_src;
+
+static void exr_on_error(exr_const_context_t e, exr_result_t code, const char *msg)
+{
+    void *user = NULL;
+    exr_get_user_data(e, &user);
+    exr_src *s = user;
+    if (s && !s->msg[0])
+        snprintf(s->msg, sizeof s->msg, "%s", msg && msg[0] ? msg : exr_get_default_error_message(code));
+}
+
+static int64_t exr_on_read(exr_const_context_t e, void *user, void *buffer, uint64_t sz, uint64_t offset,
+                           exr_stream_error_func_ptr_t error_cb)
+{
+    (void)e;
+    (void)error_cb;
+    exr_src *s = user;
+    if (offset >= s->size) return 0;
+    uint64_t n = s->size - offset < sz ? s->size - offset : sz;
+    memcpy(buffer, s->data + offset, (size_t)n);
+    return (int64_t)n;
+}
+
+static int64_t exr_on_size(exr_const_context_t e, void *user)
+{
+    (void)e;
+    return (int64_t)((exr_src *)user)->size;
+}
+
+/* Which of the file's channels go where: index into out's nc samples, -1 = skipped. */
+static int exr_pick_channels(const exr_attr_chlist_t *cl, int map[], int *nc)
+{
+    int r = -1, g = -1, b = -1, a = -1, y = -1;
+    for (int i = 0; i < cl->num_channels; i++) {
+        const char *n = cl->entries[i].name.str;
+        if (!n) continue;
+        if (!strcmp(n, "R")) r = i;
+        else if (!strcmp(n, "G")) g = i;
+        else if (!strcmp(n, "B")) b = i;
+        else if (!strcmp(n, "A")) a = i;
+        else if (!strcmp(n, "Y")) y = i;
+    }
+    for (int i = 0; i < cl->num_channels; i++) map[i] = -1;
+    if (r >= 0 && g >= 0 && b >= 0) {
+        map[r] = 0, map[g] = 1, map[b] = 2;
+        *nc = 3;
+    } else {
+        int grey = y >= 0 ? y : r >= 0 ? r : g >= 0 ? g : b >= 0 ? b : -1;
+        if (grey < 0) { /* anything: the first channel that is not alpha */
+            for (int i = 0; i < cl->num_channels && grey < 0; i++)
+                if (i != a) grey = i;
+        }
+        if (grey < 0) return -1;
+        map[grey] = 0;
+        *nc = 1;
+    }
+    if (a >= 0) map[a] = (*nc)++;
+    return 0;
+}
+
+pk_status image_decode_exr(pk_context *ctx, const void *data, size_t size, const char *name, image_buf *out)
+{
+    memset(out, 0, sizeof *out);
+    exr_src src = {data, size, ""};
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.user_data = &src;
+    init.read_fn = exr_on_read;
+    init.size_fn = exr_on_size;
+    init.error_handler_fn = exr_on_error;
+    init.max_image_width = PK_MAX_TEXTURE_SIDE;
+    init.max_image_height = PK_MAX_TEXTURE_SIDE;
+    init.max_tile_width = PK_MAX_TEXTURE_SIDE;
+    init.max_tile_height = PK_MAX_TEXTURE_SIDE;
+    init.flags = EXR_CONTEXT_FLAG_DISABLE_CHUNK_RECONSTRUCTION;
+    exr_context_t e = NULL;
+    exr_decode_pipeline_t dec;
+    bool have_dec = false;
+    int map[128];
+    pk_status st = PK_OK;
+    exr_result_t rv = exr_start_read(&e, name, &init);
+    if (rv != EXR_ERR_SUCCESS) goto exr_fail;
+    exr_storage_t storage;
+    if ((rv = exr_get_storage(e, 0, &storage)) != EXR_ERR_SUCCESS) goto exr_fail;
+    if (storage != EXR_STORAGE_SCANLINE && storage != EXR_STORAGE_TILED) {
+        st = ctx_error(ctx, PK_ERR_UNSUPPORTED, "%s: deep OpenEXR images are not supported", name);
+        goto done;
+    }
+    exr_attr_box2i_t dw;
+    if ((rv = exr_get_data_window(e, 0, &dw)) != EXR_ERR_SUCCESS) goto exr_fail;
+    int64_t w = (int64_t)dw.max.x - dw.min.x + 1, h = (int64_t)dw.max.y - dw.min.y + 1;
+    if ((st = check_size(ctx, name, w, h)) != PK_OK) goto done;
+    const exr_attr_chlist_t *cl = NULL;
+    if ((rv = exr_get_channels(e, 0, &cl)) != EXR_ERR_SUCCESS) goto exr_fail;
+    int nc = 0;
+    if (!cl || cl->num_channels <= 0 || cl->num_channels > 128 || exr_pick_channels(cl, map, &nc) != 0) {
+        st = ctx_error(ctx, PK_ERR_UNSUPPORTED, "%s: OpenEXR image has no usable channel", name);
+        goto done;
+    }
+    for (int i = 0; i < cl->num_channels; i++)
+        if (map[i] >= 0 && (cl->entries[i].x_sampling != 1 || cl->entries[i].y_sampling != 1)) {
+            st = ctx_error(ctx, PK_ERR_UNSUPPORTED, "%s: subsampled OpenEXR channels are not supported", name);
+            goto done;
+        }
+    if ((st = alloc_buf(ctx, out, (int)w, (int)h, nc, true)) != PK_OK) goto done;
+    memset(out->pxf, 0, (size_t)w * (size_t)h * (size_t)nc * sizeof(float));
+
+    /* the chunks: scanline blocks, or the tiles of level 0 */
+    int32_t nx = 1, ny, lines = 1;
+    uint32_t tw = 0, th = 0;
+    if (storage == EXR_STORAGE_SCANLINE) {
+        if ((rv = exr_get_scanlines_per_chunk(e, 0, &lines)) != EXR_ERR_SUCCESS) goto exr_fail;
+        if (lines <= 0) goto exr_bad;
+        ny = (int32_t)((h + lines - 1) / lines);
+    } else {
+        exr_tile_level_mode_t lm;
+        exr_tile_round_mode_t rm;
+        if ((rv = exr_get_tile_descriptor(e, 0, &tw, &th, &lm, &rm)) != EXR_ERR_SUCCESS) goto exr_fail;
+        if (tw == 0 || th == 0) goto exr_bad;
+        nx = (int32_t)((w + tw - 1) / tw);
+        ny = (int32_t)((h + th - 1) / th);
+    }
+    for (int32_t cy = 0; cy < ny; cy++) {
+        for (int32_t cx = 0; cx < nx; cx++) {
+            exr_chunk_info_t ci;
+            int64_t x0, y0;
+            if (storage == EXR_STORAGE_SCANLINE) {
+                rv = exr_read_scanline_chunk_info(e, 0, dw.min.y + cy * lines, &ci);
+                x0 = 0;
+                y0 = (int64_t)ci.start_y - dw.min.y;
+            } else {
+                rv = exr_read_tile_chunk_info(e, 0, cx, cy, 0, 0, &ci);
+                x0 = (int64_t)cx * tw;
+                y0 = (int64_t)cy * th;
+            }
+            if (rv != EXR_ERR_SUCCESS) goto exr_fail;
+            if (x0 < 0 || y0 < 0 || ci.width <= 0 || ci.height <= 0 || x0 + ci.width > w || y0 + ci.height > h)
+                goto exr_bad;
+            rv = have_dec ? exr_decoding_update(e, 0, &ci, &dec) : exr_decoding_initialize(e, 0, &ci, &dec);
+            if (rv != EXR_ERR_SUCCESS) goto exr_fail;
+            have_dec = true;
+            for (int c = 0; c < dec.channel_count; c++) {
+                exr_coding_channel_info_t *ch = &dec.channels[c];
+                int k = -1;
+                for (int i = 0; i < cl->num_channels; i++)
+                    if (ch->channel_name && cl->entries[i].name.str && !strcmp(ch->channel_name, cl->entries[i].name.str))
+                        k = map[i];
+                if (k < 0 || ch->width != ci.width || ch->height != ci.height) {
+                    ch->decode_to_ptr = NULL;
+                    continue;
+                }
+                ch->decode_to_ptr = (uint8_t *)(out->pxf + ((size_t)y0 * (size_t)w + (size_t)x0) * (size_t)nc + (size_t)k);
+                ch->user_pixel_stride = nc * (int32_t)sizeof(float);
+                ch->user_line_stride = (int32_t)(w * nc * (int64_t)sizeof(float));
+                ch->user_data_type = EXR_PIXEL_FLOAT;
+                ch->user_bytes_per_element = 4;
+            }
+            if ((rv = exr_decoding_choose_default_routines(e, 0, &dec)) != EXR_ERR_SUCCESS) goto exr_fail;
+            if ((rv = exr_decoding_run(e, 0, &dec)) != EXR_ERR_SUCCESS) goto exr_fail;
+        }
+    }
+    sanitize_floats(out->pxf, (size_t)w * (size_t)h * (size_t)nc);
+    goto done;
+exr_bad:
+    st = ctx_error(ctx, PK_ERR_PARSE, "%s: bad OpenEXR image: inconsistent chunk layout", name);
+    goto done;
+exr_fail:
+    st = ctx_error(ctx, rv == EXR_ERR_OUT_OF_MEMORY ? PK_ERR_NOMEM : PK_ERR_PARSE, "%s: bad OpenEXR image: %s", name,
+                   src.msg[0] ? src.msg : exr_get_default_error_message(rv));
+done:
+    if (have_dec) exr_decoding_destroy(e, &dec);
+    if (e) exr_finish(&e);
+    if (st != PK_OK) image_buf_free(&ctx->alloc, out);
+    return st;
+}
+
+/* ---- Radiance .hdr --------------------------------------------------------- */
+
+/* Next header line [*ls, *le) from *p; false at the end of the data. */
+static bool hdr_line(const unsigned char **p, const unsigned char *end, const unsigned char **ls,
+                     const unsigned char **le)
+{
+    const unsigned char *q = *p;
+    if (q >= end) return false;
+    const unsigned char *nl = memchr(q, '\n', (size_t)(end - q));
+    if (!nl) return false;
+    *ls = q;
+    *le = nl;
+    *p = nl + 1;
+    return true;
+}
+
+/* Reads "[+-]Y n [+-]X m" style tokens: sign and axis, then a number. */
+static bool hdr_axis(const unsigned char **p, const unsigned char *e, char *sign, char *axis, int64_t *n)
+{
+    const unsigned char *q = *p;
+    while (q < e && *q == ' ') q++;
+    if (e - q < 2 || (q[0] != '+' && q[0] != '-') || (q[1] != 'X' && q[1] != 'Y')) return false;
+    *sign = (char)q[0];
+    *axis = (char)q[1];
+    q += 2;
+    while (q < e && *q == ' ') q++;
+    int64_t v = 0;
+    const unsigned char *d = q;
+    while (q < e && *q >= '0' && *q <= '9' && v < 100000000) v = v * 10 + (*q++ - '0');
+    if (q == d) return false;
+    *n = v;
+    *p = q;
+    return true;
+}
+
+static inline void rgbe_to_float(const unsigned char *c, float *out)
+{
+    if (c[3] == 0) {
+        out[0] = out[1] = out[2] = 0.0f;
+        return;
+    }
+    float f = ldexpf(1.0f, (int)c[3] - (128 + 8));
+    out[0] = ((float)c[0] + 0.5f) * f;
+    out[1] = ((float)c[1] + 0.5f) * f;
+    out[2] = ((float)c[2] + 0.5f) * f;
+}
+
+/* One scanline of w RGBE pixels into line (4w bytes): adaptive RLE, or flat
+ * pixels with the old run-length repeats. Returns false on corrupt data. */
+static bool hdr_scanline(const unsigned char **pp, const unsigned char *end, int w, unsigned char *line)
+{
+    const unsigned char *p = *pp;
+    if (end - p < 4) return false;
+    if (w >= 8 && w < 32768 && p[0] == 2 && p[1] == 2 && !(p[2] & 0x80)) {
+        if (((int)p[2] << 8 | p[3]) != w) return false;
+        p += 4;
+        for (int c = 0; c < 4; c++) {
+            int i = 0;
+            while (i < w) {
+                if (p >= end) return false;
+                int n = *p++;
+                if (n > 128) {
+                    n -= 128;
+                    if (n > w - i || p >= end) return false;
+                    unsigned char v = *p++;
+                    for (int k = 0; k < n; k++) line[4 * (i + k) + c] = v;
+                } else {
+                    if (n == 0 || n > w - i || end - p < n) return false;
+                    for (int k = 0; k < n; k++) line[4 * (i + k) + c] = p[k];
+                    p += n;
+                }
+                i += n;
+            }
+        }
+        *pp = p;
+        return true;
+    }
+    int i = 0, shift = 0;
+    while (i < w) {
+        if (end - p < 4) return false;
+        if (p[0] == 1 && p[1] == 1 && p[2] == 1) { /* old RLE: repeat the previous pixel */
+            if (i == 0 || shift > 16) return false;
+            int64_t n = (int64_t)p[3] << shift;
+            if (n > w - i) return false;
+            for (int64_t k = 0; k < n; k++) memcpy(line + 4 * (i + k), line + 4 * (i - 1), 4);
+            i += (int)n;
+            shift += 8;
+        } else {
+            memcpy(line + 4 * i, p, 4);
+            i++;
+            shift = 0;
+        }
+        p += 4;
+    }
+    *pp = p;
+    return true;
+}
+
+pk_status image_decode_hdr(pk_context *ctx, const void *data, size_t size, const char *name, image_buf *out)
+{
+    memset(out, 0, sizeof *out);
+    const unsigned char *p = data, *end = p + size, *ls, *le;
+    if (!hdr_line(&p, end, &ls, &le) || le - ls < 2 || ls[0] != '#' || ls[1] != '?')
+        return ctx_error(ctx, PK_ERR_PARSE, "%s: bad Radiance HDR image: no header", name);
+    /* header lines up to an empty one */
+    for (;;) {
+        if (!hdr_line(&p, end, &ls, &le)) return ctx_error(ctx, PK_ERR_PARSE, "%s: bad Radiance HDR image: truncated header", name);
+        if (le > ls && le[-1] == '\r') le--;
+        if (le == ls) break;
+        static const char fmt[] = "FORMAT=";
+        if ((size_t)(le - ls) > sizeof fmt - 1 && memcmp(ls, fmt, sizeof fmt - 1) == 0) {
+            const unsigned char *v = ls + sizeof fmt - 1;
+            if (!((size_t)(le - v) == 15 && memcmp(v, "32-bit_rle_rgbe", 15) == 0))
+                return ctx_error(ctx, PK_ERR_UNSUPPORTED, "%s: Radiance HDR format '%.*s' is not supported (only 32-bit_rle_rgbe)",
+                                 name, (int)(le - v > 40 ? 40 : le - v), (const char *)v);
+        }
+    }
+    if (!hdr_line(&p, end, &ls, &le)) return ctx_error(ctx, PK_ERR_PARSE, "%s: bad Radiance HDR image: no resolution line", name);
+    char s1, a1, s2, a2;
+    int64_t n1, n2;
+    const unsigned char *q = ls;
+    if (!hdr_axis(&q, le, &s1, &a1, &n1) || !hdr_axis(&q, le, &s2, &a2, &n2) || a1 != 'Y' || a2 != 'X' || s2 != '+')
+        return ctx_error(ctx, PK_ERR_UNSUPPORTED, "%s: Radiance HDR resolution line is not '-Y h +X w' or '+Y h +X w'", name);
+    pk_status st = check_size(ctx, name, n2, n1);
+    if (st != PK_OK) return st;
+    int w = (int)n2, h = (int)n1;
+    if ((st = alloc_buf(ctx, out, w, h, 3, true)) != PK_OK) return st;
+    unsigned char *line = mem_alloc(&ctx->alloc, (size_t)w * 4);
+    if (!line) {
+        image_buf_free(&ctx->alloc, out);
+        return ctx_nomem(ctx);
+    }
+    for (int y = 0; y < h; y++) {
+        if (!hdr_scanline(&p, end, w, line)) {
+            mem_free(&ctx->alloc, line);
+            image_buf_free(&ctx->alloc, out);
+            return ctx_error(ctx, PK_ERR_PARSE, "%s: bad Radiance HDR image: scanline %d is corrupt or truncated", name, y);
+        }
+        int row = s1 == '-' ? y : h - 1 - y; /* +Y: bottom to top */
+        float *o = out->pxf + (size_t)row * (size_t)w * 3;
+        for (int x = 0; x < w; x++) rgbe_to_float(line + 4 * x, o + 3 * x);
+    }
+    mem_free(&ctx->alloc, line);
+    return PK_OK;
+}
+
+/* ---- PFM ------------------------------------------------------------------ */
+
+/* A decimal token after blanks; false when none (or too long). */
+static bool pfm_token(const unsigned char **pp, const unsigned char *end, char *buf, size_t n)
+{
+    const unsigned char *p = *pp;
+    while (p < end && (*p == ' ' || *p == '\t' || *p == '\r' || *p == '\n')) p++;
+    size_t k = 0;
+    while (p < end && !(*p == ' ' || *p == '\t' || *p == '\r' || *p == '\n')) {
+        if (k + 1 >= n) return false;
+        buf[k++] = (char)*p++;
+    }
+    buf[k] = '\0';
+    *pp = p;
+    return k > 0;
+}
+
+pk_status image_decode_pfm(pk_context *ctx, const void *data, size_t size, const char *name, image_buf *out)
+{
+    memset(out, 0, sizeof *out);
+    const unsigned char *p = data, *end = p + size;
+    if (size < 3 || p[0] != 'P' || (p[1] != 'F' && p[1] != 'f'))
+        return ctx_error(ctx, PK_ERR_PARSE, "%s: bad PFM image: no PF or Pf header", name);
+    int nc = p[1] == 'F' ? 3 : 1;
+    p += 2;
+    char tw[32], th[32], ts[64];
+    if (!pfm_token(&p, end, tw, sizeof tw) || !pfm_token(&p, end, th, sizeof th) || !pfm_token(&p, end, ts, sizeof ts) ||
+        p >= end)
+        return ctx_error(ctx, PK_ERR_PARSE, "%s: bad PFM image: truncated header", name);
+    p++; /* the single whitespace character before the samples */
+    char *e1, *e2, *e3;
+    long long w = strtoll(tw, &e1, 10), h = strtoll(th, &e2, 10);
+    double scale = strtod(ts, &e3);
+    if (*e1 || *e2 || *e3 || !isfinite(scale) || scale == 0.0)
+        return ctx_error(ctx, PK_ERR_PARSE, "%s: bad PFM image: bad size or scale", name);
+    pk_status st = check_size(ctx, name, w, h);
+    if (st != PK_OK) return st;
+    size_t n = (size_t)w * (size_t)h * (size_t)nc;
+    if ((size_t)(end - p) / sizeof(float) < n)
+        return ctx_error(ctx, PK_ERR_PARSE, "%s: bad PFM image: truncated (%zu bytes of samples, %zu needed)", name,
+                         (size_t)(end - p), n * sizeof(float));
+    if ((st = alloc_buf(ctx, out, (int)w, (int)h, nc, true)) != PK_OK) return st;
+    const bool little = scale < 0.0;
+    const size_t row = (size_t)w * (size_t)nc;
+    for (long long y = 0; y < h; y++) {
+        const unsigned char *src = p + (size_t)y * row * 4;
+        float *dst = out->pxf + (size_t)(h - 1 - y) * row; /* rows bottom to top */
+        for (size_t i = 0; i < row; i++) {
+            const unsigned char *b = src + 4 * i;
+            uint32_t u = little ? (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24
+                                : (uint32_t)b[3] | (uint32_t)b[2] << 8 | (uint32_t)b[1] << 16 | (uint32_t)b[0] << 24;
+            float f;
+            memcpy(&f, &u, sizeof f);
+            dst[i] = f;
+        }
+    }
+    sanitize_floats(out->pxf, n);
+    return PK_OK;
+}
+
+/* ---- files ---------------------------------------------------------------------- */
+
+pk_status image_read_file(pk_context *ctx, const char *path, image_buf *out)
+{
+    memset(out, 0, sizeof *out);
+    char *data = NULL;
+    size_t size = 0;
+    pk_status st = file_read_all(ctx, path, &data, &size);
+    if (st != PK_OK) return st;
+    st = image_decode(ctx, data, size, path, out);
+    mem_free(&ctx->alloc, data);
+    return st;
+}
+
+pk_status image_load_rgb(pk_context *ctx, const char *path, int *w, int *h, float **rgb)
+{
+    *w = *h = 0;
+    *rgb = NULL;
+    image_buf img;
+    pk_status st = image_read_file(ctx, path, &img);
+    if (st != PK_OK) return st;
+    size_t np = (size_t)img.w * (size_t)img.h;
+    float *o = mem_realloc_array(&ctx->alloc, NULL, np, 3 * sizeof(float));
+    if (!o) {
+        image_buf_free(&ctx->alloc, &img);
+        return ctx_nomem(ctx);
+    }
+    const int nc = img.nc, colour = nc >= 3;
+    for (size_t i = 0; i < np; i++) {
+        for (int c = 0; c < 3; c++) {
+            size_t k = i * (size_t)nc + (size_t)(colour ? c : 0);
+            o[3 * i + (size_t)c] = img.pxf ? img.pxf[k] : image_srgb_to_linear[img.px8[k]];
+        }
+    }
+    *w = img.w;
+    *h = img.h;
+    *rgb = o;
+    image_buf_free(&ctx->alloc, &img);
+    return PK_OK;
+}
