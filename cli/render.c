@@ -47,6 +47,7 @@ enum {
     OPT_UP,
     OPT_FOV,
     OPT_TIME,
+    OPT_ENV,
     OPT_AOV,
     OPT_STATS,
     OPT_STATS_JSON,
@@ -100,6 +101,11 @@ static const cli_option *render_options(size_t *n)
         add((cli_option){.name = "time", .id = OPT_TIME, .kind = CLI_STRING, .arg = "SECONDS",
                          .help = "render passes of --spp samples per pixel until SECONDS have passed (at least "
                                  "one pass); the image is the mean of all passes"});
+        add((cli_option){.name = "env", .id = OPT_ENV, .kind = CLI_STRING, .arg = "SPEC",
+                         .help = "the light from the surroundings, replacing the scene's: none (black), R,G,B "
+                                 "or V (a constant radiance), or an image FILE (lat-long, +y up: .hdr, .exr, "
+                                 ".pfm, .png, .jpg). A scene without lights and without an environment is lit "
+                                 "by a white one of radiance 1"});
         add((cli_option){.name = "aov", .id = OPT_AOV, .kind = CLI_STRING, .arg = "LIST",
                          .help = "also write these outputs, from the camera rays: albedo, normal, depth, "
                                  "heatmap (nodes visited + primitives tested per camera ray), comma-separated; "
@@ -176,6 +182,7 @@ typedef struct cli_opts {
     unsigned aovs;       /* --aov: PK_AOV_* */
     int has_from, has_at, has_up, has_fov;
     float from[3], at[3], up[3], fov;
+    const char *env;     /* --env, NULL when not given */
 } cli_opts;
 
 /* Returns 0 to go on, -1 after --help (exit 0), or an exit status. */
@@ -252,6 +259,7 @@ static int parse_args(int argc, char **argv, cli_opts *o)
             o->has_fov = 1;
             break;
         }
+        case OPT_ENV: o->env = v; break;
         case OPT_TIME: {
             char *end;
             o->time = strtod(v, &end);
@@ -557,6 +565,23 @@ int cli_render(int argc, char **argv)
     ro.progress = cli_progress_update;
     ro.progress_user = &bar;
     if (pk_render_options_check(ctx, &ro) != PK_OK) goto fail;
+
+    if (o.env) {
+        pk_environment env;
+        pk_environment_init(&env);
+        char *end;
+        float grey = strtof(o.env, &end);
+        if (strcmp(o.env, "none") == 0) {
+            st = pk_scene_set_environment(ctx, scene, NULL);
+        } else if (cli_parse_vec3(o.env, env.radiance) || (end != o.env && !*end && isfinite(grey))) {
+            if (end != o.env && !*end) env.radiance[0] = env.radiance[1] = env.radiance[2] = grey;
+            st = pk_scene_set_environment(ctx, scene, &env);
+        } else {
+            env.map = o.env;
+            st = pk_scene_set_environment(ctx, scene, &env);
+        }
+        if (st != PK_OK) goto fail;
+    }
 
     if (o.has_from || o.has_at || o.has_up || o.has_fov) {
         pk_camera cam;

@@ -222,6 +222,24 @@ PK_API pk_status pk_scene_load_json_memory(pk_context *ctx, const char *data, si
 PK_API pk_status pk_scene_create_cornell_box(pk_context *ctx, pk_scene **out);
 PK_API void pk_scene_destroy(pk_scene *scene);
 
+/* Light from the surroundings, replacing the scene's own (docs/scene-format.md,
+ * "environment"): a constant radiance plus a lat-long image (PNG, JPEG,
+ * OpenEXR, Radiance .hdr or PFM; +y up, looked up as Mitsuba's envmap) times
+ * map_scale, turned by rotation degrees about +y. */
+typedef struct pk_environment {
+    float radiance[3];   /* linear RGB, >= 0 */
+    const char *map;     /* image file or NULL */
+    float map_scale;     /* >= 0 */
+    float rotation;      /* degrees */
+} pk_environment;
+
+/* No radiance, no map, scale 1, no rotation. */
+PK_API void pk_environment_init(pk_environment *env);
+/* Sets the scene's environment (the map is read now); NULL = none (black),
+ * which also turns off the white environment that lights a scene with no
+ * light of its own. A failure leaves the scene as it was. */
+PK_API pk_status pk_scene_set_environment(pk_context *ctx, pk_scene *scene, const pk_environment *env);
+
 typedef struct pk_scene_info {
     size_t triangles;            /* as numbered by the file, degenerate ones included */
     size_t degenerate_triangles; /* never hit */

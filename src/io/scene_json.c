@@ -915,6 +915,125 @@ static pk_status each_element(jp *p, const cJSON *arr, const char *key,
     return PK_OK;
 }
 
+/* ---- the environment ---------------------------------------------------------- */
+
+/* A unit direction; zero vectors refused. */
+static pk_status get_direction(jp *p, const cJSON *it, const char *path, vec3 *out)
+{
+    pk_status st = get_vec3(p, it, path, out);
+    if (st) return st;
+    float len = v3_len(*out);
+    if (!(len > 0.0f) || !isfinite(len)) return jfail(p, PK_ERR_PARSE, it, path, "must be a non-zero direction");
+    *out = v3_scale(*out, 1.0f / len);
+    return PK_OK;
+}
+
+static pk_status parse_sun(jp *p, const cJSON *it, const char *path, scene_environment *env)
+{
+    enum { U_DIRECTION, U_IRRADIANCE, U_RADIANCE, U_ANGLE, U_COUNT };
+    static const char *const keys[U_COUNT] = {"direction", "irradiance", "radiance", "angle"};
+    const cJSON *f[U_COUNT];
+    char fp[JP_PATH_MAX];
+    pk_status st = object_fields(p, it, path, keys, U_COUNT, f);
+    if (st) return st;
+    if (!f[U_DIRECTION]) return jfail(p, PK_ERR_PARSE, it, path, "missing \"direction\" (toward the sun)");
+    path_key(fp, path, "direction");
+    if ((st = get_direction(p, f[U_DIRECTION], fp, &env->sun_dir))) return st;
+    if (f[U_ANGLE]) {
+        path_key(fp, path, "angle");
+        if ((st = get_float(p, f[U_ANGLE], fp, &env->sun_angle))) return st;
+        if (!(env->sun_angle > 0.0f && env->sun_angle <= 90.0f))
+            return jfail(p, PK_ERR_PARSE, f[U_ANGLE], fp, "must be an angular diameter in (0, 90] degrees");
+    }
+    if (f[U_IRRADIANCE] && f[U_RADIANCE]) {
+        path_key(fp, path, "radiance");
+        return jfail(p, PK_ERR_PARSE, f[U_RADIANCE], fp, "give \"irradiance\" or \"radiance\", not both");
+    }
+    env->sun_radiance = v3s(0.0f);
+    if (f[U_RADIANCE]) {
+        path_key(fp, path, "radiance");
+        if ((st = get_color(p, f[U_RADIANCE], fp, &env->sun_radiance))) return st;
+    } else {
+        /* irradiance E on a surface facing the sun: a uniform disc of angular
+         * radius a gives E = pi L sin^2 a (default: 100, a bright day in the
+         * units of the sky) */
+        vec3 e = v3s(100.0f);
+        path_key(fp, path, "irradiance");
+        if (f[U_IRRADIANCE] && (st = get_color(p, f[U_IRRADIANCE], fp, &e))) return st;
+        float a = 0.5f * env->sun_angle * (PK_PI / 180.0f), s = sinf(a);
+        env->sun_radiance = v3_scale(e, 1.0f / (PK_PI * s * s));
+    }
+    env->has_sun = true;
+    return PK_OK;
+}
+
+static pk_status parse_environment(jp *p, const cJSON *it)
+{
+    scene_environment *env = &p->s->env;
+    const pk_allocator *a = &p->ctx->alloc;
+    scene_env_clear(a, env);
+    env->set = true;
+    pk_status st;
+    if (cJSON_IsString(it) && strcmp(it->valuestring, "none") == 0) return PK_OK;
+    if (cJSON_IsArray(it) || cJSON_IsNumber(it)) return get_color(p, it, "environment", &env->radiance);
+    enum { E_RADIANCE, E_MAP, E_SCALE, E_ROTATION, E_SUN, E_SKY, E_COUNT };
+    static const char *const keys[E_COUNT] = {"radiance", "map", "scale", "rotation", "sun", "sky"};
+    const cJSON *f[E_COUNT];
+    if (!cJSON_IsObject(it))
+        return jfail(p, PK_ERR_PARSE, it, "environment", "must be \"none\", a colour or an object");
+    if ((st = object_fields(p, it, "environment", keys, E_COUNT, f))) return st;
+    if (f[E_RADIANCE] && (st = get_color(p, f[E_RADIANCE], "environment.radiance", &env->radiance))) return st;
+    if (f[E_SCALE]) {
+        if ((st = get_float(p, f[E_SCALE], "environment.scale", &env->map_scale))) return st;
+        if (env->map_scale < 0.0f) return jfail(p, PK_ERR_PARSE, f[E_SCALE], "environment.scale", "must not be negative");
+    }
+    if (f[E_ROTATION]) {
+        float deg = 0.0f;
+        if ((st = get_float(p, f[E_ROTATION], "environment.rotation", &deg))) return st;
+        scene_env_rotate_y(env, deg);
+    }
+    if (f[E_SUN] && (st = parse_sun(p, f[E_SUN], "environment.sun", env))) return st;
+    if (f[E_SKY]) {
+        enum { K_TURBIDITY, K_SCALE, K_SUN_DIRECTION, K_N };
+        static const char *const sk[K_N] = {"turbidity", "scale", "sun_direction"};
+        const cJSON *g[K_N];
+        if ((st = object_fields(p, f[E_SKY], "environment.sky", sk, K_N, g))) return st;
+        if (g[K_TURBIDITY]) {
+            if ((st = get_float(p, g[K_TURBIDITY], "environment.sky.turbidity", &env->sky_turbidity))) return st;
+            if (!(env->sky_turbidity >= 2.0f && env->sky_turbidity <= 10.0f))
+                return jfail(p, PK_ERR_PARSE, g[K_TURBIDITY], "environment.sky.turbidity", "must be in 2..10");
+        }
+        if (g[K_SCALE]) {
+            if ((st = get_float(p, g[K_SCALE], "environment.sky.scale", &env->sky_scale))) return st;
+            if (env->sky_scale < 0.0f)
+                return jfail(p, PK_ERR_PARSE, g[K_SCALE], "environment.sky.scale", "must not be negative");
+        }
+        if (g[K_SUN_DIRECTION]) {
+            if (env->has_sun)
+                return jfail(p, PK_ERR_PARSE, g[K_SUN_DIRECTION], "environment.sky.sun_direction",
+                             "the sky follows environment.sun.direction; give one of them");
+            if ((st = get_direction(p, g[K_SUN_DIRECTION], "environment.sky.sun_direction", &env->sun_dir))) return st;
+        } else if (!env->has_sun) {
+            return jfail(p, PK_ERR_PARSE, f[E_SKY], "environment.sky",
+                         "needs the sun's direction: an environment.sun or a \"sun_direction\"");
+        }
+        env->has_sky = true;
+    }
+    if (f[E_MAP]) {
+        if (!cJSON_IsString(f[E_MAP]) || !f[E_MAP]->valuestring[0])
+            return jfail(p, PK_ERR_PARSE, f[E_MAP], "environment.map", "must be a non-empty string (a path)");
+        env->map = path_join(a, p->base_dir, f[E_MAP]->valuestring);
+        if (!env->map) return ctx_nomem(p->ctx);
+        /* loaded now, so that a bad map is reported at its line */
+        pk_context scratch = *p->ctx;
+        scratch.status = PK_OK;
+        scratch.message[0] = '\0';
+        st = scene_env_load(&scratch, env);
+        if (st) return jfail(p, st, f[E_MAP], "environment.map", "%s", scratch.message);
+    }
+    return PK_OK;
+}
+
 /* ---- the document ---------------------------------------------------------- */
 
 static pk_status syntax_error(jp *p, const char *end)
@@ -944,9 +1063,9 @@ static pk_status syntax_error(jp *p, const char *end)
 pk_status scene_json_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size, const char *name,
                            const char *base_dir)
 {
-    enum { K_MATERIALS, K_CAMERA, K_FILM, K_RENDER, K_AMBIENT, K_MESHES, K_SPHERES, K_LIGHTS, K_COUNT };
-    static const char *const keys[K_COUNT] = {"materials", "camera", "film",    "render",
-                                              "ambient",   "meshes", "spheres", "lights"};
+    enum { K_MATERIALS, K_CAMERA, K_FILM, K_RENDER, K_AMBIENT, K_MESHES, K_SPHERES, K_LIGHTS, K_ENV, K_COUNT };
+    static const char *const keys[K_COUNT] = {"materials", "camera", "film",    "render",     "ambient",
+                                              "meshes",    "spheres", "lights", "environment"};
     if (!ctx || !s) return PK_ERR_INVALID_ARGUMENT;
     if (!data && size) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "scene_json_parse: no data");
     if (size > PK_MAX_JSON_BYTES)
@@ -993,6 +1112,7 @@ pk_status scene_json_parse(pk_context *ctx, pk_scene *s, const char *data, size_
     p->named_limit = s->nmaterials;
     if (f[K_SPHERES] && (st = each_element(p, f[K_SPHERES], "spheres", parse_sphere))) goto out;
     if (f[K_LIGHTS] && (st = each_element(p, f[K_LIGHTS], "lights", parse_light))) goto out;
+    if (f[K_ENV] && (st = parse_environment(p, f[K_ENV]))) goto out;
     st = PK_OK;
 out:
     cJSON_Delete(root);

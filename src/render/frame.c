@@ -34,6 +34,28 @@ pk_status frame_build_accel(pk_context *ctx, const pk_scene *s, pk_accel_kind ki
     return st;
 }
 
+/* Whether anything in s emits: area lights, emissive spheres, point lights. */
+static bool scene_has_light(const pk_scene *s)
+{
+    if (s->nemissive || s->nlights) return true;
+    for (size_t i = 0; i < s->nspheres; i++) {
+        vec3 ke = s->materials[s->spheres[i].material].ke;
+        if (ke.x > 0.0f || ke.y > 0.0f || ke.z > 0.0f) return true;
+    }
+    return false;
+}
+
+static pk_status frame_env(pk_context *ctx, frame *f, const pk_scene *s)
+{
+    scene_environment env = s->env;
+    if (!env.set && !scene_has_light(s)) {
+        env.radiance = v3s(1.0f);
+        ctx_warn(ctx, "%s: the scene has no light; lighting it with a uniform white environment of radiance 1 "
+                 "(--env none for black, --env r,g,b or --env FILE for another)", s->name);
+    }
+    return env_build(ctx, &env, env.map_rgb, env.map_w, env.map_h, s->bounds, &f->env);
+}
+
 pk_status frame_init(pk_context *ctx, frame *f, const pk_scene *s, pk_accel_kind kind, int threads)
 {
     memset(f, 0, sizeof *f);
@@ -49,12 +71,17 @@ pk_status frame_init(pk_context *ctx, frame *f, const pk_scene *s, pk_accel_kind
         frame_free(&ctx->alloc, f);
         return st;
     }
+    if ((st = frame_env(ctx, f, s)) != PK_OK) {
+        frame_free(&ctx->alloc, f);
+        return st;
+    }
     return PK_OK;
 }
 
 void frame_free(const pk_allocator *al, frame *f)
 {
     lights_free(al, &f->lights);
+    env_free(al, &f->env);
     accel_destroy(f->a);
     f->a = NULL;
 }

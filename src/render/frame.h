@@ -6,12 +6,14 @@
 #define PK_FRAME_H
 
 #include "../accel/accel.h"
+#include "env.h"
 #include "lights.h"
 
 typedef struct frame {
     const pk_scene *s;
     accel *a;
     light_table lights;
+    env_light env;       /* the surroundings: environment and sun */
     float eps;           /* base offset for spawned rays, world units */
     double build_s;      /* acceleration build, seconds */
 } frame;
@@ -20,7 +22,9 @@ typedef struct frame {
  * up to threads threads (0 = all). */
 PK_HIDDEN pk_status frame_build_accel(pk_context *ctx, const pk_scene *s, pk_accel_kind kind, int threads,
                                       accel **out);
-/* The accelerator, the light table and eps. */
+/* The accelerator, the light table, the environment and eps. A scene
+ * without any light and without an environment of its own is lit by a
+ * uniform white environment of radiance 1 (with a warning). */
 PK_HIDDEN pk_status frame_init(pk_context *ctx, frame *f, const pk_scene *s, pk_accel_kind kind, int threads);
 PK_HIDDEN void frame_free(const pk_allocator *al, frame *f);
 

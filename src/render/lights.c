@@ -44,13 +44,14 @@ void lights_free(const pk_allocator *al, light_table *lt)
 
 static bool emits(vec3 ke) { return ke.x > 0.0f || ke.y > 0.0f || ke.z > 0.0f; }
 
-pk_status light_set_build(pk_context *ctx, const pk_scene *s, light_set *ls)
+pk_status light_set_build(pk_context *ctx, const pk_scene *s, const env_light *env, light_set *ls)
 {
     memset(ls, 0, sizeof *ls);
+    ls->env = ls->sun = -1;
     const pk_allocator *al = &ctx->alloc;
     size_t nsph = 0;
     for (size_t i = 0; i < s->nspheres; i++) nsph += emits(s->materials[s->spheres[i].material].ke);
-    const size_t n = s->nemissive + nsph + s->nlights;
+    const size_t n = s->nemissive + nsph + s->nlights + (env->active ? 1 : 0) + (env->sun ? 1 : 0);
     ls->of_prim = mem_realloc_array(al, NULL, s->ntris + s->nspheres + 1, sizeof(int32_t));
     if (!ls->of_prim) return ctx_nomem(ctx);
     for (size_t i = 0; i < s->ntris + s->nspheres; i++) ls->of_prim[i] = -1;
@@ -102,6 +103,16 @@ pk_status light_set_build(pk_context *ctx, const pk_scene *s, light_set *ls)
         power[k] = (double)fmaxf(v3_luminance(s->lights[i].intensity), 1e-6f) * 4.0 * (double)PK_PI;
         k++;
     }
+    if (env->active) {
+        ls->lights[k] = (light){LIGHT_ENV, 0, 0.0f, v3s(0.0f)};
+        power[k] = fmax(env->power_env, 1e-6);
+        ls->env = (int32_t)k++;
+    }
+    if (env->sun) {
+        ls->lights[k] = (light){LIGHT_SUN, 0, 0.0f, v3s(0.0f)};
+        power[k] = fmax(env->power_sun, 1e-6);
+        ls->sun = (int32_t)k++;
+    }
     double total = 0.0;
     for (size_t i = 0; i < n; i++) total += isfinite(power[i]) ? power[i] : 0.0;
     double acc = 0.0;
@@ -126,4 +137,5 @@ void light_set_free(const pk_allocator *al, light_set *ls)
     mem_free(al, ls->pmf);
     mem_free(al, ls->of_prim);
     memset(ls, 0, sizeof *ls);
+    ls->env = ls->sun = -1;
 }

@@ -7,6 +7,7 @@
 #define PK_LIGHTS_H
 
 #include "../scene/scene.h"
+#include "env.h"
 
 typedef struct light_table {
     size_t n;            /* the scene's emissive triangles (s->emissive) */
@@ -38,7 +39,7 @@ static inline size_t light_pick(const light_table *lt, float u) { return cdf_pic
 
 /* ---- every light, for the path tracer ------------------------------------ */
 
-enum { LIGHT_TRIANGLE, LIGHT_SPHERE, LIGHT_POINT };
+enum { LIGHT_TRIANGLE, LIGHT_SPHERE, LIGHT_POINT, LIGHT_ENV, LIGHT_SUN };
 
 typedef struct light {
     uint32_t kind;       /* LIGHT_* */
@@ -47,18 +48,19 @@ typedef struct light {
     vec3 normal;         /* triangles: unit winding normal */
 } light;
 
-/* Emissive triangles, emissive spheres and point lights, chosen in proportion
- * to their emitted power. */
+/* Emissive triangles, emissive spheres, point lights, the environment and
+ * the sun, chosen in proportion to their emitted power. */
 typedef struct light_set {
     size_t n;
     light *lights;
     float *cdf;          /* n entries, last = 1 */
     float *pmf;          /* probability of choosing each light */
     int32_t *of_prim;    /* ntris + nspheres entries: the light a primitive is, or -1 */
+    int32_t env, sun;    /* the environment's and the sun's light, or -1 */
     double power;
 } light_set;
 
-PK_HIDDEN pk_status light_set_build(pk_context *ctx, const pk_scene *s, light_set *ls);
+PK_HIDDEN pk_status light_set_build(pk_context *ctx, const pk_scene *s, const env_light *env, light_set *ls);
 PK_HIDDEN void light_set_free(const pk_allocator *al, light_set *ls);
 
 static inline size_t light_set_pick(const light_set *ls, float u) { return cdf_pick(ls->cdf, ls->n, u); }

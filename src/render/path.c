@@ -27,7 +27,7 @@ pk_status path_init(pk_context *ctx, path_tracer *pt, const frame *f, const pk_r
     pt->f = f;
     pt->max_depth = pk_render_options_max_depth(opt);
     pt->seed = (uint32_t)opt->seed;
-    return light_set_build(ctx, f->s, &pt->lights);
+    return light_set_build(ctx, f->s, &f->env, &pt->lights);
 }
 
 void path_free(const pk_allocator *al, path_tracer *pt) { light_set_free(al, &pt->lights); }
@@ -178,6 +178,22 @@ static bool sample_light(const path_tracer *pt, vec3 o, vec3 p, float u0, float 
     if (!(psel > 0.0f)) return false;
     vec3 q, nq, le;
     float pdf;
+    if (l->kind == LIGHT_ENV || l->kind == LIGHT_SUN) { /* a direction toward the surroundings */
+        const env_light *e = &pt->f->env;
+        vec3 d;
+        if (l->kind == LIGHT_ENV) {
+            if (!env_sample(e, u1, u2, &d, &le, &pdf)) return false;
+        } else {
+            d = sun_sample(e, u1, u2);
+            le = e->sun_le, pdf = sun_pdf(e);
+        }
+        ls->wi = d;
+        ls->le = le;
+        ls->pdf = psel * pdf;
+        ls->delta = false;
+        ls->shadow = (ray){o, 0.0f, d, INFINITY};
+        return true;
+    }
     if (l->kind == LIGHT_POINT) {
         const point_light *pl = &s->lights[l->index];
         vec3 d = v3_sub(pl->position, o);
@@ -241,6 +257,35 @@ static bool sample_light(const path_tracer *pt, vec3 o, vec3 p, float u0, float 
     ls->delta = false;
     ls->shadow = (ray){o, 0.0f, d, 1.0f - SHADOW_SHORTEN};
     return true;
+}
+
+/* What a path leaving the scene toward d (unit) gathers from the
+ * environment and the sun, each weighted by MIS against its light
+ * sampling when the last bounce was not a delta one. */
+static vec3 leaving(const path_tracer *pt, vec3 d, bool prev_delta, float prev_pdf)
+{
+    const env_light *e = &pt->f->env;
+    const light_set *ls = &pt->lights;
+    vec3 L = v3s(0.0f);
+    const int parts[2] = {ls->env, ls->sun};
+    for (int k = 0; k < 2; k++) {
+        if (parts[k] < 0) continue;
+        vec3 le;
+        float pl;
+        if (k == 0) {
+            le = env_eval(e, d);
+            pl = prev_delta ? 0.0f : env_pdf(e, d);
+        } else {
+            if (!sun_covers(e, d)) continue;
+            le = e->sun_le;
+            pl = sun_pdf(e);
+        }
+        float w = 1.0f;
+        if (!prev_delta && pt->strategy == PATH_LIGHTS_ONLY) w = 0.0f;
+        if (!prev_delta && pt->strategy == PATH_MIS) w = power_heuristic(prev_pdf, ls->pmf[parts[k]] * pl);
+        L = v3_add(L, v3_scale(le, w));
+    }
+    return L;
 }
 
 /* ---- the path ------------------------------------------------------------------ */
@@ -320,7 +365,10 @@ vec3 path_radiance(const path_tracer *pt, path_thread *t, sampler *smp, const ra
         prev_pdf = pdf;
         prev_p = sf.p;
         t->rays_bounce++;
-        if (!fr->a->ops->intersect(fr->a, &r, &h, t->cp)) break; /* no environment light yet */
+        if (!fr->a->ops->intersect(fr->a, &r, &h, t->cp)) {
+            L = v3_add(L, v3_mul(beta, leaving(pt, wi, prev_delta, prev_pdf)));
+            break;
+        }
     }
     return L;
 }

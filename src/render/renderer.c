@@ -40,7 +40,7 @@ struct pk_renderer {
 
 /* Warnings about scenes that the Whitted integrator will render black or
  * lit differently from what the file suggests. */
-static void warn_lighting(pk_context *ctx, const pk_scene *s, bool path)
+static void warn_lighting(pk_context *ctx, const pk_scene *s, const env_light *env, bool path)
 {
     size_t emissive_spheres = 0;
     for (size_t i = 0; i < s->nspheres; i++) {
@@ -49,9 +49,9 @@ static void warn_lighting(pk_context *ctx, const pk_scene *s, bool path)
     }
     /* the path tracer has no ambient term */
     bool ambient = !path && (s->ambient.x > 0.0f || s->ambient.y > 0.0f || s->ambient.z > 0.0f);
-    if (s->nemissive == 0 && s->nlights == 0 && emissive_spheres == 0 && !ambient)
-        ctx_warn(ctx, "%s: the scene has no light (no emissive triangle or sphere, no point light): the image will be black",
-                 s->name);
+    if (s->nemissive == 0 && s->nlights == 0 && emissive_spheres == 0 && !ambient && !env->active && !env->sun)
+        ctx_warn(ctx, "%s: the scene has no light (no emissive triangle or sphere, no point light, a black "
+                 "environment): the image will be black", s->name);
     if (emissive_spheres && !path)
         ctx_warn(ctx, "%s: %zu emissive sphere%s visible but light%s nothing: the Whitted integrator lights the scene "
                  "only from emissive triangles and point lights", s->name, emissive_spheres,
@@ -138,7 +138,7 @@ pk_status renderer_create(pk_context *ctx, const pk_scene *s, const pk_render_op
     r->total.build_us = r->fr.build_s * 1e6;
     r->total.threads = r->nt;
     r->total.accel_builds = 1;
-    warn_lighting(ctx, s, r->path);
+    warn_lighting(ctx, s, &r->fr.env, r->path);
     if (r->path) warn_facing(ctx, s, r->fr.a);
     *out = r;
     return PK_OK;
@@ -255,7 +255,11 @@ static bool render_tile_path(const pk_renderer *r, path_thread *me, const camera
         me->rays_camera += (uint64_t)n;
         accel_intersect_many(r->fr.a, rays, hits, (size_t)n, false, me->cp);
         for (int i = 0; i < n; i++) {
-            if (hits[i].prim == PK_NO_HIT) continue;
+            if (hits[i].prim == PK_NO_HIT) { /* the camera sees the surroundings */
+                vec3 c = env_background(&r->fr.env, v3_norm(rays[i].d));
+                acc[3 * i] += c.x, acc[3 * i + 1] += c.y, acc[3 * i + 2] += c.z;
+                continue;
+            }
             int px = tl->x + i % tw, py = tl->y + i / tw;
             sampler sm = sampler_start((uint32_t)px, (uint32_t)py, first + (uint32_t)smp, r->pt.seed);
             sm.dim = 2; /* the pixel position */
@@ -286,7 +290,11 @@ static bool render_tile(const pk_renderer *r, whitted_thread *me, const camera_f
         me->rays[RAY_CAMERA] += (uint64_t)n;
         accel_intersect_many(w->f->a, rays, hits, (size_t)n, false, me->cp);
         for (int i = 0; i < n; i++) {
-            if (hits[i].prim == PK_NO_HIT) continue;
+            if (hits[i].prim == PK_NO_HIT) {
+                vec3 c = env_background(&r->fr.env, v3_norm(rays[i].d));
+                acc[3 * i] += c.x, acc[3 * i + 1] += c.y, acc[3 * i + 2] += c.z;
+                continue;
+            }
             int px = tl->x + i % tw, py = tl->y + i / tw;
             me->rng = rng_seed(((uint64_t)py << 32) | (uint32_t)px, (first + (uint64_t)smp) * 2);
             me->ray_budget = WHITTED_RAY_BUDGET;

@@ -15,7 +15,8 @@ pk_status whitted_thread_init(pk_context *ctx, const whitted *w, whitted_thread 
 {
     memset(t, 0, sizeof *t);
     const pk_allocator *al = &ctx->alloc;
-    size_t nshadow = (size_t)w->light_samples + w->f->s->nlights;
+    /* area-light and environment samples, point lights and the sun */
+    size_t nshadow = 2 * (size_t)w->light_samples + w->f->s->nlights + 1;
     if (nshadow == 0) nshadow = 1;
     t->cp = stats ? &t->counters : NULL;
     t->shadow_rays = mem_realloc_array(al, NULL, nshadow, sizeof(ray));
@@ -44,7 +45,7 @@ static vec3 trace(const whitted *w, whitted_thread *ts, const ray *r, int depth,
     ts->ray_budget--;
     ts->rays[kind]++;
     hit h;
-    if (!accel_intersect(w->f->a, r, &h, ts->cp)) return v3s(0.0f);
+    if (!accel_intersect(w->f->a, r, &h, ts->cp)) return env_background(&w->f->env, v3_norm(r->d));
     return whitted_shade(w, ts, r, &h, depth);
 }
 
@@ -99,6 +100,33 @@ static vec3 direct_light(const whitted *w, whitted_thread *ts, const surface *sf
             ts->shadow_weight[n] = v3_scale(v3_mul(f, le), cos_l / (dist2 * pdf_area) * inv_n);
             /* stop just short of the light so the emitter itself does not occlude */
             ts->shadow_rays[n] = (ray){o, 0.0f, d, 1.0f - 1e-3f};
+            n++;
+        }
+    }
+    /* the environment: light_samples directions drawn from it, and one
+     * toward the sun's disc */
+    const env_light *e = &fr->env;
+    if (e->active && ns > 0) {
+        float inv_n = 1.0f / (float)ns;
+        for (int k = 0; k < ns; k++) {
+            vec3 wi, le;
+            float pdf;
+            float u1 = rng_float(&ts->rng), u2 = rng_float(&ts->rng);
+            if (!env_sample(e, u1, u2, &wi, &le, &pdf)) continue;
+            vec3 f = brdf_cos(sf, wo, wi);
+            if (is_black(f)) continue;
+            ts->shadow_weight[n] = v3_scale(v3_mul(f, le), inv_n / pdf);
+            ts->shadow_rays[n] = (ray){o, 0.0f, wi, INFINITY};
+            n++;
+        }
+    }
+    if (e->sun) {
+        float u1 = rng_float(&ts->rng), u2 = rng_float(&ts->rng);
+        vec3 wi = sun_sample(e, u1, u2);
+        vec3 f = brdf_cos(sf, wo, wi);
+        if (!is_black(f)) {
+            ts->shadow_weight[n] = v3_scale(v3_mul(f, e->sun_le), 1.0f / sun_pdf(e));
+            ts->shadow_rays[n] = (ray){o, 0.0f, wi, INFINITY};
             n++;
         }
     }

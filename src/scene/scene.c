@@ -5,6 +5,8 @@
  */
 #include "scene.h"
 
+#include "../io/image_read.h"
+
 #include <stdio.h>
 #include <string.h>
 
@@ -31,6 +33,26 @@ void scene_env_init(scene_environment *env)
     env->sun_angle = 0.53f;
     env->sky_turbidity = 3.0f;
     env->sky_scale = 1.0f;
+}
+
+void scene_env_rotate_y(scene_environment *env, float deg)
+{
+    float c = cosf(deg * (PK_PI / 180.0f)), s = sinf(deg * (PK_PI / 180.0f));
+    const float m[9] = {c, 0.0f, s, 0.0f, 1.0f, 0.0f, -s, 0.0f, c};
+    memcpy(env->to_world, m, sizeof m);
+}
+
+void scene_env_clear(const pk_allocator *a, scene_environment *env)
+{
+    mem_free(a, env->map);
+    mem_free(a, env->map_rgb);
+    scene_env_init(env);
+}
+
+pk_status scene_env_load(pk_context *ctx, scene_environment *env)
+{
+    if (!env->map || env->map_rgb) return PK_OK;
+    return image_load_rgb(ctx, env->map, &env->map_w, &env->map_h, &env->map_rgb);
 }
 
 pk_status scene_create(pk_context *ctx, const char *name, pk_scene **out)
@@ -67,7 +89,7 @@ void scene_destroy(pk_scene *s)
     mem_free(a, s->lights);
     mem_free(a, s->degenerate);
     mem_free(a, s->emissive);
-    mem_free(a, s->env.map);
+    scene_env_clear(a, &s->env);
     mem_free(a, s->name);
     pk_allocator copy = *a;
     mem_free(&copy, s);
@@ -177,6 +199,8 @@ pk_status scene_commit(pk_context *ctx, pk_scene *s)
     char why[256];
     if (!scene_check(s, why, sizeof why))
         return ctx_error(ctx, PK_ERR_PARSE, "%s: invalid scene: %s", s->name, why);
+    pk_status est = scene_env_load(ctx, &s->env);
+    if (est != PK_OK) return est;
     mem_free(&s->alloc, s->degenerate);
     mem_free(&s->alloc, s->emissive);
     s->degenerate = NULL;

@@ -75,6 +75,8 @@ typedef struct scene_environment {
     bool set;
     vec3 radiance;        /* constant radiance, zero = none */
     char *map;            /* lat-long HDR image file (owned; NULL = none), resolved path */
+    float *map_rgb;       /* its pixels, linear RGB, row 0 on top (owned; scene_commit loads them) */
+    int map_w, map_h;
     float map_scale;      /* multiplies the map (1) */
     float to_world[9];    /* the map's rotation into the world */
     bool has_sun;
@@ -152,6 +154,12 @@ PK_HIDDEN int64_t scene_find_material(const pk_scene *s, const char *name);
 PK_HIDDEN void material_init(material *m);
 /* The empty environment (nothing set, identity rotation, scales 1, sun 0.53 degrees). */
 PK_HIDDEN void scene_env_init(scene_environment *env);
+/* Sets env's map rotation to deg degrees about +y (counter-clockwise seen from above). */
+PK_HIDDEN void scene_env_rotate_y(scene_environment *env, float deg);
+/* Frees what env owns and empties it. */
+PK_HIDDEN void scene_env_clear(const pk_allocator *a, scene_environment *env);
+/* Loads env->map into map_rgb unless loaded (a no-op without a map). */
+PK_HIDDEN pk_status scene_env_load(pk_context *ctx, scene_environment *env);
 
 /* Validates and derives (degenerate flags, emissive list, bounds).
  * PK_ERR_EMPTY_SCENE when nothing can be hit. Warns about degenerate triangles. */

@@ -8,6 +8,8 @@
  */
 #include "test.h"
 
+#include "chi2.h"
+
 #include "math/frame.h"
 #include "render/pbsdf.h"
 #include "render/sampling.h"
@@ -19,43 +21,6 @@
 typedef rng prng;
 static prng prng_make(uint64_t seed) { return rng_seed(seed, 0x5eed); }
 static float prng_f(prng *r) { return rng_float(r); }
-
-/* ---- the chi-square distribution: regularised incomplete gamma ---------- */
-
-/* Q(a, x) = Gamma(a, x) / Gamma(a), the upper tail (Numerical Recipes 6.2:
- * the series for x < a + 1, Lentz's continued fraction otherwise). */
-static double gamma_q(double a, double x)
-{
-    if (x <= 0.0) return 1.0;
-    double lg = lgamma(a);
-    if (x < a + 1.0) {
-        double ap = a, sum = 1.0 / a, del = sum;
-        for (int n = 0; n < 10000; n++) {
-            ap += 1.0;
-            del *= x / ap;
-            sum += del;
-            if (fabs(del) < fabs(sum) * 1e-15) break;
-        }
-        return 1.0 - sum * exp(-x + a * log(x) - lg);
-    }
-    double b = x + 1.0 - a, c = 1.0 / 1e-300, d = 1.0 / b, h = d;
-    for (int i = 1; i < 10000; i++) {
-        double an = -i * (i - a);
-        b += 2.0;
-        d = an * d + b;
-        if (fabs(d) < 1e-300) d = 1e-300;
-        c = b + an / c;
-        if (fabs(c) < 1e-300) c = 1e-300;
-        d = 1.0 / d;
-        double del = d * c;
-        h *= del;
-        if (fabs(del - 1.0) < 1e-15) break;
-    }
-    return exp(-x + a * log(x) - lg) * h;
-}
-/* P(X >= chi2) for X ~ chi-square with dof degrees of freedom. */
-static double chi2_pvalue(double chi2, int dof) { return gamma_q(0.5 * dof, 0.5 * chi2); }
-
 /* ---- the cases -------------------------------------------------------------- */
 
 #define N_THETA 10 /* cells in cos(theta) over [-1, 1] */

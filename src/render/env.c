@@ -1,0 +1,306 @@
+/*
+ * env.c - the environment and sun lights (see env.h).
+ */
+#include "env.h"
+
+#include <string.h>
+
+#define SKY_W 512 /* resolution of a baked sky without a map */
+#define SKY_H 256
+
+static inline vec3 mat3_mul(const float m[9], vec3 v)
+{
+    return v3(m[0] * v.x + m[1] * v.y + m[2] * v.z, m[3] * v.x + m[4] * v.y + m[5] * v.z,
+              m[6] * v.x + m[7] * v.y + m[8] * v.z);
+}
+
+/* The world direction of lat-long coordinates (u, v). */
+static vec3 latlong_dir(const env_light *e, float u, float v)
+{
+    float theta = v * PK_PI, phi = 2.0f * PK_PI * u;
+    float st = sinf(theta);
+    return mat3_mul(e->to_world, v3(st * sinf(phi), cosf(theta), -st * cosf(phi)));
+}
+
+/* Lat-long coordinates of world direction d (unit). */
+static void latlong_uv(const env_light *e, vec3 d, float *u, float *v)
+{
+    vec3 m = mat3_mul(e->to_map, d);
+    float uu = atan2f(m.x, -m.z) * (0.5f / PK_PI);
+    if (uu < 0.0f) uu += 1.0f;
+    *u = uu < 1.0f ? uu : 0.0f;
+    *v = acosf(fminf(fmaxf(m.y, -1.0f), 1.0f)) * (1.0f / PK_PI);
+}
+
+/* ---- the Preetham clear sky ------------------------------------------------ */
+
+/* The Perez luminance distribution (theta from the zenith, gamma from the sun). */
+static float perez(const float c[5], float cos_theta, float gamma, float cos_gamma)
+{
+    return (1.0f + c[0] * expf(c[1] / fmaxf(cos_theta, 0.01f))) *
+           (1.0f + c[2] * expf(c[3] * gamma) + c[4] * cos_gamma * cos_gamma);
+}
+
+vec3 sky_preetham(vec3 d, vec3 sun, float T)
+{
+    if (d.y <= 0.0f) return v3s(0.0f);
+    const float ts = acosf(fminf(fmaxf(sun.y, 0.0f), 1.0f)); /* the sun's zenith angle, at most 90 degrees */
+    /* the distribution coefficients of luminance Y and chromaticity x, y (linear in turbidity) */
+    const float cY[5] = {0.1787f * T - 1.4630f, -0.3554f * T + 0.4275f, -0.0227f * T + 5.3251f,
+                         0.1206f * T - 2.5771f, -0.0670f * T + 0.3703f};
+    const float cx[5] = {-0.0193f * T - 0.2592f, -0.0665f * T + 0.0008f, -0.0004f * T + 0.2125f,
+                         -0.0641f * T - 0.8989f, -0.0033f * T + 0.0452f};
+    const float cy[5] = {-0.0167f * T - 0.2608f, -0.0950f * T + 0.0092f, -0.0079f * T + 0.2102f,
+                         -0.0441f * T - 1.6537f, -0.0109f * T + 0.0529f};
+    /* zenith values: luminance in kcd/m^2, chromaticities */
+    const float chi = (4.0f / 9.0f - T / 120.0f) * (PK_PI - 2.0f * ts);
+    const float Yz = (4.0453f * T - 4.9710f) * tanf(chi) - 0.2155f * T + 2.4192f;
+    const float t2 = ts * ts, t3 = t2 * ts, TT = T * T;
+    const float xz = TT * (0.00166f * t3 - 0.00375f * t2 + 0.00209f * ts) +
+                     T * (-0.02903f * t3 + 0.06377f * t2 - 0.03202f * ts + 0.00394f) +
+                     (0.11693f * t3 - 0.21196f * t2 + 0.06052f * ts + 0.25886f);
+    const float yz = TT * (0.00275f * t3 - 0.00610f * t2 + 0.00317f * ts) +
+                     T * (-0.04214f * t3 + 0.08970f * t2 - 0.04153f * ts + 0.00516f) +
+                     (0.15346f * t3 - 0.26756f * t2 + 0.06670f * ts + 0.26688f);
+    const float cos_t = d.y;
+    const float cos_g = fminf(fmaxf(v3_dot(d, sun), -1.0f), 1.0f), g = acosf(cos_g);
+    const float cos_ts = cosf(ts);
+    float Y = Yz * perez(cY, cos_t, g, cos_g) / perez(cY, 1.0f, ts, cos_ts);
+    float x = xz * perez(cx, cos_t, g, cos_g) / perez(cx, 1.0f, ts, cos_ts);
+    float y = yz * perez(cy, cos_t, g, cos_g) / perez(cy, 1.0f, ts, cos_ts);
+    if (!(Y > 0.0f) || !(y > 0.0f)) return v3s(0.0f);
+    /* kcd/m^2 to W/(m^2 sr) at 683 lm/W, then xyY -> XYZ -> linear sRGB */
+    Y *= 1000.0f / 683.0f;
+    const float X = x / y * Y, Z = (1.0f - x - y) / y * Y;
+    vec3 c = v3(3.2406f * X - 1.5372f * Y - 0.4986f * Z, -0.9689f * X + 1.8758f * Y + 0.0415f * Z,
+                0.0557f * X - 0.2040f * Y + 1.0570f * Z);
+    return v3(fmaxf(c.x, 0.0f), fmaxf(c.y, 0.0f), fmaxf(c.z, 0.0f));
+}
+
+/* ---- building ---------------------------------------------------------------- */
+
+void env_free(const pk_allocator *al, env_light *e)
+{
+    mem_free(al, e->rgb);
+    mem_free(al, e->marginal);
+    mem_free(al, e->conditional);
+    mem_free(al, e->weight);
+    memset(e, 0, sizeof *e);
+}
+
+static bool any(vec3 c) { return c.x > 0.0f || c.y > 0.0f || c.z > 0.0f; }
+static float clean(float v) { return isfinite(v) && v > 0.0f ? v : 0.0f; }
+
+/* The sampling tables of the baked image: weights luminance * sin(theta). */
+static pk_status build_tables(pk_context *ctx, env_light *e)
+{
+    const int w = e->w, h = e->h;
+    const size_t n = (size_t)w * (size_t)h;
+    e->marginal = mem_realloc_array(&ctx->alloc, NULL, (size_t)h, sizeof(float));
+    e->conditional = mem_realloc_array(&ctx->alloc, NULL, n, sizeof(float));
+    e->weight = mem_realloc_array(&ctx->alloc, NULL, n, sizeof(float));
+    if (!e->marginal || !e->conditional || !e->weight) return ctx_nomem(ctx);
+    double total = 0.0, lum_solid = 0.0;
+    double *rows = mem_realloc_array(&ctx->alloc, NULL, (size_t)h, sizeof(double));
+    if (!rows) return ctx_nomem(ctx);
+    for (int j = 0; j < h; j++) {
+        const float st = sinf(((float)j + 0.5f) / (float)h * PK_PI);
+        double acc = 0.0;
+        for (int i = 0; i < w; i++) {
+            const float *p = &e->rgb[3 * ((size_t)j * (size_t)w + (size_t)i)];
+            double f = (double)v3_luminance(v3(p[0], p[1], p[2])) * (double)st;
+            e->weight[(size_t)j * (size_t)w + (size_t)i] = (float)f;
+            acc += f;
+            e->conditional[(size_t)j * (size_t)w + (size_t)i] = (float)acc;
+        }
+        float *row = &e->conditional[(size_t)j * (size_t)w];
+        for (int i = 0; i < w; i++) row[i] = acc > 0.0 ? (float)((double)row[i] / acc) : (float)(i + 1) / (float)w;
+        row[w - 1] = 1.0f;
+        rows[j] = acc;
+        total += acc;
+    }
+    /* mean radiance over the sphere: sum of L sin(theta) dtheta dphi / (4 pi) */
+    lum_solid = total * (2.0 * (double)PK_PI / w) * ((double)PK_PI / h) / (4.0 * (double)PK_PI);
+    double acc = 0.0;
+    for (int j = 0; j < h; j++) {
+        acc += rows[j];
+        e->marginal[j] = total > 0.0 ? (float)(acc / total) : (float)(j + 1) / (float)h;
+    }
+    e->marginal[h - 1] = 1.0f;
+    mem_free(&ctx->alloc, rows);
+    /* weight: the pdf over (u, v) of each pixel, f * w * h / total */
+    for (size_t k = 0; k < n; k++) e->weight[k] = total > 0.0 ? (float)((double)e->weight[k] * (double)n / total) : 0.0f;
+    e->active = total > 0.0;
+    e->power_env = lum_solid; /* times pi R^2 by the caller */
+    e->bytes += (size_t)h * sizeof(float) + 2 * n * sizeof(float);
+    return PK_OK;
+}
+
+pk_status env_build(pk_context *ctx, const scene_environment *env, const float *map_rgb, int mw, int mh, aabb bounds,
+                    env_light *e)
+{
+    memset(e, 0, sizeof *e);
+    memcpy(e->to_world, env->to_world, sizeof e->to_world);
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++) e->to_map[3 * r + c] = env->to_world[3 * c + r]; /* a rotation: its transpose */
+    vec3 ext = aabb_extent(bounds);
+    double radius = 0.5 * (double)v3_len(ext);
+    if (!isfinite(radius) || radius <= 0.0) radius = 1.0;
+    const double area = (double)PK_PI * radius * radius;
+    const vec3 constant = v3(clean(env->radiance.x), clean(env->radiance.y), clean(env->radiance.z));
+    const bool map = map_rgb && mw > 0 && mh > 0;
+    const bool sky = env->has_sky && env->sky_scale > 0.0f;
+    vec3 sun = v3_len2(env->sun_dir) > 0.0f ? v3_norm(env->sun_dir) : v3(0.0f, 1.0f, 0.0f);
+    if (!map && !sky) {
+        if (any(constant)) {
+            e->active = e->uniform = true;
+            e->constant = constant;
+            e->power_env = (double)v3_luminance(constant) * area;
+        }
+    } else {
+        e->w = map ? mw : SKY_W;
+        e->h = map ? mh : SKY_H;
+        const size_t n = (size_t)e->w * (size_t)e->h;
+        e->rgb = mem_realloc_array(&ctx->alloc, NULL, n, 3 * sizeof(float));
+        if (!e->rgb) return ctx_nomem(ctx);
+        e->bytes = n * 3 * sizeof(float);
+        const float scale = clean(env->map_scale);
+        for (int j = 0; j < e->h; j++)
+            for (int i = 0; i < e->w; i++) {
+                const size_t k = (size_t)j * (size_t)e->w + (size_t)i;
+                vec3 c = constant;
+                if (map)
+                    c = v3_add(c, v3(clean(map_rgb[3 * k]) * scale, clean(map_rgb[3 * k + 1]) * scale,
+                                     clean(map_rgb[3 * k + 2]) * scale));
+                if (sky) {
+                    vec3 d = latlong_dir(e, ((float)i + 0.5f) / (float)e->w, ((float)j + 0.5f) / (float)e->h);
+                    c = v3_add(c, v3_scale(sky_preetham(d, sun, env->sky_turbidity), env->sky_scale));
+                }
+                e->rgb[3 * k] = clean(c.x), e->rgb[3 * k + 1] = clean(c.y), e->rgb[3 * k + 2] = clean(c.z);
+            }
+        pk_status st = build_tables(ctx, e);
+        if (st != PK_OK) {
+            env_free(&ctx->alloc, e);
+            return st;
+        }
+        e->power_env *= area;
+    }
+    if (env->has_sun && any(env->sun_radiance)) {
+        float half = 0.5f * env->sun_angle * (PK_PI / 180.0f);
+        half = fminf(fmaxf(half, 1e-4f), 0.5f * PK_PI);
+        e->sun = true;
+        e->sun_dir = sun;
+        e->sun_le = v3(clean(env->sun_radiance.x), clean(env->sun_radiance.y), clean(env->sun_radiance.z));
+        e->sun_cos = cosf(half);
+        const float sh = sinf(0.5f * half);
+        e->sun_omc = 2.0f * sh * sh;
+        e->sun_frame = onb_from_normal(sun);
+        const double solid = 2.0 * (double)PK_PI * (double)e->sun_omc;
+        e->power_sun = (double)v3_luminance(e->sun_le) * solid * area;
+    }
+    return PK_OK;
+}
+
+/* ---- lookups ---------------------------------------------------------------- */
+
+vec3 env_eval(const env_light *e, vec3 d)
+{
+    if (!e->active) return v3s(0.0f);
+    if (e->uniform) return e->constant;
+    float u, v;
+    latlong_uv(e, d, &u, &v);
+    /* bilinear between pixel centres, wrapping in u and clamped in v */
+    float x = u * (float)e->w - 0.5f, y = v * (float)e->h - 0.5f;
+    float fx = floorf(x), fy = floorf(y);
+    float tx = x - fx, ty = y - fy;
+    int x0 = (int)fx, y0 = (int)fy;
+    int x1 = x0 + 1, y1 = y0 + 1;
+    if (x0 < 0) x0 += e->w;
+    if (x1 >= e->w) x1 -= e->w;
+    if (x0 < 0 || x0 >= e->w) x0 = 0;
+    if (x1 < 0 || x1 >= e->w) x1 = 0;
+    y0 = y0 < 0 ? 0 : y0 >= e->h ? e->h - 1 : y0;
+    y1 = y1 < 0 ? 0 : y1 >= e->h ? e->h - 1 : y1;
+    const float *p00 = &e->rgb[3 * ((size_t)y0 * (size_t)e->w + (size_t)x0)];
+    const float *p10 = &e->rgb[3 * ((size_t)y0 * (size_t)e->w + (size_t)x1)];
+    const float *p01 = &e->rgb[3 * ((size_t)y1 * (size_t)e->w + (size_t)x0)];
+    const float *p11 = &e->rgb[3 * ((size_t)y1 * (size_t)e->w + (size_t)x1)];
+    float c[3];
+    for (int k = 0; k < 3; k++) {
+        float top = p00[k] + (p10[k] - p00[k]) * tx, bot = p01[k] + (p11[k] - p01[k]) * tx;
+        c[k] = top + (bot - top) * ty;
+    }
+    return v3(c[0], c[1], c[2]);
+}
+
+/* The pixel of (u, v), clamped. */
+static size_t pixel_of(const env_light *e, float u, float v)
+{
+    int i = (int)(u * (float)e->w), j = (int)(v * (float)e->h);
+    i = i < 0 ? 0 : i >= e->w ? e->w - 1 : i;
+    j = j < 0 ? 0 : j >= e->h ? e->h - 1 : j;
+    return (size_t)j * (size_t)e->w + (size_t)i;
+}
+
+float env_pdf(const env_light *e, vec3 d)
+{
+    if (!e->active) return 0.0f;
+    if (e->uniform) return 1.0f / (4.0f * PK_PI);
+    float u, v;
+    latlong_uv(e, d, &u, &v);
+    float st = sinf(v * PK_PI);
+    if (!(st > 0.0f)) return 0.0f;
+    return e->weight[pixel_of(e, u, v)] / (2.0f * PK_PI * PK_PI * st);
+}
+
+/* The index i of a CDF of n entries (last 1) with cdf[i-1] <= u < cdf[i],
+ * and u's position within that interval. */
+static int pick(const float *cdf, int n, float u, float *rest)
+{
+    int lo = 0, hi = n - 1;
+    while (lo < hi) {
+        int mid = (lo + hi) / 2;
+        if (u < cdf[mid])
+            hi = mid;
+        else
+            lo = mid + 1;
+    }
+    float a = lo > 0 ? cdf[lo - 1] : 0.0f, b = cdf[lo];
+    float r = b > a ? (u - a) / (b - a) : 0.5f;
+    *rest = fminf(fmaxf(r, 0.0f), 0x1.fffffep-1f);
+    return lo;
+}
+
+bool env_sample(const env_light *e, float u1, float u2, vec3 *d, vec3 *le, float *pdf)
+{
+    if (!e->active) return false;
+    if (e->uniform) {
+        float z = 1.0f - 2.0f * u1, r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = 2.0f * PK_PI * u2;
+        *d = v3(r * cosf(phi), r * sinf(phi), z);
+        *le = e->constant;
+        *pdf = 1.0f / (4.0f * PK_PI);
+        return true;
+    }
+    float du, dv;
+    int j = pick(e->marginal, e->h, u1, &dv);
+    int i = pick(&e->conditional[(size_t)j * (size_t)e->w], e->w, u2, &du);
+    float u = ((float)i + du) / (float)e->w, v = ((float)j + dv) / (float)e->h;
+    float st = sinf(v * PK_PI);
+    float wgt = e->weight[(size_t)j * (size_t)e->w + (size_t)i];
+    if (!(st > 0.0f) || !(wgt > 0.0f)) return false;
+    *d = v3_norm(latlong_dir(e, u, v));
+    /* the pdf of the pixel the direction lands in, as env_pdf computes it
+     * (the same pixel up to float rounding at its edges) */
+    *pdf = env_pdf(e, *d);
+    if (!(*pdf > 0.0f)) return false;
+    *le = env_eval(e, *d);
+    return true;
+}
+
+vec3 sun_sample(const env_light *e, float u1, float u2)
+{
+    /* 1 - cos(theta) uniform in [0, omc]; sin from it without cancellation */
+    float omc = u1 * e->sun_omc, cos_t = 1.0f - omc, sin_t = sqrtf(fmaxf(0.0f, omc * (2.0f - omc)));
+    float phi = 2.0f * PK_PI * u2;
+    return v3_norm(onb_to_world(e->sun_frame, v3(sin_t * cosf(phi), sin_t * sinf(phi), cos_t)));
+}
