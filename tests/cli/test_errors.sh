@@ -107,7 +107,7 @@ render "MTL material without a name" 1 "bad.mtl:1: newmtl needs a name" badmtl.o
 rm -f "$tmp/bad.mtl"
 mkfifo "$tmp/bad.mtl" 2>/dev/null &&
   render "MTL library that is a FIFO" 0 "warning: badmtl.obj:1: cannot read material library 'bad.mtl' ($tmp/bad.mtl: not a regular file); its materials are not defined
-paprsek: warning: badmtl.obj: the scene has no light (no emissive triangle or sphere, no point light): the image will be black" badmtl.obj
+paprsek: warning: badmtl.obj: the scene has no light; lighting it with a uniform white environment of radiance 1 (--env none for black, --env r,g,b or --env FILE for another)" badmtl.obj
 
 # ---- JSON
 put bad.json '{ "camera": { "fov": 40,\n  "look_from": [0,0,5] \n'

@@ -25,7 +25,7 @@ renders() {
   local want=""
   for w in "$@"; do
     # @nolight: the warning every scene without any light gets
-    [ "$w" = @nolight ] && w="${file}: the scene has no light (no emissive triangle or sphere, no point light): the image will be black"
+    [ "$w" = @nolight ] && w="${file}: the scene has no light; lighting it with a uniform white environment of radiance 1 (--env none for black, --env r,g,b or --env FILE for another)"
     want+="paprsek: warning: $w"$'\n'
   done
   rm -f "$tmp/out.png"
