@@ -13,8 +13,7 @@
 
 static inline uint32_t smp_reverse_bits(uint32_t x)
 {
-    x = (x << 16) | (x >> 16);
-    x = ((x & 0x00ff00ffu) << 8) | ((x & 0xff00ff00u) >> 8);
+    x = __builtin_bswap32(x);
     x = ((x & 0x0f0f0f0fu) << 4) | ((x & 0xf0f0f0f0u) >> 4);
     x = ((x & 0x33333333u) << 2) | ((x & 0xccccccccu) >> 2);
     x = ((x & 0x55555555u) << 1) | ((x & 0xaaaaaaaau) >> 1);
@@ -34,20 +33,25 @@ static inline uint32_t smp_hash(uint32_t x)
 
 static inline uint32_t smp_hash2(uint32_t a, uint32_t b) { return smp_hash(a ^ smp_hash(b + 0x9e3779b9u)); }
 
-/* Owen scrambling of the bits of x read as a binary fraction (most significant
- * bit first): each bit is flipped by a hash of the bits above it. The
- * bit-reversed value is permuted so that a bit depends only on lower bits
- * (which, reversed back, are the higher digits): multiplications by even
- * constants and additions carry information only upwards. */
-static inline uint32_t smp_owen(uint32_t x, uint32_t seed)
+/* The hash of Owen scrambling on a bit-reversed value: bit k of the result
+ * is bit k of x flipped by a function of the bits below k (which, reversed
+ * back, are the digits above): multiplications by even constants and
+ * additions carry information only upwards. */
+static inline uint32_t smp_owen_rev(uint32_t x, uint32_t seed)
 {
-    x = smp_reverse_bits(x);
     x += seed;
     x ^= x * 0x6c50b47cu;
     x ^= x * 0xb82f1e52u;
     x ^= x * 0xc7afe638u;
     x ^= x * 0x8d22f6e6u;
-    return smp_reverse_bits(x);
+    return x;
+}
+
+/* Owen scrambling of the bits of x read as a binary fraction (most significant
+ * bit first): each bit is flipped by a hash of the bits above it. */
+static inline uint32_t smp_owen(uint32_t x, uint32_t seed)
+{
+    return smp_reverse_bits(smp_owen_rev(smp_reverse_bits(x), seed));
 }
 
 /* The first two Sobol dimensions of point i: van der Corput (bit reversal)
@@ -59,6 +63,21 @@ static inline uint32_t smp_sobol1(uint32_t i)
     for (; i; i >>= 1, v ^= v >> 1)
         if (i & 1u) x ^= v;
     return x;
+}
+
+/* smp_sobol1(i), bit-reversed, without a loop: the generator matrix of that
+ * dimension is Pascal's triangle mod 2, whose entry (j, k) is 1 exactly when
+ * the bits of j are a subset of those of k (Lucas), so bit j of the reversed
+ * value is the parity of the bits k of i that are supersets of j: five
+ * shift-and-xor steps, one per bit of the bit position. */
+static inline uint32_t smp_sobol1_rev(uint32_t i)
+{
+    i ^= (i & 0xaaaaaaaau) >> 1;
+    i ^= (i & 0xccccccccu) >> 2;
+    i ^= (i & 0xf0f0f0f0u) >> 4;
+    i ^= (i & 0xff00ff00u) >> 8;
+    i ^= (i & 0xffff0000u) >> 16;
+    return i;
 }
 
 static inline float smp_to_float(uint32_t x)
@@ -90,8 +109,10 @@ static inline void sampler_2d(sampler *s, float *u, float *v)
     /* shuffled index: an Owen scramble of the index is a permutation of each
      * power-of-two block, so every 2^k samples still form a (0,k,2)-net */
     const uint32_t i = smp_owen(s->index, smp_hash(ps ^ 0x5bd1e995u));
-    *u = smp_to_float(smp_owen(smp_sobol0(i), smp_hash(ps ^ 0x68e31da4u)));
-    *v = smp_to_float(smp_owen(smp_sobol1(i), smp_hash(ps ^ 0xb5297a4du)));
+    /* smp_owen(smp_sobol0(i)) and smp_owen(smp_sobol1(i)), the reversals
+     * that cancel left out */
+    *u = smp_to_float(smp_reverse_bits(smp_owen_rev(i, smp_hash(ps ^ 0x68e31da4u))));
+    *v = smp_to_float(smp_reverse_bits(smp_owen_rev(smp_sobol1_rev(i), smp_hash(ps ^ 0xb5297a4du))));
 }
 
 static inline float sampler_1d(sampler *s)
