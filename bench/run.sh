@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # run.sh - Paprsek's default BVH against Embree 3 on the standard workloads of
-# spec/ray-benchmark.md (primary and diffuse rays), timed interleaved in one
+# spec/ray-benchmark.md (primary and diffuse rays, closest hit; diffuse rays
+# and shadow rays toward the area lights, any hit), timed interleaved in one
 # run on this machine, with a check that both find the same hits. Prints the
 # machine and a markdown table; raw numbers stay in bench/out/.
 #
@@ -53,15 +54,30 @@ echo
 for wl in $workloads; do
     scene=$(scene_of "$wl")
     [ -r "$scene" ] || die "$scene is not there"
-    for kind in primary diffuse; do
+    for kind in primary diffuse shadow; do
         rays=$out/$wl-$kind-$size.rays
-        if [ ! -s "$rays" ]; then
+        if [ ! -s "$rays" ] && [ ! -e "$rays.none" ]; then
             echo "making $rays" >&2
-            "$bin" bench gen-rays "$scene" --workload "$wl" --shared "$shared" --size "$size" --kind "$kind" \
-                --seed 1 --threads "$threads" -o "$rays" >&2 || die "gen-rays $wl $kind failed"
+            if ! "$bin" bench gen-rays "$scene" --workload "$wl" --shared "$shared" --size "$size" --kind "$kind" \
+                --seed 1 --threads "$threads" -o "$rays" 2>"$out/gen.err"; then
+                # shadow rays need area lights: a scene without them has none
+                [ "$kind" = shadow ] && grep -q "no area light" "$out/gen.err" && : >"$rays.none" && continue
+                cat "$out/gen.err" >&2
+                die "gen-rays $wl $kind failed"
+            fi
         fi
     done
 done
+
+# the kinds of a workload: closest hit on primary and diffuse rays; any hit
+# (occlusion) on diffuse rays and, where the scene has area lights, on shadow rays
+kinds_for() {
+    echo primary diffuse diffuse-any
+    [ -s "$out/$1-shadow-$size.rays" ] && echo shadow-any
+    return 0
+}
+rays_of() { echo "$out/$1-${2%-any}-$size.rays"; }
+anyhit_of() { case $1 in *-any) echo --any-hit ;; esac; }
 
 # ---- is Embree built in? -------------------------------------------------------
 first=${workloads%% *}
@@ -91,8 +107,9 @@ for ((r = 1; r <= rounds; r++)); do
     echo "round $r/$rounds" >&2
     for wl in $workloads; do
         scene=$(scene_of "$wl")
-        for kind in primary diffuse; do
-            rays=$out/$wl-$kind-$size.rays
+        for kind in $(kinds_for "$wl"); do
+            rays=$(rays_of "$wl" "$kind")
+            any=$(anyhit_of "$kind")
             while read -r name accel quality flags; do
                 hitsopt=()
                 [ "$r" = 1 ] && hitsopt=(--hits "$out/$wl-$kind.$name.hits")
@@ -100,7 +117,7 @@ for ((r = 1; r <= rounds; r++)); do
                 [ "$flags" != - ] && flagopt=("$flags")
                 if [ "$quality" != - ]; then export PAPRSEK_EMBREE_QUALITY=$quality; else unset PAPRSEK_EMBREE_QUALITY; fi
                 line=$("$bin" bench rays "$scene" "$rays" --accel "$accel" --threads "$threads" --reps "$reps" \
-                    "${flagopt[@]}" "${hitsopt[@]}" 2>>"$out/stderr.log") || die "bench rays $wl $kind $name failed (see $out/stderr.log)"
+                    $any "${flagopt[@]}" "${hitsopt[@]}" 2>>"$out/stderr.log") || die "bench rays $wl $kind $name failed (see $out/stderr.log)"
                 unset PAPRSEK_EMBREE_QUALITY
                 echo "$wl $kind $name $r $(echo "$line" | field rays) $(echo "$line" | field mrays_per_s) $(echo "$line" | field build_ms) $(echo "$line" | field hits)" >>"$raw"
             done < <(configs_for "$kind")
@@ -112,8 +129,8 @@ done
 agree_of() {
     local wl=$1 kind=$2 a=$3 b=$4 res
     [ -f "$out/$wl-$kind.$a.hits" ] && [ -f "$out/$wl-$kind.$b.hits" ] || { echo n/a; return; }
-    res=$("$bin" bench compare "$out/$wl-$kind.$a.hits" "$out/$wl-$kind.$b.hits" \
-        --rays "$out/$wl-$kind-$size.rays" 2>/dev/null || true)
+    res=$("$bin" bench compare "$out/$wl-$kind.$a.hits" "$out/$wl-$kind.$b.hits" $(anyhit_of "$kind") \
+        --rays "$(rays_of "$wl" "$kind")" 2>/dev/null || true)
     local ok mis near
     ok=$(echo "$res" | field agree)
     mis=$(echo "$res" | field mismatches)
@@ -125,7 +142,7 @@ agree_of() {
 echo "| workload | rays | Paprsek Mrays/s | Embree Mrays/s | Paprsek/Embree | Paprsek packets | Embree packets | packets ratio | build ms Paprsek | build ms Embree | hits agree |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|"
 for wl in $workloads; do
-    for kind in primary diffuse; do
+    for kind in $(kinds_for "$wl"); do
         if [ $have_embree = 1 ]; then
             agree=$(agree_of "$wl" "$kind" bvh emb_m)
         else

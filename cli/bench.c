@@ -24,7 +24,7 @@ static const char usage_text[] =
     "                          [--hits OUT.hits] [--any-hit] [--packets] [--stats]\n"
     "       paprsek bench gen-rays [SCENE.obj] -o OUT.rays [--look-from X,Y,Z --look-at X,Y,Z --fov DEG]\n"
     "                          [--workload cornell-sphere|bunny|sponza [--shared DIR]]\n"
-    "                          [--size N] [--kind primary|diffuse] [--seed S] [--accel NAME] [--threads N]\n"
+    "                          [--size N] [--kind primary|diffuse|shadow] [--seed S] [--accel NAME] [--threads N]\n"
     "       paprsek bench compare A.hits B.hits [--any-hit] [--rays RAYS.rays]";
 
 /* ---- the options of each subcommand ---------------------------------------- */
@@ -58,7 +58,9 @@ static cli_option gen_opts[] = {
     OPT_STR("fov", B_FOV, "DEG", "vertical field of view in degrees, between 0 and 180"),
     {.name = "size", .id = B_SIZE, .kind = CLI_INT, .arg = "N", .help = "N x N primary rays",
      .min = 1, .max = PK_MAX_IMAGE_SIDE, .default_value = 1024},
-    OPT_STR("kind", B_KIND, "KIND", "primary (default) or diffuse (one bounce from each hit)"),
+    OPT_STR("kind", B_KIND, "KIND",
+            "primary (default), diffuse (one bounce from each hit) or shadow (from each hit toward a point "
+            "on the area lights, stopping just short of it: for --any-hit)"),
     OPT_STR("seed", B_SEED, "S", "random seed of the diffuse directions (default 1)"),
     OPT_STR("workload", B_WORKLOAD, "NAME", "a standard workload's scene and camera: cornell-sphere, bunny, sponza"),
     OPT_STR("shared", B_SHARED, "DIR", "where the workloads' scenes are (default ../shared)"),
@@ -470,6 +472,56 @@ static size_t make_diffuse(const pk_scene *scene, const pk_ray *prim, const pk_h
     return m;
 }
 
+/* Shadow rays: each of the n rays' origins (the diffuse rays' offset hit
+ * points) joined to a point on an area light, the light chosen in proportion
+ * to its area and the point uniform on it; the direction is the segment
+ * itself and tmax 1 - 1e-3, so that the light does not occlude itself.
+ * Rewrites rays in place; returns n, or 0 when the scene has no area light. */
+static size_t make_shadow(const pk_scene *scene, pk_ray *rays, size_t n, uint64_t seed)
+{
+    pk_scene_info si;
+    pk_scene_get_info(scene, &si);
+    const size_t nl = si.emissive_triangles;
+    if (nl == 0) return 0;
+    double *cdf = malloc(nl * sizeof *cdf);
+    float(*tv)[9] = malloc(nl * sizeof *tv);
+    if (!cdf || !tv) {
+        free(cdf);
+        free(tv);
+        return 0;
+    }
+    double total = 0.0;
+    for (size_t k = 0; k < nl; k++) {
+        size_t t = 0;
+        pk_scene_get_emissive_triangle(scene, k, &t);
+        pk_scene_get_triangle(scene, t, tv[k]);
+        dvec a = dv(tv[k][0], tv[k][1], tv[k][2]), b = dv(tv[k][3], tv[k][4], tv[k][5]),
+             c = dv(tv[k][6], tv[k][7], tv[k][8]);
+        dvec x = dv_cross(dv_sub(b, a), dv_sub(c, a));
+        total += 0.5 * sqrt(dv_dot(x, x));
+        cdf[k] = total;
+    }
+    for (size_t i = 0; i < n; i++) {
+        uint64_t bits = splitmix64(seed * 0x9E3779B97F4A7C15ull + 0x5bd1e995u + (uint64_t)i);
+        double u0 = (double)(bits >> 40) * (1.0 / 16777216.0);
+        double u1 = (double)((bits >> 16) & 0xFFFFFFu) * (1.0 / 16777216.0);
+        double u2 = (double)(splitmix64(bits) >> 40) * (1.0 / 16777216.0);
+        size_t k = 0;
+        while (k + 1 < nl && cdf[k] <= u0 * total) k++;
+        double su = sqrt(u1), b0 = 1.0 - su, b1 = u2 * su, b2 = 1.0 - b0 - b1;
+        pk_ray *r = &rays[i];
+        for (int j = 0; j < 3; j++) {
+            double q = b0 * (double)tv[k][j] + b1 * (double)tv[k][3 + j] + b2 * (double)tv[k][6 + j];
+            r->dir[j] = (float)(q - (double)r->org[j]);
+        }
+        r->tmin = 0.0f;
+        r->tmax = 1.0f - 1e-3f;
+    }
+    free(cdf);
+    free(tv);
+    return n;
+}
+
 static int bench_gen_rays(int argc, char **argv)
 {
     const char *scene_arg = NULL, *out_path = NULL, *shared = NULL, *kind_name = "primary";
@@ -512,8 +564,9 @@ static int bench_gen_rays(int argc, char **argv)
         case B_SIZE: size = p.int_value; break;
         case B_KIND:
             kind_name = v;
-            if (strcmp(kind_name, "primary") != 0 && strcmp(kind_name, "diffuse") != 0)
-                return cli_usage_error("--kind %s: expected primary or diffuse", kind_name);
+            if (strcmp(kind_name, "primary") != 0 && strcmp(kind_name, "diffuse") != 0 &&
+                strcmp(kind_name, "shadow") != 0)
+                return cli_usage_error("--kind %s: expected primary, diffuse or shadow", kind_name);
             break;
         case B_SEED: {
             char *end;
@@ -557,7 +610,8 @@ static int bench_gen_rays(int argc, char **argv)
         return cli_usage_error("bench gen-rays needs --look-from, --look-at and --fov (or --workload)");
     if (cli_check_output(out_path, 1)) return 1;
     if (threads == 0) threads = online_cpus();
-    const int diffuse = strcmp(kind_name, "diffuse") == 0;
+    const int diffuse = strcmp(kind_name, "primary") != 0; /* diffuse or shadow: from the primary hits */
+    const int shadow = strcmp(kind_name, "shadow") == 0;
 
     int rc = 1;
     pk_context *ctx = NULL;
@@ -600,6 +654,11 @@ static int bench_gen_rays(int argc, char **argv)
     pk_accel_trace(accel, rays, hits, n, threads, 0, NULL);
     size_t skipped = 0;
     size_t m = make_diffuse(scene, rays, hits, n, (uint64_t)seed, out_rays, &skipped);
+    if (shadow && (m = make_shadow(scene, out_rays, m, (uint64_t)seed)) == 0) {
+        fprintf(stderr, "paprsek: %s: the scene has no area light (no triangle with Ke) to cast shadow rays to\n",
+                scene_path);
+        goto out;
+    }
     if (skipped)
         fprintf(stderr, "paprsek: warning: %zu hits on spheres or degenerate triangles have no diffuse ray\n",
                 skipped);
@@ -609,7 +668,8 @@ static int bench_gen_rays(int argc, char **argv)
         goto out;
     }
     if (write_file_atomic(out_path, out_rays, m * sizeof *out_rays)) goto out;
-    fprintf(stderr, "paprsek: %s: %zu diffuse rays (from %zu primary rays)\n", out_path, m, n);
+    fprintf(stderr, "paprsek: %s: %zu %s rays (from %zu primary rays)\n", out_path, m, shadow ? "shadow" : "diffuse",
+            n);
     rc = 0;
 out:
     free(out_rays);

@@ -252,6 +252,9 @@ PK_API void pk_scene_get_info(const pk_scene *scene, pk_scene_info *info);
 /* Vertices of triangle k (file numbering) as v0,v1,v2 xyz; PK_ERR_INVALID_ARGUMENT
  * when k is out of range. */
 PK_API pk_status pk_scene_get_triangle(const pk_scene *scene, size_t k, float verts[9]);
+/* The number of the k-th emissive triangle (k < pk_scene_info.emissive_triangles):
+ * the area lights, in triangle order. */
+PK_API pk_status pk_scene_get_emissive_triangle(const pk_scene *scene, size_t k, size_t *triangle);
 /* The scene's camera, or one framed automatically on its bounds. */
 PK_API void pk_scene_get_camera(const pk_scene *scene, pk_camera *cam);
 /* Validates (finite, fov in (0,180), look_from != look_at, up not parallel). */

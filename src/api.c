@@ -157,6 +157,13 @@ void pk_scene_get_info(const pk_scene *s, pk_scene_info *info)
     info->has_camera = s->has_camera;
 }
 
+pk_status pk_scene_get_emissive_triangle(const pk_scene *s, size_t k, size_t *tri)
+{
+    if (!s || !tri || k >= s->nemissive) return PK_ERR_INVALID_ARGUMENT;
+    *tri = s->emissive[k];
+    return PK_OK;
+}
+
 pk_status pk_scene_get_triangle(const pk_scene *s, size_t k, float verts[9])
 {
     if (!s || !verts || k >= s->ntris) return PK_ERR_INVALID_ARGUMENT;
