@@ -3,7 +3,7 @@
 
 BUILD      ?= build
 JOBS       ?= $(shell nproc 2>/dev/null || echo 2)
-BUILD_PKGS  = gcc make cmake pkg-config libpng-dev libcjson-dev libopenexr-dev
+BUILD_PKGS  = gcc make cmake pkg-config libpng-dev libcjson-dev libopenexr-dev libexpat1-dev
 # g++: the install tests build a C++ program against the installed library
 TEST_PKGS   = $(BUILD_PKGS) libembree-dev g++
 PREFIX     ?= /usr/local

@@ -80,6 +80,8 @@ PK_API const char *pk_status_string(pk_status status);
 /* A JSON scene holds settings, materials, spheres and lights, not meshes; its
  * parsed tree takes tens of bytes per byte of text, hence a smaller bound. */
 #define PK_MAX_JSON_BYTES ((size_t)64 << 20) /* 64 MiB */
+/* A Mitsuba XML scene file (each included file too); meshes live in their own files. */
+#define PK_MAX_XML_BYTES ((size_t)64 << 20) /* 64 MiB */
 
 /* ---- camera, options, statistics ----------------------------------------- */
 
@@ -192,7 +194,7 @@ typedef struct pk_stats {
 
 typedef struct pk_scene pk_scene;
 
-/* Loads by extension: .obj (with its MTL files) or .json. */
+/* Loads by extension: .obj (with its MTL files), .json or .xml (Mitsuba). */
 PK_API pk_status pk_scene_load_file(pk_context *ctx, const char *path, pk_scene **out);
 /* OBJ from memory. name is used in messages; base_dir is where mtllib files are
  * looked up (NULL: MTL files are not read). */
@@ -203,6 +205,11 @@ PK_API pk_status pk_scene_load_obj_memory(pk_context *ctx, const char *data, siz
 PK_API pk_status pk_scene_load_json_memory(pk_context *ctx, const char *data, size_t size,
                                            const char *name, const char *base_dir,
                                            pk_scene **out);
+/* Mitsuba XML scene from memory; files it names (meshes, includes) are
+ * relative to base_dir (NULL: the current folder). */
+PK_API pk_status pk_scene_load_xml_memory(pk_context *ctx, const char *data, size_t size,
+                                          const char *name, const char *base_dir,
+                                          pk_scene **out);
 /* The built-in Cornell box (camera, light quad, two boxes). */
 PK_API pk_status pk_scene_create_cornell_box(pk_context *ctx, pk_scene **out);
 PK_API void pk_scene_destroy(pk_scene *scene);

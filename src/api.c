@@ -52,7 +52,7 @@ static bool has_ext(const char *path, const char *ext)
     return true;
 }
 
-typedef enum { FMT_OBJ, FMT_JSON } scene_format;
+typedef enum { FMT_OBJ, FMT_JSON, FMT_XML } scene_format;
 
 static pk_status load_memory(pk_context *ctx, scene_format fmt, const char *data, size_t size,
                              const char *name, const char *base_dir, pk_scene **out)
@@ -60,8 +60,9 @@ static pk_status load_memory(pk_context *ctx, scene_format fmt, const char *data
     pk_scene *s = NULL;
     pk_status st = scene_create(ctx, name, &s);
     if (st != PK_OK) return st;
-    st = fmt == FMT_OBJ ? obj_parse(ctx, s, data, size, name, base_dir, NULL)
-                        : scene_json_parse(ctx, s, data, size, name, base_dir);
+    if (fmt == FMT_OBJ) st = obj_parse(ctx, s, data, size, name, base_dir, NULL);
+    else if (fmt == FMT_JSON) st = scene_json_parse(ctx, s, data, size, name, base_dir);
+    else st = scene_xml_parse(ctx, s, data, size, name, base_dir);
     if (st == PK_OK) st = scene_commit(ctx, s);
     if (st != PK_OK) {
         scene_destroy(s);
@@ -91,6 +92,16 @@ pk_status pk_scene_load_json_memory(pk_context *ctx, const char *data, size_t si
                        base_dir ? base_dir : ".", out);
 }
 
+pk_status pk_scene_load_xml_memory(pk_context *ctx, const char *data, size_t size, const char *name,
+                                   const char *base_dir, pk_scene **out)
+{
+    if (!ctx || !out) return PK_ERR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!data && size) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "no data");
+    return load_memory(ctx, FMT_XML, data ? data : "", size, name ? name : "memory.xml",
+                       base_dir ? base_dir : ".", out);
+}
+
 pk_status pk_scene_load_file(pk_context *ctx, const char *path, pk_scene **out)
 {
     if (!ctx || !out) return PK_ERR_INVALID_ARGUMENT;
@@ -101,8 +112,11 @@ pk_status pk_scene_load_file(pk_context *ctx, const char *path, pk_scene **out)
         fmt = FMT_OBJ;
     else if (has_ext(path, ".json"))
         fmt = FMT_JSON;
+    else if (has_ext(path, ".xml"))
+        fmt = FMT_XML;
     else
-        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: unknown scene format (expected .obj or .json)", path);
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: unknown scene format (expected .obj, .json or .xml)",
+                         path);
     char *data = NULL, *dir = NULL;
     size_t size = 0;
     pk_status st = file_read_all(ctx, path, &data, &size);
