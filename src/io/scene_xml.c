@@ -1954,7 +1954,7 @@ static pk_status parse_emitter(xp *p, xnode *e)
         /* a sun of 0.1 degrees with the same irradiance */
         const float angle = 0.1f;
         float half = 0.5f * angle * (PK_PI / 180.0f);
-        float solid = 2.0f * PK_PI * (1.0f - cosf(half));
+        float sh = sinf(0.5f * half), solid = 4.0f * PK_PI * sh * sh; /* 2 pi (1 - cos half) */
         if (env->has_sun) {
             xwarn(p, e, "a second sun or directional light is not supported; ignored");
         } else {
