@@ -1575,6 +1575,34 @@ static pk_status read_relative(xp *p, const xnode *at, const char *rel, char **f
     return PK_OK;
 }
 
+/* Mitsuba emits (and tells inside from outside) by a mesh's shading
+ * normals, Paprsek by the winding: the triangles from t0 on are wound to
+ * agree with their vertex normals, or lose them with face_normals; then
+ * flip_normals reverses them all. */
+static void finish_mesh(xp *p, size_t t0, bool face_normals, bool flip)
+{
+    pk_scene *s = p->s;
+    for (size_t t = t0; t < s->ntris; t++) {
+        triangle *tr = &s->tris[t];
+        bool swap = flip;
+        if (face_normals) {
+            tr->n[0] = tr->n[1] = tr->n[2] = -1;
+        } else if (tr->n[0] >= 0 && tr->n[1] >= 0 && tr->n[2] >= 0) {
+            vec3 a, b, c;
+            scene_tri_verts(s, t, &a, &b, &c);
+            vec3 ng = v3_cross(v3_sub(b, a), v3_sub(c, a));
+            vec3 ns = v3_add(v3_add(s->normals[tr->n[0]], s->normals[tr->n[1]]), s->normals[tr->n[2]]);
+            if (v3_dot(ng, ns) < 0.0f) swap = !swap;
+        }
+        if (swap) {
+            uint32_t v = tr->v[1];
+            int32_t n = tr->n[1];
+            tr->v[1] = tr->v[2], tr->n[1] = tr->n[2];
+            tr->v[2] = v, tr->n[2] = n;
+        }
+    }
+}
+
 static pk_status shape_obj(xp *p, xnode *sh, const float m[16], bool flip, bool has_bsdf, uint32_t mat)
 {
     pk_status st;
@@ -1605,17 +1633,9 @@ static pk_status shape_obj(xp *p, xnode *sh, const float m[16], bool flip, bool 
         st = obj_parse(p->ctx, p->s, data, size, full, dir, m);
     }
     if (st) goto out;
-    for (size_t t = t0; t < p->s->ntris; t++) {
-        triangle *tr = &p->s->tris[t];
-        if (has_bsdf) tr->material = mat;
-        if (face_normals) tr->n[0] = tr->n[1] = tr->n[2] = -1;
-        if (flip) {
-            uint32_t v = tr->v[1];
-            int32_t n = tr->n[1];
-            tr->v[1] = tr->v[2], tr->n[1] = tr->n[2];
-            tr->v[2] = v, tr->n[2] = n;
-        }
-    }
+    if (has_bsdf)
+        for (size_t t = t0; t < p->s->ntris; t++) p->s->tris[t].material = mat;
+    finish_mesh(p, t0, face_normals, flip);
 out:
     mem_free(&p->ctx->alloc, data);
     mem_free(&p->ctx->alloc, dir);
@@ -1637,8 +1657,10 @@ static pk_status shape_ply(xp *p, xnode *sh, const float m[16], bool flip, uint3
     ply_mesh mesh = {0};
     if ((st = read_relative(p, at, fn, &full, &data, &size))) goto out;
     if ((st = ply_parse(p->ctx, data, size, full, &mesh))) goto out;
+    size_t t0 = p->s->ntris;
     st = add_mesh(p, mesh.positions, face_normals ? NULL : mesh.normals, mesh.nvertices, mesh.indices, mesh.ntriangles,
-                  m, flip, mat);
+                  m, false, mat);
+    if (st == PK_OK) finish_mesh(p, t0, face_normals, flip);
 out:
     ply_mesh_free(p->ctx, &mesh);
     mem_free(&p->ctx->alloc, data);

@@ -334,6 +334,15 @@ static void test_obj_ply(void)
         CHECK(near3(n, v3(0, 0, -1), 1e-6f));
     }
     pk_scene_destroy(s);
+    /* vertex normals against the winding: Mitsuba's side is the normals' */
+    write_text("back.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nvn 0 0 -1\nf 1//1 2//1 3//1\n");
+    s = load_ok("<shape type=\"obj\"><string name=\"filename\" value=\"back.obj\"/><emitter type=\"area\"/></shape>");
+    if (s) {
+        vec3 n;
+        tri_area(s, 0, &n);
+        CHECK(near3(n, v3(0, 0, -1), 1e-6f));
+    }
+    pk_scene_destroy(s);
     load_fails("<shape type=\"obj\">\n<string name=\"filename\" value=\"nothere.obj\"/></shape>", true, "scene.xml:3: ");
 
     /* one quad and one triangle in the three PLY encodings */
