@@ -2180,8 +2180,11 @@ static pk_status parse_integrator(xp *p, xnode *in, int depth)
     }
     if (!path) {
         for (xnode *c = in->child; c; c = c->next) c->used = true;
-        xwarn(p, in, "integrator \"%s\" is not supported; rendered with the path tracer (max_depth %lld)", ty,
-              (long long)md);
+        char depth_text[32];
+        if (md < 0) snprintf(depth_text, sizeof depth_text, "unbounded");
+        else snprintf(depth_text, sizeof depth_text, "%lld", (long long)md);
+        xwarn(p, in, "integrator \"%s\" is not supported; rendered with the path tracer (max_depth %s)", ty,
+              depth_text);
     }
     /* Mitsuba counts path segments (1: emitters seen directly, 2: direct
      * light); Paprsek counts bounces after the first hit: one less. -1 is
