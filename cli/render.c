@@ -125,8 +125,9 @@ void cli_render_help(FILE *f)
     const cli_option *opts = render_options(&n);
     fputs("usage: paprsek render [SCENE] -o OUT [options]\n"
           "\n"
-          "SCENE is a Wavefront .obj (materials from its .mtl files) or a .json scene\n"
-          "(docs/scene-format.md); without it the built-in Cornell box is rendered.\n"
+          "SCENE is a Wavefront .obj (materials from its .mtl files), a .json scene or\n"
+          "a Mitsuba .xml scene (docs/scene-format.md); without it the built-in Cornell\n"
+          "box is rendered.\n"
           "OUT is written by extension, through a temporary file that is renamed into\n"
           "place. Its folder is checked before the scene is read: it must exist and be\n"
           "writable. The formats:\n"

@@ -53,7 +53,7 @@ if mkfifo "$tmp/fifo.obj" 2>/dev/null; then # opening it must not wait for a wri
   expect "scene is a FIFO" 1 "$tmp/fifo.obj: not a regular file" render "$tmp/fifo.obj" -o "$tmp/out.png"
 fi
 put scene.txt 'v 0 0 0\n'
-expect "unknown scene type" 1 "$tmp/scene.txt: unknown scene format (expected .obj or .json)" \
+expect "unknown scene type" 1 "$tmp/scene.txt: unknown scene format (expected .obj, .json or .xml)" \
   render "$tmp/scene.txt" -o "$tmp/out.png"
 if truncate -s 2049M "$tmp/huge.obj" 2>/dev/null; then # sparse: takes no disk space
   render "scene file too large" 1 "$tmp/huge.obj: file is larger than 2147483648 bytes" huge.obj
