@@ -22,7 +22,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#define XML_MAX_NODES (1u << 20)      /* elements in one file */
+#define XML_MAX_NODES (1u << 20)      /* elements in a scene and its includes */
 #define XML_MAX_DEPTH 64              /* nesting of elements */
 #define XML_MAX_INCLUDE_DEPTH 8       /* <include> inside <include> ... */
 #define XML_MAX_FILES 256             /* files read through <include> */
@@ -88,6 +88,7 @@ typedef struct xp {
     xml_param params[XML_MAX_PARAMS];
     int nparams;
     int nfiles;
+    size_t nodes;         /* elements read, included files too */
     int bsdf_depth;
     /* warnings said once per kind */
     char warned[XML_MAX_WARN_KINDS][64];
@@ -106,7 +107,6 @@ typedef struct builder {
     XML_Parser parser;
     const xml_file *file;
     xnode *root, *cur;
-    size_t nodes;
     int depth;
     pk_status st;
 } builder;
@@ -213,13 +213,14 @@ static void XMLCALL on_start(void *user, const XML_Char *name, const XML_Char **
         stop(b, PK_ERR_LIMIT);
         return;
     }
-    if (b->nodes >= XML_MAX_NODES) {
-        ctx_error(p->ctx, PK_ERR_LIMIT, "%s:%lu: more than %u elements in one file", b->file->shown, line,
-                  XML_MAX_NODES);
+    if (p->nodes >= XML_MAX_NODES) {
+        ctx_error(p->ctx, PK_ERR_LIMIT, "%s:%lu: more than %u elements in the scene and its includes",
+                  b->file->shown, line, XML_MAX_NODES);
         stop(b, PK_ERR_LIMIT);
         return;
     }
-    if (!b->cur && b->root) { /* expat reports a second root as an error itself */
+    if (!b->cur && b->root) { /* expat refuses a second root itself; never reached */
+        ctx_error(p->ctx, PK_ERR_PARSE, "%s:%lu: a second document element", b->file->shown, line);
         stop(b, PK_ERR_PARSE);
         return;
     }
@@ -251,7 +252,7 @@ static void XMLCALL on_start(void *user, const XML_Char *name, const XML_Char **
     }
     b->cur = n;
     b->depth++;
-    b->nodes++;
+    p->nodes++;
     return;
 nomem:
     ctx_nomem(p->ctx);
@@ -1164,7 +1165,8 @@ static pk_status bsdf_resolve(xp *p, xnode *n, material *m)
         n = t;
     }
     if (n->busy) return xfail(p, PK_ERR_PARSE, n, "reference cycle through this bsdf");
-    if (p->bsdf_depth >= XML_MAX_BSDF_DEPTH) return xfail(p, PK_ERR_LIMIT, n, "bsdfs nested more than %d deep", XML_MAX_BSDF_DEPTH);
+    if (p->bsdf_depth >= XML_MAX_BSDF_DEPTH)
+        return xfail(p, PK_ERR_LIMIT, n, "bsdfs nested more than %d deep", XML_MAX_BSDF_DEPTH);
     n->busy = true;
     p->bsdf_depth++;
     st = bsdf_material(p, n, m);
@@ -1194,7 +1196,8 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
         if (!inner) return xfail(p, PK_ERR_PARSE, b, "twosided needs a nested bsdf");
         for (xnode *c = inner->next; c; c = c->next)
             if (strcmp(c->tag, "bsdf") == 0) {
-                xwarn(p, c, "twosided with a second bsdf for the back side is not supported; the front one is used on both");
+                xwarn(p, c, "twosided with a second bsdf for the back side is not supported; the front one is "
+                            "used on both");
                 c->used = true;
                 break;
             }
@@ -1501,7 +1504,8 @@ static pk_status shape_disk(xp *p, const float m[16], bool flip, uint32_t mat)
     for (int i = 0; i < XML_DISK_SEGMENTS; i++) {
         float a = 2.0f * PK_PI * (float)i / (float)XML_DISK_SEGMENTS;
         pos[i + 1] = v3(cosf(a), sinf(a), 0.0f);
-        tris[3 * i] = 0, tris[3 * i + 1] = (uint32_t)(i + 1), tris[3 * i + 2] = (uint32_t)((i + 1) % XML_DISK_SEGMENTS + 1);
+        tris[3 * i] = 0, tris[3 * i + 1] = (uint32_t)(i + 1);
+        tris[3 * i + 2] = (uint32_t)((i + 1) % XML_DISK_SEGMENTS + 1);
     }
     return add_mesh(p, pos, NULL, XML_DISK_SEGMENTS + 1, tris, XML_DISK_SEGMENTS, m, flip, mat);
 }
@@ -1737,7 +1741,8 @@ static pk_status parse_shape(xp *p, xnode *sh)
             emitter = c;
         } else if (strcmp(c->tag, "medium") == 0 || strcmp(c->tag, "subsurface") == 0) {
             c->used = true;
-            if (first_time(p, "medium")) xwarn(p, c, "participating media and subsurface scattering are not supported; ignored");
+            if (first_time(p, "medium"))
+                xwarn(p, c, "participating media and subsurface scattering are not supported; ignored");
         }
     }
     uint32_t mat = 0;
@@ -1803,7 +1808,8 @@ static pk_status parse_shape(xp *p, xnode *sh)
         local[3] = center.x, local[7] = center.y, local[11] = center.z;
         m_mul(m, local, full);
         /* analytic when full is a similarity (rotation, uniform scale, translation) */
-        vec3 cx = v3(full[0], full[4], full[8]), cy = v3(full[1], full[5], full[9]), cz = v3(full[2], full[6], full[10]);
+        vec3 cx = v3(full[0], full[4], full[8]), cy = v3(full[1], full[5], full[9]);
+        vec3 cz = v3(full[2], full[6], full[10]);
         float lx = v3_len(cx), ly = v3_len(cy), lz = v3_len(cz);
         float tol = 1e-4f * lx;
         bool similar = fabsf(lx - ly) <= tol && fabsf(lx - lz) <= tol && fabsf(v3_dot(cx, cy)) <= tol * lx &&
@@ -1824,7 +1830,7 @@ static pk_status parse_shape(xp *p, xnode *sh)
     default: break;
     }
     if (st) return st;
-    static const char *const quiet[] = {NULL};
+    static const char *const quiet[] = {"flip_tex_coords", "collapse", NULL};
     char kindname[64];
     snprintf(kindname, sizeof kindname, "shape \"%s\"", ty);
     warn_unused(p, sh, kindname, quiet);
