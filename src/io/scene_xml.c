@@ -712,11 +712,45 @@ static int hexval(char c)
     return -1;
 }
 
-/* <rgb>, <srgb>, <spectrum>, <float> as a colour. */
+/* <blackbody temperature="5000K" scale=/>: Planck's spectral radiance of
+ * that temperature in W m^-2 sr^-1 nm^-1, reduced to RGB like a spectrum. */
+static pk_status node_blackbody(xp *p, const xnode *n, vec3 *out)
+{
+    pk_status st;
+    const char *t = attr_st(p, n, "temperature", &st);
+    if (st) return st;
+    if (!t) return xfail(p, PK_ERR_PARSE, n, "<blackbody> needs a temperature");
+    const char *e = t + strlen(t);
+    while (e > t && (io_is_blank(e[-1]) || e[-1] == 'K' || e[-1] == 'k')) e--;
+    float kelvin, scale = 1.0f;
+    const char *q = io_parse_float(t, e, &kelvin);
+    if (!q || q != e || !(kelvin > 0.0f) || !isfinite(kelvin))
+        return xfail(p, PK_ERR_PARSE, n, "<blackbody> temperature must be a positive number of kelvins");
+    const char *sc = attr_st(p, n, "scale", &st);
+    if (st) return st;
+    if (sc) {
+        int k;
+        if ((st = numbers(p, n, "scale", sc, &scale, 1, &k))) return st;
+    }
+    enum { N = 95 };
+    float nm[N], val[N];
+    for (int i = 0; i < N; i++) {
+        double l = (360.0 + 5.0 * i) * 1e-9, h = 6.62607015e-34, c = 299792458.0, kb = 1.380649e-23;
+        double b = 2.0 * h * c * c / (l * l * l * l * l) / expm1(h * c / (l * kb * (double)kelvin));
+        nm[i] = (float)(360.0 + 5.0 * i);
+        val[i] = (float)(b * 1e-9); /* per metre -> per nanometre */
+    }
+    *out = v3_scale(spectrum_to_rgb(nm, val, N), scale);
+    if (!v3_finite(*out)) return xfail(p, PK_ERR_PARSE, n, "<blackbody> radiance is not finite");
+    return PK_OK;
+}
+
+/* <rgb>, <srgb>, <spectrum>, <blackbody>, <float> as a colour. */
 static pk_status node_color(xp *p, const xnode *n, vec3 *out)
 {
     pk_status st;
     if (strcmp(n->tag, "spectrum") == 0) return node_spectrum(p, n, out);
+    if (strcmp(n->tag, "blackbody") == 0) return node_blackbody(p, n, out);
     if (strcmp(n->tag, "float") == 0 || strcmp(n->tag, "integer") == 0) {
         float f;
         if ((st = node_float(p, n, &f))) return st;

@@ -455,6 +455,21 @@ static void test_bsdfs(void)
     CHECK(near3(m.kd, v3s(0.6f), 1e-3f));
     m = bsdf("<bsdf type=\"diffuse\"><spectrum name=\"reflectance\" value=\"400:0, 580:0, 600:1, 800:1\"/></bsdf>");
     CHECK(m.kd.x > 0.5f && m.kd.x > 4.0f * m.kd.y && m.kd.z < 0.05f);
+    /* a blackbody: 3000 K is reddish, 10000 K bluish; 5455 K (the equal-energy white point) about grey */
+    pk_scene *bb = load_ok("<shape type=\"cube\"><emitter type=\"area\"><blackbody name=\"radiance\" temperature=\"3000K\"/>"
+                           "</emitter></shape><shape type=\"rectangle\"><emitter type=\"area\"><blackbody name=\"radiance\" "
+                           "temperature=\"10000\"/></emitter></shape><shape type=\"disk\"><emitter type=\"area\">"
+                           "<blackbody name=\"radiance\" temperature=\"5455\"/></emitter></shape>");
+    if (bb) {
+        vec3 warm = bb->materials[bb->tris[0].material].ke, cold = bb->materials[bb->tris[12].material].ke;
+        vec3 white = bb->materials[bb->tris[14].material].ke;
+        CHECK(warm.x > 1.5f * warm.z && cold.z > 1.2f * cold.x);
+        CHECKF(fabsf(white.x / white.y - 1.0f) < 0.1f && fabsf(white.z / white.y - 1.0f) < 0.1f, "%g %g %g",
+               (double)white.x, (double)white.y, (double)white.z);
+        /* Planck at 5455 K and 555 nm: 2hc^2 / l^5 / (exp(hc / (l k T)) - 1) = 1.97e4 W m^-2 sr^-1 nm^-1 */
+        CHECKF(white.y > 1.77e4f && white.y < 2.17e4f, "%g", (double)white.y);
+    }
+    pk_scene_destroy(bb);
     m = bsdf("<bsdf type=\"roughdiffuse\"><rgb name=\"reflectance\" value=\"0.2\"/></bsdf>");
     CHECK(m.type == MAT_DIFFUSE && near3(m.kd, v3s(0.2f), 1e-6f) && warned("roughdiffuse"));
     m = bsdf("<bsdf type=\"conductor\"><string name=\"material\" value=\"Au\"/></bsdf>");
