@@ -1370,6 +1370,33 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
         m->ks = v3s(f0_dielectric(ior));
         if (alpha < 1e-3f) m->illum = 3;
         else m->ns = ns_from_alpha(alpha);
+    } else if (strcmp(type, "principled") == 0 || strcmp(type, "principledthin") == 0) {
+        /* Disney's model by its main parameters: a metal (Schlick, F0 =
+         * base_color) when metallic > 0.5, else a plastic of base_color */
+        vec3 base = v3s(0.5f);
+        float metallic = 0.0f, roughness = 0.5f, eta = 1.5f;
+        if ((st = get_color(p, b, "base_color", &base))) return st;
+        if ((st = get_scalar(p, b, "metallic", &metallic))) return st;
+        if ((st = get_scalar(p, b, "roughness", &roughness))) return st;
+        if ((st = get_float(p, b, "eta", &eta))) return st;
+        for (xnode *c = b->child; c; c = c->next) c->used = true;
+        if (first_time(p, "principled"))
+            xwarn(p, b, "principled is approximated by a %s of its base_color and roughness",
+                  metallic > 0.5f ? "metal" : "plastic");
+        alpha = clamp01(roughness) * clamp01(roughness);
+        if (metallic > 0.5f) {
+            m->type = MAT_CONDUCTOR;
+            m->schlick = true;
+            m->ks = clamp01v(base), m->kd = v3s(0.0f);
+        } else {
+            m->type = MAT_PLASTIC;
+            m->kd = clamp01v(base);
+            m->ni = eta > 1.0f ? eta : 1.5f;
+            m->ks = v3s(f0_dielectric(m->ni));
+        }
+        m->alpha = alpha;
+        if (alpha < 1e-3f) m->illum = 3;
+        else m->ns = ns_from_alpha(alpha);
     } else if (strcmp(type, "null") == 0) {
         m->type = MAT_DIELECTRIC; /* index 1: light passes straight through */
         m->ni = 1.0f, m->tf = v3s(1.0f), m->kd = v3s(0.0f), m->ks = v3s(0.0f);

@@ -506,6 +506,12 @@ static void test_bsdfs(void)
     m = bsdf("<bsdf type=\"bumpmap\"><texture type=\"bitmap\"><string name=\"filename\" value=\"b.png\"/></texture>"
              "<bsdf type=\"plastic\"/></bsdf>");
     CHECK(m.type == MAT_PLASTIC && warned("scene.xml:3: bsdf \"bumpmap\" is not supported; using its nested bsdf alone"));
+    m = bsdf("<bsdf type=\"principled\"><rgb name=\"base_color\" value=\"0.9 0.6 0.2\"/><float name=\"metallic\" value=\"1\"/>"
+             "<float name=\"roughness\" value=\"0.2\"/><float name=\"sheen\" value=\"0.3\"/></bsdf>");
+    CHECK(m.type == MAT_CONDUCTOR && m.schlick && near3(m.ks, v3(0.9f, 0.6f, 0.2f), 1e-6f) && fabsf(m.alpha - 0.04f) < 1e-6f);
+    CHECK(warned("principled is approximated by a metal"));
+    m = bsdf("<bsdf type=\"principled\"><rgb name=\"base_color\" value=\"0.1 0.2 0.3\"/></bsdf>");
+    CHECK(m.type == MAT_PLASTIC && near3(m.kd, v3(0.1f, 0.2f, 0.3f), 1e-6f) && fabsf(m.alpha - 0.25f) < 1e-6f);
     m = bsdf("<bsdf type=\"hanrahan_krueger\"/>");
     CHECK(m.type == MAT_DIFFUSE && warned("scene.xml:3: bsdf \"hanrahan_krueger\" is not supported"));
     /* textures go through one function: a warning, and a constant colour */
