@@ -205,6 +205,11 @@ PK_API pk_status pk_scene_load_obj_memory(pk_context *ctx, const char *data, siz
 PK_API pk_status pk_scene_load_json_memory(pk_context *ctx, const char *data, size_t size,
                                            const char *name, const char *base_dir,
                                            pk_scene **out);
+/* As pk_scene_load_file; params (nparams strings "NAME=VALUE") set the
+ * parameters ($NAME) of a Mitsuba XML scene over its <default> values.
+ * Other formats have no parameters and ignore them. */
+PK_API pk_status pk_scene_load_file_params(pk_context *ctx, const char *path, const char *const *params,
+                                           size_t nparams, pk_scene **out);
 /* Mitsuba XML scene from memory; files it names (meshes, includes) are
  * relative to base_dir (NULL: the current folder). */
 PK_API pk_status pk_scene_load_xml_memory(pk_context *ctx, const char *data, size_t size,

@@ -2361,7 +2361,7 @@ static pk_status parse_scene(xp *p, xnode *root, int include_depth)
 }
 
 pk_status scene_xml_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size, const char *name,
-                          const char *base_dir)
+                          const char *base_dir, const char *const *params, size_t nparams)
 {
     if (!ctx || !s) return PK_ERR_INVALID_ARGUMENT;
     if (!data && size) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "scene_xml_parse: no data");
@@ -2371,7 +2371,38 @@ pk_status scene_xml_parse(pk_context *ctx, pk_scene *s, const char *data, size_t
     p->s = s;
     xml_file top = {name ? name : "scene.xml", base_dir ? base_dir : "."};
     xnode *root;
-    pk_status st = parse_tree(p, data ? data : "", size, &top, &root);
+    pk_status st = PK_OK;
+    /* parameters from the caller (paprsek render -D name=value) come first */
+    for (size_t i = 0; i < nparams && st == PK_OK; i++) {
+        const char *d = params[i], *eq = d ? strchr(d, '=') : NULL;
+        char shown_d[64];
+        shown(shown_d, sizeof shown_d, d ? d : "");
+        if (!eq || eq == d) {
+            st = ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "parameter '%s': expected NAME=VALUE", shown_d);
+            break;
+        }
+        for (const char *c = d; c < eq; c++)
+            if (!is_ident(*c)) {
+                st = ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "parameter '%s': a name is letters, digits and _",
+                               shown_d);
+                break;
+            }
+        if (st) break;
+        if (param_find(p, d, (size_t)(eq - d))) continue; /* the first one holds */
+        if (p->nparams == XML_MAX_PARAMS) {
+            st = ctx_error(ctx, PK_ERR_LIMIT, "more than %d parameters", XML_MAX_PARAMS);
+            break;
+        }
+        const char *nm = arena_strndup(p, d, (size_t)(eq - d)), *v = arena_strdup(p, eq + 1);
+        if (!nm || !v) {
+            st = ctx_nomem(ctx);
+            break;
+        }
+        p->params[p->nparams].name = nm;
+        p->params[p->nparams].value = v;
+        p->nparams++;
+    }
+    if (st == PK_OK) st = parse_tree(p, data ? data : "", size, &top, &root);
     if (st == PK_OK) {
         const char *version = NULL;
         for (int i = 0; i < root->nattrs; i++)

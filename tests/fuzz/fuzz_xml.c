@@ -13,7 +13,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     pk_context_set_warning_handler(ctx, fuzz_warning, &warned);
     pk_scene *s = NULL;
     if (scene_create(ctx, "fuzz.xml", &s) == PK_OK) {
-        pk_status st = scene_xml_parse(ctx, s, (const char *)data, size, "fuzz.xml", PK_TEST_DATA);
+        pk_status st = scene_xml_parse(ctx, s, (const char *)data, size, "fuzz.xml", PK_TEST_DATA, NULL, 0);
         if (st == PK_OK) st = scene_commit(ctx, s);
         fuzz_check_error(ctx, st);
         if (st == PK_OK) {

@@ -212,6 +212,22 @@ static void test_include(void)
         CHECK(near3(s->materials[s->tris[12].material].kd, v3(0.8f, 0.1f, 0.1f), 1e-6f));
     }
     pk_scene_destroy(s);
+    /* parameters from the caller come before the file's <default>s */
+    write_text("params.xml", "<scene version=\"3.0.0\"><default name=\"r\" value=\"0.1\"/><shape type=\"$shape\">"
+                             "<bsdf type=\"diffuse\"><float name=\"reflectance\" value=\"$r\"/></bsdf></shape></scene>");
+    char path[512];
+    snprintf(path, sizeof path, "%s/params.xml", tmpdir);
+    const char *params[] = {"r=0.7", "shape=cube", "r=0.2"};
+    pk_context_clear_error(ctx);
+    s = NULL;
+    CHECKF(pk_scene_load_file_params(ctx, path, params, 3, &s) == PK_OK, "%s", pk_context_error(ctx));
+    if (s) CHECK(s->ntris == 12 && fabsf(s->materials[s->tris[0].material].kd.x - 0.7f) < 1e-6f);
+    pk_scene_destroy(s);
+    const char *bad_params[] = {"no equals sign"};
+    pk_context_clear_error(ctx);
+    s = NULL;
+    CHECK(pk_scene_load_file_params(ctx, path, bad_params, 1, &s) == PK_ERR_INVALID_ARGUMENT && !s);
+    CHECK(strstr(pk_context_error(ctx), "parameter 'no equals sign': expected NAME=VALUE") != NULL);
     write_text("loop.xml", "<scene version=\"3.0.0\">\n\n<include filename=\"loop.xml\"/></scene>");
     load_fails("<include filename=\"loop.xml\"/>", true, "loop.xml:3: includes nested more than 8 deep");
     load_fails("\n<include filename=\"absent.xml\"/>", true, "scene.xml:3: ");
