@@ -1128,6 +1128,12 @@ static pk_status get_ior(xp *p, xnode *plugin, const char *name, float *out)
                 *out = iors[i].ior;
                 return PK_OK;
             }
+        float f;
+        const char *e = v + strlen(v);
+        if (io_parse_float(v, e, &f) == e && f > 0.0f && isfinite(f)) { /* a number written as a string */
+            *out = f;
+            return PK_OK;
+        }
         char sv[48];
         shown(sv, sizeof sv, v);
         return xfail(p, PK_ERR_PARSE, c, "%s: unknown material \"%s\"", name, sv);
