@@ -2010,9 +2010,9 @@ static pk_status parse_emitter(xp *p, xnode *e)
         }
         if (!(v3_len2(dir) > 0.0f)) return xfail(p, PK_ERR_PARSE, e, "sun_direction must not be zero");
         dir = v3_norm_scaled(dir);
-        if (!(turbidity >= 1.0f && turbidity <= 10.0f)) {
-            xwarn(p, e, "turbidity %g is outside 1..10; clamped", (double)turbidity);
-            turbidity = turbidity < 1.0f ? 1.0f : 10.0f;
+        if (!(turbidity >= 2.0f && turbidity <= 10.0f)) {
+            xwarn(p, e, "turbidity %g is outside 2..10; clamped", (double)turbidity);
+            turbidity = turbidity < 2.0f ? 2.0f : 10.0f;
         }
         bool sun = type[2] == 'n', sky = strcmp(type, "sky") == 0 || strcmp(type, "sunsky") == 0;
         if (strcmp(type, "sun") == 0) sun_scale = scale;
@@ -2021,7 +2021,7 @@ static pk_status parse_emitter(xp *p, xnode *e)
         env->sun_dir = dir;
         if (sun) {
             /* sun_radius_scale widens the disc keeping its power */
-            float rs = radius_scale > 0.0f ? radius_scale : 1.0f;
+            float rs = radius_scale > 0.0f ? fminf(radius_scale, 90.0f / 0.5358f) : 1.0f;
             env->has_sun = true;
             env->sun_angle = 0.5358f * rs;
             env->sun_radiance = v3_scale(sun_radiance(dir, turbidity), sun_scale / (rs * rs));
@@ -2029,7 +2029,11 @@ static pk_status parse_emitter(xp *p, xnode *e)
         if (sky) {
             env->has_sky = true;
             env->sky_turbidity = turbidity;
-            env->sky_scale = sky_scale;
+            /* Paprsek's sky is in W m^-2 sr^-1 over the visible range (luminance
+             * / 683), Mitsuba's per nanometre: the integral of the CIE y
+             * function, 106.857 nm, converts, so that the image is as bright as
+             * Mitsuba renders it */
+            env->sky_scale = sky_scale / 106.857f;
         }
         if (first_time(p, "sunsky-model"))
             xwarn(p, e, "%s: Mitsuba's sun and sky models are approximated by Paprsek's (docs/scene-format.md)", ty);
