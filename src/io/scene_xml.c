@@ -1257,8 +1257,41 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
         warn_unused(p, b, "mask", quiet);
         return PK_OK;
     }
+    if (strcmp(type, "coating") == 0 || strcmp(type, "roughcoating") == 0) {
+        /* a dielectric coat over a diffuse base is Paprsek's plastic */
+        xnode *inner = nested_bsdf(p, b);
+        float in = 1.5046f, ext = 1.000277f, alpha = 0.0f;
+        if (type[0] == 'r' && (st = get_alpha(p, b, 0.1f, &alpha))) return st;
+        if ((st = get_ior(p, b, "int_ior", &in))) return st;
+        if ((st = get_ior(p, b, "ext_ior", &ext))) return st;
+        if (inner && (st = bsdf_resolve(p, inner, m))) return st;
+        float ior = in / ext;
+        if (inner && m->type == MAT_DIFFUSE && ior > 0.0f && ior != 1.0f) {
+            vec3 kd = m->kd;
+            float d = m->d;
+            material_init(m);
+            m->type = MAT_PLASTIC;
+            m->kd = kd, m->d = d, m->ni = ior, m->alpha = alpha;
+            m->ks = v3s(f0_dielectric(ior));
+            if (alpha < 1e-3f) m->illum = 3;
+            else m->ns = ns_from_alpha(alpha);
+            static const char *const q[] = {"distribution", NULL};
+            warn_unused(p, b, type[0] == 'r' ? "bsdf \"roughcoating\"" : "bsdf \"coating\"", q);
+            return PK_OK;
+        }
+        for (xnode *c = b->child; c; c = c->next) c->used = true;
+        if (!inner) {
+            xwarn(p, b, "bsdf \"%s\" without a nested bsdf; using a grey diffuse material", ty);
+            material_init(m);
+            m->type = MAT_DIFFUSE;
+            m->kd = v3s(0.5f);
+            return PK_OK;
+        }
+        xwarn(p, b, "bsdf \"%s\" over a non-diffuse bsdf is not supported; using its nested bsdf alone", ty);
+        return PK_OK;
+    }
     if (strcmp(type, "bumpmap") == 0 || strcmp(type, "bump") == 0 || strcmp(type, "normalmap") == 0 ||
-        strcmp(type, "coating") == 0 || strcmp(type, "roughcoating") == 0 || strcmp(type, "blendbsdf") == 0 ||
+        strcmp(type, "blendbsdf") == 0 ||
         strcmp(type, "mixturebsdf") == 0 || strcmp(type, "polarizer") == 0 || strcmp(type, "measured") == 0) {
         xnode *inner = nested_bsdf(p, b);
         for (xnode *c = b->child; c; c = c->next) c->used = true;

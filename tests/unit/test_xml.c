@@ -528,6 +528,12 @@ static void test_bsdfs(void)
     CHECK(warned("principled is approximated by a metal"));
     m = bsdf("<bsdf type=\"principled\"><rgb name=\"base_color\" value=\"0.1 0.2 0.3\"/></bsdf>");
     CHECK(m.type == MAT_PLASTIC && near3(m.kd, v3(0.1f, 0.2f, 0.3f), 1e-6f) && fabsf(m.alpha - 0.25f) < 1e-6f);
+    m = bsdf("<bsdf type=\"coating\"><float name=\"intIOR\" value=\"1.2\"/><bsdf type=\"diffuse\"><rgb name=\"reflectance\" "
+             "value=\"0.3 0.4 0.5\"/></bsdf></bsdf>");
+    CHECK(m.type == MAT_PLASTIC && near3(m.kd, v3(0.3f, 0.4f, 0.5f), 1e-6f) && fabsf(m.ni - 1.2f / 1.000277f) < 1e-5f);
+    CHECK(m.alpha == 0.0f && nwarnings == 0);
+    m = bsdf("<bsdf type=\"roughcoating\"><float name=\"thickness\" value=\"2\"/><bsdf type=\"conductor\"/></bsdf>");
+    CHECK(m.type == MAT_CONDUCTOR && warned("roughcoating\" over a non-diffuse bsdf"));
     m = bsdf("<bsdf type=\"hanrahan_krueger\"/>");
     CHECK(m.type == MAT_DIFFUSE && warned("scene.xml:3: bsdf \"hanrahan_krueger\" is not supported"));
     /* textures go through one function: a warning, and a constant colour */
