@@ -51,6 +51,7 @@ enum {
     OPT_AOV,
     OPT_STATS,
     OPT_STATS_JSON,
+    OPT_DEFINE,
     OPT_QUIET,
     OPT_HELP
 };
@@ -117,6 +118,9 @@ static const cli_option *render_options(size_t *n)
                                  "nodes, build and render time)"});
         add((cli_option){.name = "stats-json", .id = OPT_STATS_JSON, .kind = CLI_STRING, .arg = "FILE",
                          .help = "write the statistics as JSON to FILE; - writes them to standard output"});
+        add((cli_option){.name = "define", .short_name = 'D', .id = OPT_DEFINE, .kind = CLI_STRING, .arg = "NAME=VALUE",
+                         .help = "set the parameter $NAME of a Mitsuba XML scene over its <default> value "
+                                 "(may be repeated, up to 64 times)"});
         add((cli_option){.name = "quiet", .short_name = 'q', .id = OPT_QUIET, .kind = CLI_FLAG,
                          .help = "no progress bar, no 'wrote' line, no warnings (errors are still printed)"});
         add((cli_option){.name = "help", .short_name = 'h', .id = OPT_HELP, .kind = CLI_FLAG, .help = "this text"});
@@ -131,8 +135,9 @@ void cli_render_help(FILE *f)
     const cli_option *opts = render_options(&n);
     fputs("usage: paprsek render [SCENE] -o OUT [options]\n"
           "\n"
-          "SCENE is a Wavefront .obj (materials from its .mtl files) or a .json scene\n"
-          "(docs/scene-format.md); without it the built-in Cornell box is rendered.\n"
+          "SCENE is a Wavefront .obj (materials from its .mtl files), a .json scene or\n"
+          "a Mitsuba .xml scene (docs/scene-format.md); without it the built-in Cornell\n"
+          "box is rendered.\n"
           "OUT is written by extension, through a temporary file that is renamed into\n"
           "place. Its folder is checked before the scene is read: it must exist and be\n"
           "writable. The formats:\n"
@@ -183,6 +188,8 @@ typedef struct cli_opts {
     int has_from, has_at, has_up, has_fov;
     float from[3], at[3], up[3], fov;
     const char *env;     /* --env, NULL when not given */
+    const char *defines[64]; /* -D NAME=VALUE */
+    size_t ndefines;
 } cli_opts;
 
 /* Returns 0 to go on, -1 after --help (exit 0), or an exit status. */
@@ -280,6 +287,12 @@ static int parse_args(int argc, char **argv, cli_opts *o)
         }
         case OPT_STATS: o->stats = 1; break;
         case OPT_STATS_JSON: o->stats_json = v; break;
+        case OPT_DEFINE:
+            if (!strchr(v, '=') || v[0] == '=') return cli_usage_error("-D %s: expected NAME=VALUE", v);
+            if (o->ndefines == sizeof o->defines / sizeof o->defines[0])
+                return cli_usage_error("-D: more than %zu parameters", sizeof o->defines / sizeof o->defines[0]);
+            o->defines[o->ndefines++] = v;
+            break;
         case OPT_QUIET: o->quiet = 1; break;
         case OPT_HELP: cli_render_help(stdout); return -1;
         }
@@ -548,7 +561,8 @@ int cli_render(int argc, char **argv)
     cli_progress_init(&bar, stderr, o.quiet);
     if (!o.quiet) pk_context_set_warning_handler(ctx, print_warning, &bar);
     rc = 1;
-    pk_status st = o.scene ? pk_scene_load_file(ctx, o.scene, &scene) : pk_scene_create_cornell_box(ctx, &scene);
+    pk_status st = o.scene ? pk_scene_load_file_params(ctx, o.scene, o.defines, o.ndefines, &scene)
+                           : pk_scene_create_cornell_box(ctx, &scene);
     if (st != PK_OK) goto fail;
 
     pk_render_options ro;

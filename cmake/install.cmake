@@ -24,7 +24,7 @@ install(FILES ${CMAKE_CURRENT_BINARY_DIR}/paprsekConfig.cmake
   ${CMAKE_CURRENT_BINARY_DIR}/paprsekConfigVersion.cmake DESTINATION ${PK_CMAKE_DIR})
 
 # paprsek.pc. Static linking (pkg-config --static) needs what the library
-# links: libpng and cJSON through their own .pc files where they have one,
+# links: libpng, cJSON and expat through their own .pc files where they have one,
 # libjpeg, OpenEXRCore, the OpenMP flag, libm (and libdl, the thread library where the C library
 # lacks them). Embree is not listed: it is loaded at run time.
 set(PK_PC_REQUIRES_PRIVATE)
@@ -33,6 +33,7 @@ find_package(PkgConfig QUIET)
 if(PKG_CONFIG_FOUND)
   pkg_check_modules(PK_PC_LIBPNG QUIET libpng)
   pkg_check_modules(PK_PC_LIBCJSON QUIET libcjson)
+  pkg_check_modules(PK_PC_EXPAT QUIET expat)
 endif()
 if(PK_PC_LIBPNG_FOUND)
   list(APPEND PK_PC_REQUIRES_PRIVATE libpng)
@@ -47,6 +48,11 @@ if(PK_PC_LIBCJSON_FOUND)
   list(APPEND PK_PC_REQUIRES_PRIVATE libcjson)
 else()
   list(APPEND PK_PC_LIBS_PRIVATE -lcjson)
+endif()
+if(PK_PC_EXPAT_FOUND)
+  list(APPEND PK_PC_REQUIRES_PRIVATE expat)
+else()
+  list(APPEND PK_PC_LIBS_PRIVATE -lexpat)
 endif()
 # OpenEXR: the C library OpenEXRCore alone, by name. Its OpenEXR.pc would
 # link the C++ libraries too (OpenEXR, Iex, IlmThread) and add Imath's

@@ -91,6 +91,8 @@ PK_API const char *pk_status_string(pk_status status);
 #define PK_MAX_TEXTURE_SIDE 32768
 #define PK_MAX_TEXTURE_PIXELS (128u * 1024u * 1024u)
 #define PK_MAX_TEXTURE_BYTES ((size_t)4 << 30) /* 4 GiB */
+/* A Mitsuba XML scene file (each included file too); meshes live in their own files. */
+#define PK_MAX_XML_BYTES ((size_t)64 << 20) /* 64 MiB */
 
 /* ---- camera, options, statistics ----------------------------------------- */
 
@@ -207,7 +209,7 @@ typedef struct pk_stats {
 
 typedef struct pk_scene pk_scene;
 
-/* Loads by extension: .obj (with its MTL files) or .json. */
+/* Loads by extension: .obj (with its MTL files), .json or .xml (Mitsuba). */
 PK_API pk_status pk_scene_load_file(pk_context *ctx, const char *path, pk_scene **out);
 /* OBJ from memory. name is used in messages; base_dir is where mtllib files are
  * looked up (NULL: MTL files are not read). */
@@ -218,6 +220,16 @@ PK_API pk_status pk_scene_load_obj_memory(pk_context *ctx, const char *data, siz
 PK_API pk_status pk_scene_load_json_memory(pk_context *ctx, const char *data, size_t size,
                                            const char *name, const char *base_dir,
                                            pk_scene **out);
+/* As pk_scene_load_file; params (nparams strings "NAME=VALUE") set the
+ * parameters ($NAME) of a Mitsuba XML scene over its <default> values.
+ * Other formats have no parameters and ignore them. */
+PK_API pk_status pk_scene_load_file_params(pk_context *ctx, const char *path, const char *const *params,
+                                           size_t nparams, pk_scene **out);
+/* Mitsuba XML scene from memory; files it names (meshes, includes) are
+ * relative to base_dir (NULL: the current folder). */
+PK_API pk_status pk_scene_load_xml_memory(pk_context *ctx, const char *data, size_t size,
+                                          const char *name, const char *base_dir,
+                                          pk_scene **out);
 /* The built-in Cornell box (camera, light quad, two boxes). */
 PK_API pk_status pk_scene_create_cornell_box(pk_context *ctx, pk_scene **out);
 PK_API void pk_scene_destroy(pk_scene *scene);

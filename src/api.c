@@ -52,16 +52,18 @@ static bool has_ext(const char *path, const char *ext)
     return true;
 }
 
-typedef enum { FMT_OBJ, FMT_JSON } scene_format;
+typedef enum { FMT_OBJ, FMT_JSON, FMT_XML } scene_format;
 
 static pk_status load_memory(pk_context *ctx, scene_format fmt, const char *data, size_t size,
-                             const char *name, const char *base_dir, pk_scene **out)
+                             const char *name, const char *base_dir, const char *const *params, size_t nparams,
+                             pk_scene **out)
 {
     pk_scene *s = NULL;
     pk_status st = scene_create(ctx, name, &s);
     if (st != PK_OK) return st;
-    st = fmt == FMT_OBJ ? obj_parse(ctx, s, data, size, name, base_dir, NULL)
-                        : scene_json_parse(ctx, s, data, size, name, base_dir);
+    if (fmt == FMT_OBJ) st = obj_parse(ctx, s, data, size, name, base_dir, NULL);
+    else if (fmt == FMT_JSON) st = scene_json_parse(ctx, s, data, size, name, base_dir);
+    else st = scene_xml_parse(ctx, s, data, size, name, base_dir, params, nparams);
     if (st == PK_OK) st = scene_commit(ctx, s);
     if (st != PK_OK) {
         scene_destroy(s);
@@ -78,7 +80,7 @@ pk_status pk_scene_load_obj_memory(pk_context *ctx, const char *data, size_t siz
     if (!ctx || !out) return PK_ERR_INVALID_ARGUMENT;
     *out = NULL;
     if (!data && size) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "no data");
-    return load_memory(ctx, FMT_OBJ, data ? data : "", size, name ? name : "memory.obj", base_dir, out);
+    return load_memory(ctx, FMT_OBJ, data ? data : "", size, name ? name : "memory.obj", base_dir, NULL, 0, out);
 }
 
 pk_status pk_scene_load_json_memory(pk_context *ctx, const char *data, size_t size, const char *name,
@@ -88,21 +90,41 @@ pk_status pk_scene_load_json_memory(pk_context *ctx, const char *data, size_t si
     *out = NULL;
     if (!data && size) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "no data");
     return load_memory(ctx, FMT_JSON, data ? data : "", size, name ? name : "memory.json",
-                       base_dir ? base_dir : ".", out);
+                       base_dir ? base_dir : ".", NULL, 0, out);
+}
+
+pk_status pk_scene_load_xml_memory(pk_context *ctx, const char *data, size_t size, const char *name,
+                                   const char *base_dir, pk_scene **out)
+{
+    if (!ctx || !out) return PK_ERR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!data && size) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "no data");
+    return load_memory(ctx, FMT_XML, data ? data : "", size, name ? name : "memory.xml",
+                       base_dir ? base_dir : ".", NULL, 0, out);
 }
 
 pk_status pk_scene_load_file(pk_context *ctx, const char *path, pk_scene **out)
 {
+    return pk_scene_load_file_params(ctx, path, NULL, 0, out);
+}
+
+pk_status pk_scene_load_file_params(pk_context *ctx, const char *path, const char *const *params, size_t nparams,
+                                    pk_scene **out)
+{
     if (!ctx || !out) return PK_ERR_INVALID_ARGUMENT;
     *out = NULL;
+    if (nparams && !params) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "no parameters");
     if (!path) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "no scene path");
     scene_format fmt;
     if (has_ext(path, ".obj"))
         fmt = FMT_OBJ;
     else if (has_ext(path, ".json"))
         fmt = FMT_JSON;
+    else if (has_ext(path, ".xml"))
+        fmt = FMT_XML;
     else
-        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: unknown scene format (expected .obj or .json)", path);
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: unknown scene format (expected .obj, .json or .xml)",
+                         path);
     char *data = NULL, *dir = NULL;
     size_t size = 0;
     pk_status st = file_read_all(ctx, path, &data, &size);
@@ -112,7 +134,7 @@ pk_status pk_scene_load_file(pk_context *ctx, const char *path, pk_scene **out)
         st = ctx_nomem(ctx);
         goto out;
     }
-    st = load_memory(ctx, fmt, data, size, base_name(path), dir, out);
+    st = load_memory(ctx, fmt, data, size, base_name(path), dir, params, nparams, out);
 out:
     mem_free(&ctx->alloc, data);
     mem_free(&ctx->alloc, dir);

@@ -190,6 +190,13 @@ PK_HIDDEN pk_status mtl_parse(pk_context *ctx, pk_scene *s, const char *data, si
 /* Parses a JSON scene into s (meshes are loaded relative to base_dir). Does not commit. */
 PK_HIDDEN pk_status scene_json_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,
                                      const char *name, const char *base_dir);
+/* Parses a Mitsuba XML scene into s (files are read relative to base_dir;
+ * docs/scene-format.md, "Mitsuba XML"). params (nparams strings
+ * "name=value", may be NULL) set $name before the file's <default>s, which
+ * then do not change them. Does not commit. */
+PK_HIDDEN pk_status scene_xml_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,
+                                    const char *name, const char *base_dir, const char *const *params,
+                                    size_t nparams);
 /* Fills s with the built-in Cornell box. Does not commit. */
 PK_HIDDEN pk_status scene_build_cornell(pk_context *ctx, pk_scene *s);
 

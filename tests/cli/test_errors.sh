@@ -53,8 +53,21 @@ if mkfifo "$tmp/fifo.obj" 2>/dev/null; then # opening it must not wait for a wri
   expect "scene is a FIFO" 1 "$tmp/fifo.obj: not a regular file" render "$tmp/fifo.obj" -o "$tmp/out.png"
 fi
 put scene.txt 'v 0 0 0\n'
-expect "unknown scene type" 1 "$tmp/scene.txt: unknown scene format (expected .obj or .json)" \
+expect "unknown scene type" 1 "$tmp/scene.txt: unknown scene format (expected .obj, .json or .xml)" \
   render "$tmp/scene.txt" -o "$tmp/out.png"
+put bad.xml '<scene version="3.0.0">\n<shape type="cube">\n</scene>\n'
+expect "malformed XML" 1 "bad.xml:3: malformed XML: mismatched tag" render "$tmp/bad.xml" -o "$tmp/out.png"
+put param.xml '<scene version="3.0.0">\n<shape type="$kind"/><emitter type="point"><point name="position" x="0" y="0" z="5"/></emitter>\n</scene>\n'
+expect "undefined XML parameter" 1 'param.xml:2: type="...$kind...": no <default name="kind"> defines $kind' \
+  render "$tmp/param.xml" -o "$tmp/out.png"
+expect "-D without a value" 2 "-D kind: expected NAME=VALUE" render "$tmp/param.xml" -D kind -o "$tmp/out.png"
+rm -f "$tmp"/out.*
+if "$bin" render "$tmp/param.xml" -D kind=cube -o "$tmp/out.png" --spp 1 --width 4 --height 4 2>"$tmp/stderr" &&
+  [ -s "$tmp/out.png" ] && [ ! -s "$tmp/stderr" ]; then
+  echo "ok   -D sets a parameter"
+else
+  echo "FAIL -D sets a parameter: $(cat "$tmp/stderr")"; fail=1
+fi
 if truncate -s 2049M "$tmp/huge.obj" 2>/dev/null; then # sparse: takes no disk space
   render "scene file too large" 1 "$tmp/huge.obj: file is larger than 2147483648 bytes" huge.obj
   rm -f "$tmp/huge.obj"

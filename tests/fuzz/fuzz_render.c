@@ -1,5 +1,5 @@
-/* fuzz_render.c - loads a fuzzed scene (JSON when it starts with '{', OBJ
- * otherwise, with mtllib and meshes read from tests/data) and renders it at
+/* fuzz_render.c - loads a fuzzed scene (JSON when it starts with '{', Mitsuba
+ * XML when it starts with '<', OBJ otherwise, with mtllib and meshes read from tests/data) and renders it at
  * 8x8 with every code path of the integrator. */
 #include "fuzz.h"
 
@@ -11,9 +11,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     pk_context_set_warning_handler(ctx, fuzz_warning, &warned);
     pk_scene *s = NULL;
     const char *text = (const char *)data;
-    pk_status st = size && text[0] == '{'
-                       ? pk_scene_load_json_memory(ctx, text, size, "fuzz.json", PK_TEST_DATA, &s)
-                       : pk_scene_load_obj_memory(ctx, text, size, "fuzz.obj", PK_TEST_DATA, &s);
+    pk_status st = size && text[0] == '{'   ? pk_scene_load_json_memory(ctx, text, size, "fuzz.json", PK_TEST_DATA, &s)
+                   : size && text[0] == '<' ? pk_scene_load_xml_memory(ctx, text, size, "fuzz.xml", PK_TEST_DATA, &s)
+                                            : pk_scene_load_obj_memory(ctx, text, size, "fuzz.obj", PK_TEST_DATA, &s);
     fuzz_check_error(ctx, st);
     if (st == PK_OK) {
         pk_render_options o;

@@ -1,0 +1,2461 @@
+/*
+ * scene_xml.c - Mitsuba XML scenes (versions 0.4-0.6 with camelCase names,
+ * 2.x/3.x with snake_case names) read with expat into a small tree, then
+ * mapped onto a pk_scene: shapes (obj, ply, rectangle, cube, disk, sphere),
+ * BSDFs onto the material types, emitters (area, point, environment),
+ * the perspective sensor, film, sampler and integrator settings
+ * (docs/scene-format.md, "Mitsuba XML"). Errors and warnings read
+ * "file:line: what"; what is not supported is warned about and skipped.
+ *
+ * expat allocates with the C library's malloc (its memory hooks take no user
+ * pointer, so they cannot reach a context); everything else goes through the
+ * context's allocator.
+ */
+#include "io_util.h"
+#include "ply.h"
+#include "../options.h"
+#include "../scene/camera.h"
+#include "../scene/scene.h"
+
+#include <expat.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#define XML_MAX_NODES (1u << 20)      /* elements in a scene and its includes */
+#define XML_MAX_DEPTH 64              /* nesting of elements */
+#define XML_MAX_INCLUDE_DEPTH 8       /* <include> inside <include> ... */
+#define XML_MAX_FILES 256             /* files read through <include> */
+#define XML_MAX_BSDF_DEPTH 16         /* nested bsdfs and references */
+#define XML_MAX_VALUE 4096            /* bytes of an attribute after $ substitution */
+#define XML_MAX_PARAMS 256            /* <default> parameters */
+#define XML_MAX_WARN_KINDS 64         /* distinct "not supported" warnings remembered */
+#define XML_SPHERE_RINGS 32
+#define XML_SPHERE_SEGMENTS 64
+#define XML_DISK_SEGMENTS 64
+#define XML_DEFAULT_FOV 45.0f         /* Mitsuba's perspective default (fov_axis x) */
+#define XML_DEFAULT_WIDTH 768         /* Mitsuba's film default */
+#define XML_DEFAULT_HEIGHT 576
+
+/* ---- the tree --------------------------------------------------------------- */
+
+typedef struct xml_file {
+    const char *shown;   /* name in messages */
+    const char *dir;     /* relative file names are resolved against it */
+} xml_file;
+
+typedef struct xattr {
+    const char *name, *value;
+} xattr;
+
+/* One element. Attribute values are kept as written; $name substitution
+ * happens when they are read (attr()). */
+typedef struct xnode {
+    const char *tag;
+    xattr *attrs;
+    int nattrs;
+    struct xnode *parent, *child, *last, *next;
+    const xml_file *file;
+    unsigned long line;
+    int64_t mat;         /* material made of this bsdf, -1 before */
+    bool used;           /* a property that a plugin read */
+    bool busy;           /* a bsdf being converted (reference cycles) */
+} xnode;
+
+typedef struct arena_block {
+    struct arena_block *next;
+    size_t used, cap;
+    _Alignas(16) unsigned char data[];
+} arena_block;
+
+typedef struct id_entry {
+    const char *id;
+    xnode *node;
+} id_entry;
+
+typedef struct xml_param {
+    const char *name, *value;
+} xml_param;
+
+/* One load. */
+typedef struct xp {
+    pk_context *ctx;
+    pk_scene *s;
+    arena_block *arena;
+    /* id -> element, open addressing (a power of two of slots, > 2 * nids) */
+    id_entry *ids;
+    size_t nids, id_slots;
+    xml_param params[XML_MAX_PARAMS];
+    int nparams;
+    int nfiles;
+    size_t nodes;         /* elements read, included files too */
+    int bsdf_depth;
+    /* warnings said once per kind */
+    char warned[XML_MAX_WARN_KINDS][64];
+    int nwarned;
+    /* the sensor's fov needs the film's aspect: kept until the end */
+    const xnode *sensor;
+    float fov;
+    char fov_axis[16];
+    bool has_fov;
+    int film_w, film_h;
+} xp;
+
+/* expat's side of building one tree */
+typedef struct builder {
+    xp *p;
+    XML_Parser parser;
+    const xml_file *file;
+    xnode *root, *cur;
+    int depth;
+    pk_status st;
+} builder;
+
+static void *arena_alloc(xp *p, size_t n)
+{
+    n = (n + 15u) & ~(size_t)15u;
+    arena_block *b = p->arena;
+    if (!b || b->cap - b->used < n) {
+        size_t cap = n > 65536 ? n : 65536;
+        b = mem_alloc(&p->ctx->alloc, sizeof *b + cap);
+        if (!b) return NULL;
+        b->next = p->arena;
+        b->used = 0;
+        b->cap = cap;
+        p->arena = b;
+    }
+    void *r = b->data + b->used;
+    b->used += n;
+    return r;
+}
+
+static char *arena_strndup(xp *p, const char *s, size_t n)
+{
+    char *d = arena_alloc(p, n + 1);
+    if (!d) return NULL;
+    memcpy(d, s, n);
+    d[n] = '\0';
+    return d;
+}
+
+static char *arena_strdup(xp *p, const char *s) { return arena_strndup(p, s, strlen(s)); }
+
+static void arena_free(xp *p)
+{
+    for (arena_block *b = p->arena, *n; b; b = n) {
+        n = b->next;
+        mem_free(&p->ctx->alloc, b);
+    }
+    p->arena = NULL;
+}
+
+/* ---- messages ------------------------------------------------------------------ */
+
+/* Copies in to out (n bytes) with control characters as '?', cut at n - 1. */
+static void shown(char *out, size_t n, const char *in)
+{
+    size_t i = 0;
+    for (; in && in[i] && i + 1 < n; i++) out[i] = ((unsigned char)in[i] < 32 || in[i] == 127) ? '?' : in[i];
+    out[i] = '\0';
+}
+
+static pk_status xfail(xp *p, pk_status st, const xnode *n, const char *fmt, ...) PK_PRINTF(4, 5);
+static pk_status xfail(xp *p, pk_status st, const xnode *n, const char *fmt, ...)
+{
+    char msg[PK_ERRMSG_MAX];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    return ctx_error(p->ctx, st, "%s:%lu: %s", n->file->shown, n->line, msg);
+}
+
+static void xwarn(xp *p, const xnode *n, const char *fmt, ...) PK_PRINTF(3, 4);
+static void xwarn(xp *p, const xnode *n, const char *fmt, ...)
+{
+    char msg[PK_ERRMSG_MAX];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    ctx_warn(p->ctx, "%s:%lu: %s", n->file->shown, n->line, msg);
+}
+
+/* True the first time kind is seen (kinds beyond the table count as seen). */
+static bool first_time(xp *p, const char *kind)
+{
+    char k[64];
+    shown(k, sizeof k, kind);
+    for (int i = 0; i < p->nwarned; i++)
+        if (strcmp(p->warned[i], k) == 0) return false;
+    if (p->nwarned == XML_MAX_WARN_KINDS) return false;
+    memcpy(p->warned[p->nwarned++], k, sizeof k);
+    return true;
+}
+
+/* ---- reading the XML (expat) ------------------------------------------------------ */
+
+static void stop(builder *b, pk_status st)
+{
+    if (b->st == PK_OK) b->st = st;
+    XML_StopParser(b->parser, XML_FALSE);
+}
+
+static void XMLCALL on_start(void *user, const XML_Char *name, const XML_Char **atts)
+{
+    builder *b = user;
+    xp *p = b->p;
+    unsigned long line = (unsigned long)XML_GetCurrentLineNumber(b->parser);
+    if (b->st != PK_OK) return;
+    if (b->depth >= XML_MAX_DEPTH) {
+        ctx_error(p->ctx, PK_ERR_LIMIT, "%s:%lu: elements nested more than %d deep", b->file->shown, line,
+                  XML_MAX_DEPTH);
+        stop(b, PK_ERR_LIMIT);
+        return;
+    }
+    if (p->nodes >= XML_MAX_NODES) {
+        ctx_error(p->ctx, PK_ERR_LIMIT, "%s:%lu: more than %u elements in the scene and its includes",
+                  b->file->shown, line, XML_MAX_NODES);
+        stop(b, PK_ERR_LIMIT);
+        return;
+    }
+    if (!b->cur && b->root) { /* expat refuses a second root itself; never reached */
+        ctx_error(p->ctx, PK_ERR_PARSE, "%s:%lu: a second document element", b->file->shown, line);
+        stop(b, PK_ERR_PARSE);
+        return;
+    }
+    xnode *n = arena_alloc(p, sizeof *n);
+    int na = 0;
+    while (atts[2 * na]) na++;
+    xattr *a = na ? arena_alloc(p, (size_t)na * sizeof *a) : NULL;
+    if (!n || (na && !a)) goto nomem;
+    memset(n, 0, sizeof *n);
+    n->tag = arena_strdup(p, name);
+    if (!n->tag) goto nomem;
+    for (int i = 0; i < na; i++) {
+        a[i].name = arena_strdup(p, atts[2 * i]);
+        a[i].value = arena_strdup(p, atts[2 * i + 1]);
+        if (!a[i].name || !a[i].value) goto nomem;
+    }
+    n->attrs = a;
+    n->nattrs = na;
+    n->file = b->file;
+    n->line = line;
+    n->mat = -1;
+    n->parent = b->cur;
+    if (b->cur) {
+        if (b->cur->last) b->cur->last->next = n;
+        else b->cur->child = n;
+        b->cur->last = n;
+    } else {
+        b->root = n;
+    }
+    b->cur = n;
+    b->depth++;
+    p->nodes++;
+    return;
+nomem:
+    ctx_nomem(p->ctx);
+    stop(b, PK_ERR_NOMEM);
+}
+
+static void XMLCALL on_end(void *user, const XML_Char *name)
+{
+    (void)name;
+    builder *b = user;
+    if (b->st != PK_OK || !b->cur) return;
+    b->cur = b->cur->parent;
+    b->depth--;
+}
+
+/* Document type declarations (and with them entities) are refused: Mitsuba
+ * scenes have none, and entity expansion is how XML files blow up. */
+static void XMLCALL on_doctype(void *user, const XML_Char *name, const XML_Char *sysid, const XML_Char *pubid,
+                               int has_internal)
+{
+    (void)name, (void)sysid, (void)pubid, (void)has_internal;
+    builder *b = user;
+    if (b->st != PK_OK) return;
+    ctx_error(b->p->ctx, PK_ERR_PARSE, "%s:%lu: document type declarations (<!DOCTYPE ...>) are not supported",
+              b->file->shown, (unsigned long)XML_GetCurrentLineNumber(b->parser));
+    stop(b, PK_ERR_PARSE);
+}
+
+/* Parses text into a tree whose root is <scene>. */
+static pk_status parse_tree(xp *p, const char *data, size_t size, const xml_file *file, xnode **root)
+{
+    *root = NULL;
+    if (size > PK_MAX_XML_BYTES || size > (size_t)INT32_MAX)
+        return ctx_error(p->ctx, PK_ERR_LIMIT, "%s: an XML scene may hold at most %zu bytes", file->shown,
+                         (size_t)PK_MAX_XML_BYTES);
+    builder b = {.p = p, .file = file, .st = PK_OK};
+    b.parser = XML_ParserCreate(NULL);
+    if (!b.parser) return ctx_nomem(p->ctx);
+    XML_SetUserData(b.parser, &b);
+    XML_SetElementHandler(b.parser, on_start, on_end);
+    XML_SetStartDoctypeDeclHandler(b.parser, on_doctype);
+    enum XML_Status xs = XML_Parse(b.parser, data, (int)size, XML_TRUE);
+    pk_status st = b.st;
+    if (st == PK_OK && xs != XML_STATUS_OK) {
+        enum XML_Error e = XML_GetErrorCode(b.parser);
+        st = ctx_error(p->ctx, e == XML_ERROR_NO_MEMORY ? PK_ERR_NOMEM : PK_ERR_PARSE, "%s:%lu: malformed XML: %s",
+                       file->shown, (unsigned long)XML_GetCurrentLineNumber(b.parser), XML_ErrorString(e));
+    }
+    XML_ParserFree(b.parser);
+    if (st != PK_OK) return p->ctx->status ? p->ctx->status : st;
+    if (!b.root) return ctx_error(p->ctx, PK_ERR_PARSE, "%s:1: empty document (expected <scene>)", file->shown);
+    if (strcmp(b.root->tag, "scene") != 0)
+        return xfail(p, PK_ERR_PARSE, b.root, "the document element is <%.40s>, expected <scene>", b.root->tag);
+    *root = b.root;
+    return PK_OK;
+}
+
+/* ---- attributes, parameters, ids ------------------------------------------------------ */
+
+static bool is_ident(char c)
+{
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
+}
+
+static const char *param_find(const xp *p, const char *name, size_t n)
+{
+    for (int i = 0; i < p->nparams; i++)
+        if (strlen(p->params[i].name) == n && memcmp(p->params[i].name, name, n) == 0) return p->params[i].value;
+    return NULL;
+}
+
+/* Attribute name of n after $name substitution; NULL when absent or on an
+ * error (latched: *st says which). */
+static const char *attr_st(xp *p, const xnode *n, const char *name, pk_status *st)
+{
+    *st = PK_OK;
+    const char *v = NULL;
+    for (int i = 0; i < n->nattrs; i++)
+        if (strcmp(n->attrs[i].name, name) == 0) v = n->attrs[i].value;
+    if (!v || !strchr(v, '$')) return v;
+    char buf[XML_MAX_VALUE];
+    size_t o = 0;
+    for (const char *c = v; *c;) {
+        if (*c == '$' && is_ident(c[1])) {
+            const char *s = c + 1, *e = s;
+            while (is_ident(*e)) e++;
+            const char *val = param_find(p, s, (size_t)(e - s));
+            if (!val) {
+                char nm[48];
+                shown(nm, sizeof nm, s);
+                nm[e - s < 47 ? e - s : 47] = '\0';
+                *st = xfail(p, PK_ERR_PARSE, n, "%s=\"...$%s...\": no <default name=\"%s\"> defines $%s", name, nm,
+                            nm, nm);
+                return NULL;
+            }
+            size_t l = strlen(val);
+            if (o + l >= sizeof buf) goto too_long;
+            memcpy(buf + o, val, l);
+            o += l;
+            c = e;
+            continue;
+        }
+        if (o + 1 >= sizeof buf) goto too_long;
+        buf[o++] = *c++;
+    }
+    buf[o] = '\0';
+    char *r = arena_strndup(p, buf, o);
+    if (!r) *st = ctx_nomem(p->ctx);
+    return r;
+too_long:
+    *st = xfail(p, PK_ERR_LIMIT, n, "attribute %s is longer than %d bytes after $ substitution", name, XML_MAX_VALUE);
+    return NULL;
+}
+
+static uint64_t hash_str(const char *s)
+{
+    uint64_t h = 1469598103934665603ull;
+    for (; *s; s++) h = (h ^ (unsigned char)*s) * 1099511628211ull;
+    return h;
+}
+
+static xnode *id_find(const xp *p, const char *id)
+{
+    if (!p->id_slots) return NULL;
+    size_t mask = p->id_slots - 1;
+    for (size_t i = (size_t)hash_str(id) & mask;; i = (i + 1) & mask) {
+        if (!p->ids[i].id) return NULL;
+        if (strcmp(p->ids[i].id, id) == 0) return p->ids[i].node;
+    }
+}
+
+/* Registers id for n; a later element with the same id replaces the earlier. */
+static pk_status id_add(xp *p, const char *id, xnode *n)
+{
+    if (2 * (p->nids + 1) >= p->id_slots) {
+        size_t slots = p->id_slots ? 2 * p->id_slots : 64;
+        id_entry *t = mem_calloc(&p->ctx->alloc, slots, sizeof *t);
+        if (!t) return ctx_nomem(p->ctx);
+        for (size_t i = 0; i < p->id_slots; i++) {
+            if (!p->ids[i].id) continue;
+            size_t j = (size_t)hash_str(p->ids[i].id) & (slots - 1);
+            while (t[j].id) j = (j + 1) & (slots - 1);
+            t[j] = p->ids[i];
+        }
+        mem_free(&p->ctx->alloc, p->ids);
+        p->ids = t;
+        p->id_slots = slots;
+    }
+    size_t mask = p->id_slots - 1;
+    for (size_t i = (size_t)hash_str(id) & mask;; i = (i + 1) & mask) {
+        if (!p->ids[i].id) {
+            p->ids[i].id = id;
+            p->ids[i].node = n;
+            p->nids++;
+            return PK_OK;
+        }
+        if (strcmp(p->ids[i].id, id) == 0) {
+            p->ids[i].node = n;
+            return PK_OK;
+        }
+    }
+}
+
+/* Mitsuba 0.x names properties in camelCase (toWorld, intIOR), 2.x and 3.x
+ * in snake_case (to_world, int_ior): both are compared in snake_case. */
+static void snake(char *out, size_t n, const char *in)
+{
+    size_t o = 0;
+    for (size_t i = 0; in[i] && o + 2 < n; i++) {
+        char c = in[i];
+        if (c >= 'A' && c <= 'Z') {
+            if (i > 0 && ((in[i - 1] >= 'a' && in[i - 1] <= 'z') || (in[i - 1] >= '0' && in[i - 1] <= '9')))
+                out[o++] = '_';
+            c = (char)(c - 'A' + 'a');
+        }
+        out[o++] = c;
+    }
+    out[o] = '\0';
+}
+
+static bool name_is(xp *p, const xnode *c, const char *want)
+{
+    pk_status st;
+    const char *nm = attr_st(p, c, "name", &st);
+    if (!nm) return false;
+    char sn[64];
+    snake(sn, sizeof sn, nm);
+    return strcmp(sn, want) == 0;
+}
+
+/* The child of plugin holding property name (snake_case), marked used. */
+static xnode *prop(xp *p, xnode *plugin, const char *name)
+{
+    for (xnode *c = plugin->child; c; c = c->next)
+        if (name_is(p, c, name)) {
+            c->used = true;
+            return c;
+        }
+    return NULL;
+}
+
+/* ---- values ------------------------------------------------------------------------- */
+
+/* Reads up to max numbers separated by blanks and/or commas. */
+static pk_status numbers(xp *p, const xnode *n, const char *what, const char *v, float *out, int max, int *count)
+{
+    int k = 0;
+    const char *c = v, *e = v + strlen(v);
+    for (;;) {
+        while (c < e && (io_is_blank(*c) || *c == ',' || *c == '\n')) c++;
+        if (c == e) break;
+        const char *te = c;
+        while (te < e && !io_is_blank(*te) && *te != ',' && *te != '\n') te++;
+        float f;
+        const char *end = io_parse_float(c, te, &f);
+        if (!end || end != te || k == max) {
+            char sv[48];
+            shown(sv, sizeof sv, v);
+            if (k == max && end == te)
+                return xfail(p, PK_ERR_PARSE, n, "%s: \"%s\" holds more than %d numbers", what, sv, max);
+            return xfail(p, PK_ERR_PARSE, n, "%s: bad number in \"%s\"", what, sv);
+        }
+        if (!isfinite(f)) return xfail(p, PK_ERR_PARSE, n, "%s: numbers must be finite", what);
+        out[k++] = f;
+        c = te;
+    }
+    *count = k;
+    return PK_OK;
+}
+
+static pk_status value_attr(xp *p, const xnode *n, const char **v)
+{
+    pk_status st;
+    *v = attr_st(p, n, "value", &st);
+    if (st) return st;
+    if (!*v) return xfail(p, PK_ERR_PARSE, n, "<%.32s> needs a value attribute", n->tag);
+    return PK_OK;
+}
+
+static pk_status node_float(xp *p, const xnode *n, float *out)
+{
+    const char *v;
+    pk_status st = value_attr(p, n, &v);
+    if (st) return st;
+    int k;
+    float f[2];
+    if ((st = numbers(p, n, n->tag, v, f, 1, &k))) return st;
+    if (k != 1) return xfail(p, PK_ERR_PARSE, n, "<%.32s> needs one number", n->tag);
+    *out = f[0];
+    return PK_OK;
+}
+
+/* A float (or integer) property; absent leaves *out. */
+static pk_status get_float(xp *p, xnode *plugin, const char *name, float *out)
+{
+    xnode *c = prop(p, plugin, name);
+    if (!c) return PK_OK;
+    if (strcmp(c->tag, "float") != 0 && strcmp(c->tag, "integer") != 0)
+        return xfail(p, PK_ERR_PARSE, c, "%s must be a <float>, found <%.32s>", name, c->tag);
+    return node_float(p, c, out);
+}
+
+static pk_status get_int(xp *p, xnode *plugin, const char *name, int64_t *out, bool *found)
+{
+    xnode *c = prop(p, plugin, name);
+    if (found) *found = c != NULL;
+    if (!c) return PK_OK;
+    const char *v;
+    pk_status st = value_attr(p, c, &v);
+    if (st) return st;
+    const char *s = v, *e = v + strlen(v);
+    while (s < e && io_is_blank(*s)) s++;
+    while (e > s && io_is_blank(e[-1])) e--;
+    const char *end = io_parse_int(s, e, out);
+    if (!end || end != e || s == e) {
+        char sv[48];
+        shown(sv, sizeof sv, v);
+        return xfail(p, PK_ERR_PARSE, c, "%s: \"%s\" is not an integer", name, sv);
+    }
+    return PK_OK;
+}
+
+static pk_status get_bool(xp *p, xnode *plugin, const char *name, bool *out)
+{
+    xnode *c = prop(p, plugin, name);
+    if (!c) return PK_OK;
+    const char *v;
+    pk_status st = value_attr(p, c, &v);
+    if (st) return st;
+    if (strcmp(v, "true") == 0) *out = true;
+    else if (strcmp(v, "false") == 0) *out = false;
+    else {
+        char sv[48];
+        shown(sv, sizeof sv, v);
+        return xfail(p, PK_ERR_PARSE, c, "%s: \"%s\" is not true or false", name, sv);
+    }
+    return PK_OK;
+}
+
+static pk_status get_string(xp *p, xnode *plugin, const char *name, const char **out, xnode **at)
+{
+    xnode *c = prop(p, plugin, name);
+    if (at) *at = c;
+    if (!c) return PK_OK;
+    return value_attr(p, c, out);
+}
+
+/* A <point> or <vector>: x, y, z attributes (0 when absent) or value. */
+static pk_status node_vec(xp *p, const xnode *n, vec3 *out)
+{
+    pk_status st;
+    const char *v = attr_st(p, n, "value", &st);
+    if (st) return st;
+    float f[3] = {0.0f, 0.0f, 0.0f};
+    if (v) {
+        int k;
+        if ((st = numbers(p, n, n->tag, v, f, 3, &k))) return st;
+        if (k == 1) f[1] = f[2] = f[0];
+        else if (k != 3) return xfail(p, PK_ERR_PARSE, n, "<%.32s> needs 1 or 3 numbers", n->tag);
+    } else {
+        static const char *const xyz[3] = {"x", "y", "z"};
+        for (int i = 0; i < 3; i++) {
+            const char *a = attr_st(p, n, xyz[i], &st);
+            if (st) return st;
+            if (!a) continue;
+            int k;
+            if ((st = numbers(p, n, xyz[i], a, &f[i], 1, &k))) return st;
+            if (k != 1) return xfail(p, PK_ERR_PARSE, n, "%s needs one number", xyz[i]);
+        }
+    }
+    *out = v3(f[0], f[1], f[2]);
+    return PK_OK;
+}
+
+static pk_status get_vec(xp *p, xnode *plugin, const char *name, vec3 *out, bool *found)
+{
+    xnode *c = prop(p, plugin, name);
+    if (found) *found = c != NULL;
+    if (!c) return PK_OK;
+    if (strcmp(c->tag, "point") != 0 && strcmp(c->tag, "vector") != 0)
+        return xfail(p, PK_ERR_PARSE, c, "%s must be a <point> or <vector>, found <%.32s>", name, c->tag);
+    return node_vec(p, c, out);
+}
+
+/* ---- colours and spectra ------------------------------------------------------------------ */
+
+static float srgb_to_linear(float c)
+{
+    return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
+}
+
+/* CIE 1931 colour matching functions, the multi-lobe Gaussian fit of Wyman,
+ * Sloan and Shirley (2013). */
+static float gauss_lobe(float x, float mu, float s1, float s2)
+{
+    float t = (x - mu) / (x < mu ? s1 : s2);
+    return expf(-0.5f * t * t);
+}
+
+static void cie_xyz(float nm, float *x, float *y, float *z)
+{
+    *x = 1.056f * gauss_lobe(nm, 599.8f, 37.9f, 31.0f) + 0.362f * gauss_lobe(nm, 442.0f, 16.0f, 26.7f) -
+         0.065f * gauss_lobe(nm, 501.1f, 20.4f, 26.2f);
+    *y = 0.821f * gauss_lobe(nm, 568.8f, 46.9f, 40.5f) + 0.286f * gauss_lobe(nm, 530.9f, 16.3f, 31.1f);
+    *z = 1.217f * gauss_lobe(nm, 437.0f, 11.8f, 36.0f) + 0.681f * gauss_lobe(nm, 459.0f, 26.0f, 13.8f);
+}
+
+/* Linear sRGB of a spectrum given as samples (nm ascending, value), linear
+ * between them and constant beyond: XYZ by the colour matching functions
+ * over 360..830 nm, then the sRGB matrix, divided per channel by what a
+ * constant spectrum of 1 gives, so that a flat reflectance of r is grey r. */
+static vec3 spectrum_to_rgb(const float *nm, const float *val, int n)
+{
+    double X = 0, Y = 0, Z = 0, X1 = 0, Y1 = 0, Z1 = 0;
+    int j = 0;
+    for (float l = 360.0f; l <= 830.0f; l += 1.0f) {
+        while (j + 1 < n && nm[j + 1] < l) j++;
+        float v;
+        if (l <= nm[0]) v = val[0];
+        else if (l >= nm[n - 1]) v = val[n - 1];
+        else {
+            float t = (l - nm[j]) / (nm[j + 1] - nm[j]);
+            v = val[j] + t * (val[j + 1] - val[j]);
+        }
+        float x, y, z;
+        cie_xyz(l, &x, &y, &z);
+        X += (double)(x * v), Y += (double)(y * v), Z += (double)(z * v);
+        X1 += (double)x, Y1 += (double)y, Z1 += (double)z;
+    }
+    const double m[9] = {3.2404542, -1.5371385, -0.4985314, -0.9692660, 1.8760108,
+                         0.0415560, 0.0556434,  -0.2040259, 1.0572252};
+    double c[3], w[3];
+    for (int i = 0; i < 3; i++) {
+        c[i] = m[3 * i] * X + m[3 * i + 1] * Y + m[3 * i + 2] * Z;
+        w[i] = m[3 * i] * X1 + m[3 * i + 1] * Y1 + m[3 * i + 2] * Z1;
+    }
+    return v3((float)fmax(c[0] / w[0], 0.0), (float)fmax(c[1] / w[1], 0.0), (float)fmax(c[2] / w[2], 0.0));
+}
+
+/* <spectrum value="..."/>: one number (grey), three numbers (RGB, as
+ * Mitsuba 0.x's RGB mode reads them) or wavelength:value pairs. */
+static pk_status node_spectrum(xp *p, const xnode *n, vec3 *out)
+{
+    pk_status st;
+    const char *v = attr_st(p, n, "value", &st);
+    if (st) return st;
+    if (!v) {
+        const char *f = attr_st(p, n, "filename", &st);
+        if (st) return st;
+        if (f) {
+            xwarn(p, n, "spectrum files are not supported; using grey 0.5");
+            *out = v3s(0.5f);
+            return PK_OK;
+        }
+        return xfail(p, PK_ERR_PARSE, n, "<spectrum> needs a value attribute");
+    }
+    if (!strchr(v, ':')) {
+        float f[3];
+        int k;
+        if ((st = numbers(p, n, "spectrum", v, f, 3, &k))) return st;
+        if (k == 1) *out = v3s(f[0]);
+        else if (k == 3) *out = v3(f[0], f[1], f[2]);
+        else return xfail(p, PK_ERR_PARSE, n, "<spectrum> needs 1 or 3 numbers or wavelength:value pairs");
+        return PK_OK;
+    }
+    enum { MAX_SAMPLES = 256 };
+    float nm[MAX_SAMPLES], val[MAX_SAMPLES];
+    int k = 0;
+    const char *c = v, *e = v + strlen(v);
+    for (;;) {
+        while (c < e && (io_is_blank(*c) || *c == ',' || *c == '\n')) c++;
+        if (c == e) break;
+        if (k == MAX_SAMPLES) return xfail(p, PK_ERR_LIMIT, n, "<spectrum> holds more than %d samples", MAX_SAMPLES);
+        const char *q = io_parse_float(c, e, &nm[k]);
+        if (!q || q == e || *q != ':') goto bad;
+        q = io_parse_float(q + 1, e, &val[k]);
+        if (!q || (q < e && !io_is_blank(*q) && *q != ',' && *q != '\n')) goto bad;
+        if (!isfinite(nm[k]) || !isfinite(val[k]) || (k > 0 && !(nm[k] > nm[k - 1])))
+            return xfail(p, PK_ERR_PARSE, n, "<spectrum> wavelengths must be finite and increasing");
+        k++;
+        c = q;
+    }
+    if (k == 0) goto bad;
+    *out = spectrum_to_rgb(nm, val, k);
+    return PK_OK;
+bad:;
+    char sv[48];
+    shown(sv, sizeof sv, v);
+    return xfail(p, PK_ERR_PARSE, n, "<spectrum> \"%s\": expected wavelength:value pairs", sv);
+}
+
+static int hexval(char c)
+{
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return -1;
+}
+
+/* <blackbody temperature="5000K" scale=/>: Planck's spectral radiance of
+ * that temperature in W m^-2 sr^-1 nm^-1, reduced to RGB like a spectrum. */
+static pk_status node_blackbody(xp *p, const xnode *n, vec3 *out)
+{
+    pk_status st;
+    const char *t = attr_st(p, n, "temperature", &st);
+    if (st) return st;
+    if (!t) return xfail(p, PK_ERR_PARSE, n, "<blackbody> needs a temperature");
+    const char *e = t + strlen(t);
+    while (e > t && (io_is_blank(e[-1]) || e[-1] == 'K' || e[-1] == 'k')) e--;
+    float kelvin, scale = 1.0f;
+    const char *q = io_parse_float(t, e, &kelvin);
+    if (!q || q != e || !(kelvin > 0.0f) || !isfinite(kelvin))
+        return xfail(p, PK_ERR_PARSE, n, "<blackbody> temperature must be a positive number of kelvins");
+    const char *sc = attr_st(p, n, "scale", &st);
+    if (st) return st;
+    if (sc) {
+        int k;
+        if ((st = numbers(p, n, "scale", sc, &scale, 1, &k))) return st;
+    }
+    enum { N = 95 };
+    float nm[N], val[N];
+    for (int i = 0; i < N; i++) {
+        double l = (360.0 + 5.0 * i) * 1e-9, h = 6.62607015e-34, c = 299792458.0, kb = 1.380649e-23;
+        double b = 2.0 * h * c * c / (l * l * l * l * l) / expm1(h * c / (l * kb * (double)kelvin));
+        nm[i] = (float)(360.0 + 5.0 * i);
+        val[i] = (float)(b * 1e-9); /* per metre -> per nanometre */
+    }
+    *out = v3_scale(spectrum_to_rgb(nm, val, N), scale);
+    if (!v3_finite(*out)) return xfail(p, PK_ERR_PARSE, n, "<blackbody> radiance is not finite");
+    return PK_OK;
+}
+
+/* <rgb>, <srgb>, <spectrum>, <blackbody>, <float> as a colour. */
+static pk_status node_color(xp *p, const xnode *n, vec3 *out)
+{
+    pk_status st;
+    if (strcmp(n->tag, "spectrum") == 0) return node_spectrum(p, n, out);
+    if (strcmp(n->tag, "blackbody") == 0) return node_blackbody(p, n, out);
+    if (strcmp(n->tag, "float") == 0 || strcmp(n->tag, "integer") == 0) {
+        float f;
+        if ((st = node_float(p, n, &f))) return st;
+        *out = v3s(f);
+        return PK_OK;
+    }
+    bool srgb = strcmp(n->tag, "srgb") == 0;
+    if (!srgb && strcmp(n->tag, "rgb") != 0)
+        return xfail(p, PK_ERR_PARSE, n, "a colour must be <rgb>, <srgb>, <spectrum> or <float>, found <%.32s>",
+                     n->tag);
+    const char *v;
+    if ((st = value_attr(p, n, &v))) return st;
+    float f[3];
+    int k;
+    if (srgb && v[0] == '#') {
+        size_t l = strlen(v);
+        if (l != 7) return xfail(p, PK_ERR_PARSE, n, "<srgb> \"#rrggbb\" needs six hexadecimal digits");
+        for (int i = 0; i < 3; i++) {
+            int hi = hexval(v[1 + 2 * i]), lo = hexval(v[2 + 2 * i]);
+            if (hi < 0 || lo < 0) return xfail(p, PK_ERR_PARSE, n, "<srgb> \"#rrggbb\" needs six hexadecimal digits");
+            f[i] = (float)(hi * 16 + lo) / 255.0f;
+        }
+        k = 3;
+    } else if ((st = numbers(p, n, n->tag, v, f, 3, &k))) {
+        return st;
+    }
+    if (k == 1) f[1] = f[2] = f[0];
+    else if (k != 3) return xfail(p, PK_ERR_PARSE, n, "<%s> needs 1 or 3 numbers", n->tag);
+    if (srgb)
+        for (int i = 0; i < 3; i++) f[i] = srgb_to_linear(f[i]);
+    *out = v3(f[0], f[1], f[2]);
+    return PK_OK;
+}
+
+/* ---- textures: the one place they enter ----------------------------------------------- */
+
+/* Every textured parameter comes here. file is the bitmap's file resolved
+ * against the XML file's folder (NULL for procedural textures), fallback
+ * the constant that stands in for it. Textures are not rendered yet: the
+ * constant is used, with a warning. */
+static pk_status texture_param(xp *p, const xnode *tex, const char *param, const char *file, vec3 fallback,
+                               vec3 *out)
+{
+    (void)file;
+    char what[64];
+    shown(what, sizeof what, param);
+    xwarn(p, tex, "textures are not supported yet; using the constant colour %g %g %g for %s",
+          (double)fallback.x, (double)fallback.y, (double)fallback.z, what);
+    *out = fallback;
+    return PK_OK;
+}
+
+static pk_status texture_value(xp *p, xnode *tex, const char *param, vec3 fallback, vec3 *out, int depth);
+
+/* A texture element: bitmap (file name resolved), checkerboard (the mean
+ * of its two colours), scale (the scaled nested texture); others give
+ * fallback. */
+static pk_status texture_value(xp *p, xnode *tex, const char *param, vec3 fallback, vec3 *out, int depth)
+{
+    pk_status st;
+    if (depth > XML_MAX_BSDF_DEPTH) return xfail(p, PK_ERR_LIMIT, tex, "textures nested too deep");
+    if (strcmp(tex->tag, "ref") == 0) {
+        const char *id = attr_st(p, tex, "id", &st);
+        if (st) return st;
+        xnode *t = id ? id_find(p, id) : NULL;
+        if (!t || strcmp(t->tag, "texture") != 0) {
+            char sid[48];
+            shown(sid, sizeof sid, id ? id : "");
+            return xfail(p, PK_ERR_PARSE, tex, "no texture has the id \"%s\"", sid);
+        }
+        if (t->busy) return xfail(p, PK_ERR_PARSE, tex, "reference cycle through texture \"%.40s\"", id);
+        t->busy = true;
+        st = texture_value(p, t, param, fallback, out, depth + 1);
+        t->busy = false;
+        return st;
+    }
+    const char *type = attr_st(p, tex, "type", &st);
+    if (st) return st;
+    if (!type) return xfail(p, PK_ERR_PARSE, tex, "<texture> needs a type");
+    for (xnode *c = tex->child; c; c = c->next) c->used = true; /* texture options are the texture system's */
+    if (strcmp(type, "bitmap") == 0) {
+        const char *fn = NULL;
+        xnode *at;
+        if ((st = get_string(p, tex, "filename", &fn, &at))) return st;
+        if (!fn) return xfail(p, PK_ERR_PARSE, tex, "bitmap texture needs a filename");
+        char *full = path_join(&p->ctx->alloc, tex->file->dir, fn);
+        if (!full) return ctx_nomem(p->ctx);
+        st = texture_param(p, tex, param, full, fallback, out);
+        mem_free(&p->ctx->alloc, full);
+        return st;
+    }
+    if (strcmp(type, "checkerboard") == 0) {
+        vec3 c0 = v3s(0.4f), c1 = v3s(0.2f);
+        xnode *a = prop(p, tex, "color0"), *b = prop(p, tex, "color1");
+        if (a && (st = node_color(p, a, &c0))) return st;
+        if (b && (st = node_color(p, b, &c1))) return st;
+        return texture_param(p, tex, param, NULL, v3_scale(v3_add(c0, c1), 0.5f), out);
+    }
+    if (strcmp(type, "scale") == 0) {
+        float scale = 1.0f;
+        if ((st = get_float(p, tex, "scale", &scale))) return st;
+        for (xnode *c = tex->child; c; c = c->next)
+            if (strcmp(c->tag, "texture") == 0 || strcmp(c->tag, "ref") == 0) {
+                if ((st = texture_value(p, c, param, fallback, out, depth + 1))) return st;
+                *out = v3_scale(*out, scale);
+                return PK_OK;
+            }
+        *out = v3_scale(fallback, scale);
+        return PK_OK;
+    }
+    char ty[40];
+    shown(ty, sizeof ty, type);
+    xwarn(p, tex, "texture type \"%s\" is not supported; using the constant %g %g %g", ty, (double)fallback.x,
+          (double)fallback.y, (double)fallback.z);
+    *out = fallback;
+    return PK_OK;
+}
+
+/* A colour property: absent leaves *out (the default); a texture goes
+ * through texture_value with *out as its stand-in. */
+static pk_status get_color(xp *p, xnode *plugin, const char *name, vec3 *out)
+{
+    xnode *c = prop(p, plugin, name);
+    if (!c) return PK_OK;
+    if (strcmp(c->tag, "texture") == 0 || strcmp(c->tag, "ref") == 0) return texture_value(p, c, name, *out, out, 0);
+    pk_status st = node_color(p, c, out);
+    if (st == PK_OK && !v3_finite(*out)) return xfail(p, PK_ERR_PARSE, c, "%s is not finite", name);
+    return st;
+}
+
+/* A scalar property that may be a texture (roughness, opacity). */
+static pk_status get_scalar(xp *p, xnode *plugin, const char *name, float *out)
+{
+    xnode *c = prop(p, plugin, name);
+    if (!c) return PK_OK;
+    vec3 v = v3s(*out);
+    pk_status st;
+    if (strcmp(c->tag, "texture") == 0 || strcmp(c->tag, "ref") == 0) st = texture_value(p, c, name, v, &v, 0);
+    else st = node_color(p, c, &v);
+    if (st) return st;
+    *out = (v.x + v.y + v.z) / 3.0f;
+    return PK_OK;
+}
+
+/* ---- transforms ---------------------------------------------------------------------------- */
+
+static void m_identity(float m[16])
+{
+    for (int i = 0; i < 16; i++) m[i] = (i % 5 == 0) ? 1.0f : 0.0f;
+}
+
+static void m_mul(const float a[16], const float b[16], float out[16])
+{
+    double r[16];
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++) {
+            double sum = 0.0;
+            for (int k = 0; k < 4; k++) sum += (double)a[i * 4 + k] * (double)b[k * 4 + j];
+            r[i * 4 + j] = sum;
+        }
+    for (int i = 0; i < 16; i++) out[i] = (float)r[i];
+}
+
+static vec3 m_point(const float m[16], vec3 p)
+{
+    return v3(m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3], m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7],
+              m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]);
+}
+
+static vec3 m_dir(const float m[16], vec3 d)
+{
+    return v3(m[0] * d.x + m[1] * d.y + m[2] * d.z, m[4] * d.x + m[5] * d.y + m[6] * d.z,
+              m[8] * d.x + m[9] * d.y + m[10] * d.z);
+}
+
+static double m_det3(const float m[16])
+{
+    double a = m[0], b = m[1], c = m[2], d = m[4], e = m[5], f = m[6], g = m[8], h = m[9], i = m[10];
+    return a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g);
+}
+
+/* Right-handed rotation by deg degrees about axis (not zero). */
+static void m_rotate(vec3 axis, float deg, float r[16])
+{
+    m_identity(r);
+    vec3 ax = v3_norm_scaled(axis);
+    float rad = deg * (PK_PI / 180.0f), c = cosf(rad), sn = sinf(rad), k = 1.0f - c;
+    r[0] = k * ax.x * ax.x + c, r[1] = k * ax.x * ax.y - sn * ax.z, r[2] = k * ax.x * ax.z + sn * ax.y;
+    r[4] = k * ax.x * ax.y + sn * ax.z, r[5] = k * ax.y * ax.y + c, r[6] = k * ax.y * ax.z - sn * ax.x;
+    r[8] = k * ax.x * ax.z - sn * ax.y, r[9] = k * ax.y * ax.z + sn * ax.x, r[10] = k * ax.z * ax.z + c;
+}
+
+/* An attribute holding 3 numbers (origin="x, y, z"). */
+static pk_status attr_vec3(xp *p, const xnode *n, const char *name, vec3 *out, bool *found)
+{
+    pk_status st;
+    const char *v = attr_st(p, n, name, &st);
+    if (st) return st;
+    *found = v != NULL;
+    if (!v) return PK_OK;
+    float f[3];
+    int k;
+    if ((st = numbers(p, n, name, v, f, 3, &k))) return st;
+    if (k != 3) return xfail(p, PK_ERR_PARSE, n, "%s needs 3 numbers", name);
+    *out = v3(f[0], f[1], f[2]);
+    return PK_OK;
+}
+
+/* x, y, z attributes each defaulting to def, or value (1 or 3 numbers). */
+static pk_status attr_xyz(xp *p, const xnode *n, float def, vec3 *out)
+{
+    pk_status st;
+    const char *v = attr_st(p, n, "value", &st);
+    if (st) return st;
+    if (v) {
+        float f[3];
+        int k;
+        if ((st = numbers(p, n, "value", v, f, 3, &k))) return st;
+        if (k == 1) *out = v3s(f[0]);
+        else if (k == 3) *out = v3(f[0], f[1], f[2]);
+        else return xfail(p, PK_ERR_PARSE, n, "<%.32s value> needs 1 or 3 numbers", n->tag);
+        return PK_OK;
+    }
+    float f[3] = {def, def, def};
+    static const char *const xyz[3] = {"x", "y", "z"};
+    for (int i = 0; i < 3; i++) {
+        const char *a = attr_st(p, n, xyz[i], &st);
+        if (st) return st;
+        if (!a) continue;
+        int k;
+        if ((st = numbers(p, n, xyz[i], a, &f[i], 1, &k))) return st;
+        if (k != 1) return xfail(p, PK_ERR_PARSE, n, "%s needs one number", xyz[i]);
+    }
+    *out = v3(f[0], f[1], f[2]);
+    return PK_OK;
+}
+
+/* <transform>: its elements applied in order, each one after (to the left
+ * of) those before, as Mitsuba composes them. */
+static pk_status parse_transform(xp *p, xnode *t, float m[16])
+{
+    pk_status st;
+    m_identity(m);
+    if (strcmp(t->tag, "transform") != 0)
+        return xfail(p, PK_ERR_PARSE, t, "expected a <transform>, found <%.32s>", t->tag);
+    for (xnode *c = t->child; c; c = c->next) {
+        float e[16];
+        m_identity(e);
+        if (strcmp(c->tag, "matrix") == 0) {
+            const char *v;
+            if ((st = value_attr(p, c, &v))) return st;
+            float f[16];
+            int k;
+            if ((st = numbers(p, c, "matrix", v, f, 16, &k))) return st;
+            if (k == 16) {
+                memcpy(e, f, sizeof e);
+                if (e[12] != 0.0f || e[13] != 0.0f || e[14] != 0.0f || e[15] != 1.0f)
+                    return xfail(p, PK_ERR_PARSE, c, "matrix: projective matrices are not supported (last row must "
+                                                    "be 0 0 0 1)");
+            } else if (k == 9) {
+                for (int i = 0; i < 3; i++)
+                    for (int j = 0; j < 3; j++) e[4 * i + j] = f[3 * i + j];
+            } else {
+                return xfail(p, PK_ERR_PARSE, c, "matrix needs 16 (or 9) numbers, found %d", k);
+            }
+        } else if (strcmp(c->tag, "translate") == 0) {
+            vec3 d;
+            if ((st = attr_xyz(p, c, 0.0f, &d))) return st;
+            e[3] = d.x, e[7] = d.y, e[11] = d.z;
+        } else if (strcmp(c->tag, "scale") == 0) {
+            vec3 d;
+            if ((st = attr_xyz(p, c, 1.0f, &d))) return st;
+            e[0] = d.x, e[5] = d.y, e[10] = d.z;
+        } else if (strcmp(c->tag, "rotate") == 0) {
+            vec3 axis;
+            float angle = 0.0f;
+            const char *a = attr_st(p, c, "angle", &st);
+            if (st) return st;
+            if (a) {
+                int k;
+                if ((st = numbers(p, c, "angle", a, &angle, 1, &k))) return st;
+                if (k != 1) return xfail(p, PK_ERR_PARSE, c, "angle needs one number");
+            }
+            if ((st = attr_xyz(p, c, 0.0f, &axis))) return st;
+            if (!(v3_len2(axis) > 0.0f)) return xfail(p, PK_ERR_PARSE, c, "rotate: the axis must not be zero");
+            m_rotate(axis, angle, e);
+        } else if (strcmp(c->tag, "lookat") == 0 || strcmp(c->tag, "lookAt") == 0) {
+            vec3 o = v3s(0.0f), tg = v3(0.0f, 0.0f, 1.0f), up = v3(0.0f, 1.0f, 0.0f);
+            bool has_o, has_t, has_up;
+            if ((st = attr_vec3(p, c, "origin", &o, &has_o))) return st;
+            if ((st = attr_vec3(p, c, "target", &tg, &has_t))) return st;
+            if ((st = attr_vec3(p, c, "up", &up, &has_up))) return st;
+            if (!has_o || !has_t) return xfail(p, PK_ERR_PARSE, c, "lookat needs origin and target");
+            vec3 dir = v3_sub(tg, o);
+            if (!(v3_len2(dir) > 0.0f) || !v3_finite(dir))
+                return xfail(p, PK_ERR_PARSE, c, "lookat: origin and target are the same point");
+            dir = v3_norm_scaled(dir);
+            vec3 left = v3_cross(v3_norm_scaled(up), dir);
+            if (!(v3_len(left) > 1e-4f)) {
+                if (has_up) return xfail(p, PK_ERR_PARSE, c, "lookat: up is zero or parallel to the view direction");
+                left = v3_cross(v3(0.0f, 0.0f, 1.0f), dir); /* looking along y */
+            }
+            left = v3_norm(left);
+            vec3 nup = v3_cross(dir, left);
+            e[0] = left.x, e[4] = left.y, e[8] = left.z;
+            e[1] = nup.x, e[5] = nup.y, e[9] = nup.z;
+            e[2] = dir.x, e[6] = dir.y, e[10] = dir.z;
+            e[3] = o.x, e[7] = o.y, e[11] = o.z;
+        } else {
+            char tg[40];
+            shown(tg, sizeof tg, c->tag);
+            xwarn(p, c, "<%s> in a transform is not supported; ignored", tg);
+            continue;
+        }
+        m_mul(e, m, m);
+    }
+    for (int i = 0; i < 16; i++)
+        if (!isfinite(m[i])) return xfail(p, PK_ERR_PARSE, t, "the transform is not finite");
+    return PK_OK;
+}
+
+/* The to_world of a plugin (identity when absent); *found says whether given. */
+static pk_status get_to_world(xp *p, xnode *plugin, float m[16], bool *found)
+{
+    m_identity(m);
+    xnode *t = prop(p, plugin, "to_world");
+    if (found) *found = t != NULL;
+    if (!t) return PK_OK;
+    return parse_transform(p, t, m);
+}
+
+/* ---- materials ------------------------------------------------------------------------------- */
+
+typedef struct metal {
+    const char *name;
+    float eta[3], k[3];
+} metal;
+
+/* Complex indices of refraction of a few metals at the red, green and blue
+ * primaries (docs/scene-format.md); the names of Mitsuba's material table. */
+static const metal metals[] = {
+    {"Cu", {0.200438f, 0.924033f, 1.10221f}, {3.91295f, 2.45285f, 2.14219f}},
+    {"Au", {0.143119f, 0.374957f, 1.44248f}, {3.98316f, 2.38572f, 1.60322f}},
+    {"Ag", {0.155265f, 0.116723f, 0.138342f}, {4.82835f, 3.12225f, 2.14696f}},
+    {"Al", {1.65746f, 0.880369f, 0.521229f}, {9.22387f, 6.26952f, 4.837f}},
+    {"Cr", {4.36968f, 2.9167f, 1.6547f}, {5.20643f, 4.23136f, 3.75495f}},
+};
+
+typedef struct ior_name {
+    const char *name;
+    float ior;
+} ior_name;
+
+/* Mitsuba's named indices of refraction. */
+static const ior_name iors[] = {
+    {"vacuum", 1.0f},         {"helium", 1.000036f},     {"hydrogen", 1.000132f},     {"air", 1.000277f},
+    {"carbon dioxide", 1.00045f}, {"water", 1.3330f},    {"acetone", 1.36f},          {"ethanol", 1.361f},
+    {"carbon tetrachloride", 1.461f}, {"glycerol", 1.4729f}, {"benzene", 1.501f},     {"silicone oil", 1.52045f},
+    {"bromine", 1.661f},      {"water ice", 1.31f},      {"fused quartz", 1.458f},    {"pyrex", 1.470f},
+    {"acrylic glass", 1.49f}, {"polypropylene", 1.49f},  {"bk7", 1.5046f},            {"sodium chloride", 1.544f},
+    {"amber", 1.55f},         {"pet", 1.5750f},          {"diamond", 2.419f},
+};
+
+/* An index of refraction: a number or one of Mitsuba's names. */
+static pk_status get_ior(xp *p, xnode *plugin, const char *name, float *out)
+{
+    xnode *c = prop(p, plugin, name);
+    if (!c) return PK_OK;
+    pk_status st;
+    if (strcmp(c->tag, "string") == 0) {
+        const char *v;
+        if ((st = value_attr(p, c, &v))) return st;
+        for (size_t i = 0; i < sizeof iors / sizeof iors[0]; i++)
+            if (strcmp(iors[i].name, v) == 0) {
+                *out = iors[i].ior;
+                return PK_OK;
+            }
+        float f;
+        const char *e = v + strlen(v);
+        if (io_parse_float(v, e, &f) == e && f > 0.0f && isfinite(f)) { /* a number written as a string */
+            *out = f;
+            return PK_OK;
+        }
+        char sv[48];
+        shown(sv, sizeof sv, v);
+        return xfail(p, PK_ERR_PARSE, c, "%s: unknown material \"%s\"", name, sv);
+    }
+    if ((st = node_float(p, c, out))) return st;
+    if (!(*out > 0.0f)) return xfail(p, PK_ERR_PARSE, c, "%s must be positive", name);
+    return PK_OK;
+}
+
+static float f0_dielectric(float ior)
+{
+    float r = (ior - 1.0f) / (ior + 1.0f);
+    return r * r;
+}
+
+static float ns_from_alpha(float alpha) { return alpha < 1e-3f ? 1000.0f : fmaxf(2.0f / (alpha * alpha) - 2.0f, 0.0f); }
+
+static float clamp01(float x) { return x > 0.0f ? (x < 1.0f ? x : 1.0f) : 0.0f; }
+static vec3 clamp01v(vec3 c) { return v3(clamp01(c.x), clamp01(c.y), clamp01(c.z)); }
+
+/* roughness of the rough* plugins: alpha, or alpha_u/alpha_v (averaged). */
+static pk_status get_alpha(xp *p, xnode *b, float def, float *alpha)
+{
+    pk_status st;
+    float a = def, au = -1.0f, av = -1.0f;
+    if ((st = get_scalar(p, b, "alpha", &a))) return st;
+    xnode *cu = prop(p, b, "alpha_u"), *cv = prop(p, b, "alpha_v");
+    if (cu || cv) {
+        au = av = a;
+        if ((st = get_scalar(p, b, "alpha_u", &au))) return st;
+        if ((st = get_scalar(p, b, "alpha_v", &av))) return st;
+        if (au != av) xwarn(p, b, "anisotropic roughness is not supported; using alpha %g", (double)(0.5f * (au + av)));
+        a = 0.5f * (au + av);
+    }
+    const char *dist = NULL;
+    if ((st = get_string(p, b, "distribution", &dist, NULL))) return st;
+    /* beckmann and phong are rendered as GGX of the same alpha (docs) */
+    *alpha = clamp01(a);
+    return PK_OK;
+}
+
+static pk_status bsdf_material(xp *p, xnode *b, material *m);
+
+/* The nested bsdf of a wrapper (its first <bsdf> or <ref> child). */
+static xnode *nested_bsdf(xp *p, xnode *b)
+{
+    for (xnode *c = b->child; c; c = c->next)
+        if (strcmp(c->tag, "bsdf") == 0 || (strcmp(c->tag, "ref") == 0 && !attr_st(p, c, "name", &(pk_status){0}))) {
+            c->used = true;
+            return c;
+        }
+    return NULL;
+}
+
+/* Converts the bsdf (or <ref> to one) n into *m. */
+static pk_status bsdf_resolve(xp *p, xnode *n, material *m)
+{
+    pk_status st;
+    if (strcmp(n->tag, "ref") == 0) {
+        const char *id = attr_st(p, n, "id", &st);
+        if (st) return st;
+        if (!id) return xfail(p, PK_ERR_PARSE, n, "<ref> needs an id");
+        xnode *t = id_find(p, id);
+        if (!t || strcmp(t->tag, "bsdf") != 0) {
+            char sid[48];
+            shown(sid, sizeof sid, id);
+            return xfail(p, PK_ERR_PARSE, n, "no bsdf has the id \"%s\"%s", sid, t ? "" : " (defined before here)");
+        }
+        n = t;
+    }
+    if (n->busy) return xfail(p, PK_ERR_PARSE, n, "reference cycle through this bsdf");
+    if (p->bsdf_depth >= XML_MAX_BSDF_DEPTH)
+        return xfail(p, PK_ERR_LIMIT, n, "bsdfs nested more than %d deep", XML_MAX_BSDF_DEPTH);
+    n->busy = true;
+    p->bsdf_depth++;
+    st = bsdf_material(p, n, m);
+    p->bsdf_depth--;
+    n->busy = false;
+    return st;
+}
+
+static void warn_unused(xp *p, xnode *plugin, const char *kind, const char *const *quiet);
+
+/* Fills *m (material_init'ed, name unset) from the bsdf element b. */
+static pk_status bsdf_material(xp *p, xnode *b, material *m)
+{
+    pk_status st;
+    const char *type = attr_st(p, b, "type", &st);
+    if (st) return st;
+    if (!type) return xfail(p, PK_ERR_PARSE, b, "<bsdf> needs a type");
+    material_init(m);
+    char ty[40];
+    shown(ty, sizeof ty, type);
+    static const char *const quiet[] = {"ext_ior", "ext_eta", "nonlinear", "distribution", "sample_visible", NULL};
+
+    if (strcmp(type, "twosided") == 0) {
+        /* one-sided materials are shaded from either side already (the
+         * shading normal faces the viewer); only emission is one-sided */
+        xnode *inner = nested_bsdf(p, b);
+        if (!inner) return xfail(p, PK_ERR_PARSE, b, "twosided needs a nested bsdf");
+        for (xnode *c = inner->next; c; c = c->next)
+            if (strcmp(c->tag, "bsdf") == 0) {
+                xwarn(p, c, "twosided with a second bsdf for the back side is not supported; the front one is "
+                            "used on both");
+                c->used = true;
+                break;
+            }
+        return bsdf_resolve(p, inner, m);
+    }
+    if (strcmp(type, "mask") == 0) {
+        xnode *inner = nested_bsdf(p, b);
+        float opacity = 0.5f;
+        if ((st = get_scalar(p, b, "opacity", &opacity))) return st;
+        if (inner) {
+            if ((st = bsdf_resolve(p, inner, m))) return st;
+        } else {
+            m->type = MAT_DIFFUSE;
+            m->kd = v3s(0.5f);
+        }
+        if (m->type != MAT_DIELECTRIC) m->d = clamp01(opacity);
+        warn_unused(p, b, "mask", quiet);
+        return PK_OK;
+    }
+    if (strcmp(type, "coating") == 0 || strcmp(type, "roughcoating") == 0) {
+        /* a dielectric coat over a diffuse base is Paprsek's plastic */
+        xnode *inner = nested_bsdf(p, b);
+        float in = 1.5046f, ext = 1.000277f, alpha = 0.0f;
+        if (type[0] == 'r' && (st = get_alpha(p, b, 0.1f, &alpha))) return st;
+        if ((st = get_ior(p, b, "int_ior", &in))) return st;
+        if ((st = get_ior(p, b, "ext_ior", &ext))) return st;
+        if (inner && (st = bsdf_resolve(p, inner, m))) return st;
+        float ior = in / ext;
+        if (inner && m->type == MAT_DIFFUSE && ior > 0.0f && ior != 1.0f) {
+            vec3 kd = m->kd;
+            float d = m->d;
+            material_init(m);
+            m->type = MAT_PLASTIC;
+            m->kd = kd, m->d = d, m->ni = ior, m->alpha = alpha;
+            m->ks = v3s(f0_dielectric(ior));
+            if (alpha < 1e-3f) m->illum = 3;
+            else m->ns = ns_from_alpha(alpha);
+            static const char *const q[] = {"distribution", NULL};
+            warn_unused(p, b, type[0] == 'r' ? "bsdf \"roughcoating\"" : "bsdf \"coating\"", q);
+            return PK_OK;
+        }
+        for (xnode *c = b->child; c; c = c->next) c->used = true;
+        if (!inner) {
+            xwarn(p, b, "bsdf \"%s\" without a nested bsdf; using a grey diffuse material", ty);
+            material_init(m);
+            m->type = MAT_DIFFUSE;
+            m->kd = v3s(0.5f);
+            return PK_OK;
+        }
+        xwarn(p, b, "bsdf \"%s\" over a non-diffuse bsdf is not supported; using its nested bsdf alone", ty);
+        return PK_OK;
+    }
+    if (strcmp(type, "bumpmap") == 0 || strcmp(type, "bump") == 0 || strcmp(type, "normalmap") == 0 ||
+        strcmp(type, "blendbsdf") == 0 ||
+        strcmp(type, "mixturebsdf") == 0 || strcmp(type, "polarizer") == 0 || strcmp(type, "measured") == 0) {
+        xnode *inner = nested_bsdf(p, b);
+        for (xnode *c = b->child; c; c = c->next) c->used = true;
+        if (!inner) {
+            xwarn(p, b, "bsdf \"%s\" is not supported; using a grey diffuse material", ty);
+            m->type = MAT_DIFFUSE;
+            m->kd = v3s(0.5f);
+            return PK_OK;
+        }
+        xwarn(p, b, "bsdf \"%s\" is not supported; using its nested bsdf alone", ty);
+        return bsdf_resolve(p, inner, m);
+    }
+
+    float alpha = 0.0f;
+    if (strcmp(type, "diffuse") == 0 || strcmp(type, "roughdiffuse") == 0) {
+        vec3 r = v3s(0.5f);
+        if ((st = get_color(p, b, "reflectance", &r))) return st;
+        if (strcmp(type, "roughdiffuse") == 0) {
+            xnode *a = prop(p, b, "alpha");
+            (void)a;
+            if (first_time(p, "roughdiffuse"))
+                xwarn(p, b, "roughdiffuse is rendered as diffuse (Lambert), without the Oren-Nayar roughness");
+        }
+        m->type = MAT_DIFFUSE;
+        m->kd = clamp01v(r);
+    } else if (strcmp(type, "conductor") == 0 || strcmp(type, "roughconductor") == 0) {
+        bool rough = type[0] == 'r';
+        if (rough && (st = get_alpha(p, b, 0.1f, &alpha))) return st;
+        vec3 eta = v3(0.200438f, 0.924033f, 1.10221f), k = v3(3.91295f, 2.45285f, 2.14219f); /* Cu */
+        vec3 spec = v3s(1.0f);
+        float ext = 1.000277f;
+        bool none = false;
+        const char *mat = NULL;
+        xnode *mat_at;
+        if ((st = get_string(p, b, "material", &mat, &mat_at))) return st;
+        if (mat) {
+            size_t i = 0;
+            while (i < sizeof metals / sizeof metals[0] && strcmp(metals[i].name, mat) != 0) i++;
+            if (strcmp(mat, "none") == 0) none = true;
+            else if (i < sizeof metals / sizeof metals[0]) {
+                eta = v3(metals[i].eta[0], metals[i].eta[1], metals[i].eta[2]);
+                k = v3(metals[i].k[0], metals[i].k[1], metals[i].k[2]);
+            } else {
+                char sm[40];
+                shown(sm, sizeof sm, mat);
+                xwarn(p, mat_at, "conductor material \"%s\" is not in the table (Cu, Au, Ag, Al, Cr, none); using Cu",
+                      sm);
+            }
+        }
+        if ((st = get_color(p, b, "eta", &eta))) return st;
+        if ((st = get_color(p, b, "k", &k))) return st;
+        if ((st = get_ior(p, b, "ext_eta", &ext))) return st;
+        if ((st = get_color(p, b, "specular_reflectance", &spec))) return st;
+        m->type = MAT_CONDUCTOR;
+        m->alpha = alpha;
+        eta = v3_scale(eta, 1.0f / ext), k = v3_scale(k, 1.0f / ext);
+        eta = v3(fmaxf(eta.x, 1e-4f), fmaxf(eta.y, 1e-4f), fmaxf(eta.z, 1e-4f));
+        k = v3(fmaxf(k.x, 0.0f), fmaxf(k.y, 0.0f), fmaxf(k.z, 0.0f));
+        const float e[3] = {eta.x, eta.y, eta.z}, kk[3] = {k.x, k.y, k.z};
+        float r[3];
+        for (int c = 0; c < 3; c++)
+            r[c] = ((e[c] - 1.0f) * (e[c] - 1.0f) + kk[c] * kk[c]) / ((e[c] + 1.0f) * (e[c] + 1.0f) + kk[c] * kk[c]);
+        vec3 f0 = none ? v3s(1.0f) : v3(r[0], r[1], r[2]);
+        spec = clamp01v(spec);
+        if (none || spec.x != 1.0f || spec.y != 1.0f || spec.z != 1.0f) {
+            /* a scaled Fresnel term: Schlick's with the scaled normal reflectance */
+            m->schlick = true;
+            m->ks = v3_mul(f0, spec);
+        } else {
+            m->eta = eta, m->k = k;
+            m->ks = f0;
+        }
+        m->kd = v3s(0.0f);
+        if (alpha < 1e-3f) m->illum = 3;
+        else m->ns = ns_from_alpha(alpha);
+        if (!m->schlick) m->ks = f0;
+        else m->ks = clamp01v(m->ks);
+    } else if (strcmp(type, "dielectric") == 0 || strcmp(type, "roughdielectric") == 0 ||
+               strcmp(type, "thindielectric") == 0) {
+        float in = 1.5046f, ext = 1.000277f;
+        vec3 tr = v3s(1.0f), refl = v3s(1.0f);
+        if (type[0] == 'r' && (st = get_alpha(p, b, 0.1f, &alpha))) return st;
+        if ((st = get_ior(p, b, "int_ior", &in))) return st;
+        if ((st = get_ior(p, b, "ext_ior", &ext))) return st;
+        if ((st = get_color(p, b, "specular_transmittance", &tr))) return st;
+        if ((st = get_color(p, b, "specular_reflectance", &refl))) return st;
+        if (refl.x != 1.0f || refl.y != 1.0f || refl.z != 1.0f)
+            xwarn(p, b, "%s: specular_reflectance other than 1 is not supported; ignored", ty);
+        float ior = in / ext;
+        if (type[0] == 't') {
+            /* a thin sheet: light goes through unbent; its reflection is lost */
+            xwarn(p, b, "thindielectric is rendered as a clear sheet that lets light through unbent, without its "
+                        "reflection");
+            ior = 1.0f;
+        }
+        if (ior == 1.0f && alpha > 0.0f) alpha = 0.0f;
+        m->type = MAT_DIELECTRIC;
+        m->ni = ior, m->alpha = alpha, m->tf = clamp01v(tr);
+        m->kd = v3s(0.0f), m->ks = v3s(f0_dielectric(ior));
+        m->illum = 7;
+    } else if (strcmp(type, "plastic") == 0 || strcmp(type, "roughplastic") == 0) {
+        float in = 1.49f, ext = 1.000277f;
+        vec3 kd = v3s(0.5f), spec = v3s(1.0f);
+        if (type[0] == 'r' && (st = get_alpha(p, b, 0.1f, &alpha))) return st;
+        if ((st = get_ior(p, b, "int_ior", &in))) return st;
+        if ((st = get_ior(p, b, "ext_ior", &ext))) return st;
+        if ((st = get_color(p, b, "diffuse_reflectance", &kd))) return st;
+        if ((st = get_color(p, b, "specular_reflectance", &spec))) return st;
+        if (spec.x != 1.0f || spec.y != 1.0f || spec.z != 1.0f)
+            xwarn(p, b, "%s: specular_reflectance other than 1 is not supported; ignored", ty);
+        float ior = in / ext;
+        if (!(ior > 0.0f) || ior == 1.0f) ior = 1.49f;
+        m->type = MAT_PLASTIC;
+        m->kd = clamp01v(kd), m->ni = ior, m->alpha = alpha;
+        m->ks = v3s(f0_dielectric(ior));
+        if (alpha < 1e-3f) m->illum = 3;
+        else m->ns = ns_from_alpha(alpha);
+    } else if (strcmp(type, "principled") == 0 || strcmp(type, "principledthin") == 0) {
+        /* Disney's model by its main parameters: a metal (Schlick, F0 =
+         * base_color) when metallic > 0.5, else a plastic of base_color */
+        vec3 base = v3s(0.5f);
+        float metallic = 0.0f, roughness = 0.5f, eta = 1.5f;
+        if ((st = get_color(p, b, "base_color", &base))) return st;
+        if ((st = get_scalar(p, b, "metallic", &metallic))) return st;
+        if ((st = get_scalar(p, b, "roughness", &roughness))) return st;
+        if ((st = get_float(p, b, "eta", &eta))) return st;
+        for (xnode *c = b->child; c; c = c->next) c->used = true;
+        if (first_time(p, "principled"))
+            xwarn(p, b, "principled is approximated by a %s of its base_color and roughness",
+                  metallic > 0.5f ? "metal" : "plastic");
+        alpha = clamp01(roughness) * clamp01(roughness);
+        if (metallic > 0.5f) {
+            m->type = MAT_CONDUCTOR;
+            m->schlick = true;
+            m->ks = clamp01v(base), m->kd = v3s(0.0f);
+        } else {
+            m->type = MAT_PLASTIC;
+            m->kd = clamp01v(base);
+            m->ni = eta > 1.0f ? eta : 1.5f;
+            m->ks = v3s(f0_dielectric(m->ni));
+        }
+        m->alpha = alpha;
+        if (alpha < 1e-3f) m->illum = 3;
+        else m->ns = ns_from_alpha(alpha);
+    } else if (strcmp(type, "null") == 0) {
+        m->type = MAT_DIELECTRIC; /* index 1: light passes straight through */
+        m->ni = 1.0f, m->tf = v3s(1.0f), m->kd = v3s(0.0f), m->ks = v3s(0.0f);
+        m->illum = 7;
+    } else {
+        for (xnode *c = b->child; c; c = c->next) c->used = true;
+        xwarn(p, b, "bsdf \"%s\" is not supported; using a grey diffuse material", ty);
+        m->type = MAT_DIFFUSE;
+        m->kd = v3s(0.5f);
+        return PK_OK;
+    }
+    char kind[64];
+    snprintf(kind, sizeof kind, "bsdf \"%s\"", ty);
+    warn_unused(p, b, kind, quiet);
+    return PK_OK;
+}
+
+/* A material for element b (a bsdf or a ref), made once per bsdf element. */
+static pk_status material_of(xp *p, xnode *b, uint32_t *index)
+{
+    pk_status st;
+    xnode *target = b;
+    if (strcmp(b->tag, "ref") == 0) {
+        const char *id = attr_st(p, b, "id", &st);
+        if (st) return st;
+        xnode *t = id ? id_find(p, id) : NULL;
+        if (t && strcmp(t->tag, "bsdf") == 0) target = t;
+    }
+    if (target->mat >= 0) {
+        *index = (uint32_t)target->mat;
+        return PK_OK;
+    }
+    material m;
+    if ((st = bsdf_resolve(p, b, &m))) return st;
+    char name[96];
+    const char *id = attr_st(p, target, "id", &st);
+    if (id) {
+        shown(name, sizeof name, id);
+    } else {
+        snprintf(name, sizeof name, "bsdf@%s:%lu", target->file->shown, target->line);
+    }
+    uint32_t idx;
+    if ((st = scene_add_material(p->ctx, p->s, name, &idx))) return st;
+    material *dst = &p->s->materials[idx];
+    char *owned = dst->name;
+    *dst = m;
+    dst->name = owned;
+    target->mat = (int64_t)idx;
+    *index = idx;
+    return PK_OK;
+}
+
+/* ---- unused properties --------------------------------------------------------------------- */
+
+static bool is_property_tag(const char *t)
+{
+    static const char *const tags[] = {"float", "integer", "boolean", "string", "rgb", "srgb", "spectrum",
+                                       "point", "vector", "transform", "texture", "blackbody", NULL};
+    for (int i = 0; tags[i]; i++)
+        if (strcmp(t, tags[i]) == 0) return true;
+    return false;
+}
+
+/* Warns once per (kind, property) about the properties of plugin that no
+ * code read, except those in quiet (NULL-terminated, snake_case). */
+static void warn_unused(xp *p, xnode *plugin, const char *kind, const char *const *quiet)
+{
+    for (xnode *c = plugin->child; c; c = c->next) {
+        if (c->used || !is_property_tag(c->tag)) continue;
+        pk_status st;
+        const char *nm = attr_st(p, c, "name", &st);
+        if (!nm) continue;
+        char sn[64];
+        snake(sn, sizeof sn, nm);
+        bool q = false;
+        for (int i = 0; quiet && quiet[i]; i++)
+            if (strcmp(quiet[i], sn) == 0) q = true;
+        if (q) continue;
+        char key[128];
+        snprintf(key, sizeof key, "%s/%s", kind, sn);
+        if (!first_time(p, key)) continue;
+        char snm[48];
+        shown(snm, sizeof snm, nm);
+        xwarn(p, c, "%s: property \"%s\" is not supported; ignored", kind, snm);
+    }
+}
+
+/* ---- meshes ---------------------------------------------------------------------------------- */
+
+/* Appends triangles (tris: 3 indices each into pos) transformed by m.
+ * flip reverses the winding; normals (optional, local) are transformed by
+ * the inverse transpose. */
+static pk_status add_mesh(xp *p, const vec3 *pos, const vec3 *nrm, size_t npos, const uint32_t *tris, size_t ntris,
+                          const float m[16], bool flip, uint32_t mat)
+{
+    pk_scene *s = p->s;
+    size_t pbase = s->npositions, nbase = s->nnormals;
+    pk_status st;
+    float cof[9] = {0};
+    if (nrm) {
+        const float a = m[0], b = m[1], c = m[2], d = m[4], e = m[5], f = m[6], g = m[8], h = m[9], i = m[10];
+        const float cf[9] = {e * i - f * h, f * g - d * i, d * h - e * g, c * h - b * i, a * i - c * g,
+                             b * g - a * h, b * f - c * e, c * d - a * f, a * e - b * d};
+        float sign = m_det3(m) < 0.0 ? -1.0f : 1.0f;
+        for (int k = 0; k < 9; k++) cof[k] = sign * cf[k];
+    }
+    for (size_t i = 0; i < npos; i++) {
+        vec3 q = m_point(m, pos[i]);
+        if (!v3_finite(q)) return ctx_error(p->ctx, PK_ERR_PARSE, "%s: a transformed vertex is not finite", s->name);
+        if ((st = scene_add_position(p->ctx, s, q))) return st;
+        if (nrm) {
+            vec3 n = v3(cof[0] * nrm[i].x + cof[1] * nrm[i].y + cof[2] * nrm[i].z,
+                        cof[3] * nrm[i].x + cof[4] * nrm[i].y + cof[5] * nrm[i].z,
+                        cof[6] * nrm[i].x + cof[7] * nrm[i].y + cof[8] * nrm[i].z);
+            n = v3_norm_scaled(n);
+            if (!v3_finite(n)) n = v3s(0.0f);
+            if ((st = scene_add_normal(p->ctx, s, n))) return st;
+        }
+    }
+    for (size_t t = 0; t < ntris; t++) {
+        triangle tr;
+        uint32_t a = tris[3 * t], b = tris[3 * t + 1], c = tris[3 * t + 2];
+        if (flip) {
+            uint32_t x = b;
+            b = c, c = x;
+        }
+        tr.v[0] = (uint32_t)(pbase + a), tr.v[1] = (uint32_t)(pbase + b), tr.v[2] = (uint32_t)(pbase + c);
+        for (int k = 0; k < 3; k++) tr.n[k] = nrm ? (int32_t)(nbase + tr.v[k] - pbase) : -1;
+        tr.material = mat;
+        if ((st = scene_add_triangle(p->ctx, s, &tr))) return st;
+    }
+    return PK_OK;
+}
+
+/* The unit square [-1, 1]^2 at z = 0, facing +z. */
+static pk_status shape_rectangle(xp *p, const float m[16], bool flip, uint32_t mat)
+{
+    static const vec3 pos[4] = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
+    static const uint32_t tris[6] = {0, 1, 2, 2, 3, 0};
+    return add_mesh(p, pos, NULL, 4, tris, 2, m, flip, mat);
+}
+
+/* The cube [-1, 1]^3, faces wound outward. */
+static pk_status shape_cube(xp *p, const float m[16], bool flip, uint32_t mat)
+{
+    vec3 pos[8];
+    for (int i = 0; i < 8; i++) pos[i] = v3(i & 1 ? 1.0f : -1.0f, i & 2 ? 1.0f : -1.0f, i & 4 ? 1.0f : -1.0f);
+    /* each face: its four corners in counter-clockwise order seen from outside */
+    static const uint32_t quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
+                                         {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+    uint32_t tris[36];
+    for (int f = 0; f < 6; f++) {
+        const uint32_t *q = quads[f];
+        uint32_t t[6] = {q[0], q[1], q[2], q[2], q[3], q[0]};
+        memcpy(tris + 6 * f, t, sizeof t);
+    }
+    return add_mesh(p, pos, NULL, 8, tris, 12, m, flip, mat);
+}
+
+/* The unit disk at z = 0, facing +z, as a fan of XML_DISK_SEGMENTS triangles. */
+static pk_status shape_disk(xp *p, const float m[16], bool flip, uint32_t mat)
+{
+    vec3 pos[XML_DISK_SEGMENTS + 1];
+    uint32_t tris[3 * XML_DISK_SEGMENTS];
+    pos[0] = v3s(0.0f);
+    for (int i = 0; i < XML_DISK_SEGMENTS; i++) {
+        float a = 2.0f * PK_PI * (float)i / (float)XML_DISK_SEGMENTS;
+        pos[i + 1] = v3(cosf(a), sinf(a), 0.0f);
+        tris[3 * i] = 0, tris[3 * i + 1] = (uint32_t)(i + 1);
+        tris[3 * i + 2] = (uint32_t)((i + 1) % XML_DISK_SEGMENTS + 1);
+    }
+    return add_mesh(p, pos, NULL, XML_DISK_SEGMENTS + 1, tris, XML_DISK_SEGMENTS, m, flip, mat);
+}
+
+/* The unit sphere as a latitude-longitude mesh with vertex normals, wound
+ * outward (inward with flip). */
+static pk_status shape_sphere_mesh(xp *p, const float m[16], bool flip, uint32_t mat)
+{
+    enum { R = XML_SPHERE_RINGS, S = XML_SPHERE_SEGMENTS, NV = (R + 1) * (S + 1), NT = 2 * R * S };
+    const pk_allocator *a = &p->ctx->alloc;
+    vec3 *pos = mem_alloc(a, NV * sizeof *pos);
+    uint32_t *tris = mem_alloc(a, 3 * NT * sizeof *tris);
+    pk_status st = PK_OK;
+    if (!pos || !tris) {
+        st = ctx_nomem(p->ctx);
+        goto out;
+    }
+    for (int i = 0; i <= R; i++) {
+        float th = PK_PI * (float)i / (float)R;
+        for (int j = 0; j <= S; j++) {
+            float ph = 2.0f * PK_PI * (float)j / (float)S;
+            pos[i * (S + 1) + j] = v3(sinf(th) * cosf(ph), sinf(th) * sinf(ph), cosf(th));
+        }
+    }
+    size_t nt = 0;
+    for (int i = 0; i < R; i++)
+        for (int j = 0; j < S; j++) {
+            uint32_t v00 = (uint32_t)(i * (S + 1) + j), v01 = v00 + 1, v10 = v00 + S + 1, v11 = v10 + 1;
+            /* outward: (v00, v10, v11) has normal along +r */
+            if (i != R - 1) {
+                uint32_t t[3] = {v00, v10, v11};
+                memcpy(tris + 3 * nt++, t, sizeof t);
+            }
+            if (i != 0) {
+                uint32_t t[3] = {v00, v11, v01};
+                memcpy(tris + 3 * nt++, t, sizeof t);
+            }
+        }
+    st = add_mesh(p, pos, flip ? NULL : pos, NV, tris, nt, m, flip, mat);
+out:
+    mem_free(a, pos);
+    mem_free(a, tris);
+    return st;
+}
+
+/* A warning handler that passes on all but the OBJ reader's "material ...
+ * is not defined" (the XML's bsdf replaces the OBJ's materials). */
+typedef struct warn_filter {
+    pk_warning_fn fn;
+    void *user;
+} warn_filter;
+
+static void filtered_warning(void *user, const char *msg)
+{
+    const warn_filter *f = user;
+    if (strstr(msg, "is not defined; its faces use the default material")) return;
+    if (f->fn) f->fn(f->user, msg);
+}
+
+/* Reads file (relative to the XML file of n) into *data. */
+static pk_status read_relative(xp *p, const xnode *at, const char *rel, char **full, char **data, size_t *size)
+{
+    *data = NULL;
+    *full = path_join(&p->ctx->alloc, at->file->dir, rel);
+    if (!*full) return ctx_nomem(p->ctx);
+    pk_context scratch = *p->ctx;
+    scratch.status = PK_OK;
+    scratch.message[0] = '\0';
+    pk_status st = file_read_all(&scratch, *full, data, size);
+    if (st) return xfail(p, st, at, "%s", scratch.message);
+    return PK_OK;
+}
+
+/* Mitsuba emits (and tells inside from outside) by a mesh's shading
+ * normals, Paprsek by the winding: the triangles from t0 on are wound to
+ * agree with their vertex normals, or lose them with face_normals; then
+ * flip_normals reverses them all. */
+static void finish_mesh(xp *p, size_t t0, bool face_normals, bool flip)
+{
+    pk_scene *s = p->s;
+    for (size_t t = t0; t < s->ntris; t++) {
+        triangle *tr = &s->tris[t];
+        bool swap = flip;
+        if (face_normals) {
+            tr->n[0] = tr->n[1] = tr->n[2] = -1;
+        } else if (tr->n[0] >= 0 && tr->n[1] >= 0 && tr->n[2] >= 0) {
+            vec3 a, b, c;
+            scene_tri_verts(s, t, &a, &b, &c);
+            vec3 ng = v3_cross(v3_sub(b, a), v3_sub(c, a));
+            vec3 ns = v3_add(v3_add(s->normals[tr->n[0]], s->normals[tr->n[1]]), s->normals[tr->n[2]]);
+            if (v3_dot(ng, ns) < 0.0f) swap = !swap;
+        }
+        if (swap) {
+            uint32_t v = tr->v[1];
+            int32_t n = tr->n[1];
+            tr->v[1] = tr->v[2], tr->n[1] = tr->n[2];
+            tr->v[2] = v, tr->n[2] = n;
+        }
+    }
+}
+
+static pk_status shape_obj(xp *p, xnode *sh, const float m[16], bool flip, bool has_bsdf, uint32_t mat)
+{
+    pk_status st;
+    const char *fn = NULL;
+    xnode *at;
+    if ((st = get_string(p, sh, "filename", &fn, &at))) return st;
+    if (!fn) return xfail(p, PK_ERR_PARSE, sh, "shape obj needs a filename");
+    bool face_normals = false;
+    if ((st = get_bool(p, sh, "face_normals", &face_normals))) return st;
+    char *full = NULL, *data = NULL, *dir = NULL;
+    size_t size = 0;
+    size_t t0 = p->s->ntris;
+    if ((st = read_relative(p, at, fn, &full, &data, &size))) goto out;
+    dir = path_dirname(&p->ctx->alloc, full);
+    if (!dir) {
+        st = ctx_nomem(p->ctx);
+        goto out;
+    }
+    if (has_bsdf) {
+        /* the XML's bsdf replaces the OBJ's materials: its MTL is not read */
+        warn_filter f = {p->ctx->warn, p->ctx->warn_user};
+        p->ctx->warn = filtered_warning;
+        p->ctx->warn_user = &f;
+        st = obj_parse(p->ctx, p->s, data, size, full, NULL, m);
+        p->ctx->warn = f.fn;
+        p->ctx->warn_user = f.user;
+    } else {
+        st = obj_parse(p->ctx, p->s, data, size, full, dir, m);
+    }
+    if (st) goto out;
+    if (has_bsdf)
+        for (size_t t = t0; t < p->s->ntris; t++) p->s->tris[t].material = mat;
+    finish_mesh(p, t0, face_normals, flip);
+out:
+    mem_free(&p->ctx->alloc, data);
+    mem_free(&p->ctx->alloc, dir);
+    mem_free(&p->ctx->alloc, full);
+    return st;
+}
+
+static pk_status shape_ply(xp *p, xnode *sh, const float m[16], bool flip, uint32_t mat)
+{
+    pk_status st;
+    const char *fn = NULL;
+    xnode *at;
+    if ((st = get_string(p, sh, "filename", &fn, &at))) return st;
+    if (!fn) return xfail(p, PK_ERR_PARSE, sh, "shape ply needs a filename");
+    bool face_normals = false;
+    if ((st = get_bool(p, sh, "face_normals", &face_normals))) return st;
+    char *full = NULL, *data = NULL;
+    size_t size = 0;
+    ply_mesh mesh = {0};
+    if ((st = read_relative(p, at, fn, &full, &data, &size))) goto out;
+    if ((st = ply_parse(p->ctx, data, size, full, &mesh))) goto out;
+    size_t t0 = p->s->ntris;
+    st = add_mesh(p, mesh.positions, face_normals ? NULL : mesh.normals, mesh.nvertices, mesh.indices, mesh.ntriangles,
+                  m, false, mat);
+    if (st == PK_OK) finish_mesh(p, t0, face_normals, flip);
+out:
+    ply_mesh_free(p->ctx, &mesh);
+    mem_free(&p->ctx->alloc, data);
+    mem_free(&p->ctx->alloc, full);
+    return st;
+}
+
+/* ---- shapes --------------------------------------------------------------------------------- */
+
+static pk_status parse_emitter_area(xp *p, xnode *e, vec3 *radiance)
+{
+    pk_status st;
+    *radiance = v3s(1.0f);
+    if ((st = get_color(p, e, "radiance", radiance))) return st;
+    if (!(radiance->x >= 0.0f && radiance->y >= 0.0f && radiance->z >= 0.0f))
+        return xfail(p, PK_ERR_PARSE, e, "radiance must not be negative");
+    static const char *const quiet[] = {"sampling_weight", NULL};
+    warn_unused(p, e, "emitter \"area\"", quiet);
+    return PK_OK;
+}
+
+static pk_status parse_shape(xp *p, xnode *sh)
+{
+    pk_status st;
+    const char *type = attr_st(p, sh, "type", &st);
+    if (st) return st;
+    if (!type) return xfail(p, PK_ERR_PARSE, sh, "<shape> needs a type");
+    char ty[40];
+    shown(ty, sizeof ty, type);
+    enum { SH_OBJ, SH_PLY, SH_RECT, SH_CUBE, SH_DISK, SH_SPHERE, SH_OTHER } kind = SH_OTHER;
+    static const char *const names[] = {"obj", "ply", "rectangle", "cube", "disk", "sphere"};
+    for (int i = 0; i < 6; i++)
+        if (strcmp(type, names[i]) == 0) kind = (int)i;
+    if (kind == SH_OTHER) {
+        xwarn(p, sh, "shape \"%s\" is not supported; skipped", ty);
+        return PK_OK;
+    }
+    const char *id = attr_st(p, sh, "id", &st);
+    if (st) return st;
+    if (id && (st = id_add(p, id, sh))) return st;
+
+    float m[16];
+    if ((st = get_to_world(p, sh, m, NULL))) return st;
+    bool flip = false;
+    if ((st = get_bool(p, sh, "flip_normals", &flip))) return st;
+
+    /* its bsdf (a nested one or a reference) and its area emitter */
+    xnode *bsdf = NULL, *emitter = NULL;
+    for (xnode *c = sh->child; c; c = c->next) {
+        if (strcmp(c->tag, "bsdf") == 0 || strcmp(c->tag, "ref") == 0) {
+            if (strcmp(c->tag, "ref") == 0) {
+                const char *rid = attr_st(p, c, "id", &st);
+                if (st) return st;
+                xnode *t = rid ? id_find(p, rid) : NULL;
+                if (t && strcmp(t->tag, "bsdf") != 0) {
+                    if (strcmp(t->tag, "emitter") == 0 && !emitter) emitter = t;
+                    else xwarn(p, c, "a reference to a <%.32s> in a shape is not supported; ignored", t->tag);
+                    c->used = true;
+                    continue;
+                }
+            }
+            c->used = true;
+            if (bsdf) {
+                xwarn(p, c, "a shape takes one bsdf; this one is ignored");
+                continue;
+            }
+            bsdf = c;
+        } else if (strcmp(c->tag, "emitter") == 0) {
+            c->used = true;
+            if (emitter) {
+                xwarn(p, c, "a shape takes one emitter; this one is ignored");
+                continue;
+            }
+            emitter = c;
+        } else if (strcmp(c->tag, "medium") == 0 || strcmp(c->tag, "subsurface") == 0) {
+            c->used = true;
+            if (first_time(p, "medium"))
+                xwarn(p, c, "participating media and subsurface scattering are not supported; ignored");
+        }
+    }
+    uint32_t mat = 0;
+    bool has_bsdf = bsdf != NULL;
+    if (bsdf && (st = material_of(p, bsdf, &mat))) return st;
+    if (!bsdf) { /* Mitsuba's default: diffuse, reflectance 0.5 */
+        int64_t d = scene_find_material(p->s, "mitsuba-default-diffuse");
+        if (d < 0) {
+            uint32_t idx;
+            if ((st = scene_add_material(p->ctx, p->s, "mitsuba-default-diffuse", &idx))) return st;
+            material *dm = &p->s->materials[idx];
+            dm->type = MAT_DIFFUSE;
+            dm->kd = v3s(0.5f);
+            d = idx;
+        }
+        mat = (uint32_t)d;
+    }
+    if (emitter) {
+        const char *et = attr_st(p, emitter, "type", &st);
+        if (st) return st;
+        if (!et || strcmp(et, "area") != 0) {
+            char se[40];
+            shown(se, sizeof se, et ? et : "");
+            xwarn(p, emitter, "emitter \"%s\" on a shape is not supported (only \"area\"); ignored", se);
+        } else {
+            vec3 radiance;
+            if ((st = parse_emitter_area(p, emitter, &radiance))) return st;
+            /* a copy of the material that also emits (one-sided, as Mitsuba's) */
+            material copy = p->s->materials[mat];
+            char name[96];
+            snprintf(name, sizeof name, "%s+emitter@%lu", copy.name, emitter->line);
+            uint32_t idx;
+            if ((st = scene_add_material(p->ctx, p->s, name, &idx))) return st;
+            material *dst = &p->s->materials[idx];
+            char *owned = dst->name;
+            *dst = p->s->materials[mat];
+            dst->name = owned;
+            dst->ke = radiance;
+            dst->two_sided = false;
+            mat = idx;
+        }
+    }
+    /* Mitsuba orients an analytic shape's normal by the inverse transpose
+     * of to_world, so a mirroring transform keeps it: the winding, which
+     * such a transform reverses, is turned back. */
+    bool mirror = m_det3(m) < 0.0;
+    switch (kind) {
+    case SH_OBJ: st = shape_obj(p, sh, m, flip, has_bsdf, mat); break;
+    case SH_PLY: st = shape_ply(p, sh, m, flip, mat); break;
+    case SH_RECT: st = shape_rectangle(p, m, flip != mirror, mat); break;
+    case SH_CUBE: st = shape_cube(p, m, flip != mirror, mat); break;
+    case SH_DISK: st = shape_disk(p, m, flip != mirror, mat); break;
+    case SH_SPHERE: {
+        vec3 center = v3s(0.0f);
+        float radius = 1.0f;
+        if ((st = get_vec(p, sh, "center", &center, NULL))) return st;
+        if ((st = get_float(p, sh, "radius", &radius))) return st;
+        if (!(radius > 0.0f)) return xfail(p, PK_ERR_PARSE, sh, "sphere: radius must be positive");
+        /* to_world * translate(center) * scale(radius) */
+        float local[16], full[16];
+        m_identity(local);
+        local[0] = local[5] = local[10] = radius;
+        local[3] = center.x, local[7] = center.y, local[11] = center.z;
+        m_mul(m, local, full);
+        /* analytic when full is a similarity (rotation, uniform scale, translation) */
+        vec3 cx = v3(full[0], full[4], full[8]), cy = v3(full[1], full[5], full[9]);
+        vec3 cz = v3(full[2], full[6], full[10]);
+        float lx = v3_len(cx), ly = v3_len(cy), lz = v3_len(cz);
+        float tol = 1e-4f * lx;
+        bool similar = fabsf(lx - ly) <= tol && fabsf(lx - lz) <= tol && fabsf(v3_dot(cx, cy)) <= tol * lx &&
+                       fabsf(v3_dot(cx, cz)) <= tol * lx && fabsf(v3_dot(cy, cz)) <= tol * lx;
+        if (similar && !flip) {
+            sphere sp = {m_point(full, v3s(0.0f)), lx, mat};
+            if (!v3_finite(sp.center) || !(sp.radius > 0.0f) || !isfinite(sp.radius))
+                return xfail(p, PK_ERR_PARSE, sh, "sphere: the transformed sphere is not finite");
+            st = scene_add_sphere(p->ctx, p->s, &sp);
+        } else {
+            if (!similar && first_time(p, "sphere-mesh"))
+                xwarn(p, sh, "sphere with a non-uniform to_world: tessellated into %d triangles",
+                      2 * XML_SPHERE_SEGMENTS * (XML_SPHERE_RINGS - 1));
+            st = shape_sphere_mesh(p, full, flip != mirror, mat);
+        }
+        break;
+    }
+    default: break;
+    }
+    if (st) return st;
+    static const char *const quiet[] = {"flip_tex_coords", "collapse", NULL};
+    char kindname[64];
+    snprintf(kindname, sizeof kindname, "shape \"%s\"", ty);
+    warn_unused(p, sh, kindname, quiet);
+    return PK_OK;
+}
+
+/* ---- emitters ------------------------------------------------------------------------------------- */
+
+/* Radiance of the sun's disc, linear RGB in Mitsuba's units (W m^-2 sr^-1
+ * nm^-1): the sun's spectral radiance above the atmosphere at the three
+ * primaries, attenuated by Rayleigh and aerosol scattering along the air
+ * mass of its elevation (Preetham et al. 1999 for the optical depths,
+ * Kasten and Young 1989 for the air mass). */
+static vec3 sun_radiance(vec3 to_sun, float turbidity)
+{
+    const float lambda[3] = {0.61f, 0.55f, 0.465f};     /* micrometres */
+    const float outside[3] = {24170.0f, 25500.0f, 30500.0f};
+    float cos_z = fmaxf(to_sun.y, 0.0f);
+    float zen = acosf(fminf(cos_z, 1.0f)) * (180.0f / PK_PI);
+    float mass = 1.0f / (cos_z + 0.50572f * powf(fmaxf(96.07995f - zen, 1e-3f), -1.6364f));
+    float beta = 0.04608f * turbidity - 0.04586f;
+    float r[3];
+    for (int c = 0; c < 3; c++) {
+        float tau = 0.008735f * powf(lambda[c], -4.08f) + beta * powf(lambda[c], -1.3f);
+        r[c] = outside[c] * expf(-mass * tau);
+    }
+    return v3(r[0], r[1], r[2]);
+}
+
+static pk_status parse_emitter(xp *p, xnode *e)
+{
+    pk_status st;
+    const char *type = attr_st(p, e, "type", &st);
+    if (st) return st;
+    if (!type) return xfail(p, PK_ERR_PARSE, e, "<emitter> needs a type");
+    char ty[40];
+    shown(ty, sizeof ty, type);
+    char kind[64];
+    snprintf(kind, sizeof kind, "emitter \"%s\"", ty);
+    static const char *const quiet[] = {"sampling_weight", NULL};
+    scene_environment *env = &p->s->env;
+    const char *id = attr_st(p, e, "id", &st);
+    if (id && (st = id_add(p, id, e))) return st;
+
+    if (strcmp(type, "point") == 0 || strcmp(type, "spot") == 0) {
+        point_light l;
+        vec3 pos = v3s(0.0f), intensity = v3s(1.0f);
+        bool has_pos;
+        float m[16];
+        if ((st = get_to_world(p, e, m, NULL))) return st;
+        if ((st = get_vec(p, e, "position", &pos, &has_pos))) return st;
+        if ((st = get_color(p, e, "intensity", &intensity))) return st;
+        if (type[0] == 's') {
+            float cutoff = 20.0f, beam = 15.0f;
+            if ((st = get_float(p, e, "cutoff_angle", &cutoff))) return st;
+            if ((st = get_float(p, e, "beam_width", &beam))) return st;
+            xwarn(p, e, "spot light rendered as a point light shining in every direction");
+        }
+        l.position = has_pos ? pos : m_point(m, v3s(0.0f));
+        l.intensity = intensity;
+        if (!v3_finite(l.position) || !v3_finite(l.intensity))
+            return xfail(p, PK_ERR_PARSE, e, "point light: position and intensity must be finite");
+        if (!(intensity.x >= 0.0f && intensity.y >= 0.0f && intensity.z >= 0.0f))
+            return xfail(p, PK_ERR_PARSE, e, "intensity must not be negative");
+        if ((st = scene_add_point_light(p->ctx, p->s, &l))) return st;
+    } else if (strcmp(type, "constant") == 0) {
+        vec3 r = v3s(1.0f);
+        if ((st = get_color(p, e, "radiance", &r))) return st;
+        env->set = true;
+        env->radiance = v3_add(env->radiance, r);
+    } else if (strcmp(type, "envmap") == 0) {
+        const char *fn = NULL;
+        xnode *at;
+        float scale = 1.0f, m[16];
+        if ((st = get_string(p, e, "filename", &fn, &at))) return st;
+        if (!fn) return xfail(p, PK_ERR_PARSE, e, "envmap needs a filename");
+        if ((st = get_float(p, e, "scale", &scale))) return st;
+        if ((st = get_to_world(p, e, m, NULL))) return st;
+        if (env->map) {
+            xwarn(p, e, "a second envmap is not supported; ignored");
+        } else {
+            env->map = path_join(&p->s->alloc, e->file->dir, fn);
+            if (!env->map) return ctx_nomem(p->ctx);
+            env->map_scale = scale;
+            /* the rotation part, columns normalised (a scale means nothing here) */
+            for (int c = 0; c < 3; c++) {
+                vec3 col = v3_norm_scaled(v3(m[c], m[4 + c], m[8 + c]));
+                env->to_world[c] = col.x, env->to_world[3 + c] = col.y, env->to_world[6 + c] = col.z;
+            }
+        }
+        static const char *const q2[] = {"sampling_weight", "gamma", "filter_type", "cache", NULL};
+        warn_unused(p, e, kind, q2);
+        env->set = true;
+        return PK_OK;
+    } else if (strcmp(type, "sun") == 0 || strcmp(type, "sky") == 0 || strcmp(type, "sunsky") == 0) {
+        float turbidity = 3.0f, sun_scale = 1.0f, sky_scale = 1.0f, radius_scale = 1.0f, scale = 1.0f;
+        vec3 dir = v3(0.0f, 1.0f, 0.0f);
+        bool has_dir;
+        if ((st = get_float(p, e, "turbidity", &turbidity))) return st;
+        if ((st = get_float(p, e, "sun_scale", &sun_scale))) return st;
+        if ((st = get_float(p, e, "sky_scale", &sky_scale))) return st;
+        if ((st = get_float(p, e, "scale", &scale))) return st;
+        if ((st = get_float(p, e, "sun_radius_scale", &radius_scale))) return st;
+        if ((st = get_vec(p, e, "sun_direction", &dir, &has_dir))) return st;
+        if (!has_dir) {
+            xwarn(p, e, "%s: the sun's position from date, time and place is not computed; give sun_direction "
+                        "(the sun is put at 45 degrees)",
+                  ty);
+            dir = v3(0.0f, 0.7071068f, 0.7071068f);
+        }
+        if (!(v3_len2(dir) > 0.0f)) return xfail(p, PK_ERR_PARSE, e, "sun_direction must not be zero");
+        dir = v3_norm_scaled(dir);
+        if (!(turbidity >= 2.0f && turbidity <= 10.0f)) {
+            xwarn(p, e, "turbidity %g is outside 2..10; clamped", (double)turbidity);
+            turbidity = turbidity < 2.0f ? 2.0f : 10.0f;
+        }
+        bool sun = type[2] == 'n', sky = strcmp(type, "sky") == 0 || strcmp(type, "sunsky") == 0;
+        if (strcmp(type, "sun") == 0) sun_scale = scale;
+        if (strcmp(type, "sky") == 0) sky_scale = scale;
+        env->set = true;
+        env->sun_dir = dir;
+        if (sun) {
+            /* sun_radius_scale widens the disc keeping its power */
+            float rs = radius_scale > 0.0f ? fminf(radius_scale, 90.0f / 0.5358f) : 1.0f;
+            env->has_sun = true;
+            env->sun_angle = 0.5358f * rs;
+            env->sun_radiance = v3_scale(sun_radiance(dir, turbidity), sun_scale / (rs * rs));
+        }
+        if (sky) {
+            env->has_sky = true;
+            env->sky_turbidity = turbidity;
+            /* Paprsek's sky is in W m^-2 sr^-1 over the visible range (luminance
+             * / 683), Mitsuba's per nanometre: the integral of the CIE y
+             * function, 106.857 nm, converts, so that the image is as bright as
+             * Mitsuba renders it */
+            env->sky_scale = sky_scale / 106.857f;
+        }
+        if (first_time(p, "sunsky-model"))
+            xwarn(p, e, "%s: Mitsuba's sun and sky models are approximated by Paprsek's (docs/scene-format.md)", ty);
+        static const char *const q2[] = {"sampling_weight", "resolution", "albedo", "stretch", "extend", NULL};
+        warn_unused(p, e, kind, q2);
+        return PK_OK;
+    } else if (strcmp(type, "directional") == 0 || strcmp(type, "distant") == 0) {
+        vec3 dir = v3(0.0f, 0.0f, 1.0f), irr = v3s(1.0f);
+        bool has_dir;
+        float m[16];
+        bool has_m;
+        if ((st = get_to_world(p, e, m, &has_m))) return st;
+        if ((st = get_vec(p, e, "direction", &dir, &has_dir))) return st;
+        if (!has_dir && has_m) dir = m_dir(m, v3(0.0f, 0.0f, 1.0f));
+        if ((st = get_color(p, e, "irradiance", &irr))) return st;
+        if (!(v3_len2(dir) > 0.0f)) return xfail(p, PK_ERR_PARSE, e, "direction must not be zero");
+        /* a sun of 0.1 degrees with the same irradiance */
+        const float angle = 0.1f;
+        float half = 0.5f * angle * (PK_PI / 180.0f);
+        float sh = sinf(0.5f * half), solid = 4.0f * PK_PI * sh * sh; /* 2 pi (1 - cos half) */
+        if (env->has_sun) {
+            xwarn(p, e, "a second sun or directional light is not supported; ignored");
+        } else {
+            env->set = true;
+            env->has_sun = true;
+            env->sun_dir = v3_neg(v3_norm_scaled(dir));
+            env->sun_angle = angle;
+            env->sun_radiance = v3_scale(irr, 1.0f / solid);
+            xwarn(p, e, "directional light rendered as a sun of %g degrees with the same irradiance", (double)angle);
+        }
+    } else if (strcmp(type, "area") == 0) {
+        xwarn(p, e, "an area emitter belongs inside a shape; ignored");
+        return PK_OK;
+    } else {
+        for (xnode *c = e->child; c; c = c->next) c->used = true;
+        xwarn(p, e, "emitter \"%s\" is not supported; ignored", ty);
+        return PK_OK;
+    }
+    warn_unused(p, e, kind, quiet);
+    return PK_OK;
+}
+
+/* ---- sensor, film, sampler, integrator ------------------------------------------------------- */
+
+static pk_status parse_film(xp *p, xnode *f)
+{
+    pk_status st;
+    int64_t w = XML_DEFAULT_WIDTH, h = XML_DEFAULT_HEIGHT;
+    bool hw, hh;
+    if ((st = get_int(p, f, "width", &w, &hw))) return st;
+    if ((st = get_int(p, f, "height", &h, &hh))) return st;
+    const pk_int_option *ow = pk_int_option_find("width"), *oh = pk_int_option_find("height");
+    if (w < ow->min || w > ow->max || h < oh->min || h > oh->max)
+        return xfail(p, (w > ow->max || h > oh->max) ? PK_ERR_LIMIT : PK_ERR_PARSE, f,
+                     "film: width and height must be in %d..%d", ow->min, ow->max);
+    if ((uint64_t)w * (uint64_t)h > (uint64_t)PK_MAX_IMAGE_PIXELS)
+        return xfail(p, PK_ERR_LIMIT, f, "film: %dx%d is more than %u pixels", (int)w, (int)h,
+                     (unsigned)PK_MAX_IMAGE_PIXELS);
+    scene_render_settings *r = &p->s->render;
+    r->opt.width = (int)w, r->opt.height = (int)h;
+    r->has_width = r->has_height = true;
+    p->film_w = (int)w, p->film_h = (int)h;
+    for (xnode *c = f->child; c; c = c->next)
+        if (strcmp(c->tag, "rfilter") == 0) c->used = true; /* pixel filters: Paprsek's is a box */
+    xnode *crop = prop(p, f, "crop_width");
+    if (crop) xwarn(p, crop, "film: crop windows are not supported; the whole image is rendered");
+    prop(p, f, "crop_height"), prop(p, f, "crop_offset_x"), prop(p, f, "crop_offset_y");
+    static const char *const quiet[] = {"file_format", "pixel_format", "component_format", "banner", "gamma",
+                                        "high_quality_edges", "attach_log", "exposure", "tonemap_method",
+                                        "rfilter", "label", "key", "burn", NULL};
+    warn_unused(p, f, "film", quiet);
+    return PK_OK;
+}
+
+static pk_status parse_sampler(xp *p, xnode *smp)
+{
+    pk_status st;
+    int64_t spp = 4;
+    bool found;
+    if ((st = get_int(p, smp, "sample_count", &spp, &found))) return st;
+    if (found) {
+        const pk_int_option *o = pk_int_option_find("spp");
+        if (spp < o->min || spp > o->max) {
+            int64_t c = spp < o->min ? o->min : o->max;
+            xwarn(p, smp, "sample_count %lld is outside %d..%d; using %lld", (long long)spp, o->min, o->max,
+                  (long long)c);
+            spp = c;
+        }
+        p->s->render.opt.spp = (int)spp;
+        p->s->render.has_spp = true;
+    }
+    static const char *const quiet[] = {"seed", "scramble", "dimension", "jitter", NULL};
+    warn_unused(p, smp, "sampler", quiet);
+    return PK_OK;
+}
+
+static pk_status parse_sensor(xp *p, xnode *sn)
+{
+    pk_status st;
+    const char *type = attr_st(p, sn, "type", &st);
+    if (st) return st;
+    if (!type) return xfail(p, PK_ERR_PARSE, sn, "<sensor> needs a type");
+    char ty[40];
+    shown(ty, sizeof ty, type);
+    if (strcmp(type, "perspective") != 0) {
+        if (strcmp(type, "thinlens") == 0) {
+            xwarn(p, sn, "sensor \"thinlens\" rendered as a pinhole camera (no depth of field)");
+            prop(p, sn, "aperture_radius"), prop(p, sn, "focus_distance");
+        } else {
+            xwarn(p, sn, "sensor \"%s\" is not supported; rendered as a perspective camera", ty);
+            for (xnode *c = sn->child; c; c = c->next)
+                if (is_property_tag(c->tag) && strcmp(c->tag, "transform") != 0) c->used = true;
+        }
+    }
+    float m[16];
+    bool has_m;
+    if ((st = get_to_world(p, sn, m, &has_m))) return st;
+    float fov = XML_DEFAULT_FOV;
+    xnode *fn = prop(p, sn, "fov");
+    if (fn && (st = node_float(p, fn, &fov))) return st;
+    if (fn && !(fov > 0.0f && fov < 180.0f)) return xfail(p, PK_ERR_PARSE, fn, "fov must be in (0, 180) degrees");
+    if (!fn && prop(p, sn, "focal_length"))
+        xwarn(p, sn, "focal_length is not supported; using fov %g", (double)fov);
+    const char *axis = "x";
+    xnode *an;
+    if ((st = get_string(p, sn, "fov_axis", &axis, &an))) return st;
+    if (strcmp(axis, "x") && strcmp(axis, "y") && strcmp(axis, "diagonal") && strcmp(axis, "smaller") &&
+        strcmp(axis, "larger"))
+        return xfail(p, PK_ERR_PARSE, an, "fov_axis must be x, y, diagonal, smaller or larger");
+    snprintf(p->fov_axis, sizeof p->fov_axis, "%s", axis);
+    p->fov = fov;
+    p->has_fov = true;
+
+    /* Mitsuba's camera looks along +z of its frame with +y up; its image x
+     * runs along -x (so a right-handed frame has the image's right on the
+     * right). */
+    vec3 o = m_point(m, v3s(0.0f));
+    vec3 fwd = v3_norm_scaled(m_dir(m, v3(0.0f, 0.0f, 1.0f)));
+    vec3 up = v3_norm_scaled(m_dir(m, v3(0.0f, 1.0f, 0.0f)));
+    vec3 right = v3_neg(m_dir(m, v3(1.0f, 0.0f, 0.0f)));
+    if (v3_dot(v3_cross(fwd, up), right) < 0.0f)
+        xwarn(p, sn, "the camera's to_world mirrors the image; rendered unmirrored");
+    vec3 at = v3_add(o, fwd);
+    pk_camera cam = {{o.x, o.y, o.z}, {at.x, at.y, at.z}, {up.x, up.y, up.z}, 45.0f};
+    switch (camera_check(&cam)) {
+    case CAMERA_OK: break;
+    default: return xfail(p, PK_ERR_PARSE, sn, "the sensor's to_world gives no usable camera (singular or not finite)");
+    }
+    p->s->camera = cam;
+    p->s->has_camera = true;
+    p->sensor = sn;
+
+    for (xnode *c = sn->child; c; c = c->next) {
+        if (strcmp(c->tag, "film") == 0) {
+            c->used = true;
+            if ((st = parse_film(p, c))) return st;
+        } else if (strcmp(c->tag, "sampler") == 0) {
+            c->used = true;
+            if ((st = parse_sampler(p, c))) return st;
+        }
+    }
+    static const char *const quiet[] = {"near_clip", "far_clip", "focus_distance", "shutter_open", "shutter_close",
+                                        "principal_point_offset_x", "principal_point_offset_y", NULL};
+    warn_unused(p, sn, "sensor", quiet);
+    return PK_OK;
+}
+
+/* The vertical fov of the camera from Mitsuba's fov and fov_axis, for the
+ * film's aspect (the XML's film size; a size given on the command line
+ * later keeps this vertical angle). */
+static pk_status finish_camera(xp *p)
+{
+    if (!p->sensor) return PK_OK;
+    int w = p->film_w ? p->film_w : XML_DEFAULT_WIDTH, h = p->film_h ? p->film_h : XML_DEFAULT_HEIGHT;
+    double t = tan(0.5 * (double)p->fov * (double)PK_PI / 180.0), ty;
+    const char *ax = p->fov_axis;
+    if (strcmp(ax, "smaller") == 0) ax = w <= h ? "x" : "y";
+    if (strcmp(ax, "larger") == 0) ax = w >= h ? "x" : "y";
+    if (strcmp(ax, "x") == 0) ty = t * (double)h / (double)w;
+    else if (strcmp(ax, "y") == 0) ty = t;
+    else ty = t * (double)h / sqrt((double)w * w + (double)h * h);
+    float fov = (float)(2.0 * atan(ty) * 180.0 / (double)PK_PI);
+    if (!(fov > 0.0f && fov < 180.0f)) return xfail(p, PK_ERR_PARSE, p->sensor, "the vertical fov is out of range");
+    p->s->camera.fov_deg = fov;
+    return PK_OK;
+}
+
+static pk_status parse_integrator(xp *p, xnode *in, int depth)
+{
+    pk_status st;
+    if (depth > 4) return xfail(p, PK_ERR_LIMIT, in, "integrators nested too deep");
+    const char *type = attr_st(p, in, "type", &st);
+    if (st) return st;
+    if (!type) return xfail(p, PK_ERR_PARSE, in, "<integrator> needs a type");
+    char ty[40];
+    shown(ty, sizeof ty, type);
+    if (strcmp(type, "aov") == 0 || strcmp(type, "moment") == 0 || strcmp(type, "adaptive") == 0 ||
+        strcmp(type, "irrcache") == 0 || strcmp(type, "multichannel") == 0) {
+        for (xnode *c = in->child; c; c = c->next) {
+            c->used = true;
+            if (strcmp(c->tag, "integrator") == 0) return parse_integrator(p, c, depth + 1);
+        }
+        return PK_OK;
+    }
+    static const char *const pathlike[] = {"path", "volpath", "volpath_simple", "volpathmis", "prb", "prbvolpath",
+                                           "direct_projective", "prb_projective", "path_reparam", NULL};
+    bool path = false;
+    for (int i = 0; pathlike[i]; i++)
+        if (strcmp(type, pathlike[i]) == 0) path = true;
+    scene_render_settings *r = &p->s->render;
+    r->opt.integrator = PK_INTEGRATOR_PATH;
+    r->has_integrator = true;
+    int64_t md = -1;
+    bool found = false;
+    if (strcmp(type, "direct") == 0) {
+        md = 2;
+        path = true;
+        prop(p, in, "emitter_samples"), prop(p, in, "bsdf_samples"), prop(p, in, "shading_samples");
+    } else if ((st = get_int(p, in, "max_depth", &md, &found))) {
+        return st;
+    }
+    if (!path) {
+        for (xnode *c = in->child; c; c = c->next) c->used = true;
+        char depth_text[32];
+        if (md < 0) snprintf(depth_text, sizeof depth_text, "unbounded");
+        else snprintf(depth_text, sizeof depth_text, "%lld", (long long)md);
+        xwarn(p, in, "integrator \"%s\" is not supported; rendered with the path tracer (max_depth %s)", ty,
+              depth_text);
+    }
+    /* Mitsuba counts path segments (1: emitters seen directly, 2: direct
+     * light); Paprsek counts bounces after the first hit: one less. -1 is
+     * unbounded, as deep as Paprsek goes. */
+    int pd;
+    if (md < 0) pd = PK_MAX_DEPTH;
+    else if (md == 0) {
+        xwarn(p, in, "max_depth 0 renders nothing in Mitsuba; rendering the emitters seen directly");
+        pd = 0;
+    } else pd = md - 1 > PK_MAX_DEPTH ? PK_MAX_DEPTH : (int)(md - 1);
+    r->opt.max_depth = pd;
+    r->has_max_depth = true;
+    static const char *const quiet[] = {"rr_depth", "strict_normals", "hide_emitters", "samples_per_pass",
+                                        "block_size", "timeout", "luminance_samples", NULL};
+    warn_unused(p, in, "integrator", quiet);
+    return PK_OK;
+}
+
+/* ---- the document ------------------------------------------------------------------------- */
+
+static pk_status parse_scene(xp *p, xnode *root, int include_depth);
+
+static pk_status parse_include(xp *p, xnode *inc, int include_depth)
+{
+    pk_status st;
+    const char *fn = attr_st(p, inc, "filename", &st);
+    if (st) return st;
+    if (!fn) return xfail(p, PK_ERR_PARSE, inc, "<include> needs a filename");
+    if (include_depth >= XML_MAX_INCLUDE_DEPTH)
+        return xfail(p, PK_ERR_LIMIT, inc, "includes nested more than %d deep (a file that includes itself?)",
+                     XML_MAX_INCLUDE_DEPTH);
+    if (p->nfiles >= XML_MAX_FILES) return xfail(p, PK_ERR_LIMIT, inc, "more than %d included files", XML_MAX_FILES);
+    char *full = NULL, *data = NULL, *dir = NULL;
+    size_t size = 0;
+    if ((st = read_relative(p, inc, fn, &full, &data, &size))) goto out;
+    xml_file *f = arena_alloc(p, sizeof *f);
+    dir = path_dirname(&p->ctx->alloc, full);
+    if (!f || !dir) {
+        st = ctx_nomem(p->ctx);
+        goto out;
+    }
+    f->shown = arena_strdup(p, full);
+    f->dir = arena_strdup(p, dir);
+    if (!f->shown || !f->dir) {
+        st = ctx_nomem(p->ctx);
+        goto out;
+    }
+    p->nfiles++;
+    xnode *root;
+    if ((st = parse_tree(p, data, size, f, &root))) goto out;
+    st = parse_scene(p, root, include_depth + 1);
+out:
+    mem_free(&p->ctx->alloc, data);
+    mem_free(&p->ctx->alloc, dir);
+    mem_free(&p->ctx->alloc, full);
+    return st;
+}
+
+static pk_status parse_scene(xp *p, xnode *root, int include_depth)
+{
+    pk_status st;
+    for (xnode *c = root->child; c; c = c->next) {
+        const char *t = c->tag;
+        if (strcmp(t, "default") == 0) {
+            const char *nm = attr_st(p, c, "name", &st);
+            if (st) return st;
+            const char *v = attr_st(p, c, "value", &st);
+            if (st) return st;
+            if (!nm || !v) return xfail(p, PK_ERR_PARSE, c, "<default> needs name and value");
+            if (param_find(p, nm, strlen(nm))) continue; /* the first definition holds */
+            if (p->nparams == XML_MAX_PARAMS)
+                return xfail(p, PK_ERR_LIMIT, c, "more than %d <default> parameters", XML_MAX_PARAMS);
+            p->params[p->nparams].name = nm;
+            p->params[p->nparams].value = v;
+            p->nparams++;
+        } else if (strcmp(t, "include") == 0) {
+            if ((st = parse_include(p, c, include_depth))) return st;
+        } else if (strcmp(t, "bsdf") == 0 || strcmp(t, "texture") == 0) {
+            const char *id = attr_st(p, c, "id", &st);
+            if (st) return st;
+            if (id && (st = id_add(p, id, c))) return st;
+        } else if (strcmp(t, "shape") == 0) {
+            if ((st = parse_shape(p, c))) return st;
+        } else if (strcmp(t, "emitter") == 0) {
+            if ((st = parse_emitter(p, c))) return st;
+        } else if (strcmp(t, "sensor") == 0 || strcmp(t, "camera") == 0) {
+            if (p->sensor) {
+                xwarn(p, c, "a second sensor is not supported; ignored");
+                continue;
+            }
+            if ((st = parse_sensor(p, c))) return st;
+        } else if (strcmp(t, "integrator") == 0) {
+            if ((st = parse_integrator(p, c, 0))) return st;
+        } else if (strcmp(t, "medium") == 0 || strcmp(t, "phase") == 0) {
+            if (first_time(p, "medium")) xwarn(p, c, "participating media are not supported; ignored");
+        } else if (strcmp(t, "ref") == 0 || strcmp(t, "null") == 0) {
+            continue;
+        } else {
+            char tg[40];
+            shown(tg, sizeof tg, t);
+            char key[64];
+            snprintf(key, sizeof key, "element %s", tg);
+            if (first_time(p, key)) xwarn(p, c, "<%s> is not supported; ignored", tg);
+        }
+    }
+    return PK_OK;
+}
+
+pk_status scene_xml_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size, const char *name,
+                          const char *base_dir, const char *const *params, size_t nparams)
+{
+    if (!ctx || !s) return PK_ERR_INVALID_ARGUMENT;
+    if (!data && size) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "scene_xml_parse: no data");
+    xp *p = mem_calloc(&ctx->alloc, 1, sizeof *p);
+    if (!p) return ctx_nomem(ctx);
+    p->ctx = ctx;
+    p->s = s;
+    xml_file top = {name ? name : "scene.xml", base_dir ? base_dir : "."};
+    xnode *root;
+    pk_status st = PK_OK;
+    /* parameters from the caller (paprsek render -D name=value) come first */
+    for (size_t i = 0; i < nparams && st == PK_OK; i++) {
+        const char *d = params[i], *eq = d ? strchr(d, '=') : NULL;
+        char shown_d[64];
+        shown(shown_d, sizeof shown_d, d ? d : "");
+        if (!eq || eq == d) {
+            st = ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "parameter '%s': expected NAME=VALUE", shown_d);
+            break;
+        }
+        for (const char *c = d; c < eq; c++)
+            if (!is_ident(*c)) {
+                st = ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "parameter '%s': a name is letters, digits and _",
+                               shown_d);
+                break;
+            }
+        if (st) break;
+        if (param_find(p, d, (size_t)(eq - d))) continue; /* the first one holds */
+        if (p->nparams == XML_MAX_PARAMS) {
+            st = ctx_error(ctx, PK_ERR_LIMIT, "more than %d parameters", XML_MAX_PARAMS);
+            break;
+        }
+        const char *nm = arena_strndup(p, d, (size_t)(eq - d)), *v = arena_strdup(p, eq + 1);
+        if (!nm || !v) {
+            st = ctx_nomem(ctx);
+            break;
+        }
+        p->params[p->nparams].name = nm;
+        p->params[p->nparams].value = v;
+        p->nparams++;
+    }
+    if (st == PK_OK) st = parse_tree(p, data ? data : "", size, &top, &root);
+    if (st == PK_OK) {
+        const char *version = NULL;
+        for (int i = 0; i < root->nattrs; i++)
+            if (strcmp(root->attrs[i].name, "version") == 0) version = root->attrs[i].value;
+        if (!version) xwarn(p, root, "<scene> has no version; read as Mitsuba 3");
+        st = parse_scene(p, root, 0);
+    }
+    if (st == PK_OK) st = finish_camera(p);
+    arena_free(p);
+    mem_free(&ctx->alloc, p->ids);
+    mem_free(&ctx->alloc, p);
+    return st;
+}
