@@ -2020,6 +2020,11 @@ static pk_status parse_emitter(xp *p, xnode *e)
                 vec3 col = v3_norm_scaled(v3(m[c], m[4 + c], m[8 + c]));
                 env->to_world[c] = col.x, env->to_world[3 + c] = col.y, env->to_world[6 + c] = col.z;
             }
+            /* read now, so that a bad map is reported at its element */
+            pk_context scratch = *p->ctx;
+            scratch.status = PK_OK;
+            scratch.message[0] = '\0';
+            if ((st = scene_env_load(&scratch, env))) return xfail(p, st, e, "envmap: %s", scratch.message);
         }
         static const char *const q2[] = {"sampling_weight", "gamma", "filter_type", "cache", NULL};
         warn_unused(p, e, kind, q2);

@@ -574,13 +574,26 @@ static void test_emitters(void)
     s = load_ok("<shape type=\"cube\"/><emitter type=\"constant\"><rgb name=\"radiance\" value=\"0.5 0.25 1\"/></emitter>");
     CHECK(s && s->env.set && near3(s->env.radiance, v3(0.5f, 0.25f, 1.0f), 0));
     pk_scene_destroy(s);
-    s = load_ok("<shape type=\"cube\"/><emitter type=\"envmap\"><string name=\"filename\" value=\"sky.exr\"/>"
+    {
+        /* a 2 x 1 PFM map */
+        char path[512];
+        snprintf(path, sizeof path, "%s/sky.pfm", tmpdir);
+        FILE *f = fopen(path, "wb");
+        REQUIRE(f);
+        const float px[6] = {1, 1, 1, 2, 2, 2};
+        fprintf(f, "PF\n2 1\n-1.0\n");
+        REQUIRE(fwrite(px, sizeof px, 1, f) == 1);
+        fclose(f);
+    }
+    load_fails("<shape type=\"cube\"/>\n<emitter type=\"envmap\"><string name=\"filename\" value=\"nowhere.exr\"/></emitter>",
+               true, "scene.xml:3: envmap: ");
+    s = load_ok("<shape type=\"cube\"/><emitter type=\"envmap\"><string name=\"filename\" value=\"sky.pfm\"/>"
                 "<float name=\"scale\" value=\"2\"/><transform name=\"to_world\"><rotate y=\"1\" angle=\"90\"/></transform></emitter>");
     if (s) {
         char want[512];
-        snprintf(want, sizeof want, "%s/sky.exr", tmpdir);
+        snprintf(want, sizeof want, "%s/sky.pfm", tmpdir);
         CHECK(s->env.set && s->env.map && strcmp(s->env.map, want) == 0);
-        CHECK(s->env.map_scale == 2.0f);
+        CHECK(s->env.map_scale == 2.0f && s->env.map_w == 2 && s->env.map_h == 1 && s->env.map_rgb[3] == 2.0f);
         /* a rotation of 90 degrees about y takes x to -z */
         CHECK(fabsf(s->env.to_world[0]) < 1e-6f && fabsf(s->env.to_world[6] + 1.0f) < 1e-6f);
     }
