@@ -267,7 +267,9 @@ static pk_status read_library(obj_state *st, const char *rel)
     bool was_ok = r->ctx->status == PK_OK;
     pk_status rc = file_read_all(r->ctx, path, &data, &size);
     if (rc == PK_OK) {
-        rc = mtl_parse(r->ctx, st->s, data, size, rel);
+        char *dir = path_dirname(&r->ctx->alloc, path);
+        rc = dir ? mtl_parse_dir(r->ctx, st->s, data, size, rel, dir) : ctx_nomem(r->ctx);
+        mem_free(&r->ctx->alloc, dir);
         mem_free(&r->ctx->alloc, data);
     } else if (rc != PK_ERR_NOMEM && was_ok) {
         char why[PK_ERRMSG_MAX];

@@ -202,9 +202,14 @@ static inline void scene_tri_verts(const pk_scene *s, size_t k, vec3 *a, vec3 *b
  * inverse transpose to normals); NULL = identity. Does not commit. */
 PK_HIDDEN pk_status obj_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,
                               const char *name, const char *base_dir, const float *xform);
-/* Parses MTL text, adding its materials to s. */
+/* Parses MTL text, adding its materials to s. Texture maps are parsed but
+ * not loaded. */
 PK_HIDDEN pk_status mtl_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,
                               const char *name);
+/* The same, loading the texture maps from files relative to tex_dir (NULL:
+ * not loaded). A texture that cannot be used is a warning. */
+PK_HIDDEN pk_status mtl_parse_dir(pk_context *ctx, pk_scene *s, const char *data, size_t size,
+                                  const char *name, const char *tex_dir);
 /* Parses a JSON scene into s (meshes are loaded relative to base_dir). Does not commit. */
 PK_HIDDEN pk_status scene_json_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,
                                      const char *name, const char *base_dir);
