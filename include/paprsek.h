@@ -222,6 +222,8 @@ typedef struct pk_scene_info {
     size_t spheres, materials, point_lights, emissive_triangles;
     float bounds_min[3], bounds_max[3];
     int has_camera;              /* 0: the camera is framed on the bounds */
+    size_t textures;             /* images loaded for texture maps (one per file and decode mode) */
+    size_t texture_bytes;        /* their texels, mipmaps included */
 } pk_scene_info;
 
 PK_API void pk_scene_get_info(const pk_scene *scene, pk_scene_info *info);
