@@ -116,7 +116,10 @@ void surface_texture(const pk_scene *s, const ray *r, const hit *h, float cone_w
     if (m->map_kd.kind) tm->kd = v3_mul(m->kd, tex_eval_rgb(s->textures, &m->map_kd, q));
     if (m->map_ks.kind) tm->ks = v3_mul(m->ks, tex_eval_rgb(s->textures, &m->map_ks, q));
     if (m->map_ns.kind) tm->ns = m->ns * tex_eval_scalar(s->textures, &m->map_ns, q);
-    if (m->map_alpha.kind) tm->alpha = m->alpha * tex_eval_scalar(s->textures, &m->map_alpha, q);
+    if (m->map_alpha.kind) {
+        float a = tex_eval_scalar(s->textures, &m->map_alpha, q);
+        tm->alpha = m->alpha * (m->map_alpha.squared ? a * a : a);
+    }
     sf->m = tm;
     if (!m->map_bump.kind && !m->map_norm.kind) return;
     /* a frame on the surface, z = the shading normal as it faces the ray */

@@ -46,6 +46,7 @@ typedef enum tex_kind { TEX_NONE, TEX_IMAGE, TEX_CHECKER } tex_kind;
 typedef struct tex_ref {
     uint8_t kind;      /* tex_kind; TEX_NONE (0) = the constant alone */
     bool clamp;
+    bool squared;      /* scalars: the value squared (roughness maps read as GGX alpha) */
     int32_t tex;       /* TEX_IMAGE: index into the scene's textures */
     float s[2], o[2];
     float bm;          /* bump maps: the multiplier of the heights (-bm) */
