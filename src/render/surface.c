@@ -97,6 +97,11 @@ surface_uv surface_uv_at(const pk_scene *s, const ray *r, const hit *h)
     return q;
 }
 
+static inline vec3 clamp_rgb(vec3 c)
+{
+    return v3(fminf(fmaxf(c.x, 0.0f), 1.0f), fminf(fmaxf(c.y, 0.0f), 1.0f), fminf(fmaxf(c.z, 0.0f), 1.0f));
+}
+
 /* Height of a bump map at (u, v), the fine level. */
 static inline float bump_height(const pk_scene *s, const tex_ref *ref, float u, float v)
 {
@@ -113,12 +118,13 @@ void surface_texture(const pk_scene *s, const ray *r, const hit *h, float cone_w
     const float cosv = dl > 0.0f ? fabsf(v3_dot(r->d, sf->ng)) / dl : 1.0f;
     tex_query q = {uv.u, uv.v, cone_width / fmaxf(cosv, MIN_COS) * uv.uv_per_len};
     if (!isfinite(q.width)) q.width = 0.0f;
-    if (m->map_kd.kind) tm->kd = v3_mul(m->kd, tex_eval_rgb(s->textures, &m->map_kd, q));
-    if (m->map_ks.kind) tm->ks = v3_mul(m->ks, tex_eval_rgb(s->textures, &m->map_ks, q));
-    if (m->map_ns.kind) tm->ns = m->ns * tex_eval_scalar(s->textures, &m->map_ns, q);
+    /* texture values: colours and alpha in 0..1 (HDR images may hold more), Ns >= 0 */
+    if (m->map_kd.kind) tm->kd = v3_mul(m->kd, clamp_rgb(tex_eval_rgb(s->textures, &m->map_kd, q)));
+    if (m->map_ks.kind) tm->ks = v3_mul(m->ks, clamp_rgb(tex_eval_rgb(s->textures, &m->map_ks, q)));
+    if (m->map_ns.kind) tm->ns = m->ns * fmaxf(tex_eval_scalar(s->textures, &m->map_ns, q), 0.0f);
     if (m->map_alpha.kind) {
-        float a = tex_eval_scalar(s->textures, &m->map_alpha, q);
-        tm->alpha = m->alpha * (m->map_alpha.squared ? a * a : a);
+        float a = fminf(fmaxf(tex_eval_scalar(s->textures, &m->map_alpha, q), 0.0f), 1.0f);
+        tm->alpha = fminf(m->alpha * (m->map_alpha.squared ? a * a : a), 1.0f);
     }
     sf->m = tm;
     if (!m->map_bump.kind && !m->map_norm.kind) return;
