@@ -118,6 +118,9 @@ void surface_texture(const pk_scene *s, const ray *r, const hit *h, float cone_w
     const float cosv = dl > 0.0f ? fabsf(v3_dot(r->d, sf->ng)) / dl : 1.0f;
     tex_query q = {uv.u, uv.v, cone_width / fmaxf(cosv, MIN_COS) * uv.uv_per_len};
     if (!isfinite(q.width)) q.width = 0.0f;
+#ifdef PK_TEX_NO_CONES /* (-D for measurements: the finest level always, bilinear) */
+    q.width = 0.0f;
+#endif
     /* texture values: colours and alpha in 0..1 (HDR images may hold more), Ns >= 0 */
     if (m->map_kd.kind) tm->kd = v3_mul(m->kd, clamp_rgb(tex_eval_rgb(s->textures, &m->map_kd, q)));
     if (m->map_ks.kind) tm->ks = v3_mul(m->ks, clamp_rgb(tex_eval_rgb(s->textures, &m->map_ks, q)));

@@ -365,6 +365,54 @@ static void test_render_quad(void)
     pk_scene_destroy(s);
 }
 
+/* JSON: textures and checkers in material parameters, a missing file warned about. */
+static void test_json(void)
+{
+    char *text = NULL;
+    size_t size = 0;
+    REQUIRE(file_read_all(ctx, PK_TEST_DATA "/tex_json.json", &text, &size) == PK_OK);
+    warns w = {0, ""};
+    pk_scene *s;
+    REQUIRE(scene_create(ctx, "tex_json.json", &s) == PK_OK);
+    pk_context_set_warning_handler(ctx, on_warn, &w);
+    CHECKF(scene_json_parse(ctx, s, text, size, "tex_json.json", PK_TEST_DATA) == PK_OK, "%s", pk_context_error(ctx));
+    pk_context_set_warning_handler(ctx, NULL, NULL);
+    mem_free(&ctx->alloc, text);
+    const material *floor = &s->materials[scene_find_material(s, "floor")];
+    const material *ball = &s->materials[scene_find_material(s, "ball")];
+    const material *metal = &s->materials[scene_find_material(s, "metal")];
+    const material *oops = &s->materials[scene_find_material(s, "oops")];
+    CHECK(floor->map_kd.kind == TEX_CHECKER && floor->map_kd.checker_scale == 300.0f && floor->kd.x == 1.0f);
+    CHECK(floor->map_kd.odd.x == 0.1f);
+    CHECK(ball->map_kd.kind == TEX_IMAGE && ball->map_kd.s[0] == 4.0f && ball->map_kd.s[1] == 2.0f);
+    CHECK(ball->map_bump.kind == TEX_IMAGE && ball->map_bump.bm == 0.05f && ball->kd.x == 1.0f);
+    CHECK(metal->map_alpha.kind == TEX_IMAGE && metal->map_alpha.squared && metal->alpha == 1.0f);
+    CHECK(oops->map_kd.kind == TEX_NONE && oops->kd.x == 0.8f); /* the default kd */
+    CHECK(oops->map_d.kind == TEX_CHECKER);
+    CHECK(s->ntextures == 2); /* tex_checker.png (colour), tex_bump.png (data, twice) */
+    CHECKF(w.count == 1 && strstr(w.all, "tex_json.json:10: materials.oops.kd.texture: texture 'nothere.png' not used ("),
+           "%s", w.all);
+    scene_destroy(s);
+
+    /* malformed texture objects are errors naming the value */
+    static const struct {
+        const char *json, *msg;
+    } bad[] = {
+        {"{\"materials\": {\"m\": {\"kd\": {\"scale\": 2}}}}", "materials.m.kd: a texture needs \"texture\""},
+        {"{\"materials\": {\"m\": {\"kd\": {\"texture\": \"a.png\", \"checker\": {}}}}}", "a texture needs"},
+        {"{\"materials\": {\"m\": {\"kd\": {\"texture\": 3}}}}", "materials.m.kd.texture: must be a file name"},
+        {"{\"materials\": {\"m\": {\"kd\": {\"checker\": {\"scale\": 0}}}}}", "materials.m.kd.checker.scale: must be a positive"},
+        {"{\"materials\": {\"m\": {\"type\": \"diffuse\", \"opacity\": 0.5}}}", "materials.m.opacity: must be a texture object"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        REQUIRE(scene_create(ctx, "bad.json", &s) == PK_OK);
+        CHECK(scene_json_parse(ctx, s, bad[i].json, strlen(bad[i].json), "bad.json", PK_TEST_DATA) == PK_ERR_PARSE);
+        CHECKF(strstr(pk_context_error(ctx), bad[i].msg) != NULL, "%s", pk_context_error(ctx));
+        pk_context_clear_error(ctx);
+        scene_destroy(s);
+    }
+}
+
 int main(void)
 {
     REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
@@ -376,6 +424,7 @@ int main(void)
     test_cache_and_fallback();
     test_cutout();
     test_render_quad();
+    test_json();
     pk_context_destroy(ctx);
     return test_done("test_texture");
 }
