@@ -94,11 +94,15 @@ static pk_status alloc_buf(pk_context *ctx, image_buf *out, int w, int h, int nc
     return PK_OK;
 }
 
-/* Non-finite samples (NaN, inf) become 0: lookups must stay finite. */
+/* Non-finite samples (NaN, inf) become 0, and magnitudes are kept within
+ * IMAGE_MAX_SAMPLE: lookups, which interpolate and average, must stay finite. */
 static void sanitize_floats(float *p, size_t n)
 {
-    for (size_t i = 0; i < n; i++)
+    for (size_t i = 0; i < n; i++) {
         if (!isfinite(p[i])) p[i] = 0.0f;
+        else if (p[i] > IMAGE_MAX_SAMPLE) p[i] = IMAGE_MAX_SAMPLE;
+        else if (p[i] < -IMAGE_MAX_SAMPLE) p[i] = -IMAGE_MAX_SAMPLE;
+    }
 }
 
 image_format image_sniff(const void *data, size_t size)
@@ -583,6 +587,7 @@ pk_status image_decode_hdr(pk_context *ctx, const void *data, size_t size, const
         for (int x = 0; x < w; x++) rgbe_to_float(line + 4 * x, o + 3 * x);
     }
     mem_free(&ctx->alloc, line);
+    sanitize_floats(out->pxf, (size_t)w * (size_t)h * 3);
     return PK_OK;
 }
 
