@@ -395,7 +395,9 @@ pk_status image_decode_exr(pk_context *ctx, const void *data, size_t size, const
             exr_chunk_info_t ci;
             int64_t x0, y0;
             if (storage == EXR_STORAGE_SCANLINE) {
-                rv = exr_read_scanline_chunk_info(e, 0, dw.min.y + cy * lines, &ci);
+                const int64_t y = (int64_t)dw.min.y + (int64_t)cy * lines;
+                if (y > INT32_MAX) goto exr_bad;
+                rv = exr_read_scanline_chunk_info(e, 0, (int)y, &ci);
                 x0 = 0;
                 y0 = (int64_t)ci.start_y - dw.min.y;
             } else {

@@ -117,12 +117,14 @@ static const struct {
 } ignored_options[] = {{"-blendu", 1}, {"-blendv", 1}, {"-boost", 1}, {"-mm", 2}, {"-texres", 1},
                        {"-imfchan", 1}, {"-cc", 1}, {"-type", 1}, {"-t", 3}};
 
-/* Up to 3 numbers after an option (-s, -o: u [v [w]]); at least 1. */
-static pk_status map_numbers(mtl_state *st, const char *opt, size_t on, const char **pp, const char *le, float *out,
-                             int max, int *n)
+/* Up to max numbers after an option (-s, -o: u [v [w]]). false (with a
+ * warning) when there is none or one is not finite: the option is ignored. */
+static bool map_numbers(mtl_state *st, const char *opt, size_t on, const char **pp, const char *le, float *out,
+                        int max, int *n)
 {
     const char *p = *pp;
     *n = 0;
+    bool finite = true;
     while (*n < max) {
         const char *t = io_skip_blanks(p, le);
         if (t == le) break;
@@ -130,13 +132,16 @@ static pk_status map_numbers(mtl_state *st, const char *opt, size_t on, const ch
         float v;
         const char *q = io_parse_float(t, te, &v);
         if (!q || q != te) break;
-        if (!isfinite(v)) return io_error(&st->r, PK_ERR_PARSE, "%.*s: number is not finite", (int)on, opt);
+        finite &= isfinite(v) != 0;
         out[(*n)++] = v;
         p = te;
     }
-    if (*n == 0) return io_error(&st->r, PK_ERR_PARSE, "%.*s needs a number", (int)on, opt);
     *pp = p;
-    return PK_OK;
+    if (*n == 0 || !finite) {
+        io_warn(&st->r, "texture option %.*s needs %s; ignored", (int)on, opt, *n ? "finite numbers" : "a number");
+        return false;
+    }
+    return true;
 }
 
 /* "map_X [options] file": fills ref (and loads the texture when the scene's
@@ -155,20 +160,22 @@ static pk_status parse_map(mtl_state *st, const char *kw, size_t kn, const char 
         p = oe;
         float v[3];
         int n;
-        pk_status rc;
         if (kw_ci(o, on, "-s") || kw_ci(o, on, "-o")) {
-            if ((rc = map_numbers(st, o, on, &p, le, v, 3, &n)) != PK_OK) return rc;
+            if (!map_numbers(st, o, on, &p, le, v, 3, &n)) continue;
             float *dst = (o[1] | 0x20) == 's' ? nr.s : nr.o;
             dst[0] = v[0];
             dst[1] = n >= 2 ? v[1] : (o[1] | 0x20) == 's' ? 1.0f : 0.0f;
         } else if (kw_ci(o, on, "-bm")) {
-            if ((rc = map_numbers(st, o, on, &p, le, v, 1, &n)) != PK_OK) return rc;
+            if (!map_numbers(st, o, on, &p, le, v, 1, &n)) continue;
             nr.bm = v[0];
         } else if (kw_ci(o, on, "-clamp")) {
             const char *t = io_skip_blanks(p, le), *te = io_token_end(t, le);
             if (kw_ci(t, (size_t)(te - t), "on")) nr.clamp = true;
             else if (kw_ci(t, (size_t)(te - t), "off")) nr.clamp = false;
-            else return io_error(r, PK_ERR_PARSE, "-clamp needs on or off");
+            else {
+                io_warn(r, "texture option -clamp needs on or off; ignored");
+                continue;
+            }
             p = te;
         } else {
             int skip = -1;
@@ -193,8 +200,10 @@ static pk_status parse_map(mtl_state *st, const char *kw, size_t kn, const char 
     }
     const char *fs, *fe;
     io_rest(p, le, &fs, &fe);
-    if (fs == fe) return io_error(r, PK_ERR_PARSE, "%.*s needs a file name", io_tok_len(kw, kw + kn), kw);
-    if (!tex_ref_valid(&nr)) return io_error(r, PK_ERR_PARSE, "%.*s: options are not finite", io_tok_len(kw, kw + kn), kw);
+    if (fs == fe) {
+        io_warn(r, "%.*s without a file name ignored", io_tok_len(kw, kw + kn), kw);
+        return PK_OK;
+    }
     if (!st->tex_dir) return PK_OK; /* parsed only (no files are read) */
     pk_context *ctx = r->ctx;
     char *rel = mem_strndup(&ctx->alloc, fs, (size_t)(fe - fs));

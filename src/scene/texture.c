@@ -21,12 +21,6 @@ void tex_ref_init(tex_ref *r)
     r->checker_scale = 1.0f;
 }
 
-bool tex_ref_valid(const tex_ref *r)
-{
-    return isfinite(r->s[0]) && isfinite(r->s[1]) && isfinite(r->o[0]) && isfinite(r->o[1]) && isfinite(r->bm) &&
-           isfinite(r->checker_scale);
-}
-
 void texture_free(const pk_allocator *a, texture *t)
 {
     for (int k = 0; k < t->nlevels; k++) {

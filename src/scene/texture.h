@@ -89,8 +89,4 @@ PK_HIDDEN vec3 tex_eval_rgb(const texture *textures, const tex_ref *r, tex_query
 PK_HIDDEN float tex_eval_scalar(const texture *textures, const tex_ref *r, tex_query q);
 PK_HIDDEN float tex_eval_alpha(const texture *textures, const tex_ref *r, tex_query q);
 
-/* Options of an MTL map statement or a JSON texture: parsed by the callers
- * into a tex_ref; this checks the transform is finite. */
-PK_HIDDEN bool tex_ref_valid(const tex_ref *r);
-
 #endif

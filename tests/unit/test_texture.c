@@ -228,7 +228,8 @@ static void test_cache_and_fallback(void)
     warns w = {0, ""};
     const char *mtl = "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd tex_rgbw.png\nmap_d tex_rgbw.png\n"
                       "newmtl b\nmap_Kd -s 2 3 -o 0.5 0.25 -clamp on -blendu off -zz tex_rgbw.png\n"
-                      "newmtl c\nKd 0.2 0.3 0.4\nmap_Kd missing.png\nmap_Ks tex_bad.png\n";
+                      "newmtl c\nKd 0.2 0.3 0.4\nmap_Kd missing.png\nmap_Ks tex_bad.png\n"
+                      "newmtl d\nmap_Kd -s -clamp -bm inf tex_rgbw.png\nmap_Ks\n";
     pk_scene *s;
     REQUIRE(scene_create(ctx, "m", &s) == PK_OK);
     pk_context_set_warning_handler(ctx, on_warn, &w);
@@ -244,7 +245,14 @@ static void test_cache_and_fallback(void)
     CHECK(b->map_kd.s[0] == 2.0f && b->map_kd.s[1] == 3.0f && b->map_kd.o[0] == 0.5f && b->map_kd.o[1] == 0.25f &&
           b->map_kd.clamp);
     CHECK(c->map_kd.kind == TEX_NONE && c->map_ks.kind == TEX_NONE && c->kd.x == 0.2f);
-    CHECKF(w.count == 4, "%s", w.all);
+    const material *d = &s->materials[scene_find_material(s, "d")];
+    /* malformed options are warned about and skipped; the texture is still used */
+    CHECK(d->map_kd.kind == TEX_IMAGE && d->map_kd.s[0] == 1.0f && !d->map_kd.clamp && d->map_kd.bm == 1.0f);
+    CHECKF(strstr(w.all, "m.mtl:12: texture option -s needs a number; ignored\n"), "%s", w.all);
+    CHECKF(strstr(w.all, "m.mtl:12: texture option -clamp needs on or off; ignored\n"), "%s", w.all);
+    CHECKF(strstr(w.all, "m.mtl:12: texture option -bm needs finite numbers; ignored\n"), "%s", w.all);
+    CHECKF(strstr(w.all, "m.mtl:13: map_Ks without a file name ignored\n"), "%s", w.all);
+    CHECKF(w.count == 8, "%s", w.all);
     CHECKF(strstr(w.all, "m.mtl:6: texture option '-blendu' is not supported, ignored"), "%s", w.all);
     CHECKF(strstr(w.all, "m.mtl:6: unknown texture option '-zz' skipped"), "%s", w.all);
     CHECKF(strstr(w.all, "m.mtl:9: texture 'missing.png' not used (" PK_TEST_DATA "/missing.png: cannot open"), "%s", w.all);
