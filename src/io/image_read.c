@@ -346,6 +346,8 @@ pk_status image_decode_exr(pk_context *ctx, const void *data, size_t size, const
     exr_context_t e = NULL;
     exr_decode_pipeline_t dec;
     bool have_dec = false;
+    float *scratch = NULL;  /* one chunk's decoded channels */
+    size_t scratch_n = 0;
     int map[128];
     pk_status st = PK_OK;
     exr_result_t rv = exr_start_read(&e, name, &init);
@@ -408,7 +410,22 @@ pk_status image_decode_exr(pk_context *ctx, const void *data, size_t size, const
             if (rv != EXR_ERR_SUCCESS) goto exr_fail;
             if (x0 < 0 || y0 < 0 || ci.width <= 0 || ci.height <= 0 || x0 + ci.width > w || y0 + ci.height > h)
                 goto exr_bad;
-            rv = have_dec ? exr_decoding_update(e, 0, &ci, &dec) : exr_decoding_initialize(e, 0, &ci, &dec);
+            const size_t plane = (size_t)ci.width * (size_t)ci.height; /* <= w * h */
+            if (plane * (size_t)nc > scratch_n) {
+                float *ns = mem_realloc_array(&ctx->alloc, scratch, plane * (size_t)nc, sizeof(float));
+                if (!ns) {
+                    st = ctx_nomem(ctx);
+                    goto done;
+                }
+                scratch = ns;
+                scratch_n = plane * (size_t)nc;
+            }
+            memset(scratch, 0, plane * (size_t)nc * sizeof(float));
+            /* a pipeline per chunk: exr_decoding_update (OpenEXR 3.1) mixes up
+             * the sizes of a full tile after a partial one */
+            if (have_dec) exr_decoding_destroy(e, &dec);
+            have_dec = false;
+            rv = exr_decoding_initialize(e, 0, &ci, &dec);
             if (rv != EXR_ERR_SUCCESS) goto exr_fail;
             have_dec = true;
             for (int c = 0; c < dec.channel_count; c++) {
@@ -421,14 +438,22 @@ pk_status image_decode_exr(pk_context *ctx, const void *data, size_t size, const
                     ch->decode_to_ptr = NULL;
                     continue;
                 }
-                ch->decode_to_ptr = (uint8_t *)(out->pxf + ((size_t)y0 * (size_t)w + (size_t)x0) * (size_t)nc + (size_t)k);
-                ch->user_pixel_stride = nc * (int32_t)sizeof(float);
-                ch->user_line_stride = (int32_t)(w * nc * (int64_t)sizeof(float));
+                /* planar, one plane per channel: OpenEXR 3.1's routines for
+                 * interleaved output assume the file's channel order */
+                ch->decode_to_ptr = (uint8_t *)(scratch + (size_t)k * plane);
+                ch->user_pixel_stride = (int32_t)sizeof(float);
+                ch->user_line_stride = ci.width * (int32_t)sizeof(float);
                 ch->user_data_type = EXR_PIXEL_FLOAT;
                 ch->user_bytes_per_element = 4;
             }
             if ((rv = exr_decoding_choose_default_routines(e, 0, &dec)) != EXR_ERR_SUCCESS) goto exr_fail;
             if ((rv = exr_decoding_run(e, 0, &dec)) != EXR_ERR_SUCCESS) goto exr_fail;
+            for (int k = 0; k < nc; k++)
+                for (int y = 0; y < ci.height; y++) {
+                    const float *src_row = scratch + (size_t)k * plane + (size_t)y * (size_t)ci.width;
+                    float *dst = out->pxf + ((size_t)(y0 + y) * (size_t)w + (size_t)x0) * (size_t)nc + (size_t)k;
+                    for (int x = 0; x < ci.width; x++) dst[(size_t)x * (size_t)nc] = src_row[x];
+                }
         }
     }
     sanitize_floats(out->pxf, (size_t)w * (size_t)h * (size_t)nc);
@@ -442,6 +467,7 @@ exr_fail:
 done:
     if (have_dec) exr_decoding_destroy(e, &dec);
     if (e) exr_finish(&e);
+    mem_free(&ctx->alloc, scratch);
     if (st != PK_OK) image_buf_free(&ctx->alloc, out);
     return st;
 }
