@@ -87,7 +87,7 @@ PK_API const char *pk_status_string(pk_status status);
  * at most PK_MAX_TEXTURE_BYTES. A texture past a bound is left out with a
  * warning, and its material keeps its constant values. */
 #define PK_MAX_TEXTURE_SIDE 32768
-#define PK_MAX_TEXTURE_PIXELS (128u * 1024u * 1024u)
+#define PK_MAX_TEXTURE_PIXELS (64u * 1024u * 1024u)
 #define PK_MAX_TEXTURE_BYTES ((size_t)4 << 30) /* 4 GiB */
 
 /* ---- camera, options, statistics ----------------------------------------- */
