@@ -66,6 +66,8 @@ def hdr_rle(path, w, h, rgbe):
 def main():
     # 2x2 sRGB: red, green / blue, white (linear mean 0.5 per channel)
     png(os.path.join(HERE, "tex_rgbw.png"), 2, 2, 3, [[(255, 0, 0), (0, 255, 0)], [(0, 0, 255), (255, 255, 255)]])
+    # 2x2 white (a lossless textured albedo in the furnace tests)
+    png(os.path.join(HERE, "tex_white.png"), 2, 2, 3, [[(255, 255, 255)] * 2] * 2)
     # 64x64 checker of 8x8 blocks
     png(os.path.join(HERE, "tex_checker.png"), 64, 64, 3,
         [[(230, 200, 60) if (x // 8 + y // 8) % 2 else (40, 60, 150) for x in range(64)] for y in range(64)])
