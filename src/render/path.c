@@ -260,8 +260,10 @@ vec3 path_radiance(const path_tracer *pt, path_thread *t, sampler *smp, const ra
         if (s->has_cutout && !trace_past_holes(fr->a, s, &r, &h, t->cp)) break; /* map_d holes */
         surface sf = surface_at(s, &r, &h);
         material textured;
-        cone += pt->spread * h.t * v3_len(r.d);
-        if (sf.m->textured) surface_texture(s, &r, &h, cone, &sf, &textured);
+        if (s->has_textured) { /* the ray cone, widened by the distance travelled */
+            cone += pt->spread * h.t * v3_len(r.d);
+            if (sf.m->textured) sf = surface_texture(s, &r, &h, cone, sf, &textured);
+        }
         const vec3 wo = v3_neg(v3_norm(r.d));
         /* emission reached by the path */
         vec3 le = emitted(&sf);

@@ -323,7 +323,7 @@ static void render_tile_aovs(const pk_renderer *r, const camera_frame *cf, const
             if (!got || (s->has_cutout && !trace_past_holes(r->fr.a, s, &cr, &h, NULL))) continue;
             surface sf = surface_at(s, &cr, &h);
             material textured;
-            if (sf.m->textured) surface_texture(s, &cr, &h, r->w.spread * h.t * v3_len(cr.d), &sf, &textured);
+            if (sf.m->textured) sf = surface_texture(s, &cr, &h, r->w.spread * h.t * v3_len(cr.d), sf, &textured);
             a[0] += sf.m->kd.x, a[1] += sf.m->kd.y, a[2] += sf.m->kd.z;
             nn[0] += sf.ns.x, nn[1] += sf.ns.y, nn[2] += sf.ns.z;
             const float dist = h.t * v3_len(cr.d);

@@ -109,7 +109,7 @@ static inline float bump_height(const pk_scene *s, const tex_ref *ref, float u, 
     return tex_eval_scalar(s->textures, ref, q);
 }
 
-void surface_texture(const pk_scene *s, const ray *r, const hit *h, float cone_width, surface *sf, material *tm)
+static void texture_at(const pk_scene *s, const ray *r, const hit *h, float cone_width, surface *sf, material *tm)
 {
     const material *m = sf->m;
     *tm = *m;
@@ -192,4 +192,10 @@ bool occluded_past_holes(const accel *a, const pk_scene *s, const ray *r, accel_
     hit h;
     if (!accel_intersect(a, &rr, &h, cp)) return false;
     return trace_past_holes(a, s, &rr, &h, cp);
+}
+
+surface surface_texture(const pk_scene *s, const ray *r, const hit *h, float cone_width, surface sf, material *tm)
+{
+    texture_at(s, r, h, cone_width, &sf, tm);
+    return sf;
 }

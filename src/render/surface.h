@@ -34,12 +34,13 @@ typedef struct surface_uv {
 } surface_uv;
 PK_HIDDEN surface_uv surface_uv_at(const pk_scene *s, const ray *r, const hit *h);
 
-/* For a material with texture maps (sf->m->textured): looks its maps up
+/* For a material with texture maps (sf.m->textured): looks its maps up
  * for a ray cone of width cone_width (scene units) where it meets the
- * surface, writes the textured material into *tm and points sf->m at it;
- * bump and normal maps bend sf->ns. */
-PK_HIDDEN void surface_texture(const pk_scene *s, const ray *r, const hit *h, float cone_width, surface *sf,
-                               material *tm);
+ * surface, writes the textured material into *tm and returns sf with m
+ * pointing at it; bump and normal maps bend its ns. (sf by value, so that
+ * callers keep theirs in registers.) */
+PK_HIDDEN surface surface_texture(const pk_scene *s, const ray *r, const hit *h, float cone_width, surface sf,
+                                  material *tm);
 
 /* True when the hit lies in a hole of its material's map_d (opacity < 0.5). */
 PK_HIDDEN bool surface_is_hole(const pk_scene *s, const ray *r, const hit *h);

@@ -105,9 +105,13 @@ static vec3 direct_light(const whitted *w, whitted_thread *ts, const surface *sf
     if (n == 0) return L;
     ts->rays[RAY_SHADOW] += n;
     accel_intersect_many(fr->a, ts->shadow_rays, ts->shadow_hits, n, true, ts->cp);
-    for (size_t i = 0; i < n; i++)
-        if (ts->shadow_hits[i].prim == PK_NO_HIT ||
-            (s->has_cutout && !occluded_past_holes(fr->a, s, &ts->shadow_rays[i], ts->cp)))
+    if (!s->has_cutout) {
+        for (size_t i = 0; i < n; i++)
+            if (ts->shadow_hits[i].prim == PK_NO_HIT) L = v3_add(L, ts->shadow_weight[i]);
+        return L;
+    }
+    for (size_t i = 0; i < n; i++) /* map_d holes: a blocked ray may pass through them */
+        if (ts->shadow_hits[i].prim == PK_NO_HIT || !occluded_past_holes(fr->a, s, &ts->shadow_rays[i], ts->cp))
             L = v3_add(L, ts->shadow_weight[i]);
     return L;
 }
@@ -116,9 +120,9 @@ static vec3 shade_opaque(const whitted *w, whitted_thread *ts, const ray *r, con
 {
     const frame *fr = w->f;
     surface sf = surface_at(fr->s, r, h);
-    const float cone = ts->cone + w->spread * h->t * v3_len(r->d);
+    const float cone = fr->s->has_textured ? ts->cone + w->spread * h->t * v3_len(r->d) : 0.0f;
     material textured;
-    if (sf.m->textured) surface_texture(fr->s, r, h, cone, &sf, &textured);
+    if (sf.m->textured) sf = surface_texture(fr->s, r, h, cone, sf, &textured);
     const material *m = sf.m;
     vec3 wo = v3_neg(v3_norm(r->d));
     vec3 L = m->ke; /* emitters are two-sided */

@@ -151,6 +151,7 @@ struct pk_scene {
     uint8_t *degenerate;    /* ntris flags */
     size_t ndegenerate;
     bool has_cutout;        /* a material has map_d */
+    bool has_textured;      /* a material has a map other than map_d (its textured flag) */
     uint32_t *emissive;     /* indices of emissive triangles */
     size_t nemissive;
     aabb bounds;
