@@ -144,6 +144,16 @@ static bool map_numbers(mtl_state *st, const char *opt, size_t on, const char **
     return true;
 }
 
+/* An RGB texture whose mean colour is the flat tangent-space normal's
+ * bluish (0.5, 0.5, 1): a normal map, not heights. */
+static bool looks_like_normal_map(const texture *t)
+{
+    if (t->nc < 3) return false;
+    float c[4];
+    texture_bilinear(t, t->nlevels - 1, 0.5f, 0.5f, false, c); /* the 1x1 level: the mean */
+    return c[2] > 0.7f && fabsf(c[0] - 0.5f) < 0.15f && fabsf(c[1] - 0.5f) < 0.15f;
+}
+
 /* "map_X [options] file": fills ref (and loads the texture when the scene's
  * files are read). colour: the texture holds colours (decoded from sRGB). */
 static pk_status parse_map(mtl_state *st, const char *kw, size_t kn, const char *p, const char *le, tex_ref *ref,
@@ -221,6 +231,11 @@ static pk_status parse_map(mtl_state *st, const char *kw, size_t kn, const char 
     if (rc == PK_OK) {
         nr.kind = TEX_IMAGE;
         nr.tex = idx;
+        if (ref == &st->s->materials[st->cur].map_bump && looks_like_normal_map(&st->s->textures[idx])) {
+            /* exporters (Blender's among them) write normal maps as map_Bump */
+            ref = &st->s->materials[st->cur].map_norm;
+            io_warn_once(r, "bump normal map", 15, "a bump map that holds normals (bluish RGB) is read as a normal map");
+        }
         *ref = nr;
     } else if (rc != PK_ERR_NOMEM && was_ok) {
         char why[PK_ERRMSG_MAX];

@@ -229,14 +229,17 @@ static void test_cache_and_fallback(void)
     const char *mtl = "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd tex_rgbw.png\nmap_d tex_rgbw.png\n"
                       "newmtl b\nmap_Kd -s 2 3 -o 0.5 0.25 -clamp on -blendu off -zz tex_rgbw.png\n"
                       "newmtl c\nKd 0.2 0.3 0.4\nmap_Kd missing.png\nmap_Ks tex_bad.png\n"
-                      "newmtl d\nmap_Kd -s -clamp -bm inf tex_rgbw.png\nmap_Ks\n";
+                      "newmtl d\nmap_Kd -s -clamp -bm inf tex_rgbw.png\nmap_Ks\n"
+                      "newmtl e\nbump tex_normal.png\nnewmtl f\nbump -bm 0.5 tex_bump.png\n";
     pk_scene *s;
     REQUIRE(scene_create(ctx, "m", &s) == PK_OK);
     pk_context_set_warning_handler(ctx, on_warn, &w);
     CHECKF(mtl_parse_dir(ctx, s, mtl, strlen(mtl), "m.mtl", PK_TEST_DATA) == PK_OK, "%s", pk_context_error(ctx));
     pk_context_set_warning_handler(ctx, NULL, NULL);
-    /* one load per file and mode: tex_rgbw.png as colour (a's and b's map_Kd) and as data (map_d) */
-    CHECK(s->ntextures == 2);
+    /* one load per file and mode: tex_rgbw.png as colour (a's, b's and d's map_Kd) and as data
+     * (map_d), then tex_normal.png and tex_bump.png */
+    CHECK(s->ntextures == 4);
+    CHECK(s->textures[0].bytes == 2 * 2 * 3 + 3 && s->textures[1].bytes == 2 * 2 * 3 + 3);
     const material *a = &s->materials[scene_find_material(s, "a")];
     const material *b = &s->materials[scene_find_material(s, "b")];
     const material *c = &s->materials[scene_find_material(s, "c")];
@@ -252,7 +255,13 @@ static void test_cache_and_fallback(void)
     CHECKF(strstr(w.all, "m.mtl:12: texture option -clamp needs on or off; ignored\n"), "%s", w.all);
     CHECKF(strstr(w.all, "m.mtl:12: texture option -bm needs finite numbers; ignored\n"), "%s", w.all);
     CHECKF(strstr(w.all, "m.mtl:13: map_Ks without a file name ignored\n"), "%s", w.all);
-    CHECKF(w.count == 8, "%s", w.all);
+    /* a bump map of bluish RGB is a normal map (as exporters write them); grey heights stay heights */
+    const material *e = &s->materials[scene_find_material(s, "e")];
+    const material *f = &s->materials[scene_find_material(s, "f")];
+    CHECK(e->map_norm.kind == TEX_IMAGE && e->map_bump.kind == TEX_NONE);
+    CHECK(f->map_bump.kind == TEX_IMAGE && f->map_norm.kind == TEX_NONE && f->map_bump.bm == 0.5f);
+    CHECKF(strstr(w.all, "m.mtl:15: a bump map that holds normals (bluish RGB) is read as a normal map"), "%s", w.all);
+    CHECKF(w.count == 9, "%s", w.all);
     CHECKF(strstr(w.all, "m.mtl:6: texture option '-blendu' is not supported, ignored"), "%s", w.all);
     CHECKF(strstr(w.all, "m.mtl:6: unknown texture option '-zz' skipped"), "%s", w.all);
     CHECKF(strstr(w.all, "m.mtl:9: texture 'missing.png' not used (" PK_TEST_DATA "/missing.png: cannot open"), "%s", w.all);
@@ -262,7 +271,7 @@ static void test_cache_and_fallback(void)
     REQUIRE(scene_add_sphere(ctx, s, &sp) == PK_OK);
     REQUIRE(scene_commit(ctx, s) == PK_OK);
     CHECK(a->textured && a->cutout && !c->textured && s->has_cutout);
-    CHECK(s->texture_bytes == (2 * 2 * 3 + 3) * 2);
+    CHECK(s->ntextures == 4);
     scene_destroy(s);
 }
 
