@@ -9,7 +9,7 @@ TEST_PKGS   = $(BUILD_PKGS) libembree-dev g++
 PREFIX     ?= /usr/local
 FUZZ_PKGS   = $(TEST_PKGS) clang libclang-rt-14-dev libomp-14-dev
 FUZZ_SECONDS ?= 60
-FUZZERS     = obj mtl json xml render
+FUZZERS     = obj mtl json xml render image
 
 .PHONY: all build demo test deps deps-test install bench clean build-asan sanitize fuzz fuzz-build fuzz-seeds fuzz-merge
 
@@ -82,8 +82,8 @@ FUZZ_FLAGS = -max_len=65536 -rss_limit_mb=2048 -timeout=10 -print_final_stats=1
 FUZZ_SEEDS = tests/data $(wildcard ../shared/scenes/cornell)
 # The public scenes of ../shared/scenes (when present) seed the fuzzers too,
 # by kind: $(FUZZ_DIR)/seeds/<name> holds links to every .obj (obj, render),
-# .mtl (mtl), .json (json, render) and .xml (xml, render) file there; inputs beyond -max_len are
-# read truncated.
+# .mtl (mtl), .json (json, render), .xml (xml, render) and image (image: .png, .jpg, .exr,
+# .hdr, .pfm) file there; inputs beyond -max_len are read truncated.
 SHARED_SCENES = ../shared/scenes
 
 $(FUZZ_DIR)/CMakeCache.txt:
@@ -97,13 +97,15 @@ fuzz-build: $(FUZZ_DIR)/CMakeCache.txt
 fuzz-seeds:
 	@for f in $(FUZZERS); do rm -rf $(FUZZ_DIR)/seeds/$$f; mkdir -p $(FUZZ_DIR)/seeds/$$f; done
 	@if [ -d $(SHARED_SCENES) ]; then \
-	  find $(abspath $(SHARED_SCENES)) -type f \( -name '*.obj' -o -name '*.mtl' -o -name '*.json' -o -name '*.xml' \) | while read -r p; do \
+	  find $(abspath $(SHARED_SCENES)) -type f \( -name '*.obj' -o -name '*.mtl' -o -name '*.json' -o -name '*.xml' -o -name '*.png' \
+	    -o -name '*.jpg' -o -name '*.jpeg' -o -name '*.exr' -o -name '*.hdr' -o -name '*.pfm' \) | while read -r p; do \
 	    n=$$(echo "$${p#$(abspath $(SHARED_SCENES))/}" | tr '/' '_'); \
 	    case "$$p" in \
 	      *.obj) ln -sf "$$p" $(FUZZ_DIR)/seeds/obj/$$n; ln -sf "$$p" $(FUZZ_DIR)/seeds/render/$$n;; \
 	      *.mtl) ln -sf "$$p" $(FUZZ_DIR)/seeds/mtl/$$n;; \
 	      *.json) ln -sf "$$p" $(FUZZ_DIR)/seeds/json/$$n; ln -sf "$$p" $(FUZZ_DIR)/seeds/render/$$n;; \
 	      *.xml) ln -sf "$$p" $(FUZZ_DIR)/seeds/xml/$$n; ln -sf "$$p" $(FUZZ_DIR)/seeds/render/$$n;; \
+	      *) ln -sf "$$p" $(FUZZ_DIR)/seeds/image/$$n;; \
 	    esac; \
 	  done; \
 	else echo "$(SHARED_SCENES) is absent: the fuzzers start from tests/data and the corpus only"; fi

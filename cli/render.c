@@ -333,8 +333,10 @@ static double peak_rss_mib(void)
     return (double)ru.ru_maxrss / 1024.0;
 }
 
-static void print_table(const char *scene, const pk_render_options *ro, const pk_stats *st)
+static void print_table(const char *scene, const pk_scene *sc, const pk_render_options *ro, const pk_stats *st)
 {
+    pk_scene_info si;
+    pk_scene_get_info(sc, &si);
     uint64_t rays = st->rays_camera + st->rays_shadow + st->rays_reflection + st->rays_refraction + st->rays_bounce;
     double r = rays ? (double)rays : 1.0;
     const int path = ro->integrator != PK_INTEGRATOR_WHITTED;
@@ -367,6 +369,8 @@ static void print_table(const char *scene, const pk_render_options *ro, const pk
     printf("%-28s %.2f\n", "Mrays/s", st->render_s > 0 ? (double)rays / st->render_s / 1e6 : 0.0);
     printf("%-28s %d per pixel (film: 3 float sums + a count), peak resident %.1f MiB\n", "memory [bytes]",
            FILM_BYTES_PER_PIXEL, peak_rss_mib());
+    printf("%-28s %zu image%s, %.2f MiB (mipmaps included)\n", "textures", si.textures, si.textures == 1 ? "" : "s",
+           (double)si.texture_bytes / (1024.0 * 1024.0));
 }
 
 /* Writes s as a JSON string literal. */
@@ -386,8 +390,11 @@ static void json_string(FILE *f, const char *s)
 }
 
 /* path "-": standard output. */
-static int write_stats_json(const char *path, const char *scene, const pk_render_options *ro, const pk_stats *st)
+static int write_stats_json(const char *path, const char *scene, const pk_scene *sc, const pk_render_options *ro,
+                            const pk_stats *st)
 {
+    pk_scene_info si;
+    pk_scene_get_info(sc, &si);
     uint64_t rays = st->rays_camera + st->rays_shadow + st->rays_reflection + st->rays_refraction + st->rays_bounce;
     const int to_stdout = strcmp(path, "-") == 0;
     FILE *f = to_stdout ? stdout : fopen(path, "w");
@@ -401,7 +408,8 @@ static int write_stats_json(const char *path, const char *scene, const pk_render
             "  \"rays_shadow\": %llu,\n  \"rays_reflection\": %llu,\n  \"rays_refraction\": %llu,\n"
             "  \"intersection_tests\": %llu,\n  \"nodes_visited\": %llu,\n  \"mrays_per_s\": %.3f,\n"
             "  \"integrator\": \"%s\",\n  \"seed\": %d,\n  \"rays_bounce\": %llu,\n  \"samples_per_s\": %.1f,\n"
-            "  \"film_bytes_per_pixel\": %d,\n  \"peak_rss_mib\": %.1f\n}\n",
+            "  \"film_bytes_per_pixel\": %d,\n  \"peak_rss_mib\": %.1f,\n  \"textures\": %zu,\n"
+            "  \"texture_bytes\": %zu\n}\n",
             pk_accel_kind_name(ro->accel), ro->width, ro->height, ro->spp, ro->light_samples, pk_render_options_max_depth(ro),
             ro->fresnel ? "true" : "false", st->threads, st->build_us, st->render_s, (unsigned long long)rays,
             (unsigned long long)st->rays_camera, (unsigned long long)st->rays_shadow,
@@ -410,7 +418,7 @@ static int write_stats_json(const char *path, const char *scene, const pk_render
             st->render_s > 0 ? (double)rays / st->render_s / 1e6 : 0.0, pk_integrator_name(ro->integrator), ro->seed,
             (unsigned long long)st->rays_bounce,
             st->render_s > 0 ? (double)st->pixels * ro->spp / st->render_s : 0.0, FILM_BYTES_PER_PIXEL,
-            peak_rss_mib());
+            peak_rss_mib(), si.textures, si.texture_bytes);
     if (to_stdout ? fflush(f) != 0 || ferror(f) : fclose(f) != 0)
         return cli_failure("%s: cannot write: %s", to_stdout ? "standard output" : path, strerror(errno));
     return 0;
@@ -680,8 +688,8 @@ int cli_render(int argc, char **argv)
             fprintf(stderr, "wrote %s (%dx%d, %s)\n", o.out, ro.width, ro.height, took);
     }
     const char *name = o.scene ? o.scene : "cornell-box (built in)";
-    if (o.stats) print_table(name, &ro, &stats);
-    if (o.stats_json && write_stats_json(o.stats_json, name, &ro, &stats) != 0) goto out;
+    if (o.stats) print_table(name, scene, &ro, &stats);
+    if (o.stats_json && write_stats_json(o.stats_json, name, scene, &ro, &stats) != 0) goto out;
     rc = 0;
     goto out;
 fail:

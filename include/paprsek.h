@@ -89,7 +89,7 @@ PK_API const char *pk_status_string(pk_status status);
  * at most PK_MAX_TEXTURE_BYTES. A texture past a bound is left out with a
  * warning, and its material keeps its constant values. */
 #define PK_MAX_TEXTURE_SIDE 32768
-#define PK_MAX_TEXTURE_PIXELS (128u * 1024u * 1024u)
+#define PK_MAX_TEXTURE_PIXELS (64u * 1024u * 1024u)
 #define PK_MAX_TEXTURE_BYTES ((size_t)4 << 30) /* 4 GiB */
 /* A Mitsuba XML scene file (each included file too); meshes live in their own files. */
 #define PK_MAX_XML_BYTES ((size_t)64 << 20) /* 64 MiB */
@@ -258,6 +258,8 @@ typedef struct pk_scene_info {
     size_t spheres, materials, point_lights, emissive_triangles;
     float bounds_min[3], bounds_max[3];
     int has_camera;              /* 0: the camera is framed on the bounds */
+    size_t textures;             /* images loaded for texture maps (one per file and decode mode) */
+    size_t texture_bytes;        /* their texels, mipmaps included */
 } pk_scene_info;
 
 PK_API void pk_scene_get_info(const pk_scene *scene, pk_scene_info *info);

@@ -177,6 +177,8 @@ void pk_scene_get_info(const pk_scene *s, pk_scene_info *info)
     info->bounds_max[1] = s->bounds.hi.y;
     info->bounds_max[2] = s->bounds.hi.z;
     info->has_camera = s->has_camera;
+    info->textures = s->ntextures;
+    info->texture_bytes = s->texture_bytes;
 }
 
 pk_status pk_scene_get_emissive_triangle(const pk_scene *s, size_t k, size_t *tri)

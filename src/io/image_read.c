@@ -94,11 +94,15 @@ static pk_status alloc_buf(pk_context *ctx, image_buf *out, int w, int h, int nc
     return PK_OK;
 }
 
-/* Non-finite samples (NaN, inf) become 0: lookups must stay finite. */
+/* Non-finite samples (NaN, inf) become 0, and magnitudes are kept within
+ * IMAGE_MAX_SAMPLE: lookups, which interpolate and average, must stay finite. */
 static void sanitize_floats(float *p, size_t n)
 {
-    for (size_t i = 0; i < n; i++)
+    for (size_t i = 0; i < n; i++) {
         if (!isfinite(p[i])) p[i] = 0.0f;
+        else if (p[i] > IMAGE_MAX_SAMPLE) p[i] = IMAGE_MAX_SAMPLE;
+        else if (p[i] < -IMAGE_MAX_SAMPLE) p[i] = -IMAGE_MAX_SAMPLE;
+    }
 }
 
 image_format image_sniff(const void *data, size_t size)
@@ -342,6 +346,8 @@ pk_status image_decode_exr(pk_context *ctx, const void *data, size_t size, const
     exr_context_t e = NULL;
     exr_decode_pipeline_t dec;
     bool have_dec = false;
+    float *scratch = NULL;  /* one chunk's decoded channels */
+    size_t scratch_n = 0;
     int map[128];
     pk_status st = PK_OK;
     exr_result_t rv = exr_start_read(&e, name, &init);
@@ -391,7 +397,9 @@ pk_status image_decode_exr(pk_context *ctx, const void *data, size_t size, const
             exr_chunk_info_t ci;
             int64_t x0, y0;
             if (storage == EXR_STORAGE_SCANLINE) {
-                rv = exr_read_scanline_chunk_info(e, 0, dw.min.y + cy * lines, &ci);
+                const int64_t y = (int64_t)dw.min.y + (int64_t)cy * lines;
+                if (y > INT32_MAX) goto exr_bad;
+                rv = exr_read_scanline_chunk_info(e, 0, (int)y, &ci);
                 x0 = 0;
                 y0 = (int64_t)ci.start_y - dw.min.y;
             } else {
@@ -402,7 +410,22 @@ pk_status image_decode_exr(pk_context *ctx, const void *data, size_t size, const
             if (rv != EXR_ERR_SUCCESS) goto exr_fail;
             if (x0 < 0 || y0 < 0 || ci.width <= 0 || ci.height <= 0 || x0 + ci.width > w || y0 + ci.height > h)
                 goto exr_bad;
-            rv = have_dec ? exr_decoding_update(e, 0, &ci, &dec) : exr_decoding_initialize(e, 0, &ci, &dec);
+            const size_t plane = (size_t)ci.width * (size_t)ci.height; /* <= w * h */
+            if (plane * (size_t)nc > scratch_n) {
+                float *ns = mem_realloc_array(&ctx->alloc, scratch, plane * (size_t)nc, sizeof(float));
+                if (!ns) {
+                    st = ctx_nomem(ctx);
+                    goto done;
+                }
+                scratch = ns;
+                scratch_n = plane * (size_t)nc;
+            }
+            memset(scratch, 0, plane * (size_t)nc * sizeof(float));
+            /* a pipeline per chunk: exr_decoding_update (OpenEXR 3.1) mixes up
+             * the sizes of a full tile after a partial one */
+            if (have_dec) exr_decoding_destroy(e, &dec);
+            have_dec = false;
+            rv = exr_decoding_initialize(e, 0, &ci, &dec);
             if (rv != EXR_ERR_SUCCESS) goto exr_fail;
             have_dec = true;
             for (int c = 0; c < dec.channel_count; c++) {
@@ -415,14 +438,22 @@ pk_status image_decode_exr(pk_context *ctx, const void *data, size_t size, const
                     ch->decode_to_ptr = NULL;
                     continue;
                 }
-                ch->decode_to_ptr = (uint8_t *)(out->pxf + ((size_t)y0 * (size_t)w + (size_t)x0) * (size_t)nc + (size_t)k);
-                ch->user_pixel_stride = nc * (int32_t)sizeof(float);
-                ch->user_line_stride = (int32_t)(w * nc * (int64_t)sizeof(float));
+                /* planar, one plane per channel: OpenEXR 3.1's routines for
+                 * interleaved output assume the file's channel order */
+                ch->decode_to_ptr = (uint8_t *)(scratch + (size_t)k * plane);
+                ch->user_pixel_stride = (int32_t)sizeof(float);
+                ch->user_line_stride = ci.width * (int32_t)sizeof(float);
                 ch->user_data_type = EXR_PIXEL_FLOAT;
                 ch->user_bytes_per_element = 4;
             }
             if ((rv = exr_decoding_choose_default_routines(e, 0, &dec)) != EXR_ERR_SUCCESS) goto exr_fail;
             if ((rv = exr_decoding_run(e, 0, &dec)) != EXR_ERR_SUCCESS) goto exr_fail;
+            for (int k = 0; k < nc; k++)
+                for (int y = 0; y < ci.height; y++) {
+                    const float *src_row = scratch + (size_t)k * plane + (size_t)y * (size_t)ci.width;
+                    float *dst = out->pxf + ((size_t)(y0 + y) * (size_t)w + (size_t)x0) * (size_t)nc + (size_t)k;
+                    for (int x = 0; x < ci.width; x++) dst[(size_t)x * (size_t)nc] = src_row[x];
+                }
         }
     }
     sanitize_floats(out->pxf, (size_t)w * (size_t)h * (size_t)nc);
@@ -436,6 +467,7 @@ exr_fail:
 done:
     if (have_dec) exr_decoding_destroy(e, &dec);
     if (e) exr_finish(&e);
+    mem_free(&ctx->alloc, scratch);
     if (st != PK_OK) image_buf_free(&ctx->alloc, out);
     return st;
 }
@@ -583,6 +615,7 @@ pk_status image_decode_hdr(pk_context *ctx, const void *data, size_t size, const
         for (int x = 0; x < w; x++) rgbe_to_float(line + 4 * x, o + 3 * x);
     }
     mem_free(&ctx->alloc, line);
+    sanitize_floats(out->pxf, (size_t)w * (size_t)h * 3);
     return PK_OK;
 }
 

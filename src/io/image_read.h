@@ -20,7 +20,9 @@
  * 2 (grey, alpha), 3 (RGB) or 4 (RGBA). Exactly one of px8 and pxf is set:
  * px8 for the 8-bit formats (PNG, JPEG), the bytes as stored in the file
  * (sRGB-encoded for colour); pxf for the HDR formats (OpenEXR, .hdr, PFM),
- * linear floats, every sample finite. */
+ * linear floats, every sample finite and within +-IMAGE_MAX_SAMPLE (larger
+ * ones are clamped, non-finite ones read as 0). */
+#define IMAGE_MAX_SAMPLE 1e30f
 typedef struct image_buf {
     int w, h, nc;
     uint8_t *px8;

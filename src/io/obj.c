@@ -18,11 +18,11 @@
 
 typedef struct corner {
     uint32_t v;
-    int32_t n;
+    int32_t n, t;
 } corner;
 
 /* Invariants:
- *  1. pos_base <= s->npositions and nrm_base <= s->nnormals: file index i > 0
+ *  1. pos_base <= s->npositions, nrm_base <= s->nnormals and uv_base <= s->nuvs: file index i > 0
  *     names position pos_base + i - 1, and is valid while i <= npositions - pos_base.
  *  2. corners holds cap_corners <= PK_MAX_POLYGON_VERTICES entries (or the
  *     inline array when heap_corners is NULL). */
@@ -30,8 +30,7 @@ typedef struct obj_state {
     io_reader r;
     pk_scene *s;
     const char *base_dir;
-    size_t pos_base, nrm_base;
-    size_t ntex;                 /* vt statements so far */
+    size_t pos_base, nrm_base, uv_base;
     uint32_t material;           /* current usemtl, 0 = default */
     int undefined_warnings;
     bool has_xform;
@@ -132,8 +131,8 @@ static pk_status parse_vt(obj_state *st, const char *p, const char *le)
     if (rc != PK_OK) return rc;
     if (n < 1) return io_error(&st->r, PK_ERR_PARSE, "vt needs 1 to 3 coordinates, found none");
     if (!io_at_end(p, le)) return io_error(&st->r, PK_ERR_PARSE, "vt takes 1 to 3 coordinates, found more");
-    st->ntex++;
-    return PK_OK;
+    uv2 t = {c[0], n >= 2 ? c[1] : 0.0f};
+    return scene_add_uv(st->r.ctx, st->s, t);
 }
 
 /* Resolves OBJ index i (1-based, or negative = relative to the end) against
@@ -175,6 +174,7 @@ static pk_status parse_f(obj_state *st, const char *p, const char *le)
     io_reader *r = &st->r;
     const size_t npos = st->s->npositions - st->pos_base;
     const size_t nnrm = st->s->nnormals - st->nrm_base;
+    const size_t ntex = st->s->nuvs - st->uv_base;
     size_t k = 0;
     for (;;) {
         p = io_skip_blanks(p, le);
@@ -202,9 +202,9 @@ static pk_status parse_f(obj_state *st, const char *p, const char *le)
         }
         if (q != te) goto bad;
 
-        size_t vi, ni = 0, ti;
+        size_t vi, ni = 0, ti = 0;
         pk_status rc = resolve(st, idx[0], npos, "face", xs[0], xe[0], &vi);
-        if (rc == PK_OK && xs[1]) rc = resolve(st, idx[1], st->ntex, "texture coordinate", xs[1], xe[1], &ti);
+        if (rc == PK_OK && xs[1]) rc = resolve(st, idx[1], ntex, "texture coordinate", xs[1], xe[1], &ti);
         if (rc == PK_OK && xs[2]) rc = resolve(st, idx[2], nnrm, "normal", xs[2], xe[2], &ni);
         if (rc != PK_OK) return rc;
 
@@ -212,6 +212,7 @@ static pk_status parse_f(obj_state *st, const char *p, const char *le)
         if (!c) return ctx_nomem(r->ctx);
         c->v = (uint32_t)(st->pos_base + vi);
         c->n = xs[2] ? (int32_t)(st->nrm_base + ni) : -1;
+        c->t = xs[1] ? (int32_t)(st->uv_base + ti) : -1;
         k++;
         p = te;
         continue;
@@ -225,11 +226,14 @@ static pk_status parse_f(obj_state *st, const char *p, const char *le)
     t.material = st->material;
     t.v[0] = cs[0].v;
     t.n[0] = cs[0].n;
+    t.t[0] = cs[0].t;
     for (size_t j = 1; j + 1 < k; j++) {
         t.v[1] = cs[j].v;
         t.n[1] = cs[j].n;
+        t.t[1] = cs[j].t;
         t.v[2] = cs[j + 1].v;
         t.n[2] = cs[j + 1].n;
+        t.t[2] = cs[j + 1].t;
         pk_status rc = scene_add_triangle(r->ctx, st->s, &t);
         if (rc != PK_OK) return rc;
     }
@@ -263,7 +267,9 @@ static pk_status read_library(obj_state *st, const char *rel)
     bool was_ok = r->ctx->status == PK_OK;
     pk_status rc = file_read_all(r->ctx, path, &data, &size);
     if (rc == PK_OK) {
-        rc = mtl_parse(r->ctx, st->s, data, size, rel);
+        char *dir = path_dirname(&r->ctx->alloc, path);
+        rc = dir ? mtl_parse_dir(r->ctx, st->s, data, size, rel, dir) : ctx_nomem(r->ctx);
+        mem_free(&r->ctx->alloc, dir);
         mem_free(&r->ctx->alloc, data);
     } else if (rc != PK_ERR_NOMEM && was_ok) {
         char why[PK_ERRMSG_MAX];
@@ -392,6 +398,7 @@ pk_status obj_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,
     st->base_dir = base_dir;
     st->pos_base = s->npositions;
     st->nrm_base = s->nnormals;
+    st->uv_base = s->nuvs;
 
     pk_status rc = xform ? setup_xform(st, xform) : PK_OK;
     const char *ls, *le;

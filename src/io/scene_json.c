@@ -249,11 +249,120 @@ static pk_status get_array(jp *p, const cJSON *it, const char *path)
     return cJSON_IsArray(it) ? PK_OK : jfail(p, PK_ERR_PARSE, it, path, "must be an array");
 }
 
+/* ---- textures --------------------------------------------------------------- */
+
+enum { TX_TEXTURE, TX_CHECKER, TX_SCALE, TX_OFFSET, TX_CLAMP, TX_STRENGTH, TX_COUNT };
+static const char *const tx_keys[TX_COUNT] = {"texture", "checker", "scale", "offset", "clamp", "strength"};
+
+/* A checker's colour: three numbers, or one for a scalar parameter. */
+static pk_status get_checker_value(jp *p, const cJSON *it, const char *path, vec3 *out)
+{
+    if (cJSON_IsNumber(it)) {
+        float f = 0.0f;
+        pk_status st = get_float(p, it, path, &f);
+        if (st == PK_OK && f < 0.0f) return jfail(p, PK_ERR_PARSE, it, path, "must not be negative");
+        *out = v3s(f);
+        return st;
+    }
+    return get_color(p, it, path, out);
+}
+
+/* A parameter given as a texture object: {"texture": "file.png", "scale": [su, sv],
+ * "offset": [ou, ov], "clamp": false} or {"checker": {"even": c, "odd": c,
+ * "scale": n}, ...}; bump maps also take "strength" (-bm). Fills *ref. An image that cannot be used is a warning:
+ * ref stays without a texture and *loaded is false. colour: the image holds
+ * colours (decoded from sRGB). */
+static pk_status get_texture(jp *p, const cJSON *it, const char *path, bool colour, tex_ref *ref, bool *loaded)
+{
+    *loaded = false;
+    const cJSON *f[TX_COUNT];
+    pk_status st = object_fields(p, it, path, tx_keys, TX_COUNT, f);
+    if (st) return st;
+    tex_ref r;
+    tex_ref_init(&r);
+    char fp[JP_PATH_MAX];
+    if (!f[TX_TEXTURE] == !f[TX_CHECKER])
+        return jfail(p, PK_ERR_PARSE, it, path, "a texture needs \"texture\" (an image file) or \"checker\", one of them");
+    if (f[TX_SCALE]) {
+        path_key(fp, path, "scale");
+        if (cJSON_IsNumber(f[TX_SCALE])) {
+            if ((st = get_float(p, f[TX_SCALE], fp, &r.s[0]))) return st;
+            r.s[1] = r.s[0];
+        } else if ((st = get_floats(p, f[TX_SCALE], fp, r.s, 2))) {
+            return st;
+        }
+    }
+    if (f[TX_OFFSET]) {
+        path_key(fp, path, "offset");
+        if ((st = get_floats(p, f[TX_OFFSET], fp, r.o, 2))) return st;
+    }
+    if (f[TX_STRENGTH]) {
+        path_key(fp, path, "strength");
+        if ((st = get_float(p, f[TX_STRENGTH], fp, &r.bm))) return st;
+    }
+    if (f[TX_CLAMP]) {
+        path_key(fp, path, "clamp");
+        if (!cJSON_IsBool(f[TX_CLAMP])) return jfail(p, PK_ERR_PARSE, f[TX_CLAMP], fp, "must be true or false");
+        r.clamp = cJSON_IsTrue(f[TX_CLAMP]);
+    }
+    if (f[TX_CHECKER]) {
+        static const char *const ck[3] = {"even", "odd", "scale"};
+        const cJSON *c[3];
+        char cp[JP_PATH_MAX];
+        path_key(cp, path, "checker");
+        if ((st = object_fields(p, f[TX_CHECKER], cp, ck, 3, c))) return st;
+        r.kind = TEX_CHECKER;
+        r.even = v3s(0.8f), r.odd = v3s(0.2f), r.checker_scale = 8.0f;
+        if (c[0]) {
+            path_key(fp, cp, "even");
+            if ((st = get_checker_value(p, c[0], fp, &r.even))) return st;
+        }
+        if (c[1]) {
+            path_key(fp, cp, "odd");
+            if ((st = get_checker_value(p, c[1], fp, &r.odd))) return st;
+        }
+        if (c[2]) {
+            path_key(fp, cp, "scale");
+            if ((st = get_float(p, c[2], fp, &r.checker_scale))) return st;
+            if (!(r.checker_scale > 0.0f)) return jfail(p, PK_ERR_PARSE, c[2], fp, "must be a positive number");
+        }
+        *ref = r;
+        *loaded = true;
+        return PK_OK;
+    }
+    path_key(fp, path, "texture");
+    if (!cJSON_IsString(f[TX_TEXTURE]) || !f[TX_TEXTURE]->valuestring[0])
+        return jfail(p, PK_ERR_PARSE, f[TX_TEXTURE], fp, "must be a file name");
+    const pk_allocator *a = &p->ctx->alloc;
+    char *full = path_join(a, p->base_dir, f[TX_TEXTURE]->valuestring);
+    if (!full) return ctx_nomem(p->ctx);
+    int32_t idx;
+    const bool was_ok = p->ctx->status == PK_OK;
+    st = texture_load(p->ctx, p->s, full, colour, &idx);
+    mem_free(a, full);
+    if (st == PK_OK) {
+        r.kind = TEX_IMAGE;
+        r.tex = idx;
+        *ref = r;
+        *loaded = true;
+    } else if (st != PK_ERR_NOMEM && was_ok) {
+        char why[PK_ERRMSG_MAX], name[128];
+        snprintf(why, sizeof why, "%s", p->ctx->message);
+        sanitize(name, sizeof name, f[TX_TEXTURE]->valuestring);
+        pk_context_clear_error(p->ctx);
+        ctx_warn(p->ctx, "%s:%d: %s: texture '%s' not used (%s); the constant value is used", p->name,
+                 item_line(p, f[TX_TEXTURE]), fp, name, why);
+        st = PK_OK;
+    }
+    return st;
+}
+
 /* ---- materials ------------------------------------------------------------ */
 
-enum { MF_NAME, MF_KD, MF_KS, MF_KE, MF_TF, MF_KA, MF_NS, MF_NI, MF_D, MF_ILLUM, MF_TWO_SIDED, MF_COUNT };
-static const char *const material_keys[MF_COUNT] = {"name", "kd", "ks", "ke", "tf", "ka",
-                                                    "ns", "ni", "d",  "illum", "two_sided"};
+enum { MF_NAME, MF_KD, MF_KS, MF_KE, MF_TF, MF_KA, MF_NS, MF_NI, MF_D, MF_ILLUM, MF_TWO_SIDED, MF_BUMP, MF_NORMAL,
+       MF_COUNT };
+static const char *const material_keys[MF_COUNT] = {"name", "kd", "ks", "ke", "tf", "ka", "ns", "ni", "d",
+                                                    "illum", "two_sided", "bump", "normal_map"};
 
 /* A reflectance: three finite numbers in 0..1. */
 static pk_status get_reflectance(jp *p, const cJSON *it, const char *path, vec3 *out)
@@ -303,6 +412,30 @@ static const mat_type_def mat_types[] = {
 };
 #define N_MAT_TYPES (sizeof mat_types / sizeof mat_types[0])
 
+/* The maps any material may have: "d"/"opacity" as a texture (cut-out
+ * holes where it is below 0.5), "bump" (heights, with "strength": -bm) and
+ * "normal_map" (tangent space). Numbers for opacity are read by the callers. */
+static pk_status read_surface_maps(jp *p, const cJSON *opacity, const cJSON *bump, const cJSON *normal,
+                                   const char *path, material *m)
+{
+    char fp[JP_PATH_MAX];
+    bool loaded;
+    pk_status st;
+    if (opacity && cJSON_IsObject(opacity)) {
+        path_key(fp, path, opacity->string);
+        if ((st = get_texture(p, opacity, fp, false, &m->map_d, &loaded))) return st;
+    }
+    if (normal) {
+        path_key(fp, path, "normal_map");
+        if ((st = get_texture(p, normal, fp, false, &m->map_norm, &loaded))) return st;
+    }
+    if (bump) {
+        path_key(fp, path, "bump");
+        if ((st = get_texture(p, bump, fp, false, &m->map_bump, &loaded))) return st;
+    }
+    return PK_OK;
+}
+
 /* Reads a material object with a "type" (type_item) into *m. */
 static pk_status read_typed_material(jp *p, const cJSON *obj, const cJSON *type_item, const char *path,
                                      bool with_name, material *m, const cJSON **name_item)
@@ -319,20 +452,50 @@ static pk_status read_typed_material(jp *p, const cJSON *obj, const cJSON *type_
     const mat_type_def *def = &mat_types[t];
     /* the known keys: "type", "two_sided", the type's parameters, and "name"
      * where materials are listed in an array */
-    const char *keys[8];
-    const cJSON *f[8];
+    const char *keys[12];
+    const cJSON *f[12];
     size_t nk = 0;
-    keys[nk++] = "type", keys[nk++] = "two_sided";
+    keys[nk++] = "type", keys[nk++] = "two_sided", keys[nk++] = "opacity", keys[nk++] = "bump",
+    keys[nk++] = "normal_map";
     for (int i = 0; i < def->nparams; i++) keys[nk++] = tp_keys[def->params[i]];
     if (with_name) keys[nk++] = "name";
     pk_status st = object_fields(p, obj, path, keys, nk, f);
     if (st) return st;
     const cJSON *pv[TP_COUNT] = {NULL}; /* the parameters by their TP_ number */
-    for (int i = 0; i < def->nparams; i++) pv[def->params[i]] = f[2 + i];
+    for (int i = 0; i < def->nparams; i++) pv[def->params[i]] = f[5 + i];
     const cJSON *two_sided = f[1];
     if (name_item) *name_item = with_name ? f[nk - 1] : NULL;
 
     material_init(m);
+    if (f[2] && !cJSON_IsObject(f[2])) {
+        path_key(fp, path, "opacity");
+        return jfail(p, PK_ERR_PARSE, f[2], fp, "must be a texture object (cut-out holes where it is below 0.5)");
+    }
+    if ((st = read_surface_maps(p, f[2], f[3], f[4], path, m))) return st;
+    /* textured parameters: the texture's value alone where it loaded */
+    bool loaded;
+    vec3 tex_albedo = v3s(-1.0f), tex_specular = v3s(-1.0f);
+    float tex_alpha = -1.0f;
+    if (pv[TP_ALBEDO] && cJSON_IsObject(pv[TP_ALBEDO])) {
+        path_key(fp, path, "albedo");
+        if ((st = get_texture(p, pv[TP_ALBEDO], fp, true, &m->map_kd, &loaded))) return st;
+        tex_albedo = loaded ? v3s(1.0f) : v3s(0.5f);
+        pv[TP_ALBEDO] = NULL;
+    }
+    if (pv[TP_SPECULAR] && cJSON_IsObject(pv[TP_SPECULAR])) {
+        path_key(fp, path, "specular");
+        if ((st = get_texture(p, pv[TP_SPECULAR], fp, true, &m->map_ks, &loaded))) return st;
+        tex_specular = loaded ? v3s(1.0f) : v3s(0.04f);
+        pv[TP_SPECULAR] = NULL;
+    }
+    for (int k = TP_ROUGHNESS; k <= TP_ALPHA; k++) {
+        if (!pv[k] || !cJSON_IsObject(pv[k])) continue;
+        path_key(fp, path, tp_keys[k]);
+        if ((st = get_texture(p, pv[k], fp, false, &m->map_alpha, &loaded))) return st;
+        m->map_alpha.squared = k == TP_ROUGHNESS; /* alpha = roughness^2 */
+        tex_alpha = loaded ? 1.0f : 0.0f;
+        pv[k] = NULL;
+    }
     char pp[TP_COUNT][JP_PATH_MAX];
     for (int i = 0; i < TP_COUNT; i++)
         if (pv[i]) path_key(pp[i], path, tp_keys[i]);
@@ -357,6 +520,8 @@ static pk_status read_typed_material(jp *p, const cJSON *obj, const cJSON *type_
         if (ior == 1.0f && alpha > 0.0f)
             return jfail(p, PK_ERR_PARSE, pv[TP_IOR], pp[TP_IOR], "must not be 1 on a rough surface (roughness > 0)");
     }
+    if (tex_albedo.x >= 0.0f) albedo = tex_albedo;
+    if (tex_alpha >= 0.0f) alpha = tex_alpha;
     m->alpha = alpha;
     if (t == 5) { /* two_sided: the nested material, reflecting and emitting on both sides */
         const cJSON *in = pv[TP_BSDF];
@@ -394,6 +559,9 @@ static pk_status read_typed_material(jp *p, const cJSON *obj, const cJSON *type_
                 return jfail(p, PK_ERR_PARSE, other, op, "give \"eta\" and \"k\" or \"specular\", not both");
             }
             if ((st = get_reflectance(p, pv[TP_SPECULAR], pp[TP_SPECULAR], &f0))) return st;
+            m->schlick = true;
+        } else if (tex_specular.x >= 0.0f) {
+            f0 = tex_specular;
             m->schlick = true;
         } else {
             if (pv[TP_ETA]) {
@@ -476,22 +644,33 @@ static pk_status read_material(jp *p, const cJSON *obj, const char *path, bool w
     material_init(m);
     vec3 *colours[] = {NULL, &m->kd, &m->ks, &m->ke, &m->tf, &m->ka};
     char fp[JP_PATH_MAX];
+    bool loaded;
     for (int i = MF_KD; i <= MF_KA; i++) {
         if (!f[i]) continue;
         path_key(fp, path, material_keys[i]);
+        if ((i == MF_KD || i == MF_KS) && cJSON_IsObject(f[i])) { /* a texture: its value alone */
+            if ((st = get_texture(p, f[i], fp, true, i == MF_KD ? &m->map_kd : &m->map_ks, &loaded))) return st;
+            if (loaded) *colours[i] = v3s(1.0f);
+            continue;
+        }
         if ((st = get_color(p, f[i], fp, colours[i]))) return st;
     }
-    if (f[MF_NS]) {
+    if (f[MF_NS] && cJSON_IsObject(f[MF_NS])) {
+        path_key(fp, path, "ns");
+        if ((st = get_texture(p, f[MF_NS], fp, false, &m->map_ns, &loaded))) return st;
+        if (loaded) m->ns = 1.0f;
+    } else if (f[MF_NS]) {
         path_key(fp, path, "ns");
         if ((st = get_float(p, f[MF_NS], fp, &m->ns))) return st;
         if (m->ns < 0.0f) return jfail(p, PK_ERR_PARSE, f[MF_NS], fp, "must not be negative");
     }
+    if ((st = read_surface_maps(p, f[MF_D], f[MF_BUMP], f[MF_NORMAL], path, m))) return st;
     if (f[MF_NI]) {
         path_key(fp, path, "ni");
         if ((st = get_float(p, f[MF_NI], fp, &m->ni))) return st;
         if (!(m->ni > 0.0f)) return jfail(p, PK_ERR_PARSE, f[MF_NI], fp, "must be a positive number");
     }
-    if (f[MF_D]) {
+    if (f[MF_D] && !cJSON_IsObject(f[MF_D])) {
         path_key(fp, path, "d");
         if ((st = get_float(p, f[MF_D], fp, &m->d))) return st;
         if (m->d < 0.0f || m->d > 1.0f) return jfail(p, PK_ERR_PARSE, f[MF_D], fp, "must be in 0..1");

@@ -300,8 +300,18 @@ vec3 path_radiance(const path_tracer *pt, path_thread *t, sampler *smp, const ra
     bool prev_delta = true; /* the camera: emission is counted in full */
     float prev_pdf = 0.0f;
     vec3 prev_p = r.o;
+    float cone = 0.0f; /* the ray cone's width where the path left the last vertex */
     for (int depth = 0;; depth++) {
+        if (s->has_cutout && !trace_past_holes(fr->a, s, &r, &h, t->cp)) { /* through map_d holes, out */
+            L = v3_add(L, v3_mul(beta, leaving(pt, v3_norm(r.d), prev_delta, prev_pdf)));
+            break;
+        }
         surface sf = surface_at(s, &r, &h);
+        material textured;
+        if (s->has_textured) { /* the ray cone, widened by the distance travelled */
+            cone += pt->spread * h.t * v3_len(r.d);
+            if (sf.m->textured) sf = surface_texture(s, &r, &h, cone, sf, &textured);
+        }
         const vec3 wo = v3_neg(v3_norm(r.d));
         /* emission reached by the path */
         vec3 le = emitted(&sf);
@@ -335,7 +345,9 @@ vec3 path_radiance(const path_tracer *pt, path_thread *t, sampler *smp, const ra
                 if (!black(f)) {
                     hit blocker;
                     t->rays_shadow++;
-                    if (!fr->a->ops->occluded(fr->a, &ls.shadow, &blocker, t->cp)) {
+                    const bool blocked = s->has_cutout ? occluded_past_holes(fr->a, s, &ls.shadow, t->cp)
+                                                       : fr->a->ops->occluded(fr->a, &ls.shadow, &blocker, t->cp);
+                    if (!blocked) {
                         float w = ls.delta || pt->strategy == PATH_LIGHTS_ONLY ? 1.0f : power_heuristic(ls.pdf, pb);
                         L = v3_add(L, v3_mul(beta, v3_scale(v3_mul(f, ls.le), w / ls.pdf)));
                     }

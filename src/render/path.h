@@ -22,6 +22,7 @@ typedef struct path_tracer {
     int max_depth;       /* bounces after the camera ray */
     uint32_t seed;
     int strategy;        /* PATH_* */
+    float spread;        /* ray cone spread angle per unit length: the camera's pixel angle (textures) */
 } path_tracer;
 
 typedef struct path_thread {

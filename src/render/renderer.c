@@ -115,7 +115,9 @@ pk_status renderer_create(pk_context *ctx, const pk_scene *s, const pk_render_op
         return st;
     }
     r->path = opt->integrator != PK_INTEGRATOR_WHITTED;
-    r->w = (whitted){&r->fr, opt->light_samples, pk_render_options_max_depth(opt), opt->fresnel != 0};
+    /* the ray cone of a pixel: its angle, which texture filtering widens with distance */
+    const float spread = 2.0f * tanf(0.5f * cam->fov_deg * PK_PI / 180.0f) / (float)opt->height;
+    r->w = (whitted){&r->fr, opt->light_samples, pk_render_options_max_depth(opt), opt->fresnel != 0, spread};
     r->ts = mem_calloc(&ctx->alloc, (size_t)r->nt, sizeof *r->ts);
     r->pts = mem_calloc(&ctx->alloc, (size_t)r->nt, sizeof *r->pts);
     if (!r->ts || !r->pts) {
@@ -127,6 +129,7 @@ pk_status renderer_create(pk_context *ctx, const pk_scene *s, const pk_render_op
             renderer_destroy(r);
             return st;
         }
+        r->pt.spread = spread;
         for (int t = 0; t < r->nt; t++) r->pts[t].cp = opt->collect_stats ? &r->pts[t].counters : NULL;
     } else {
         for (int t = 0; t < r->nt; t++)
@@ -298,6 +301,7 @@ static bool render_tile(const pk_renderer *r, whitted_thread *me, const camera_f
             int px = tl->x + i % tw, py = tl->y + i / tw;
             me->rng = rng_seed(((uint64_t)py << 32) | (uint32_t)px, (first + (uint64_t)smp) * 2);
             me->ray_budget = WHITTED_RAY_BUDGET;
+            me->cone = 0.0f;
             vec3 c = whitted_shade(w, me, &rays[i], &hits[i], 0);
             acc[3 * i] += c.x;
             acc[3 * i + 1] += c.y;
@@ -324,8 +328,10 @@ static void render_tile_aovs(const pk_renderer *r, const camera_frame *cf, const
             float *a = &v[0][3 * i], *nn = &v[1][3 * i], *d = &v[2][3 * i], *hm = &v[3][3 * i];
             const float heat = (float)(c.nodes + c.tests);
             hm[0] += heat, hm[1] += heat, hm[2] += heat;
-            if (!got) continue;
+            if (!got || (s->has_cutout && !trace_past_holes(r->fr.a, s, &cr, &h, NULL))) continue;
             surface sf = surface_at(s, &cr, &h);
+            material textured;
+            if (sf.m->textured) sf = surface_texture(s, &cr, &h, r->w.spread * h.t * v3_len(cr.d), sf, &textured);
             a[0] += sf.m->kd.x, a[1] += sf.m->kd.y, a[2] += sf.m->kd.z;
             nn[0] += sf.ns.x, nn[1] += sf.ns.y, nn[2] += sf.ns.z;
             const float dist = h.t * v3_len(cr.d);

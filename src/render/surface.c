@@ -43,3 +43,159 @@ surface surface_at(const pk_scene *s, const ray *r, const hit *h)
     sf.ns = ns;
     return sf;
 }
+
+/* ---- textures ------------------------------------------------------------------ */
+
+#define HOLE_STEPS 256   /* holes passed along one ray at most; then the surface counts */
+#define MIN_COS 0.05f    /* footprints of grazing hits stop growing here */
+
+surface_uv surface_uv_at(const pk_scene *s, const ray *r, const hit *h)
+{
+    surface_uv q;
+    if (h->prim < s->ntris) {
+        const triangle *t = &s->tris[h->prim];
+        vec3 a, b, c;
+        scene_tri_verts(s, h->prim, &a, &b, &c);
+        uv2 ta = {0.0f, 0.0f}, tb = {1.0f, 0.0f}, tc = {0.0f, 1.0f};
+        if (t->t[0] >= 0 && t->t[1] >= 0 && t->t[2] >= 0) {
+            ta = s->uvs[t->t[0]];
+            tb = s->uvs[t->t[1]];
+            tc = s->uvs[t->t[2]];
+        }
+        const float w = 1.0f - h->u - h->v;
+        q.u = ta.u * w + tb.u * h->u + tc.u * h->v;
+        q.v = ta.v * w + tb.v * h->u + tc.v * h->v;
+        /* dp/du, dp/dv from the two edges (pbrt's construction) */
+        const float du1 = tb.u - ta.u, dv1 = tb.v - ta.v, du2 = tc.u - ta.u, dv2 = tc.v - ta.v;
+        const vec3 e1 = v3_sub(b, a), e2 = v3_sub(c, a);
+        const float det = du1 * dv2 - dv1 * du2;
+        const float area = v3_len(v3_cross(e1, e2));
+        if (fabsf(det) > 1e-20f && isfinite(1.0f / det)) {
+            const float inv = 1.0f / det;
+            q.dpdu = v3_scale(v3_sub(v3_scale(e1, dv2), v3_scale(e2, dv1)), inv);
+            q.dpdv = v3_scale(v3_sub(v3_scale(e2, du1), v3_scale(e1, du2)), inv);
+        } else { /* uv degenerate: any frame around the normal */
+            q.dpdu = v3_norm_scaled(e1);
+            q.dpdv = v3_cross(v3_norm_scaled(v3_cross(e1, e2)), q.dpdu);
+        }
+        q.uv_per_len = area > 0.0f ? sqrtf(fabsf(det) / area) : 0.0f;
+    } else {
+        const sphere *sp = &s->spheres[h->prim - s->ntris];
+        vec3 p = v3_add(r->o, v3_scale(r->d, h->t));
+        vec3 n = v3_norm_scaled(v3_sub(p, sp->center));
+        const float phi = atan2f(n.z, n.x), theta = acosf(fminf(1.0f, fmaxf(-1.0f, n.y)));
+        q.u = (phi + PK_PI) * (0.5f / PK_PI);
+        q.v = 1.0f - theta * (1.0f / PK_PI);
+        const float rr = sp->radius, st = sinf(theta);
+        /* p = c + r (-cos(2 pi u) sin t, cos t, -sin(2 pi u) sin t), t = pi (1 - v) */
+        q.dpdu = v3(-2.0f * PK_PI * rr * n.z, 0.0f, 2.0f * PK_PI * rr * n.x);
+        q.dpdv = v3_scale(v3(n.x * n.y / fmaxf(st, 1e-6f), -st, n.z * n.y / fmaxf(st, 1e-6f)), -PK_PI * rr);
+        if (st < 1e-6f) q.dpdu = v3_cross(q.dpdv, n);
+        /* uv area 1 over the sphere's 4 pi r^2 */
+        q.uv_per_len = 1.0f / (rr * 2.0f * sqrtf(PK_PI));
+    }
+    return q;
+}
+
+static inline vec3 clamp_rgb(vec3 c)
+{
+    return v3(fminf(fmaxf(c.x, 0.0f), 1.0f), fminf(fmaxf(c.y, 0.0f), 1.0f), fminf(fmaxf(c.z, 0.0f), 1.0f));
+}
+
+/* Height of a bump map at (u, v), the fine level. */
+static inline float bump_height(const pk_scene *s, const tex_ref *ref, float u, float v)
+{
+    tex_query q = {u, v, 0.0f};
+    return tex_eval_scalar(s->textures, ref, q);
+}
+
+static void texture_at(const pk_scene *s, const ray *r, const hit *h, float cone_width, surface *sf, material *tm)
+{
+    const material *m = sf->m;
+    *tm = *m;
+    const surface_uv uv = surface_uv_at(s, r, h);
+    const float dl = v3_len(r->d);
+    const float cosv = dl > 0.0f ? fabsf(v3_dot(r->d, sf->ng)) / dl : 1.0f;
+    tex_query q = {uv.u, uv.v, cone_width / fmaxf(cosv, MIN_COS) * uv.uv_per_len};
+    if (!isfinite(q.width)) q.width = 0.0f;
+#ifdef PK_TEX_NO_CONES /* (-D for measurements: the finest level always, bilinear) */
+    q.width = 0.0f;
+#endif
+    /* texture values: colours and alpha in 0..1 (HDR images may hold more), Ns >= 0 */
+    if (m->map_kd.kind) tm->kd = v3_mul(m->kd, clamp_rgb(tex_eval_rgb(s->textures, &m->map_kd, q)));
+    if (m->map_ks.kind) tm->ks = v3_mul(m->ks, clamp_rgb(tex_eval_rgb(s->textures, &m->map_ks, q)));
+    if (m->map_ns.kind) tm->ns = m->ns * fmaxf(tex_eval_scalar(s->textures, &m->map_ns, q), 0.0f);
+    if (m->map_alpha.kind) {
+        float a = fminf(fmaxf(tex_eval_scalar(s->textures, &m->map_alpha, q), 0.0f), 1.0f);
+        tm->alpha = fminf(m->alpha * (m->map_alpha.squared ? a * a : a), 1.0f);
+    }
+    sf->m = tm;
+    if (!m->map_bump.kind && !m->map_norm.kind) return;
+    /* a frame on the surface, z = the shading normal as it faces the ray */
+    const vec3 n = sf->ns;
+    vec3 t = v3_sub(uv.dpdu, v3_scale(n, v3_dot(n, uv.dpdu)));
+    if (!(v3_len2(t) > 0.0f) || !v3_finite(t)) return;
+    t = v3_norm(t);
+    vec3 b = v3_cross(n, t);
+    if (v3_dot(b, uv.dpdv) < 0.0f) b = v3_neg(b);
+    vec3 nn = n;
+    if (m->map_norm.kind) {
+        vec3 c = tex_eval_rgb(s->textures, &m->map_norm, q);
+        vec3 tl = v3(2.0f * c.x - 1.0f, 2.0f * c.y - 1.0f, 2.0f * c.z - 1.0f);
+        nn = v3_add(v3_add(v3_scale(t, tl.x), v3_scale(b, tl.y)), v3_scale(n, tl.z));
+    } else {
+        /* heights times bm displace along n: n' = (dp/du + dh/du n) x (dp/dv + dh/dv n) */
+        const tex_ref *ref = &m->map_bump;
+        int size = 1;
+        if (ref->kind == TEX_IMAGE) {
+            const texture *tx = &s->textures[ref->tex];
+            size = tx->lv[0].w > tx->lv[0].h ? tx->lv[0].w : tx->lv[0].h;
+        }
+        const float du = 0.5f / (float)size, dv = du;
+        const float h0 = bump_height(s, ref, uv.u, uv.v);
+        const float hu = (bump_height(s, ref, uv.u + du, uv.v) - h0) / du * ref->bm;
+        const float hv = (bump_height(s, ref, uv.u, uv.v + dv) - h0) / dv * ref->bm;
+        /* in the frame (t, b, n) with dp/du ~ |dpdu| t and dp/dv ~ |dpdv| b */
+        const float lu = v3_len(uv.dpdu), lv = v3_len(uv.dpdv);
+        if (!(lu > 0.0f) || !(lv > 0.0f)) return;
+        nn = v3_sub(n, v3_add(v3_scale(t, hu / lu), v3_scale(b, hv / lv)));
+    }
+    if (!v3_finite(nn) || !(v3_len2(nn) > 0.0f)) return;
+    nn = v3_norm(nn);
+    if (v3_dot(nn, sf->ng) <= 0.0f) return; /* would face away: kept as it was */
+    sf->ns = nn;
+}
+
+bool surface_is_hole(const pk_scene *s, const ray *r, const hit *h)
+{
+    const uint32_t mi = h->prim < s->ntris ? s->tris[h->prim].material : s->spheres[h->prim - s->ntris].material;
+    const material *m = &s->materials[mi];
+    if (!m->cutout) return false;
+    const surface_uv uv = surface_uv_at(s, r, h);
+    tex_query q = {uv.u, uv.v, 0.0f};
+    return tex_eval_alpha(s->textures, &m->map_d, q) < 0.5f;
+}
+
+bool trace_past_holes(const accel *a, const pk_scene *s, ray *r, hit *h, accel_counters *cp)
+{
+    for (int k = 0; k < HOLE_STEPS && surface_is_hole(s, r, h); k++) {
+        r->tmin = nextafterf(h->t, INFINITY);
+        if (!accel_intersect(a, r, h, cp)) return false;
+    }
+    return true;
+}
+
+bool occluded_past_holes(const accel *a, const pk_scene *s, const ray *r, accel_counters *cp)
+{
+    if (!s->has_cutout) return accel_occluded(a, r, cp);
+    ray rr = *r;
+    hit h;
+    if (!accel_intersect(a, &rr, &h, cp)) return false;
+    return trace_past_holes(a, s, &rr, &h, cp);
+}
+
+surface surface_texture(const pk_scene *s, const ray *r, const hit *h, float cone_width, surface sf, material *tm)
+{
+    texture_at(s, r, h, cone_width, &sf, tm);
+    return sf;
+}

@@ -133,15 +133,24 @@ static vec3 direct_light(const whitted *w, whitted_thread *ts, const surface *sf
     if (n == 0) return L;
     ts->rays[RAY_SHADOW] += n;
     accel_intersect_many(fr->a, ts->shadow_rays, ts->shadow_hits, n, true, ts->cp);
-    for (size_t i = 0; i < n; i++)
-        if (ts->shadow_hits[i].prim == PK_NO_HIT) L = v3_add(L, ts->shadow_weight[i]);
+    if (!s->has_cutout) {
+        for (size_t i = 0; i < n; i++)
+            if (ts->shadow_hits[i].prim == PK_NO_HIT) L = v3_add(L, ts->shadow_weight[i]);
+        return L;
+    }
+    for (size_t i = 0; i < n; i++) /* map_d holes: a blocked ray may pass through them */
+        if (ts->shadow_hits[i].prim == PK_NO_HIT || !occluded_past_holes(fr->a, s, &ts->shadow_rays[i], ts->cp))
+            L = v3_add(L, ts->shadow_weight[i]);
     return L;
 }
 
-vec3 whitted_shade(const whitted *w, whitted_thread *ts, const ray *r, const hit *h, int depth)
+static vec3 shade_opaque(const whitted *w, whitted_thread *ts, const ray *r, const hit *h, int depth)
 {
     const frame *fr = w->f;
     surface sf = surface_at(fr->s, r, h);
+    const float cone = fr->s->has_textured ? ts->cone + w->spread * h->t * v3_len(r->d) : 0.0f;
+    material textured;
+    if (sf.m->textured) sf = surface_texture(fr->s, r, h, cone, sf, &textured);
     const material *m = sf.m;
     vec3 wo = v3_neg(v3_norm(r->d));
     vec3 L = m->ke; /* emitters are two-sided */
@@ -155,6 +164,7 @@ vec3 whitted_shade(const whitted *w, whitted_thread *ts, const ray *r, const hit
             vec3 wr = v3_reflect(dn, sf.ns);
             if (v3_dot(wr, sf.ng) <= 0.0f) wr = v3_reflect(dn, sf.ng);
             ray rr = {offset_origin(fr->eps, sf.p, sf.ng), 0.0f, wr, INFINITY};
+            ts->cone = cone;
             L = v3_add(L, v3_mul(m->ks, trace(w, ts, &rr, depth + 1, RAY_REFLECTION)));
         } else if (dielectric) {
             /* entering when the ray hits the front of the geometric normal */
@@ -179,18 +189,33 @@ vec3 whitted_shade(const whitted *w, whitted_thread *ts, const ray *r, const hit
             }
             if (!is_black(kr)) {
                 ray rr = {offset_origin(fr->eps, sf.p, sf.ng), 0.0f, wr, INFINITY};
+                ts->cone = cone;
                 L = v3_add(L, v3_mul(kr, trace(w, ts, &rr, depth + 1, RAY_REFLECTION)));
             }
             if (!is_black(kt)) {
                 ray rt = {offset_origin(fr->eps, sf.p, v3_neg(sf.ng)), 0.0f, wt, INFINITY};
+                ts->cone = cone;
                 L = v3_add(L, v3_mul(kt, trace(w, ts, &rt, depth + 1, RAY_REFRACTION)));
             }
         }
         if (!dielectric && m->d < 1.0f) { /* dissolve: see through the surface */
             ray rt = {offset_origin(fr->eps, sf.p, v3_neg(sf.ng)), 0.0f, r->d, INFINITY};
+            ts->cone = cone;
             vec3 behind = trace(w, ts, &rt, depth + 1, RAY_REFRACTION);
             L = v3_add(v3_scale(L, m->d), v3_scale(behind, 1.0f - m->d));
         }
     }
     return L;
+}
+
+vec3 whitted_shade(const whitted *w, whitted_thread *ts, const ray *r, const hit *h, int depth)
+{
+    const pk_scene *s = w->f->s;
+    if (s->has_cutout && surface_is_hole(s, r, h)) { /* map_d holes: what lies behind */
+        ray rr = *r;
+        hit hh = *h;
+        if (!trace_past_holes(w->f->a, s, &rr, &hh, ts->cp)) return env_background(&w->f->env, v3_norm(rr.d));
+        return shade_opaque(w, ts, &rr, &hh, depth);
+    }
+    return shade_opaque(w, ts, r, h, depth);
 }

@@ -25,6 +25,7 @@ typedef struct whitted {
     const frame *f;
     int light_samples, max_depth;
     bool fresnel;
+    float spread;        /* ray cone spread angle: the camera's pixel angle (textures) */
 } whitted;
 
 /* Per-thread scratch, allocated once per renderer. */
@@ -37,6 +38,7 @@ typedef struct whitted_thread {
     vec3 *shadow_weight;
     rng rng;
     uint32_t ray_budget; /* secondary rays left for the current camera ray */
+    float cone;          /* ray cone width at the origin of the ray being shaded (0 for camera rays) */
 } whitted_thread;
 
 PK_HIDDEN pk_status whitted_thread_init(pk_context *ctx, const whitted *w, whitted_thread *t, bool stats);

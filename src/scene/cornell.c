@@ -61,7 +61,7 @@ static pk_status add_quad(pk_context *ctx, pk_scene *s, const cb_quad *q, uint32
         if (q->material == CB_LIGHT) y -= CB_LIGHT_DROP_MM;
         if ((st = scene_add_position(ctx, s, v3(q->v[i][0] * CB_MM, y * CB_MM, q->v[i][2] * CB_MM)))) return st;
     }
-    triangle t = {{base, base + 1, base + 2}, {-1, -1, -1}, mat};
+    triangle t = {{base, base + 1, base + 2}, {-1, -1, -1}, {-1, -1, -1}, mat};
     if ((st = scene_add_triangle(ctx, s, &t))) return st;
     t.v[1] = base + 2;
     t.v[2] = base + 3;

@@ -22,6 +22,13 @@ void material_init(material *m)
     m->ni = 1.0f;
     m->d = 1.0f;
     m->illum = 2;
+    tex_ref_init(&m->map_kd);
+    tex_ref_init(&m->map_ks);
+    tex_ref_init(&m->map_ns);
+    tex_ref_init(&m->map_d);
+    tex_ref_init(&m->map_alpha);
+    tex_ref_init(&m->map_bump);
+    tex_ref_init(&m->map_norm);
 }
 
 void scene_env_init(scene_environment *env)
@@ -84,6 +91,9 @@ void scene_destroy(pk_scene *s)
     mem_free(a, s->mat_index);
     mem_free(a, s->positions);
     mem_free(a, s->normals);
+    mem_free(a, s->uvs);
+    for (size_t i = 0; i < s->ntextures; i++) texture_free(a, &s->textures[i]);
+    mem_free(a, s->textures);
     mem_free(a, s->tris);
     mem_free(a, s->spheres);
     mem_free(a, s->lights);
@@ -115,6 +125,11 @@ pk_status scene_add_position(pk_context *ctx, pk_scene *s, vec3 p)
 pk_status scene_add_normal(pk_context *ctx, pk_scene *s, vec3 n)
 {
     APPEND(ctx, s, normals, nnormals, cap_normals, n, SCENE_MAX_PRIMS, "normals");
+}
+
+pk_status scene_add_uv(pk_context *ctx, pk_scene *s, uv2 t)
+{
+    APPEND(ctx, s, uvs, nuvs, cap_uvs, t, SCENE_MAX_PRIMS, "texture coordinates");
 }
 
 pk_status scene_add_triangle(pk_context *ctx, pk_scene *s, const triangle *t)
@@ -207,6 +222,15 @@ pk_status scene_commit(pk_context *ctx, pk_scene *s)
     s->emissive = NULL;
     s->ndegenerate = s->nemissive = 0;
     s->bounds = aabb_empty();
+    s->has_cutout = s->has_textured = false;
+    for (size_t i = 0; i < s->nmaterials; i++) {
+        material *m = &s->materials[i];
+        m->cutout = m->map_d.kind != TEX_NONE;
+        m->textured = m->map_kd.kind != TEX_NONE || m->map_ks.kind != TEX_NONE || m->map_ns.kind != TEX_NONE ||
+                      m->map_alpha.kind != TEX_NONE || m->map_bump.kind != TEX_NONE || m->map_norm.kind != TEX_NONE;
+        s->has_cutout |= m->cutout;
+        s->has_textured |= m->textured;
+    }
     if (s->ntris) {
         s->degenerate = mem_calloc(&s->alloc, s->ntris, 1);
         if (!s->degenerate) return ctx_nomem(ctx);
@@ -260,12 +284,26 @@ bool scene_check(const pk_scene *s, char *why, size_t n)
         if (!v3_finite(s->positions[i])) FAIL("position %zu is not finite", i);
     for (size_t i = 0; i < s->nnormals; i++)
         if (!v3_finite(s->normals[i])) FAIL("normal %zu is not finite", i);
+    for (size_t i = 0; i < s->nuvs; i++)
+        if (!isfinite(s->uvs[i].u) || !isfinite(s->uvs[i].v)) FAIL("uv %zu is not finite", i);
+    size_t tex_bytes = 0;
+    for (size_t i = 0; i < s->ntextures; i++) tex_bytes += s->textures[i].bytes;
+    if (tex_bytes != s->texture_bytes) FAIL("texture bytes do not add up");
+    for (size_t i = 0; i < s->nmaterials; i++) {
+        const material *m = &s->materials[i];
+        const tex_ref *maps[7] = {&m->map_kd, &m->map_ks, &m->map_ns, &m->map_d, &m->map_alpha, &m->map_bump, &m->map_norm};
+        for (int j = 0; j < 7; j++)
+            if (maps[j]->kind == TEX_IMAGE && (maps[j]->tex < 0 || (size_t)maps[j]->tex >= s->ntextures))
+                FAIL("material %zu: texture index out of range", i);
+    }
     for (size_t k = 0; k < s->ntris; k++) {
         const triangle *t = &s->tris[k];
         for (int j = 0; j < 3; j++) {
             if (t->v[j] >= s->npositions) FAIL("triangle %zu: vertex index out of range", k);
             if (t->n[j] < -1 || (t->n[j] >= 0 && (size_t)t->n[j] >= s->nnormals))
                 FAIL("triangle %zu: normal index out of range", k);
+            if (t->t[j] < -1 || (t->t[j] >= 0 && (size_t)t->t[j] >= s->nuvs))
+                FAIL("triangle %zu: uv index out of range", k);
         }
         if (t->material >= s->nmaterials) FAIL("triangle %zu: material out of range", k);
     }

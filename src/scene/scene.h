@@ -10,6 +10,7 @@
 #include "../math/tri.h"
 #include "../math/vec3.h"
 #include "../paprsek_internal.h"
+#include "texture.h"
 
 /* Material as read from MTL (or JSON); colours are linear RGB.
  * illum follows the MTL convention: 3/5 add mirror reflection weighted by ks,
@@ -43,6 +44,15 @@ typedef struct material {
     float alpha;
     vec3 eta, k;
     bool schlick;
+    /* Texture maps (docs/materials.md), kind TEX_NONE when absent. A map's
+     * value multiplies its constant: map_kd kd, map_ks ks, map_ns ns,
+     * map_alpha alpha. map_d cuts holes: where its opacity is below 0.5 the
+     * surface is not there for any ray (the constant d still dissolves the
+     * rest). map_bump is a height field (heights times bm, in scene units);
+     * map_norm a tangent-space normal map. */
+    tex_ref map_kd, map_ks, map_ns, map_d, map_alpha, map_bump, map_norm;
+    bool textured;   /* derived by scene_commit: a map other than map_d is set */
+    bool cutout;     /* derived by scene_commit: map_d is set */
 } material;
 
 typedef enum material_type { MAT_MTL, MAT_DIFFUSE, MAT_CONDUCTOR, MAT_DIELECTRIC, MAT_PLASTIC } material_type;
@@ -51,8 +61,14 @@ typedef enum material_type { MAT_MTL, MAT_DIFFUSE, MAT_CONDUCTOR, MAT_DIELECTRIC
 typedef struct triangle {
     uint32_t v[3];   /* indices into positions */
     int32_t n[3];    /* indices into normals, -1 when the face has none */
+    int32_t t[3];    /* indices into uvs, -1 when the face has none */
     uint32_t material;
 } triangle;
+
+/* A texture coordinate (OBJ vt: u to the right, v up). */
+typedef struct uv2 {
+    float u, v;
+} uv2;
 
 typedef struct sphere {
     vec3 center;     /* world space */
@@ -96,8 +112,11 @@ typedef struct scene_render_settings {
 } scene_render_settings;
 
 /* Invariants (scene_check tests them after commit):
- *  1. every triangle's v[] < npositions, n[] is -1 or < nnormals, material < nmaterials;
- *  2. every position and normal is finite;
+ *  1. every triangle's v[] < npositions, n[] is -1 or < nnormals, t[] is -1
+ *     or < nuvs, material < nmaterials;
+ *  2. every position, normal and uv is finite;
+ *  7. every material's image maps name a texture < ntextures, and
+ *     texture_bytes is the sum of the textures' bytes;
  *  3. every sphere has a finite center and radius > 0, material < nmaterials;
  *  4. material 0 exists and is the neutral grey default;
  *  5. after commit, degenerate[k] says whether triangle k can never be hit,
@@ -110,6 +129,7 @@ struct pk_scene {
 
     vec3 *positions; size_t npositions, cap_positions;
     vec3 *normals;   size_t nnormals, cap_normals;
+    uv2 *uvs;        size_t nuvs, cap_uvs;
     triangle *tris;  size_t ntris, cap_tris;
     sphere *spheres; size_t nspheres, cap_spheres;
     material *materials; size_t nmaterials, cap_materials;
@@ -117,6 +137,10 @@ struct pk_scene {
      * slots holding 1 + the newest material of a name, 0 when empty. */
     uint32_t *mat_index; size_t mat_slots;
     point_light *lights; size_t nlights, cap_lights;
+    /* Images the materials' maps use, each file loaded once per decode mode
+     * (texture_load). */
+    texture *textures; size_t ntextures, cap_textures;
+    size_t texture_bytes;
 
     vec3 ambient;           /* ambient light; zero unless the scene asks */
     scene_environment env;  /* the surroundings; nothing unless the scene asks */
@@ -128,6 +152,8 @@ struct pk_scene {
     bool committed;
     uint8_t *degenerate;    /* ntris flags */
     size_t ndegenerate;
+    bool has_cutout;        /* a material has map_d */
+    bool has_textured;      /* a material has a map other than map_d (its textured flag) */
     uint32_t *emissive;     /* indices of emissive triangles */
     size_t nemissive;
     aabb bounds;
@@ -140,6 +166,7 @@ PK_HIDDEN void scene_destroy(pk_scene *s);
 /* Builders: return PK_OK or latch an error in ctx (PK_ERR_NOMEM / PK_ERR_LIMIT). */
 PK_HIDDEN pk_status scene_add_position(pk_context *ctx, pk_scene *s, vec3 p);
 PK_HIDDEN pk_status scene_add_normal(pk_context *ctx, pk_scene *s, vec3 n);
+PK_HIDDEN pk_status scene_add_uv(pk_context *ctx, pk_scene *s, uv2 t);
 PK_HIDDEN pk_status scene_add_triangle(pk_context *ctx, pk_scene *s, const triangle *t);
 PK_HIDDEN pk_status scene_add_sphere(pk_context *ctx, pk_scene *s, const sphere *sp);
 PK_HIDDEN pk_status scene_add_point_light(pk_context *ctx, pk_scene *s, const point_light *l);
@@ -184,9 +211,14 @@ static inline void scene_tri_verts(const pk_scene *s, size_t k, vec3 *a, vec3 *b
  * inverse transpose to normals); NULL = identity. Does not commit. */
 PK_HIDDEN pk_status obj_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,
                               const char *name, const char *base_dir, const float *xform);
-/* Parses MTL text, adding its materials to s. */
+/* Parses MTL text, adding its materials to s. Texture maps are parsed but
+ * not loaded. */
 PK_HIDDEN pk_status mtl_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,
                               const char *name);
+/* The same, loading the texture maps from files relative to tex_dir (NULL:
+ * not loaded). A texture that cannot be used is a warning. */
+PK_HIDDEN pk_status mtl_parse_dir(pk_context *ctx, pk_scene *s, const char *data, size_t size,
+                                  const char *name, const char *tex_dir);
 /* Parses a JSON scene into s (meshes are loaded relative to base_dir). Does not commit. */
 PK_HIDDEN pk_status scene_json_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,
                                      const char *name, const char *base_dir);

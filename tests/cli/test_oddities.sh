@@ -63,8 +63,9 @@ renders odd_unknown.obj \
   "odd_unknown.obj:10: unknown statement 'p' ignored (further ones not reported)" \
   @nolight
 renders odd_maps.obj \
-  "odd_maps.mtl:5: unknown statement 'map_Kd' ignored (further ones not reported)" \
-  "odd_maps.mtl:7: unknown statement 'bump' ignored (further ones not reported)" \
+  "odd_maps.mtl:5: texture 'paint.png' not used ($data/paint.png: cannot open: No such file or directory); Kd is used alone" \
+  "odd_maps.mtl:6: texture 'paint2.png' not used ($data/paint2.png: cannot open: No such file or directory); Kd is used alone" \
+  "odd_maps.mtl:7: texture 'paint_bump.png' not used ($data/paint_bump.png: cannot open: No such file or directory); the surface is not bumped" \
   "odd_maps.mtl:8: 'Tf spectral' is not supported, statement ignored (further ones not reported)" \
   @nolight
 renders odd_missing_mtl.obj \

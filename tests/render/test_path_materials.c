@@ -108,6 +108,9 @@ int main(void)
         "{\"type\": \"conductor\", \"specular\": [1, 1, 1], \"roughness\": 0}",
         "{\"type\": \"dielectric\", \"ior\": 1.0}",
         "{\"type\": \"diffuse\", \"albedo\": [1, 1, 1]}",
+        /* textured: a white image (sRGB 255 is 1), a checker of white */
+        "{\"type\": \"diffuse\", \"albedo\": {\"texture\": \"" PK_TEST_DATA "/tex_white.png\", \"scale\": 3}}",
+        "{\"type\": \"diffuse\", \"albedo\": {\"checker\": {\"even\": [1, 1, 1], \"odd\": 1}}}",
         "{\"type\": \"diffuse\", \"albedo\": [1, 1, 1], \"two_sided\": true}",
     };
     const char *lossy[] = {
@@ -118,6 +121,8 @@ int main(void)
         "{\"type\": \"dielectric\", \"ior\": 1.5, \"roughness\": 0.6}",
         "{\"type\": \"dielectric\", \"ior\": 1.5, \"transmittance\": [0.5, 0.8, 1]}",
         "{\"type\": \"diffuse\", \"albedo\": [0.5, 0.5, 0.5]}",
+        "{\"type\": \"diffuse\", \"albedo\": {\"texture\": \"" PK_TEST_DATA "/tex_rgbw.png\"}}",
+        "{\"type\": \"diffuse\", \"albedo\": {\"checker\": {\"even\": 1, \"odd\": 0.25}}}",
     };
     for (size_t i = 0; i < sizeof lossless / sizeof lossless[0]; i++) {
         check(lossless[i], 0.0f, 0.5f, true); /* a pure emitter shell: no noise at all */
