@@ -16,6 +16,7 @@
 #include "../options.h"
 #include "../scene/camera.h"
 #include "../scene/scene.h"
+#include "../scene/texture.h"
 
 #include <expat.h>
 #include <math.h>
@@ -99,6 +100,9 @@ typedef struct xp {
     char fov_axis[16];
     bool has_fov;
     int film_w, film_h;
+    /* where the colour property being read may put a texture (the diffuse
+     * reflectances); NULL: textures stand in as constants */
+    tex_ref *want_tex;
 } xp;
 
 /* expat's side of building one tree */
@@ -787,19 +791,50 @@ static pk_status node_color(xp *p, const xnode *n, vec3 *out)
 
 /* ---- textures: the one place they enter ----------------------------------------------- */
 
-/* Every textured parameter comes here. file is the bitmap's file resolved
- * against the XML file's folder (NULL for procedural textures), fallback
- * the constant that stands in for it. Textures are not rendered yet: the
- * constant is used, with a warning. */
-static pk_status texture_param(xp *p, const xnode *tex, const char *param, const char *file, vec3 fallback,
-                               vec3 *out)
+/* Every textured parameter comes here: file is the bitmap's file resolved
+ * against the XML file's folder, or NULL for a checkerboard (colours c0, c1);
+ * fallback the constant that stands in for it. Where the property takes a
+ * texture (p->want_tex), the texture goes there and *out becomes 1 (the
+ * texture's value multiplies the constant); elsewhere, and for a bitmap that
+ * cannot be read, the constant is used with a warning. uv' = (us u, vs v). */
+static pk_status texture_param(xp *p, const xnode *tex, const char *param, const char *file, vec3 c0, vec3 c1,
+                               float us, float vs, vec3 fallback, vec3 *out)
 {
-    (void)file;
     char what[64];
     shown(what, sizeof what, param);
-    xwarn(p, tex, "textures are not supported yet; using the constant colour %g %g %g for %s",
-          (double)fallback.x, (double)fallback.y, (double)fallback.z, what);
     *out = fallback;
+    if (!p->want_tex) {
+        xwarn(p, tex, "a texture for %s is not supported; using the constant %g %g %g", what, (double)fallback.x,
+              (double)fallback.y, (double)fallback.z);
+        return PK_OK;
+    }
+    tex_ref r;
+    tex_ref_init(&r);
+    r.s[0] = us, r.s[1] = vs;
+    if (file) {
+        int32_t idx;
+        const bool was_ok = p->ctx->status == PK_OK;
+        pk_status st = texture_load(p->ctx, p->s, file, true, &idx);
+        if (st == PK_ERR_NOMEM) return st;
+        if (st != PK_OK) {
+            char why[PK_ERRMSG_MAX];
+            snprintf(why, sizeof why, "%s", p->ctx->message);
+            if (was_ok) pk_context_clear_error(p->ctx);
+            xwarn(p, tex, "texture not used (%s); using the constant %g %g %g for %s", why, (double)fallback.x,
+                  (double)fallback.y, (double)fallback.z, what);
+            return PK_OK;
+        }
+        r.kind = TEX_IMAGE;
+        r.tex = idx;
+    } else {
+        /* Mitsuba's checkerboard: color0 where u and v are both below or both
+         * above one half, color1 elsewhere (two squares a side) */
+        r.kind = TEX_CHECKER;
+        r.even = c0, r.odd = c1;
+        r.checker_scale = 2.0f;
+    }
+    *p->want_tex = r;
+    *out = v3s(1.0f);
     return PK_OK;
 }
 
@@ -838,7 +873,12 @@ static pk_status texture_value(xp *p, xnode *tex, const char *param, vec3 fallba
         if (!fn) return xfail(p, PK_ERR_PARSE, tex, "bitmap texture needs a filename");
         char *full = path_join(&p->ctx->alloc, tex->file->dir, fn);
         if (!full) return ctx_nomem(p->ctx);
-        st = texture_param(p, tex, param, full, fallback, out);
+        float us = 1.0f, vs = 1.0f;
+        if ((st = get_float(p, tex, "uscale", &us)) || (st = get_float(p, tex, "vscale", &vs))) {
+            mem_free(&p->ctx->alloc, full);
+            return st;
+        }
+        st = texture_param(p, tex, param, full, v3s(0.0f), v3s(0.0f), us, vs, fallback, out);
         mem_free(&p->ctx->alloc, full);
         return st;
     }
@@ -847,17 +887,24 @@ static pk_status texture_value(xp *p, xnode *tex, const char *param, vec3 fallba
         xnode *a = prop(p, tex, "color0"), *b = prop(p, tex, "color1");
         if (a && (st = node_color(p, a, &c0))) return st;
         if (b && (st = node_color(p, b, &c1))) return st;
-        return texture_param(p, tex, param, NULL, v3_scale(v3_add(c0, c1), 0.5f), out);
+        float us = 1.0f, vs = 1.0f;
+        if ((st = get_float(p, tex, "uscale", &us)) || (st = get_float(p, tex, "vscale", &vs))) return st;
+        return texture_param(p, tex, param, NULL, c0, c1, us, vs, v3_scale(v3_add(c0, c1), 0.5f), out);
     }
     if (strcmp(type, "scale") == 0) {
         float scale = 1.0f;
         if ((st = get_float(p, tex, "scale", &scale))) return st;
+        tex_ref *want = p->want_tex;
+        p->want_tex = NULL; /* a scaled texture stands in as a constant */
         for (xnode *c = tex->child; c; c = c->next)
             if (strcmp(c->tag, "texture") == 0 || strcmp(c->tag, "ref") == 0) {
-                if ((st = texture_value(p, c, param, fallback, out, depth + 1))) return st;
+                st = texture_value(p, c, param, fallback, out, depth + 1);
+                p->want_tex = want;
+                if (st) return st;
                 *out = v3_scale(*out, scale);
                 return PK_OK;
             }
+        p->want_tex = want;
         *out = v3_scale(fallback, scale);
         return PK_OK;
     }
@@ -878,6 +925,16 @@ static pk_status get_color(xp *p, xnode *plugin, const char *name, vec3 *out)
     if (strcmp(c->tag, "texture") == 0 || strcmp(c->tag, "ref") == 0) return texture_value(p, c, name, *out, out, 0);
     pk_status st = node_color(p, c, out);
     if (st == PK_OK && !v3_finite(*out)) return xfail(p, PK_ERR_PARSE, c, "%s is not finite", name);
+    return st;
+}
+
+/* A colour property that may be a texture, which goes to *tex (a diffuse
+ * reflectance: the texture multiplies *out, which becomes 1). */
+static pk_status get_color_tex(xp *p, xnode *plugin, const char *name, vec3 *out, tex_ref *tex)
+{
+    p->want_tex = tex;
+    pk_status st = get_color(p, plugin, name, out);
+    p->want_tex = NULL;
     return st;
 }
 
@@ -1308,7 +1365,7 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
     float alpha = 0.0f;
     if (strcmp(type, "diffuse") == 0 || strcmp(type, "roughdiffuse") == 0) {
         vec3 r = v3s(0.5f);
-        if ((st = get_color(p, b, "reflectance", &r))) return st;
+        if ((st = get_color_tex(p, b, "reflectance", &r, &m->map_kd))) return st;
         if (strcmp(type, "roughdiffuse") == 0) {
             xnode *a = prop(p, b, "alpha");
             (void)a;
@@ -1398,7 +1455,7 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
         if (type[0] == 'r' && (st = get_alpha(p, b, 0.1f, &alpha))) return st;
         if ((st = get_ior(p, b, "int_ior", &in))) return st;
         if ((st = get_ior(p, b, "ext_ior", &ext))) return st;
-        if ((st = get_color(p, b, "diffuse_reflectance", &kd))) return st;
+        if ((st = get_color_tex(p, b, "diffuse_reflectance", &kd, &m->map_kd))) return st;
         if ((st = get_color(p, b, "specular_reflectance", &spec))) return st;
         if (spec.x != 1.0f || spec.y != 1.0f || spec.z != 1.0f)
             xwarn(p, b, "%s: specular_reflectance other than 1 is not supported; ignored", ty);
@@ -1527,12 +1584,12 @@ static void warn_unused(xp *p, xnode *plugin, const char *kind, const char *cons
 
 /* Appends triangles (tris: 3 indices each into pos) transformed by m.
  * flip reverses the winding; normals (optional, local) are transformed by
- * the inverse transpose. */
-static pk_status add_mesh(xp *p, const vec3 *pos, const vec3 *nrm, size_t npos, const uint32_t *tris, size_t ntris,
-                          const float m[16], bool flip, uint32_t mat)
+ * the inverse transpose; uv (optional) holds 2 texture coordinates a vertex. */
+static pk_status add_mesh(xp *p, const vec3 *pos, const vec3 *nrm, const float *uv, size_t npos, const uint32_t *tris,
+                          size_t ntris, const float m[16], bool flip, uint32_t mat)
 {
     pk_scene *s = p->s;
-    size_t pbase = s->npositions, nbase = s->nnormals;
+    size_t pbase = s->npositions, nbase = s->nnormals, tbase = s->nuvs;
     pk_status st;
     float cof[9] = {0};
     if (nrm) {
@@ -1554,6 +1611,11 @@ static pk_status add_mesh(xp *p, const vec3 *pos, const vec3 *nrm, size_t npos, 
             if (!v3_finite(n)) n = v3s(0.0f);
             if ((st = scene_add_normal(p->ctx, s, n))) return st;
         }
+        if (uv) {
+            uv2 t = {uv[2 * i], uv[2 * i + 1]};
+            if (!isfinite(t.u) || !isfinite(t.v)) t.u = t.v = 0.0f;
+            if ((st = scene_add_uv(p->ctx, s, t))) return st;
+        }
     }
     for (size_t t = 0; t < ntris; t++) {
         triangle tr;
@@ -1564,6 +1626,7 @@ static pk_status add_mesh(xp *p, const vec3 *pos, const vec3 *nrm, size_t npos, 
         }
         tr.v[0] = (uint32_t)(pbase + a), tr.v[1] = (uint32_t)(pbase + b), tr.v[2] = (uint32_t)(pbase + c);
         for (int k = 0; k < 3; k++) tr.n[k] = nrm ? (int32_t)(nbase + tr.v[k] - pbase) : -1;
+        for (int k = 0; k < 3; k++) tr.t[k] = uv ? (int32_t)(tbase + tr.v[k] - pbase) : -1;
         tr.material = mat;
         if ((st = scene_add_triangle(p->ctx, s, &tr))) return st;
     }
@@ -1575,7 +1638,8 @@ static pk_status shape_rectangle(xp *p, const float m[16], bool flip, uint32_t m
 {
     static const vec3 pos[4] = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
     static const uint32_t tris[6] = {0, 1, 2, 2, 3, 0};
-    return add_mesh(p, pos, NULL, 4, tris, 2, m, flip, mat);
+    static const float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1}; /* as Mitsuba's rectangle */
+    return add_mesh(p, pos, NULL, uv, 4, tris, 2, m, flip, mat);
 }
 
 /* The cube [-1, 1]^3, faces wound outward. */
@@ -1592,22 +1656,25 @@ static pk_status shape_cube(xp *p, const float m[16], bool flip, uint32_t mat)
         uint32_t t[6] = {q[0], q[1], q[2], q[2], q[3], q[0]};
         memcpy(tris + 6 * f, t, sizeof t);
     }
-    return add_mesh(p, pos, NULL, 8, tris, 12, m, flip, mat);
+    return add_mesh(p, pos, NULL, NULL, 8, tris, 12, m, flip, mat);
 }
 
 /* The unit disk at z = 0, facing +z, as a fan of XML_DISK_SEGMENTS triangles. */
 static pk_status shape_disk(xp *p, const float m[16], bool flip, uint32_t mat)
 {
     vec3 pos[XML_DISK_SEGMENTS + 1];
+    float uv[2 * (XML_DISK_SEGMENTS + 1)];
     uint32_t tris[3 * XML_DISK_SEGMENTS];
     pos[0] = v3s(0.0f);
+    uv[0] = uv[1] = 0.5f;
     for (int i = 0; i < XML_DISK_SEGMENTS; i++) {
         float a = 2.0f * PK_PI * (float)i / (float)XML_DISK_SEGMENTS;
         pos[i + 1] = v3(cosf(a), sinf(a), 0.0f);
+        uv[2 * (i + 1)] = 0.5f + 0.5f * pos[i + 1].x, uv[2 * (i + 1) + 1] = 0.5f + 0.5f * pos[i + 1].y;
         tris[3 * i] = 0, tris[3 * i + 1] = (uint32_t)(i + 1);
         tris[3 * i + 2] = (uint32_t)((i + 1) % XML_DISK_SEGMENTS + 1);
     }
-    return add_mesh(p, pos, NULL, XML_DISK_SEGMENTS + 1, tris, XML_DISK_SEGMENTS, m, flip, mat);
+    return add_mesh(p, pos, NULL, uv, XML_DISK_SEGMENTS + 1, tris, XML_DISK_SEGMENTS, m, flip, mat);
 }
 
 /* The unit sphere as a latitude-longitude mesh with vertex normals, wound
@@ -1617,9 +1684,10 @@ static pk_status shape_sphere_mesh(xp *p, const float m[16], bool flip, uint32_t
     enum { R = XML_SPHERE_RINGS, S = XML_SPHERE_SEGMENTS, NV = (R + 1) * (S + 1), NT = 2 * R * S };
     const pk_allocator *a = &p->ctx->alloc;
     vec3 *pos = mem_alloc(a, NV * sizeof *pos);
+    float *uv = mem_alloc(a, 2 * NV * sizeof *uv);
     uint32_t *tris = mem_alloc(a, 3 * NT * sizeof *tris);
     pk_status st = PK_OK;
-    if (!pos || !tris) {
+    if (!pos || !uv || !tris) {
         st = ctx_nomem(p->ctx);
         goto out;
     }
@@ -1628,6 +1696,7 @@ static pk_status shape_sphere_mesh(xp *p, const float m[16], bool flip, uint32_t
         for (int j = 0; j <= S; j++) {
             float ph = 2.0f * PK_PI * (float)j / (float)S;
             pos[i * (S + 1) + j] = v3(sinf(th) * cosf(ph), sinf(th) * sinf(ph), cosf(th));
+            uv[2 * (i * (S + 1) + j)] = (float)j / (float)S, uv[2 * (i * (S + 1) + j) + 1] = (float)i / (float)R;
         }
     }
     size_t nt = 0;
@@ -1644,9 +1713,10 @@ static pk_status shape_sphere_mesh(xp *p, const float m[16], bool flip, uint32_t
                 memcpy(tris + 3 * nt++, t, sizeof t);
             }
         }
-    st = add_mesh(p, pos, flip ? NULL : pos, NV, tris, nt, m, flip, mat);
+    st = add_mesh(p, pos, flip ? NULL : pos, uv, NV, tris, nt, m, flip, mat);
 out:
     mem_free(a, pos);
+    mem_free(a, uv);
     mem_free(a, tris);
     return st;
 }
@@ -1762,7 +1832,7 @@ static pk_status shape_ply(xp *p, xnode *sh, const float m[16], bool flip, uint3
     if ((st = read_relative(p, at, fn, &full, &data, &size))) goto out;
     if ((st = ply_parse(p->ctx, data, size, full, &mesh))) goto out;
     size_t t0 = p->s->ntris;
-    st = add_mesh(p, mesh.positions, face_normals ? NULL : mesh.normals, mesh.nvertices, mesh.indices, mesh.ntriangles,
+    st = add_mesh(p, mesh.positions, face_normals ? NULL : mesh.normals, mesh.uvs, mesh.nvertices, mesh.indices, mesh.ntriangles,
                   m, false, mat);
     if (st == PK_OK) finish_mesh(p, t0, face_normals, flip);
 out:

@@ -9,6 +9,7 @@
 
 #include "io/ply.h"
 #include "scene/scene.h"
+#include "scene/texture.h"
 
 #include <sys/stat.h>
 
@@ -536,13 +537,36 @@ static void test_bsdfs(void)
     CHECK(m.type == MAT_CONDUCTOR && warned("roughcoating\" over a non-diffuse bsdf"));
     m = bsdf("<bsdf type=\"hanrahan_krueger\"/>");
     CHECK(m.type == MAT_DIFFUSE && warned("scene.xml:3: bsdf \"hanrahan_krueger\" is not supported"));
-    /* textures go through one function: a warning, and a constant colour */
+    /* textures: a diffuse reflectance takes a bitmap (its value times kd = 1)
+     * or a checkerboard; a missing file or another property gives a warning
+     * and a constant colour */
     m = bsdf("<bsdf type=\"diffuse\">\n<texture name=\"reflectance\" type=\"bitmap\"><string name=\"filename\" value=\"t.jpg\"/>"
              "</texture></bsdf>");
-    CHECK(near3(m.kd, v3s(0.5f), 0) && warned("scene.xml:4: textures are not supported yet; using the constant colour 0.5 0.5 0.5"));
+    CHECK(near3(m.kd, v3s(0.5f), 0) && m.map_kd.kind == TEX_NONE && warned("scene.xml:4: texture not used (") &&
+          warned("t.jpg: cannot open") && warned("using the constant 0.5 0.5 0.5 for reflectance"));
+    {
+        char path[512];
+        snprintf(path, sizeof path, "%s/t.pfm", tmpdir);
+        FILE *f = fopen(path, "wb");
+        REQUIRE(f);
+        const float px[6] = {0.25f, 0.5f, 1, 1, 1, 1};
+        fprintf(f, "PF\n2 1\n-1.0\n");
+        REQUIRE(fwrite(px, sizeof px, 1, f) == 1);
+        fclose(f);
+    }
+    m = bsdf("<bsdf type=\"diffuse\"><texture name=\"reflectance\" type=\"bitmap\"><string name=\"filename\" value=\"t.pfm\"/>"
+             "<float name=\"uscale\" value=\"4\"/></texture></bsdf>");
+    CHECK(near3(m.kd, v3s(1.0f), 0) && m.map_kd.kind == TEX_IMAGE && m.map_kd.s[0] == 4.0f && m.map_kd.s[1] == 1.0f &&
+          nwarnings == 0);
+    m = bsdf("<bsdf type=\"roughplastic\"><texture name=\"diffuse_reflectance\" type=\"bitmap\"><string name=\"filename\" "
+             "value=\"t.pfm\"/></texture></bsdf>");
+    CHECK(m.type == MAT_PLASTIC && near3(m.kd, v3s(1.0f), 0) && m.map_kd.kind == TEX_IMAGE);
     m = bsdf("<bsdf type=\"diffuse\"><texture name=\"reflectance\" type=\"checkerboard\"><rgb name=\"color0\" value=\"0.8\"/>"
              "<rgb name=\"color1\" value=\"0.2 0.4 0.6\"/></texture></bsdf>");
-    CHECK(near3(m.kd, v3(0.5f, 0.6f, 0.7f), 1e-6f));
+    CHECK(near3(m.kd, v3s(1.0f), 0) && m.map_kd.kind == TEX_CHECKER && near3(m.map_kd.even, v3s(0.8f), 1e-6f) &&
+          near3(m.map_kd.odd, v3(0.2f, 0.4f, 0.6f), 1e-6f) && m.map_kd.checker_scale == 2.0f);
+    m = bsdf("<bsdf type=\"roughconductor\">\n<texture name=\"specular_reflectance\" type=\"checkerboard\"/></bsdf>");
+    CHECK(m.map_kd.kind == TEX_NONE && warned("scene.xml:4: a texture for specular_reflectance is not supported; using the constant"));
     /* unknown properties: a warning naming the bsdf and the property */
     m = bsdf("<bsdf type=\"diffuse\"><float name=\"sheen\" value=\"1\"/></bsdf>");
     CHECK(warned("scene.xml:3: bsdf \"diffuse\": property \"sheen\" is not supported; ignored"));
