@@ -224,7 +224,20 @@ static pk_status cu_fail(pk_context *ctx, const char *what, CUresult e)
     return ctx_error(ctx, PK_ERR_IO, "accelerator 'cuda': %s failed: %s", what, cu_error(e));
 }
 
-static double mib(size_t bytes) { return (double)bytes / (1024.0 * 1024.0); }
+/* "123 bytes" below a mebibyte, "12.3 MiB" above, for messages. */
+typedef struct size_text {
+    char s[32];
+} size_text;
+
+static size_text size_str(size_t bytes)
+{
+    size_text t;
+    if (bytes < ((size_t)1 << 20))
+        snprintf(t.s, sizeof t.s, "%zu bytes", bytes);
+    else
+        snprintf(t.s, sizeof t.s, "%.1f MiB", (double)bytes / (1024.0 * 1024.0));
+    return t;
+}
 
 /* Device buffers for up to want rays; latches an error when they do not fit. */
 static pk_status ensure_buffers(cuda_accel *c, size_t want)
@@ -241,15 +254,14 @@ static pk_status ensure_buffers(cuda_accel *c, size_t want)
     if (e != CUDA_SUCCESS) return cu_fail(c->ctx, "cuMemGetInfo", e);
     if (need > free_b)
         return ctx_error(c->ctx, PK_ERR_NOMEM,
-                         "accelerator 'cuda': not enough device memory for %zu rays: %.1f MiB needed, %.1f MiB free "
-                         "of %.1f MiB",
-                         want, mib(need), mib(free_b), mib(total));
+                         "accelerator 'cuda': not enough device memory for %zu rays: %s needed, %s free of %s", want,
+                         size_str(need).s, size_str(free_b).s, size_str(total).s);
     if ((e = cu.MemAlloc(&c->d_rays, want * sizeof(pk_ray))) != CUDA_SUCCESS ||
         (e = cu.MemAlloc(&c->d_hits, want * sizeof(pk_hit))) != CUDA_SUCCESS) {
         if (c->d_rays) cu.MemFree(c->d_rays);
         c->d_rays = 0;
-        return ctx_error(c->ctx, PK_ERR_NOMEM, "accelerator 'cuda': cannot allocate %.1f MiB for %zu rays: %s",
-                         mib(need), want, cu_error(e));
+        return ctx_error(c->ctx, PK_ERR_NOMEM, "accelerator 'cuda': cannot allocate %s for %zu rays: %s",
+                         size_str(need).s, want, cu_error(e));
     }
     c->cap = want;
     c->stats.device_bytes = c->stats.structure_bytes + need;
@@ -363,11 +375,10 @@ static pk_status cuda_setup(pk_context *ctx, cuda_accel *c)
         cu.DriverGetVersion(&drv);
         if (e == CUDA_ERROR_UNSUPPORTED_PTX_VERSION || e == CUDA_ERROR_NO_BINARY_FOR_GPU)
             return ctx_error(ctx, PK_ERR_UNSUPPORTED,
-                             "accelerator 'cuda': the kernels do not run on %s (compute capability %d.%d, driver "
-                             "%d.%d): %s; they were built for sm_80, sm_90 and later GPUs with CUDA %d.%d, which "
-                             "needs a driver at least as recent",
-                             c->stats.device, major, minor, drv / 1000, drv % 1000 / 10, cu_error(e),
-                             PK_CUDA_VERSION_MAJOR, PK_CUDA_VERSION_MINOR);
+                             "accelerator 'cuda': the kernels, built with CUDA %d.%d, do not run on %s (compute "
+                             "capability %d.%d) with driver %d.%d (%s): they need a driver for CUDA %d.%d or newer",
+                             PK_CUDA_VERSION_MAJOR, PK_CUDA_VERSION_MINOR, c->stats.device, major, minor, drv / 1000,
+                             drv % 1000 / 10, cu_error(e), PK_CUDA_VERSION_MAJOR, PK_CUDA_VERSION_MINOR);
         return cu_fail(ctx, "loading the kernels", e);
     }
     if ((e = cu.ModuleGetFunction(&c->k_closest, c->module, "pk_trace_closest")) != CUDA_SUCCESS ||
@@ -380,13 +391,12 @@ static pk_status cuda_setup(pk_context *ctx, cuda_accel *c)
     if ((e = cu.MemGetInfo(&free_b, &total)) != CUDA_SUCCESS) return cu_fail(ctx, "cuMemGetInfo", e);
     if (bn + bt > free_b)
         return ctx_error(ctx, PK_ERR_NOMEM,
-                         "accelerator 'cuda': not enough device memory for the BVH: %.1f MiB needed, %.1f MiB free "
-                         "of %.1f MiB",
-                         mib(bn + bt), mib(free_b), mib(total));
+                         "accelerator 'cuda': not enough device memory for the BVH: %s needed, %s free of %s",
+                         size_str(bn + bt).s, size_str(free_b).s, size_str(total).s);
     double t0 = time_now();
     if ((e = cu.MemAlloc(&c->d_nodes, bn)) != CUDA_SUCCESS || (e = cu.MemAlloc(&c->d_tris, bt)) != CUDA_SUCCESS)
-        return ctx_error(ctx, PK_ERR_NOMEM, "accelerator 'cuda': cannot allocate %.1f MiB for the BVH: %s",
-                         mib(bn + bt), cu_error(e));
+        return ctx_error(ctx, PK_ERR_NOMEM, "accelerator 'cuda': cannot allocate %s for the BVH: %s",
+                         size_str(bn + bt).s, cu_error(e));
     if ((e = cu.MemcpyHtoD(c->d_nodes, c->layout.nodes, bn)) != CUDA_SUCCESS ||
         (e = cu.MemcpyHtoD(c->d_tris, c->layout.tris, bt)) != CUDA_SUCCESS || (e = cu.CtxSynchronize()) != CUDA_SUCCESS)
         return cu_fail(ctx, "copying the BVH to the device", e);
