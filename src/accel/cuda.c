@@ -33,8 +33,15 @@ bool accel_cuda_built(void) { return true; }
 
 /* ---- the Driver API, as much of it as is used ------------------------- */
 
+#if defined(PK_CHECK_CUDA_DECLS)
+/* A compile-only build of this file (the pk_cuda_decls target) takes the
+ * types from CUDA's own header, and the assertions below check that every
+ * function pointer here has the type of CUDA's declaration. */
+#include <cuda.h>
+#else
 typedef int CUresult;
 typedef int CUdevice;
+typedef int CUdevice_attribute;
 typedef unsigned long long CUdeviceptr;
 typedef struct CUctx_st *CUcontext;
 typedef struct CUmod_st *CUmodule;
@@ -51,44 +58,55 @@ enum {
     CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MAJOR = 75,
     CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MINOR = 76
 };
+#endif
 
 #define CUDA_LIBRARY "libcuda.so.1"
 
-/* X(field, symbol, return type, parameters); every one returns CUresult. */
+/* X(field, symbol, parameters); every one returns CUresult. */
 #define CU_FUNCTIONS(X)                                                                                   \
-    X(Init, "cuInit", (unsigned flags))                                                                   \
-    X(DriverGetVersion, "cuDriverGetVersion", (int *version))                                             \
-    X(GetErrorString, "cuGetErrorString", (CUresult e, const char **s))                                   \
-    X(DeviceGetCount, "cuDeviceGetCount", (int *count))                                                   \
-    X(DeviceGet, "cuDeviceGet", (CUdevice * d, int ordinal))                                              \
-    X(DeviceGetName, "cuDeviceGetName", (char *name, int len, CUdevice d))                               \
-    X(DeviceGetAttribute, "cuDeviceGetAttribute", (int *v, int attr, CUdevice d))                         \
-    X(DevicePrimaryCtxRetain, "cuDevicePrimaryCtxRetain", (CUcontext * c, CUdevice d))                    \
-    X(DevicePrimaryCtxRelease, "cuDevicePrimaryCtxRelease_v2", (CUdevice d))                              \
-    X(CtxSetCurrent, "cuCtxSetCurrent", (CUcontext c))                                                    \
-    X(CtxSynchronize, "cuCtxSynchronize", (void))                                                         \
-    X(ModuleLoadData, "cuModuleLoadData", (CUmodule * m, const void *image))                              \
-    X(ModuleUnload, "cuModuleUnload", (CUmodule m))                                                       \
-    X(ModuleGetFunction, "cuModuleGetFunction", (CUfunction * f, CUmodule m, const char *name))           \
-    X(MemGetInfo, "cuMemGetInfo_v2", (size_t * free_bytes, size_t * total))                               \
-    X(MemAlloc, "cuMemAlloc_v2", (CUdeviceptr * p, size_t bytes))                                         \
-    X(MemFree, "cuMemFree_v2", (CUdeviceptr p))                                                           \
-    X(MemcpyHtoD, "cuMemcpyHtoD_v2", (CUdeviceptr dst, const void *src, size_t bytes))                    \
-    X(MemcpyDtoH, "cuMemcpyDtoH_v2", (void *dst, CUdeviceptr src, size_t bytes))                          \
-    X(LaunchKernel, "cuLaunchKernel",                                                                     \
+    X(Init, cuInit, (unsigned flags))                                                                     \
+    X(DriverGetVersion, cuDriverGetVersion, (int *version))                                               \
+    X(GetErrorString, cuGetErrorString, (CUresult e, const char **s))                                     \
+    X(DeviceGetCount, cuDeviceGetCount, (int *count))                                                     \
+    X(DeviceGet, cuDeviceGet, (CUdevice * d, int ordinal))                                                \
+    X(DeviceGetName, cuDeviceGetName, (char *name, int len, CUdevice d))                                 \
+    X(DeviceGetAttribute, cuDeviceGetAttribute, (int *v, CUdevice_attribute attr, CUdevice d))            \
+    X(DevicePrimaryCtxRetain, cuDevicePrimaryCtxRetain, (CUcontext * c, CUdevice d))                      \
+    X(DevicePrimaryCtxRelease, cuDevicePrimaryCtxRelease_v2, (CUdevice d))                                \
+    X(CtxSetCurrent, cuCtxSetCurrent, (CUcontext c))                                                      \
+    X(CtxSynchronize, cuCtxSynchronize, (void))                                                           \
+    X(ModuleLoadData, cuModuleLoadData, (CUmodule * m, const void *image))                                \
+    X(ModuleUnload, cuModuleUnload, (CUmodule m))                                                         \
+    X(ModuleGetFunction, cuModuleGetFunction, (CUfunction * f, CUmodule m, const char *name))             \
+    X(MemGetInfo, cuMemGetInfo_v2, (size_t * free_bytes, size_t * total))                                 \
+    X(MemAlloc, cuMemAlloc_v2, (CUdeviceptr * p, size_t bytes))                                           \
+    X(MemFree, cuMemFree_v2, (CUdeviceptr p))                                                             \
+    X(MemcpyHtoD, cuMemcpyHtoD_v2, (CUdeviceptr dst, const void *src, size_t bytes))                      \
+    X(MemcpyDtoH, cuMemcpyDtoH_v2, (void *dst, CUdeviceptr src, size_t bytes))                            \
+    X(LaunchKernel, cuLaunchKernel,                                                                       \
       (CUfunction f, unsigned gx, unsigned gy, unsigned gz, unsigned bx, unsigned by, unsigned bz,        \
        unsigned shared, CUstream s, void **params, void **extra))                                         \
-    X(EventCreate, "cuEventCreate", (CUevent * e, unsigned flags))                                        \
-    X(EventDestroy, "cuEventDestroy_v2", (CUevent e))                                                     \
-    X(EventRecord, "cuEventRecord", (CUevent e, CUstream s))                                              \
-    X(EventSynchronize, "cuEventSynchronize", (CUevent e))
+    X(EventCreate, cuEventCreate, (CUevent * e, unsigned flags))                                          \
+    X(EventDestroy, cuEventDestroy_v2, (CUevent e))                                                       \
+    X(EventRecord, cuEventRecord, (CUevent e, CUstream s))                                                \
+    X(EventSynchronize, cuEventSynchronize, (CUevent e))
 
 static struct cu_table {
-#define CU_FIELD(field, sym, params) CUresult (*field) params;
+#define CU_FIELD(field, symbol, params) CUresult (*field) params;
     CU_FUNCTIONS(CU_FIELD)
 #undef CU_FIELD
     CUresult (*EventElapsedTime)(float *ms, CUevent start, CUevent end);
 } cu;
+
+#if defined(PK_CHECK_CUDA_DECLS)
+#define CU_CHECK(field, symbol, params)                                                       \
+    _Static_assert(__builtin_types_compatible_p(__typeof__(cu.field), __typeof__(&symbol)), \
+                   #symbol " is declared differently by cuda.h");
+CU_FUNCTIONS(CU_CHECK)
+#undef CU_CHECK
+_Static_assert(__builtin_types_compatible_p(__typeof__(cu.EventElapsedTime), __typeof__(&cuEventElapsedTime_v2)),
+               "cuEventElapsedTime_v2 is declared differently by cuda.h");
+#endif
 
 /* Invariant: after load_once has run, driver_ok says whether every field
  * of cu is set and cuInit succeeded; otherwise load_error says why. The
@@ -118,10 +136,10 @@ static void load_driver(void)
     }
     struct cu_table t;
     void *sym;
-#define CU_LOAD(field, symname, params)                                                               \
-    sym = dlsym(h, symname);                                                                          \
+#define CU_LOAD(field, symbol, params)                                                                \
+    sym = dlsym(h, #symbol);                                                                          \
     if (!sym) {                                                                                       \
-        snprintf(load_error, sizeof load_error, "no CUDA driver (%s has no %s: too old?)", name, symname); \
+        snprintf(load_error, sizeof load_error, "no CUDA driver (%s has no " #symbol ": too old?)", name); \
         dlclose(h);                                                                                   \
         return;                                                                                       \
     }                                                                                                 \
