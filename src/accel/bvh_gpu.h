@@ -119,6 +119,8 @@ typedef struct gpu_ray {
     float rd[3], rdf[3];     /* 1/d, and 1/d * (1 + slack) for far planes */
     int near[3], far[3];     /* plane rows per axis: 2 * axis + (1/d < 0), and the other */
     int kx, ky, kz;          /* shear axes (geom.h ray_prepare) */
+    float ox, oy, oz;        /* origin components along kx, ky, kz (no indexing by a variable
+                                in the triangle test: the ray stays in registers on the GPU) */
     float sx, sy, sz;
     float tmin;
 } gpu_ray;
@@ -147,6 +149,7 @@ static inline PK_HD void gpu_ray_init(gpu_ray *g, const pk_ray *r)
         ky = tmp;
     }
     g->kx = kx, g->ky = ky, g->kz = kz;
+    g->ox = r->org[kx], g->oy = r->org[ky], g->oz = r->org[kz];
     g->sx = r->dir[kx] / dz;
     g->sy = r->dir[ky] / dz;
     g->sz = 1.0f / dz;
@@ -156,7 +159,7 @@ static inline PK_HD void gpu_ray_init(gpu_ray *g, const pk_ray *r)
 static inline PK_HD bool gpu_tri_intersect(const gpu_ray *r, const gpu_tri *tri, float tmax, float *t_out,
                                            float *u_out, float *v_out)
 {
-    const float ox = r->o[r->kx], oy = r->o[r->ky], oz = r->o[r->kz];
+    const float ox = r->ox, oy = r->oy, oz = r->oz;
     const float ax0 = tri->a[r->kx] - ox, ay0 = tri->a[r->ky] - oy, az0 = tri->a[r->kz] - oz;
     const float bx0 = tri->b[r->kx] - ox, by0 = tri->b[r->ky] - oy, bz0 = tri->b[r->kz] - oz;
     const float cx0 = tri->c[r->kx] - ox, cy0 = tri->c[r->ky] - oy, cz0 = tri->c[r->kz] - oz;
