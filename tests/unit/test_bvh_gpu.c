@@ -539,6 +539,34 @@ static void check_file(pk_context *ctx, const char *rel, size_t nrays, size_t nb
     pk_scene_destroy(s);
 }
 
+/* ---- names and the public door ---------------------------------------------- */
+
+static void test_public(pk_context *ctx)
+{
+    pk_accel_kind k = PK_ACCEL_DEFAULT;
+    CHECK(pk_accel_kind_parse("cuda", &k) == PK_OK && k == PK_ACCEL_CUDA);
+    CHECK(strcmp(pk_accel_kind_name(PK_ACCEL_CUDA), "cuda") == 0);
+    CHECK(pk_accel_available(PK_ACCEL_CUDA) == PK_HAVE_CUDA_BUILD);
+    /* a CPU accelerator has no device information */
+    pk_scene *s = NULL;
+    REQUIRE(pk_scene_create_cornell_box(ctx, &s) == PK_OK);
+    pk_accel *pa = NULL;
+    REQUIRE(pk_accel_create(ctx, s, PK_ACCEL_BVH, 1, &pa) == PK_OK);
+    pk_accel_device_info di;
+    memset(&di, 0x55, sizeof di);
+    CHECK(pk_accel_get_device_info(pa, &di) == 0 && di.kernel_ms == 0.0 && di.device[0] == '\0');
+    CHECK(pk_accel_get_device_info(NULL, &di) == 0 && pk_accel_get_device_info(pa, NULL) == 0);
+    pk_accel_destroy(pa);
+    /* rendering with the GPU is refused with a message */
+    pk_render_options o;
+    pk_scene_get_render_options(s, &o);
+    o.accel = PK_ACCEL_CUDA;
+    CHECK(pk_render_options_check(ctx, &o) == PK_ERR_UNSUPPORTED);
+    if (PK_HAVE_CUDA_BUILD) CHECK(strstr(pk_context_error(ctx), "rendering on the GPU is not there yet") != NULL);
+    pk_context_clear_error(ctx);
+    pk_scene_destroy(s);
+}
+
 int main(void)
 {
     pk_context *ctx = NULL;
@@ -551,6 +579,7 @@ int main(void)
     test_synthetic(ctx);
     printf("synthetic cases: %.2f s\n", omp_get_wtime() - t0);
     test_checker(ctx);
+    test_public(ctx);
     const char *cornell[] = {"CornellBox-Empty-CO.obj", "CornellBox-Glossy.obj", "CornellBox-Mirror.obj",
                              "CornellBox-Original.obj", "CornellBox-Sphere.obj", "CornellBox-Water.obj"};
     for (size_t i = 0; i < sizeof cornell / sizeof *cornell; i++) {
