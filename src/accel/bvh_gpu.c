@@ -102,8 +102,10 @@ pk_status gpu_layout_build(pk_context *ctx, const pk_allocator *al, const accel 
         gpu_layout_free(al, out);
         return ctx_nomem(ctx);
     }
-    out->nnodes = b->nnodes;
+    out->nnodes = b->nnodes ? b->nnodes : 1;
     out->scene_tris = b->base.ntris;
+    if (!b->nnodes) /* (the builder always makes a root; an empty one otherwise) */
+        for (int s = 0; s < GPU_WIDTH; s++) out->nodes[0].child[s] = GPU_EMPTY, out->nodes[0].ex[s % 3] = 127;
     size_t r = 0;
     uint32_t need = 0;
     for (size_t i = 0; i < b->nnodes; i++) {
