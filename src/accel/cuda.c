@@ -104,8 +104,13 @@ static struct cu_table {
                    #symbol " is declared differently by cuda.h");
 CU_FUNCTIONS(CU_CHECK)
 #undef CU_CHECK
+#if CUDA_VERSION >= 12080 /* (the _v2 came with CUDA 12.8) */
 _Static_assert(__builtin_types_compatible_p(__typeof__(cu.EventElapsedTime), __typeof__(&cuEventElapsedTime_v2)),
                "cuEventElapsedTime_v2 is declared differently by cuda.h");
+#else
+_Static_assert(__builtin_types_compatible_p(__typeof__(cu.EventElapsedTime), __typeof__(&cuEventElapsedTime)),
+               "cuEventElapsedTime is declared differently by cuda.h");
+#endif
 #endif
 
 /* Invariant: after load_once has run, driver_ok says whether every field
