@@ -34,7 +34,7 @@ enum {
     B_OUTPUT, B_LOOK_FROM, B_LOOK_AT, B_FOV, B_SIZE, B_KIND, B_SEED, B_WORKLOAD, B_SHARED, B_RAYS
 };
 
-#define ACCEL_HELP "none, midpoint, bvh (default) or embree"
+#define ACCEL_HELP "none, midpoint, bvh (default), embree or cuda (an NVIDIA GPU)"
 #define OPT_FLAG(n, i, h) {.name = n, .id = i, .kind = CLI_FLAG, .help = h}
 #define OPT_STR(n, i, a, h) {.name = n, .id = i, .kind = CLI_STRING, .arg = a, .help = h}
 
@@ -238,7 +238,7 @@ static int bench_rays(int argc, char **argv)
         switch (rays_opts[p.index].id) {
         case B_ACCEL:
             if (pk_accel_kind_parse(v, &kind) != PK_OK)
-                return cli_usage_error("--accel %s: expected none, midpoint, bvh or embree", v);
+                return cli_usage_error("--accel %s: expected none, midpoint, bvh, embree or cuda", v);
             break;
         case B_THREADS: threads = p.int_value; break;
         case B_REPS: reps = p.int_value; break;
@@ -271,17 +271,29 @@ static int bench_rays(int argc, char **argv)
         goto out;
     }
     hits = malloc(n * sizeof *hits);
-    times = malloc((size_t)reps * sizeof *times);
+    times = malloc(4 * (size_t)reps * sizeof *times);
     if (!hits || !times) {
         fprintf(stderr, "paprsek: out of memory (%zu rays)\n", n);
         goto out;
     }
+    /* a device accelerator also reports its copies and its kernel per pass */
+    pk_accel_device_info dev;
+    const int on_device = pk_accel_get_device_info(accel, &dev);
+    double *kernel_ms = times + reps, *up_ms = times + 2 * reps, *down_ms = times + 3 * reps;
     unsigned flags = (any_hit ? PK_TRACE_ANY_HIT : 0u) | (packets ? PK_TRACE_COHERENT : 0u);
     pk_accel_trace(accel, rays, hits, n, threads, flags, NULL); /* warm-up */
-    for (int k = 0; k < reps; k++) {
+    for (int k = 0; k < reps && pk_context_status(ctx) == PK_OK; k++) {
         double t0 = cli_now();
         pk_accel_trace(accel, rays, hits, n, threads, flags, NULL);
         times[k] = cli_now() - t0;
+        if (on_device) {
+            pk_accel_get_device_info(accel, &dev);
+            kernel_ms[k] = dev.kernel_ms, up_ms[k] = dev.rays_upload_ms, down_ms[k] = dev.download_ms;
+        }
+    }
+    if (pk_context_status(ctx) != PK_OK) { /* a device that failed */
+        rc = cli_fail_ctx(ctx);
+        goto out;
     }
     double tmed = median(times, reps), tmin = times[0];
     size_t nhits = 0;
@@ -304,6 +316,18 @@ static int bench_rays(int argc, char **argv)
     if (info.name && strcmp(info.name, "embree") == 0) {
         const char *q = getenv("PAPRSEK_EMBREE_QUALITY");
         printf(" embree_quality=%s", q && q[0] ? q : "medium");
+    }
+    if (on_device) {
+        /* the device's name without spaces, so that the line stays key=value pairs */
+        char name[sizeof dev.device];
+        size_t k = 0;
+        for (; dev.device[k] && k + 1 < sizeof name; k++) name[k] = dev.device[k] == ' ' ? '_' : dev.device[k];
+        name[k] = '\0';
+        const double kmed = median(kernel_ms, reps);
+        printf(" device=%s upload_ms=%.3f structure_bytes=%zu device_bytes=%zu rays_upload_ms=%.3f kernel_ms=%.3f"
+               " download_ms=%.3f kernel_mrays_per_s=%.3f",
+               name[0] ? name : "unknown", dev.upload_ms, dev.structure_bytes, dev.device_bytes, median(up_ms, reps),
+               kmed, median(down_ms, reps), kmed > 0.0 ? (double)n / (kmed * 1e-3) / 1e6 : 0.0);
     }
     if (stats) {
         /* A separate pass: counting costs a little and is not timed. */
@@ -585,7 +609,7 @@ static int bench_gen_rays(int argc, char **argv)
         case B_SHARED: shared = v; break;
         case B_ACCEL:
             if (pk_accel_kind_parse(v, &accel_kind) != PK_OK)
-                return cli_usage_error("--accel %s: expected none, midpoint, bvh or embree", v);
+                return cli_usage_error("--accel %s: expected none, midpoint, bvh, embree or cuda", v);
             break;
         case B_THREADS: threads = p.int_value; break;
         case B_OUTPUT: out_path = v; break;

@@ -87,7 +87,8 @@ static const cli_option *render_options(size_t *n)
         add((cli_option){.name = "accel", .id = OPT_ACCEL, .kind = CLI_STRING, .arg = "NAME",
                          .help = "the acceleration structure: bvh (default: binned SAH, wide SIMD BVH), midpoint "
                                  "(simple BVH, for comparison), none (every ray tests every primitive), embree "
-                                 "(Embree 3, when built with it); all give the same image"});
+                                 "(Embree 3, when built with it); all give the same image (cuda, the GPU, traces "
+                                 "rays for bench rays only)"});
         add((cli_option){.name = "integrator", .id = OPT_INTEGRATOR, .kind = CLI_STRING, .arg = "NAME",
                          .help = "path (default: path tracing, global illumination, one-sided area lights) or "
                                  "whitted (direct light, mirrors and glass; emitters two-sided)"});
@@ -231,8 +232,9 @@ static int parse_args(int argc, char **argv, cli_opts *o)
             if (pk_accel_kind_parse(v, &o->accel) != PK_OK)
                 return cli_usage_error("--accel: unknown accelerator '%s' (none, midpoint, bvh, embree)", v);
             if (!pk_accel_available(o->accel))
-                return cli_usage_error("--accel %s: not available in this build (install libembree-dev and rebuild)",
-                                       v);
+                return cli_usage_error("--accel %s: not available in this build (%s)", v,
+                                       o->accel == PK_ACCEL_CUDA ? "rebuild where nvcc is, with -DPK_WITH_CUDA=ON"
+                                                                 : "install libembree-dev and rebuild");
             o->has_accel = 1;
             break;
         case OPT_INTEGRATOR:

@@ -109,13 +109,15 @@ typedef enum pk_accel_kind {
     PK_ACCEL_NONE = 1,     /* every ray tests every primitive */
     PK_ACCEL_MIDPOINT = 2, /* simple BVH (midpoint split), for comparison */
     PK_ACCEL_BVH = 3,      /* binned SAH, wide SIMD BVH */
-    PK_ACCEL_EMBREE = 4    /* Embree 3, when built with it */
+    PK_ACCEL_EMBREE = 4,   /* Embree 3, when built with it */
+    PK_ACCEL_CUDA = 5      /* an NVIDIA GPU (batches of rays only), when built with CUDA */
 } pk_accel_kind;
 
 PK_API const char *pk_accel_kind_name(pk_accel_kind kind);
-/* Returns PK_OK and sets *out for "none", "midpoint", "bvh", "embree". */
+/* Returns PK_OK and sets *out for "none", "midpoint", "bvh", "embree", "cuda". */
 PK_API pk_status pk_accel_kind_parse(const char *name, pk_accel_kind *out);
-/* 1 when the accelerator is compiled in. */
+/* 1 when the accelerator is compiled in (for Embree: and its library loads;
+ * for CUDA: compiled in, whether or not this machine has a GPU). */
 PK_API int pk_accel_available(pk_accel_kind kind);
 
 typedef enum pk_integrator_kind {
@@ -455,9 +457,27 @@ PK_API pk_status pk_accel_create(pk_context *ctx, const pk_scene *scene, pk_acce
 PK_API void pk_accel_destroy(pk_accel *accel);
 PK_API void pk_accel_get_info(const pk_accel *accel, pk_accel_info *info);
 /* Traces n rays with up to threads threads; hits[i] answers rays[i].
- * counters may be NULL (nothing is counted then). */
+ * counters may be NULL (nothing is counted then). A device accelerator
+ * (PK_ACCEL_CUDA) that fails (a kernel error) latches the error in the
+ * accelerator's context and leaves every hit a miss. */
 PK_API void pk_accel_trace(const pk_accel *accel, const pk_ray *rays, pk_hit *hits, size_t n,
                            int threads, unsigned flags, pk_trace_counters *counters);
+
+/* Where a device accelerator spends its time, in milliseconds, and the
+ * device memory it holds. */
+typedef struct pk_accel_device_info {
+    char device[128];         /* the device's name */
+    double upload_ms;         /* copying the structure to the device (at pk_accel_create) */
+    size_t structure_bytes;   /* device memory held by the structure */
+    size_t device_bytes;      /* all device memory held (structure, ray and hit buffers) */
+    /* of the last pk_accel_trace: */
+    double rays_upload_ms;    /* rays to the device */
+    double kernel_ms;         /* the traversal kernel alone */
+    double download_ms;       /* hits back from the device */
+} pk_accel_device_info;
+
+/* 1 and *info filled when accel runs on a device, else 0. */
+PK_API int pk_accel_get_device_info(const pk_accel *accel, pk_accel_device_info *info);
 
 #ifdef __cplusplus
 }

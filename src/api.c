@@ -20,6 +20,7 @@
 int pk_accel_available(pk_accel_kind kind)
 {
     if (kind == PK_ACCEL_EMBREE) return accel_embree_available();
+    if (kind == PK_ACCEL_CUDA) return accel_cuda_built();
     return (unsigned)kind <= PK_ACCEL_BVH;
 }
 
@@ -301,6 +302,9 @@ static pk_status check_options(pk_context *ctx, const pk_render_options *o)
     pk_status st = options_check(ctx, o);
     if (st != PK_OK) return st;
     if (!pk_accel_available(o->accel)) return accel_unavailable(ctx, o->accel);
+    if (o->accel == PK_ACCEL_CUDA)
+        return ctx_error(ctx, PK_ERR_UNSUPPORTED, "accelerator 'cuda': the GPU traces rays for bench rays only; "
+                                                  "rendering on the GPU is not there yet");
     return PK_OK;
 }
 
@@ -495,7 +499,7 @@ pk_status pk_accel_create(pk_context *ctx, const pk_scene *scene, pk_accel_kind 
     const pk_int_option *th = pk_int_option_find("threads");
     if (threads < th->min || threads > th->max)
         return ctx_error(ctx, PK_ERR_LIMIT, "threads %d is out of range (%d..%d)", threads, th->min, th->max);
-    if ((unsigned)kind > PK_ACCEL_EMBREE)
+    if ((unsigned)kind > PK_ACCEL_CUDA)
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "unknown accelerator %d", (int)kind);
     if (!pk_accel_available(kind)) return accel_unavailable(ctx, kind);
     pk_accel *pa = mem_calloc(&ctx->alloc, 1, sizeof *pa);
@@ -528,4 +532,13 @@ void pk_accel_trace(const pk_accel *pa, const pk_ray *rays, pk_hit *hits, size_t
 {
     if (!pa || !rays || !hits || n == 0) return;
     accel_trace_batch(pa->a, (const ray *)rays, (hit *)hits, n, threads, flags, counters);
+}
+
+int pk_accel_get_device_info(const pk_accel *pa, pk_accel_device_info *info)
+{
+    if (!pa || !info) return 0;
+    memset(info, 0, sizeof *info);
+    if (!pa->a->ops->device_info) return 0;
+    pa->a->ops->device_info(pa->a, info);
+    return 1;
 }

@@ -81,7 +81,7 @@ pk_status options_check(pk_context *ctx, const pk_render_options *o)
     if ((uint64_t)o->width * (uint64_t)o->height > PK_MAX_IMAGE_PIXELS)
         return ctx_error(ctx, PK_ERR_LIMIT, "image of %dx%d pixels is larger than %u pixels", o->width, o->height,
                          PK_MAX_IMAGE_PIXELS);
-    if ((unsigned)o->accel > PK_ACCEL_EMBREE)
+    if ((unsigned)o->accel > PK_ACCEL_CUDA)
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "unknown accelerator %d", (int)o->accel);
     if ((unsigned)o->integrator > PK_INTEGRATOR_PATH)
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "unknown integrator %d", (int)o->integrator);
@@ -110,7 +110,7 @@ pk_status pk_integrator_parse(const char *name, pk_integrator_kind *out)
 
 /* ---- accelerator names ----------------------------------------------------- */
 
-static const char *const accel_names[] = {"bvh", "none", "midpoint", "bvh", "embree"};
+static const char *const accel_names[] = {"bvh", "none", "midpoint", "bvh", "embree", "cuda"};
 
 const char *pk_accel_kind_name(pk_accel_kind kind)
 {
@@ -121,7 +121,7 @@ const char *pk_accel_kind_name(pk_accel_kind kind)
 pk_status pk_accel_kind_parse(const char *name, pk_accel_kind *out)
 {
     if (!name || !out) return PK_ERR_INVALID_ARGUMENT;
-    for (int k = PK_ACCEL_NONE; k <= PK_ACCEL_EMBREE; k++)
+    for (int k = PK_ACCEL_NONE; k <= PK_ACCEL_CUDA; k++)
         if (strcmp(name, accel_names[k]) == 0) {
             *out = (pk_accel_kind)k;
             return PK_OK;

@@ -44,6 +44,14 @@ typedef struct accel_ops {
      * any_hit: only occlusion (h[i].t finite on a hit). */
     void (*intersect_packet)(const accel *a, const ray *r, hit *h, size_t n, bool any_hit,
                              accel_counters *c);
+    /* Optional (may be NULL): a whole batch at once (a device accelerator);
+     * accel_trace_batch uses it when present. flags as PK_TRACE_*. On a
+     * failure the error is latched in the context the accelerator was
+     * created with and every hit is a miss. */
+    void (*trace_batch)(const accel *a, const ray *rays, hit *hits, size_t n, unsigned flags,
+                        pk_trace_counters *counters);
+    /* Optional: what a device accelerator reports (pk_accel_get_device_info). */
+    void (*device_info)(const accel *a, pk_accel_device_info *info);
 } accel_ops;
 
 /* Every accelerator starts with this header. */
@@ -81,6 +89,10 @@ PK_HIDDEN pk_status accel_midpoint_create(pk_context *ctx, const accel_input *in
 PK_HIDDEN pk_status accel_bvh_create(pk_context *ctx, const accel_input *in, accel **out);
 PK_HIDDEN pk_status accel_embree_create(pk_context *ctx, const accel_input *in, accel **out);
 PK_HIDDEN bool accel_embree_available(void);
+/* The GPU accelerator (cuda.c): built in? (a driver and a device are looked
+ * for only when one is created) */
+PK_HIDDEN pk_status accel_cuda_create(pk_context *ctx, const accel_input *in, accel **out);
+PK_HIDDEN bool accel_cuda_built(void);
 /* When Embree is not available: latches why (PK_ERR_UNSUPPORTED) and returns it. */
 PK_HIDDEN pk_status accel_embree_unavailable(pk_context *ctx);
 /* Invariant checkers (tests): false with a reason when the structure is broken. */

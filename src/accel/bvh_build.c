@@ -821,7 +821,7 @@ static void bvh_destroy(accel *a)
     mem_free(al, t);
 }
 
-static const accel_ops bvh_ops = {bvh_destroy, bvh_intersect, bvh_occluded, bvh_intersect_packet};
+static const accel_ops bvh_ops = {bvh_destroy, bvh_intersect, bvh_occluded, bvh_intersect_packet, NULL, NULL};
 
 /* Nodes, triangle and sphere blocks in one block of memory; large ones start
  * on a 2 MiB boundary and ask for transparent huge pages, which saves TLB

@@ -204,7 +204,7 @@ static void mid_destroy(accel *a)
     mem_free(al, m);
 }
 
-static const accel_ops mid_ops = {mid_destroy, mid_intersect, mid_occluded, NULL};
+static const accel_ops mid_ops = {mid_destroy, mid_intersect, mid_occluded, NULL, NULL, NULL};
 
 pk_status accel_midpoint_create(pk_context *ctx, const accel_input *in, accel **out)
 {

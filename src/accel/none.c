@@ -54,7 +54,7 @@ static bool none_occluded(const accel *a, const ray *r, hit *out, accel_counters
     return false;
 }
 
-static const accel_ops none_ops = {none_destroy, none_intersect, none_occluded, NULL};
+static const accel_ops none_ops = {none_destroy, none_intersect, none_occluded, NULL, NULL, NULL};
 
 pk_status accel_none_create(pk_context *ctx, const accel_input *in, accel **out)
 {

@@ -17,6 +17,7 @@ pk_status accel_create(pk_context *ctx, pk_accel_kind kind, const accel_input *i
     case PK_ACCEL_DEFAULT:
     case PK_ACCEL_BVH: st = accel_bvh_create(ctx, in, out); break;
     case PK_ACCEL_EMBREE: st = accel_embree_create(ctx, in, out); break;
+    case PK_ACCEL_CUDA: st = accel_cuda_create(ctx, in, out); break;
     default: return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "unknown accelerator %d", (int)kind);
     }
     if (st == PK_OK && *out) {

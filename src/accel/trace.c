@@ -1,7 +1,8 @@
 /*
  * trace.c - tracing a batch of rays through any accelerator in parallel
  * (OpenMP over chunks of 256 rays): single rays, any-hit queries or
- * coherent packets.
+ * coherent packets; an accelerator with a batch operation of its own (the
+ * GPU) takes the whole batch.
  */
 #include "accel.h"
 
@@ -10,6 +11,10 @@
 void accel_trace_batch(const accel *a, const ray *rays, hit *hits, size_t n, int threads, unsigned flags,
                        pk_trace_counters *counters)
 {
+    if (a->ops->trace_batch) {
+        a->ops->trace_batch(a, rays, hits, n, flags, counters);
+        return;
+    }
     int nt = threads > 0 ? threads : omp_get_max_threads();
     const bool any = (flags & PK_TRACE_ANY_HIT) != 0, coherent = (flags & PK_TRACE_COHERENT) != 0;
     const size_t chunk = 256;

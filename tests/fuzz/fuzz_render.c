@@ -23,7 +23,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         o.light_samples = 2;
         if (o.max_depth < 0 || o.max_depth > 4) o.max_depth = 4;
         o.threads = 1;
-        if (o.accel == PK_ACCEL_EMBREE) o.accel = PK_ACCEL_BVH;
+        if (o.accel == PK_ACCEL_EMBREE || o.accel == PK_ACCEL_CUDA) o.accel = PK_ACCEL_BVH;
         o.collect_stats = (int)(size & 1); /* both paths of the counters */
         pk_stats stats;
         pk_image *img = NULL;

@@ -1,0 +1,342 @@
+/*
+ * bvh_gpu.h - the BVH as the GPU traverses it, and the traversal itself,
+ * written once: plain C over plain structs (no intrinsics), PK_HD so that
+ * nvcc compiles the same functions for the device (src/accel/cuda/trace.cu)
+ * that the CPU tests call on the host (tests/unit/test_bvh_gpu.c).
+ *
+ * Layout (docs/gpu.md says why): the 8-wide tree of bvh.h, node for node,
+ * with each node's eight child boxes quantised to 8 bits per plane in a
+ * frame of the node's own (origin = the low corner of the union of its
+ * children, one power-of-two scale per axis), after Ylitie, Karras and
+ * Laine 2017. A node is 96 bytes (three 32-byte memory sectors) where the
+ * CPU's float node is 224: a ray that visits it reads eight boxes, the
+ * child references and the frame at once. Leaves are runs of 48-byte
+ * triangle records (the three vertices as they are in the scene, and the
+ * triangle's number), so the test is geom.h's watertight test, operation
+ * for operation, and gives the same t, u, v bit for bit (the device code is
+ * compiled with -fmad=false, the CPU's with -ffp-contract=off).
+ *
+ * Decoded planes are org + q * 2^e computed in float; the converter picks q
+ * (rounding down for low planes, up for high ones, and checking the float
+ * result) so that every decoded box contains the CPU's float box: the slab
+ * test over it, with the CPU's rounding slack, can only enter more boxes
+ * than the CPU traversal does, never fewer, so no hit is lost; the closest
+ * hit rule (smallest t, then smallest number) makes the answer independent
+ * of the order in which leaves are visited.
+ */
+#ifndef PK_BVH_GPU_H
+#define PK_BVH_GPU_H
+
+#include "../paprsek_internal.h"
+
+#include <math.h>
+#include <string.h>
+
+#define GPU_WIDTH 8
+/* Traversal stack entries; the converter refuses a tree that could need
+ * more (gpu_layout.stack_need). */
+#define GPU_STACK 128
+#define GPU_EMPTY 0xFFFFFFFFu
+/* Child reference: bit 31 clear: index of an inner node; set: a leaf of
+ * ((ref >> 27) & 15) + 1 triangle records from index ref & GPU_LEAF_INDEX. */
+#define GPU_LEAF 0x80000000u
+#define GPU_LEAF_SHIFT 27
+#define GPU_LEAF_MAX 16u
+#define GPU_LEAF_INDEX 0x07FFFFFFu
+/* Relative slack of the far slab distances and of the cull distance: the
+ * CPU traversal's (bvh.h BVH_BOX_SLACK). */
+#define GPU_BOX_SLACK 0x1p-20f
+
+/* Plane rows in bvh.h's order: lo_x, hi_x, lo_y, hi_y, lo_z, hi_z. */
+typedef struct gpu_node {
+    float org[3];               /* low corner of the frame */
+    uint8_t ex[3];              /* per axis: scale 2^(ex - 127), ex in 1..254 */
+    uint8_t pad;
+    uint8_t q[6][GPU_WIDTH];    /* quantised planes [row][child] */
+    uint32_t child[GPU_WIDTH];  /* references as above; GPU_EMPTY for an unused slot */
+} gpu_node;
+
+typedef struct gpu_tri {
+    float a[3];
+    uint32_t prim;              /* the triangle's number in the scene */
+    float b[3];
+    float pad0;
+    float c[3];
+    float pad1;
+} gpu_tri;
+
+#ifndef __cplusplus
+_Static_assert(sizeof(gpu_node) == 96 && sizeof(gpu_tri) == 48, "GPU node and triangle sizes");
+#endif
+
+static inline PK_HD uint32_t gpu_leaf_ref(uint32_t first, uint32_t count)
+{
+    return GPU_LEAF | ((count - 1u) << GPU_LEAF_SHIFT) | first;
+}
+static inline PK_HD uint32_t gpu_leaf_count(uint32_t ref) { return ((ref >> GPU_LEAF_SHIFT) & 15u) + 1u; }
+static inline PK_HD uint32_t gpu_leaf_first(uint32_t ref) { return ref & GPU_LEAF_INDEX; }
+
+/* 2^(biased - 127) for biased in 1..254 (a normal float, exact). */
+static inline PK_HD float gpu_scale(unsigned biased)
+{
+#if defined(__CUDA_ARCH__)
+    return __uint_as_float((unsigned)biased << 23);
+#else
+    uint32_t bits = (uint32_t)biased << 23;
+    float f;
+    memcpy(&f, &bits, sizeof f);
+    return f;
+#endif
+}
+
+/* A decoded plane: org + q * scale (q * scale is exact, the sum rounds). */
+static inline PK_HD float gpu_plane(float org, unsigned q, float scale) { return org + (float)q * scale; }
+
+/* The SSE min/max rules of the CPU traversal: a NaN first operand (0 * inf,
+ * a ray lying in a slab plane) gives the second, i.e. no limit. */
+static inline PK_HD float gpu_max(float a, float b) { return a > b ? a : b; }
+static inline PK_HD float gpu_min(float a, float b) { return a < b ? a : b; }
+
+static inline PK_HD float gpu_cull_limit(float t) { return t + fabsf(t) * GPU_BOX_SLACK; }
+
+/* geom.h's ray_rcp. */
+static inline PK_HD float gpu_rcp(float d)
+{
+    const float r = 1.0f / d;
+    return d != 0.0f && isinf(r) ? NAN : r;
+}
+
+/* geom.h's ray_traceable. */
+static inline PK_HD bool gpu_ray_traceable(const pk_ray *r)
+{
+    return isfinite(r->org[0]) && isfinite(r->org[1]) && isfinite(r->org[2]) && !isnan(r->dir[0]) &&
+           !isnan(r->dir[1]) && !isnan(r->dir[2]) && !isnan(r->tmin) && !isnan(r->tmax);
+}
+
+/* What traversal needs of a ray: box and triangle constants. */
+typedef struct gpu_ray {
+    float o[3];
+    float rd[3], rdf[3];     /* 1/d, and 1/d * (1 + slack) for far planes */
+    int near[3], far[3];     /* plane rows per axis: 2 * axis + (1/d < 0), and the other */
+    int kx, ky, kz;          /* shear axes (geom.h ray_prepare) */
+    float ox, oy, oz;        /* origin components along kx, ky, kz (no indexing by a variable
+                                in the triangle test: the ray stays in registers on the GPU) */
+    float sx, sy, sz;
+    float tmin;
+} gpu_ray;
+
+static inline PK_HD void gpu_ray_init(gpu_ray *g, const pk_ray *r)
+{
+    for (int k = 0; k < 3; k++) {
+        g->o[k] = r->org[k];
+        const float rd = gpu_rcp(r->dir[k]);
+        g->rd[k] = rd;
+        g->rdf[k] = rd * (1.0f + GPU_BOX_SLACK);
+        const int neg = signbit(rd) ? 1 : 0;
+        g->near[k] = 2 * k + neg;
+        g->far[k] = 2 * k + 1 - neg;
+    }
+    g->tmin = r->tmin;
+    /* kz: the largest |d| component (vec3.h v3_max_axis_abs), then ray_prepare's axes */
+    const float x = fabsf(r->dir[0]), y = fabsf(r->dir[1]), z = fabsf(r->dir[2]);
+    const int kz = (x > y) ? (x > z ? 0 : 2) : (y > z ? 1 : 2);
+    int kx = kz + 1 == 3 ? 0 : kz + 1;
+    int ky = kx + 1 == 3 ? 0 : kx + 1;
+    const float dz = r->dir[kz];
+    if (dz < 0.0f) {
+        const int tmp = kx;
+        kx = ky;
+        ky = tmp;
+    }
+    g->kx = kx, g->ky = ky, g->kz = kz;
+    g->ox = r->org[kx], g->oy = r->org[ky], g->oz = r->org[kz];
+    g->sx = r->dir[kx] / dz;
+    g->sy = r->dir[ky] / dz;
+    g->sz = 1.0f / dz;
+}
+
+/* geom.h's tri_intersect, the same float operations in the same order. */
+static inline PK_HD bool gpu_tri_intersect(const gpu_ray *r, const gpu_tri *tri, float tmax, float *t_out,
+                                           float *u_out, float *v_out)
+{
+    const float ox = r->ox, oy = r->oy, oz = r->oz;
+    const float ax0 = tri->a[r->kx] - ox, ay0 = tri->a[r->ky] - oy, az0 = tri->a[r->kz] - oz;
+    const float bx0 = tri->b[r->kx] - ox, by0 = tri->b[r->ky] - oy, bz0 = tri->b[r->kz] - oz;
+    const float cx0 = tri->c[r->kx] - ox, cy0 = tri->c[r->ky] - oy, cz0 = tri->c[r->kz] - oz;
+    const float ax = ax0 - r->sx * az0, ay = ay0 - r->sy * az0;
+    const float bx = bx0 - r->sx * bz0, by = by0 - r->sy * bz0;
+    const float cx = cx0 - r->sx * cz0, cy = cy0 - r->sy * cz0;
+    float U = cx * by - cy * bx;
+    float V = ax * cy - ay * cx;
+    float W = bx * ay - by * ax;
+    if (U == 0.0f || V == 0.0f || W == 0.0f) {
+        U = (float)((double)cx * (double)by - (double)cy * (double)bx);
+        V = (float)((double)ax * (double)cy - (double)ay * (double)cx);
+        W = (float)((double)bx * (double)ay - (double)by * (double)ax);
+    }
+    if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f)) return false;
+    const float det = U + V + W;
+    if (det == 0.0f) return false;
+    const float az = r->sz * az0, bz = r->sz * bz0, cz = r->sz * cz0;
+    const float T = U * az + V * bz + W * cz;
+    const float rcp = 1.0f / det;
+    const float t = T * rcp;
+    if (!(t >= r->tmin && t <= tmax && t < INFINITY)) return false;
+    *t_out = t;
+    *u_out = V * rcp;
+    *v_out = W * rcp;
+    return true;
+}
+
+/* Slots of node n whose decoded box the segment [tmin, tcull] touches, with
+ * their entry distances in tn[]. */
+static inline PK_HD unsigned gpu_node_hits(const gpu_node *n, const gpu_ray *r, float tcull, float tn[GPU_WIDTH])
+{
+    const float sx = gpu_scale(n->ex[0]), sy = gpu_scale(n->ex[1]), sz = gpu_scale(n->ex[2]);
+    unsigned mask = 0;
+    for (int k = 0; k < GPU_WIDTH; k++) {
+        if (n->child[k] == GPU_EMPTY) continue;
+        const float tnx = (gpu_plane(n->org[0], n->q[r->near[0]][k], sx) - r->o[0]) * r->rd[0];
+        const float tny = (gpu_plane(n->org[1], n->q[r->near[1]][k], sy) - r->o[1]) * r->rd[1];
+        const float tnz = (gpu_plane(n->org[2], n->q[r->near[2]][k], sz) - r->o[2]) * r->rd[2];
+        const float tfx = (gpu_plane(n->org[0], n->q[r->far[0]][k], sx) - r->o[0]) * r->rdf[0];
+        const float tfy = (gpu_plane(n->org[1], n->q[r->far[1]][k], sy) - r->o[1]) * r->rdf[1];
+        const float tfz = (gpu_plane(n->org[2], n->q[r->far[2]][k], sz) - r->o[2]) * r->rdf[2];
+        const float near = gpu_max(tnx, gpu_max(tny, gpu_max(tnz, r->tmin)));
+        const float far = gpu_min(tfx, gpu_min(tfy, gpu_min(tfz, tcull)));
+        tn[k] = near;
+        if (near <= far) mask |= 1u << k;
+    }
+    return mask;
+}
+
+typedef struct gpu_stack_entry {
+    uint32_t ref;
+    float t;   /* entry distance of the child's box */
+} gpu_stack_entry;
+
+/* Traversal counters (the host path counts; the kernel passes NULL). */
+typedef struct gpu_counters {
+    uint64_t nodes, tests;
+} gpu_counters;
+
+/* Closest hit (any = false) or any hit (any = true) of *in against the
+ * layout: fills *out (a miss: t = +inf, prim = PK_NO_HIT, u = v = 0) and
+ * returns whether something was hit. The same closest hit as every CPU
+ * accelerator; for any hit, some hit in [tmin, tmax] with its t, u, v. */
+static inline PK_HD bool gpu_trace(const gpu_node *nodes, const gpu_tri *tris, const pk_ray *in, bool any,
+                                   pk_hit *out, gpu_counters *count)
+{
+    out->t = INFINITY;
+    out->prim = PK_NO_HIT;
+    out->u = out->v = 0.0f;
+    if (!gpu_ray_traceable(in)) return false;
+    gpu_ray r;
+    gpu_ray_init(&r, in);
+    float best_t = in->tmax, best_u = 0.0f, best_v = 0.0f;
+    uint32_t best_prim = PK_NO_HIT;
+    float tcull = gpu_cull_limit(best_t);
+
+    gpu_stack_entry stack[GPU_STACK];
+    int sp = 0;
+    uint32_t ref = 0;
+    for (;;) {
+        while (!(ref & GPU_LEAF)) {
+            const gpu_node *n = &nodes[ref];
+            if (count) count->nodes++;
+            float tn[GPU_WIDTH];
+            unsigned mask = gpu_node_hits(n, &r, tcull, tn);
+            if (!mask) goto pop;
+            /* push every hit child, sort the run far to near, take the nearest */
+            const int base = sp;
+            for (int k = 0; k < GPU_WIDTH; k++) {
+                if (!(mask >> k & 1u)) continue;
+                gpu_stack_entry e = {n->child[k], tn[k]};
+                int j = sp++;
+                for (; j > base && stack[j - 1].t < e.t; j--) stack[j] = stack[j - 1];
+                stack[j] = e;
+            }
+            ref = stack[--sp].ref;
+        }
+        {
+            if (count) count->nodes++;
+            const uint32_t first = gpu_leaf_first(ref), cnt = gpu_leaf_count(ref);
+            for (uint32_t i = 0; i < cnt; i++) {
+                const gpu_tri *tri = &tris[first + i];
+                float t, u, v;
+                if (count) count->tests++;
+                if (!gpu_tri_intersect(&r, tri, best_t, &t, &u, &v)) continue;
+                const uint32_t prim = tri->prim;
+                if (t < best_t || (t == best_t && prim < best_prim)) {
+                    best_t = t, best_prim = prim, best_u = u, best_v = v;
+                    if (any) goto done;
+                }
+            }
+            tcull = gpu_cull_limit(best_t);
+        }
+    pop:
+        for (;;) {
+            if (sp == 0) goto done;
+            --sp;
+            if (stack[sp].t <= tcull) {
+                ref = stack[sp].ref;
+                break;
+            }
+        }
+    }
+done:
+    if (best_prim == PK_NO_HIT) return false;
+    out->t = best_t;
+    out->prim = best_prim;
+    out->u = best_u;
+    out->v = best_v;
+    return true;
+}
+
+#ifndef __CUDACC__
+/* ---- the host side: conversion and checks (bvh_gpu.c) -------------------- */
+
+struct accel;
+
+/* Invariants (gpu_layout_check tests them):
+ *  1. nodes[0] is the root; every other node is the child of exactly one
+ *     slot and comes after its parent (no cycles); references are in range.
+ *  2. Each leaf holds 1..GPU_LEAF_MAX records; every record belongs to
+ *     exactly one leaf; a record's prim is < ntris and its vertices are the
+ *     scene's vertices of that triangle, bit for bit.
+ *  3. Every triangle that can be hit (not degenerate) is in at least one
+ *     leaf (in several when the builder's spatial splits cut it), no
+ *     degenerate one in any; each of its vertices lies inside every decoded
+ *     box on the path to at least one leaf holding it (all three inside one
+ *     path when it is in a single leaf).
+ *  4. Used slots have low planes <= high planes; unused slots are GPU_EMPTY.
+ *  5. The traversal stack never needs more than GPU_STACK entries:
+ *     stack_need (the largest sum, over a root-to-node path, of the hit
+ *     children a node can push) <= GPU_STACK. */
+typedef struct gpu_layout {
+    gpu_node *nodes;
+    size_t nnodes;
+    gpu_tri *tris;
+    size_t ntris;          /* triangle records (references) */
+    size_t scene_tris;     /* triangles of the scene (prim < scene_tris) */
+    uint32_t stack_need;
+} gpu_layout;
+
+/* Converts the wide BVH b (accel_bvh_create's, triangles only) into *out.
+ * Errors (NOMEM, LIMIT) are latched in ctx. */
+PK_HIDDEN pk_status gpu_layout_build(pk_context *ctx, const pk_allocator *al, const struct accel *b,
+                                     gpu_layout *out);
+PK_HIDDEN void gpu_layout_free(const pk_allocator *al, gpu_layout *g);
+/* Every decoded box of b's conversion contains the CPU box it came from
+ * (g must be b's conversion): false with a reason otherwise. */
+PK_HIDDEN bool gpu_layout_check_boxes(const gpu_layout *g, const struct accel *b, char *why, size_t n);
+/* Invariants 1-5 against the scene's vertices (3 per triangle); false with
+ * a reason in why (may be NULL). */
+PK_HIDDEN bool gpu_layout_check(const gpu_layout *g, const float *verts, char *why, size_t n);
+/* Quantises the interval [lo, hi] of a child within the frame (org, scale
+ * 2^(ex-127)): *qlo, *qhi with gpu_plane(org, qlo) <= lo and
+ * gpu_plane(org, qhi) >= hi; false when it does not fit in 0..255. */
+PK_HIDDEN bool gpu_quantise(float org, unsigned ex, float lo, float hi, uint8_t *qlo, uint8_t *qhi);
+#endif
+
+#endif

@@ -1,0 +1,78 @@
+#!/usr/bin/env bash
+# test_cuda_errors.sh - `--accel cuda` fails cleanly where it cannot run: no
+# driver, no device, a driver too old for the kernels, too little device
+# memory, a kernel that fails, and rendering (not there yet). Each is exit
+# status 1, one line on stderr ("paprsek: ..." saying what is wrong),
+# nothing on stdout and no hit file. The driver is replaced by a stub
+# (cuda_stub.c, through PAPRSEK_CUDA_LIBRARY) that plays each failure, so
+# this runs on machines without a GPU.
+# Usage: test_cuda_errors.sh PAPRSEK TEST_DATA_DIR HAVE_CUDA STUB_LIBRARY
+set -u
+bin=$1
+have_cuda=$3
+stub=${4:-}
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+# two triangles, no materials (nothing to warn about)
+scene="$tmp/quad.obj"
+printf 'v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nf 1 2 3\nf 1 3 4\n' >"$scene"
+fails=0
+fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+
+"$bin" bench gen-rays "$scene" --look-from 0.1,1,0.2 --look-at 0,0,0 --fov 60 --size 16 -o "$tmp/r.rays" 2>/dev/null ||
+    fail "gen-rays"
+
+# expect_failure WHAT PATTERN command...: exit 1, one stderr line matching PATTERN, empty stdout
+expect_failure() {
+    local what=$1 pattern=$2
+    shift 2
+    rm -f "$tmp/h.hits"
+    "$@" >"$tmp/out" 2>"$tmp/err"
+    local rc=$?
+    local lines
+    lines=$(wc -l <"$tmp/err")
+    if [ "$rc" != 1 ]; then
+        fail "$what: exit status $rc, expected 1 ($(head -3 "$tmp/err"))"
+    elif [ "$lines" != 1 ]; then
+        fail "$what: $lines lines on stderr, expected 1: $(cat "$tmp/err")"
+    elif ! grep -Eq "^paprsek: .*$pattern" "$tmp/err"; then
+        fail "$what: message '$(cat "$tmp/err")' does not say '$pattern'"
+    elif [ -s "$tmp/out" ]; then
+        fail "$what: something on stdout: $(head -2 "$tmp/out")"
+    elif [ -e "$tmp/h.hits" ]; then
+        fail "$what: a hit file was written"
+    else
+        echo "ok: $what: $(cat "$tmp/err")"
+    fi
+}
+
+rays=("$bin" bench rays "$scene" "$tmp/r.rays" --accel cuda --reps 1 --hits "$tmp/h.hits")
+
+if [ "$have_cuda" != 1 ]; then
+    expect_failure "not built in" "not available in this build" "${rays[@]}"
+    [ "$fails" = 0 ] || exit 1
+    exit 0
+fi
+
+PAPRSEK_CUDA_LIBRARY="$tmp/no-such-dir/libcuda.so.1" \
+    expect_failure "no driver" "no CUDA driver \(.*libcuda.so.1" "${rays[@]}"
+if [ -z "$stub" ] || [ ! -r "$stub" ]; then
+    echo "SKIP: the stub driver ($stub) is not there"
+    exit 77
+fi
+export PAPRSEK_CUDA_LIBRARY="$stub"
+PK_CUDA_STUB=nodevice expect_failure "cuInit: no device" "no CUDA device$" "${rays[@]}"
+PK_CUDA_STUB=zero expect_failure "no device counted" "no CUDA device$" "${rays[@]}"
+PK_CUDA_STUB=oldptx expect_failure "driver too old" "built with CUDA [0-9.]+, do not run on Stub GPU \(compute capability 9.0\) with driver 11.4 \(.*\): they need a driver for CUDA [0-9.]+ or newer$" "${rays[@]}"
+PK_CUDA_STUB=nomem expect_failure "too little memory" "not enough device memory for the BVH: [0-9]+ bytes needed, 64 bytes free of 16384.0 MiB$" \
+    "${rays[@]}"
+PK_CUDA_STUB=kernelfail expect_failure "kernel failure" "the traversal kernel failed: unspecified launch failure" \
+    "${rays[@]}"
+PK_CUDA_STUB=kernelfail expect_failure "kernel failure, any-hit" "the traversal kernel failed" "${rays[@]}" --any-hit
+# a device that works is no reason to render on it (yet)
+PK_CUDA_STUB=kernelfail expect_failure "render" "rendering on the GPU is not there yet" \
+    "$bin" render "$scene" -o "$tmp/h.hits.png" --accel cuda --width 8 --height 8
+[ -e "$tmp/h.hits.png" ] && fail "render: an image was written"
+
+[ "$fails" = 0 ] || { echo "$fails failure(s)"; exit 1; }
+echo "all ok"
