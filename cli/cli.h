@@ -167,7 +167,10 @@ void cli_format_duration(char *buf, size_t cap, double s);
 
 /* ---- shared helpers (cli/util.c) ------------------------------------------ */
 
-/* Prints "paprsek: <ctx error>" to stderr and returns 1. */
+/* The name that begins messages: "paprsek" (paprsek-mpi sets its own). */
+extern const char *cli_program;
+
+/* Prints "<cli_program>: <ctx error>" to stderr and returns 1. */
 int cli_fail_ctx(pk_context *ctx);
 /* Prints "paprsek: <fmt>" to stderr and returns 2 (usage errors). */
 int cli_usage_error(const char *fmt, ...);

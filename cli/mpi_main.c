@@ -699,6 +699,7 @@ static pk_stats job_stats(const rank_report *reps, double wall_s)
 int main(int argc, char **argv)
 {
     const double t_start = cli_now();
+    cli_program = "paprsek-mpi";
     int provided = 0;
     if (MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS) {
         fprintf(stderr, "paprsek-mpi: MPI could not start\n");
