@@ -857,7 +857,16 @@ int main(int argc, char **argv)
     double wall_s = 0.0;
     if (g_rank != 0) {
         rc = worker(&j, &rep, max_tile);
-        if (rc < 0) _exit(128 + (g_stop ? (int)g_stop : SIGTERM)); /* stopped: mpirun ends the job */
+        if (rc < 0) {
+            /* Stopped (mpirun passes Ctrl-C on as SIGTERM, and kills every
+             * rank a second later): an early exit here would make mpirun
+             * kill rank 0 before it has written OUT.partial, so wait. */
+            for (int k = 0; k < 100; k++) {
+                struct timespec ts = {0, 100000000};
+                nanosleep(&ts, NULL);
+            }
+            _exit(128 + (g_stop ? (int)g_stop : SIGTERM));
+        }
         if (rc > 0) {
             /* rank 0 reports it (TAG_FAIL); wait to be stopped */
             while (!g_stop) sleep(1);
