@@ -86,7 +86,7 @@ static int wait_message(int source, int tag, MPI_Status *st)
         if (g_stop) return 0;
         struct timespec ts = {0, ns};
         nanosleep(&ts, NULL);
-        if (ns < 500000) ns += ns / 2;
+        if (ns < 2000000) ns += ns / 2;
     }
 }
 
@@ -616,7 +616,7 @@ static pk_status deal_pass(dealer *d, double t0, double seconds)
         } else {
             struct timespec ts = {0, ns};
             nanosleep(&ts, NULL);
-            if (ns < 200000) ns += ns / 2;
+            if (ns < 2000000) ns += ns / 2;
         }
     }
     return PK_OK;
