@@ -32,6 +32,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -293,6 +294,7 @@ typedef struct rank_report {
     uint64_t tiles;
     uint64_t bytes_sent, bytes_received;
     double busy_s; /* seconds in pk_renderer_render */
+    double cpu_s;  /* the process's CPU time (user + system), start to end */
     char host[64];
 } rank_report;
 
@@ -663,11 +665,11 @@ static void print_ranks(const rank_report *reps, const pk_render_options *ro, do
         const uint64_t rays = s->rays_camera + s->rays_shadow + s->rays_reflection + s->rays_refraction + s->rays_bounce;
         char label[40];
         snprintf(label, sizeof label, "rank %d", r);
-        printf("%-28s %s, %d thread%s, %llu tiles (%.1f%%), %llu rays, %llu samples, busy %.3f s, sent %llu B, "
-               "received %llu B\n",
+        printf("%-28s %s, %d thread%s, %llu tiles (%.1f%%), %llu rays, %llu samples, busy %.3f s, cpu %.3f s, "
+               "sent %llu B, received %llu B\n",
                label, reps[r].host, s->threads, s->threads == 1 ? "" : "s", (unsigned long long)reps[r].tiles,
                tiles_total ? 100.0 * (double)reps[r].tiles / (double)tiles_total : 0.0, (unsigned long long)rays,
-               (unsigned long long)(s->pixels * (uint64_t)ro->spp), reps[r].busy_s,
+               (unsigned long long)(s->pixels * (uint64_t)ro->spp), reps[r].busy_s, reps[r].cpu_s,
                (unsigned long long)reps[r].bytes_sent, (unsigned long long)reps[r].bytes_received);
     }
 }
@@ -946,6 +948,10 @@ int main(int argc, char **argv)
 
     /* every rank's statistics to rank 0 */
     pk_renderer_get_stats(r, &rep.stats);
+    struct rusage ru;
+    if (getrusage(RUSAGE_SELF, &ru) == 0)
+        rep.cpu_s = (double)ru.ru_utime.tv_sec + (double)ru.ru_utime.tv_usec * 1e-6 + (double)ru.ru_stime.tv_sec +
+                    (double)ru.ru_stime.tv_usec * 1e-6;
     rank_report *reps = g_rank == 0 ? calloc((size_t)g_size, sizeof *reps) : NULL;
     if (g_rank == 0 && !reps) {
         say("rank 0: out of memory");
