@@ -5,7 +5,7 @@ set -u
 bin=$1 mpi=$2 mpiexec=$3 data=$4
 [ -x "$bin" ] || { echo "SKIP: $bin is not a program"; exit 77; }
 if [ -z "$mpi" ] || [ ! -x "$mpi" ] || [ -z "$mpiexec" ]; then
-  echo "SKIP: paprsek-mpi is not built (MPI was not found: install libopenmpi-dev openmpi-bin and reconfigure)"
+  echo "SKIP: paprsek-mpi is not built (MPI was not found, or -DPK_WITH_MPI=OFF: install libopenmpi-dev openmpi-bin and reconfigure)"
   exit 77
 fi
 # Open MPI refuses to start as root without these.
