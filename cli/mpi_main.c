@@ -790,9 +790,14 @@ int main(int argc, char **argv)
     memset(&rep, 0, sizeof rep);
     snprintf(rep.host, sizeof rep.host, "%.63s", g_host);
     pk_status st = PK_OK;
+    pk_render_options ro;
+    /* Rank 0 loads the scene and applies the command line (which may read
+     * files too, as an environment map) while its reader records; then the
+     * recorded files go to the other ranks, which do the same from them. */
     int loaded0 = 1;
     if (g_rank == 0) {
         st = o.scene ? pk_scene_load_file(ctx, o.scene, &scene) : pk_scene_create_cornell_box(ctx, &scene);
+        if (st == PK_OK) st = cli_render_settings(ctx, &o, scene, &ro);
         loaded0 = st == PK_OK;
     }
     MPI_Bcast(&loaded0, 1, MPI_INT, 0, MPI_COMM_WORLD);
@@ -803,15 +808,16 @@ int main(int argc, char **argv)
     }
     int bcast_ok = 1;
     rep.bytes_sent += g_rank == 0 ? bcast_files(&files, &bcast_ok) : 0;
-    if (g_rank != 0) {
+    if (g_rank == 0) {
+        file_set_free(&files); /* sent; rank 0 records anything read later afresh */
+    } else {
         rep.bytes_received += bcast_files(&files, &bcast_ok);
         if (bcast_ok)
             st = o.scene ? pk_scene_load_file(ctx, o.scene, &scene) : pk_scene_create_cornell_box(ctx, &scene);
+        if (bcast_ok && st == PK_OK) st = cli_render_settings(ctx, &o, scene, &ro);
+        /* the files stay served: a file read later that rank 0 did not
+         * send is an error naming it */
     }
-    file_set_free(&files);
-    pk_context_set_file_reader(ctx, NULL, NULL);
-    pk_render_options ro;
-    if (bcast_ok && st == PK_OK) st = cli_render_settings(ctx, &o, scene, &ro);
     if (bcast_ok && st == PK_OK) {
         ro.cancel = &g_cancel;
         ro.progress = NULL; /* the bar follows the tiles of the whole job */
