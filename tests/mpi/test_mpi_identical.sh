@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # paprsek-mpi with 1, 2 and 3 ranks writes the image `paprsek render` writes,
 # byte for byte, for the path tracer and the Whitted integrator, an OBJ+MTL
-# scene and a JSON scene with OBJ meshes, tiles of two sizes; the scene's
-# files exist only in rank 0's folder. --time passes of 1 spp equal one
+# scene and a JSON scene with OBJ meshes, tiles of three sizes, an
+# environment map (--env FILE); the scene's files exist only in rank 0's
+# folder. --time passes of 1 spp equal one
 # render of as many samples. --stats reports every rank.
 # usage: test_mpi_identical.sh PAPRSEK PAPRSEK_MPI MPIEXEC DATA_DIR
 . "$(dirname "$0")/mpi_common.sh"
@@ -36,6 +37,17 @@ for integ in path whitted; do
     done
   done
 done
+
+# --env FILE: the environment map is a file too, read while applying the
+# command line; it exists only beside the scene (a 4x2 PFM: RGB 1, 0.5, 2)
+{ printf 'PF\n4 2\n-1.0\n'; for i in 1 2 3 4 5 6 7 8; do printf '\000\000\200\077\000\000\000\077\000\000\000\100'; done; } \
+  >"$tmp/scene/sky.pfm"
+(cd "$tmp/scene" && "$bin" render mpi_room.obj -o "$tmp/one.pfm" "${common[@]}" --spp 2 --env sky.pfm "${cam[@]}") ||
+  bad "paprsek render --env sky.pfm"
+rm -f "$tmp/many.pfm"
+run_mpi 2 mpi_room.obj -o "$tmp/many.pfm" "${common[@]}" --spp 2 --env sky.pfm --tile 16 "${cam[@]}" >"$tmp/out" 2>"$tmp/err" ||
+  { bad "2 ranks with --env sky.pfm"; cat "$tmp/err"; }
+cmp -s "$tmp/one.pfm" "$tmp/many.pfm" || bad "2 ranks with --env sky.pfm: the image differs"
 
 # PNG and --stats: every rank listed, tiles adding up to the image's
 (cd "$tmp/scene" && "$bin" render mpi_room.obj -o "$tmp/one.png" "${common[@]}" --spp 2 "${cam[@]}") ||
