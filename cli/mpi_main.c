@@ -796,7 +796,8 @@ int main(int argc, char **argv)
      * recorded files go to the other ranks, which do the same from them. */
     int loaded0 = 1;
     if (g_rank == 0) {
-        st = o.scene ? pk_scene_load_file(ctx, o.scene, &scene) : pk_scene_create_cornell_box(ctx, &scene);
+        st = o.scene ? pk_scene_load_file_params(ctx, o.scene, o.defines, o.ndefines, &scene)
+                    : pk_scene_create_cornell_box(ctx, &scene);
         if (st == PK_OK) st = cli_render_settings(ctx, &o, scene, &ro);
         loaded0 = st == PK_OK;
     }
@@ -813,7 +814,8 @@ int main(int argc, char **argv)
     } else {
         rep.bytes_received += bcast_files(&files, &bcast_ok);
         if (bcast_ok)
-            st = o.scene ? pk_scene_load_file(ctx, o.scene, &scene) : pk_scene_create_cornell_box(ctx, &scene);
+            st = o.scene ? pk_scene_load_file_params(ctx, o.scene, o.defines, o.ndefines, &scene)
+                    : pk_scene_create_cornell_box(ctx, &scene);
         if (bcast_ok && st == PK_OK) st = cli_render_settings(ctx, &o, scene, &ro);
         /* the files stay served: a file read later that rank 0 did not
          * send is an error naming it */
@@ -987,12 +989,12 @@ int main(int argc, char **argv)
             const char *name = o.scene ? o.scene : "cornell-box (built in)";
             pk_stats js = job_stats(reps, wall_s);
             if (o.stats) {
-                cli_print_stats(name, &ro, &js);
+                cli_print_stats(name, scene, &ro, &js);
                 printf("%-28s %u of %d spp\n", "passes", passes, ro.spp);
                 print_ranks(reps, &ro, wall_s, (uint64_t)ntiles * passes);
                 fflush(stdout);
             }
-            if (o.stats_json && cli_write_stats_json(o.stats_json, name, &ro, &js) != 0) rc = 1;
+            if (o.stats_json && cli_write_stats_json(o.stats_json, name, scene, &ro, &js) != 0) rc = 1;
         }
         free(reps);
     }

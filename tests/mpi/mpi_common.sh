@@ -24,8 +24,13 @@ bad() { echo "FAIL $*"; fail=1; }
 
 # The scene lives in $tmp/scene only; the other ranks run in $tmp/empty.
 mkdir -p "$tmp/scene" "$tmp/empty"
-cp "$data/mpi_room.obj" "$data/mpi_room.mtl" "$data/json_example.json" "$data/json_floor.obj" \
-   "$data/json_lamp.obj" "$tmp/scene/"
+cp "$data/mpi_room.obj" "$data/mpi_room.mtl" "$data/mpi_tex.obj" "$data/mpi_tex.mtl" "$data/json_example.json" \
+   "$data/json_floor.obj" "$data/json_lamp.obj" "$tmp/scene/"
+# mpi_tex.mtl's texture: a 2x2 PFM (red, green / blue, white)
+{ printf 'PF\n2 2\n-1.0\n'
+  printf '\000\000\200\077\000\000\000\076\000\000\000\076\000\000\000\076\000\000\200\077\000\000\000\076'
+  printf '\000\000\000\076\000\000\000\076\000\000\200\077\000\000\200\077\000\000\200\077\000\000\200\077'
+} >"$tmp/scene/mpi_tex.pfm"
 
 # run_mpi N ARGS...: mpirun with N ranks (1..), rank 0 in $tmp/scene and the
 # others in $tmp/empty, each given ARGS (after "render").

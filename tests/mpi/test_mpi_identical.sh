@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # paprsek-mpi with 1, 2 and 3 ranks writes the image `paprsek render` writes,
 # byte for byte, for the path tracer and the Whitted integrator, an OBJ+MTL
-# scene and a JSON scene with OBJ meshes, tiles of three sizes, an
+# scene, an OBJ+MTL+texture scene and a JSON scene with OBJ meshes, tiles of three sizes, an
 # environment map (--env FILE); the scene's files exist only in rank 0's
 # folder. --time passes of 1 spp equal one
 # render of as many samples. --stats reports every rank.
@@ -16,15 +16,15 @@ common=(--width 48 --height 32 --threads 1 --quiet)
   bad "the scene can be read from the other ranks' folder"
 
 for integ in path whitted; do
-  for scene in mpi_room.obj json_example.json; do
+  for scene in mpi_room.obj mpi_tex.obj json_example.json; do
     extra=()
-    [ "$scene" = mpi_room.obj ] && extra=("${cam[@]}")
+    [ "$scene" != json_example.json ] && extra=("${cam[@]}")
     (cd "$tmp/scene" && "$bin" render "$scene" -o "$tmp/one.pfm" "${common[@]}" --spp 3 --integrator "$integ" \
       "${extra[@]}") || { bad "paprsek render $scene --integrator $integ"; continue; }
     # one tile size per number of ranks: 16, 24 (tiles cut by the image's edge), 8
     for n in 1 2 3; do
       for t in $(echo 16 24 8 | cut -d' ' -f"$n"); do
-        [ "$scene" = json_example.json ] && [ "$n" = 1 ] && continue
+        [ "$scene" != mpi_room.obj ] && [ "$n" = 1 ] && continue
         rm -f "$tmp/many.pfm"
         if ! run_mpi "$n" "$scene" -o "$tmp/many.pfm" "${common[@]}" --spp 3 --integrator "$integ" --tile "$t" \
           "${extra[@]}" >"$tmp/out" 2>"$tmp/err"; then
