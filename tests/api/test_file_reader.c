@@ -2,7 +2,7 @@
  * test_file_reader.c - pk_context_set_file_reader: scenes whose files exist
  * only in memory load exactly as from the file system (OBJ + MTL, an MTL name
  * holding a blank, JSON + OBJ meshes); every path the library asks for is the
- * one it would open; a reader's refusal is latched as "path: reason"; sizes
+ * one it would open; a texture map comes through it too; a reader's refusal is latched as "path: reason"; sizes
  * beyond PK_MAX_FILE_BYTES are refused; NULL restores the file system.
  */
 #include "paprsek.h"
@@ -33,6 +33,21 @@ static pk_status serve(void *user, const char *path, const void **data, size_t *
         }
     snprintf(why, why_cap, "not in the archive");
     return PK_ERR_IO;
+}
+
+/* serve, and the texture t/mpi_tex.pfm (binary: not a C string) */
+static const char *g_pfm;
+static size_t g_pfm_size;
+static pk_status serve_tex(void *user, const char *path, const void **data, size_t *size, char *why, size_t why_cap)
+{
+    archive *a = user;
+    if (strcmp(path, "t/mpi_tex.pfm") == 0) {
+        if (a->nasked < 16) snprintf(a->asked[a->nasked++], sizeof a->asked[0], "%s", path);
+        *data = g_pfm;
+        *size = g_pfm_size;
+        return PK_OK;
+    }
+    return serve(user, path, data, size, why, why_cap);
 }
 
 /* The scene at path read from the file system; its info. */
@@ -89,9 +104,31 @@ int main(void)
     info_from_disk(PK_TEST_DATA "/obj_mat.obj", &disk);
     CHECK(same_info(&mem, &disk));
     CHECK(mem.materials >= 3); /* the MTL file was read through the reader */
-    CHECK(a1.nasked == 2);
+    /* the OBJ, its MTL, then whatever the MTL names (texture maps), all
+     * under the scene's folder as the library would open them */
+    CHECK(a1.nasked >= 2);
     CHECK(strcmp(a1.asked[0], "nowhere/obj_mat.obj") == 0);
     CHECK(strcmp(a1.asked[1], "nowhere/obj_mat.mtl") == 0);
+    for (size_t i = 2; i < a1.nasked; i++) CHECKF(strncmp(a1.asked[i], "nowhere/", 8) == 0, "%s", a1.asked[i]);
+
+    /* a texture map named by the MTL file comes through the reader too (a
+     * 2x2 PFM, in memory only) */
+    static const char pfm[] = "PF\n2 2\n-1.0\n"
+                              "\0\0\x80\x3f\0\0\0\x3e\0\0\0\x3e\0\0\0\x3e\0\0\x80\x3f\0\0\0\x3e"
+                              "\0\0\0\x3e\0\0\0\x3e\0\0\x80\x3f\0\0\x80\x3f\0\0\x80\x3f\0\0\x80\x3f";
+    const mem_file ft[] = {{"t/mpi_tex.obj", slurp(PK_TEST_DATA "/mpi_tex.obj")},
+                           {"t/mpi_tex.mtl", slurp(PK_TEST_DATA "/mpi_tex.mtl")}};
+    archive at = {.files = ft, .n = 2};
+    pk_context_set_file_reader(ctx, serve_tex, &at);
+    g_pfm = pfm;
+    g_pfm_size = sizeof pfm - 1;
+    CHECKF(pk_scene_load_file(ctx, "t/mpi_tex.obj", &s) == PK_OK, "%s", pk_context_error(ctx));
+    REQUIRE(s);
+    pk_scene_get_info(s, &mem);
+    pk_scene_destroy(s);
+    s = NULL;
+    CHECKF(mem.textures == 1, "%zu textures", mem.textures);
+    CHECK(at.nasked == 3 && strcmp(at.asked[2], "t/mpi_tex.pfm") == 0);
 
     /* "mtllib odd library.mtl": one file whose name holds a blank; the
      * reader answers the library's question whether it exists */
