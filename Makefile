@@ -4,8 +4,9 @@
 BUILD      ?= build
 JOBS       ?= $(shell nproc 2>/dev/null || echo 2)
 BUILD_PKGS  = gcc make cmake pkg-config libpng-dev libjpeg62-turbo-dev libcjson-dev libopenexr-dev libexpat1-dev
-# g++: the install tests build a C++ program against the installed library
-TEST_PKGS   = $(BUILD_PKGS) libembree-dev g++
+# g++: the install tests build a C++ program against the installed library;
+# Open MPI: paprsek-mpi and its tests (mpirun), iproute2: their two-host test
+TEST_PKGS   = $(BUILD_PKGS) libembree-dev g++ libopenmpi-dev openmpi-bin iproute2
 PREFIX     ?= /usr/local
 FUZZ_PKGS   = $(TEST_PKGS) clang libclang-rt-14-dev libomp-14-dev
 FUZZ_SECONDS ?= 60

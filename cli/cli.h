@@ -80,6 +80,68 @@ void cli_print_options(FILE *f, const cli_option *opts, size_t n);
  * to be a likely typing mistake. */
 const char *cli_nearest(const char *word, size_t len, const char *const *names, size_t n);
 
+/* ---- the render options, checks and outputs (cli/render_common.c) --------
+ * Shared by `paprsek render` and paprsek-mpi. */
+
+#define CLI_RENDER_MAX_OPTIONS 48
+#define CLI_RENDER_MAX_EXTRA 8
+enum { CLI_RENDER_EXTRA = 100 }; /* ids of a program's own options: CLI_RENDER_EXTRA + k */
+
+typedef struct cli_render_opts {
+    const char *scene, *out, *stats_json;
+    int has_exposure;
+    float exposure;
+    int stats, quiet;
+    int int_set[CLI_RENDER_MAX_OPTIONS]; /* per table entry: given on the command line */
+    int int_value[CLI_RENDER_MAX_OPTIONS];
+    int fresnel;         /* -1: not given */
+    int has_accel;
+    pk_accel_kind accel;
+    int has_integrator;
+    pk_integrator_kind integrator;
+    double time;         /* --time: seconds of passes, 0 when not given */
+    unsigned aovs;       /* --aov: PK_AOV_* */
+    int has_from, has_at, has_up, has_fov;
+    float from[3], at[3], up[3], fov;
+    const char *env;     /* --env, NULL when not given */
+    const char *defines[64]; /* -D NAME=VALUE */
+    size_t ndefines;
+    /* a program's own options (cli_render_add_option): the value given ("" for
+     * a flag), NULL when absent */
+    const char *extra[CLI_RENDER_MAX_EXTRA];
+} cli_render_opts;
+
+/* Adds an option of a program's own (id CLI_RENDER_EXTRA + k) to the table,
+ * before --help; only before the table is first used. */
+void cli_render_add_option(cli_option o);
+/* The table: -o, the library's integer options, the rest. */
+const cli_option *cli_render_options(size_t *n);
+/* The help of the render options after usage_line. */
+void cli_render_usage(FILE *f, const char *usage_line);
+/* Parses the arguments (argv[0] is the command's name). Returns 0 to go
+ * on, -1 after --help was printed by help (exit 0), or an exit status after
+ * a message. */
+int cli_render_parse(int argc, char **argv, cli_render_opts *o, void (*help)(FILE *f));
+/* What would fail only after the render: OUT's format and folder, files
+ * written over the scene, --stats-json's file. Fills *wo (the exposure).
+ * Returns 0 or an exit status after a message. */
+int cli_render_check(const cli_render_opts *o, pk_write_options *wo);
+/* The scene's render settings with the command line's over them (collect_stats
+ * when statistics are asked for), checked; --env and the camera options
+ * applied to scene (--env FILE reads the file through ctx). */
+pk_status cli_render_settings(pk_context *ctx, const cli_render_opts *o, pk_scene *scene, pk_render_options *ro);
+/* Writes OUT (through pk_image_write_ex: a temporary file renamed into place)
+ * and the AOVs of --aov from film. */
+pk_status cli_render_write(pk_context *ctx, const cli_render_opts *o, const pk_write_options *wo,
+                           const pk_image *img, const pk_film *film);
+/* "dir/name.png" -> "dir/name.partial.png" (malloc'ed; NULL when out of memory) */
+char *cli_partial_name(const char *out);
+/* The statistics table of --stats on standard output (sc: its textures). */
+void cli_print_stats(const char *scene, const pk_scene *sc, const pk_render_options *ro, const pk_stats *st);
+/* --stats-json: path "-" is standard output. Returns 0 or 1 after a message. */
+int cli_write_stats_json(const char *path, const char *scene, const pk_scene *sc, const pk_render_options *ro,
+                         const pk_stats *st);
+
 /* ---- the progress bar (cli/progress.c) --------------------------------- */
 
 typedef struct cli_progress {
@@ -105,7 +167,10 @@ void cli_format_duration(char *buf, size_t cap, double s);
 
 /* ---- shared helpers (cli/util.c) ------------------------------------------ */
 
-/* Prints "paprsek: <ctx error>" to stderr and returns 1. */
+/* The name that begins messages: "paprsek" (paprsek-mpi sets its own). */
+extern const char *cli_program;
+
+/* Prints "<cli_program>: <ctx error>" to stderr and returns 1. */
 int cli_fail_ctx(pk_context *ctx);
 /* Prints "paprsek: <fmt>" to stderr and returns 2 (usage errors). */
 int cli_usage_error(const char *fmt, ...);

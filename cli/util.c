@@ -14,10 +14,12 @@
 #include <time.h>
 #include <unistd.h>
 
+const char *cli_program = "paprsek";
+
 int cli_fail_ctx(pk_context *ctx)
 {
     const char *msg = pk_context_error(ctx);
-    fprintf(stderr, "paprsek: %s\n", msg && msg[0] ? msg : "unknown error");
+    fprintf(stderr, "%s: %s\n", cli_program, msg && msg[0] ? msg : "unknown error");
     return 1;
 }
 
@@ -25,7 +27,7 @@ int cli_usage_error(const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
-    fputs("paprsek: ", stderr);
+    fprintf(stderr, "%s: ", cli_program);
     vfprintf(stderr, fmt, ap);
     fputs("\n", stderr);
     va_end(ap);
@@ -36,7 +38,7 @@ int cli_failure(const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
-    fputs("paprsek: ", stderr);
+    fprintf(stderr, "%s: ", cli_program);
     vfprintf(stderr, fmt, ap);
     fputs("\n", stderr);
     va_end(ap);
@@ -76,7 +78,7 @@ int cli_parse_vec3(const char *s, float out[3])
 void cli_print_warning(void *user, const char *message)
 {
     (void)user;
-    fprintf(stderr, "paprsek: warning: %s\n", message);
+    fprintf(stderr, "%s: warning: %s\n", cli_program, message);
 }
 
 double cli_now(void)

@@ -1,5 +1,5 @@
 # install.cmake - what `cmake --install` puts under the prefix:
-#   bin/paprsek, include/paprsek.h, lib/libpaprsek.so.0.1.0 (+ .so.0, .so),
+#   bin/paprsek (and bin/paprsek-mpi when MPI was found), include/paprsek.h, lib/libpaprsek.so.0.1.0 (+ .so.0, .so),
 #   lib/libpaprsek.a, lib/pkgconfig/paprsek.pc and lib/cmake/paprsek/
 #   (paprsekConfig.cmake, its version file, the exported targets
 #   paprsek::paprsek and paprsek::paprsek_static).
@@ -8,6 +8,10 @@ include(CMakePackageConfigHelpers)
 set(PK_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/paprsek)
 
 install(TARGETS paprsek_cli RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+# paprsek-mpi, when MPI was found: mpirun starts it by the same path on every machine
+if(TARGET paprsek_mpi)
+  install(TARGETS paprsek_mpi RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+endif()
 install(TARGETS paprsek_shared paprsek_static EXPORT paprsekTargets
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}

@@ -65,6 +65,29 @@ PK_API void pk_context_clear_error(pk_context *ctx);
  * without a handler they are dropped. */
 PK_API void pk_context_set_warning_handler(pk_context *ctx, pk_warning_fn fn, void *user);
 
+/* Where the library's files come from. By default every file the library
+ * reads (a scene, the MTL files an OBJ names, the OBJ meshes of a JSON scene,
+ * any file a scene refers to) is read from the file system. A file reader
+ * replaces that for every read through ctx: a program can serve files from
+ * memory, from an archive or from another machine, or record which files a
+ * scene needs (paprsek-mpi does both, docs/distributed.md).
+ *
+ * The reader is called with the path as the library would open it (the
+ * scene's folder joined with the name the scene gives). On success it
+ * returns PK_OK and sets *data and *size to the whole file's bytes; they stay
+ * the reader's and must stay valid until the reader returns to the library
+ * again or is replaced (the library copies them at once). Files larger than
+ * PK_MAX_FILE_BYTES are refused as from the file system. On failure it
+ * returns a status (PK_ERR_IO for a file it does not have) and may write a
+ * short reason, NUL-terminated, into why (why_cap bytes, at least 128): the
+ * library's message is then "path: reason". The library also asks the reader
+ * whether a file exists where it tries more than one name (an OBJ's mtllib
+ * line whose whole rest may name one file): a reader answers that as a read.
+ * fn NULL restores reading from the file system. */
+typedef pk_status (*pk_file_reader_fn)(void *user, const char *path, const void **data, size_t *size,
+                                       char *why, size_t why_cap);
+PK_API void pk_context_set_file_reader(pk_context *ctx, pk_file_reader_fn fn, void *user);
+
 PK_API const char *pk_status_string(pk_status status);
 
 /* ---- limits (checked on every input) ------------------------------------ */

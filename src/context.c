@@ -137,6 +137,13 @@ void pk_context_set_warning_handler(pk_context *ctx, pk_warning_fn fn, void *use
     ctx->warn_user = user;
 }
 
+void pk_context_set_file_reader(pk_context *ctx, pk_file_reader_fn fn, void *user)
+{
+    if (!ctx) return;
+    ctx->read_file = fn;
+    ctx->read_file_user = fn ? user : NULL;
+}
+
 const char *pk_status_string(pk_status status)
 {
     switch (status) {
@@ -187,10 +194,49 @@ void ctx_warn(pk_context *ctx, const char *fmt, ...)
 
 /* ---- files -------------------------------------------------------------- */
 
+/* A file through the context's reader: its bytes copied into a buffer of
+ * the library's own, or its failure latched as "path: reason". */
+static pk_status read_through_hook(pk_context *ctx, const char *path, char **data, size_t *size)
+{
+    const void *bytes = NULL;
+    size_t n = 0;
+    char why[PK_ERRMSG_MAX];
+    why[0] = '\0';
+    pk_status st = ctx->read_file(ctx->read_file_user, path, &bytes, &n, why, sizeof why);
+    why[sizeof why - 1] = '\0';
+    if (st != PK_OK) {
+        if (st == PK_ERR_NOMEM) return ctx_nomem(ctx);
+        return ctx_error(ctx, st, "%s: %s", path, why[0] ? why : "the file reader does not have this file");
+    }
+    if (!bytes && n > 0) return ctx_error(ctx, PK_ERR_IO, "%s: the file reader gave no bytes", path);
+    if (n > PK_MAX_FILE_BYTES)
+        return ctx_error(ctx, PK_ERR_LIMIT, "%s: file is larger than %zu bytes", path, (size_t)PK_MAX_FILE_BYTES);
+    char *buf = mem_alloc(&ctx->alloc, n + 1);
+    if (!buf) return ctx_nomem(ctx);
+    if (n) memcpy(buf, bytes, n);
+    buf[n] = '\0';
+    *data = buf;
+    *size = n;
+    return PK_OK;
+}
+
+bool file_exists(pk_context *ctx, const char *path)
+{
+    if (ctx->read_file) {
+        const void *bytes = NULL;
+        size_t n = 0;
+        char why[PK_ERRMSG_MAX];
+        return ctx->read_file(ctx->read_file_user, path, &bytes, &n, why, sizeof why) == PK_OK;
+    }
+    struct stat sb;
+    return stat(path, &sb) == 0 && S_ISREG(sb.st_mode);
+}
+
 pk_status file_read_all(pk_context *ctx, const char *path, char **data, size_t *size)
 {
     *data = NULL;
     *size = 0;
+    if (ctx->read_file) return read_through_hook(ctx, path, data, size);
     /* O_NONBLOCK: opening a FIFO (mtllib /some/fifo) must not wait for a
      * writer; it is refused below like any file that is not regular. */
     int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);

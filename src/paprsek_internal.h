@@ -51,6 +51,8 @@ struct pk_context {
     char message[PK_ERRMSG_MAX];
     pk_warning_fn warn;
     void *warn_user;
+    pk_file_reader_fn read_file; /* NULL: files are read from the file system */
+    void *read_file_user;
 };
 
 /* ---- allocation: every library allocation goes through the context's hook */
@@ -93,6 +95,9 @@ PK_HIDDEN void ctx_warn(pk_context *ctx, const char *fmt, ...) PK_PRINTF(2, 3);
 /* Reads a whole file (at most PK_MAX_FILE_BYTES) into a NUL-terminated buffer
  * owned by the caller (mem_free). Errors are latched in ctx. */
 PK_HIDDEN pk_status file_read_all(pk_context *ctx, const char *path, char **data, size_t *size);
+/* True when file_read_all would find a file at path: a regular file, or one
+ * the context's file reader gives. Latches nothing. */
+PK_HIDDEN bool file_exists(pk_context *ctx, const char *path);
 /* Directory part of path ("." when none), caller frees. */
 PK_HIDDEN char *path_dirname(const pk_allocator *a, const char *path);
 /* dir + "/" + rel (rel kept when absolute), caller frees. */

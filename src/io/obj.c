@@ -11,7 +11,6 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #define OBJ_INLINE_CORNERS 64
 #define OBJ_MAX_UNDEFINED_WARNINGS 10
@@ -286,8 +285,7 @@ static pk_status read_library(obj_state *st, const char *rel)
 static bool library_exists(obj_state *st, const char *rel)
 {
     char *path = path_join(&st->r.ctx->alloc, st->base_dir, rel);
-    struct stat sb;
-    bool ok = path && stat(path, &sb) == 0 && S_ISREG(sb.st_mode);
+    bool ok = path && file_exists(st->r.ctx, path);
     mem_free(&st->r.ctx->alloc, path);
     return ok;
 }

@@ -14,6 +14,12 @@ for f in bin/paprsek include/paprsek.h "$PK_LIBDIR/libpaprsek.a" "$PK_LIBDIR/lib
     "$PK_LIBDIR/cmake/paprsek/paprsekConfigVersion.cmake" "$PK_LIBDIR/cmake/paprsek/paprsekTargets.cmake"; do
     if [ -f "$PK_PREFIX/$f" ]; then ok "$f"; else fail "$f is not installed"; fi
 done
+# paprsek-mpi: installed exactly when it was built (MPI found)
+if [ "${PK_HAVE_MPI:-0}" = 1 ]; then
+    [ -x "$PK_PREFIX/bin/paprsek-mpi" ] && ok "bin/paprsek-mpi" || fail "bin/paprsek-mpi is not installed"
+else
+    [ -e "$PK_PREFIX/bin/paprsek-mpi" ] && fail "bin/paprsek-mpi is installed without MPI" || ok "no bin/paprsek-mpi (no MPI)"
+fi
 [ "$(readlink "$lib/libpaprsek.so.0")" = libpaprsek.so.0.1.0 ] && ok "libpaprsek.so.0 -> libpaprsek.so.0.1.0" \
     || fail "libpaprsek.so.0 is not a link to libpaprsek.so.0.1.0"
 [ "$(readlink "$lib/libpaprsek.so")" = libpaprsek.so.0 ] && ok "libpaprsek.so -> libpaprsek.so.0" \

@@ -1,0 +1,583 @@
+/*
+ * render_common.c - what `paprsek render` and paprsek-mpi share: the render
+ * options (one table for parsing, ranges and --help), the checks made before
+ * any work, the settings a scene gets from the command line, the outputs
+ * (image, AOVs, OUT.partial) and the statistics.
+ */
+#include "cli.h"
+
+#include <errno.h>
+#include <math.h>
+#include <sys/resource.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+/* ---- the options: one table for parsing, ranges and --help ---------------- */
+
+enum {
+    OPT_OUTPUT = 1,
+    OPT_EXPOSURE,
+    OPT_INT, /* an integer render option of the library's table */
+    OPT_ACCEL,
+    OPT_INTEGRATOR,
+    OPT_FRESNEL,
+    OPT_LOOK_FROM,
+    OPT_LOOK_AT,
+    OPT_UP,
+    OPT_FOV,
+    OPT_TIME,
+    OPT_ENV,
+    OPT_AOV,
+    OPT_STATS,
+    OPT_STATS_JSON,
+    OPT_DEFINE,
+    OPT_QUIET,
+    OPT_HELP
+};
+
+#define MAX_RENDER_OPTIONS CLI_RENDER_MAX_OPTIONS
+static cli_option g_opts[MAX_RENDER_OPTIONS];
+static char g_int_names[MAX_RENDER_OPTIONS][64];
+static size_t g_nopts;
+static cli_option g_extra[CLI_RENDER_MAX_EXTRA]; /* a program's own options */
+static size_t g_nextra;
+
+void cli_render_add_option(cli_option o)
+{
+    if (g_nopts == 0 && g_nextra < CLI_RENDER_MAX_EXTRA) g_extra[g_nextra++] = o;
+}
+
+static void add(cli_option o)
+{
+    if (g_nopts < MAX_RENDER_OPTIONS) g_opts[g_nopts++] = o;
+}
+
+/* The table: -o first, the library's integer options (pk_int_options) in
+ * its order, then the rest. Built once. */
+const cli_option *cli_render_options(size_t *n)
+{
+    if (g_nopts == 0) {
+        add((cli_option){.name = "output", .short_name = 'o', .id = OPT_OUTPUT, .kind = CLI_STRING, .arg = "FILE",
+                         .help = "the image to write (required): .png (8-bit sRGB), .pfm or .exr (linear "
+                                 "float RGB)"});
+        add((cli_option){.name = "exposure", .id = OPT_EXPOSURE, .kind = CLI_STRING, .arg = "EV",
+                         .help = "PNG only: multiply the linear values by 2^EV before the tone curve; a number "
+                                 "in -20..20, default 0 (.pfm and .exr are written unscaled)"});
+        size_t count = 0;
+        const pk_int_option *ints = pk_int_options(&count);
+        for (size_t i = 0; i < count && g_nopts < MAX_RENDER_OPTIONS; i++) {
+            cli_option o = cli_option_from_render(&ints[i], g_int_names[g_nopts], sizeof g_int_names[0]);
+            o.id = OPT_INT;
+            add(o);
+        }
+        add((cli_option){.name = "accel", .id = OPT_ACCEL, .kind = CLI_STRING, .arg = "NAME",
+                         .help = "the acceleration structure: bvh (default: binned SAH, wide SIMD BVH), midpoint "
+                                 "(simple BVH, for comparison), none (every ray tests every primitive), embree "
+                                 "(Embree 3, when built with it); all give the same image (cuda, the GPU, traces "
+                                 "rays for bench rays only)"});
+        add((cli_option){.name = "integrator", .id = OPT_INTEGRATOR, .kind = CLI_STRING, .arg = "NAME",
+                         .help = "path (default: path tracing, global illumination, one-sided area lights) or "
+                                 "whitted (direct light, mirrors and glass; emitters two-sided)"});
+        add((cli_option){.name = "fresnel", .id = OPT_FRESNEL, .kind = CLI_STRING, .arg = "on|off",
+                         .help = "on: exact dielectric Fresnel (default); off: fixed Ks/Tf weights"});
+        add((cli_option){.name = "look-from", .id = OPT_LOOK_FROM, .kind = CLI_STRING, .arg = "X,Y,Z",
+                         .help = "camera position"});
+        add((cli_option){.name = "look-at", .id = OPT_LOOK_AT, .kind = CLI_STRING, .arg = "X,Y,Z",
+                         .help = "camera target"});
+        add((cli_option){.name = "up", .id = OPT_UP, .kind = CLI_STRING, .arg = "X,Y,Z",
+                         .help = "camera up vector (default 0,1,0)"});
+        add((cli_option){.name = "time", .id = OPT_TIME, .kind = CLI_STRING, .arg = "SECONDS",
+                         .help = "render passes of --spp samples per pixel until SECONDS have passed (at least "
+                                 "one pass); the image is the mean of all passes"});
+        add((cli_option){.name = "env", .id = OPT_ENV, .kind = CLI_STRING, .arg = "SPEC",
+                         .help = "the light from the surroundings, replacing the scene's: none (black), R,G,B "
+                                 "or V (a constant radiance), or an image FILE (lat-long, +y up: .hdr, .exr, "
+                                 ".pfm, .png, .jpg). A scene without lights and without an environment is lit "
+                                 "by a white one of radiance 1"});
+        add((cli_option){.name = "aov", .id = OPT_AOV, .kind = CLI_STRING, .arg = "LIST",
+                         .help = "also write these outputs, from the camera rays: albedo, normal, depth, "
+                                 "heatmap (nodes visited + primitives tested per camera ray), comma-separated; "
+                                 "layers NAME.R/G/B of an .exr OUT, else files beside OUT as NAME.AOV.EXT"});
+        add((cli_option){.name = "fov", .id = OPT_FOV, .kind = CLI_STRING, .arg = "DEG",
+                         .help = "vertical field of view in degrees, between 0 and 180"});
+        add((cli_option){.name = "stats", .id = OPT_STATS, .kind = CLI_FLAG,
+                         .help = "print the statistics table on standard output (rays, intersection tests, "
+                                 "nodes, build and render time)"});
+        add((cli_option){.name = "stats-json", .id = OPT_STATS_JSON, .kind = CLI_STRING, .arg = "FILE",
+                         .help = "write the statistics as JSON to FILE; - writes them to standard output"});
+        add((cli_option){.name = "define", .short_name = 'D', .id = OPT_DEFINE, .kind = CLI_STRING, .arg = "NAME=VALUE",
+                         .help = "set the parameter $NAME of a Mitsuba XML scene over its <default> value "
+                                 "(may be repeated, up to 64 times)"});
+        add((cli_option){.name = "quiet", .short_name = 'q', .id = OPT_QUIET, .kind = CLI_FLAG,
+                         .help = "no progress bar, no 'wrote' line, no warnings (errors are still printed)"});
+        for (size_t i = 0; i < g_nextra; i++) add(g_extra[i]);
+        add((cli_option){.name = "help", .short_name = 'h', .id = OPT_HELP, .kind = CLI_FLAG, .help = "this text"});
+    }
+    *n = g_nopts;
+    return g_opts;
+}
+
+void cli_render_usage(FILE *f, const char *usage_line)
+{
+    size_t n;
+    const cli_option *opts = cli_render_options(&n);
+    fputs(usage_line, f);
+    fputs("\n"
+          "SCENE is a Wavefront .obj (materials from its .mtl files), a .json scene or\n"
+          "a Mitsuba .xml scene (docs/scene-format.md); without it the built-in Cornell\n"
+          "box is rendered.\n"
+          "OUT is written by extension, through a temporary file that is renamed into\n"
+          "place. Its folder is checked before the scene is read: it must exist and be\n"
+          "writable. The formats:\n"
+          "  .png  8-bit sRGB. Tone curve (clamp): each linear value v becomes\n"
+          "        x = v * 2^EV (--exposure, default 0); x <= 0 gives 0, x >= 1 gives\n"
+          "        255, else the sRGB curve s = 12.92 x (x <= 0.0031308) or\n"
+          "        1.055 x^(1/2.4) - 0.055, stored as floor(255 s + 0.5).\n"
+          "  .pfm  linear 32-bit float RGB, the rendered values unchanged.\n"
+          "  .exr  OpenEXR, linear 32-bit float channels R, G, B, the rendered values\n"
+          "        unchanged (scanlines, lossless ZIP compression).\n"
+          "\n"
+          "options (they override the scene's own \"render\" settings; --name VALUE and\n"
+          "--name=VALUE are the same, and a unique beginning of a name is enough):\n",
+          f);
+    cli_print_options(f, opts, n);
+    fputs("\n"
+          "When stderr is a terminal, a progress bar (percentage, elapsed time, ETA)\n"
+          "is redrawn there, and at the end one line says what was written, e.g.\n"
+          "\"wrote cornell.png (512x512, 1.2 s)\" (the time from start to finish).\n"
+          "Otherwise, and with --quiet, stderr carries only warnings and errors.\n"
+          "\n"
+          "exit status:\n"
+          "  0    the image was written\n"
+          "  1    a runtime failure: a file that cannot be read or written, a malformed\n"
+          "       scene, a scene beyond the limits\n"
+          "  2    a usage error: unknown option, bad value, unknown image format\n"
+          "  130  interrupted by SIGINT (Ctrl-C)\n"
+          "  143  interrupted by SIGTERM\n"
+          "On SIGINT or SIGTERM the render stops, the finished tiles are written to\n"
+          "OUT with '.partial' before the extension, and OUT itself is left untouched.\n",
+          f);
+}
+
+
+int cli_render_parse(int argc, char **argv, cli_render_opts *o, void (*help)(FILE *f))
+{
+    memset(o, 0, sizeof *o);
+    o->fresnel = -1;
+    size_t n;
+    const cli_option *opts = cli_render_options(&n);
+    cli_parser p;
+    cli_parser_init(&p, "render", opts, n, argc, argv);
+    int r;
+    while ((r = cli_next(&p)) != CLI_END) {
+        if (r == CLI_ERROR) return 2;
+        const char *v = p.value;
+        if (r == CLI_ARGUMENT) {
+            if (o->scene) return cli_usage_error("render: more than one scene given ('%s' and '%s')", o->scene, v);
+            o->scene = v;
+            continue;
+        }
+        const char *name = opts[p.index].name;
+        switch (opts[p.index].id) {
+        case OPT_OUTPUT: o->out = v; break;
+        case OPT_EXPOSURE: {
+            char *end;
+            double ev = strtod(v, &end);
+            if (*end || end == v || !(ev >= -PK_MAX_EXPOSURE_EV && ev <= PK_MAX_EXPOSURE_EV))
+                return cli_usage_error("--exposure: '%s' must be a number of stops in %d..%d", v,
+                                       -PK_MAX_EXPOSURE_EV, PK_MAX_EXPOSURE_EV);
+            o->exposure = (float)ev;
+            o->has_exposure = 1;
+            break;
+        }
+        case OPT_INT:
+            o->int_set[p.index] = 1;
+            o->int_value[p.index] = p.int_value;
+            break;
+        case OPT_ACCEL:
+            if (pk_accel_kind_parse(v, &o->accel) != PK_OK)
+                return cli_usage_error("--accel: unknown accelerator '%s' (none, midpoint, bvh, embree)", v);
+            if (!pk_accel_available(o->accel))
+                return cli_usage_error("--accel %s: not available in this build (%s)", v,
+                                       o->accel == PK_ACCEL_CUDA ? "rebuild where nvcc is, with -DPK_WITH_CUDA=ON"
+                                                                 : "install libembree-dev and rebuild");
+            o->has_accel = 1;
+            break;
+        case OPT_INTEGRATOR:
+            if (pk_integrator_parse(v, &o->integrator) != PK_OK)
+                return cli_usage_error("--integrator: unknown integrator '%s' (whitted, path)", v);
+            o->has_integrator = 1;
+            break;
+        case OPT_FRESNEL:
+            if (strcmp(v, "on") == 0)
+                o->fresnel = 1;
+            else if (strcmp(v, "off") == 0)
+                o->fresnel = 0;
+            else
+                return cli_usage_error("--fresnel: expected on or off, not '%s'", v);
+            break;
+        case OPT_LOOK_FROM:
+        case OPT_LOOK_AT:
+        case OPT_UP: {
+            int id = opts[p.index].id;
+            float *dst = id == OPT_LOOK_FROM ? o->from : id == OPT_LOOK_AT ? o->at : o->up;
+            if (!cli_parse_vec3(v, dst))
+                return cli_usage_error("--%s: '%s' is not x,y,z (three finite numbers)", name, v);
+            *(id == OPT_LOOK_FROM ? &o->has_from : id == OPT_LOOK_AT ? &o->has_at : &o->has_up) = 1;
+            break;
+        }
+        case OPT_FOV: {
+            char *end;
+            o->fov = strtof(v, &end);
+            if (*end || end == v || !(o->fov > 0.0f && o->fov < 180.0f))
+                return cli_usage_error("--fov: '%s' must be a number of degrees between 0 and 180", v);
+            o->has_fov = 1;
+            break;
+        }
+        case OPT_ENV: o->env = v; break;
+        case OPT_TIME: {
+            char *end;
+            o->time = strtod(v, &end);
+            if (*end || end == v || !(o->time > 0.0 && o->time <= 1e7))
+                return cli_usage_error("--time: '%s' must be a number of seconds in (0, 10000000]", v);
+            break;
+        }
+        case OPT_AOV: {
+            char buf[128];
+            snprintf(buf, sizeof buf, "%s", v);
+            for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
+                unsigned a = pk_aov_parse(tok);
+                if (!a) return cli_usage_error("--aov: unknown output '%s' (albedo, normal, depth, heatmap)", tok);
+                o->aovs |= a;
+            }
+            if (!o->aovs) return cli_usage_error("--aov: no output named (albedo, normal, depth, heatmap)");
+            break;
+        }
+        case OPT_STATS: o->stats = 1; break;
+        case OPT_STATS_JSON: o->stats_json = v; break;
+        case OPT_DEFINE:
+            if (!strchr(v, '=') || v[0] == '=') return cli_usage_error("-D %s: expected NAME=VALUE", v);
+            if (o->ndefines == sizeof o->defines / sizeof o->defines[0])
+                return cli_usage_error("-D: more than %zu parameters", sizeof o->defines / sizeof o->defines[0]);
+            o->defines[o->ndefines++] = v;
+            break;
+        case OPT_QUIET: o->quiet = 1; break;
+        default:
+            if (opts[p.index].id >= CLI_RENDER_EXTRA && opts[p.index].id < CLI_RENDER_EXTRA + CLI_RENDER_MAX_EXTRA)
+                o->extra[opts[p.index].id - CLI_RENDER_EXTRA] = v ? v : "";
+            break;
+        case OPT_HELP: help(stdout); return -1;
+        }
+    }
+    if (!o->out) return cli_usage_error("render: no output file (-o OUT.png)");
+    return 0;
+}
+
+/* True when path ends with ext (ASCII, any case). */
+static int ends_with_ci(const char *path, const char *ext)
+{
+    size_t lp = strlen(path), le = strlen(ext);
+    if (lp < le) return 0;
+    for (size_t i = 0; i < le; i++) {
+        char c = path[lp - le + i];
+        if (c >= 'A' && c <= 'Z') c = (char)(c - 'A' + 'a');
+        if (c != ext[i]) return 0;
+    }
+    return 1;
+}
+
+/* True when a and b name the same existing file. */
+static int same_file(const char *a, const char *b)
+{
+    struct stat sa, sb;
+    if (stat(a, &sa) != 0 || stat(b, &sb) != 0) return 0;
+    return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+}
+
+/* pk_film: 3 float sums and a uint32 count per pixel (include/paprsek.h). */
+#define FILM_BYTES_PER_PIXEL ((int)(3 * sizeof(float) + sizeof(uint32_t)))
+
+/* The process's peak resident memory so far (getrusage: kilobytes on Linux). */
+static double peak_rss_mib(void)
+{
+    struct rusage ru;
+    if (getrusage(RUSAGE_SELF, &ru) != 0) return 0.0;
+    return (double)ru.ru_maxrss / 1024.0;
+}
+
+void cli_print_stats(const char *scene, const pk_scene *sc, const pk_render_options *ro, const pk_stats *st)
+{
+    pk_scene_info si;
+    pk_scene_get_info(sc, &si);
+    uint64_t rays = st->rays_camera + st->rays_shadow + st->rays_reflection + st->rays_refraction + st->rays_bounce;
+    double r = rays ? (double)rays : 1.0;
+    const int path = ro->integrator != PK_INTEGRATOR_WHITTED;
+    printf("%-28s %s\n", "scene", scene);
+    if (path) /* light samples and the Fresnel switch are the Whitted integrator's */
+        printf("%-28s %s, %d thread%s, %dx%d, %d spp, depth %d\n", "settings", pk_accel_kind_name(ro->accel),
+               st->threads, st->threads == 1 ? "" : "s", ro->width, ro->height, ro->spp, pk_render_options_max_depth(ro));
+    else
+        printf("%-28s %s, %d thread%s, %dx%d, %d spp, %d light samples, depth %d, fresnel %s\n", "settings",
+               pk_accel_kind_name(ro->accel), st->threads, st->threads == 1 ? "" : "s", ro->width, ro->height, ro->spp,
+               ro->light_samples, pk_render_options_max_depth(ro), ro->fresnel ? "on" : "off");
+    printf("%-28s %.0f\n", "build [us]", st->build_us);
+    printf("%-28s %.3f\n", "render [s]", st->render_s);
+    if (path) {
+        printf("%-28s path tracing, seed %d\n", "integrator", ro->seed);
+        printf("%-28s %llu (camera %llu, bounce %llu, shadow %llu)\n", "rays", (unsigned long long)rays,
+               (unsigned long long)st->rays_camera, (unsigned long long)st->rays_bounce,
+               (unsigned long long)st->rays_shadow);
+        printf("%-28s %.0f\n", "samples/s", st->render_s > 0 ? (double)st->pixels * ro->spp / st->render_s : 0.0);
+    } else {
+        printf("%-28s %llu (camera %llu, shadow %llu, reflection %llu, refraction %llu)\n", "rays",
+               (unsigned long long)rays, (unsigned long long)st->rays_camera, (unsigned long long)st->rays_shadow,
+               (unsigned long long)st->rays_reflection, (unsigned long long)st->rays_refraction);
+    }
+    printf("%-28s %llu\n", "intersection tests", (unsigned long long)st->intersection_tests);
+    printf("%-28s %llu\n", "nodes traversed", (unsigned long long)st->nodes_visited);
+    printf("%-28s %.2f\n", "tests/ray", (double)st->intersection_tests / r);
+    printf("%-28s %.2f\n", "nodes/ray", (double)st->nodes_visited / r);
+    printf("%-28s %.4f\n", "traversal time/ray [us]", st->render_s * st->threads / r * 1e6);
+    printf("%-28s %.2f\n", "Mrays/s", st->render_s > 0 ? (double)rays / st->render_s / 1e6 : 0.0);
+    printf("%-28s %d per pixel (film: 3 float sums + a count), peak resident %.1f MiB\n", "memory [bytes]",
+           FILM_BYTES_PER_PIXEL, peak_rss_mib());
+    printf("%-28s %zu image%s, %.2f MiB (mipmaps included)\n", "textures", si.textures, si.textures == 1 ? "" : "s",
+           (double)si.texture_bytes / (1024.0 * 1024.0));
+}
+
+/* Writes s as a JSON string literal. */
+static void json_string(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (; *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\')
+            fprintf(f, "\\%c", c);
+        else if (c < 0x20)
+            fprintf(f, "\\u%04x", c);
+        else
+            fputc(c, f);
+    }
+    fputc('"', f);
+}
+
+/* path "-": standard output. */
+int cli_write_stats_json(const char *path, const char *scene, const pk_scene *sc, const pk_render_options *ro,
+                         const pk_stats *st)
+{
+    pk_scene_info si;
+    pk_scene_get_info(sc, &si);
+    uint64_t rays = st->rays_camera + st->rays_shadow + st->rays_reflection + st->rays_refraction + st->rays_bounce;
+    const int to_stdout = strcmp(path, "-") == 0;
+    FILE *f = to_stdout ? stdout : fopen(path, "w");
+    if (!f) return cli_failure("%s: cannot write: %s", path, strerror(errno));
+    fputs("{\n  \"scene\": ", f);
+    json_string(f, scene);
+    fprintf(f,
+            ",\n  \"accel\": \"%s\",\n  \"width\": %d,\n  \"height\": %d,\n  \"spp\": %d,\n"
+            "  \"light_samples\": %d,\n  \"max_depth\": %d,\n  \"fresnel\": %s,\n  \"threads\": %d,\n"
+            "  \"build_us\": %.1f,\n  \"render_s\": %.6f,\n  \"rays\": %llu,\n  \"rays_camera\": %llu,\n"
+            "  \"rays_shadow\": %llu,\n  \"rays_reflection\": %llu,\n  \"rays_refraction\": %llu,\n"
+            "  \"intersection_tests\": %llu,\n  \"nodes_visited\": %llu,\n  \"mrays_per_s\": %.3f,\n"
+            "  \"integrator\": \"%s\",\n  \"seed\": %d,\n  \"rays_bounce\": %llu,\n  \"samples_per_s\": %.1f,\n"
+            "  \"film_bytes_per_pixel\": %d,\n  \"peak_rss_mib\": %.1f,\n  \"textures\": %zu,\n"
+            "  \"texture_bytes\": %zu\n}\n",
+            pk_accel_kind_name(ro->accel), ro->width, ro->height, ro->spp, ro->light_samples, pk_render_options_max_depth(ro),
+            ro->fresnel ? "true" : "false", st->threads, st->build_us, st->render_s, (unsigned long long)rays,
+            (unsigned long long)st->rays_camera, (unsigned long long)st->rays_shadow,
+            (unsigned long long)st->rays_reflection, (unsigned long long)st->rays_refraction,
+            (unsigned long long)st->intersection_tests, (unsigned long long)st->nodes_visited,
+            st->render_s > 0 ? (double)rays / st->render_s / 1e6 : 0.0, pk_integrator_name(ro->integrator), ro->seed,
+            (unsigned long long)st->rays_bounce,
+            st->render_s > 0 ? (double)st->pixels * ro->spp / st->render_s : 0.0, FILM_BYTES_PER_PIXEL,
+            peak_rss_mib(), si.textures, si.texture_bytes);
+    if (to_stdout ? fflush(f) != 0 || ferror(f) : fclose(f) != 0)
+        return cli_failure("%s: cannot write: %s", to_stdout ? "standard output" : path, strerror(errno));
+    return 0;
+}
+
+/* "dir/name.png" -> "dir/name.partial.png" */
+char *cli_partial_name(const char *out)
+{
+    size_t n = strlen(out);
+    const char *dot = strrchr(out, '.');
+    const char *slash = strrchr(out, '/');
+    if (!dot || (slash && dot < slash)) dot = out + n;
+    char *p = malloc(n + 16);
+    if (!p) return NULL;
+    size_t head = (size_t)(dot - out);
+    memcpy(p, out, head);
+    strcpy(p + head, ".partial");
+    strcat(p, dot);
+    return p;
+}
+
+
+/* "dir/name.png" + "depth" -> "dir/name.depth.png" */
+static char *aov_name(const char *out, const char *aov)
+{
+    size_t n = strlen(out);
+    const char *dot = strrchr(out, '.');
+    const char *slash = strrchr(out, '/');
+    if (!dot || (slash && dot < slash)) dot = out + n;
+    char *p = malloc(n + strlen(aov) + 2);
+    if (!p) return NULL;
+    size_t head = (size_t)(dot - out);
+    memcpy(p, out, head);
+    p[head] = '.';
+    strcpy(p + head + 1, aov);
+    strcat(p, dot);
+    return p;
+}
+
+/* For 8-bit PNG only: normals from [-1, 1] to [0, 1], depth divided by its
+ * largest value, the heatmap on a blue-green-red scale between its smallest
+ * and largest value (the range is printed). HDR files keep the raw values. */
+static void aov_for_png(pk_image *img, unsigned aov, int quiet)
+{
+    float *px = pk_image_pixels(img);
+    const size_t n = (size_t)pk_image_width(img) * (size_t)pk_image_height(img);
+    if (aov == PK_AOV_NORMAL) {
+        for (size_t i = 0; i < 3 * n; i++) px[i] = px[i] * 0.5f + 0.5f;
+        return;
+    }
+    if (aov != PK_AOV_DEPTH && aov != PK_AOV_HEATMAP) return;
+    float lo = INFINITY, hi = 0.0f;
+    for (size_t i = 0; i < n; i++) {
+        lo = px[3 * i] < lo ? px[3 * i] : lo;
+        hi = px[3 * i] > hi ? px[3 * i] : hi;
+    }
+    if (aov == PK_AOV_DEPTH) {
+        for (size_t i = 0; i < 3 * n; i++) px[i] = hi > 0.0f ? px[i] / hi : 0.0f;
+        if (!quiet) fprintf(stderr, "depth: black 0 to white %g (scene units)\n", (double)hi);
+        return;
+    }
+    for (size_t i = 0; i < n; i++) {
+        float t = hi > lo ? (px[3 * i] - lo) / (hi - lo) : 0.0f;
+        /* blue (few) -> green -> red (many), linear values for the sRGB encoding */
+        px[3 * i] = t > 0.5f ? 2.0f * t - 1.0f : 0.0f;
+        px[3 * i + 1] = t < 0.5f ? 2.0f * t : 2.0f - 2.0f * t;
+        px[3 * i + 2] = t < 0.5f ? 1.0f - 2.0f * t : 0.0f;
+    }
+    if (!quiet)
+        fprintf(stderr, "heatmap: blue %g to red %g nodes visited + primitives tested per camera ray\n", (double)lo,
+                (double)hi);
+}
+
+/* ---- before, during and after the render ------------------------------------ */
+
+int cli_render_check(const cli_render_opts *o, pk_write_options *wo)
+{
+    struct stat sb;
+    if (stat(o->out, &sb) == 0 && S_ISDIR(sb.st_mode)) return cli_failure("%s: is a folder; name a file in it", o->out);
+    const int png = ends_with_ci(o->out, ".png");
+    if (!png && !ends_with_ci(o->out, ".pfm") && !ends_with_ci(o->out, ".exr"))
+        return cli_usage_error("%s: unknown image format (use .png, .pfm or .exr)", o->out);
+    pk_write_options_init(wo);
+    if (o->has_exposure) wo->exposure_ev = o->exposure;
+    if (o->has_exposure && o->exposure != 0.0f && !png && !o->quiet)
+        cli_print_warning(NULL, "--exposure applies to PNG only; the HDR image is written unscaled");
+    if (o->scene && same_file(o->scene, o->out))
+        return cli_usage_error("render: refusing to write the image over the scene file '%s'", o->scene);
+    const int json_stdout = o->stats_json && strcmp(o->stats_json, "-") == 0;
+    if (json_stdout && o->stats)
+        return cli_usage_error("render: --stats and --stats-json - both write to standard output; choose one");
+    if (o->stats_json && !json_stdout && o->scene && same_file(o->scene, o->stats_json))
+        return cli_usage_error("render: refusing to write the statistics over the scene file '%s'", o->scene);
+    if (o->stats_json && !json_stdout && (strcmp(o->stats_json, o->out) == 0 || same_file(o->stats_json, o->out)))
+        return cli_usage_error("render: --stats-json and -o name the same file '%s'", o->out);
+    if (cli_check_output(o->out, 1)) return 1;
+    if (o->stats_json && !json_stdout && cli_check_output(o->stats_json, 0)) return 1;
+    return 0;
+}
+
+pk_status cli_render_settings(pk_context *ctx, const cli_render_opts *o, pk_scene *scene, pk_render_options *ro)
+{
+    pk_scene_get_render_options(scene, ro);
+    size_t nopts;
+    const cli_option *opts = cli_render_options(&nopts);
+    for (size_t i = 0; i < nopts; i++)
+        if (o->int_set[i]) *(int *)(void *)((char *)ro + opts[i].render->offset) = o->int_value[i];
+    if (o->fresnel >= 0) ro->fresnel = o->fresnel;
+    if (o->has_accel) ro->accel = o->accel;
+    if (o->has_integrator) ro->integrator = o->integrator;
+    ro->collect_stats = o->stats || o->stats_json;
+    pk_status st = pk_render_options_check(ctx, ro);
+    if (st != PK_OK) return st;
+    if (o->env) {
+        pk_environment env;
+        pk_environment_init(&env);
+        char *end;
+        float grey = strtof(o->env, &end);
+        if (strcmp(o->env, "none") == 0) {
+            st = pk_scene_set_environment(ctx, scene, NULL);
+        } else if (cli_parse_vec3(o->env, env.radiance) || (end != o->env && !*end && isfinite(grey))) {
+            if (end != o->env && !*end) env.radiance[0] = env.radiance[1] = env.radiance[2] = grey;
+            st = pk_scene_set_environment(ctx, scene, &env);
+        } else {
+            env.map = o->env;
+            st = pk_scene_set_environment(ctx, scene, &env);
+        }
+        if (st != PK_OK) return st;
+    }
+    if (o->has_from || o->has_at || o->has_up || o->has_fov) {
+        pk_camera cam;
+        pk_scene_get_camera(scene, &cam);
+        if (o->has_from) memcpy(cam.look_from, o->from, sizeof o->from);
+        if (o->has_at) memcpy(cam.look_at, o->at, sizeof o->at);
+        if (o->has_up) memcpy(cam.up, o->up, sizeof o->up);
+        if (o->has_fov) cam.fov_deg = o->fov;
+        st = pk_scene_set_camera(ctx, scene, &cam);
+    }
+    return st;
+}
+
+pk_status cli_render_write(pk_context *ctx, const cli_render_opts *o, const pk_write_options *wo_in,
+                           const pk_image *img, const pk_film *film)
+{
+    pk_write_options wo = *wo_in;
+    if (o->aovs && ends_with_ci(o->out, ".exr")) {
+        /* one file: the AOVs as layers */
+        pk_image *li[4] = {NULL, NULL, NULL, NULL};
+        const char *ln[4];
+        size_t nl = 0;
+        pk_status ls = PK_OK;
+        for (unsigned a = 1; a <= PK_AOV_HEATMAP && ls == PK_OK; a <<= 1)
+            if (o->aovs & a) {
+                ln[nl] = pk_aov_name(a);
+                ls = pk_film_resolve_aov(ctx, film, a, &li[nl++]);
+            }
+        if (ls == PK_OK) {
+            wo.nlayers = nl;
+            wo.layers = (const pk_image *const *)li;
+            wo.layer_names = ln;
+            ls = pk_image_write_ex(ctx, img, o->out, &wo);
+        }
+        for (size_t l = 0; l < 4; l++) pk_image_destroy(li[l]);
+        if (ls != PK_OK) return ls;
+    } else {
+        pk_status ws = pk_image_write_ex(ctx, img, o->out, &wo);
+        if (ws != PK_OK) return ws;
+    }
+    for (unsigned a = 1; a <= PK_AOV_HEATMAP; a <<= 1) {
+        if (!(o->aovs & a) || ends_with_ci(o->out, ".exr")) continue;
+        pk_image *ai = NULL;
+        char *name = aov_name(o->out, pk_aov_name(a));
+        if (!name) return PK_ERR_NOMEM;
+        pk_status ws = pk_film_resolve_aov(ctx, film, a, &ai);
+        if (ws != PK_OK) {
+            free(name);
+            return ws;
+        }
+        if (ends_with_ci(o->out, ".png")) aov_for_png(ai, a, o->quiet);
+        pk_write_options aw;
+        pk_write_options_init(&aw); /* no exposure: these are data, not pictures */
+        ws = pk_image_write_ex(ctx, ai, name, &aw);
+        pk_image_destroy(ai);
+        free(name);
+        if (ws != PK_OK) return ws;
+    }
+    return PK_OK;
+}
