@@ -389,6 +389,22 @@ static void test_renders(const char *dir)
     expect_mean("sun, whitted", sun, PK_INTEGRATOR_WHITTED, 0, 16, want);
     pk_scene_destroy(sun);
 
+    /* the furnace of the issue: a diffuse sphere of albedo r under a constant
+     * environment of radiance 1 has radiance r (it sees only the environment);
+     * the camera is close enough that the sphere fills the image */
+    const char *sphere_json =
+        "{\"spheres\": [{\"center\": [0, 0, 0], \"radius\": 1, \"material\": {\"type\": \"diffuse\", "
+        "\"albedo\": [0.7, 0.7, 0.7]}}], \"camera\": {\"look_from\": [0, 0, 3], \"look_at\": [0, 0, 0], \"fov\": 20},"
+        " \"environment\": [1, 1, 1]}";
+    pk_scene *ball = NULL;
+    REQUIRE(pk_scene_load_json_memory(ctx, sphere_json, strlen(sphere_json), "ball.json", dir, &ball) == PK_OK);
+    for (int k = 0; k < 3; k++) {
+        snprintf(what, sizeof what, "sphere furnace, path (%s)", names[k]);
+        expect_mean(what, ball, PK_INTEGRATOR_PATH, strategies[k], 16, 0.7);
+    }
+    expect_mean("sphere furnace, whitted", ball, PK_INTEGRATOR_WHITTED, 0, 16, 0.7);
+    pk_scene_destroy(ball);
+
     /* none: black, and no white default either */
     REQUIRE(pk_scene_set_environment(ctx, s, NULL) == PK_OK);
     double mean, se;
