@@ -142,6 +142,17 @@ static inline __attribute__((always_inline)) bool traverse(const bvh *t, const r
                 ref = child[k0];
                 continue;
             }
+            if (any) {
+                /* occlusion: any hit ends the search, so the order of the
+                 * children matters less than the cost of sorting them */
+                ref = child[k0];
+                do {
+                    unsigned k = (unsigned)__builtin_ctz(mask);
+                    mask &= mask - 1;
+                    *sp++ = (stack_entry){child[k], -INFINITY};
+                } while (mask);
+                continue;
+            }
             _Alignas(32) float tn[BVH_WIDTH];
             VF_STORE(tn, tnv);
             unsigned k1 = (unsigned)__builtin_ctz(mask);
