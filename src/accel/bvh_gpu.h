@@ -28,6 +28,7 @@
 #define PK_BVH_GPU_H
 
 #include "../paprsek_internal.h"
+#include "tri_test.h"
 
 #include <math.h>
 #include <string.h>
@@ -155,37 +156,14 @@ static inline PK_HD void gpu_ray_init(gpu_ray *g, const pk_ray *r)
     g->sz = 1.0f / dz;
 }
 
-/* geom.h's tri_intersect, the same float operations in the same order. */
+/* geom.h's tri_intersect: the same test (tri_test.h) on the GPU's records. */
 static inline PK_HD bool gpu_tri_intersect(const gpu_ray *r, const gpu_tri *tri, float tmax, float *t_out,
                                            float *u_out, float *v_out)
 {
     const float ox = r->ox, oy = r->oy, oz = r->oz;
-    const float ax0 = tri->a[r->kx] - ox, ay0 = tri->a[r->ky] - oy, az0 = tri->a[r->kz] - oz;
-    const float bx0 = tri->b[r->kx] - ox, by0 = tri->b[r->ky] - oy, bz0 = tri->b[r->kz] - oz;
-    const float cx0 = tri->c[r->kx] - ox, cy0 = tri->c[r->ky] - oy, cz0 = tri->c[r->kz] - oz;
-    const float ax = ax0 - r->sx * az0, ay = ay0 - r->sy * az0;
-    const float bx = bx0 - r->sx * bz0, by = by0 - r->sy * bz0;
-    const float cx = cx0 - r->sx * cz0, cy = cy0 - r->sy * cz0;
-    float U = cx * by - cy * bx;
-    float V = ax * cy - ay * cx;
-    float W = bx * ay - by * ax;
-    if (U == 0.0f || V == 0.0f || W == 0.0f) {
-        U = (float)((double)cx * (double)by - (double)cy * (double)bx);
-        V = (float)((double)ax * (double)cy - (double)ay * (double)cx);
-        W = (float)((double)bx * (double)ay - (double)by * (double)ax);
-    }
-    if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f)) return false;
-    const float det = U + V + W;
-    if (det == 0.0f) return false;
-    const float az = r->sz * az0, bz = r->sz * bz0, cz = r->sz * cz0;
-    const float T = U * az + V * bz + W * cz;
-    const float rcp = 1.0f / det;
-    const float t = T * rcp;
-    if (!(t >= r->tmin && t <= tmax && t < INFINITY)) return false;
-    *t_out = t;
-    *u_out = V * rcp;
-    *v_out = W * rcp;
-    return true;
+    return tri_test_watertight(tri->a[r->kx] - ox, tri->a[r->ky] - oy, tri->a[r->kz] - oz, tri->b[r->kx] - ox,
+                               tri->b[r->ky] - oy, tri->b[r->kz] - oz, tri->c[r->kx] - ox, tri->c[r->ky] - oy,
+                               tri->c[r->kz] - oz, r->sx, r->sy, r->sz, r->tmin, tmax, t_out, u_out, v_out);
 }
 
 /* Slots of node n whose decoded box the segment [tmin, tcull] touches, with

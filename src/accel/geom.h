@@ -14,6 +14,7 @@
 
 #include "../math/vec3.h"
 #include "../paprsek_internal.h"
+#include "tri_test.h"
 
 #include <string.h>
 
@@ -114,33 +115,10 @@ static inline bool tri_intersect(const ray_pre *r, vec3 a, vec3 b, vec3 c, float
                                  float *u_out, float *v_out)
 {
     const float ox = v3_get(r->o, r->kx), oy = v3_get(r->o, r->ky), oz = v3_get(r->o, r->kz);
-    const float ax0 = v3_get(a, r->kx) - ox, ay0 = v3_get(a, r->ky) - oy, az0 = v3_get(a, r->kz) - oz;
-    const float bx0 = v3_get(b, r->kx) - ox, by0 = v3_get(b, r->ky) - oy, bz0 = v3_get(b, r->kz) - oz;
-    const float cx0 = v3_get(c, r->kx) - ox, cy0 = v3_get(c, r->ky) - oy, cz0 = v3_get(c, r->kz) - oz;
-    const float ax = ax0 - r->sx * az0, ay = ay0 - r->sy * az0;
-    const float bx = bx0 - r->sx * bz0, by = by0 - r->sy * bz0;
-    const float cx = cx0 - r->sx * cz0, cy = cy0 - r->sy * cz0;
-    float U = cx * by - cy * bx;
-    float V = ax * cy - ay * cx;
-    float W = bx * ay - by * ax;
-    if (PK_UNLIKELY(U == 0.0f || V == 0.0f || W == 0.0f)) {
-        U = (float)((double)cx * (double)by - (double)cy * (double)bx);
-        V = (float)((double)ax * (double)cy - (double)ay * (double)cx);
-        W = (float)((double)bx * (double)ay - (double)by * (double)ax);
-    }
-    if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f)) return false;
-    const float det = U + V + W;
-    if (det == 0.0f) return false;
-    const float az = r->sz * az0, bz = r->sz * bz0, cz = r->sz * cz0;
-    const float T = U * az + V * bz + W * cz;
-    const float rcp = 1.0f / det;
-    const float t = T * rcp;
-    /* t may overflow to +inf for huge coordinates: a hit at infinity is no hit */
-    if (!(t >= r->tmin && t <= tmax && t < INFINITY)) return false;
-    *t_out = t;
-    *u_out = V * rcp;
-    *v_out = W * rcp;
-    return true;
+    return tri_test_watertight(v3_get(a, r->kx) - ox, v3_get(a, r->ky) - oy, v3_get(a, r->kz) - oz,
+                               v3_get(b, r->kx) - ox, v3_get(b, r->ky) - oy, v3_get(b, r->kz) - oz,
+                               v3_get(c, r->kx) - ox, v3_get(c, r->ky) - oy, v3_get(c, r->kz) - oz, r->sx, r->sy,
+                               r->sz, r->tmin, tmax, t_out, u_out, v_out);
 }
 
 /* Ray-sphere test (geometric form, robust for rays starting inside). Returns
