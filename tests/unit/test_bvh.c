@@ -6,37 +6,13 @@
 #include "accel/bvh.h"
 #include "scene/scene.h"
 #include "test.h"
+#include "test_rng.h"
 
 #include <omp.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* ---- random numbers ------------------------------------------------------ */
-
-typedef struct rng {
-    uint64_t s;
-} rng;
-
-static uint32_t rng_u32(rng *r)
-{
-    r->s = r->s * 6364136223846793005ull + 1442695040888963407ull;
-    uint64_t x = r->s;
-    uint32_t xs = (uint32_t)(((x >> 18u) ^ x) >> 27u);
-    uint32_t rot = (uint32_t)(x >> 59u);
-    return (xs >> rot) | (xs << ((32u - rot) & 31u));
-}
-static float rng_f(rng *r) { return (float)(rng_u32(r) >> 8) * (1.0f / 16777216.0f); }
-static float rng_range(rng *r, float lo, float hi) { return lo + (hi - lo) * rng_f(r); }
-
-static vec3 rng_dir(rng *r)
-{
-    for (;;) {
-        vec3 d = v3(rng_range(r, -1, 1), rng_range(r, -1, 1), rng_range(r, -1, 1));
-        float l = v3_len2(d);
-        if (l > 1e-4f && l <= 1.0f) return d;
-    }
-}
 
 /* ---- brute force: every primitive with geom.h's tests --------------------- */
 

@@ -14,6 +14,7 @@
 #include "accel/accel.h"
 #include "scene/scene.h"
 #include "test.h"
+#include "test_rng.h"
 
 #include <omp.h>
 #include <stdint.h>
@@ -22,30 +23,6 @@
 
 _Static_assert(sizeof(vec3) == 3 * sizeof(float), "vec3 arrays are float arrays");
 
-/* ---- random numbers ------------------------------------------------------ */
-
-typedef struct rng {
-    uint64_t s;
-} rng;
-
-static uint32_t rng_u32(rng *r)
-{
-    r->s = r->s * 6364136223846793005ull + 1442695040888963407ull;
-    uint64_t x = r->s;
-    uint32_t xs = (uint32_t)(((x >> 18u) ^ x) >> 27u);
-    uint32_t rot = (uint32_t)(x >> 59u);
-    return (xs >> rot) | (xs << ((32u - rot) & 31u));
-}
-static float rng_f(rng *r) { return (float)(rng_u32(r) >> 8) * (1.0f / 16777216.0f); }
-static float rng_range(rng *r, float lo, float hi) { return lo + (hi - lo) * rng_f(r); }
-static vec3 rng_dir(rng *r)
-{
-    for (;;) {
-        vec3 d = v3(rng_range(r, -1, 1), rng_range(r, -1, 1), rng_range(r, -1, 1));
-        float l = v3_len2(d);
-        if (l > 1e-4f && l <= 1.0f) return d;
-    }
-}
 
 static bool same_bits(float a, float b) { return memcmp(&a, &b, sizeof a) == 0; }
 static bool same_hit(const pk_hit *a, const pk_hit *b)
