@@ -3,6 +3,8 @@
  */
 #include "env.h"
 
+#include "../math/distrib.h"
+
 #include <string.h>
 
 #define SKY_W 512 /* resolution of a baked sky without a map */
@@ -253,24 +255,6 @@ float env_pdf(const env_light *e, vec3 d)
     return e->weight[pixel_of(e, u, v)] / (2.0f * PK_PI * PK_PI * st);
 }
 
-/* The index i of a CDF of n entries (last 1) with cdf[i-1] <= u < cdf[i],
- * and u's position within that interval. */
-static int pick(const float *cdf, int n, float u, float *rest)
-{
-    int lo = 0, hi = n - 1;
-    while (lo < hi) {
-        int mid = (lo + hi) / 2;
-        if (u < cdf[mid])
-            hi = mid;
-        else
-            lo = mid + 1;
-    }
-    float a = lo > 0 ? cdf[lo - 1] : 0.0f, b = cdf[lo];
-    float r = b > a ? (u - a) / (b - a) : 0.5f;
-    *rest = fminf(fmaxf(r, 0.0f), 0x1.fffffep-1f);
-    return lo;
-}
-
 bool env_sample(const env_light *e, float u1, float u2, vec3 *d, vec3 *le, float *pdf)
 {
     if (!e->active) return false;
@@ -282,11 +266,14 @@ bool env_sample(const env_light *e, float u1, float u2, vec3 *d, vec3 *le, float
         return true;
     }
     float du, dv;
-    int j = pick(e->marginal, e->h, u1, &dv);
-    int i = pick(&e->conditional[(size_t)j * (size_t)e->w], e->w, u2, &du);
+    const size_t j = cdf_pick(e->marginal, (size_t)e->h, u1);
+    const float *row = &e->conditional[j * (size_t)e->w];
+    const size_t i = cdf_pick(row, (size_t)e->w, u2);
+    dv = cdf_remainder(e->marginal, j, u1);
+    du = cdf_remainder(row, i, u2);
     float u = ((float)i + du) / (float)e->w, v = ((float)j + dv) / (float)e->h;
     float st = sinf(v * PK_PI);
-    float wgt = e->weight[(size_t)j * (size_t)e->w + (size_t)i];
+    float wgt = e->weight[j * (size_t)e->w + i];
     if (!(st > 0.0f) || !(wgt > 0.0f)) return false;
     *d = v3_norm(latlong_dir(e, u, v));
     /* the pdf of the pixel the direction lands in, as env_pdf computes it

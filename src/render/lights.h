@@ -6,6 +6,7 @@
 #ifndef PK_LIGHTS_H
 #define PK_LIGHTS_H
 
+#include "../math/distrib.h"
 #include "../scene/scene.h"
 #include "env.h"
 
@@ -19,20 +20,6 @@ typedef struct light_table {
 
 PK_HIDDEN pk_status lights_build(pk_context *ctx, const pk_scene *s, light_table *lt);
 PK_HIDDEN void lights_free(const pk_allocator *al, light_table *lt);
-
-/* The index i of a CDF of n > 0 entries (last = 1) with cdf[i-1] <= u < cdf[i]. */
-static inline size_t cdf_pick(const float *cdf, size_t n, float u)
-{
-    size_t lo = 0, hi = n - 1;
-    while (lo < hi) {
-        size_t mid = (lo + hi) / 2;
-        if (u < cdf[mid])
-            hi = mid;
-        else
-            lo = mid + 1;
-    }
-    return lo;
-}
 
 /* The light whose CDF interval holds u in [0, 1) (lt->n > 0). */
 static inline size_t light_pick(const light_table *lt, float u) { return cdf_pick(lt->cdf, lt->n, u); }
