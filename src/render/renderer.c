@@ -241,68 +241,46 @@ static inline ray sample_camera_ray(const pk_renderer *r, const camera_frame *cf
     return camera_ray(cf, (float)px + jx, (float)py + jy);
 }
 
-/* The path tracer's version of render_tile: the pixel position of each
- * sample comes from its sampler (the first two dimensions). */
-static bool render_tile_path(const pk_renderer *r, path_thread *me, const camera_frame *cf, const tile *tl,
-                             float *acc, volatile const int *cancel, atomic_int *stop)
+/* Renders the samples of tile tl into acc (3 floats a pixel): camera rays
+ * traced as one batch, then each sample shaded by the renderer's integrator
+ * (the path tracer takes the pixel position from its sampler's first two
+ * dimensions; the Whitted integrator draws from a PCG stream seeded by pixel
+ * and sample). Camera rays that miss see the environment. Returns false when
+ * cancelled before the last sample. */
+static bool render_tile(const pk_renderer *r, int tid, const camera_frame *cf, const tile *tl, float *acc,
+                        volatile const int *cancel, atomic_int *stop)
 {
-    const int spp = r->opt.spp;
-    const uint32_t first = r->pass * (uint32_t)spp; /* the pass's first sample number */
-    const int tw = tl->w, n = tl->w * tl->h;
-    ray rays[BATCH];
-    hit hits[BATCH];
-    memset(acc, 0, sizeof(float) * 3 * (size_t)n);
-    for (int smp = 0; smp < spp; smp++) {
-        if (smp > 0 && ((cancel && *cancel) || atomic_load_explicit(stop, memory_order_relaxed))) return false;
-        for (int i = 0; i < n; i++) rays[i] = sample_camera_ray(r, cf, tl->x + i % tw, tl->y + i / tw, smp);
-        me->rays_camera += (uint64_t)n;
-        accel_intersect_many(r->fr.a, rays, hits, (size_t)n, false, me->cp);
-        for (int i = 0; i < n; i++) {
-            if (hits[i].prim == PK_NO_HIT) { /* the camera sees the surroundings */
-                vec3 c = env_background(&r->fr.env, v3_norm(rays[i].d));
-                acc[3 * i] += c.x, acc[3 * i + 1] += c.y, acc[3 * i + 2] += c.z;
-                continue;
-            }
-            int px = tl->x + i % tw, py = tl->y + i / tw;
-            sampler sm = sampler_start((uint32_t)px, (uint32_t)py, first + (uint32_t)smp, r->pt.seed);
-            sm.dim = 2; /* the pixel position */
-            vec3 c = path_radiance(&r->pt, me, &sm, &rays[i], &hits[i]);
-            if (!v3_finite(c)) continue; /* a lost sample, not a poisoned pixel */
-            acc[3 * i] += c.x;
-            acc[3 * i + 1] += c.y;
-            acc[3 * i + 2] += c.z;
-        }
-    }
-    return true;
-}
-
-static bool render_tile(const pk_renderer *r, whitted_thread *me, const camera_frame *cf, const tile *tl,
-                        float *acc, volatile const int *cancel, atomic_int *stop)
-{
-    const whitted *w = &r->w;
     const int spp = r->opt.spp;
     const uint64_t first = (uint64_t)r->pass * (uint64_t)spp; /* the pass's first sample number */
     const int tw = tl->w, n = tl->w * tl->h;
+    path_thread *pt = &r->pts[tid];
+    whitted_thread *wt = &r->ts[tid];
     ray rays[BATCH];
     hit hits[BATCH];
     memset(acc, 0, sizeof(float) * 3 * (size_t)n);
     for (int smp = 0; smp < spp; smp++) {
-        /* also between passes: a tile at many samples may take long */
+        /* also between samples: a tile at many samples may take long */
         if (smp > 0 && ((cancel && *cancel) || atomic_load_explicit(stop, memory_order_relaxed))) return false;
         for (int i = 0; i < n; i++) rays[i] = sample_camera_ray(r, cf, tl->x + i % tw, tl->y + i / tw, smp);
-        me->rays[RAY_CAMERA] += (uint64_t)n;
-        accel_intersect_many(w->f->a, rays, hits, (size_t)n, false, me->cp);
+        if (r->path) pt->rays_camera += (uint64_t)n;
+        else wt->rays[RAY_CAMERA] += (uint64_t)n;
+        accel_intersect_many(r->fr.a, rays, hits, (size_t)n, false, r->path ? pt->cp : wt->cp);
         for (int i = 0; i < n; i++) {
+            vec3 c;
+            const int px = tl->x + i % tw, py = tl->y + i / tw;
             if (hits[i].prim == PK_NO_HIT) {
-                vec3 c = env_background(&r->fr.env, v3_norm(rays[i].d));
-                acc[3 * i] += c.x, acc[3 * i + 1] += c.y, acc[3 * i + 2] += c.z;
-                continue;
+                c = env_background(&r->fr.env, v3_norm(rays[i].d));
+            } else if (r->path) {
+                sampler sm = sampler_start((uint32_t)px, (uint32_t)py, (uint32_t)(first + (uint64_t)smp), r->pt.seed);
+                sm.dim = 2; /* the pixel position */
+                c = path_radiance(&r->pt, pt, &sm, &rays[i], &hits[i]);
+                if (!v3_finite(c)) continue; /* a lost sample, not a poisoned pixel */
+            } else {
+                wt->rng = rng_seed(((uint64_t)py << 32) | (uint32_t)px, (first + (uint64_t)smp) * 2);
+                wt->ray_budget = WHITTED_RAY_BUDGET;
+                wt->cone = 0.0f;
+                c = whitted_shade(&r->w, wt, &rays[i], &hits[i], 0);
             }
-            int px = tl->x + i % tw, py = tl->y + i / tw;
-            me->rng = rng_seed(((uint64_t)py << 32) | (uint32_t)px, (first + (uint64_t)smp) * 2);
-            me->ray_budget = WHITTED_RAY_BUDGET;
-            me->cone = 0.0f;
-            vec3 c = whitted_shade(w, me, &rays[i], &hits[i], 0);
             acc[3 * i] += c.x;
             acc[3 * i + 1] += c.y;
             acc[3 * i + 2] += c.z;
@@ -391,8 +369,6 @@ pk_status renderer_render(pk_renderer *r, const pk_region *regions, size_t nregi
 #pragma omp parallel num_threads(r->nt)
     {
         const int tid = omp_get_thread_num();
-        whitted_thread *me = &r->ts[tid];
-        path_thread *pme = &r->pts[tid];
         float acc[BATCH * 3];
 #pragma omp for schedule(dynamic, 1)
         for (int ti = 0; ti < nt_total; ti++) {
@@ -402,8 +378,7 @@ pk_status renderer_render(pk_renderer *r, const pk_region *regions, size_t nregi
                 continue;
             }
             const tile *tl = &tiles[ti];
-            const bool finished = r->path ? render_tile_path(r, pme, &cf, tl, acc, cancel, &stop)
-                                           : render_tile(r, me, &cf, tl, acc, cancel, &stop);
+            const bool finished = render_tile(r, tid, &cf, tl, acc, cancel, &stop);
             if (!finished) { /* an unfinished tile stays black */
 #pragma omp atomic write
                 cancelled = 1;
