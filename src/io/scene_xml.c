@@ -564,32 +564,37 @@ static pk_status get_string(xp *p, xnode *plugin, const char *name, const char *
     return value_attr(p, c, out);
 }
 
-/* A <point> or <vector>: x, y, z attributes (0 when absent) or value. */
-static pk_status node_vec(xp *p, const xnode *n, vec3 *out)
+/* x, y, z attributes each defaulting to def, or value (1 or 3 numbers). */
+static pk_status attr_xyz(xp *p, const xnode *n, float def, vec3 *out)
 {
     pk_status st;
     const char *v = attr_st(p, n, "value", &st);
     if (st) return st;
-    float f[3] = {0.0f, 0.0f, 0.0f};
     if (v) {
+        float f[3];
         int k;
-        if ((st = numbers(p, n, n->tag, v, f, 3, &k))) return st;
-        if (k == 1) f[1] = f[2] = f[0];
-        else if (k != 3) return xfail(p, PK_ERR_PARSE, n, "<%.32s> needs 1 or 3 numbers", n->tag);
-    } else {
-        static const char *const xyz[3] = {"x", "y", "z"};
-        for (int i = 0; i < 3; i++) {
-            const char *a = attr_st(p, n, xyz[i], &st);
-            if (st) return st;
-            if (!a) continue;
-            int k;
-            if ((st = numbers(p, n, xyz[i], a, &f[i], 1, &k))) return st;
-            if (k != 1) return xfail(p, PK_ERR_PARSE, n, "%s needs one number", xyz[i]);
-        }
+        if ((st = numbers(p, n, "value", v, f, 3, &k))) return st;
+        if (k == 1) *out = v3s(f[0]);
+        else if (k == 3) *out = v3(f[0], f[1], f[2]);
+        else return xfail(p, PK_ERR_PARSE, n, "<%.32s value> needs 1 or 3 numbers", n->tag);
+        return PK_OK;
+    }
+    float f[3] = {def, def, def};
+    static const char *const xyz[3] = {"x", "y", "z"};
+    for (int i = 0; i < 3; i++) {
+        const char *a = attr_st(p, n, xyz[i], &st);
+        if (st) return st;
+        if (!a) continue;
+        int k;
+        if ((st = numbers(p, n, xyz[i], a, &f[i], 1, &k))) return st;
+        if (k != 1) return xfail(p, PK_ERR_PARSE, n, "%s needs one number", xyz[i]);
     }
     *out = v3(f[0], f[1], f[2]);
     return PK_OK;
 }
+
+/* A <point> or <vector>: x, y, z attributes (0 when absent) or value. */
+static pk_status node_vec(xp *p, const xnode *n, vec3 *out) { return attr_xyz(p, n, 0.0f, out); }
 
 static pk_status get_vec(xp *p, xnode *plugin, const char *name, vec3 *out, bool *found)
 {
@@ -1012,35 +1017,6 @@ static pk_status attr_vec3(xp *p, const xnode *n, const char *name, vec3 *out, b
     int k;
     if ((st = numbers(p, n, name, v, f, 3, &k))) return st;
     if (k != 3) return xfail(p, PK_ERR_PARSE, n, "%s needs 3 numbers", name);
-    *out = v3(f[0], f[1], f[2]);
-    return PK_OK;
-}
-
-/* x, y, z attributes each defaulting to def, or value (1 or 3 numbers). */
-static pk_status attr_xyz(xp *p, const xnode *n, float def, vec3 *out)
-{
-    pk_status st;
-    const char *v = attr_st(p, n, "value", &st);
-    if (st) return st;
-    if (v) {
-        float f[3];
-        int k;
-        if ((st = numbers(p, n, "value", v, f, 3, &k))) return st;
-        if (k == 1) *out = v3s(f[0]);
-        else if (k == 3) *out = v3(f[0], f[1], f[2]);
-        else return xfail(p, PK_ERR_PARSE, n, "<%.32s value> needs 1 or 3 numbers", n->tag);
-        return PK_OK;
-    }
-    float f[3] = {def, def, def};
-    static const char *const xyz[3] = {"x", "y", "z"};
-    for (int i = 0; i < 3; i++) {
-        const char *a = attr_st(p, n, xyz[i], &st);
-        if (st) return st;
-        if (!a) continue;
-        int k;
-        if ((st = numbers(p, n, xyz[i], a, &f[i], 1, &k))) return st;
-        if (k != 1) return xfail(p, PK_ERR_PARSE, n, "%s needs one number", xyz[i]);
-    }
     *out = v3(f[0], f[1], f[2]);
     return PK_OK;
 }
