@@ -25,13 +25,7 @@
 #define PK_UNLIKELY(x) (x)
 #endif
 
-/* Functions compiled for the CPU and, by nvcc, for the GPU (docs/gpu.md):
- * plain C over plain structs, no intrinsics. */
-#if defined(__CUDACC__)
-#define PK_HD __host__ __device__
-#else
-#define PK_HD
-#endif
+#include "pk_hd.h"
 
 #ifdef NDEBUG
 #define PK_ASSERT(x) ((void)0)

@@ -36,7 +36,7 @@ typedef struct hit {
 _Static_assert(sizeof(ray) == 32 && sizeof(pk_ray) == 32, "ray layout");
 _Static_assert(sizeof(hit) == 16 && sizeof(pk_hit) == 16, "hit layout");
 
-static inline void hit_clear(hit *h)
+static inline PK_HD void hit_clear(hit *h)
 {
     h->t = INFINITY;
     h->prim = PK_NO_HIT;
@@ -58,7 +58,7 @@ typedef struct ray_pre {
  * |d| t, which matters for boxes only denormals apart; the slab tests take a
  * NaN distance as "no limit on this axis" (conservative), and the triangle
  * test decides exactly. */
-static inline float ray_rcp(float d)
+static inline PK_HD float ray_rcp(float d)
 {
     const float r = 1.0f / d;
     return d != 0.0f && isinf(r) ? NAN : r;
@@ -68,7 +68,7 @@ static inline float ray_rcp(float d)
  * reciprocal: 1/d rounds to inf exactly when 0 < |d| <= 2^-128 (the next
  * float above 2^-128 has a finite reciprocal). Compares only: it runs once
  * per ray of every packet. */
-static inline bool ray_dir_tiny(vec3 d)
+static inline PK_HD bool ray_dir_tiny(vec3 d)
 {
     return (fabsf(d.x) <= 0x1p-128f && d.x != 0.0f) || (fabsf(d.y) <= 0x1p-128f && d.y != 0.0f) ||
            (fabsf(d.z) <= 0x1p-128f && d.z != 0.0f);
@@ -78,13 +78,13 @@ static inline bool ray_dir_tiny(vec3 d)
  * interval. Others hit nothing (the triangle and sphere tests say so too),
  * and must not reach a slab test: there NaN means "no limit on this axis",
  * which would let them into empty child slots (boxes of +inf..-inf). */
-static inline bool ray_traceable(const ray *r)
+static inline PK_HD bool ray_traceable(const ray *r)
 {
     return v3_finite(r->o) && !isnan(r->d.x) && !isnan(r->d.y) && !isnan(r->d.z) && !isnan(r->tmin) &&
            !isnan(r->tmax);
 }
 
-static inline ray_pre ray_prepare(const ray *r)
+static inline PK_HD ray_pre ray_prepare(const ray *r)
 {
     ray_pre p;
     p.o = r->o;
@@ -111,7 +111,7 @@ static inline ray_pre ray_prepare(const ray *r)
 
 /* Watertight ray-triangle test. On a hit with t in [tmin, tmax] returns true
  * with t, u (weight of b) and v (weight of c). */
-static inline bool tri_intersect(const ray_pre *r, vec3 a, vec3 b, vec3 c, float tmax, float *t_out,
+static inline PK_HD bool tri_intersect(const ray_pre *r, vec3 a, vec3 b, vec3 c, float tmax, float *t_out,
                                  float *u_out, float *v_out)
 {
     const float ox = v3_get(r->o, r->kx), oy = v3_get(r->o, r->ky), oz = v3_get(r->o, r->kz);
@@ -124,7 +124,7 @@ static inline bool tri_intersect(const ray_pre *r, vec3 a, vec3 b, vec3 c, float
 /* Ray-sphere test (geometric form, robust for rays starting inside). Returns
  * the nearest root in [tmin, tmax]; u, v are the spherical coordinates of the
  * hit point scaled to [0,1]. */
-static inline bool sphere_intersect(const ray_pre *r, vec3 center, float radius, float tmax,
+static inline PK_HD bool sphere_intersect(const ray_pre *r, vec3 center, float radius, float tmax,
                                     float *t_out, float *u_out, float *v_out)
 {
     vec3 oc = v3_sub(r->o, center);
@@ -159,7 +159,7 @@ static inline bool sphere_intersect(const ray_pre *r, vec3 center, float radius,
 }
 
 /* The closest-hit rule shared by all accelerators. */
-static inline bool hit_better(float t, uint32_t prim, const hit *best)
+static inline PK_HD bool hit_better(float t, uint32_t prim, const hit *best)
 {
     return t < best->t || (t == best->t && prim < best->prim);
 }

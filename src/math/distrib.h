@@ -6,11 +6,13 @@
 #ifndef PK_MATH_DISTRIB_H
 #define PK_MATH_DISTRIB_H
 
+#include "../pk_hd.h"
+
 #include <stddef.h>
 
 /* The index i of a CDF of n > 0 entries (non-decreasing, last = 1) with
  * cdf[i-1] <= u < cdf[i]. */
-static inline size_t cdf_pick(const float *cdf, size_t n, float u)
+static inline PK_HD size_t cdf_pick(const float *cdf, size_t n, float u)
 {
     size_t lo = 0, hi = n - 1;
     while (lo < hi) {
@@ -25,7 +27,7 @@ static inline size_t cdf_pick(const float *cdf, size_t n, float u)
 
 /* Where u lies within the interval of entry i that cdf_pick chose, in
  * [0, 1): the remaining random number, uniform within the entry. */
-static inline float cdf_remainder(const float *cdf, size_t i, float u)
+static inline PK_HD float cdf_remainder(const float *cdf, size_t i, float u)
 {
     const float a = i > 0 ? cdf[i - 1] : 0.0f, b = cdf[i];
     const float r = b > a ? (u - a) / (b - a) : 0.5f;

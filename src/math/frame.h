@@ -2,7 +2,7 @@
  * frame.h - an orthonormal shading basis (s, t, n) built from a unit normal,
  * and the change of coordinates between world space and the local frame in
  * which n is +z (the frame the BSDFs of render/pbsdf.h work in).
- * Plain static inline functions over a plain struct.
+ * Plain static inline PK_HD functions over a plain struct.
  */
 #ifndef PK_MATH_FRAME_H
 #define PK_MATH_FRAME_H
@@ -18,7 +18,7 @@ typedef struct onb {
 /* The basis around the unit normal n, without branches on the normal's
  * direction except its sign (Duff et al. 2017, "Building an Orthonormal
  * Basis, Revisited"): continuous everywhere but on the n.z = 0 seam. */
-static inline onb onb_from_normal(vec3 n)
+static inline PK_HD onb onb_from_normal(vec3 n)
 {
     float sign = copysignf(1.0f, n.z);
     float a = -1.0f / (sign + n.z);
@@ -31,13 +31,13 @@ static inline onb onb_from_normal(vec3 n)
 }
 
 /* World direction -> local coordinates (z along n). */
-static inline vec3 onb_to_local(onb f, vec3 v)
+static inline PK_HD vec3 onb_to_local(onb f, vec3 v)
 {
     return v3(v3_dot(v, f.s), v3_dot(v, f.t), v3_dot(v, f.n));
 }
 
 /* Local coordinates -> world direction. */
-static inline vec3 onb_to_world(onb f, vec3 v)
+static inline PK_HD vec3 onb_to_world(onb f, vec3 v)
 {
     return v3_add(v3_add(v3_scale(f.s, v.x), v3_scale(f.t, v.y)), v3_scale(f.n, v.z));
 }

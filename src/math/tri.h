@@ -12,7 +12,7 @@
 /* Triangles that can never be hit: a non-finite vertex or zero area. The
  * cross product is taken in double so that huge (1e30) and tiny (1e-30)
  * triangles are not mistaken for degenerate ones by overflow or underflow. */
-static inline bool tri_is_degenerate(vec3 a, vec3 b, vec3 c)
+static inline PK_HD bool tri_is_degenerate(vec3 a, vec3 b, vec3 c)
 {
     if (!v3_finite(a) || !v3_finite(b) || !v3_finite(c)) return true;
     double ex = (double)b.x - (double)a.x, ey = (double)b.y - (double)a.y, ez = (double)b.z - (double)a.z;
@@ -24,7 +24,7 @@ static inline bool tri_is_degenerate(vec3 a, vec3 b, vec3 c)
 /* Unit normal of triangle abc (unnormalised orientation cross(b-a, c-a)),
  * taken in double so that huge (1e30) and tiny (1e-30) triangles, which
  * scenes keep, do not get an overflowed or vanished normal. */
-static inline vec3 tri_normal_double(vec3 a, vec3 b, vec3 c)
+static inline PK_HD vec3 tri_normal_double(vec3 a, vec3 b, vec3 c)
 {
     double ex = (double)b.x - (double)a.x, ey = (double)b.y - (double)a.y, ez = (double)b.z - (double)a.z;
     double fx = (double)c.x - (double)a.x, fy = (double)c.y - (double)a.y, fz = (double)c.z - (double)a.z;
@@ -38,7 +38,7 @@ static inline vec3 tri_normal_double(vec3 a, vec3 b, vec3 c)
 
 /* The float cross product serves all but extreme triangles, whose squared
  * length overflows or vanishes; those take the double path. */
-static inline vec3 tri_normal(vec3 a, vec3 b, vec3 c)
+static inline PK_HD vec3 tri_normal(vec3 a, vec3 b, vec3 c)
 {
     vec3 n = v3_cross(v3_sub(b, a), v3_sub(c, a));
     float l2 = v3_len2(n);

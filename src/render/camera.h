@@ -14,7 +14,7 @@ typedef struct camera_frame {
 } camera_frame;
 
 /* cam has passed camera_validate. */
-static inline camera_frame camera_setup(const pk_camera *cam, int width, int height)
+static inline PK_HD camera_frame camera_setup(const pk_camera *cam, int width, int height)
 {
     camera_frame f;
     vec3 from = v3(cam->look_from[0], cam->look_from[1], cam->look_from[2]);
@@ -32,7 +32,7 @@ static inline camera_frame camera_setup(const pk_camera *cam, int width, int hei
 }
 
 /* Ray through image position (x, y) in pixels, (0,0) the top-left corner. */
-static inline ray camera_ray(const camera_frame *f, float x, float y)
+static inline PK_HD ray camera_ray(const camera_frame *f, float x, float y)
 {
     float sx = (2.0f * x / (float)f->width - 1.0f) * f->half_w;
     float sy = (1.0f - 2.0f * y / (float)f->height) * f->half_h;

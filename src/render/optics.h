@@ -11,7 +11,7 @@
 /* Fresnel reflectance of a dielectric interface for light arriving with
  * cos_i = cos(angle to the normal) >= 0 from a medium of index eta_i into one
  * of index eta_t. Returns 1 on total internal reflection. */
-static inline float fresnel_dielectric(float cos_i, float eta_i, float eta_t)
+static inline PK_HD float fresnel_dielectric(float cos_i, float eta_i, float eta_t)
 {
     cos_i = fminf(1.0f, fmaxf(0.0f, cos_i));
     float sin_i = sqrtf(fmaxf(0.0f, 1.0f - cos_i * cos_i));
@@ -26,7 +26,7 @@ static inline float fresnel_dielectric(float cos_i, float eta_i, float eta_t)
 /* Refracts the incident direction d (unit, pointing at the surface) through a
  * surface with normal n (unit, dot(d, n) < 0) and relative index
  * eta = eta_i / eta_t. Returns false on total internal reflection. */
-static inline bool refract_dir(vec3 d, vec3 n, float eta, vec3 *out)
+static inline PK_HD bool refract_dir(vec3 d, vec3 n, float eta, vec3 *out)
 {
     float cos_i = -v3_dot(d, n);
     float k = 1.0f - eta * eta * (1.0f - cos_i * cos_i);

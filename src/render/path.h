@@ -8,6 +8,7 @@
 #ifndef PK_PATH_H
 #define PK_PATH_H
 
+#include "camera.h"
 #include "frame.h"
 #include "sampler.h"
 
@@ -23,6 +24,7 @@ typedef struct path_tracer {
     uint32_t seed;
     int strategy;        /* PATH_* */
     float spread;        /* ray cone spread angle per unit length: the camera's pixel angle (textures) */
+    const void *gpu_nodes, *gpu_tris;  /* in the GPU's copy only: the device BVH (bvh_gpu.h) */
 } path_tracer;
 
 typedef struct path_thread {
@@ -33,8 +35,13 @@ typedef struct path_thread {
 
 PK_HIDDEN pk_status path_init(pk_context *ctx, path_tracer *pt, const frame *f, const pk_render_options *opt);
 PK_HIDDEN void path_free(const pk_allocator *al, path_tracer *pt);
-/* Radiance along camera ray r (already traced: h), with the sampler of its
- * pixel sample (the first two dimensions were the pixel position). */
-PK_HIDDEN vec3 path_radiance(const path_tracer *pt, path_thread *t, sampler *smp, const ray *r, const hit *h);
+/* The camera ray of sample index (counted over all passes) of pixel
+ * (px, py), placed in the pixel by the sampler's first two dimensions. */
+PK_HIDDEN ray path_camera(const path_tracer *pt, const camera_frame *cf, int px, int py, uint32_t index);
+/* The radiance that sample arrives with along its camera ray r (path_camera's),
+ * whose closest hit is *h, or NULL when it missed (the surroundings).
+ * False for a lost sample (not finite), to be left out. */
+PK_HIDDEN bool path_sample(const path_tracer *pt, path_thread *t, int px, int py, uint32_t index, const ray *r,
+                           const hit *h, vec3 *out);
 
 #endif

@@ -2,7 +2,7 @@
  * pbsdf.h - physically based BSDFs for the path tracer: Lambert, GGX
  * conductors, smooth and rough dielectrics (Walter et al. 2007), plastic (a
  * diffuse base under a dielectric coating) and the MTL "glossy over diffuse"
- * model. Plain static inline C over one plain struct: no context, no
+ * model. Plain static inline PK_HD C over one plain struct: no context, no
  * allocation, no function pointers, so that nvcc can compile the same code.
  * docs/materials.md describes the models, their parameters and conventions.
  *
@@ -71,7 +71,7 @@ typedef struct pbsdf {
 
 /* ---- constructors ------------------------------------------------------- */
 
-static inline pbsdf pbsdf__blank(int type)
+static inline PK_HD pbsdf pbsdf__blank(int type)
 {
     pbsdf b;
     b.type = type;
@@ -83,13 +83,13 @@ static inline pbsdf pbsdf__blank(int type)
     b.ior = 1.5f;
     return b;
 }
-static inline pbsdf pbsdf_diffuse(vec3 albedo)
+static inline PK_HD pbsdf pbsdf_diffuse(vec3 albedo)
 {
     pbsdf b = pbsdf__blank(PBSDF_DIFFUSE);
     b.albedo = albedo;
     return b;
 }
-static inline pbsdf pbsdf_conductor(vec3 eta, vec3 k, float alpha)
+static inline PK_HD pbsdf pbsdf_conductor(vec3 eta, vec3 k, float alpha)
 {
     pbsdf b = pbsdf__blank(PBSDF_CONDUCTOR);
     b.eta = eta;
@@ -97,7 +97,7 @@ static inline pbsdf pbsdf_conductor(vec3 eta, vec3 k, float alpha)
     b.alpha = alpha;
     return b;
 }
-static inline pbsdf pbsdf_conductor_schlick(vec3 f0, float alpha)
+static inline PK_HD pbsdf pbsdf_conductor_schlick(vec3 f0, float alpha)
 {
     pbsdf b = pbsdf__blank(PBSDF_CONDUCTOR);
     b.flags = PBSDF_SCHLICK;
@@ -105,7 +105,7 @@ static inline pbsdf pbsdf_conductor_schlick(vec3 f0, float alpha)
     b.alpha = alpha;
     return b;
 }
-static inline pbsdf pbsdf_dielectric(float ior, float alpha, vec3 transmittance)
+static inline PK_HD pbsdf pbsdf_dielectric(float ior, float alpha, vec3 transmittance)
 {
     pbsdf b = pbsdf__blank(PBSDF_DIELECTRIC);
     b.ior = ior;
@@ -113,7 +113,7 @@ static inline pbsdf pbsdf_dielectric(float ior, float alpha, vec3 transmittance)
     b.transmittance = transmittance;
     return b;
 }
-static inline pbsdf pbsdf_plastic(vec3 albedo, float ior, float alpha)
+static inline PK_HD pbsdf pbsdf_plastic(vec3 albedo, float ior, float alpha)
 {
     pbsdf b = pbsdf__blank(PBSDF_PLASTIC);
     b.albedo = albedo;
@@ -121,7 +121,7 @@ static inline pbsdf pbsdf_plastic(vec3 albedo, float ior, float alpha)
     b.alpha = alpha;
     return b;
 }
-static inline pbsdf pbsdf_glossy(vec3 kd, vec3 ks, float alpha)
+static inline PK_HD pbsdf pbsdf_glossy(vec3 kd, vec3 ks, float alpha)
 {
     pbsdf b = pbsdf__blank(PBSDF_GLOSSY);
     b.albedo = kd;
@@ -130,13 +130,13 @@ static inline pbsdf pbsdf_glossy(vec3 kd, vec3 ks, float alpha)
     return b;
 }
 /* GGX roughness for an MTL Phong exponent: alpha = sqrt(2 / (Ns + 2)). */
-static inline float pbsdf_alpha_from_ns(float ns)
+static inline PK_HD float pbsdf_alpha_from_ns(float ns)
 {
     return sqrtf(2.0f / (fmaxf(ns, 0.0f) + 2.0f));
 }
 /* MTL Kd, Ks, Ns -> glossy over diffuse. Where Kd + Ks > 1 in a channel both
  * are scaled down in that channel so that the pair conserves energy. */
-static inline pbsdf pbsdf_glossy_mtl(vec3 kd, vec3 ks, float ns)
+static inline PK_HD pbsdf pbsdf_glossy_mtl(vec3 kd, vec3 ks, float ns)
 {
     float *d[3] = {&kd.x, &kd.y, &kd.z}, *s[3] = {&ks.x, &ks.y, &ks.z};
     for (int c = 0; c < 3; c++) {
@@ -155,7 +155,7 @@ static inline pbsdf pbsdf_glossy_mtl(vec3 kd, vec3 ks, float ns)
  * cosine to the normal on the side wo is on: cos_i >= 0 means outside
  * (relative index eta = inside / outside), cos_i < 0 inside. 1 under total
  * internal reflection. */
-static inline float pbsdf_fresnel_dielectric(float cos_i, float eta)
+static inline PK_HD float pbsdf_fresnel_dielectric(float cos_i, float eta)
 {
     cos_i = fminf(1.0f, fmaxf(-1.0f, cos_i));
     if (cos_i < 0.0f) {
@@ -172,7 +172,7 @@ static inline float pbsdf_fresnel_dielectric(float cos_i, float eta)
 
 /* Fresnel reflectance of a conductor with complex index eta + i k (relative
  * to the outside), unpolarised, one channel; cos_i in [0, 1]. */
-static inline float pbsdf__fresnel_conductor1(float cos_i, float eta, float k)
+static inline PK_HD float pbsdf__fresnel_conductor1(float cos_i, float eta, float k)
 {
     cos_i = fminf(1.0f, fmaxf(0.0f, cos_i));
     float cos2 = cos_i * cos_i, sin2 = 1.0f - cos2;
@@ -189,7 +189,7 @@ static inline float pbsdf__fresnel_conductor1(float cos_i, float eta, float k)
     return 0.5f * (rp + rs);
 }
 
-static inline vec3 pbsdf__fresnel_conductor(const pbsdf *b, float cos_i)
+static inline PK_HD vec3 pbsdf__fresnel_conductor(const pbsdf *b, float cos_i)
 {
     if (b->flags & PBSDF_SCHLICK) {
         float m = 1.0f - fminf(1.0f, fmaxf(0.0f, cos_i));
@@ -204,7 +204,7 @@ static inline vec3 pbsdf__fresnel_conductor(const pbsdf *b, float cos_i)
 /* ---- GGX (Trowbridge-Reitz), isotropic, local frame ---------------------- */
 
 /* Normal distribution D(m) for m.z > 0. */
-static inline float pbsdf_ggx_d(float alpha, vec3 m)
+static inline PK_HD float pbsdf_ggx_d(float alpha, vec3 m)
 {
     if (m.z <= 0.0f) return 0.0f;
     float a2 = alpha * alpha;
@@ -213,24 +213,24 @@ static inline float pbsdf_ggx_d(float alpha, vec3 m)
 }
 
 /* Smith's Lambda(w); G1(w) = 1 / (1 + Lambda(w)). */
-static inline float pbsdf_ggx_lambda(float alpha, vec3 w)
+static inline PK_HD float pbsdf_ggx_lambda(float alpha, vec3 w)
 {
     float z2 = w.z * w.z;
     if (z2 <= 0.0f) return INFINITY;
     float t2 = alpha * alpha * (w.x * w.x + w.y * w.y) / z2;
     return 0.5f * (sqrtf(1.0f + t2) - 1.0f);
 }
-static inline float pbsdf_ggx_g1(float alpha, vec3 w) { return 1.0f / (1.0f + pbsdf_ggx_lambda(alpha, w)); }
+static inline PK_HD float pbsdf_ggx_g1(float alpha, vec3 w) { return 1.0f / (1.0f + pbsdf_ggx_lambda(alpha, w)); }
 /* Height-correlated masking-shadowing (Heitz 2014), used (as pbrt-v4 does)
  * for reflection and transmission alike. Symmetric in wo, wi. */
-static inline float pbsdf_ggx_g2(float alpha, vec3 wo, vec3 wi)
+static inline PK_HD float pbsdf_ggx_g2(float alpha, vec3 wo, vec3 wi)
 {
     return 1.0f / (1.0f + pbsdf_ggx_lambda(alpha, wo) + pbsdf_ggx_lambda(alpha, wi));
 }
 
 /* Density of the visible normals seen from w (either hemisphere; it is
  * mirrored to +z): G1(w) max(0, w.m) D(m) / |w.z|, per unit solid angle of m. */
-static inline float pbsdf_ggx_vndf_pdf(float alpha, vec3 w, vec3 m)
+static inline PK_HD float pbsdf_ggx_vndf_pdf(float alpha, vec3 w, vec3 m)
 {
     if (w.z < 0.0f) w = v3_neg(w);
     float wm = v3_dot(w, m);
@@ -240,7 +240,7 @@ static inline float pbsdf_ggx_vndf_pdf(float alpha, vec3 w, vec3 m)
 
 /* Samples a visible normal from w (either hemisphere; mirrored to +z),
  * Heitz 2018, "Sampling the GGX Distribution of Visible Normals". */
-static inline vec3 pbsdf_ggx_vndf_sample(float alpha, vec3 w, float u1, float u2)
+static inline PK_HD vec3 pbsdf_ggx_vndf_sample(float alpha, vec3 w, float u1, float u2)
 {
     if (w.z < 0.0f) w = v3_neg(w);
     vec3 vh = v3_norm(v3(alpha * w.x, alpha * w.y, w.z));
@@ -258,12 +258,12 @@ static inline vec3 pbsdf_ggx_vndf_sample(float alpha, vec3 w, float u1, float u2
 
 /* ---- lobes (local frame, wo.z > 0 and wi.z > 0 checked by the caller) -- */
 
-static inline bool pbsdf__smooth(const pbsdf *b) { return b->alpha < PBSDF_ALPHA_SMOOTH; }
-static inline float pbsdf__mean(vec3 c) { return (c.x + c.y + c.z) * (1.0f / 3.0f); }
-static inline vec3 pbsdf__mirror(vec3 w) { return v3(-w.x, -w.y, w.z); }
+static inline PK_HD bool pbsdf__smooth(const pbsdf *b) { return b->alpha < PBSDF_ALPHA_SMOOTH; }
+static inline PK_HD float pbsdf__mean(vec3 c) { return (c.x + c.y + c.z) * (1.0f / 3.0f); }
+static inline PK_HD vec3 pbsdf__mirror(vec3 w) { return v3(-w.x, -w.y, w.z); }
 
 /* GGX reflection without Fresnel: D G2 / (4 cos_o cos_i) * cos_i. */
-static inline float pbsdf__ggx_refl_cos(float alpha, vec3 wo, vec3 wi, vec3 *h_out)
+static inline PK_HD float pbsdf__ggx_refl_cos(float alpha, vec3 wo, vec3 wi, vec3 *h_out)
 {
     vec3 h = v3_add(wo, wi);
     if (v3_len2(h) <= 0.0f) return 0.0f;
@@ -272,7 +272,7 @@ static inline float pbsdf__ggx_refl_cos(float alpha, vec3 wo, vec3 wi, vec3 *h_o
     return pbsdf_ggx_d(alpha, h) * pbsdf_ggx_g2(alpha, wo, wi) / (4.0f * wo.z);
 }
 /* Density of wi for a VNDF-sampled half vector reflected about it. */
-static inline float pbsdf__ggx_refl_pdf(float alpha, vec3 wo, vec3 wi)
+static inline PK_HD float pbsdf__ggx_refl_pdf(float alpha, vec3 wo, vec3 wi)
 {
     vec3 h = v3_add(wo, wi);
     if (v3_len2(h) <= 0.0f) return 0.0f;
@@ -284,7 +284,7 @@ static inline float pbsdf__ggx_refl_pdf(float alpha, vec3 wo, vec3 wi)
 
 /* Probability of choosing the specular lobe over the diffuse one, from
  * estimates of their albedos. */
-static inline float pbsdf__spec_prob(const pbsdf *b, vec3 wo)
+static inline PK_HD float pbsdf__spec_prob(const pbsdf *b, vec3 wo)
 {
     float es, ed;
     if (b->type == PBSDF_PLASTIC) {
@@ -300,7 +300,7 @@ static inline float pbsdf__spec_prob(const pbsdf *b, vec3 wo)
 }
 
 /* Plastic's diffuse base: albedo / pi, through the coating twice. */
-static inline vec3 pbsdf__plastic_diffuse_cos(const pbsdf *b, vec3 wo, vec3 wi)
+static inline PK_HD vec3 pbsdf__plastic_diffuse_cos(const pbsdf *b, vec3 wo, vec3 wi)
 {
     float t = (1.0f - pbsdf_fresnel_dielectric(wo.z, b->ior)) * (1.0f - pbsdf_fresnel_dielectric(wi.z, b->ior));
     return v3_scale(b->albedo, t * wi.z / PK_PI);
@@ -311,7 +311,7 @@ static inline vec3 pbsdf__plastic_diffuse_cos(const pbsdf *b, vec3 wo, vec3 wi)
 /* Generalised half vector of a rough dielectric (Walter 2007), facing +z;
  * *etap = relative index across the boundary as seen from wo (1 for
  * reflection). False where no microfacet connects wo and wi. */
-static inline bool pbsdf__dielectric_half(const pbsdf *b, vec3 wo, vec3 wi, vec3 *m, float *etap)
+static inline PK_HD bool pbsdf__dielectric_half(const pbsdf *b, vec3 wo, vec3 wi, vec3 *m, float *etap)
 {
     bool reflect = wo.z * wi.z > 0.0f;
     float e = 1.0f;
@@ -327,7 +327,7 @@ static inline bool pbsdf__dielectric_half(const pbsdf *b, vec3 wo, vec3 wi, vec3
     return true;
 }
 
-static inline vec3 pbsdf__dielectric_eval(const pbsdf *b, vec3 wo, vec3 wi)
+static inline PK_HD vec3 pbsdf__dielectric_eval(const pbsdf *b, vec3 wo, vec3 wi)
 {
     vec3 m;
     float e;
@@ -344,7 +344,7 @@ static inline vec3 pbsdf__dielectric_eval(const pbsdf *b, vec3 wo, vec3 wi)
     return v3_scale(b->transmittance, t);
 }
 
-static inline float pbsdf__dielectric_pdf(const pbsdf *b, vec3 wo, vec3 wi)
+static inline PK_HD float pbsdf__dielectric_pdf(const pbsdf *b, vec3 wo, vec3 wi)
 {
     vec3 m;
     float e;
@@ -361,7 +361,7 @@ static inline float pbsdf__dielectric_pdf(const pbsdf *b, vec3 wo, vec3 wi)
 
 /* Refracts w (pointing away, either side) through the facet m (m.z > 0,
  * ior = inside / outside). False on total internal reflection. */
-static inline bool pbsdf__refract(vec3 w, vec3 m, float ior, vec3 *out)
+static inline PK_HD bool pbsdf__refract(vec3 w, vec3 m, float ior, vec3 *out)
 {
     float c = v3_dot(w, m), eta = ior;
     if (c < 0.0f) {
@@ -380,7 +380,7 @@ static inline bool pbsdf__refract(vec3 w, vec3 m, float ior, vec3 *out)
 
 /* True if the BSDF has a non-delta part, i.e. light sampling and MIS can
  * reach it (eval and pdf are not identically 0). */
-static inline bool pbsdf_has_nondelta(const pbsdf *b)
+static inline PK_HD bool pbsdf_has_nondelta(const pbsdf *b)
 {
     switch (b->type) {
     case PBSDF_DIFFUSE: case PBSDF_PLASTIC: case PBSDF_GLOSSY: return true;
@@ -389,7 +389,7 @@ static inline bool pbsdf_has_nondelta(const pbsdf *b)
 }
 
 /* f(wo, wi) * |wi.z| of the non-delta part. Local frame, unit vectors. */
-static inline vec3 pbsdf_eval(const pbsdf *b, vec3 wo, vec3 wi)
+static inline PK_HD vec3 pbsdf_eval(const pbsdf *b, vec3 wo, vec3 wi)
 {
     if (b->type == PBSDF_DIELECTRIC) return pbsdf__dielectric_eval(b, wo, wi);
     if (!(wo.z > 0.0f && wi.z > 0.0f)) return v3s(0.0f);
@@ -426,7 +426,7 @@ static inline vec3 pbsdf_eval(const pbsdf *b, vec3 wo, vec3 wi)
 
 /* Solid-angle density with which pbsdf_sample returns wi as a non-delta
  * sample (the lobe choice included). */
-static inline float pbsdf_pdf(const pbsdf *b, vec3 wo, vec3 wi)
+static inline PK_HD float pbsdf_pdf(const pbsdf *b, vec3 wo, vec3 wi)
 {
     if (b->type == PBSDF_DIELECTRIC) return pbsdf__dielectric_pdf(b, wo, wi);
     if (!(wo.z > 0.0f && wi.z > 0.0f)) return 0.0f;
@@ -455,7 +455,7 @@ static inline float pbsdf_pdf(const pbsdf *b, vec3 wo, vec3 wi)
  * weight already contains it). False when no direction was produced (wo
  * below a one-sided surface, a reflection below the horizon, ...): the path
  * ends there, and those samples count as weight 0 in every estimate. */
-static inline bool pbsdf_sample(const pbsdf *b, vec3 wo, const float u[3], vec3 *wi, vec3 *weight, float *pdf,
+static inline PK_HD bool pbsdf_sample(const pbsdf *b, vec3 wo, const float u[3], vec3 *wi, vec3 *weight, float *pdf,
                                 bool *is_delta)
 {
     *is_delta = false;

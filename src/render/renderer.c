@@ -228,10 +228,8 @@ static inline ray sample_camera_ray(const pk_renderer *r, const camera_frame *cf
 {
     const int spp = r->opt.spp;
     float jx = 0.5f, jy = 0.5f;
-    if (r->path) {
-        sampler sm = sampler_start((uint32_t)px, (uint32_t)py, r->pass * (uint32_t)spp + (uint32_t)smp, r->pt.seed);
-        sampler_2d(&sm, &jx, &jy);
-    } else if (spp > 1) {
+    if (r->path) return path_camera(&r->pt, cf, px, py, r->pass * (uint32_t)spp + (uint32_t)smp);
+    if (spp > 1) {
         const int sx = (int)ceilf(sqrtf((float)spp)), sy = (spp + sx - 1) / sx;
         const uint64_t first = (uint64_t)r->pass * (uint64_t)spp;
         rng jr = rng_seed(((uint64_t)py << 32) | (uint32_t)px, (first + (uint64_t)smp) * 2 + 1);
@@ -268,13 +266,12 @@ static bool render_tile(const pk_renderer *r, int tid, const camera_frame *cf, c
         for (int i = 0; i < n; i++) {
             vec3 c;
             const int px = tl->x + i % tw, py = tl->y + i / tw;
-            if (hits[i].prim == PK_NO_HIT) {
+            if (r->path) {
+                if (!path_sample(&r->pt, pt, px, py, (uint32_t)(first + (uint64_t)smp), &rays[i],
+                                 hits[i].prim == PK_NO_HIT ? NULL : &hits[i], &c))
+                    continue; /* a lost sample, not a poisoned pixel */
+            } else if (hits[i].prim == PK_NO_HIT) {
                 c = env_background(&r->fr.env, v3_norm(rays[i].d));
-            } else if (r->path) {
-                sampler sm = sampler_start((uint32_t)px, (uint32_t)py, (uint32_t)(first + (uint64_t)smp), r->pt.seed);
-                sm.dim = 2; /* the pixel position */
-                c = path_radiance(&r->pt, pt, &sm, &rays[i], &hits[i]);
-                if (!v3_finite(c)) continue; /* a lost sample, not a poisoned pixel */
             } else {
                 wt->rng = rng_seed(((uint64_t)py << 32) | (uint32_t)px, (first + (uint64_t)smp) * 2);
                 wt->ray_budget = WHITTED_RAY_BUDGET;

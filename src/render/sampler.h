@@ -9,19 +9,25 @@
 #ifndef PK_SAMPLER_H
 #define PK_SAMPLER_H
 
+#include "../pk_hd.h"
+
 #include <stdint.h>
 
-static inline uint32_t smp_reverse_bits(uint32_t x)
+static inline PK_HD uint32_t smp_reverse_bits(uint32_t x)
 {
+#if defined(__CUDA_ARCH__)
+    return __brev(x); /* one instruction on the GPU, the same result */
+#else
     x = __builtin_bswap32(x);
     x = ((x & 0x0f0f0f0fu) << 4) | ((x & 0xf0f0f0f0u) >> 4);
     x = ((x & 0x33333333u) << 2) | ((x & 0xccccccccu) >> 2);
     x = ((x & 0x55555555u) << 1) | ((x & 0xaaaaaaaau) >> 1);
     return x;
+#endif
 }
 
 /* A 32-bit mixing hash (a good avalanche, from the murmur finaliser family). */
-static inline uint32_t smp_hash(uint32_t x)
+static inline PK_HD uint32_t smp_hash(uint32_t x)
 {
     x ^= x >> 16;
     x *= 0x21f0aaadu;
@@ -31,13 +37,13 @@ static inline uint32_t smp_hash(uint32_t x)
     return x;
 }
 
-static inline uint32_t smp_hash2(uint32_t a, uint32_t b) { return smp_hash(a ^ smp_hash(b + 0x9e3779b9u)); }
+static inline PK_HD uint32_t smp_hash2(uint32_t a, uint32_t b) { return smp_hash(a ^ smp_hash(b + 0x9e3779b9u)); }
 
 /* The hash of Owen scrambling on a bit-reversed value: bit k of the result
  * is bit k of x flipped by a function of the bits below k (which, reversed
  * back, are the digits above): multiplications by even constants and
  * additions carry information only upwards. */
-static inline uint32_t smp_owen_rev(uint32_t x, uint32_t seed)
+static inline PK_HD uint32_t smp_owen_rev(uint32_t x, uint32_t seed)
 {
     x += seed;
     x ^= x * 0x6c50b47cu;
@@ -49,15 +55,15 @@ static inline uint32_t smp_owen_rev(uint32_t x, uint32_t seed)
 
 /* Owen scrambling of the bits of x read as a binary fraction (most significant
  * bit first): each bit is flipped by a hash of the bits above it. */
-static inline uint32_t smp_owen(uint32_t x, uint32_t seed)
+static inline PK_HD uint32_t smp_owen(uint32_t x, uint32_t seed)
 {
     return smp_reverse_bits(smp_owen_rev(smp_reverse_bits(x), seed));
 }
 
 /* The first two Sobol dimensions of point i: van der Corput (bit reversal)
  * and the dimension of primitive polynomial x + 1. */
-static inline uint32_t smp_sobol0(uint32_t i) { return smp_reverse_bits(i); }
-static inline uint32_t smp_sobol1(uint32_t i)
+static inline PK_HD uint32_t smp_sobol0(uint32_t i) { return smp_reverse_bits(i); }
+static inline PK_HD uint32_t smp_sobol1(uint32_t i)
 {
     uint32_t v = 1u << 31, x = 0;
     for (; i; i >>= 1, v ^= v >> 1)
@@ -70,7 +76,7 @@ static inline uint32_t smp_sobol1(uint32_t i)
  * the bits of j are a subset of those of k (Lucas), so bit j of the reversed
  * value is the parity of the bits k of i that are supersets of j: five
  * shift-and-xor steps, one per bit of the bit position. */
-static inline uint32_t smp_sobol1_rev(uint32_t i)
+static inline PK_HD uint32_t smp_sobol1_rev(uint32_t i)
 {
     i ^= (i & 0xaaaaaaaau) >> 1;
     i ^= (i & 0xccccccccu) >> 2;
@@ -80,7 +86,7 @@ static inline uint32_t smp_sobol1_rev(uint32_t i)
     return i;
 }
 
-static inline float smp_to_float(uint32_t x)
+static inline PK_HD float smp_to_float(uint32_t x)
 {
     return (float)(x >> 8) * 0x1p-24f; /* [0, 1): 24 bits, never rounds up to 1 */
 }
@@ -91,7 +97,7 @@ typedef struct sampler {
     uint32_t dim;         /* next dimension */
 } sampler;
 
-static inline sampler sampler_start(uint32_t px, uint32_t py, uint32_t index, uint32_t seed)
+static inline PK_HD sampler sampler_start(uint32_t px, uint32_t py, uint32_t index, uint32_t seed)
 {
     sampler s;
     s.pixel_seed = smp_hash2(smp_hash2(px, py), seed);
@@ -101,7 +107,7 @@ static inline sampler sampler_start(uint32_t px, uint32_t py, uint32_t index, ui
 }
 
 /* The next two dimensions as one 2-D point of the scrambled sequence. */
-static inline void sampler_2d(sampler *s, float *u, float *v)
+static inline PK_HD void sampler_2d(sampler *s, float *u, float *v)
 {
     const uint32_t pair = s->dim >> 1;
     s->dim += 2;
@@ -115,7 +121,7 @@ static inline void sampler_2d(sampler *s, float *u, float *v)
     *v = smp_to_float(smp_reverse_bits(smp_owen_rev(smp_sobol1_rev(i), smp_hash(ps ^ 0xb5297a4du))));
 }
 
-static inline float sampler_1d(sampler *s)
+static inline PK_HD float sampler_1d(sampler *s)
 {
     float u, v;
     sampler_2d(s, &u, &v);

@@ -14,7 +14,7 @@ typedef struct rng {
     uint64_t state, inc;
 } rng;
 
-static inline uint32_t rng_u32(rng *r)
+static inline PK_HD uint32_t rng_u32(rng *r)
 {
     uint64_t old = r->state;
     r->state = old * 6364136223846793005ull + r->inc;
@@ -23,14 +23,14 @@ static inline uint32_t rng_u32(rng *r)
     return (xorshifted >> rot) | (xorshifted << ((-rot) & 31));
 }
 
-static inline uint64_t mix64(uint64_t z)
+static inline PK_HD uint64_t mix64(uint64_t z)
 {
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
     z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
     return z ^ (z >> 31);
 }
 
-static inline rng rng_seed(uint64_t a, uint64_t b)
+static inline PK_HD rng rng_seed(uint64_t a, uint64_t b)
 {
     rng r;
     r.state = 0;
@@ -42,10 +42,10 @@ static inline rng rng_seed(uint64_t a, uint64_t b)
 }
 
 /* Uniform in [0, 1). */
-static inline float rng_float(rng *r) { return (float)(rng_u32(r) >> 8) * 0x1p-24f; }
+static inline PK_HD float rng_float(rng *r) { return (float)(rng_u32(r) >> 8) * 0x1p-24f; }
 
 /* Cosine-weighted direction about the unit normal n. */
-static inline vec3 sample_cosine(vec3 n, float u1, float u2)
+static inline PK_HD vec3 sample_cosine(vec3 n, float u1, float u2)
 {
     float r = sqrtf(u1), phi = 2.0f * PK_PI * u2;
     vec3 t = fabsf(n.x) > 0.5f ? v3(-n.y, n.x, 0.0f) : v3(0.0f, -n.z, n.y);
@@ -56,7 +56,7 @@ static inline vec3 sample_cosine(vec3 n, float u1, float u2)
 }
 
 /* Uniform point on triangle (a, b, c). */
-static inline vec3 sample_triangle(vec3 a, vec3 b, vec3 c, float u1, float u2)
+static inline PK_HD vec3 sample_triangle(vec3 a, vec3 b, vec3 c, float u1, float u2)
 {
     float su = sqrtf(u1);
     float b0 = 1.0f - su, b1 = u2 * su;

@@ -19,7 +19,45 @@ typedef struct surface {
 } surface;
 
 /* The surface that ray r hit at h (h->prim is a triangle or a sphere of s). */
-PK_HIDDEN surface surface_at(const pk_scene *s, const ray *r, const hit *h);
+static inline PK_HD surface surface_at(const pk_scene *s, const ray *r, const hit *h)
+{
+    surface sf;
+    vec3 ng, ns;
+    if (h->prim < s->ntris) {
+        const triangle *t = &s->tris[h->prim];
+        vec3 a, b, c;
+        scene_tri_verts(s, h->prim, &a, &b, &c);
+        float w = 1.0f - h->u - h->v;
+        sf.p = v3_add(v3_add(v3_scale(a, w), v3_scale(b, h->u)), v3_scale(c, h->v));
+        ng = tri_normal(a, b, c);
+        ns = ng;
+        if (t->n[0] >= 0 && t->n[1] >= 0 && t->n[2] >= 0) {
+            vec3 n = v3_add(v3_add(v3_scale(s->normals[t->n[0]], w), v3_scale(s->normals[t->n[1]], h->u)),
+                            v3_scale(s->normals[t->n[2]], h->v));
+            if (v3_len2(n) > 0.0f) {
+                n = v3_norm(n);
+                /* vertex normals pointing against the face are taken as flipped faces */
+                ns = v3_dot(n, ng) >= 0.0f ? n : v3_neg(n);
+            }
+        }
+        sf.m = &s->materials[t->material];
+    } else {
+        const sphere *sp = &s->spheres[h->prim - s->ntris];
+        vec3 p = v3_add(r->o, v3_scale(r->d, h->t));
+        ng = v3_norm_scaled(v3_sub(p, sp->center));
+        sf.p = v3_add(sp->center, v3_scale(ng, sp->radius));
+        ns = ng;
+        sf.m = &s->materials[sp->material];
+    }
+    sf.front = v3_dot(ng, r->d) < 0.0f;
+    if (!sf.front) {
+        ng = v3_neg(ng);
+        ns = v3_neg(ns);
+    }
+    sf.ng = ng;
+    sf.ns = ns;
+    return sf;
+}
 
 /* Texture coordinates at a hit: a triangle's interpolated vt (or its
  * barycentric coordinates (0,0), (1,0), (0,1) when it has none), a sphere's
@@ -32,18 +70,147 @@ typedef struct surface_uv {
     vec3 dpdu, dpdv;
     float uv_per_len;
 } surface_uv;
-PK_HIDDEN surface_uv surface_uv_at(const pk_scene *s, const ray *r, const hit *h);
+#define SURFACE_MIN_COS 0.05f    /* footprints of grazing hits stop growing here */
+static inline PK_HD surface_uv surface_uv_at(const pk_scene *s, const ray *r, const hit *h)
+{
+    surface_uv q;
+    if (h->prim < s->ntris) {
+        const triangle *t = &s->tris[h->prim];
+        vec3 a, b, c;
+        scene_tri_verts(s, h->prim, &a, &b, &c);
+        uv2 ta = {0.0f, 0.0f}, tb = {1.0f, 0.0f}, tc = {0.0f, 1.0f};
+        if (t->t[0] >= 0 && t->t[1] >= 0 && t->t[2] >= 0) {
+            ta = s->uvs[t->t[0]];
+            tb = s->uvs[t->t[1]];
+            tc = s->uvs[t->t[2]];
+        }
+        const float w = 1.0f - h->u - h->v;
+        q.u = ta.u * w + tb.u * h->u + tc.u * h->v;
+        q.v = ta.v * w + tb.v * h->u + tc.v * h->v;
+        /* dp/du, dp/dv from the two edges (pbrt's construction) */
+        const float du1 = tb.u - ta.u, dv1 = tb.v - ta.v, du2 = tc.u - ta.u, dv2 = tc.v - ta.v;
+        const vec3 e1 = v3_sub(b, a), e2 = v3_sub(c, a);
+        const float det = du1 * dv2 - dv1 * du2;
+        const float area = v3_len(v3_cross(e1, e2));
+        if (fabsf(det) > 1e-20f && isfinite(1.0f / det)) {
+            const float inv = 1.0f / det;
+            q.dpdu = v3_scale(v3_sub(v3_scale(e1, dv2), v3_scale(e2, dv1)), inv);
+            q.dpdv = v3_scale(v3_sub(v3_scale(e2, du1), v3_scale(e1, du2)), inv);
+        } else { /* uv degenerate: any frame around the normal */
+            q.dpdu = v3_norm_scaled(e1);
+            q.dpdv = v3_cross(v3_norm_scaled(v3_cross(e1, e2)), q.dpdu);
+        }
+        q.uv_per_len = area > 0.0f ? sqrtf(fabsf(det) / area) : 0.0f;
+    } else {
+        const sphere *sp = &s->spheres[h->prim - s->ntris];
+        vec3 p = v3_add(r->o, v3_scale(r->d, h->t));
+        vec3 n = v3_norm_scaled(v3_sub(p, sp->center));
+        const float phi = atan2f(n.z, n.x), theta = acosf(fminf(1.0f, fmaxf(-1.0f, n.y)));
+        q.u = (phi + PK_PI) * (0.5f / PK_PI);
+        q.v = 1.0f - theta * (1.0f / PK_PI);
+        const float rr = sp->radius, st = sinf(theta);
+        /* p = c + r (-cos(2 pi u) sin t, cos t, -sin(2 pi u) sin t), t = pi (1 - v) */
+        q.dpdu = v3(-2.0f * PK_PI * rr * n.z, 0.0f, 2.0f * PK_PI * rr * n.x);
+        q.dpdv = v3_scale(v3(n.x * n.y / fmaxf(st, 1e-6f), -st, n.z * n.y / fmaxf(st, 1e-6f)), -PK_PI * rr);
+        if (st < 1e-6f) q.dpdu = v3_cross(q.dpdv, n);
+        /* uv area 1 over the sphere's 4 pi r^2 */
+        q.uv_per_len = 1.0f / (rr * 2.0f * sqrtf(PK_PI));
+    }
+    return q;
+}
+
+static inline PK_HD vec3 surface_clamp_rgb(vec3 c)
+{
+    return v3(fminf(fmaxf(c.x, 0.0f), 1.0f), fminf(fmaxf(c.y, 0.0f), 1.0f), fminf(fmaxf(c.z, 0.0f), 1.0f));
+}
+
+/* Height of a bump map at (u, v), the fine level. */
+static inline PK_HD float surface_bump_height(const pk_scene *s, const tex_ref *ref, float u, float v)
+{
+    tex_query q = {u, v, 0.0f};
+    return tex_eval_scalar(s->textures, ref, q);
+}
+
+static inline PK_HD void surface_texture_at(const pk_scene *s, const ray *r, const hit *h, float cone_width, surface *sf, material *tm)
+{
+    const material *m = sf->m;
+    *tm = *m;
+    const surface_uv uv = surface_uv_at(s, r, h);
+    const float dl = v3_len(r->d);
+    const float cosv = dl > 0.0f ? fabsf(v3_dot(r->d, sf->ng)) / dl : 1.0f;
+    tex_query q = {uv.u, uv.v, cone_width / fmaxf(cosv, SURFACE_MIN_COS) * uv.uv_per_len};
+    if (!isfinite(q.width)) q.width = 0.0f;
+#ifdef PK_TEX_NO_CONES /* (-D for measurements: the finest level always, bilinear) */
+    q.width = 0.0f;
+#endif
+    /* texture values: colours and alpha in 0..1 (HDR images may hold more), Ns >= 0 */
+    if (m->map_kd.kind) tm->kd = v3_mul(m->kd, surface_clamp_rgb(tex_eval_rgb(s->textures, &m->map_kd, q)));
+    if (m->map_ks.kind) tm->ks = v3_mul(m->ks, surface_clamp_rgb(tex_eval_rgb(s->textures, &m->map_ks, q)));
+    if (m->map_ns.kind) tm->ns = m->ns * fmaxf(tex_eval_scalar(s->textures, &m->map_ns, q), 0.0f);
+    if (m->map_alpha.kind) {
+        float a = fminf(fmaxf(tex_eval_scalar(s->textures, &m->map_alpha, q), 0.0f), 1.0f);
+        tm->alpha = fminf(m->alpha * (m->map_alpha.squared ? a * a : a), 1.0f);
+    }
+    sf->m = tm;
+    if (!m->map_bump.kind && !m->map_norm.kind) return;
+    /* a frame on the surface, z = the shading normal as it faces the ray */
+    const vec3 n = sf->ns;
+    vec3 t = v3_sub(uv.dpdu, v3_scale(n, v3_dot(n, uv.dpdu)));
+    if (!(v3_len2(t) > 0.0f) || !v3_finite(t)) return;
+    t = v3_norm(t);
+    vec3 b = v3_cross(n, t);
+    if (v3_dot(b, uv.dpdv) < 0.0f) b = v3_neg(b);
+    vec3 nn = n;
+    if (m->map_norm.kind) {
+        vec3 c = tex_eval_rgb(s->textures, &m->map_norm, q);
+        vec3 tl = v3(2.0f * c.x - 1.0f, 2.0f * c.y - 1.0f, 2.0f * c.z - 1.0f);
+        nn = v3_add(v3_add(v3_scale(t, tl.x), v3_scale(b, tl.y)), v3_scale(n, tl.z));
+    } else {
+        /* heights times bm displace along n: n' = (dp/du + dh/du n) x (dp/dv + dh/dv n) */
+        const tex_ref *ref = &m->map_bump;
+        int size = 1;
+        if (ref->kind == TEX_IMAGE) {
+            const texture *tx = &s->textures[ref->tex];
+            size = tx->lv[0].w > tx->lv[0].h ? tx->lv[0].w : tx->lv[0].h;
+        }
+        const float du = 0.5f / (float)size, dv = du;
+        const float h0 = surface_bump_height(s, ref, uv.u, uv.v);
+        const float hu = (surface_bump_height(s, ref, uv.u + du, uv.v) - h0) / du * ref->bm;
+        const float hv = (surface_bump_height(s, ref, uv.u, uv.v + dv) - h0) / dv * ref->bm;
+        /* in the frame (t, b, n) with dp/du ~ |dpdu| t and dp/dv ~ |dpdv| b */
+        const float lu = v3_len(uv.dpdu), lv = v3_len(uv.dpdv);
+        if (!(lu > 0.0f) || !(lv > 0.0f)) return;
+        nn = v3_sub(n, v3_add(v3_scale(t, hu / lu), v3_scale(b, hv / lv)));
+    }
+    if (!v3_finite(nn) || !(v3_len2(nn) > 0.0f)) return;
+    nn = v3_norm(nn);
+    if (v3_dot(nn, sf->ng) <= 0.0f) return; /* would face away: kept as it was */
+    sf->ns = nn;
+}
 
 /* For a material with texture maps (sf.m->textured): looks its maps up
  * for a ray cone of width cone_width (scene units) where it meets the
  * surface, writes the textured material into *tm and returns sf with m
  * pointing at it; bump and normal maps bend its ns. (sf by value, so that
  * callers keep theirs in registers.) */
-PK_HIDDEN surface surface_texture(const pk_scene *s, const ray *r, const hit *h, float cone_width, surface sf,
-                                  material *tm);
+static inline PK_HD surface surface_texture(const pk_scene *s, const ray *r, const hit *h, float cone_width, surface sf, material *tm)
+{
+    surface_texture_at(s, r, h, cone_width, &sf, tm);
+    return sf;
+}
+
+#define HOLE_STEPS 256   /* holes passed along one ray at most; then the surface counts */
 
 /* True when the hit lies in a hole of its material's map_d (opacity < 0.5). */
-PK_HIDDEN bool surface_is_hole(const pk_scene *s, const ray *r, const hit *h);
+static inline PK_HD bool surface_is_hole(const pk_scene *s, const ray *r, const hit *h)
+{
+    const uint32_t mi = h->prim < s->ntris ? s->tris[h->prim].material : s->spheres[h->prim - s->ntris].material;
+    const material *m = &s->materials[mi];
+    if (!m->cutout) return false;
+    const surface_uv uv = surface_uv_at(s, r, h);
+    tex_query q = {uv.u, uv.v, 0.0f};
+    return tex_eval_alpha(s->textures, &m->map_d, q) < 0.5f;
+}
 
 /* Steps past holes: while h (a hit of *r) is a hole, looks further along *r
  * (tmin just past the hole). Returns false when nothing else is hit. For
@@ -56,7 +223,7 @@ PK_HIDDEN bool occluded_past_holes(const accel *a, const pk_scene *s, const ray 
 /* Origin for a ray leaving p on the side of normal n: a robust offset of eps
  * (the frame's, proportional to the scene's size) plus a part proportional
  * to the magnitude of p. */
-static inline vec3 offset_origin(float eps, vec3 p, vec3 n)
+static inline PK_HD vec3 offset_origin(float eps, vec3 p, vec3 n)
 {
     float mag = fmaxf(fabsf(p.x), fmaxf(fabsf(p.y), fabsf(p.z)));
     return v3_add(p, v3_scale(n, eps + mag * 4e-6f));

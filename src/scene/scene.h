@@ -195,7 +195,7 @@ PK_HIDDEN pk_status scene_commit(pk_context *ctx, pk_scene *s);
 PK_HIDDEN bool scene_check(const pk_scene *s, char *why, size_t why_size);
 
 /* Geometry of triangle k. */
-static inline void scene_tri_verts(const pk_scene *s, size_t k, vec3 *a, vec3 *b, vec3 *c)
+static inline PK_HD void scene_tri_verts(const pk_scene *s, size_t k, vec3 *a, vec3 *b, vec3 *c)
 {
     const triangle *t = &s->tris[k];
     *a = s->positions[t->v[0]];

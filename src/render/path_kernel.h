@@ -1,0 +1,443 @@
+/*
+ * path_kernel.h - the path tracer's sampling of one camera sample, written
+ * once for the CPU (path.c) and the GPU (src/accel/cuda/path.cu): plain C
+ * over the read-only structures of a render (path_tracer, its frame, the
+ * scene, the light set, the environment, the textures), every function
+ * PK_HD. What differs is how rays are traced; the includer defines
+ *
+ *   PATH_TRACE(pt, t, r, h)   closest hit of ray *r into *h: true when hit
+ *   PATH_OCCLUDED(pt, t, r)   whether anything lies on ray *r (any hit)
+ *
+ * before including this file (pt: const path_tracer *, t: path_thread *).
+ *
+ * Materials are the MTL models mapped to pbsdf.h (docs/materials.md): Kd
+ * diffuse; Ks with Ns a GGX lobe over it (illum 2); illum 3 an ideal mirror
+ * weighted by Ks over the diffuse part, illum 5 a mirror with Fresnel;
+ * illum 4, 6, 7 smooth dielectrics (Ni, Tf) with exact Fresnel; dissolve
+ * d < 1 lets a fraction of the light pass straight through. The JSON
+ * material types (diffuse, conductor, dielectric, plastic) map to their
+ * pbsdf directly.
+ */
+#ifndef PK_PATH_KERNEL_H
+#define PK_PATH_KERNEL_H
+
+#if !defined(PATH_TRACE) || !defined(PATH_OCCLUDED)
+#error "define PATH_TRACE and PATH_OCCLUDED before including path_kernel.h"
+#endif
+
+#include "../math/frame.h"
+#include "camera.h"
+#include "path.h"
+#include "pbsdf.h"
+#include "sampler.h"
+#include "sampling.h"
+#include "surface.h"
+
+#define RR_START 3            /* Russian roulette from this bounce on */
+#define SHADOW_SHORTEN 1e-3f  /* shadow rays stop this fraction short of the light */
+
+/* ---- rays through map_d holes ------------------------------------------------- */
+
+/* Steps past holes (surface.h trace_past_holes, with the includer's tracing). */
+static inline PK_HD bool path_past_holes(const path_tracer *pt, path_thread *t, ray *r, hit *h)
+{
+    for (int k = 0; k < HOLE_STEPS && surface_is_hole(pt->f->s, r, h); k++) {
+        r->tmin = nextafterf(h->t, INFINITY);
+        if (!PATH_TRACE(pt, t, r, h)) return false;
+    }
+    return true;
+}
+
+/* Whether a shadow ray is blocked, seeing through holes. */
+static inline PK_HD bool path_occluded(const path_tracer *pt, path_thread *t, const ray *r)
+{
+    if (!pt->f->s->has_cutout) return PATH_OCCLUDED(pt, t, r);
+    ray rr = *r;
+    hit h;
+    if (!PATH_TRACE(pt, t, &rr, &h)) return false;
+    return path_past_holes(pt, t, &rr, &h);
+}
+
+static inline PK_HD bool black(vec3 c) { return !(c.x > 0.0f || c.y > 0.0f || c.z > 0.0f); }
+static inline PK_HD float power_heuristic(float a, float b)
+{
+    a *= a, b *= b;
+    return a + b > 0.0f ? a / (a + b) : 0.0f;
+}
+
+/* Radiance a surface emits toward wo (unit, pointing away from it). */
+static inline PK_HD vec3 emitted(const surface *sf) { return sf->front || sf->m->two_sided ? sf->m->ke : v3s(0.0f); }
+
+/* ---- materials: the MTL models as physically based BSDFs (pbsdf.h) ----------- */
+
+/* The BSDF at a surface, its frame, and the dissolve: with probability
+ * 1 - opaque the path passes straight through (a delta lobe of its own). */
+typedef struct shading {
+    pbsdf b;
+    onb frame;           /* z = the shading normal; for dielectrics the outward one */
+    float opaque;
+    bool nondelta;       /* the BSDF has a part that light sampling can reach */
+} shading;
+
+static inline PK_HD shading shading_at(const surface *sf)
+{
+    const material *m = sf->m;
+    shading sh;
+    const bool glass = m->type == MAT_MTL && (m->illum == 4 || m->illum == 6 || m->illum == 7);
+    sh.opaque = glass || m->type == MAT_DIELECTRIC ? 1.0f : fminf(fmaxf(m->d, 0.0f), 1.0f);
+    vec3 n = sf->ns;
+    if (m->type != MAT_MTL) { /* the physically based types of JSON scenes */
+        switch (m->type) {
+        case MAT_CONDUCTOR:
+            sh.b = m->schlick ? pbsdf_conductor_schlick(m->ks, m->alpha) : pbsdf_conductor(m->eta, m->k, m->alpha);
+            break;
+        case MAT_DIELECTRIC:
+            sh.b = pbsdf_dielectric(m->ni, m->alpha, sf->front ? m->tf : v3s(1.0f));
+            if (!sf->front) n = v3_neg(n); /* the outward normal: wo.z < 0 inside */
+            break;
+        case MAT_PLASTIC: sh.b = pbsdf_plastic(m->kd, m->ni, m->alpha); break;
+        default: sh.b = pbsdf_diffuse(m->kd); break;
+        }
+    } else if (glass) {
+        /* Tf: the hue of what enters, normalised to the brightest channel
+         * (exporters write grey Tf of any strength for clear glass) */
+        float tmax_c = v3_max_comp(m->tf);
+        vec3 tint = tmax_c > 0.0f ? v3_scale(m->tf, 1.0f / tmax_c) : v3s(1.0f);
+        sh.b = pbsdf_dielectric(m->ni, 0.0f, sf->front ? tint : v3s(1.0f));
+        if (!sf->front) n = v3_neg(n); /* the outward normal: wo.z < 0 inside */
+    } else if (m->illum == 5) {
+        sh.b = pbsdf_conductor_schlick(m->ks, 0.0f); /* a mirror with Fresnel */
+    } else if (m->illum == 3) {
+        sh.b = pbsdf_glossy(m->kd, m->ks, 0.0f); /* diffuse + an ideal mirror weighted by Ks */
+    } else if (m->illum == 2 && (m->ks.x > 0.0f || m->ks.y > 0.0f || m->ks.z > 0.0f)) {
+        sh.b = pbsdf_glossy_mtl(m->kd, m->ks, m->ns);
+    } else {
+        sh.b = pbsdf_diffuse(m->kd);
+    }
+    sh.frame = onb_from_normal(n);
+    sh.nondelta = sh.opaque > 0.0f && pbsdf_has_nondelta(&sh.b) &&
+                  (sh.b.type != PBSDF_DIFFUSE || !black(sh.b.albedo));
+    return sh;
+}
+
+/* f * cos toward wi (world, unit) and its pdf, the dissolve included; zero
+ * where the geometric normal says the light comes through the surface. */
+static inline PK_HD vec3 shading_eval(const surface *sf, const shading *sh, vec3 wo, vec3 wi, float *pdf)
+{
+    *pdf = 0.0f;
+    const float side = v3_dot(wi, sf->ng), shade = v3_dot(wi, sf->ns);
+    if (sh->b.type != PBSDF_DIELECTRIC && (side <= 0.0f || shade <= 0.0f)) return v3s(0.0f);
+    vec3 lo = onb_to_local(sh->frame, wo), li = onb_to_local(sh->frame, wi);
+    *pdf = sh->opaque * pbsdf_pdf(&sh->b, lo, li);
+    return v3_scale(pbsdf_eval(&sh->b, lo, li), sh->opaque);
+}
+
+/* Samples the next direction. Returns false when the path ends. */
+static inline PK_HD bool shading_sample(const surface *sf, const shading *sh, vec3 wo, float u0, float u1, float u2, vec3 *wi,
+                           vec3 *weight, float *pdf, bool *delta)
+{
+    if (u0 >= sh->opaque) { /* straight through (dissolve) */
+        *wi = v3_neg(wo);
+        *weight = v3s(1.0f);
+        *pdf = 0.0f;
+        *delta = true;
+        return true;
+    }
+    const float u[3] = {u0 / sh->opaque, u1, u2};
+    vec3 lo = onb_to_local(sh->frame, wo), li, w;
+    float p;
+    bool d;
+    if (!pbsdf_sample(&sh->b, lo, u, &li, &w, &p, &d)) return false;
+    vec3 out = v3_norm(onb_to_world(sh->frame, li));
+    /* reflection stays on the side of the incoming ray, transmission crosses:
+     * by the geometric normal, so that shading normals never leak light */
+    const bool transmit = li.z * lo.z < 0.0f;
+    if (transmit ? v3_dot(out, sf->ng) >= 0.0f : v3_dot(out, sf->ng) <= 0.0f) return false;
+    *wi = out;
+    *weight = w;
+    *pdf = d ? 0.0f : p * sh->opaque;
+    *delta = d;
+    return true;
+}
+
+/* ---- lights ------------------------------------------------------------------- */
+
+/* Solid-angle pdf of sampling the point q (normal nq, on light l) from p by
+ * light sampling, the choice of the light excluded. */
+static inline PK_HD float light_pdf_dir(const path_tracer *pt, const light *l, vec3 p, vec3 q, vec3 nq)
+{
+    const pk_scene *s = pt->f->s;
+    vec3 d = v3_sub(q, p);
+    float dist2 = v3_len2(d);
+    if (!(dist2 > 0.0f)) return 0.0f;
+    if (l->kind == LIGHT_SPHERE) {
+        const sphere *sp = &s->spheres[l->index];
+        float dc2 = v3_len2(v3_sub(sp->center, p)), r2 = sp->radius * sp->radius;
+        if (dc2 > r2 * 1.0001f) { /* outside: uniform in the cone of the sphere */
+            float sin2 = r2 / dc2, cos_max = sqrtf(fmaxf(0.0f, 1.0f - sin2));
+            float one_minus = sin2 / (1.0f + cos_max);
+            return 1.0f / (2.0f * PK_PI * one_minus);
+        }
+    }
+    /* uniform by area, converted to solid angle */
+    float cos_l = fabsf(v3_dot(nq, v3_scale(d, 1.0f / sqrtf(dist2))));
+    if (!(cos_l > 0.0f) || !(l->area > 0.0f)) return 0.0f;
+    return dist2 / (cos_l * l->area);
+}
+
+typedef struct light_sample {
+    vec3 wi;       /* unit direction from p to the light */
+    vec3 le;       /* radiance (or intensity / dist^2 for point lights) arriving at p */
+    float pdf;     /* solid angle, the light's choice included; 1 for point lights */
+    bool delta;
+    ray shadow;
+} light_sample;
+
+static inline PK_HD bool sample_light(const path_tracer *pt, vec3 o, vec3 p, float u0, float u1, float u2, light_sample *ls)
+{
+    const light_set *set = &pt->lights;
+    const pk_scene *s = pt->f->s;
+    if (set->n == 0) return false;
+    size_t li = light_set_pick(set, u0);
+    const light *l = &set->lights[li];
+    const float psel = set->pmf[li];
+    if (!(psel > 0.0f)) return false;
+    vec3 q, nq, le;
+    float pdf;
+    if (l->kind == LIGHT_ENV || l->kind == LIGHT_SUN) { /* a direction toward the surroundings */
+        const env_light *e = &pt->f->env;
+        vec3 d;
+        if (l->kind == LIGHT_ENV) {
+            if (!env_sample(e, u1, u2, &d, &le, &pdf)) return false;
+        } else {
+            d = sun_sample(e, u1, u2);
+            le = e->sun_le, pdf = sun_pdf(e);
+        }
+        ls->wi = d;
+        ls->le = le;
+        ls->pdf = psel * pdf;
+        ls->delta = false;
+        ls->shadow = (ray){o, 0.0f, d, INFINITY};
+        return true;
+    }
+    if (l->kind == LIGHT_POINT) {
+        const point_light *pl = &s->lights[l->index];
+        vec3 d = v3_sub(pl->position, o);
+        float dist2 = v3_len2(d);
+        if (!(dist2 > 0.0f)) return false;
+        ls->wi = v3_scale(d, 1.0f / sqrtf(dist2));
+        ls->le = v3_scale(pl->intensity, 1.0f / dist2);
+        ls->pdf = psel;
+        ls->delta = true;
+        ls->shadow = (ray){o, 0.0f, d, 1.0f};
+        return true;
+    }
+    const material *m;
+    if (l->kind == LIGHT_TRIANGLE) {
+        vec3 a, b, c;
+        scene_tri_verts(s, l->index, &a, &b, &c);
+        q = sample_triangle(a, b, c, u1, u2);
+        nq = l->normal;
+        m = &s->materials[s->tris[l->index].material];
+        vec3 toward = v3_sub(p, q);
+        bool front = v3_dot(nq, toward) > 0.0f;
+        if (!front && !m->two_sided) return false;
+    } else {
+        const sphere *sp = &s->spheres[l->index];
+        m = &s->materials[sp->material];
+        vec3 dc = v3_sub(sp->center, p);
+        float dc2 = v3_len2(dc), r2 = sp->radius * sp->radius;
+        if (dc2 > r2 * 1.0001f) {
+            /* a direction uniform in the cone, then the point where it meets the sphere */
+            float dcl = sqrtf(dc2), sin2 = r2 / dc2, cos_max = sqrtf(fmaxf(0.0f, 1.0f - sin2));
+            float one_minus = sin2 / (1.0f + cos_max);
+            float cos_t = 1.0f - u1 * one_minus, sin_t = sqrtf(fmaxf(0.0f, 1.0f - cos_t * cos_t));
+            float phi = 2.0f * PK_PI * u2;
+            vec3 w = v3_scale(dc, 1.0f / dcl);
+            vec3 t = fabsf(w.x) > 0.5f ? v3(-w.y, w.x, 0.0f) : v3(0.0f, -w.z, w.y);
+            t = v3_norm(t);
+            vec3 bb = v3_cross(w, t);
+            vec3 dir = v3_add(v3_add(v3_scale(t, sin_t * cosf(phi)), v3_scale(bb, sin_t * sinf(phi))), v3_scale(w, cos_t));
+            /* nearest intersection of p + s dir with the sphere */
+            float bq = v3_dot(dir, dc), disc = bq * bq - (dc2 - r2);
+            float sdist = bq - sqrtf(fmaxf(0.0f, disc));
+            q = v3_add(p, v3_scale(dir, sdist));
+            nq = v3_norm_scaled(v3_sub(q, sp->center)); /* seen from outside: the emitting side */
+        } else {
+            /* inside: uniform on the sphere, seen from within (its back) */
+            float z = 1.0f - 2.0f * u1, rr = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = 2.0f * PK_PI * u2;
+            nq = v3(rr * cosf(phi), rr * sinf(phi), z);
+            q = v3_add(sp->center, v3_scale(nq, sp->radius));
+            if (!m->two_sided) return false;
+        }
+    }
+    le = m->ke;
+    pdf = light_pdf_dir(pt, l, p, q, nq);
+    if (!(pdf > 0.0f) || !isfinite(pdf)) return false;
+    vec3 d = v3_sub(q, o);
+    float dist2 = v3_len2(d);
+    if (!(dist2 > 0.0f)) return false;
+    ls->wi = v3_scale(d, 1.0f / sqrtf(dist2));
+    ls->le = le;
+    ls->pdf = psel * pdf;
+    ls->delta = false;
+    ls->shadow = (ray){o, 0.0f, d, 1.0f - SHADOW_SHORTEN};
+    return true;
+}
+
+/* What a path leaving the scene toward d (unit) gathers from the
+ * environment and the sun, each weighted by MIS against its light
+ * sampling when the last bounce was not a delta one. */
+static inline PK_HD vec3 leaving(const path_tracer *pt, vec3 d, bool prev_delta, float prev_pdf)
+{
+    const env_light *e = &pt->f->env;
+    const light_set *ls = &pt->lights;
+    vec3 L = v3s(0.0f);
+    const int parts[2] = {ls->env, ls->sun};
+    for (int k = 0; k < 2; k++) {
+        if (parts[k] < 0) continue;
+        vec3 le;
+        float pl;
+        if (k == 0) {
+            le = env_eval(e, d);
+            pl = prev_delta ? 0.0f : env_pdf(e, d);
+        } else {
+            if (!sun_covers(e, d)) continue;
+            le = e->sun_le;
+            pl = sun_pdf(e);
+        }
+        float w = 1.0f;
+        if (!prev_delta && pt->strategy == PATH_LIGHTS_ONLY) w = 0.0f;
+        if (!prev_delta && pt->strategy == PATH_MIS) w = power_heuristic(prev_pdf, ls->pmf[parts[k]] * pl);
+        L = v3_add(L, v3_scale(le, w));
+    }
+    return L;
+}
+
+/* ---- the path ------------------------------------------------------------------ */
+
+static inline PK_HD vec3 path_li(const path_tracer *pt, path_thread *t, sampler *smp, const ray *r0, const hit *h0)
+{
+    const frame *fr = pt->f;
+    const pk_scene *s = fr->s;
+    vec3 L = v3s(0.0f), beta = v3s(1.0f);
+    ray r = *r0;
+    hit h = *h0;
+    bool prev_delta = true; /* the camera: emission is counted in full */
+    float prev_pdf = 0.0f;
+    vec3 prev_p = r.o;
+    float cone = 0.0f; /* the ray cone's width where the path left the last vertex */
+    for (int depth = 0;; depth++) {
+        if (s->has_cutout && !path_past_holes(pt, t, &r, &h)) { /* through map_d holes, out */
+            L = v3_add(L, v3_mul(beta, leaving(pt, v3_norm(r.d), prev_delta, prev_pdf)));
+            break;
+        }
+        surface sf = surface_at(s, &r, &h);
+        material textured;
+        if (s->has_textured) { /* the ray cone, widened by the distance travelled */
+            cone += pt->spread * h.t * v3_len(r.d);
+            if (sf.m->textured) sf = surface_texture(s, &r, &h, cone, sf, &textured);
+        }
+        const vec3 wo = v3_neg(v3_norm(r.d));
+        /* emission reached by the path */
+        vec3 le = emitted(&sf);
+        if (!black(le)) {
+            float w = 1.0f;
+            if (!prev_delta && pt->strategy == PATH_LIGHTS_ONLY) w = 0.0f; /* light sampling found it */
+            if (!prev_delta && pt->strategy == PATH_MIS) {
+                int32_t li = pt->lights.of_prim[h.prim];
+                if (li >= 0) {
+                    const light *l = &pt->lights.lights[li];
+                    float pl = pt->lights.pmf[li] * light_pdf_dir(pt, l, prev_p, sf.p,
+                                                                   l->kind == LIGHT_TRIANGLE ? l->normal : sf.ng);
+                    w = power_heuristic(prev_pdf, pl);
+                }
+            }
+            L = v3_add(L, v3_mul(beta, v3_scale(le, w)));
+        }
+        if (depth >= pt->max_depth) break;
+        const shading sh = shading_at(&sf);
+        float u0, u1, u2, u3, u4, u5;
+        sampler_2d(smp, &u0, &u1);
+        sampler_2d(smp, &u2, &u3);
+        sampler_2d(smp, &u4, &u5);
+        /* next-event estimation: one light, chosen by power */
+        if (sh.nondelta && pt->lights.n && pt->strategy != PATH_BSDF_ONLY) {
+            light_sample ls;
+            vec3 o = offset_origin(fr->eps, sf.p, sf.ng);
+            if (sample_light(pt, o, sf.p, u0, u1, u2, &ls)) {
+                float pb;
+                vec3 f = shading_eval(&sf, &sh, wo, ls.wi, &pb);
+                if (!black(f)) {
+                    t->rays_shadow++;
+                    const bool blocked = path_occluded(pt, t, &ls.shadow);
+                    if (!blocked) {
+                        float w = ls.delta || pt->strategy == PATH_LIGHTS_ONLY ? 1.0f : power_heuristic(ls.pdf, pb);
+                        L = v3_add(L, v3_mul(beta, v3_scale(v3_mul(f, ls.le), w / ls.pdf)));
+                    }
+                }
+            }
+        }
+        /* the next direction, from the material */
+        vec3 wi, weight;
+        float pdf;
+        bool delta;
+        if (!shading_sample(&sf, &sh, wo, u3, u4, u5, &wi, &weight, &pdf, &delta)) break;
+        beta = v3_mul(beta, weight);
+        if (black(beta) || !v3_finite(beta)) break;
+        /* Russian roulette on the throughput: a path carrying less than 1
+         * survives with probability max(beta) and is weighted up by its
+         * inverse (unbiased) */
+        if (depth + 1 >= RR_START) {
+            float q = v3_max_comp(beta);
+            if (q < 1.0f) {
+                if (sampler_1d(smp) >= q) break;
+                beta = v3_scale(beta, 1.0f / q);
+            }
+        }
+        const bool below = v3_dot(wi, sf.ng) < 0.0f;
+        r = (ray){offset_origin(fr->eps, sf.p, below ? v3_neg(sf.ng) : sf.ng), 0.0f, wi, INFINITY};
+        prev_delta = delta;
+        prev_pdf = pdf;
+        prev_p = sf.p;
+        t->rays_bounce++;
+        if (!PATH_TRACE(pt, t, &r, &h)) {
+            L = v3_add(L, v3_mul(beta, leaving(pt, wi, prev_delta, prev_pdf)));
+            break;
+        }
+    }
+    return L;
+}
+
+/* ---- camera samples -------------------------------------------------------------- */
+
+/* The camera ray of sample index of pixel (px, py): the sampler's first two
+ * dimensions place it in the pixel. */
+static inline PK_HD ray path_camera_ray(const path_tracer *pt, const camera_frame *cf, int px, int py, uint32_t index)
+{
+    sampler sm = sampler_start((uint32_t)px, (uint32_t)py, index, pt->seed);
+    float jx, jy;
+    sampler_2d(&sm, &jx, &jy);
+    return camera_ray(cf, (float)px + jx, (float)py + jy);
+}
+
+/* What sample index of pixel (px, py) sees along its camera ray r, whose
+ * closest hit is *h (NULL: it left the scene and sees the surroundings).
+ * False for a lost sample (not finite), which the caller leaves out rather
+ * than let it poison the pixel. */
+static inline PK_HD bool path_camera_sample(const path_tracer *pt, path_thread *t, int px, int py, uint32_t index,
+                                            const ray *r, const hit *h, vec3 *out)
+{
+    if (!h) {
+        *out = env_background(&pt->f->env, v3_norm(r->d));
+        return true;
+    }
+    sampler sm = sampler_start((uint32_t)px, (uint32_t)py, index, pt->seed);
+    sm.dim = 2; /* the pixel position */
+    const vec3 c = path_li(pt, t, &sm, r, h);
+    if (!v3_finite(c)) return false;
+    *out = c;
+    return true;
+}
+
+#endif
