@@ -21,6 +21,7 @@ enum {
     OPT_EXPOSURE,
     OPT_INT, /* an integer render option of the library's table */
     OPT_ACCEL,
+    OPT_DEVICE,
     OPT_INTEGRATOR,
     OPT_FRESNEL,
     OPT_LOOK_FROM,
@@ -75,8 +76,11 @@ const cli_option *cli_render_options(size_t *n)
         add((cli_option){.name = "accel", .id = OPT_ACCEL, .kind = CLI_STRING, .arg = "NAME",
                          .help = "the acceleration structure: bvh (default: binned SAH, wide SIMD BVH), midpoint "
                                  "(simple BVH, for comparison), none (every ray tests every primitive), embree "
-                                 "(Embree 3, when built with it); all give the same image (cuda, the GPU, traces "
-                                 "rays for bench rays only)"});
+                                 "(Embree 3, when built with it); all give the same image; cuda: render on the "
+                                 "GPU (as --device cuda)"});
+        add((cli_option){.name = "device", .id = OPT_DEVICE, .kind = CLI_STRING, .arg = "cpu|cuda",
+                         .help = "where to render: cpu (default) or cuda (an NVIDIA GPU: the path tracer, "
+                                 "triangles only; the same image as the CPU's up to noise)"});
         add((cli_option){.name = "integrator", .id = OPT_INTEGRATOR, .kind = CLI_STRING, .arg = "NAME",
                          .help = "path (default: path tracing, global illumination, one-sided area lights) or "
                                  "whitted (direct light, mirrors and glass; emitters two-sided)"});
@@ -204,6 +208,19 @@ int cli_render_parse(int argc, char **argv, cli_render_opts *o, void (*help)(FIL
                                        o->accel == PK_ACCEL_CUDA ? "rebuild where nvcc is, with -DPK_WITH_CUDA=ON"
                                                                  : "install libembree-dev and rebuild");
             o->has_accel = 1;
+            break;
+        case OPT_DEVICE:
+            if (strcmp(v, "cuda") == 0) {
+                if (!pk_accel_available(PK_ACCEL_CUDA))
+                    return cli_usage_error("--device cuda: not available in this build (rebuild where nvcc is, "
+                                           "with -DPK_WITH_CUDA=ON)");
+                o->accel = PK_ACCEL_CUDA;
+                o->has_accel = 1;
+            } else if (strcmp(v, "cpu") == 0) {
+                if (o->has_accel && o->accel == PK_ACCEL_CUDA) o->has_accel = 0;
+            } else {
+                return cli_usage_error("--device: unknown device '%s' (cpu, cuda)", v);
+            }
             break;
         case OPT_INTEGRATOR:
             if (pk_integrator_parse(v, &o->integrator) != PK_OK)

@@ -302,9 +302,9 @@ static pk_status check_options(pk_context *ctx, const pk_render_options *o)
     pk_status st = options_check(ctx, o);
     if (st != PK_OK) return st;
     if (!pk_accel_available(o->accel)) return accel_unavailable(ctx, o->accel);
-    if (o->accel == PK_ACCEL_CUDA)
-        return ctx_error(ctx, PK_ERR_UNSUPPORTED, "accelerator 'cuda': the GPU traces rays for bench rays only; "
-                                                  "rendering on the GPU is not there yet");
+    if (o->accel == PK_ACCEL_CUDA && o->integrator == PK_INTEGRATOR_WHITTED)
+        return ctx_error(ctx, PK_ERR_UNSUPPORTED, "device 'cuda': the GPU renders with the path tracer only, not "
+                                                  "the Whitted integrator");
     return PK_OK;
 }
 

@@ -12,4 +12,9 @@
 #define PK_HD
 #endif
 
+/* C11's static assertion, under nvcc (C++) */
+#if defined(__cplusplus) && !defined(_Static_assert)
+#define _Static_assert static_assert
+#endif
+
 #endif

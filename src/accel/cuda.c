@@ -469,6 +469,88 @@ pk_status accel_cuda_create(pk_context *ctx, const accel_input *in, accel **out)
     return PK_OK;
 }
 
+
+/* ---- the device, for the module's other kernels (the GPU path tracer) ---------- */
+
+static cuda_accel *as_cuda(const accel *a) { return (cuda_accel *)(uintptr_t)a; }
+
+pk_status cuda_device_alloc(const accel *a, const void *src, size_t bytes, uint64_t *out)
+{
+    cuda_accel *c = as_cuda(a);
+    *out = 0;
+    if (bytes == 0) return PK_OK;
+    CUresult e = cu.CtxSetCurrent(c->pctx);
+    if (e != CUDA_SUCCESS) return cu_fail(c->ctx, "cuCtxSetCurrent", e);
+    size_t free_b = 0, total = 0;
+    if ((e = cu.MemGetInfo(&free_b, &total)) != CUDA_SUCCESS) return cu_fail(c->ctx, "cuMemGetInfo", e);
+    if (bytes > free_b)
+        return ctx_error(c->ctx, PK_ERR_NOMEM, "device 'cuda': not enough device memory: %s more needed, %s free of %s",
+                         size_str(bytes).s, size_str(free_b).s, size_str(total).s);
+    CUdeviceptr p = 0;
+    if ((e = cu.MemAlloc(&p, bytes)) != CUDA_SUCCESS)
+        return ctx_error(c->ctx, PK_ERR_NOMEM, "device 'cuda': cannot allocate %s: %s", size_str(bytes).s, cu_error(e));
+    if (src && (e = cu.MemcpyHtoD(p, src, bytes)) != CUDA_SUCCESS) {
+        cu.MemFree(p);
+        return cu_fail(c->ctx, "copying the scene to the device", e);
+    }
+    *out = (uint64_t)p;
+    return PK_OK;
+}
+
+void cuda_device_free(const accel *a, uint64_t p)
+{
+    if (!p) return;
+    cuda_accel *c = as_cuda(a);
+    cu.CtxSetCurrent(c->pctx);
+    cu.MemFree((CUdeviceptr)p);
+}
+
+pk_status cuda_device_copy(const accel *a, void *host, uint64_t dev, size_t bytes, bool to_device)
+{
+    cuda_accel *c = as_cuda(a);
+    CUresult e = cu.CtxSetCurrent(c->pctx);
+    if (e == CUDA_SUCCESS)
+        e = to_device ? cu.MemcpyHtoD((CUdeviceptr)dev, host, bytes) : cu.MemcpyDtoH(host, (CUdeviceptr)dev, bytes);
+    return e == CUDA_SUCCESS ? PK_OK : cu_fail(c->ctx, to_device ? "copying to the device" : "copying from the device", e);
+}
+
+pk_status cuda_device_launch(const accel *a, const char *kernel, size_t threads, unsigned block, void **params,
+                             double *ms)
+{
+    cuda_accel *c = as_cuda(a);
+    CUfunction f;
+    CUresult e = cu.CtxSetCurrent(c->pctx);
+    if (e != CUDA_SUCCESS) return cu_fail(c->ctx, "cuCtxSetCurrent", e);
+    if ((e = cu.ModuleGetFunction(&f, c->module, kernel)) != CUDA_SUCCESS)
+        return cu_fail(c->ctx, "finding the kernels", e);
+    const size_t grid = (threads + block - 1) / block;
+    if (grid == 0) return PK_OK;
+    if (grid > 0x7fffffffu) return ctx_error(c->ctx, PK_ERR_LIMIT, "device 'cuda': %zu threads are too many", threads);
+    pthread_mutex_lock(&c->lock);
+    if ((e = cu.EventRecord(c->ev[0], NULL)) == CUDA_SUCCESS &&
+        (e = cu.LaunchKernel(f, (unsigned)grid, 1, 1, block, 1, 1, 0, NULL, params, NULL)) == CUDA_SUCCESS &&
+        (e = cu.EventRecord(c->ev[1], NULL)) == CUDA_SUCCESS)
+        e = cu.EventSynchronize(c->ev[1]);
+    float t = 0.0f;
+    if (e == CUDA_SUCCESS && ms) *ms = cu.EventElapsedTime(&t, c->ev[0], c->ev[1]) == CUDA_SUCCESS ? (double)t : 0.0;
+    pthread_mutex_unlock(&c->lock);
+    if (e != CUDA_SUCCESS) {
+        char what[96];
+        snprintf(what, sizeof what, "the kernel %s", kernel);
+        return cu_fail(c->ctx, what, e);
+    }
+    return PK_OK;
+}
+
+void cuda_device_bvh(const accel *a, uint64_t *nodes, uint64_t *tris)
+{
+    const cuda_accel *c = as_cuda(a);
+    *nodes = (uint64_t)c->d_nodes;
+    *tris = (uint64_t)c->d_tris;
+}
+
+const char *cuda_device_name(const accel *a) { return as_cuda(a)->stats.device; }
+
 #else /* no CUDA at build time */
 
 bool accel_cuda_built(void) { return false; }
@@ -479,6 +561,36 @@ pk_status accel_cuda_create(pk_context *ctx, const accel_input *in, accel **out)
     *out = NULL;
     return ctx_error(ctx, PK_ERR_UNSUPPORTED,
                      "accelerator 'cuda' is not available in this build (configure where nvcc is, with -DPK_WITH_CUDA=ON)");
+}
+
+
+pk_status cuda_device_alloc(const accel *a, const void *src, size_t bytes, uint64_t *out)
+{
+    (void)a, (void)src, (void)bytes;
+    *out = 0;
+    return PK_ERR_UNSUPPORTED;
+}
+void cuda_device_free(const accel *a, uint64_t p) { (void)a, (void)p; }
+pk_status cuda_device_copy(const accel *a, void *host, uint64_t dev, size_t bytes, bool to_device)
+{
+    (void)a, (void)host, (void)dev, (void)bytes, (void)to_device;
+    return PK_ERR_UNSUPPORTED;
+}
+pk_status cuda_device_launch(const accel *a, const char *kernel, size_t threads, unsigned block, void **params,
+                             double *ms)
+{
+    (void)a, (void)kernel, (void)threads, (void)block, (void)params, (void)ms;
+    return PK_ERR_UNSUPPORTED;
+}
+void cuda_device_bvh(const accel *a, uint64_t *nodes, uint64_t *tris)
+{
+    (void)a;
+    *nodes = *tris = 0;
+}
+const char *cuda_device_name(const accel *a)
+{
+    (void)a;
+    return "";
 }
 
 #endif

@@ -22,7 +22,7 @@ PK_HIDDEN pk_status lights_build(pk_context *ctx, const pk_scene *s, light_table
 PK_HIDDEN void lights_free(const pk_allocator *al, light_table *lt);
 
 /* The light whose CDF interval holds u in [0, 1) (lt->n > 0). */
-static inline size_t light_pick(const light_table *lt, float u) { return cdf_pick(lt->cdf, lt->n, u); }
+static inline PK_HD size_t light_pick(const light_table *lt, float u) { return cdf_pick(lt->cdf, lt->n, u); }
 
 /* ---- every light, for the path tracer ------------------------------------ */
 
@@ -50,6 +50,6 @@ typedef struct light_set {
 PK_HIDDEN pk_status light_set_build(pk_context *ctx, const pk_scene *s, const env_light *env, light_set *ls);
 PK_HIDDEN void light_set_free(const pk_allocator *al, light_set *ls);
 
-static inline size_t light_set_pick(const light_set *ls, float u) { return cdf_pick(ls->cdf, ls->n, u); }
+static inline PK_HD size_t light_set_pick(const light_set *ls, float u) { return cdf_pick(ls->cdf, ls->n, u); }
 
 #endif

@@ -11,6 +11,7 @@
 
 #include "camera.h"
 #include "path.h"
+#include "path_gpu.h"
 #include "sampling.h"
 #include "surface.h"
 #include "whitted.h"
@@ -33,6 +34,7 @@ struct pk_renderer {
     whitted_thread *ts;     /* nt entries */
     path_tracer pt;
     path_thread *pts;       /* nt entries */
+    path_gpu *gpu;          /* the path tracer on the GPU (accel PK_ACCEL_CUDA), else NULL */
     pk_camera cam;
     uint32_t pass;          /* sample numbers start at pass * spp */
     pk_stats total;         /* since creation */
@@ -131,6 +133,10 @@ pk_status renderer_create(pk_context *ctx, const pk_scene *s, const pk_render_op
         }
         r->pt.spread = spread;
         for (int t = 0; t < r->nt; t++) r->pts[t].cp = opt->collect_stats ? &r->pts[t].counters : NULL;
+        if (opt->accel == PK_ACCEL_CUDA && (st = path_gpu_create(ctx, &r->pt, &r->gpu)) != PK_OK) {
+            renderer_destroy(r);
+            return st;
+        }
     } else {
         for (int t = 0; t < r->nt; t++)
             if ((st = whitted_thread_init(ctx, &r->w, &r->ts[t], opt->collect_stats != 0)) != PK_OK) {
@@ -155,6 +161,7 @@ void renderer_destroy(pk_renderer *r)
         for (int t = 0; t < r->nt; t++) whitted_thread_free(al, &r->ts[t]);
     mem_free(al, r->ts);
     mem_free(al, r->pts);
+    path_gpu_destroy(r->gpu);
     path_free(al, &r->pt);
     frame_free(al, &r->fr);
     mem_free(al, r);
@@ -168,9 +175,8 @@ void renderer_stats(const pk_renderer *r, pk_stats *stats) { *stats = r->total; 
 void renderer_set_path_strategy(pk_renderer *r, int strategy) { r->pt.strategy = strategy; }
 void renderer_set_pass(pk_renderer *r, uint32_t pass) { r->pass = pass; }
 
-typedef struct tile {
-    int x, y, w, h;
-} tile;
+typedef gpu_tile tile; /* x, y, w, h: at most TILE x TILE */
+_Static_assert(TILE * TILE == GPU_TILE_PIXELS, "tiles of the GPU");
 
 static bool regions_overlap(const pk_region *a, const pk_region *b)
 {
@@ -316,6 +322,59 @@ static void render_tile_aovs(const pk_renderer *r, const camera_frame *cf, const
         if (film->aovs & (1u << k)) film_add_aov_block(film, k, tl->x, tl->y, tl->w, tl->h, v[k]);
 }
 
+/* ---- on the GPU ------------------------------------------------------------------ */
+
+typedef struct gpu_progress {
+    const pk_renderer *r;
+    uint64_t ntiles;
+    double t1;
+} gpu_progress;
+
+/* Progress in tiles: the fraction of the samples done, of every tile. */
+static bool gpu_progress_fn(void *user, uint64_t done, uint64_t total)
+{
+    const gpu_progress *p = user;
+    const pk_render_options *opt = &p->r->opt;
+    if (opt->cancel && *opt->cancel) return false;
+    if (!opt->progress) return true;
+    const uint64_t tiles = p->ntiles * done / total;
+    return opt->progress(opt->progress_user, tiles < p->ntiles ? tiles : p->ntiles - 1, p->ntiles, time_now() - p->t1) == 0;
+}
+
+/* The tiles rendered by the GPU path tracer, then added to the film (and
+ * their AOVs computed on the CPU). A cancelled render adds nothing: every
+ * tile is then short of samples. */
+static pk_status render_gpu(pk_renderer *r, const tile *tiles, size_t ntiles, const camera_frame *cf, pk_film *film,
+                            double t1)
+{
+    const pk_render_options *opt = &r->opt;
+    if (ntiles > SIZE_MAX / (GPU_TILE_PIXELS * 3 * sizeof(float))) return ctx_nomem(r->ctx);
+    float *acc = mem_realloc_array(&r->ctx->alloc, NULL, ntiles * GPU_TILE_PIXELS * 3, sizeof(float));
+    if (!acc) return ctx_nomem(r->ctx);
+    gpu_progress gp = {r, (uint64_t)ntiles, t1};
+    if (opt->progress && opt->progress(opt->progress_user, 0, (uint64_t)ntiles, 0.0) != 0) {
+        mem_free(&r->ctx->alloc, acc);
+        return PK_ERR_CANCELLED;
+    }
+    uint64_t rays[3] = {0, 0, 0};
+    pk_status st = path_gpu_render(r->gpu, cf, tiles, ntiles, r->pass * (uint32_t)opt->spp, opt->spp, acc, rays,
+                                   gpu_progress_fn, &gp);
+    r->pts[0].rays_camera += rays[0];
+    r->pts[0].rays_bounce += rays[1];
+    r->pts[0].rays_shadow += rays[2];
+    if (st == PK_OK) {
+        const long n = (long)ntiles;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(r->nt)
+        for (long i = 0; i < n; i++) {
+            const tile *tl = &tiles[i];
+            film_add_block(film, tl->x, tl->y, tl->w, tl->h, &acc[(size_t)i * GPU_TILE_PIXELS * 3], (uint32_t)opt->spp);
+            if (film->aovs) render_tile_aovs(r, cf, tl, film);
+        }
+    }
+    mem_free(&r->ctx->alloc, acc);
+    return st;
+}
+
 pk_status renderer_render(pk_renderer *r, const pk_region *regions, size_t nregions, pk_film *film)
 {
     pk_context *ctx = r->ctx;
@@ -355,6 +414,20 @@ pk_status renderer_render(pk_renderer *r, const pk_region *regions, size_t nregi
         r->pts[t].cp = cp;
     }
     const camera_frame cf = camera_setup(&r->cam, opt->width, opt->height);
+    if (r->gpu) {
+        const double t0 = time_now();
+        st = render_gpu(r, tiles, ntiles, &cf, film, t0);
+        const double render_s = time_now() - t0;
+        mem_free(&ctx->alloc, tiles);
+        if (opt->progress && st == PK_OK) opt->progress(opt->progress_user, (uint64_t)ntiles, (uint64_t)ntiles, render_s);
+        r->total.rays_camera += r->pts[0].rays_camera;
+        r->total.rays_bounce += r->pts[0].rays_bounce;
+        r->total.rays_shadow += r->pts[0].rays_shadow;
+        r->total.render_s += render_s;
+        if (st == PK_OK) r->total.pixels += pixels;
+        if (st == PK_ERR_CANCELLED) return ctx_error(ctx, PK_ERR_CANCELLED, "render cancelled");
+        return st;
+    }
     volatile const int *cancel = opt->cancel;
     atomic_int stop = 0;      /* set when the progress callback asks to stop */
     atomic_long done = 0;     /* finished tiles */

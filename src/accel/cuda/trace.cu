@@ -32,3 +32,4 @@ extern "C" __global__ void __launch_bounds__(128) pk_trace_any(const gpu_node *_
     gpu_trace(nodes, tris, &r, true, &h, NULL);
     hits[i] = h;
 }
+#include "path.cu"

@@ -1,0 +1,91 @@
+/*
+ * path.cu - the GPU path tracer's kernels (see src/render/path_gpu.h): the
+ * CPU's sampling code (path_kernel.h) with rays traced by gpu_trace of
+ * bvh_gpu.h, one thread per pixel, a few samples per launch. Included by
+ * trace.cu (one module).
+ */
+#include "render/path.h"
+
+/* closest and any hit on the device BVH of the path tracer's copy */
+static __device__ __forceinline__ bool path_gpu_trace(const path_tracer *pt, const ray *r, hit *h, bool any)
+{
+    return gpu_trace((const gpu_node *)pt->gpu_nodes, (const gpu_tri *)pt->gpu_tris, (const pk_ray *)r, any,
+                     (pk_hit *)h, NULL);
+}
+static __device__ __forceinline__ bool path_gpu_occluded(const path_tracer *pt, const ray *r)
+{
+    hit h;
+    return path_gpu_trace(pt, r, &h, true);
+}
+#define PATH_TRACE(pt, t, r, h) path_gpu_trace((pt), (r), (h), false)
+#define PATH_OCCLUDED(pt, t, r) path_gpu_occluded((pt), (r))
+#include "render/path_gpu.h"
+#include "render/path_kernel.h"
+
+/* The sizes of the structures the host copies, as laid out here (path_gpu.c
+ * compares them with its own). */
+extern "C" __global__ void pk_path_layout(unsigned long long *out)
+{
+    if (threadIdx.x != 0 || blockIdx.x != 0) return;
+    out[0] = sizeof(pk_scene);
+    out[1] = sizeof(material);
+    out[2] = sizeof(texture);
+    out[3] = sizeof(env_light);
+    out[4] = sizeof(light_set);
+    out[5] = sizeof(path_tracer);
+    out[6] = sizeof(frame);
+    out[7] = sizeof(camera_frame);
+}
+
+/* Samples first..first+n-1 of pixel (thread % 256) of tile (thread / 256):
+ * their sum is written to (accumulate = 0) or added to acc; rays counts
+ * camera, bounce and shadow rays. */
+extern "C" __global__ void __launch_bounds__(128) pk_path_render(const path_tracer *__restrict__ pt, camera_frame cf,
+                                                                 const gpu_tile *__restrict__ tiles, unsigned nthreads,
+                                                                 unsigned first, unsigned n, int accumulate,
+                                                                 float *__restrict__ acc, unsigned long long *rays)
+{
+    const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
+    if (i >= nthreads) return;
+    const gpu_tile tl = tiles[i / GPU_TILE_PIXELS];
+    const int k = (int)(i % GPU_TILE_PIXELS);
+    path_thread t;
+    t.rays_camera = t.rays_bounce = t.rays_shadow = 0;
+    t.cp = NULL;
+    float sx = 0.0f, sy = 0.0f, sz = 0.0f;
+    if (k < tl.w * tl.h) {
+        const int px = tl.x + k % tl.w, py = tl.y + k / tl.w;
+        for (unsigned s = 0; s < n; s++) {
+            const uint32_t index = first + s;
+            const ray r = path_camera_ray(pt, &cf, px, py, index);
+            hit h;
+            const bool got = path_gpu_trace(pt, &r, &h, false);
+            t.rays_camera++;
+            vec3 c;
+            if (path_camera_sample(pt, &t, px, py, index, &r, got ? &h : NULL, &c)) {
+                sx += c.x;
+                sy += c.y;
+                sz += c.z;
+            }
+        }
+    }
+    float *a = &acc[3 * (size_t)i];
+    if (accumulate) {
+        sx += a[0];
+        sy += a[1];
+        sz += a[2];
+    }
+    a[0] = sx, a[1] = sy, a[2] = sz;
+    /* one atomic per warp and counter */
+    unsigned long long c0 = t.rays_camera, c1 = t.rays_bounce, c2 = t.rays_shadow;
+    for (int off = 16; off > 0; off >>= 1) {
+        c0 += __shfl_down_sync(0xffffffffu, c0, off);
+        c1 += __shfl_down_sync(0xffffffffu, c1, off);
+        c2 += __shfl_down_sync(0xffffffffu, c2, off);
+    }
+    if ((threadIdx.x & 31) == 0) {
+        atomicAdd(&rays[0], c0);
+        atomicAdd(&rays[1], c1);
+        atomicAdd(&rays[2], c2);
+    }
+}
