@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # test_cuda_errors.sh - `--accel cuda` fails cleanly where it cannot run: no
 # driver, no device, a driver too old for the kernels, too little device
-# memory, a kernel that fails, and rendering (not there yet). Each is exit
+# memory, a kernel that fails, and rendering on the GPU. Each is exit
 # status 1, one line on stderr ("paprsek: ..." saying what is wrong),
 # nothing on stdout and no hit file. The driver is replaced by a stub
 # (cuda_stub.c, through PAPRSEK_CUDA_LIBRARY) that plays each failure, so
@@ -69,10 +69,17 @@ PK_CUDA_STUB=nomem expect_failure "too little memory" "not enough device memory 
 PK_CUDA_STUB=kernelfail expect_failure "kernel failure" "the traversal kernel failed: unspecified launch failure" \
     "${rays[@]}"
 PK_CUDA_STUB=kernelfail expect_failure "kernel failure, any-hit" "the traversal kernel failed" "${rays[@]}" --any-hit
-# a device that works is no reason to render on it (yet)
-PK_CUDA_STUB=kernelfail expect_failure "render" "rendering on the GPU is not there yet" \
-    "$bin" render "$scene" -o "$tmp/h.hits.png" --accel cuda --width 8 --height 8
+# rendering on the GPU: the same messages, and no image written
+PK_CUDA_STUB=kernelfail expect_failure "render, kernel failure" "the kernel pk_path_[a-z]+ failed: unspecified launch failure$" \
+    "$bin" render "$scene" -o "$tmp/h.hits.png" --device cuda --env 1 --width 8 --height 8
 [ -e "$tmp/h.hits.png" ] && fail "render: an image was written"
+PK_CUDA_STUB=nomem expect_failure "render, too little memory" "not enough device memory for the BVH: [0-9]+ bytes needed, 64 bytes free of 16384.0 MiB$" \
+    "$bin" render "$scene" -o "$tmp/h.hits.png" --device cuda --env 1 --width 8 --height 8
+[ -e "$tmp/h.hits.png" ] && fail "render: an image was written"
+PK_CUDA_STUB=nodevice expect_failure "render, no device" "no CUDA device$" \
+    "$bin" render "$scene" -o "$tmp/h.hits.png" --device cuda --env 1 --width 8 --height 8
+expect_failure "render, Whitted" "the GPU renders with the path tracer only, not the Whitted integrator$" \
+    "$bin" render "$scene" -o "$tmp/h.hits.png" --device cuda --integrator whitted --env 1 --width 8 --height 8
 
 [ "$fails" = 0 ] || { echo "$fails failure(s)"; exit 1; }
 echo "all ok"

@@ -534,12 +534,16 @@ static void test_public(pk_context *ctx)
     CHECK(pk_accel_get_device_info(pa, &di) == 0 && di.kernel_ms == 0.0 && di.device[0] == '\0');
     CHECK(pk_accel_get_device_info(NULL, &di) == 0 && pk_accel_get_device_info(pa, NULL) == 0);
     pk_accel_destroy(pa);
-    /* rendering with the GPU is refused with a message */
+    /* the GPU renders with the path tracer, not the Whitted integrator */
     pk_render_options o;
     pk_scene_get_render_options(s, &o);
     o.accel = PK_ACCEL_CUDA;
+    o.integrator = PK_INTEGRATOR_PATH;
+    CHECK(pk_render_options_check(ctx, &o) == (PK_HAVE_CUDA_BUILD ? PK_OK : PK_ERR_UNSUPPORTED));
+    pk_context_clear_error(ctx);
+    o.integrator = PK_INTEGRATOR_WHITTED;
     CHECK(pk_render_options_check(ctx, &o) == PK_ERR_UNSUPPORTED);
-    if (PK_HAVE_CUDA_BUILD) CHECK(strstr(pk_context_error(ctx), "rendering on the GPU is not there yet") != NULL);
+    if (PK_HAVE_CUDA_BUILD) CHECK(strstr(pk_context_error(ctx), "path tracer only") != NULL);
     pk_context_clear_error(ctx);
     pk_scene_destroy(s);
 }

@@ -32,4 +32,8 @@ extern "C" __global__ void __launch_bounds__(128) pk_trace_any(const gpu_node *_
     gpu_trace(nodes, tris, &r, true, &h, NULL);
     hits[i] = h;
 }
+
+/* the path tracer (left out to check the traversal's PTX alone: tests/cuda/test_cuda_ptx.sh) */
+#ifndef PK_TRAVERSAL_ONLY
 #include "path.cu"
+#endif
