@@ -316,97 +316,125 @@ static inline PK_HD vec3 leaving(const path_tracer *pt, vec3 d, bool prev_delta,
 
 /* ---- the path ------------------------------------------------------------------ */
 
-static inline PK_HD vec3 path_li(const path_tracer *pt, path_thread *t, sampler *smp, const ray *r0, const hit *h0)
+/* A path in progress: what it has gathered, its throughput, the ray it
+ * follows and that ray's closest hit, and what MIS needs of the vertex it
+ * left. */
+typedef struct path_state {
+    vec3 L, beta;
+    ray r;
+    hit h;
+    bool prev_delta;   /* the last bounce was a delta one (the camera counts as one) */
+    float prev_pdf;    /* its solid-angle pdf */
+    vec3 prev_p;       /* the vertex it left */
+    float cone;        /* the ray cone's width where the path left the last vertex */
+    int depth;
+    sampler smp;
+} path_state;
+
+/* The state of a path whose camera ray r hit at h, with the sampler of its
+ * pixel sample (past the pixel position). */
+static inline PK_HD void path_begin(path_state *ps, const ray *r, const hit *h, const sampler *smp)
+{
+    ps->L = v3s(0.0f);
+    ps->beta = v3s(1.0f);
+    ps->r = *r;
+    ps->h = *h;
+    ps->prev_delta = true; /* the camera: emission is counted in full */
+    ps->prev_pdf = 0.0f;
+    ps->prev_p = r->o;
+    ps->cone = 0.0f;
+    ps->depth = 0;
+    ps->smp = *smp;
+}
+
+/* One vertex of the path: the surface at its hit (emission, light sampling),
+ * then the next direction and its closest hit. False when the path has
+ * ended (ps->L is then its radiance). The CPU loops over it per sample; GPU
+ * threads that start a new path as soon as one ends run the same steps. */
+static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_state *ps)
 {
     const frame *fr = pt->f;
     const pk_scene *s = fr->s;
-    vec3 L = v3s(0.0f), beta = v3s(1.0f);
-    ray r = *r0;
-    hit h = *h0;
-    bool prev_delta = true; /* the camera: emission is counted in full */
-    float prev_pdf = 0.0f;
-    vec3 prev_p = r.o;
-    float cone = 0.0f; /* the ray cone's width where the path left the last vertex */
-    for (int depth = 0;; depth++) {
-        if (s->has_cutout && !path_past_holes(pt, t, &r, &h)) { /* through map_d holes, out */
-            L = v3_add(L, v3_mul(beta, leaving(pt, v3_norm(r.d), prev_delta, prev_pdf)));
-            break;
+    sampler *smp = &ps->smp;
+    if (s->has_cutout && !path_past_holes(pt, t, &ps->r, &ps->h)) { /* through map_d holes, out */
+        ps->L = v3_add(ps->L, v3_mul(ps->beta, leaving(pt, v3_norm(ps->r.d), ps->prev_delta, ps->prev_pdf)));
+        return false;
+    }
+    surface sf = surface_at(s, &ps->r, &ps->h);
+    material textured;
+    if (s->has_textured) { /* the ray cone, widened by the distance travelled */
+        ps->cone += pt->spread * ps->h.t * v3_len(ps->r.d);
+        if (sf.m->textured) sf = surface_texture(s, &ps->r, &ps->h, ps->cone, sf, &textured);
+    }
+    const vec3 wo = v3_neg(v3_norm(ps->r.d));
+    /* emission reached by the path */
+    vec3 le = emitted(&sf);
+    if (!black(le)) {
+        float w = 1.0f;
+        if (!ps->prev_delta && pt->strategy == PATH_LIGHTS_ONLY) w = 0.0f; /* light sampling found it */
+        if (!ps->prev_delta && pt->strategy == PATH_MIS) {
+            int32_t li = pt->lights.of_prim[ps->h.prim];
+            if (li >= 0) {
+                const light *l = &pt->lights.lights[li];
+                float pl = pt->lights.pmf[li] * light_pdf_dir(pt, l, ps->prev_p, sf.p,
+                                                               l->kind == LIGHT_TRIANGLE ? l->normal : sf.ng);
+                w = power_heuristic(ps->prev_pdf, pl);
+            }
         }
-        surface sf = surface_at(s, &r, &h);
-        material textured;
-        if (s->has_textured) { /* the ray cone, widened by the distance travelled */
-            cone += pt->spread * h.t * v3_len(r.d);
-            if (sf.m->textured) sf = surface_texture(s, &r, &h, cone, sf, &textured);
-        }
-        const vec3 wo = v3_neg(v3_norm(r.d));
-        /* emission reached by the path */
-        vec3 le = emitted(&sf);
-        if (!black(le)) {
-            float w = 1.0f;
-            if (!prev_delta && pt->strategy == PATH_LIGHTS_ONLY) w = 0.0f; /* light sampling found it */
-            if (!prev_delta && pt->strategy == PATH_MIS) {
-                int32_t li = pt->lights.of_prim[h.prim];
-                if (li >= 0) {
-                    const light *l = &pt->lights.lights[li];
-                    float pl = pt->lights.pmf[li] * light_pdf_dir(pt, l, prev_p, sf.p,
-                                                                   l->kind == LIGHT_TRIANGLE ? l->normal : sf.ng);
-                    w = power_heuristic(prev_pdf, pl);
+        ps->L = v3_add(ps->L, v3_mul(ps->beta, v3_scale(le, w)));
+    }
+    if (ps->depth >= pt->max_depth) return false;
+    const shading sh = shading_at(&sf);
+    float u0, u1, u2, u3, u4, u5;
+    sampler_2d(smp, &u0, &u1);
+    sampler_2d(smp, &u2, &u3);
+    sampler_2d(smp, &u4, &u5);
+    /* next-event estimation: one light, chosen by power */
+    if (sh.nondelta && pt->lights.n && pt->strategy != PATH_BSDF_ONLY) {
+        light_sample ls;
+        vec3 o = offset_origin(fr->eps, sf.p, sf.ng);
+        if (sample_light(pt, o, sf.p, u0, u1, u2, &ls)) {
+            float pb;
+            vec3 f = shading_eval(&sf, &sh, wo, ls.wi, &pb);
+            if (!black(f)) {
+                t->rays_shadow++;
+                const bool blocked = path_occluded(pt, t, &ls.shadow);
+                if (!blocked) {
+                    float w = ls.delta || pt->strategy == PATH_LIGHTS_ONLY ? 1.0f : power_heuristic(ls.pdf, pb);
+                    ps->L = v3_add(ps->L, v3_mul(ps->beta, v3_scale(v3_mul(f, ls.le), w / ls.pdf)));
                 }
             }
-            L = v3_add(L, v3_mul(beta, v3_scale(le, w)));
-        }
-        if (depth >= pt->max_depth) break;
-        const shading sh = shading_at(&sf);
-        float u0, u1, u2, u3, u4, u5;
-        sampler_2d(smp, &u0, &u1);
-        sampler_2d(smp, &u2, &u3);
-        sampler_2d(smp, &u4, &u5);
-        /* next-event estimation: one light, chosen by power */
-        if (sh.nondelta && pt->lights.n && pt->strategy != PATH_BSDF_ONLY) {
-            light_sample ls;
-            vec3 o = offset_origin(fr->eps, sf.p, sf.ng);
-            if (sample_light(pt, o, sf.p, u0, u1, u2, &ls)) {
-                float pb;
-                vec3 f = shading_eval(&sf, &sh, wo, ls.wi, &pb);
-                if (!black(f)) {
-                    t->rays_shadow++;
-                    const bool blocked = path_occluded(pt, t, &ls.shadow);
-                    if (!blocked) {
-                        float w = ls.delta || pt->strategy == PATH_LIGHTS_ONLY ? 1.0f : power_heuristic(ls.pdf, pb);
-                        L = v3_add(L, v3_mul(beta, v3_scale(v3_mul(f, ls.le), w / ls.pdf)));
-                    }
-                }
-            }
-        }
-        /* the next direction, from the material */
-        vec3 wi, weight;
-        float pdf;
-        bool delta;
-        if (!shading_sample(&sf, &sh, wo, u3, u4, u5, &wi, &weight, &pdf, &delta)) break;
-        beta = v3_mul(beta, weight);
-        if (black(beta) || !v3_finite(beta)) break;
-        /* Russian roulette on the throughput: a path carrying less than 1
-         * survives with probability max(beta) and is weighted up by its
-         * inverse (unbiased) */
-        if (depth + 1 >= RR_START) {
-            float q = v3_max_comp(beta);
-            if (q < 1.0f) {
-                if (sampler_1d(smp) >= q) break;
-                beta = v3_scale(beta, 1.0f / q);
-            }
-        }
-        const bool below = v3_dot(wi, sf.ng) < 0.0f;
-        r = (ray){offset_origin(fr->eps, sf.p, below ? v3_neg(sf.ng) : sf.ng), 0.0f, wi, INFINITY};
-        prev_delta = delta;
-        prev_pdf = pdf;
-        prev_p = sf.p;
-        t->rays_bounce++;
-        if (!PATH_TRACE(pt, t, &r, &h)) {
-            L = v3_add(L, v3_mul(beta, leaving(pt, wi, prev_delta, prev_pdf)));
-            break;
         }
     }
-    return L;
+    /* the next direction, from the material */
+    vec3 wi, weight;
+    float pdf;
+    bool delta;
+    if (!shading_sample(&sf, &sh, wo, u3, u4, u5, &wi, &weight, &pdf, &delta)) return false;
+    ps->beta = v3_mul(ps->beta, weight);
+    if (black(ps->beta) || !v3_finite(ps->beta)) return false;
+    /* Russian roulette on the throughput: a path carrying less than 1
+     * survives with probability max(beta) and is weighted up by its
+     * inverse (unbiased) */
+    if (ps->depth + 1 >= RR_START) {
+        float q = v3_max_comp(ps->beta);
+        if (q < 1.0f) {
+            if (sampler_1d(smp) >= q) return false;
+            ps->beta = v3_scale(ps->beta, 1.0f / q);
+        }
+    }
+    const bool below = v3_dot(wi, sf.ng) < 0.0f;
+    ps->r = (ray){offset_origin(fr->eps, sf.p, below ? v3_neg(sf.ng) : sf.ng), 0.0f, wi, INFINITY};
+    ps->prev_delta = delta;
+    ps->prev_pdf = pdf;
+    ps->prev_p = sf.p;
+    t->rays_bounce++;
+    if (!PATH_TRACE(pt, t, &ps->r, &ps->h)) {
+        ps->L = v3_add(ps->L, v3_mul(ps->beta, leaving(pt, wi, ps->prev_delta, ps->prev_pdf)));
+        return false;
+    }
+    ps->depth++;
+    return true;
 }
 
 /* ---- camera samples -------------------------------------------------------------- */
@@ -421,23 +449,41 @@ static inline PK_HD ray path_camera_ray(const path_tracer *pt, const camera_fram
     return camera_ray(cf, (float)px + jx, (float)py + jy);
 }
 
-/* What sample index of pixel (px, py) sees along its camera ray r, whose
- * closest hit is *h (NULL: it left the scene and sees the surroundings).
- * False for a lost sample (not finite), which the caller leaves out rather
- * than let it poison the pixel. */
-static inline PK_HD bool path_camera_sample(const path_tracer *pt, path_thread *t, int px, int py, uint32_t index,
-                                            const ray *r, const hit *h, vec3 *out)
+/* Starts sample index of pixel (px, py) along its camera ray r, whose
+ * closest hit is *h (NULL: it left the scene). True with *ps ready for
+ * path_step; false when the ray sees the surroundings, *bg. */
+static inline PK_HD bool path_start(const path_tracer *pt, int px, int py, uint32_t index, const ray *r, const hit *h,
+                                    path_state *ps, vec3 *bg)
 {
     if (!h) {
-        *out = env_background(&pt->f->env, v3_norm(r->d));
-        return true;
+        *bg = env_background(&pt->f->env, v3_norm(r->d));
+        return false;
     }
     sampler sm = sampler_start((uint32_t)px, (uint32_t)py, index, pt->seed);
     sm.dim = 2; /* the pixel position */
-    const vec3 c = path_li(pt, t, &sm, r, h);
-    if (!v3_finite(c)) return false;
-    *out = c;
+    path_begin(ps, r, h, &sm);
     return true;
+}
+
+/* A finished path's radiance; false for a lost sample (not finite), which
+ * the caller leaves out rather than let it poison the pixel. */
+static inline PK_HD bool path_result(const path_state *ps, vec3 *out)
+{
+    if (!v3_finite(ps->L)) return false;
+    *out = ps->L;
+    return true;
+}
+
+/* What sample index of pixel (px, py) sees along its camera ray r (path_start's
+ * arguments); false for a lost sample. */
+static inline PK_HD bool path_camera_sample(const path_tracer *pt, path_thread *t, int px, int py, uint32_t index,
+                                            const ray *r, const hit *h, vec3 *out)
+{
+    path_state ps;
+    if (!path_start(pt, px, py, index, r, h, &ps, out)) return true;
+    while (path_step(pt, t, &ps)) {
+    }
+    return path_result(&ps, out);
 }
 
 #endif

@@ -8,6 +8,8 @@
  * probability below 1e-3). Tolerances come from the measured spread of the
  * renders, nothing else.
  *
+ * Also: a long render stops soon after its progress callback asks.
+ *
  * usage: test_cuda_render SCENE... (exit 77: no CUDA device; skipped)
  */
 #include "paprsek.h"
@@ -85,6 +87,40 @@ static int render_means(pk_context *ctx, const pk_scene *sc, pk_accel_kind kind,
     return 1;
 }
 
+/* Cancels at the first report after some work was done. */
+static int cancel_soon(void *user, uint64_t done, uint64_t total, double elapsed)
+{
+    (void)total, (void)elapsed;
+    int *calls = user;
+    ++*calls;
+    return done > 0;
+}
+
+/* A long render on the GPU stops soon after its progress callback asks,
+ * with PK_ERR_CANCELLED and the message. */
+static int check_cancel(pk_context *ctx, const pk_scene *sc)
+{
+    pk_render_options o;
+    pk_render_options_init(&o);
+    o.width = o.height = 256;
+    o.spp = 1 << 16; /* minutes on any GPU */
+    o.accel = PK_ACCEL_CUDA;
+    int calls = 0;
+    o.progress = cancel_soon;
+    o.progress_user = &calls;
+    pk_image *img = NULL;
+    const pk_status st = pk_render(ctx, sc, &o, &img, NULL);
+    pk_image_destroy(img);
+    const char *msg = pk_context_error(ctx);
+    if (st != PK_ERR_CANCELLED || !msg || !strstr(msg, "cancelled")) {
+        fprintf(stderr, "cancelling: status %d, message %s\n", (int)st, msg ? msg : "(none)");
+        return 0;
+    }
+    printf("cancelled after %d progress report(s): %s\n", calls, msg);
+    pk_context_clear_error(ctx);
+    return 1;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -142,6 +178,7 @@ int main(int argc, char **argv)
         }
         printf("%s: image mean CPU %.5f GPU %.5f (ratio %.4f); smallest p %.3g (region %d channel %d), bound %.2g\n",
                argv[a], sum_cpu / ncmp, sum_gpu / ncmp, sum_gpu / sum_cpu, worst_p, worst / 3, worst % 3, p_min);
+        if (a == 1 && !check_cancel(ctx, sc)) failures++;
         if (!(sum_cpu > 0.0)) {
             fprintf(stderr, "%s: the CPU image is black: not a test of anything\n", argv[a]);
             failures++;

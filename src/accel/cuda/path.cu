@@ -39,43 +39,61 @@ extern "C" __global__ void pk_path_layout(unsigned long long *out)
 
 /* Samples first..first+n-1 of pixel (thread % 256) of tile (thread / 256):
  * their sum is written to (accumulate = 0) or added to acc; rays counts
- * camera, bounce and shadow rays. */
-extern "C" __global__ void __launch_bounds__(128) pk_path_render(const path_tracer *__restrict__ pt, camera_frame cf,
-                                                                 const gpu_tile *__restrict__ tiles, unsigned nthreads,
-                                                                 unsigned first, unsigned n, int accumulate,
-                                                                 float *__restrict__ acc, unsigned long long *rays)
+ * camera, bounce and shadow rays. With regen, a thread starts its next
+ * sample as soon as a path ends, one path_step at a time (Novak et al.
+ * 2010: the lanes of a warp stay busy while paths of different lengths
+ * end); without, each sample's path runs to its end before the next, and
+ * a warp waits for its longest path. */
+template <bool regen>
+static __device__ __forceinline__ void path_render(const path_tracer *__restrict__ pt, const camera_frame &cf,
+                                                   const gpu_tile *__restrict__ tiles, unsigned nthreads, unsigned first,
+                                                   unsigned n, int accumulate, float *__restrict__ acc,
+                                                   unsigned long long *rays)
 {
     const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
-    if (i >= nthreads) return;
+    if (i >= nthreads) return; /* (nthreads is a multiple of 256: whole warps) */
     const gpu_tile tl = tiles[i / GPU_TILE_PIXELS];
     const int k = (int)(i % GPU_TILE_PIXELS);
     path_thread t;
     t.rays_camera = t.rays_bounce = t.rays_shadow = 0;
     t.cp = NULL;
-    float sx = 0.0f, sy = 0.0f, sz = 0.0f;
+    vec3 sum = v3s(0.0f);
     if (k < tl.w * tl.h) {
         const int px = tl.x + k % tl.w, py = tl.y + k / tl.w;
-        for (unsigned s = 0; s < n; s++) {
-            const uint32_t index = first + s;
-            const ray r = path_camera_ray(pt, &cf, px, py, index);
-            hit h;
-            const bool got = path_gpu_trace(pt, &r, &h, false);
-            t.rays_camera++;
-            vec3 c;
-            if (path_camera_sample(pt, &t, px, py, index, &r, got ? &h : NULL, &c)) {
-                sx += c.x;
-                sy += c.y;
-                sz += c.z;
+        path_state ps;
+        bool active = false;
+        unsigned s = 0;
+        for (;;) {
+            if (!active) {
+                if (s == n) break;
+                const uint32_t index = first + s++;
+                const ray r = path_camera_ray(pt, &cf, px, py, index);
+                hit h;
+                const bool got = path_gpu_trace(pt, &r, &h, false);
+                t.rays_camera++;
+                vec3 bg;
+                if (!path_start(pt, px, py, index, &r, got ? &h : NULL, &ps, &bg)) {
+                    sum = v3_add(sum, bg);
+                    continue;
+                }
+                active = true;
+                if (!regen) {
+                    while (path_step(pt, &t, &ps)) {
+                    }
+                } else if (path_step(pt, &t, &ps)) {
+                    continue;
+                }
+            } else if (path_step(pt, &t, &ps)) {
+                continue;
             }
+            vec3 c;
+            if (path_result(&ps, &c)) sum = v3_add(sum, c);
+            active = false;
         }
     }
     float *a = &acc[3 * (size_t)i];
-    if (accumulate) {
-        sx += a[0];
-        sy += a[1];
-        sz += a[2];
-    }
-    a[0] = sx, a[1] = sy, a[2] = sz;
+    if (accumulate) sum = v3_add(sum, v3(a[0], a[1], a[2]));
+    a[0] = sum.x, a[1] = sum.y, a[2] = sum.z;
     /* one atomic per warp and counter */
     unsigned long long c0 = t.rays_camera, c1 = t.rays_bounce, c2 = t.rays_shadow;
     for (int off = 16; off > 0; off >>= 1) {
@@ -89,3 +107,17 @@ extern "C" __global__ void __launch_bounds__(128) pk_path_render(const path_trac
         atomicAdd(&rays[2], c2);
     }
 }
+
+#define PATH_KERNEL(name, bounds, regen)                                                                         \
+    extern "C" __global__ void bounds name(const path_tracer *__restrict__ pt, camera_frame cf,                 \
+                                           const gpu_tile *__restrict__ tiles, unsigned nthreads, unsigned first, \
+                                           unsigned n, int accumulate, float *__restrict__ acc,                   \
+                                           unsigned long long *rays)                                              \
+    {                                                                                                            \
+        path_render<regen>(pt, cf, tiles, nthreads, first, n, accumulate, acc, rays);                            \
+    }
+PATH_KERNEL(pk_path_render, __launch_bounds__(128), true)
+PATH_KERNEL(pk_path_render_loop, __launch_bounds__(128), false)
+PATH_KERNEL(pk_path_render_o4, __launch_bounds__(128, 4), true)
+PATH_KERNEL(pk_path_render_o6, __launch_bounds__(128, 6), true)
+PATH_KERNEL(pk_path_render_loop6, __launch_bounds__(128, 6), false)
