@@ -167,8 +167,9 @@ static inline PK_HD bool gpu_tri_intersect(const gpu_ray *r, const gpu_tri *tri,
 }
 
 /* Slots of node n whose decoded box the segment [tmin, tcull] touches, with
- * their entry distances in tn[]. */
-static inline PK_HD unsigned gpu_node_hits(const gpu_node *n, const gpu_ray *r, float tcull, float tn[GPU_WIDTH])
+ * their entry distances in tn[]: the first version (v0), reading the node
+ * byte by byte with the ray's plane rows as run-time indices. */
+static inline PK_HD unsigned gpu_node_hits_v0(const gpu_node *n, const gpu_ray *r, float tcull, float tn[GPU_WIDTH])
 {
     const float sx = gpu_scale(n->ex[0]), sy = gpu_scale(n->ex[1]), sz = gpu_scale(n->ex[2]);
     unsigned mask = 0;
@@ -198,11 +199,11 @@ typedef struct gpu_counters {
     uint64_t nodes, tests;
 } gpu_counters;
 
-/* Closest hit (any = false) or any hit (any = true) of *in against the
- * layout: fills *out (a miss: t = +inf, prim = PK_NO_HIT, u = v = 0) and
- * returns whether something was hit. The same closest hit as every CPU
- * accelerator; for any hit, some hit in [tmin, tmax] with its t, u, v. */
-static inline PK_HD bool gpu_trace(const gpu_node *nodes, const gpu_tri *tris, const pk_ray *in, bool any,
+/* The first traversal (kernel v0, kept to be timed against gpu_trace):
+ * gpu_node_hits_v0, every hit child pushed with an insertion sort and the
+ * nearest popped again, triangles read field by field. Same answers as
+ * gpu_trace, bit for bit (the same arithmetic, the same visiting order). */
+static inline PK_HD bool gpu_trace_v0(const gpu_node *nodes, const gpu_tri *tris, const pk_ray *in, bool any,
                                    pk_hit *out, gpu_counters *count)
 {
     out->t = INFINITY;
@@ -223,7 +224,7 @@ static inline PK_HD bool gpu_trace(const gpu_node *nodes, const gpu_tri *tris, c
             const gpu_node *n = &nodes[ref];
             if (count) count->nodes++;
             float tn[GPU_WIDTH];
-            unsigned mask = gpu_node_hits(n, &r, tcull, tn);
+            unsigned mask = gpu_node_hits_v0(n, &r, tcull, tn);
             if (!mask) goto pop;
             /* push every hit child, sort the run far to near, take the nearest */
             const int base = sp;
@@ -245,6 +246,217 @@ static inline PK_HD bool gpu_trace(const gpu_node *nodes, const gpu_tri *tris, c
                 if (count) count->tests++;
                 if (!gpu_tri_intersect(&r, tri, best_t, &t, &u, &v)) continue;
                 const uint32_t prim = tri->prim;
+                if (t < best_t || (t == best_t && prim < best_prim)) {
+                    best_t = t, best_prim = prim, best_u = u, best_v = v;
+                    if (any) goto done;
+                }
+            }
+            tcull = gpu_cull_limit(best_t);
+        }
+    pop:
+        for (;;) {
+            if (sp == 0) goto done;
+            --sp;
+            if (stack[sp].t <= tcull) {
+                ref = stack[sp].ref;
+                break;
+            }
+        }
+    }
+done:
+    if (best_prim == PK_NO_HIT) return false;
+    out->t = best_t;
+    out->prim = best_prim;
+    out->u = best_u;
+    out->v = best_v;
+    return true;
+}
+
+/* ---- the traversal (kernels v1, v2; docs/gpu.md) ---------------------------
+ * The same arithmetic and the same visiting order as gpu_trace_v0, so the
+ * same answers bit for bit, arranged for the GPU:
+ *  - a node is read as six 16-byte loads into 24 registers (gpu_node_load)
+ *    and its bytes are taken out with constant shifts: the ray's near and
+ *    far rows per axis are chosen by a select on the ray's direction signs,
+ *    never by indexing memory with a run-time row;
+ *  - the eight slots are unrolled, so the entry distances stay in
+ *    registers; the nearest hit child is kept in a register and goes next,
+ *    only the others are pushed (still sorted far to near);
+ *  - a triangle record is three 16-byte loads, its vertices permuted to the
+ *    ray's axes by selects. */
+
+#if defined(__CUDACC__)
+#define GPU_UNROLL _Pragma("unroll")
+#else
+#define GPU_UNROLL
+#endif
+
+static inline PK_HD float gpu_bits_float(uint32_t u)
+{
+#if defined(__CUDA_ARCH__)
+    return __uint_as_float(u);
+#else
+    float f;
+    memcpy(&f, &u, sizeof f);
+    return f;
+#endif
+}
+
+/* The 96 bytes of a node as 24 words: 0-2 org, 3 the exponents (byte k:
+ * axis k), 4 + 2 * row + (slot >= 4) the plane row's bytes of four slots
+ * (byte slot & 3), 16 + slot the child references. */
+static inline PK_HD void gpu_node_load(const gpu_node *n, uint32_t w[24])
+{
+#if defined(__CUDA_ARCH__)
+    const uint4 *p = (const uint4 *)n;
+    GPU_UNROLL
+    for (int i = 0; i < 6; i++) {
+        const uint4 v = __ldg(p + i);
+        w[4 * i] = v.x, w[4 * i + 1] = v.y, w[4 * i + 2] = v.z, w[4 * i + 3] = v.w;
+    }
+#else
+    memcpy(w, n, sizeof *n);
+#endif
+}
+
+/* Byte b (0..3, a constant) of word w as a float, exactly: the bits of
+ * 2^23 + byte, less 2^23 (one byte permute and one add on the GPU). */
+static inline PK_HD float gpu_byte_float(uint32_t w, int b)
+{
+#if defined(__CUDA_ARCH__)
+    return __uint_as_float(__byte_perm(w, 0x4B000000u, 0x7540u | (unsigned)b)) - 8388608.0f;
+#else
+    return gpu_bits_float(0x4B000000u | ((w >> (8 * b)) & 255u)) - 8388608.0f;
+#endif
+}
+
+/* gpu_node_hits_v0 on a node in registers: the same planes, the same
+ * operations in the same order, so the same distances bit for bit. */
+static inline PK_HD unsigned gpu_node_hits(const uint32_t w[24], const gpu_ray *r, float tcull, float tn[GPU_WIDTH])
+{
+    float org[3], sc[3];
+    uint32_t nw[3][2], fw[3][2]; /* near and far rows' words (slots 0-3, 4-7) per axis */
+    GPU_UNROLL
+    for (int k = 0; k < 3; k++) {
+        org[k] = gpu_bits_float(w[k]);
+        sc[k] = gpu_scale((w[3] >> (8 * k)) & 255u);
+        const bool neg = (r->near[k] & 1) != 0; /* near row 2k+1 (hi) when 1/d < 0 */
+        const uint32_t lo0 = w[4 + 4 * k], lo1 = w[5 + 4 * k], hi0 = w[6 + 4 * k], hi1 = w[7 + 4 * k];
+        nw[k][0] = neg ? hi0 : lo0, nw[k][1] = neg ? hi1 : lo1;
+        fw[k][0] = neg ? lo0 : hi0, fw[k][1] = neg ? lo1 : hi1;
+    }
+    unsigned mask = 0;
+    GPU_UNROLL
+    for (int s = 0; s < GPU_WIDTH; s++) {
+        tn[s] = 0.0f;
+        if (w[16 + s] == GPU_EMPTY) continue;
+        const int h = s >> 2, b = s & 3;
+        const float tnx = (org[0] + gpu_byte_float(nw[0][h], b) * sc[0] - r->o[0]) * r->rd[0];
+        const float tny = (org[1] + gpu_byte_float(nw[1][h], b) * sc[1] - r->o[1]) * r->rd[1];
+        const float tnz = (org[2] + gpu_byte_float(nw[2][h], b) * sc[2] - r->o[2]) * r->rd[2];
+        const float tfx = (org[0] + gpu_byte_float(fw[0][h], b) * sc[0] - r->o[0]) * r->rdf[0];
+        const float tfy = (org[1] + gpu_byte_float(fw[1][h], b) * sc[1] - r->o[1]) * r->rdf[1];
+        const float tfz = (org[2] + gpu_byte_float(fw[2][h], b) * sc[2] - r->o[2]) * r->rdf[2];
+        const float near = gpu_max(tnx, gpu_max(tny, gpu_max(tnz, r->tmin)));
+        const float far = gpu_min(tfx, gpu_min(tfy, gpu_min(tfz, tcull)));
+        tn[s] = near;
+        if (near <= far) mask |= 1u << s;
+    }
+    return mask;
+}
+
+static inline PK_HD float gpu_sel3(const float v[3], int k) { return k == 0 ? v[0] : k == 1 ? v[1] : v[2]; }
+
+/* gpu_tri_intersect on a record read with three 16-byte loads; *prim is
+ * the record's triangle number. */
+static inline PK_HD bool gpu_tri_intersect_rec(const gpu_ray *r, const gpu_tri *tri, float tmax, float *t_out,
+                                               float *u_out, float *v_out, uint32_t *prim)
+{
+    float a[3], b[3], c[3];
+#if defined(__CUDA_ARCH__)
+    const float4 *p = (const float4 *)tri;
+    const float4 x = __ldg(p), y = __ldg(p + 1), z = __ldg(p + 2);
+    a[0] = x.x, a[1] = x.y, a[2] = x.z, *prim = __float_as_uint(x.w);
+    b[0] = y.x, b[1] = y.y, b[2] = y.z;
+    c[0] = z.x, c[1] = z.y, c[2] = z.z;
+#else
+    memcpy(a, tri->a, sizeof a), memcpy(b, tri->b, sizeof b), memcpy(c, tri->c, sizeof c);
+    *prim = tri->prim;
+#endif
+    const float ox = r->ox, oy = r->oy, oz = r->oz;
+    const int kx = r->kx, ky = r->ky, kz = r->kz;
+    return tri_test_watertight(gpu_sel3(a, kx) - ox, gpu_sel3(a, ky) - oy, gpu_sel3(a, kz) - oz, gpu_sel3(b, kx) - ox,
+                               gpu_sel3(b, ky) - oy, gpu_sel3(b, kz) - oz, gpu_sel3(c, kx) - ox, gpu_sel3(c, ky) - oy,
+                               gpu_sel3(c, kz) - oz, r->sx, r->sy, r->sz, r->tmin, tmax, t_out, u_out, v_out);
+}
+
+/* Closest hit (any = false) or any hit (any = true) of *in against the
+ * layout: fills *out (a miss: t = +inf, prim = PK_NO_HIT, u = v = 0) and
+ * returns whether something was hit. The same closest hit as every CPU
+ * accelerator; for any hit, some hit in [tmin, tmax] with its t, u, v (the
+ * first found, leaves visited near first). Callable from other device code
+ * (one ray per thread; the stack is the thread's own). */
+static inline PK_HD bool gpu_trace(const gpu_node *nodes, const gpu_tri *tris, const pk_ray *in, bool any,
+                                   pk_hit *out, gpu_counters *count)
+{
+    out->t = INFINITY;
+    out->prim = PK_NO_HIT;
+    out->u = out->v = 0.0f;
+    if (!gpu_ray_traceable(in)) return false;
+    gpu_ray r;
+    gpu_ray_init(&r, in);
+    float best_t = in->tmax, best_u = 0.0f, best_v = 0.0f;
+    uint32_t best_prim = PK_NO_HIT;
+    float tcull = gpu_cull_limit(best_t);
+
+    gpu_stack_entry stack[GPU_STACK];
+    int sp = 0;
+    uint32_t ref = 0;
+    for (;;) {
+        while (!(ref & GPU_LEAF)) {
+            if (count) count->nodes++;
+            uint32_t w[24];
+            gpu_node_load(&nodes[ref], w);
+            float tn[GPU_WIDTH];
+            const unsigned mask = gpu_node_hits(w, &r, tcull, tn);
+            if (!mask) goto pop;
+            /* The order of gpu_trace_v0, which pushes every hit child with
+             * an insertion sort (a child goes above those nearer than it and
+             * above equals from lower slots) and pops the top: here the top,
+             * the nearest (the highest slot among equals), stays in cur. A
+             * child replacing cur is at least as near as every pushed one,
+             * and a pushed one as near as cur came from a lower slot, so the
+             * old cur goes straight on top; any other child is inserted. */
+            uint32_t cur = GPU_EMPTY;
+            float ct = 0.0f;
+            const int base = sp;
+            GPU_UNROLL
+            for (int k = 0; k < GPU_WIDTH; k++) {
+                if (!(mask >> k & 1u)) continue;
+                const uint32_t c = w[16 + k];
+                const float t = tn[k];
+                if (cur == GPU_EMPTY) {
+                    cur = c, ct = t;
+                } else if (t <= ct) {
+                    stack[sp].ref = cur, stack[sp].t = ct;
+                    sp++;
+                    cur = c, ct = t;
+                } else {
+                    int j = sp++;
+                    for (; j > base && stack[j - 1].t < t; j--) stack[j] = stack[j - 1];
+                    stack[j].ref = c, stack[j].t = t;
+                }
+            }
+            ref = cur;
+        }
+        {
+            if (count) count->nodes++;
+            const uint32_t first = gpu_leaf_first(ref), cnt = gpu_leaf_count(ref);
+            for (uint32_t i = 0; i < cnt; i++) {
+                float t, u, v;
+                uint32_t prim;
+                if (count) count->tests++;
+                if (!gpu_tri_intersect_rec(&r, &tris[first + i], best_t, &t, &u, &v, &prim)) continue;
                 if (t < best_t || (t == best_t && prim < best_prim)) {
                     best_t = t, best_prim = prim, best_u = u, best_v = v;
                     if (any) goto done;

@@ -27,6 +27,14 @@ n_rn=$(grep -Ec '(mul|add|sub)\.rn\.f32' "$tmp/build.ptx")
 [ "$n_fma" = 0 ] || fail "$n_fma fused multiply-adds in the kernels' PTX"
 [ "$n_approx" = 0 ] || fail "$n_approx approximate divisions or square roots in the kernels' PTX"
 [ "$n_rn" -gt 100 ] || fail "only $n_rn rounded float operations: is this the traversal?"
+# every kernel version that src/accel/cuda.c can ask for is there
+versions=$(sed -n 's/^static const char \*const kernel_names\[\] = {\(.*\)};$/\1/p' "$src/src/accel/cuda.c" | tr -d '"' | tr ',' ' ')
+[ -n "$versions" ] || fail "no kernel_names in src/accel/cuda.c"
+for v in $versions; do
+    for k in closest any; do
+        grep -q "^\.visible \.entry pk_trace_${k}_$v(" "$tmp/build.ptx" || fail "no kernel pk_trace_${k}_$v in the PTX"
+    done
+done
 # the same source with contraction allowed (nvcc's default) does fuse
 ptx "$tmp/fused.ptx" -O3 -std=c++17 -fmad=true || fail "nvcc -fmad=true"
 n_fused=$(grep -c 'fma\.' "$tmp/fused.ptx")

@@ -193,15 +193,22 @@ static ray *make_rays(rng *g, const accel_input *in, size_t n)
  * CPU BVH when cpu_too), any-hit agreeing on hit/miss with a real hit. */
 static void check_rays(const built *b, const accel_input *in, const ray *rays, size_t n, bool brute, const char *name)
 {
-    long bad_brute = 0, bad_cpu = 0, bad_any = 0, bad_anyhit = 0, nhits = 0, ties = 0;
+    long bad_brute = 0, bad_cpu = 0, bad_any = 0, bad_anyhit = 0, bad_v0 = 0, nhits = 0, ties = 0;
     const long nn = (long)n;
-#pragma omp parallel for schedule(dynamic, 64) reduction(+ : bad_brute, bad_cpu, bad_any, bad_anyhit, nhits, ties)
+#pragma omp parallel for schedule(dynamic, 64) reduction(+ : bad_brute, bad_cpu, bad_any, bad_anyhit, bad_v0, nhits, ties)
     for (long i = 0; i < nn; i++) {
         const ray *r = &rays[i];
         pk_hit got, any;
         hit want, cpu;
         gpu_trace(b->g.nodes, b->g.tris, (const pk_ray *)r, false, &got, NULL);
         gpu_trace(b->g.nodes, b->g.tris, (const pk_ray *)r, true, &any, NULL);
+        /* the first kernel's traversal: the same answers, any hits included
+         * (the same visiting order) */
+        pk_hit got0, any0;
+        const bool f0 = gpu_trace_v0(b->g.nodes, b->g.tris, (const pk_ray *)r, false, &got0, NULL);
+        const bool a0 = gpu_trace_v0(b->g.nodes, b->g.tris, (const pk_ray *)r, true, &any0, NULL);
+        bad_v0 += !same_hit(&got, &got0) || !same_hit(&any, &any0) || f0 != (got.prim != PK_NO_HIT) ||
+                  a0 != (any.prim != PK_NO_HIT);
         accel_intersect(b->cpu, r, &cpu, NULL);
         bad_cpu += !same_hit(&got, (const pk_hit *)&cpu);
         if (brute) {
@@ -241,6 +248,7 @@ static void check_rays(const built *b, const accel_input *in, const ray *rays, s
     }
     CHECKF(bad_brute == 0, "%s: %ld of %zu closest hits differ from brute force", name, bad_brute, n);
     CHECKF(bad_cpu == 0, "%s: %ld of %zu closest hits differ from the CPU BVH", name, bad_cpu, n);
+    CHECKF(bad_v0 == 0, "%s: %ld of %zu hits differ between gpu_trace and gpu_trace_v0", name, bad_v0, n);
     CHECKF(bad_any == 0, "%s: %ld of %zu any-hit answers disagree with the closest hit", name, bad_any, n);
     CHECKF(bad_anyhit == 0, "%s: %ld of %zu any-hit answers are not real hits", name, bad_anyhit, n);
     if (ties) printf("%s: %ld exact ties went to another triangle than brute force's\n", name, ties);

@@ -1,34 +1,61 @@
 /*
- * trace.cu - the GPU kernels of the cuda accelerator: one thread per ray,
- * each running gpu_trace of bvh_gpu.h, the traversal the CPU tests check on
- * the host. Compiled by nvcc alone into a fat binary embedded in the
+ * trace.cu - the GPU kernels of the cuda accelerator, each running a
+ * traversal of bvh_gpu.h (the code the CPU tests check on the host) for one
+ * ray per thread. Compiled by nvcc alone into a fat binary embedded in the
  * library (see CMakeLists.txt and docs/gpu.md), with -fmad=false so that
  * the triangle test rounds as the CPU's does.
+ *
+ * Versions, chosen at run time by cuda.c (PAPRSEK_CUDA_KERNEL, for timing
+ * them against each other; all give the same hits bit for bit):
+ *   v0  gpu_trace_v0, one thread per ray (the first kernel);
+ *   v1  gpu_trace, one thread per ray;
+ *   v2  gpu_trace, persistent warps: as many threads as the GPU holds at
+ *       once, each warp taking the next 32 rays from a global counter
+ *       (Aila and Laine 2009) until none are left.
+ * Every kernel takes (nodes, tris, rays, hits, n, counter); counter is a
+ * device word set to 0 before a v2 launch (ignored by the others).
  */
 #include "accel/bvh_gpu.h"
 
-extern "C" __global__ void __launch_bounds__(128) pk_trace_closest(const gpu_node *__restrict__ nodes,
-                                                                  const gpu_tri *__restrict__ tris,
-                                                                  const pk_ray *__restrict__ rays,
-                                                                  pk_hit *__restrict__ hits, unsigned n)
-{
-    const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
-    if (i >= n) return;
-    const pk_ray r = rays[i];
-    pk_hit h;
-    gpu_trace(nodes, tris, &r, false, &h, NULL);
-    hits[i] = h;
-}
+#define PK_KERNEL_PARAMS                                                                                       \
+    const gpu_node *__restrict__ nodes, const gpu_tri *__restrict__ tris, const pk_ray *__restrict__ rays, \
+        pk_hit *__restrict__ hits, unsigned n, unsigned *__restrict__ counter
 
-extern "C" __global__ void __launch_bounds__(128) pk_trace_any(const gpu_node *__restrict__ nodes,
-                                                              const gpu_tri *__restrict__ tris,
-                                                              const pk_ray *__restrict__ rays,
-                                                              pk_hit *__restrict__ hits, unsigned n)
-{
-    const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
-    if (i >= n) return;
-    const pk_ray r = rays[i];
-    pk_hit h;
-    gpu_trace(nodes, tris, &r, true, &h, NULL);
-    hits[i] = h;
-}
+#define PK_ONE_PER_THREAD(name, trace, any)                                        \
+    extern "C" __global__ void __launch_bounds__(128) name(PK_KERNEL_PARAMS)       \
+    {                                                                              \
+        (void)counter;                                                             \
+        const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;                  \
+        if (i >= n) return;                                                        \
+        const pk_ray r = rays[i];                                                  \
+        pk_hit h;                                                                  \
+        trace(nodes, tris, &r, any, &h, NULL);                                     \
+        hits[i] = h;                                                               \
+    }
+
+PK_ONE_PER_THREAD(pk_trace_closest_v0, gpu_trace_v0, false)
+PK_ONE_PER_THREAD(pk_trace_any_v0, gpu_trace_v0, true)
+PK_ONE_PER_THREAD(pk_trace_closest_v1, gpu_trace, false)
+PK_ONE_PER_THREAD(pk_trace_any_v1, gpu_trace, true)
+
+#define PK_PERSISTENT(name, trace, any)                                            \
+    extern "C" __global__ void __launch_bounds__(128) name(PK_KERNEL_PARAMS)       \
+    {                                                                              \
+        const unsigned lane = threadIdx.x & 31u;                                   \
+        for (;;) {                                                                 \
+            unsigned base = 0;                                                     \
+            if (lane == 0) base = atomicAdd(counter, 32u);                         \
+            base = __shfl_sync(0xFFFFFFFFu, base, 0);                              \
+            if (base >= n) return;                                                 \
+            const unsigned i = base + lane;                                        \
+            if (i < n) {                                                           \
+                const pk_ray r = rays[i];                                          \
+                pk_hit h;                                                          \
+                trace(nodes, tris, &r, any, &h, NULL);                             \
+                hits[i] = h;                                                       \
+            }                                                                      \
+        }                                                                          \
+    }
+
+PK_PERSISTENT(pk_trace_closest_v2, gpu_trace, false)
+PK_PERSISTENT(pk_trace_any_v2, gpu_trace, true)
