@@ -330,20 +330,158 @@ static inline PK_HD float gpu_byte_float(uint32_t w, int b)
 #endif
 }
 
-/* gpu_node_hits_v0 on a node in registers: the same planes, the same
- * operations in the same order, so the same distances bit for bit. */
-static inline PK_HD unsigned gpu_node_hits(const uint32_t w[24], const gpu_ray *r, float tcull, float tn[GPU_WIDTH])
+/* Box tests on a node in registers (gpu_node_load). Each fills tn[] with
+ * the entry distances and returns the mask of the slots whose box the
+ * segment [tmin, tcull] touches; all enter every box the CPU's traversal
+ * enters (docs/gpu.md). GPU_BOX_INLINE lets the PTX check
+ * (tests/cuda/test_cuda_ptx.sh) keep them out of line, to see that their
+ * fused multiply-adds are the only ones. */
+#if defined(__CUDACC__) && defined(PK_GPU_BOX_NOINLINE)
+#define GPU_BOX_INLINE __noinline__
+#else
+#define GPU_BOX_INLINE inline
+#endif
+
+/* a * b + c rounded once (the GPU's fma instruction; C's fmaf on the host,
+ * also correctly rounded, so both compute the same bits). */
+static inline PK_HD float gpu_fma(float a, float b, float c)
 {
+#if defined(__CUDA_ARCH__)
+    return __fmaf_rn(a, b, c);
+#else
+    return fmaf(a, b, c);
+#endif
+}
+
+/* The plane rows of the node for this ray: per axis the near and the far
+ * row's two words (slots 0-3, 4-7), chosen by a select on the sign of 1/d. */
+typedef struct gpu_rows {
     float org[3], sc[3];
-    uint32_t nw[3][2], fw[3][2]; /* near and far rows' words (slots 0-3, 4-7) per axis */
+    uint32_t nw[3][2], fw[3][2];
+} gpu_rows;
+
+static inline PK_HD void gpu_node_rows(const uint32_t w[24], const gpu_ray *r, gpu_rows *x)
+{
     GPU_UNROLL
     for (int k = 0; k < 3; k++) {
-        org[k] = gpu_bits_float(w[k]);
-        sc[k] = gpu_scale((w[3] >> (8 * k)) & 255u);
+        x->org[k] = gpu_bits_float(w[k]);
+        x->sc[k] = gpu_scale((w[3] >> (8 * k)) & 255u);
         const bool neg = (r->near[k] & 1) != 0; /* near row 2k+1 (hi) when 1/d < 0 */
         const uint32_t lo0 = w[4 + 4 * k], lo1 = w[5 + 4 * k], hi0 = w[6 + 4 * k], hi1 = w[7 + 4 * k];
-        nw[k][0] = neg ? hi0 : lo0, nw[k][1] = neg ? hi1 : lo1;
-        fw[k][0] = neg ? lo0 : hi0, fw[k][1] = neg ? lo1 : hi1;
+        x->nw[k][0] = neg ? hi0 : lo0, x->nw[k][1] = neg ? hi1 : lo1;
+        x->fw[k][0] = neg ? lo0 : hi0, x->fw[k][1] = neg ? lo1 : hi1;
+    }
+}
+
+/* v1: gpu_node_hits_v0's planes and operations in the same order, so the
+ * same distances bit for bit. fmaxf/fminf instead of gpu_max/gpu_min: the
+ * second operand is never NaN here (tmin and tcull are not, nor is an
+ * fmaxf/fminf of them), and then the two agree but for the sign of a zero,
+ * which no comparison sees. */
+static GPU_BOX_INLINE PK_HD unsigned gpu_node_hits(const uint32_t w[24], const gpu_ray *r, float tcull,
+                                                   float tn[GPU_WIDTH])
+{
+    gpu_rows x;
+    gpu_node_rows(w, r, &x);
+    unsigned mask = 0;
+    GPU_UNROLL
+    for (int s = 0; s < GPU_WIDTH; s++) {
+        tn[s] = 0.0f;
+        if (w[16 + s] == GPU_EMPTY) continue;
+        const int h = s >> 2, b = s & 3;
+        float near = r->tmin, far = tcull;
+        GPU_UNROLL
+        for (int k = 2; k >= 0; k--) {
+            near = fmaxf((x.org[k] + gpu_byte_float(x.nw[k][h], b) * x.sc[k] - r->o[k]) * r->rd[k], near);
+            far = fminf((x.org[k] + gpu_byte_float(x.fw[k][h], b) * x.sc[k] - r->o[k]) * r->rdf[k], far);
+        }
+        tn[s] = near;
+        if (near <= far) mask |= 1u << s;
+    }
+    return mask;
+}
+
+/* v3: the same distances bit for bit with one operation less per plane:
+ * org + q * scale with q * scale exact is one fma (one rounding of the
+ * same exact value). The converter makes sure q * scale never overflows
+ * where it matters (gpu_quantise checks both forms). */
+static GPU_BOX_INLINE PK_HD unsigned gpu_node_hits_fma(const uint32_t w[24], const gpu_ray *r, float tcull,
+                                                       float tn[GPU_WIDTH])
+{
+    gpu_rows x;
+    gpu_node_rows(w, r, &x);
+    unsigned mask = 0;
+    GPU_UNROLL
+    for (int s = 0; s < GPU_WIDTH; s++) {
+        tn[s] = 0.0f;
+        if (w[16 + s] == GPU_EMPTY) continue;
+        const int h = s >> 2, b = s & 3;
+        float near = r->tmin, far = tcull;
+        GPU_UNROLL
+        for (int k = 2; k >= 0; k--) {
+            near = fmaxf((gpu_fma(gpu_byte_float(x.nw[k][h], b), x.sc[k], x.org[k]) - r->o[k]) * r->rd[k], near);
+            far = fminf((gpu_fma(gpu_byte_float(x.fw[k][h], b), x.sc[k], x.org[k]) - r->o[k]) * r->rdf[k], far);
+        }
+        tn[s] = near;
+        if (near <= far) mask |= 1u << s;
+    }
+    return mask;
+}
+
+/* v4: one fma per plane, t = q * S + A with S = scale / d and
+ * A = (org - o) / d per node and axis, moved out by a bound E on the
+ * rounding: near distances down, far ones up.
+ *
+ * Why it enters every box v1 enters (so every box the CPU enters). With
+ * u = 2^-24, P = org + q * scale (exact) and x = (P - o) * rd (exact):
+ * v1's distance fl(fl(fl(P) - o) * rd) is within
+ * u * (|o rd| + 3.01 * 255 |S| + 3.01 |A|) of x (three roundings, |P| <=
+ * |org - o| + |o| + 255 scale). Here S = scale * rd is exact (a power of
+ * two times rd; a subnormal S errs by at most 2^-150, covered by the
+ * 2^-126 below) and A = fl(fl(org - o) * rd) is within 2.0001 u |(org-o) rd|
+ * of its exact value; fl(q * S + fl(A - E)) is then within
+ * u * (2.0001 |(org-o) rd| + 2.0001 |A| + 255 |S| + 2.0001 E) of x - E.
+ * So it is below v1's distance when E >= u * (|o rd| + 1023 |S| + 7.03 |A|)
+ * (+ a little for E's own rounding); E = 2^-20 * (|A| + 255 |S| + |o rd|)
+ * + 2^-126 is twice that or more on every term. The far side is the same
+ * with rdf and + E. Nothing there uses the signs of q, S or A, so it holds
+ * for either row and either direction. Infinite or NaN values only loosen
+ * the test: 1/d = +-inf (d = 0) or an overflowing S, A or |o rd| makes E
+ * infinite, so every near distance of that axis is -inf or NaN and every
+ * far one +inf or NaN, and a NaN plane is no limit (fmaxf, fminf); 1/d NaN
+ * makes them all NaN, as in v1. (So that an axis-parallel ray is not slowed
+ * down by it, gpu_trace_box gives rays with a 1/d component of 2^64 or more
+ * gpu_node_hits_fma instead.) The cost: boxes are looser by 2^-20 of the
+ * distances involved, and of |o| / |d| (scenes far from the origin). The
+ * entry distances differ from v1's by as much, so children at nearly equal
+ * distances may be visited in another order: the closest hit is the same
+ * (smallest t, then smallest number), an any hit may be another. */
+#define GPU_LOOSE_REL 0x1p-20f
+#define GPU_LOOSE_ABS 0x1p-126f
+
+/* The per-ray terms of E: 2^-20 |o / d| + 2^-126 per axis, with 1/d and
+ * with the far planes' 1/d * (1 + GPU_BOX_SLACK). */
+static GPU_BOX_INLINE PK_HD void gpu_loose_terms(const gpu_ray *r, float kn[3], float kf[3])
+{
+    for (int k = 0; k < 3; k++) {
+        kn[k] = gpu_fma(GPU_LOOSE_REL, fabsf(r->o[k] * r->rd[k]), GPU_LOOSE_ABS);
+        kf[k] = gpu_fma(GPU_LOOSE_REL, fabsf(r->o[k] * r->rdf[k]), GPU_LOOSE_ABS);
+    }
+}
+
+static GPU_BOX_INLINE PK_HD unsigned gpu_node_hits_slack(const uint32_t w[24], const gpu_ray *r, const float kn[3],
+                                                         const float kf[3], float tcull, float tn[GPU_WIDTH])
+{
+    gpu_rows x;
+    gpu_node_rows(w, r, &x);
+    float sn[3], an[3], sf[3], af[3];
+    GPU_UNROLL
+    for (int k = 0; k < 3; k++) {
+        const float d = x.org[k] - r->o[k];
+        const float a = d * r->rd[k], s = x.sc[k] * r->rd[k];
+        const float a2 = d * r->rdf[k], s2 = x.sc[k] * r->rdf[k];
+        sn[k] = s, an[k] = a - gpu_fma(GPU_LOOSE_REL, gpu_fma(255.0f, fabsf(s), fabsf(a)), kn[k]);
+        sf[k] = s2, af[k] = a2 + gpu_fma(GPU_LOOSE_REL, gpu_fma(255.0f, fabsf(s2), fabsf(a2)), kf[k]);
     }
     unsigned mask = 0;
     GPU_UNROLL
@@ -351,14 +489,12 @@ static inline PK_HD unsigned gpu_node_hits(const uint32_t w[24], const gpu_ray *
         tn[s] = 0.0f;
         if (w[16 + s] == GPU_EMPTY) continue;
         const int h = s >> 2, b = s & 3;
-        const float tnx = (org[0] + gpu_byte_float(nw[0][h], b) * sc[0] - r->o[0]) * r->rd[0];
-        const float tny = (org[1] + gpu_byte_float(nw[1][h], b) * sc[1] - r->o[1]) * r->rd[1];
-        const float tnz = (org[2] + gpu_byte_float(nw[2][h], b) * sc[2] - r->o[2]) * r->rd[2];
-        const float tfx = (org[0] + gpu_byte_float(fw[0][h], b) * sc[0] - r->o[0]) * r->rdf[0];
-        const float tfy = (org[1] + gpu_byte_float(fw[1][h], b) * sc[1] - r->o[1]) * r->rdf[1];
-        const float tfz = (org[2] + gpu_byte_float(fw[2][h], b) * sc[2] - r->o[2]) * r->rdf[2];
-        const float near = gpu_max(tnx, gpu_max(tny, gpu_max(tnz, r->tmin)));
-        const float far = gpu_min(tfx, gpu_min(tfy, gpu_min(tfz, tcull)));
+        float near = r->tmin, far = tcull;
+        GPU_UNROLL
+        for (int k = 2; k >= 0; k--) {
+            near = fmaxf(gpu_fma(gpu_byte_float(x.nw[k][h], b), sn[k], an[k]), near);
+            far = fminf(gpu_fma(gpu_byte_float(x.fw[k][h], b), sf[k], af[k]), far);
+        }
         tn[s] = near;
         if (near <= far) mask |= 1u << s;
     }
@@ -390,14 +526,11 @@ static inline PK_HD bool gpu_tri_intersect_rec(const gpu_ray *r, const gpu_tri *
                                gpu_sel3(c, kz) - oz, r->sx, r->sy, r->sz, r->tmin, tmax, t_out, u_out, v_out);
 }
 
-/* Closest hit (any = false) or any hit (any = true) of *in against the
- * layout: fills *out (a miss: t = +inf, prim = PK_NO_HIT, u = v = 0) and
- * returns whether something was hit. The same closest hit as every CPU
- * accelerator; for any hit, some hit in [tmin, tmax] with its t, u, v (the
- * first found, leaves visited near first). Callable from other device code
- * (one ray per thread; the stack is the thread's own). */
-static inline PK_HD bool gpu_trace(const gpu_node *nodes, const gpu_tri *tris, const pk_ray *in, bool any,
-                                   pk_hit *out, gpu_counters *count)
+/* The traversal with box test box (a constant: GPU_TEST_EXACT, GPU_TEST_FMA
+ * or GPU_TEST_LOOSE); gpu_trace below is the one to call. */
+enum { GPU_TEST_EXACT = 1, GPU_TEST_FMA = 3, GPU_TEST_LOOSE = 4 };
+static inline PK_HD bool gpu_trace_box(const gpu_node *nodes, const gpu_tri *tris, const pk_ray *in, bool any,
+                                       pk_hit *out, gpu_counters *count, int box)
 {
     out->t = INFINITY;
     out->prim = PK_NO_HIT;
@@ -408,6 +541,13 @@ static inline PK_HD bool gpu_trace(const gpu_node *nodes, const gpu_tri *tris, c
     float best_t = in->tmax, best_u = 0.0f, best_v = 0.0f;
     uint32_t best_prim = PK_NO_HIT;
     float tcull = gpu_cull_limit(best_t);
+    /* GPU_TEST_LOOSE's per-ray terms; a ray with a huge or infinite 1/d
+     * component (d = 0: axis-parallel) takes GPU_TEST_FMA instead, where
+     * the bound would be infinite and the axis would limit nothing */
+    const bool loose = box == GPU_TEST_LOOSE && fabsf(r.rd[0]) < 0x1p64f && fabsf(r.rd[1]) < 0x1p64f &&
+                       fabsf(r.rd[2]) < 0x1p64f;
+    float kn[3] = {0.0f, 0.0f, 0.0f}, kf[3] = {0.0f, 0.0f, 0.0f};
+    if (loose) gpu_loose_terms(&r, kn, kf);
 
     gpu_stack_entry stack[GPU_STACK];
     int sp = 0;
@@ -418,7 +558,9 @@ static inline PK_HD bool gpu_trace(const gpu_node *nodes, const gpu_tri *tris, c
             uint32_t w[24];
             gpu_node_load(&nodes[ref], w);
             float tn[GPU_WIDTH];
-            const unsigned mask = gpu_node_hits(w, &r, tcull, tn);
+            const unsigned mask = loose ? gpu_node_hits_slack(w, &r, kn, kf, tcull, tn)
+                                  : box != GPU_TEST_EXACT ? gpu_node_hits_fma(w, &r, tcull, tn)
+                                                          : gpu_node_hits(w, &r, tcull, tn);
             if (!mask) goto pop;
             /* The order of gpu_trace_v0, which pushes every hit child with
              * an insertion sort (a child goes above those nearer than it and
@@ -483,6 +625,21 @@ done:
     return true;
 }
 
+/* Closest hit (any = false) or any hit (any = true) of *in against the
+ * layout: fills *out (a miss: t = +inf, prim = PK_NO_HIT, u = v = 0) and
+ * returns whether something was hit. The same closest hit as every CPU
+ * accelerator; for any hit, some hit in [tmin, tmax] with its t, u, v (the
+ * first found, leaves visited near first). Callable from other device code
+ * (one ray per thread; the stack is the thread's own). */
+#ifndef GPU_TRACE_BOX
+#define GPU_TRACE_BOX GPU_TEST_FMA
+#endif
+static inline PK_HD bool gpu_trace(const gpu_node *nodes, const gpu_tri *tris, const pk_ray *in, bool any,
+                                   pk_hit *out, gpu_counters *count)
+{
+    return gpu_trace_box(nodes, tris, in, any, out, count, GPU_TRACE_BOX);
+}
+
 #ifndef __CUDACC__
 /* ---- the host side: conversion and checks (bvh_gpu.c) -------------------- */
 
@@ -525,7 +682,8 @@ PK_HIDDEN bool gpu_layout_check_boxes(const gpu_layout *g, const struct accel *b
 PK_HIDDEN bool gpu_layout_check(const gpu_layout *g, const float *verts, char *why, size_t n);
 /* Quantises the interval [lo, hi] of a child within the frame (org, scale
  * 2^(ex-127)): *qlo, *qhi with gpu_plane(org, qlo) <= lo and
- * gpu_plane(org, qhi) >= hi; false when it does not fit in 0..255. */
+ * gpu_plane(org, qhi) >= hi, and the same of gpu_fma(q, scale, org); false
+ * when it does not fit in 0..255. */
 PK_HIDDEN bool gpu_quantise(float org, unsigned ex, float lo, float hi, uint8_t *qlo, uint8_t *qhi);
 #endif
 

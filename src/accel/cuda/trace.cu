@@ -8,10 +8,17 @@
  * Versions, chosen at run time by cuda.c (PAPRSEK_CUDA_KERNEL, for timing
  * them against each other; all give the same hits bit for bit):
  *   v0  gpu_trace_v0, one thread per ray (the first kernel);
- *   v1  gpu_trace, one thread per ray;
- *   v2  gpu_trace, persistent warps: as many threads as the GPU holds at
+ *   v1  gpu_trace_box with GPU_TEST_EXACT (nodes and triangles read into
+ *       registers with 16-byte loads, the nearest child kept in a register),
+ *       one thread per ray;
+ *   v2  as v1, with persistent warps: as many threads as the GPU holds at
  *       once, each warp taking the next 32 rays from a global counter
- *       (Aila and Laine 2009) until none are left.
+ *       (Aila and Laine 2009) until none are left;
+ *   v3  GPU_TEST_FMA (the same distances, one operation less per plane),
+ *       one thread per ray;
+ *   v4  GPU_TEST_LOOSE (one fma per plane, boxes loosened by a bound on the
+ *       rounding), one thread per ray;
+ *   v5  as v4, with persistent warps.
  * Every kernel takes (nodes, tris, rays, hits, n, counter); counter is a
  * device word set to 0 before a v2 launch (ignored by the others).
  */
@@ -35,8 +42,22 @@
 
 PK_ONE_PER_THREAD(pk_trace_closest_v0, gpu_trace_v0, false)
 PK_ONE_PER_THREAD(pk_trace_any_v0, gpu_trace_v0, true)
-PK_ONE_PER_THREAD(pk_trace_closest_v1, gpu_trace, false)
-PK_ONE_PER_THREAD(pk_trace_any_v1, gpu_trace, true)
+#define PK_TRACE_WITH(box)                                                                                \
+    static __device__ __forceinline__ bool trace_##box(const gpu_node *nodes, const gpu_tri *tris, const pk_ray *r, \
+                                                       bool any, pk_hit *h, gpu_counters *c)               \
+    {                                                                                                      \
+        return gpu_trace_box(nodes, tris, r, any, h, c, box);                                              \
+    }
+PK_TRACE_WITH(GPU_TEST_EXACT)
+PK_TRACE_WITH(GPU_TEST_FMA)
+PK_TRACE_WITH(GPU_TEST_LOOSE)
+
+PK_ONE_PER_THREAD(pk_trace_closest_v1, trace_GPU_TEST_EXACT, false)
+PK_ONE_PER_THREAD(pk_trace_any_v1, trace_GPU_TEST_EXACT, true)
+PK_ONE_PER_THREAD(pk_trace_closest_v3, trace_GPU_TEST_FMA, false)
+PK_ONE_PER_THREAD(pk_trace_any_v3, trace_GPU_TEST_FMA, true)
+PK_ONE_PER_THREAD(pk_trace_closest_v4, trace_GPU_TEST_LOOSE, false)
+PK_ONE_PER_THREAD(pk_trace_any_v4, trace_GPU_TEST_LOOSE, true)
 
 #define PK_PERSISTENT(name, trace, any)                                            \
     extern "C" __global__ void __launch_bounds__(128) name(PK_KERNEL_PARAMS)       \
@@ -57,5 +78,7 @@ PK_ONE_PER_THREAD(pk_trace_any_v1, gpu_trace, true)
         }                                                                          \
     }
 
-PK_PERSISTENT(pk_trace_closest_v2, gpu_trace, false)
-PK_PERSISTENT(pk_trace_any_v2, gpu_trace, true)
+PK_PERSISTENT(pk_trace_closest_v2, trace_GPU_TEST_EXACT, false)
+PK_PERSISTENT(pk_trace_any_v2, trace_GPU_TEST_EXACT, true)
+PK_PERSISTENT(pk_trace_closest_v5, trace_GPU_TEST_LOOSE, false)
+PK_PERSISTENT(pk_trace_any_v5, trace_GPU_TEST_LOOSE, true)
