@@ -438,12 +438,12 @@ static GPU_BOX_INLINE PK_HD unsigned gpu_node_hits_fma(const uint32_t w[24], con
  * u * (|o rd| + 3.01 * 255 |S| + 3.01 |A|) of x (three roundings, |P| <=
  * |org - o| + |o| + 255 scale). Here S = scale * rd is exact (a power of
  * two times rd; a subnormal S errs by at most 2^-150, covered by the
- * 2^-126 below) and A = fl(fl(org - o) * rd) is within 2.0001 u |(org-o) rd|
+ * 2^-100 below) and A = fl(fl(org - o) * rd) is within 2.0001 u |(org-o) rd|
  * of its exact value; fl(q * S + fl(A - E)) is then within
  * u * (2.0001 |(org-o) rd| + 2.0001 |A| + 255 |S| + 2.0001 E) of x - E.
  * So it is below v1's distance when E >= u * (|o rd| + 1023 |S| + 7.03 |A|)
  * (+ a little for E's own rounding); E = 2^-20 * (|A| + 255 |S| + |o rd|)
- * + 2^-126 is twice that or more on every term. The far side is the same
+ * + 2^-100 is twice that or more on every term. The far side is the same
  * with rdf and + E. Nothing there uses the signs of q, S or A, so it holds
  * for either row and either direction. Infinite or NaN values only loosen
  * the test: 1/d = +-inf (d = 0) or an overflowing S, A or |o rd| makes E
@@ -457,9 +457,9 @@ static GPU_BOX_INLINE PK_HD unsigned gpu_node_hits_fma(const uint32_t w[24], con
  * distances may be visited in another order: the closest hit is the same
  * (smallest t, then smallest number), an any hit may be another. */
 #define GPU_LOOSE_REL 0x1p-20f
-#define GPU_LOOSE_ABS 0x1p-126f
+#define GPU_LOOSE_ABS 0x1p-100f
 
-/* The per-ray terms of E: 2^-20 |o / d| + 2^-126 per axis, with 1/d and
+/* The per-ray terms of E: 2^-20 |o / d| + 2^-100 per axis, with 1/d and
  * with the far planes' 1/d * (1 + GPU_BOX_SLACK). */
 static GPU_BOX_INLINE PK_HD void gpu_loose_terms(const gpu_ray *r, float kn[3], float kf[3])
 {
@@ -501,6 +501,63 @@ static GPU_BOX_INLINE PK_HD unsigned gpu_node_hits_slack(const uint32_t w[24], c
     return mask;
 }
 
+/* Byte b (0..3, a constant) of word w as the float 2^23 + 256 * byte,
+ * exactly: its bits with the byte in bits 8-15 (one byte permute). */
+static inline PK_HD float gpu_byte_wide(uint32_t w, int b)
+{
+#if defined(__CUDA_ARCH__)
+    return __uint_as_float(__byte_perm(w, 0x4B000000u, 0x7504u | ((unsigned)b << 4)));
+#else
+    return gpu_bits_float(0x4B000000u | ((w >> (8 * b)) & 255u) << 8);
+#endif
+}
+
+/* v6: gpu_node_hits_slack without the add that turns the byte into a
+ * float: with m = 2^23 + 256 q (gpu_byte_wide, a byte permute),
+ * t = fma(m, S', A'') where S' = S * 2^-8 and A'' = fl(fl(A - E) - 2^15 S)
+ * (one fma: 2^23 * S' is exact), since m * S' = 2^15 S + q S. Against the
+ * bound of gpu_node_hits_slack this adds the rounding of A'' and of the
+ * extra subtraction, u * (2 |A| + 2 E + 2^15 |S|): v1's distance is then
+ * above this one when E >= u * (|o rd| + 8.02 |A| + 33791 |S|) (+ E's own
+ * rounding); E = 2^-20 * (|A| + |o rd|) + 2^-8 |S| + 2^-100 is 1.9 times
+ * that or more on every term (2^-8 |S| is 1/256 of a quantisation step). A
+ * subnormal S' errs by at most 2^-150, times m < 2^24: covered by 2^-100.
+ * Infinite and NaN values loosen the test as in gpu_node_hits_slack, and
+ * gpu_trace_box gives it the same rays (every |1/d| < 2^64). */
+static GPU_BOX_INLINE PK_HD unsigned gpu_node_hits_wide(const uint32_t w[24], const gpu_ray *r, const float kn[3],
+                                                        const float kf[3], float tcull, float tn[GPU_WIDTH])
+{
+    gpu_rows x;
+    gpu_node_rows(w, r, &x);
+    float sn[3], an[3], sf[3], af[3];
+    GPU_UNROLL
+    for (int k = 0; k < 3; k++) {
+        const float d = x.org[k] - r->o[k];
+        const float a = d * r->rd[k], s = x.sc[k] * r->rd[k];
+        const float a2 = d * r->rdf[k], s2 = x.sc[k] * r->rdf[k];
+        const float e = gpu_fma(0x1p-8f, fabsf(s), gpu_fma(GPU_LOOSE_REL, fabsf(a), kn[k]));
+        const float e2 = gpu_fma(0x1p-8f, fabsf(s2), gpu_fma(GPU_LOOSE_REL, fabsf(a2), kf[k]));
+        sn[k] = s * 0x1p-8f, an[k] = gpu_fma(-0x1p23f, sn[k], a - e);
+        sf[k] = s2 * 0x1p-8f, af[k] = gpu_fma(-0x1p23f, sf[k], a2 + e2);
+    }
+    unsigned mask = 0;
+    GPU_UNROLL
+    for (int s = 0; s < GPU_WIDTH; s++) {
+        tn[s] = 0.0f;
+        if (w[16 + s] == GPU_EMPTY) continue;
+        const int h = s >> 2, b = s & 3;
+        float near = r->tmin, far = tcull;
+        GPU_UNROLL
+        for (int k = 2; k >= 0; k--) {
+            near = fmaxf(gpu_fma(gpu_byte_wide(x.nw[k][h], b), sn[k], an[k]), near);
+            far = fminf(gpu_fma(gpu_byte_wide(x.fw[k][h], b), sf[k], af[k]), far);
+        }
+        tn[s] = near;
+        if (near <= far) mask |= 1u << s;
+    }
+    return mask;
+}
+
 static inline PK_HD float gpu_sel3(const float v[3], int k) { return k == 0 ? v[0] : k == 1 ? v[1] : v[2]; }
 
 /* gpu_tri_intersect on a record read with three 16-byte loads; *prim is
@@ -526,9 +583,9 @@ static inline PK_HD bool gpu_tri_intersect_rec(const gpu_ray *r, const gpu_tri *
                                gpu_sel3(c, kz) - oz, r->sx, r->sy, r->sz, r->tmin, tmax, t_out, u_out, v_out);
 }
 
-/* The traversal with box test box (a constant: GPU_TEST_EXACT, GPU_TEST_FMA
- * or GPU_TEST_LOOSE); gpu_trace below is the one to call. */
-enum { GPU_TEST_EXACT = 1, GPU_TEST_FMA = 3, GPU_TEST_LOOSE = 4 };
+/* The traversal with box test box (a constant: GPU_TEST_EXACT, GPU_TEST_FMA,
+ * GPU_TEST_LOOSE or GPU_TEST_WIDE); gpu_trace below is the one to call. */
+enum { GPU_TEST_EXACT = 1, GPU_TEST_FMA = 3, GPU_TEST_LOOSE = 4, GPU_TEST_WIDE = 6 };
 static inline PK_HD bool gpu_trace_box(const gpu_node *nodes, const gpu_tri *tris, const pk_ray *in, bool any,
                                        pk_hit *out, gpu_counters *count, int box)
 {
@@ -544,7 +601,7 @@ static inline PK_HD bool gpu_trace_box(const gpu_node *nodes, const gpu_tri *tri
     /* GPU_TEST_LOOSE's per-ray terms; a ray with a huge or infinite 1/d
      * component (d = 0: axis-parallel) takes GPU_TEST_FMA instead, where
      * the bound would be infinite and the axis would limit nothing */
-    const bool loose = box == GPU_TEST_LOOSE && fabsf(r.rd[0]) < 0x1p64f && fabsf(r.rd[1]) < 0x1p64f &&
+    const bool loose = (box == GPU_TEST_LOOSE || box == GPU_TEST_WIDE) && fabsf(r.rd[0]) < 0x1p64f && fabsf(r.rd[1]) < 0x1p64f &&
                        fabsf(r.rd[2]) < 0x1p64f;
     float kn[3] = {0.0f, 0.0f, 0.0f}, kf[3] = {0.0f, 0.0f, 0.0f};
     if (loose) gpu_loose_terms(&r, kn, kf);
@@ -558,7 +615,8 @@ static inline PK_HD bool gpu_trace_box(const gpu_node *nodes, const gpu_tri *tri
             uint32_t w[24];
             gpu_node_load(&nodes[ref], w);
             float tn[GPU_WIDTH];
-            const unsigned mask = loose ? gpu_node_hits_slack(w, &r, kn, kf, tcull, tn)
+            const unsigned mask = loose ? (box == GPU_TEST_WIDE ? gpu_node_hits_wide(w, &r, kn, kf, tcull, tn)
+                                                                : gpu_node_hits_slack(w, &r, kn, kf, tcull, tn))
                                   : box != GPU_TEST_EXACT ? gpu_node_hits_fma(w, &r, tcull, tn)
                                                           : gpu_node_hits(w, &r, tcull, tn);
             if (!mask) goto pop;

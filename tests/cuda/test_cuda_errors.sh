@@ -70,10 +70,10 @@ PK_CUDA_STUB=kernelfail expect_failure "kernel failure" "the traversal kernel fa
     "${rays[@]}"
 PK_CUDA_STUB=kernelfail expect_failure "kernel failure, any-hit" "the traversal kernel failed" "${rays[@]}" --any-hit
 # every kernel version goes as far as the launch; an unknown one is refused
-for v in v0 v1 v2 v3 v4 v5; do
+for v in v0 v1 v2 v3 v4 v5 v6 v7; do
     PAPRSEK_CUDA_KERNEL=$v PK_CUDA_STUB=kernelfail expect_failure "kernel $v" "the traversal kernel failed" "${rays[@]}"
 done
-PAPRSEK_CUDA_KERNEL=v9 expect_failure "unknown kernel version" "PAPRSEK_CUDA_KERNEL=v9 is not a kernel version \\(v0 to v5\\)$" \
+PAPRSEK_CUDA_KERNEL=v9 expect_failure "unknown kernel version" "PAPRSEK_CUDA_KERNEL=v9 is not a kernel version \\(v0 to v7\\)$" \
     "${rays[@]}"
 # a device that works is no reason to render on it (yet)
 PK_CUDA_STUB=kernelfail expect_failure "render" "rendering on the GPU is not there yet" \

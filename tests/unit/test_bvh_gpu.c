@@ -198,7 +198,7 @@ static ray *make_rays(rng *g, const accel_input *in, size_t n)
 static void check_box_tests(const built *b, const accel_input *in, rng *g, size_t nrays, const char *name)
 {
     ray *rays = make_rays(g, in, nrays);
-    long bad_exact = 0, bad_fma = 0, bad_loose = 0, entered = 0, extra = 0;
+    long bad_exact = 0, bad_fma = 0, bad_loose = 0, bad_wide = 0, entered = 0, extra = 0, extra6 = 0;
     for (size_t i = 0; i < nrays; i++) {
         ray r = rays[i];
         const uint32_t kind = rng_u32(g) % 8;
@@ -216,23 +216,26 @@ static void check_box_tests(const built *b, const accel_input *in, rng *g, size_
             const gpu_node *nd = &b->g.nodes[j];
             uint32_t w[24];
             gpu_node_load(nd, w);
-            float t0[GPU_WIDTH], t1[GPU_WIDTH], t3[GPU_WIDTH], t4[GPU_WIDTH];
+            float t0[GPU_WIDTH], t1[GPU_WIDTH], t3[GPU_WIDTH], t4[GPU_WIDTH], t6[GPU_WIDTH];
             const unsigned m0 = gpu_node_hits_v0(nd, &q, tcull, t0), m1 = gpu_node_hits(w, &q, tcull, t1);
             const unsigned m3 = gpu_node_hits_fma(w, &q, tcull, t3);
             const unsigned m4 = gpu_node_hits_slack(w, &q, kn, kf, tcull, t4);
+            const unsigned m6 = gpu_node_hits_wide(w, &q, kn, kf, tcull, t6);
             /* (gpu_trace_box uses it only for rays with every |1/d| < 2^64; here it is
              * tried on all, overflows included) */
             if (kind >= 4 && fabsf(q.rd[0]) < 0x1p64f && fabsf(q.rd[1]) < 0x1p64f && fabsf(q.rd[2]) < 0x1p64f) {
                 /* rays it is used for */
                 entered += __builtin_popcount(m0);
                 extra += __builtin_popcount(m4 & ~m0);
+                extra6 += __builtin_popcount(m6 & ~m0);
             }
-            bad_exact += m1 != m0, bad_fma += m3 != m0, bad_loose += (m4 & m0) != m0;
+            bad_exact += m1 != m0, bad_fma += m3 != m0, bad_loose += (m4 & m0) != m0, bad_wide += (m6 & m0) != m0;
             for (int s = 0; s < GPU_WIDTH; s++) {
                 if (!(m0 >> s & 1u)) continue;
                 bad_exact += !(t1[s] == t0[s]);
                 bad_fma += !(t3[s] == t0[s]);
                 bad_loose += !(t4[s] <= t0[s]);
+                bad_wide += !(t6[s] <= t0[s]);
             }
         }
     }
@@ -240,8 +243,11 @@ static void check_box_tests(const built *b, const accel_input *in, rng *g, size_
     CHECKF(bad_exact == 0, "%s: GPU_TEST_EXACT differs from gpu_node_hits_v0 %ld times", name, bad_exact);
     CHECKF(bad_fma == 0, "%s: GPU_TEST_FMA differs from gpu_node_hits_v0 %ld times", name, bad_fma);
     CHECKF(bad_loose == 0, "%s: GPU_TEST_LOOSE misses a box or enters it later %ld times", name, bad_loose);
-    printf("%s: box tests: %ld boxes entered by ordinary rays, %ld more (%.3f%%) by GPU_TEST_LOOSE\n", name, entered, extra,
-           100.0 * (double)extra / (double)(entered ? entered : 1));
+    CHECKF(bad_wide == 0, "%s: GPU_TEST_WIDE misses a box or enters it later %ld times", name, bad_wide);
+    printf("%s: box tests: %ld boxes entered by ordinary rays, %ld more (%.3f%%) by GPU_TEST_LOOSE, %ld (%.3f%%) by "
+           "GPU_TEST_WIDE\n",
+           name, entered, extra, 100.0 * (double)extra / (double)(entered ? entered : 1), extra6,
+           100.0 * (double)extra6 / (double)(entered ? entered : 1));
 }
 
 /* Every ray: closest hit bit for bit against brute force (and against the
@@ -261,7 +267,7 @@ static void check_rays(const built *b, const accel_input *in, const ray *rays, s
         gpu_trace(b->g.nodes, b->g.tris, (const pk_ray *)r, true, &any, NULL);
         /* every kernel's traversal: the first one's answers, any hits
          * included where the box distances are the same (the same visiting
-         * order); the loosened boxes give the same closest hit */
+         * order); the loosened boxes give the same closest hit (but for ties) */
         pk_hit got0, any0, h;
         const bool f0 = gpu_trace_v0(b->g.nodes, b->g.tris, (const pk_ray *)r, false, &got0, NULL);
         const bool a0 = gpu_trace_v0(b->g.nodes, b->g.tris, (const pk_ray *)r, true, &any0, NULL);
@@ -276,25 +282,28 @@ static void check_rays(const built *b, const accel_input *in, const ray *rays, s
         }
         /* (the visiting order may differ: an exact tie in t may then go to
          * another triangle, as between brute force and the CPU BVH) */
-        bool fl = gpu_trace_box(b->g.nodes, b->g.tris, (const pk_ray *)r, false, &h, NULL, GPU_TEST_LOOSE);
-        if (fl != f0) bad_loose++;
-        else if (!same_hit(&h, &got0)) {
-            const vec3 *p = in->verts + 3 * (size_t)h.prim;
-            ray_pre pre = ray_prepare(r);
-            float t, u, v;
-            const bool tie = same_bits(h.t, got0.t) && h.prim < in->ntris &&
-                             tri_intersect(&pre, p[0], p[1], p[2], r->tmax, &t, &u, &v) && same_bits(t, h.t);
-            loose_ties += tie;
-            bad_loose += !tie;
-        }
-        fl = gpu_trace_box(b->g.nodes, b->g.tris, (const pk_ray *)r, true, &h, NULL, GPU_TEST_LOOSE);
-        if (fl != a0) bad_loose++;
-        else if (fl) { /* some real hit in [tmin, tmax] */
-            const vec3 *p = in->verts + 3 * (size_t)h.prim;
-            ray_pre pre = ray_prepare(r);
-            float t, u, v;
-            bad_loose += !(h.prim < in->ntris && tri_intersect(&pre, p[0], p[1], p[2], r->tmax, &t, &u, &v) &&
-                           same_bits(t, h.t) && same_bits(u, h.u) && same_bits(v, h.v));
+        const int loose_modes[2] = {GPU_TEST_LOOSE, GPU_TEST_WIDE};
+        for (int lm = 0; lm < 2; lm++) {
+            bool fl = gpu_trace_box(b->g.nodes, b->g.tris, (const pk_ray *)r, false, &h, NULL, loose_modes[lm]);
+            if (fl != f0) bad_loose++;
+            else if (!same_hit(&h, &got0)) {
+                const vec3 *p = in->verts + 3 * (size_t)h.prim;
+                ray_pre pre = ray_prepare(r);
+                float t, u, v;
+                const bool tie = same_bits(h.t, got0.t) && h.prim < in->ntris &&
+                                 tri_intersect(&pre, p[0], p[1], p[2], r->tmax, &t, &u, &v) && same_bits(t, h.t);
+                loose_ties += tie;
+                bad_loose += !tie;
+            }
+            fl = gpu_trace_box(b->g.nodes, b->g.tris, (const pk_ray *)r, true, &h, NULL, loose_modes[lm]);
+            if (fl != a0) bad_loose++;
+            else if (fl) { /* some real hit in [tmin, tmax] */
+                const vec3 *p = in->verts + 3 * (size_t)h.prim;
+                ray_pre pre = ray_prepare(r);
+                float t, u, v;
+                bad_loose += !(h.prim < in->ntris && tri_intersect(&pre, p[0], p[1], p[2], r->tmax, &t, &u, &v) &&
+                               same_bits(t, h.t) && same_bits(u, h.u) && same_bits(v, h.v));
+            }
         }
         accel_intersect(b->cpu, r, &cpu, NULL);
         bad_cpu += !same_hit(&got, (const pk_hit *)&cpu);

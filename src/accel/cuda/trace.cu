@@ -18,7 +18,10 @@
  *       one thread per ray;
  *   v4  GPU_TEST_LOOSE (one fma per plane, boxes loosened by a bound on the
  *       rounding), one thread per ray;
- *   v5  as v4, with persistent warps.
+ *   v5  as v4, with persistent warps;
+ *   v6  GPU_TEST_WIDE (as v4 without the add that makes a byte a float),
+ *       one thread per ray;
+ *   v7  as v6, with persistent warps.
  * Every kernel takes (nodes, tris, rays, hits, n, counter); counter is a
  * device word set to 0 before a v2 launch (ignored by the others).
  */
@@ -51,6 +54,7 @@ PK_ONE_PER_THREAD(pk_trace_any_v0, gpu_trace_v0, true)
 PK_TRACE_WITH(GPU_TEST_EXACT)
 PK_TRACE_WITH(GPU_TEST_FMA)
 PK_TRACE_WITH(GPU_TEST_LOOSE)
+PK_TRACE_WITH(GPU_TEST_WIDE)
 
 PK_ONE_PER_THREAD(pk_trace_closest_v1, trace_GPU_TEST_EXACT, false)
 PK_ONE_PER_THREAD(pk_trace_any_v1, trace_GPU_TEST_EXACT, true)
@@ -58,6 +62,8 @@ PK_ONE_PER_THREAD(pk_trace_closest_v3, trace_GPU_TEST_FMA, false)
 PK_ONE_PER_THREAD(pk_trace_any_v3, trace_GPU_TEST_FMA, true)
 PK_ONE_PER_THREAD(pk_trace_closest_v4, trace_GPU_TEST_LOOSE, false)
 PK_ONE_PER_THREAD(pk_trace_any_v4, trace_GPU_TEST_LOOSE, true)
+PK_ONE_PER_THREAD(pk_trace_closest_v6, trace_GPU_TEST_WIDE, false)
+PK_ONE_PER_THREAD(pk_trace_any_v6, trace_GPU_TEST_WIDE, true)
 
 #define PK_PERSISTENT(name, trace, any)                                            \
     extern "C" __global__ void __launch_bounds__(128) name(PK_KERNEL_PARAMS)       \
@@ -82,3 +88,5 @@ PK_PERSISTENT(pk_trace_closest_v2, trace_GPU_TEST_EXACT, false)
 PK_PERSISTENT(pk_trace_any_v2, trace_GPU_TEST_EXACT, true)
 PK_PERSISTENT(pk_trace_closest_v5, trace_GPU_TEST_LOOSE, false)
 PK_PERSISTENT(pk_trace_any_v5, trace_GPU_TEST_LOOSE, true)
+PK_PERSISTENT(pk_trace_closest_v7, trace_GPU_TEST_WIDE, false)
+PK_PERSISTENT(pk_trace_any_v7, trace_GPU_TEST_WIDE, true)
