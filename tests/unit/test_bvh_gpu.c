@@ -604,16 +604,35 @@ static void check_file(pk_context *ctx, const char *rel, size_t nrays, size_t nb
         REQUIRE(dev && host);
         pk_accel *cpu = NULL;
         REQUIRE(pk_accel_create(ctx, s, PK_ACCEL_BVH, 2, &cpu) == PK_OK);
-        for (int any = 0; any < 2; any++) {
-            unsigned flags = any ? PK_TRACE_ANY_HIT : 0u;
-            pk_accel_trace(pa, (const pk_ray *)rays, dev, n, 0, flags, NULL);
-            CHECKF(pk_context_status(ctx) == PK_OK, "%s: device trace: %s", rel, pk_context_error(ctx));
-            pk_accel_trace(cpu, (const pk_ray *)rays, host, n, 0, flags, NULL);
-            size_t bad = 0;
-            for (size_t i = 0; i < n; i++)
-                bad += any ? (dev[i].prim != PK_NO_HIT) != (host[i].prim != PK_NO_HIT) : !same_hit(&dev[i], &host[i]);
-            CHECKF(bad == 0, "%s: %zu of %zu device %s hits differ from the CPU's", rel, bad, n, any ? "any" : "closest");
+        /* the default kernel, then every version (PAPRSEK_CUDA_KERNEL) */
+        static const char *const versions[] = {"", "v0", "v1", "v2", "v3", "v4", "v5", "v6", "v7"};
+        const char *keep = getenv("PAPRSEK_CUDA_KERNEL");
+        for (size_t ver = 0; ver < sizeof versions / sizeof *versions; ver++) {
+            pk_accel *pv = pa;
+            if (ver > 0) {
+                setenv("PAPRSEK_CUDA_KERNEL", versions[ver], 1);
+                st = pk_accel_create(ctx, s, PK_ACCEL_CUDA, 2, &pv);
+                CHECKF(st == PK_OK, "%s: kernel %s: %s", rel, versions[ver], pk_context_error(ctx));
+                if (st != PK_OK) {
+                    pk_context_clear_error(ctx);
+                    continue;
+                }
+            }
+            for (int any = 0; any < 2; any++) {
+                unsigned flags = any ? PK_TRACE_ANY_HIT : 0u;
+                pk_accel_trace(pv, (const pk_ray *)rays, dev, n, 0, flags, NULL);
+                CHECKF(pk_context_status(ctx) == PK_OK, "%s: device trace: %s", rel, pk_context_error(ctx));
+                pk_accel_trace(cpu, (const pk_ray *)rays, host, n, 0, flags, NULL);
+                size_t bad = 0;
+                for (size_t i = 0; i < n; i++)
+                    bad += any ? (dev[i].prim != PK_NO_HIT) != (host[i].prim != PK_NO_HIT) : !same_hit(&dev[i], &host[i]);
+                CHECKF(bad == 0, "%s: kernel %s: %zu of %zu device %s hits differ from the CPU's", rel,
+                       ver ? versions[ver] : "(default)", bad, n, any ? "any" : "closest");
+            }
+            if (ver > 0) pk_accel_destroy(pv);
         }
+        if (keep) setenv("PAPRSEK_CUDA_KERNEL", keep, 1);
+        else unsetenv("PAPRSEK_CUDA_KERNEL");
         pk_accel_device_info di;
         CHECK(pk_accel_get_device_info(pa, &di) == 1 && di.kernel_ms > 0.0 && di.structure_bytes > 0);
         CHECK(pk_accel_get_device_info(cpu, &di) == 0);

@@ -23,7 +23,10 @@
  *       one thread per ray;
  *   v7  as v6, with persistent warps.
  * Every kernel takes (nodes, tris, rays, hits, n, counter); counter is a
- * device word set to 0 before a v2 launch (ignored by the others).
+ * device word set to 0 before a persistent launch (ignored by the others).
+ * Blocks of 128 threads; v1-v3 ask for 8 blocks per multiprocessor (at most
+ * 64 registers a thread, no spills), v4-v7 for 7 (72 registers, a few bytes
+ * spilled, where they would take 79); v0 is compiled as it was.
  */
 #include "accel/bvh_gpu.h"
 
@@ -31,8 +34,8 @@
     const gpu_node *__restrict__ nodes, const gpu_tri *__restrict__ tris, const pk_ray *__restrict__ rays, \
         pk_hit *__restrict__ hits, unsigned n, unsigned *__restrict__ counter
 
-#define PK_ONE_PER_THREAD(name, trace, any)                                        \
-    extern "C" __global__ void __launch_bounds__(128) name(PK_KERNEL_PARAMS)       \
+#define PK_ONE_PER_THREAD(name, trace, any, blocks)                                \
+    extern "C" __global__ void __launch_bounds__(128, blocks) name(PK_KERNEL_PARAMS) \
     {                                                                              \
         (void)counter;                                                             \
         const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;                  \
@@ -43,8 +46,8 @@
         hits[i] = h;                                                               \
     }
 
-PK_ONE_PER_THREAD(pk_trace_closest_v0, gpu_trace_v0, false)
-PK_ONE_PER_THREAD(pk_trace_any_v0, gpu_trace_v0, true)
+PK_ONE_PER_THREAD(pk_trace_closest_v0, gpu_trace_v0, false, 0)
+PK_ONE_PER_THREAD(pk_trace_any_v0, gpu_trace_v0, true, 0)
 #define PK_TRACE_WITH(box)                                                                                \
     static __device__ __forceinline__ bool trace_##box(const gpu_node *nodes, const gpu_tri *tris, const pk_ray *r, \
                                                        bool any, pk_hit *h, gpu_counters *c)               \
@@ -56,17 +59,17 @@ PK_TRACE_WITH(GPU_TEST_FMA)
 PK_TRACE_WITH(GPU_TEST_LOOSE)
 PK_TRACE_WITH(GPU_TEST_WIDE)
 
-PK_ONE_PER_THREAD(pk_trace_closest_v1, trace_GPU_TEST_EXACT, false)
-PK_ONE_PER_THREAD(pk_trace_any_v1, trace_GPU_TEST_EXACT, true)
-PK_ONE_PER_THREAD(pk_trace_closest_v3, trace_GPU_TEST_FMA, false)
-PK_ONE_PER_THREAD(pk_trace_any_v3, trace_GPU_TEST_FMA, true)
-PK_ONE_PER_THREAD(pk_trace_closest_v4, trace_GPU_TEST_LOOSE, false)
-PK_ONE_PER_THREAD(pk_trace_any_v4, trace_GPU_TEST_LOOSE, true)
-PK_ONE_PER_THREAD(pk_trace_closest_v6, trace_GPU_TEST_WIDE, false)
-PK_ONE_PER_THREAD(pk_trace_any_v6, trace_GPU_TEST_WIDE, true)
+PK_ONE_PER_THREAD(pk_trace_closest_v1, trace_GPU_TEST_EXACT, false, 8)
+PK_ONE_PER_THREAD(pk_trace_any_v1, trace_GPU_TEST_EXACT, true, 8)
+PK_ONE_PER_THREAD(pk_trace_closest_v3, trace_GPU_TEST_FMA, false, 8)
+PK_ONE_PER_THREAD(pk_trace_any_v3, trace_GPU_TEST_FMA, true, 8)
+PK_ONE_PER_THREAD(pk_trace_closest_v4, trace_GPU_TEST_LOOSE, false, 7)
+PK_ONE_PER_THREAD(pk_trace_any_v4, trace_GPU_TEST_LOOSE, true, 7)
+PK_ONE_PER_THREAD(pk_trace_closest_v6, trace_GPU_TEST_WIDE, false, 7)
+PK_ONE_PER_THREAD(pk_trace_any_v6, trace_GPU_TEST_WIDE, true, 7)
 
-#define PK_PERSISTENT(name, trace, any)                                            \
-    extern "C" __global__ void __launch_bounds__(128) name(PK_KERNEL_PARAMS)       \
+#define PK_PERSISTENT(name, trace, any, blocks)                                    \
+    extern "C" __global__ void __launch_bounds__(128, blocks) name(PK_KERNEL_PARAMS) \
     {                                                                              \
         const unsigned lane = threadIdx.x & 31u;                                   \
         for (;;) {                                                                 \
@@ -84,9 +87,9 @@ PK_ONE_PER_THREAD(pk_trace_any_v6, trace_GPU_TEST_WIDE, true)
         }                                                                          \
     }
 
-PK_PERSISTENT(pk_trace_closest_v2, trace_GPU_TEST_EXACT, false)
-PK_PERSISTENT(pk_trace_any_v2, trace_GPU_TEST_EXACT, true)
-PK_PERSISTENT(pk_trace_closest_v5, trace_GPU_TEST_LOOSE, false)
-PK_PERSISTENT(pk_trace_any_v5, trace_GPU_TEST_LOOSE, true)
-PK_PERSISTENT(pk_trace_closest_v7, trace_GPU_TEST_WIDE, false)
-PK_PERSISTENT(pk_trace_any_v7, trace_GPU_TEST_WIDE, true)
+PK_PERSISTENT(pk_trace_closest_v2, trace_GPU_TEST_EXACT, false, 8)
+PK_PERSISTENT(pk_trace_any_v2, trace_GPU_TEST_EXACT, true, 8)
+PK_PERSISTENT(pk_trace_closest_v5, trace_GPU_TEST_LOOSE, false, 7)
+PK_PERSISTENT(pk_trace_any_v5, trace_GPU_TEST_LOOSE, true, 7)
+PK_PERSISTENT(pk_trace_closest_v7, trace_GPU_TEST_WIDE, false, 7)
+PK_PERSISTENT(pk_trace_any_v7, trace_GPU_TEST_WIDE, true, 7)
