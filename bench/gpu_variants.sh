@@ -8,7 +8,9 @@
 # bench/out/gpu_variants/.
 #
 # usage: bench/gpu_variants.sh [SHARED_DIR [PAPRSEK]]   (defaults: ../shared, build/paprsek)
-# environment: SIZE (4096), REPS (3), THREADS (0 = all cores), VARIANTS (v0 v1 v3 v4 v6 v7),
+# environment: SIZE (4096), REPS (3), THREADS (0 = all cores),
+#              VARIANTS (v0 v1 v3 v4 v6 v7 v3/t4 v6/t4: kernel version, and /tN for a tree
+#              collapsed for the GPU with node cost N, PAPRSEK_CUDA_TREE=N),
 #              WORKLOADS (cornell-sphere bunny sponza), KINDS (primary diffuse diffuse-any)
 set -euo pipefail
 
@@ -19,7 +21,7 @@ bin=${2:-$repo/build/paprsek}
 size=${SIZE:-4096}
 reps=${REPS:-3}
 threads=${THREADS:-0}
-variants=${VARIANTS:-v0 v1 v3 v4 v6 v7}
+variants=${VARIANTS:-v0 v1 v3 v4 v6 v7 v3/t4 v6/t4}
 workloads=${WORKLOADS:-cornell-sphere bunny sponza}
 kinds=${KINDS:-primary diffuse diffuse-any}
 out=$here/out/gpu_variants
@@ -59,7 +61,8 @@ for wl in $workloads; do
         echo "$wl $kind CPU $c" >>"$out/raw.txt"
         row="| $wl $kind |"
         for v in $variants; do
-            g=$(PAPRSEK_CUDA_KERNEL=$v "$bin" bench rays "$scene" "$rays" --accel cuda --reps "$reps" $any --hits "$out/gpu.hits" 2>>"$out/err.log") || g=
+            tree=; case $v in */t*) tree=${v##*/t} ;; esac
+            g=$(PAPRSEK_CUDA_KERNEL=${v%%/*} PAPRSEK_CUDA_TREE=$tree "$bin" bench rays "$scene" "$rays" --accel cuda --reps "$reps" $any --hits "$out/gpu.hits" 2>>"$out/err.log") || g=
             echo "$wl $kind $v $g" >>"$out/raw.txt"
             kg=$(echo "$g" | field kernel_mrays_per_s)
             if [ -z "$kg" ]; then

@@ -470,10 +470,22 @@ pk_status accel_cuda_create(pk_context *ctx, const accel_input *in, accel **out)
             return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT,
                              "accelerator 'cuda': PAPRSEK_CUDA_KERNEL=%.40s is not a kernel version (v0 to v7)", kv);
     }
+    /* PAPRSEK_CUDA_TREE=N collapses the binary tree for the GPU: a node visit
+     * costs N triangle tests (the CPU's tree when unset) */
+    bvh_costs costs = {0.0f, 1, GPU_LEAF_MAX};
+    const char *tv = getenv("PAPRSEK_CUDA_TREE");
+    if (tv && tv[0]) {
+        char *end = NULL;
+        const double v = strtod(tv, &end);
+        if (*end || !(v >= 0.25 && v <= 64.0))
+            return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT,
+                             "accelerator 'cuda': PAPRSEK_CUDA_TREE=%.40s is not a node cost from 0.25 to 64", tv);
+        costs.node = (float)v;
+    }
     if (!driver_loaded()) return ctx_error(ctx, PK_ERR_UNSUPPORTED, "accelerator 'cuda': %s", load_error);
     const double t0 = time_now();
     accel *b = NULL;
-    pk_status st = accel_bvh_create(ctx, in, &b);
+    pk_status st = accel_bvh_create_costs(ctx, in, costs.node > 0.0f ? &costs : NULL, &b);
     if (st != PK_OK) return st;
     const pk_allocator *al = &ctx->alloc;
     cuda_accel *c = mem_calloc(al, 1, sizeof *c);

@@ -112,10 +112,12 @@ typedef struct built {
     gpu_layout g;
 } built;
 
-static bool build_all(pk_context *ctx, const accel_input *in, const char *name, built *b)
+/* costs: the collapse's cost model (NULL: the CPU's tree) */
+static bool build_tree(pk_context *ctx, const accel_input *in, const bvh_costs *costs, const char *name, built *b)
 {
     memset(b, 0, sizeof *b);
-    pk_status st = accel_create(ctx, PK_ACCEL_BVH, in, &b->cpu);
+    pk_status st = accel_bvh_create_costs(ctx, in, costs, &b->cpu);
+    if (st == PK_OK) b->cpu->ntris = in->ntris, b->cpu->nspheres = in->nspheres; /* (as accel_create does) */
     CHECKF(st == PK_OK, "%s: bvh: %s", name, pk_context_error(ctx));
     if (st != PK_OK) return false;
     REQUIRE(accel_create(ctx, PK_ACCEL_NONE, in, &b->none) == PK_OK);
@@ -126,6 +128,11 @@ static bool build_all(pk_context *ctx, const accel_input *in, const char *name, 
     CHECKF(gpu_layout_check(&b->g, (const float *)in->verts, why, sizeof why), "%s: gpu_layout_check: %s", name, why);
     CHECKF(gpu_layout_check_boxes(&b->g, b->cpu, why, sizeof why), "%s: gpu_layout_check_boxes: %s", name, why);
     return true;
+}
+
+static bool build_all(pk_context *ctx, const accel_input *in, const char *name, built *b)
+{
+    return build_tree(ctx, in, NULL, name, b);
 }
 
 static void free_all(pk_context *ctx, built *b)
@@ -550,6 +557,23 @@ static void test_checker(pk_context *ctx)
 
 /* ---- shared scenes ---------------------------------------------------------- */
 
+/* Nodes visited, triangles tested and bytes read per ray (closest hit) on
+ * rays from inside the scene's box: what the tree costs the GPU (printed). */
+static void traffic(const built *b, const accel_input *in, const char *what, const char *name)
+{
+    rng g = {4242};
+    const size_t n = 20000;
+    ray *rays = make_rays(&g, in, n);
+    gpu_counters c = {0, 0};
+    for (size_t i = 0; i < n; i++) {
+        pk_hit h;
+        gpu_trace(b->g.nodes, b->g.tris, (const pk_ray *)&rays[i], false, &h, &c);
+    }
+    free(rays);
+    printf("%-44s %s: %.1f nodes and leaves, %.1f triangles, %.0f bytes a ray\n", name, what, (double)c.nodes / n,
+           (double)c.tests / n, ((double)c.nodes * sizeof(gpu_node) + (double)c.tests * sizeof(gpu_tri)) / n);
+}
+
 static void check_file(pk_context *ctx, const char *rel, size_t nrays, size_t nbrute)
 {
     char path[1024];
@@ -581,9 +605,29 @@ static void check_file(pk_context *ctx, const char *rel, size_t nrays, size_t nb
         printf("%-44s %7zu tris %6zu nodes %7zu records (%.1f MiB) stack %3u  %.2f s\n", rel, s->ntris, b.g.nnodes,
                b.g.ntris, (double)(b.g.nnodes * sizeof(gpu_node) + b.g.ntris * sizeof(gpu_tri)) / 1048576.0,
                b.g.stack_need, omp_get_wtime() - t0);
+        traffic(&b, &in, "the CPU's tree", rel);
     }
     free_all(ctx, &b);
     pk_context_clear_error(ctx);
+    /* trees collapsed for the GPU (PAPRSEK_CUDA_TREE): the same checks */
+    static const float node_costs[] = {2.0f, 4.0f, 8.0f};
+    for (size_t c = 0; c < sizeof node_costs / sizeof *node_costs; c++) {
+        const bvh_costs costs = {node_costs[c], 1, 16};
+        char what[64];
+        snprintf(what, sizeof what, "node cost %g", (double)costs.node);
+        if (build_tree(ctx, &in, &costs, rel, &b)) {
+            rng g = {77 + c};
+            ray *rays = make_rays(&g, &in, nrays / 4);
+            check_rays(&b, &in, rays, nbrute / 4, true, rel);
+            check_rays(&b, &in, rays + nbrute / 4, nrays / 4 - nbrute / 4, false, rel);
+            free(rays);
+            printf("%-44s %s: %6zu nodes %7zu records (%.1f MiB) stack %3u\n", rel, what, b.g.nnodes, b.g.ntris,
+                   (double)(b.g.nnodes * sizeof(gpu_node) + b.g.ntris * sizeof(gpu_tri)) / 1048576.0, b.g.stack_need);
+            traffic(&b, &in, what, rel);
+        }
+        free_all(ctx, &b);
+        pk_context_clear_error(ctx);
+    }
 
     /* the public door: without a driver or device a clean error; with one,
      * the GPU's hits against the host's */
