@@ -9,7 +9,7 @@
 #
 # usage: bench/gpu_variants.sh [SHARED_DIR [PAPRSEK]]   (defaults: ../shared, build/paprsek)
 # environment: SIZE (4096), REPS (3), THREADS (0 = all cores),
-#              VARIANTS (v0 v1 v3 v4 v6 v7 v3/t4 v6/t4: kernel version, and /tN for a tree
+#              VARIANTS (v0 v1 v3 v6 v7 v8 v9 v3/t4 v6/t4: kernel version, and /tN for a tree
 #              collapsed for the GPU with node cost N, PAPRSEK_CUDA_TREE=N),
 #              WORKLOADS (cornell-sphere bunny sponza), KINDS (primary diffuse diffuse-any)
 set -euo pipefail
@@ -21,7 +21,7 @@ bin=${2:-$repo/build/paprsek}
 size=${SIZE:-4096}
 reps=${REPS:-3}
 threads=${THREADS:-0}
-variants=${VARIANTS:-v0 v1 v3 v4 v6 v7 v3/t4 v6/t4}
+variants=${VARIANTS:-v0 v1 v3 v6 v7 v8 v9 v3/t4 v6/t4}
 workloads=${WORKLOADS:-cornell-sphere bunny sponza}
 kinds=${KINDS:-primary diffuse diffuse-any}
 out=$here/out/gpu_variants

@@ -586,101 +586,134 @@ static inline PK_HD bool gpu_tri_intersect_rec(const gpu_ray *r, const gpu_tri *
 /* The traversal with box test box (a constant: GPU_TEST_EXACT, GPU_TEST_FMA,
  * GPU_TEST_LOOSE or GPU_TEST_WIDE); gpu_trace below is the one to call. */
 enum { GPU_TEST_EXACT = 1, GPU_TEST_FMA = 3, GPU_TEST_LOOSE = 4, GPU_TEST_WIDE = 6 };
-static inline PK_HD bool gpu_trace_box(const gpu_node *nodes, const gpu_tri *tris, const pk_ray *in, bool any,
-                                       pk_hit *out, gpu_counters *count, int box)
-{
-    out->t = INFINITY;
-    out->prim = PK_NO_HIT;
-    out->u = out->v = 0.0f;
-    if (!gpu_ray_traceable(in)) return false;
+/* One ray's traversal as a state that advances a step at a time: a step
+ * goes down to a leaf, tests its triangles and pops the next node, so that
+ * a kernel can give a lane whose ray is done a new ray between steps
+ * (gpu_walk_*; gpu_trace_box runs the steps in a loop). The stack is the
+ * caller's (GPU_STACK entries), sp and ref index into it. */
+typedef struct gpu_walk {
     gpu_ray r;
-    gpu_ray_init(&r, in);
-    float best_t = in->tmax, best_u = 0.0f, best_v = 0.0f;
-    uint32_t best_prim = PK_NO_HIT;
-    float tcull = gpu_cull_limit(best_t);
+    float best_t, best_u, best_v, tcull;
+    uint32_t best_prim, ref;
+    int sp;
+    bool loose;             /* GPU_TEST_LOOSE or _WIDE for this ray */
+    float kn[3], kf[3];     /* their per-ray terms */
+} gpu_walk;
+
+/* Starts *w on *in; false when there is nothing to trace (no hit). */
+static inline PK_HD bool gpu_walk_init(gpu_walk *w, const pk_ray *in, int box)
+{
+    w->best_t = in->tmax, w->best_u = w->best_v = 0.0f;
+    w->best_prim = PK_NO_HIT;
+    w->ref = 0, w->sp = 0;
+    if (!gpu_ray_traceable(in)) return false;
+    gpu_ray_init(&w->r, in);
+    w->tcull = gpu_cull_limit(w->best_t);
     /* GPU_TEST_LOOSE's per-ray terms; a ray with a huge or infinite 1/d
      * component (d = 0: axis-parallel) takes GPU_TEST_FMA instead, where
      * the bound would be infinite and the axis would limit nothing */
-    const bool loose = (box == GPU_TEST_LOOSE || box == GPU_TEST_WIDE) && fabsf(r.rd[0]) < 0x1p64f && fabsf(r.rd[1]) < 0x1p64f &&
-                       fabsf(r.rd[2]) < 0x1p64f;
-    float kn[3] = {0.0f, 0.0f, 0.0f}, kf[3] = {0.0f, 0.0f, 0.0f};
-    if (loose) gpu_loose_terms(&r, kn, kf);
+    w->loose = (box == GPU_TEST_LOOSE || box == GPU_TEST_WIDE) && fabsf(w->r.rd[0]) < 0x1p64f &&
+               fabsf(w->r.rd[1]) < 0x1p64f && fabsf(w->r.rd[2]) < 0x1p64f;
+    w->kn[0] = w->kn[1] = w->kn[2] = w->kf[0] = w->kf[1] = w->kf[2] = 0.0f;
+    if (w->loose) gpu_loose_terms(&w->r, w->kn, w->kf);
+    return true;
+}
 
-    gpu_stack_entry stack[GPU_STACK];
-    int sp = 0;
-    uint32_t ref = 0;
+/* One step; true when the ray is done (gpu_walk_hit then has the answer). */
+static inline PK_HD bool gpu_walk_step(gpu_walk *ws, gpu_stack_entry *stack, const gpu_node *nodes,
+                                       const gpu_tri *tris, bool any, gpu_counters *count, int box)
+{
+    const gpu_ray *r = &ws->r;
+    uint32_t ref = ws->ref;
+    int sp = ws->sp;
+    float tcull = ws->tcull;
+    while (!(ref & GPU_LEAF)) {
+        if (count) count->nodes++;
+        uint32_t w[24];
+        gpu_node_load(&nodes[ref], w);
+        float tn[GPU_WIDTH];
+        const unsigned mask = ws->loose ? (box == GPU_TEST_WIDE ? gpu_node_hits_wide(w, r, ws->kn, ws->kf, tcull, tn)
+                                                                : gpu_node_hits_slack(w, r, ws->kn, ws->kf, tcull, tn))
+                              : box != GPU_TEST_EXACT ? gpu_node_hits_fma(w, r, tcull, tn)
+                                                      : gpu_node_hits(w, r, tcull, tn);
+        if (!mask) goto pop;
+        /* The order of gpu_trace_v0, which pushes every hit child with an
+         * insertion sort (a child goes above those nearer than it and above
+         * equals from lower slots) and pops the top: here the top, the
+         * nearest (the highest slot among equals), stays in cur. A child
+         * replacing cur is at least as near as every pushed one, and a
+         * pushed one as near as cur came from a lower slot, so the old cur
+         * goes straight on top; any other child is inserted. */
+        uint32_t cur = GPU_EMPTY;
+        float ct = 0.0f;
+        const int base = sp;
+        GPU_UNROLL
+        for (int k = 0; k < GPU_WIDTH; k++) {
+            if (!(mask >> k & 1u)) continue;
+            const uint32_t c = w[16 + k];
+            const float t = tn[k];
+            if (cur == GPU_EMPTY) {
+                cur = c, ct = t;
+            } else if (t <= ct) {
+                stack[sp].ref = cur, stack[sp].t = ct;
+                sp++;
+                cur = c, ct = t;
+            } else {
+                int j = sp++;
+                for (; j > base && stack[j - 1].t < t; j--) stack[j] = stack[j - 1];
+                stack[j].ref = c, stack[j].t = t;
+            }
+        }
+        ref = cur;
+    }
+    {
+        if (count) count->nodes++;
+        const uint32_t first = gpu_leaf_first(ref), cnt = gpu_leaf_count(ref);
+        for (uint32_t i = 0; i < cnt; i++) {
+            float t, u, v;
+            uint32_t prim;
+            if (count) count->tests++;
+            if (!gpu_tri_intersect_rec(r, &tris[first + i], ws->best_t, &t, &u, &v, &prim)) continue;
+            if (t < ws->best_t || (t == ws->best_t && prim < ws->best_prim)) {
+                ws->best_t = t, ws->best_prim = prim, ws->best_u = u, ws->best_v = v;
+                if (any) return true;
+            }
+        }
+        tcull = gpu_cull_limit(ws->best_t);
+    }
+pop:
     for (;;) {
-        while (!(ref & GPU_LEAF)) {
-            if (count) count->nodes++;
-            uint32_t w[24];
-            gpu_node_load(&nodes[ref], w);
-            float tn[GPU_WIDTH];
-            const unsigned mask = loose ? (box == GPU_TEST_WIDE ? gpu_node_hits_wide(w, &r, kn, kf, tcull, tn)
-                                                                : gpu_node_hits_slack(w, &r, kn, kf, tcull, tn))
-                                  : box != GPU_TEST_EXACT ? gpu_node_hits_fma(w, &r, tcull, tn)
-                                                          : gpu_node_hits(w, &r, tcull, tn);
-            if (!mask) goto pop;
-            /* The order of gpu_trace_v0, which pushes every hit child with
-             * an insertion sort (a child goes above those nearer than it and
-             * above equals from lower slots) and pops the top: here the top,
-             * the nearest (the highest slot among equals), stays in cur. A
-             * child replacing cur is at least as near as every pushed one,
-             * and a pushed one as near as cur came from a lower slot, so the
-             * old cur goes straight on top; any other child is inserted. */
-            uint32_t cur = GPU_EMPTY;
-            float ct = 0.0f;
-            const int base = sp;
-            GPU_UNROLL
-            for (int k = 0; k < GPU_WIDTH; k++) {
-                if (!(mask >> k & 1u)) continue;
-                const uint32_t c = w[16 + k];
-                const float t = tn[k];
-                if (cur == GPU_EMPTY) {
-                    cur = c, ct = t;
-                } else if (t <= ct) {
-                    stack[sp].ref = cur, stack[sp].t = ct;
-                    sp++;
-                    cur = c, ct = t;
-                } else {
-                    int j = sp++;
-                    for (; j > base && stack[j - 1].t < t; j--) stack[j] = stack[j - 1];
-                    stack[j].ref = c, stack[j].t = t;
-                }
-            }
-            ref = cur;
-        }
-        {
-            if (count) count->nodes++;
-            const uint32_t first = gpu_leaf_first(ref), cnt = gpu_leaf_count(ref);
-            for (uint32_t i = 0; i < cnt; i++) {
-                float t, u, v;
-                uint32_t prim;
-                if (count) count->tests++;
-                if (!gpu_tri_intersect_rec(&r, &tris[first + i], best_t, &t, &u, &v, &prim)) continue;
-                if (t < best_t || (t == best_t && prim < best_prim)) {
-                    best_t = t, best_prim = prim, best_u = u, best_v = v;
-                    if (any) goto done;
-                }
-            }
-            tcull = gpu_cull_limit(best_t);
-        }
-    pop:
-        for (;;) {
-            if (sp == 0) goto done;
-            --sp;
-            if (stack[sp].t <= tcull) {
-                ref = stack[sp].ref;
-                break;
-            }
+        if (sp == 0) return true;
+        --sp;
+        if (stack[sp].t <= tcull) {
+            ref = stack[sp].ref;
+            break;
         }
     }
-done:
-    if (best_prim == PK_NO_HIT) return false;
-    out->t = best_t;
-    out->prim = best_prim;
-    out->u = best_u;
-    out->v = best_v;
-    return true;
+    ws->ref = ref, ws->sp = sp, ws->tcull = tcull;
+    return false;
+}
+
+/* The answer of a finished walk (a miss: t = +inf, PK_NO_HIT, u = v = 0). */
+static inline PK_HD bool gpu_walk_hit(const gpu_walk *w, pk_hit *out)
+{
+    const bool found = w->best_prim != PK_NO_HIT;
+    out->t = found ? w->best_t : INFINITY;
+    out->prim = w->best_prim;
+    out->u = found ? w->best_u : 0.0f;
+    out->v = found ? w->best_v : 0.0f;
+    return found;
+}
+
+static inline PK_HD bool gpu_trace_box(const gpu_node *nodes, const gpu_tri *tris, const pk_ray *in, bool any,
+                                       pk_hit *out, gpu_counters *count, int box)
+{
+    gpu_walk w;
+    gpu_stack_entry stack[GPU_STACK];
+    if (gpu_walk_init(&w, in, box))
+        while (!gpu_walk_step(&w, stack, nodes, tris, any, count, box)) {
+        }
+    return gpu_walk_hit(&w, out);
 }
 
 /* Closest hit (any = false) or any hit (any = true) of *in against the

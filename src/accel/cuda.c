@@ -181,10 +181,10 @@ static bool driver_loaded(void) { return pthread_once(&load_once, load_driver) =
 
 /* The kernel versions of cuda/trace.cu; PAPRSEK_CUDA_KERNEL picks one by
  * name (for timing them against each other: they give the same hits). */
-static const char *const kernel_names[] = {"v0", "v1", "v2", "v3", "v4", "v5", "v6", "v7"};
+static const char *const kernel_names[] = {"v0", "v1", "v2", "v3", "v4", "v5", "v6", "v7", "v8", "v9"};
 #define KERNEL_DEFAULT 3
-/* v2, v5 and v7: persistent warps, a ray counter on the device */
-static bool kernel_persistent(int k) { return k == 2 || k == 5 || k == 7; }
+/* v2, v5, v7, v8 and v9: persistent warps, a ray counter on the device */
+static bool kernel_persistent(int k) { return k == 2 || k == 5 || k >= 7; }
 
 /* Invariants:
  *  1. layout is the converted BVH; d_nodes and d_tris hold copies of its
@@ -459,7 +459,7 @@ pk_status accel_cuda_create(pk_context *ctx, const accel_input *in, accel **out)
     if (in->nspheres)
         return ctx_error(ctx, PK_ERR_UNSUPPORTED, "accelerator 'cuda': the GPU traces triangles only (the scene has "
                                                   "%zu sphere%s)", in->nspheres, in->nspheres == 1 ? "" : "s");
-    /* PAPRSEK_CUDA_KERNEL=v0..v7 picks the kernel version (for timing) */
+    /* PAPRSEK_CUDA_KERNEL=v0..v9 picks the kernel version (for timing) */
     int kernel = KERNEL_DEFAULT;
     const char *kv = getenv("PAPRSEK_CUDA_KERNEL");
     if (kv && kv[0]) {
@@ -468,7 +468,7 @@ pk_status accel_cuda_create(pk_context *ctx, const accel_input *in, accel **out)
             if (strcmp(kv, kernel_names[i]) == 0) kernel = i;
         if (kernel < 0)
             return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT,
-                             "accelerator 'cuda': PAPRSEK_CUDA_KERNEL=%.40s is not a kernel version (v0 to v7)", kv);
+                             "accelerator 'cuda': PAPRSEK_CUDA_KERNEL=%.40s is not a kernel version (v0 to v9)", kv);
     }
     /* PAPRSEK_CUDA_TREE=N collapses the binary tree for the GPU: a node visit
      * costs N triangle tests (the CPU's tree when unset) */

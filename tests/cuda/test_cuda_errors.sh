@@ -70,13 +70,13 @@ PK_CUDA_STUB=kernelfail expect_failure "kernel failure" "the traversal kernel fa
     "${rays[@]}"
 PK_CUDA_STUB=kernelfail expect_failure "kernel failure, any-hit" "the traversal kernel failed" "${rays[@]}" --any-hit
 # every kernel version goes as far as the launch; an unknown one is refused
-for v in v0 v1 v2 v3 v4 v5 v6 v7; do
+for v in v0 v1 v2 v3 v4 v5 v6 v7 v8 v9; do
     PAPRSEK_CUDA_KERNEL=$v PK_CUDA_STUB=kernelfail expect_failure "kernel $v" "the traversal kernel failed" "${rays[@]}"
 done
 PAPRSEK_CUDA_TREE=4 PAPRSEK_CUDA_KERNEL=v6 PK_CUDA_STUB=kernelfail expect_failure "tree for the GPU" \
     "the traversal kernel failed" "${rays[@]}"
 PAPRSEK_CUDA_TREE=0 expect_failure "bad tree cost" "PAPRSEK_CUDA_TREE=0 is not a node cost from 0.25 to 64$" "${rays[@]}"
-PAPRSEK_CUDA_KERNEL=v9 expect_failure "unknown kernel version" "PAPRSEK_CUDA_KERNEL=v9 is not a kernel version \\(v0 to v7\\)$" \
+PAPRSEK_CUDA_KERNEL=v10 expect_failure "unknown kernel version" "PAPRSEK_CUDA_KERNEL=v10 is not a kernel version \\(v0 to v9\\)$" \
     "${rays[@]}"
 # a device that works is no reason to render on it (yet)
 PK_CUDA_STUB=kernelfail expect_failure "render" "rendering on the GPU is not there yet" \

@@ -649,7 +649,7 @@ static void check_file(pk_context *ctx, const char *rel, size_t nrays, size_t nb
         pk_accel *cpu = NULL;
         REQUIRE(pk_accel_create(ctx, s, PK_ACCEL_BVH, 2, &cpu) == PK_OK);
         /* the default kernel, then every version (PAPRSEK_CUDA_KERNEL) */
-        static const char *const versions[] = {"", "v0", "v1", "v2", "v3", "v4", "v5", "v6", "v7"};
+        static const char *const versions[] = {"", "v0", "v1", "v2", "v3", "v4", "v5", "v6", "v7", "v8", "v9"};
         const char *keep = getenv("PAPRSEK_CUDA_KERNEL");
         for (size_t ver = 0; ver < sizeof versions / sizeof *versions; ver++) {
             pk_accel *pv = pa;

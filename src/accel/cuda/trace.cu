@@ -21,7 +21,10 @@
  *   v5  as v4, with persistent warps;
  *   v6  GPU_TEST_WIDE (as v4 without the add that makes a byte a float),
  *       one thread per ray;
- *   v7  as v6, with persistent warps.
+ *   v7  as v6, with persistent warps;
+ *   v8  as v6, with persistent warps whose lanes take new rays as theirs
+ *       finish (dynamic fetch, below);
+ *   v9  as v3, with dynamic fetch.
  * Every kernel takes (nodes, tris, rays, hits, n, counter); counter is a
  * device word set to 0 before a persistent launch (ignored by the others).
  * Blocks of 128 threads; v1-v3 ask for 8 blocks per multiprocessor (at most
@@ -86,6 +89,56 @@ PK_ONE_PER_THREAD(pk_trace_any_v6, trace_GPU_TEST_WIDE, true, 7)
             }                                                                      \
         }                                                                          \
     }
+
+/* Persistent warps that keep every lane busy (Aila and Laine 2009, "dynamic
+ * fetch"): each lane walks its ray a step at a time (gpu_walk_step: down to
+ * a leaf, its triangles, the next pop); when at least a quarter of the
+ * warp's lanes are done, those lanes take the next rays from the counter
+ * together (one atomic add a warp). The same steps as one thread per ray,
+ * so the same hits. */
+#define PK_FETCHING(name, box, any, blocks)                                                     \
+    extern "C" __global__ void __launch_bounds__(128, blocks) name(PK_KERNEL_PARAMS)             \
+    {                                                                                           \
+        const unsigned lane = threadIdx.x & 31u;                                                \
+        gpu_stack_entry stack[GPU_STACK];                                                       \
+        gpu_walk w;                                                                             \
+        unsigned ray = 0;                                                                       \
+        bool busy = false, exhausted = false;                                                   \
+        for (;;) {                                                                              \
+            const unsigned idle = __ballot_sync(0xFFFFFFFFu, !busy);                            \
+            if (!exhausted && __popc(idle) >= 8) {                                              \
+                unsigned base = 0;                                                              \
+                if (lane == (unsigned)(__ffs(idle) - 1)) base = atomicAdd(counter, __popc(idle)); \
+                base = __shfl_sync(0xFFFFFFFFu, base, __ffs(idle) - 1);                         \
+                if (base + __popc(idle) >= n) exhausted = true;                                 \
+                if (!busy) {                                                                    \
+                    ray = base + __popc(idle & ((1u << lane) - 1u));                            \
+                    while (ray < n) {                                                           \
+                        const pk_ray r = rays[ray];                                             \
+                        if (gpu_walk_init(&w, &r, box)) {                                       \
+                            busy = true;                                                        \
+                            break;                                                              \
+                        }                                                                       \
+                        gpu_walk_hit(&w, &hits[ray]);                                           \
+                        ray = n;                                                                \
+                    }                                                                           \
+                }                                                                               \
+            }                                                                                   \
+            if (!__any_sync(0xFFFFFFFFu, busy)) {                                               \
+                if (exhausted) return;                                                          \
+                continue;                                                                       \
+            }                                                                                   \
+            if (busy && gpu_walk_step(&w, stack, nodes, tris, any, NULL, box)) {                \
+                gpu_walk_hit(&w, &hits[ray]);                                                   \
+                busy = false;                                                                   \
+            }                                                                                   \
+        }                                                                                       \
+    }
+
+PK_FETCHING(pk_trace_closest_v8, GPU_TEST_WIDE, false, 7)
+PK_FETCHING(pk_trace_any_v8, GPU_TEST_WIDE, true, 7)
+PK_FETCHING(pk_trace_closest_v9, GPU_TEST_FMA, false, 8)
+PK_FETCHING(pk_trace_any_v9, GPU_TEST_FMA, true, 8)
 
 PK_PERSISTENT(pk_trace_closest_v2, trace_GPU_TEST_EXACT, false, 8)
 PK_PERSISTENT(pk_trace_any_v2, trace_GPU_TEST_EXACT, true, 8)
