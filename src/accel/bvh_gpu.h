@@ -435,42 +435,32 @@ static GPU_BOX_INLINE PK_HD unsigned gpu_node_hits_fma(const uint32_t w[24], con
  * Why it enters every box v1 enters (so every box the CPU enters). With
  * u = 2^-24, P = org + q * scale (exact) and x = (P - o) * rd (exact):
  * v1's distance fl(fl(fl(P) - o) * rd) is within
- * u * (|o rd| + 3.01 * 255 |S| + 3.01 |A|) of x (three roundings, |P| <=
- * |org - o| + |o| + 255 scale). Here S = scale * rd is exact (a power of
+ * u * (|org rd| + 3.01 * 255 |S| + 2.01 |A|) of x (three roundings, |P| <=
+ * |org| + 255 scale). Here S = scale * rd is exact (a power of
  * two times rd; a subnormal S errs by at most 2^-150, covered by the
  * 2^-100 below) and A = fl(fl(org - o) * rd) is within 2.0001 u |(org-o) rd|
  * of its exact value; fl(q * S + fl(A - E)) is then within
  * u * (2.0001 |(org-o) rd| + 2.0001 |A| + 255 |S| + 2.0001 E) of x - E.
- * So it is below v1's distance when E >= u * (|o rd| + 1023 |S| + 7.03 |A|)
- * (+ a little for E's own rounding); E = 2^-20 * (|A| + 255 |S| + |o rd|)
+ * So it is below v1's distance when E >= u * (|org rd| + 1023 |S| + 6.03 |A|)
+ * (+ a little for E's own rounding); E = 2^-20 * (|A| + 255 |S| + |org rd|)
  * + 2^-100 is twice that or more on every term. The far side is the same
  * with rdf and + E. Nothing there uses the signs of q, S or A, so it holds
  * for either row and either direction. Infinite or NaN values only loosen
- * the test: 1/d = +-inf (d = 0) or an overflowing S, A or |o rd| makes E
+ * the test: 1/d = +-inf (d = 0) or an overflowing S, A or |org rd| makes E
  * infinite, so every near distance of that axis is -inf or NaN and every
  * far one +inf or NaN, and a NaN plane is no limit (fmaxf, fminf); 1/d NaN
  * makes them all NaN, as in v1. (So that an axis-parallel ray is not slowed
  * down by it, gpu_trace_box gives rays with a 1/d component of 2^64 or more
  * gpu_node_hits_fma instead.) The cost: boxes are looser by 2^-20 of the
- * distances involved, and of |o| / |d| (scenes far from the origin). The
+ * distances involved, and of |org| / |d| (scenes far from the origin). The
  * entry distances differ from v1's by as much, so children at nearly equal
  * distances may be visited in another order: the closest hit is the same
  * (smallest t, then smallest number), an any hit may be another. */
 #define GPU_LOOSE_REL 0x1p-20f
 #define GPU_LOOSE_ABS 0x1p-100f
 
-/* The per-ray terms of E: 2^-20 |o / d| + 2^-100 per axis, with 1/d and
- * with the far planes' 1/d * (1 + GPU_BOX_SLACK). */
-static GPU_BOX_INLINE PK_HD void gpu_loose_terms(const gpu_ray *r, float kn[3], float kf[3])
-{
-    for (int k = 0; k < 3; k++) {
-        kn[k] = gpu_fma(GPU_LOOSE_REL, fabsf(r->o[k] * r->rd[k]), GPU_LOOSE_ABS);
-        kf[k] = gpu_fma(GPU_LOOSE_REL, fabsf(r->o[k] * r->rdf[k]), GPU_LOOSE_ABS);
-    }
-}
-
-static GPU_BOX_INLINE PK_HD unsigned gpu_node_hits_slack(const uint32_t w[24], const gpu_ray *r, const float kn[3],
-                                                         const float kf[3], float tcull, float tn[GPU_WIDTH])
+static GPU_BOX_INLINE PK_HD unsigned gpu_node_hits_slack(const uint32_t w[24], const gpu_ray *r, float tcull,
+                                                         float tn[GPU_WIDTH])
 {
     gpu_rows x;
     gpu_node_rows(w, r, &x);
@@ -480,8 +470,9 @@ static GPU_BOX_INLINE PK_HD unsigned gpu_node_hits_slack(const uint32_t w[24], c
         const float d = x.org[k] - r->o[k];
         const float a = d * r->rd[k], s = x.sc[k] * r->rd[k];
         const float a2 = d * r->rdf[k], s2 = x.sc[k] * r->rdf[k];
-        sn[k] = s, an[k] = a - gpu_fma(GPU_LOOSE_REL, gpu_fma(255.0f, fabsf(s), fabsf(a)), kn[k]);
-        sf[k] = s2, af[k] = a2 + gpu_fma(GPU_LOOSE_REL, gpu_fma(255.0f, fabsf(s2), fabsf(a2)), kf[k]);
+        const float g = fabsf(a) + fabsf(x.org[k] * r->rd[k]), g2 = fabsf(a2) + fabsf(x.org[k] * r->rdf[k]);
+        sn[k] = s, an[k] = a - gpu_fma(GPU_LOOSE_REL, gpu_fma(255.0f, fabsf(s), g), GPU_LOOSE_ABS);
+        sf[k] = s2, af[k] = a2 + gpu_fma(GPU_LOOSE_REL, gpu_fma(255.0f, fabsf(s2), g2), GPU_LOOSE_ABS);
     }
     unsigned mask = 0;
     GPU_UNROLL
@@ -518,14 +509,14 @@ static inline PK_HD float gpu_byte_wide(uint32_t w, int b)
  * (one fma: 2^23 * S' is exact), since m * S' = 2^15 S + q S. Against the
  * bound of gpu_node_hits_slack this adds the rounding of A'' and of the
  * extra subtraction, u * (2 |A| + 2 E + 2^15 |S|): v1's distance is then
- * above this one when E >= u * (|o rd| + 8.02 |A| + 33791 |S|) (+ E's own
- * rounding); E = 2^-20 * (|A| + |o rd|) + 2^-8 |S| + 2^-100 is 1.9 times
+ * above this one when E >= u * (|org rd| + 7.02 |A| + 33791 |S|) (+ E's own
+ * rounding); E = 2^-20 * (|A| + |org rd|) + 2^-8 |S| + 2^-100 is 1.9 times
  * that or more on every term (2^-8 |S| is 1/256 of a quantisation step). A
  * subnormal S' errs by at most 2^-150, times m < 2^24: covered by 2^-100.
  * Infinite and NaN values loosen the test as in gpu_node_hits_slack, and
  * gpu_trace_box gives it the same rays (every |1/d| < 2^64). */
-static GPU_BOX_INLINE PK_HD unsigned gpu_node_hits_wide(const uint32_t w[24], const gpu_ray *r, const float kn[3],
-                                                        const float kf[3], float tcull, float tn[GPU_WIDTH])
+static GPU_BOX_INLINE PK_HD unsigned gpu_node_hits_wide(const uint32_t w[24], const gpu_ray *r, float tcull,
+                                                        float tn[GPU_WIDTH])
 {
     gpu_rows x;
     gpu_node_rows(w, r, &x);
@@ -535,8 +526,9 @@ static GPU_BOX_INLINE PK_HD unsigned gpu_node_hits_wide(const uint32_t w[24], co
         const float d = x.org[k] - r->o[k];
         const float a = d * r->rd[k], s = x.sc[k] * r->rd[k];
         const float a2 = d * r->rdf[k], s2 = x.sc[k] * r->rdf[k];
-        const float e = gpu_fma(0x1p-8f, fabsf(s), gpu_fma(GPU_LOOSE_REL, fabsf(a), kn[k]));
-        const float e2 = gpu_fma(0x1p-8f, fabsf(s2), gpu_fma(GPU_LOOSE_REL, fabsf(a2), kf[k]));
+        const float g = fabsf(a) + fabsf(x.org[k] * r->rd[k]), g2 = fabsf(a2) + fabsf(x.org[k] * r->rdf[k]);
+        const float e = gpu_fma(0x1p-8f, fabsf(s), gpu_fma(GPU_LOOSE_REL, g, GPU_LOOSE_ABS));
+        const float e2 = gpu_fma(0x1p-8f, fabsf(s2), gpu_fma(GPU_LOOSE_REL, g2, GPU_LOOSE_ABS));
         sn[k] = s * 0x1p-8f, an[k] = gpu_fma(-0x1p23f, sn[k], a - e);
         sf[k] = s2 * 0x1p-8f, af[k] = gpu_fma(-0x1p23f, sf[k], a2 + e2);
     }
@@ -597,7 +589,6 @@ typedef struct gpu_walk {
     uint32_t best_prim, ref;
     int sp;
     bool loose;             /* GPU_TEST_LOOSE or _WIDE for this ray */
-    float kn[3], kf[3];     /* their per-ray terms */
 } gpu_walk;
 
 /* Starts *w on *in; false when there is nothing to trace (no hit). */
@@ -614,8 +605,6 @@ static inline PK_HD bool gpu_walk_init(gpu_walk *w, const pk_ray *in, int box)
      * the bound would be infinite and the axis would limit nothing */
     w->loose = (box == GPU_TEST_LOOSE || box == GPU_TEST_WIDE) && fabsf(w->r.rd[0]) < 0x1p64f &&
                fabsf(w->r.rd[1]) < 0x1p64f && fabsf(w->r.rd[2]) < 0x1p64f;
-    w->kn[0] = w->kn[1] = w->kn[2] = w->kf[0] = w->kf[1] = w->kf[2] = 0.0f;
-    if (w->loose) gpu_loose_terms(&w->r, w->kn, w->kf);
     return true;
 }
 
@@ -632,8 +621,8 @@ static inline PK_HD bool gpu_walk_step(gpu_walk *ws, gpu_stack_entry *stack, con
         uint32_t w[24];
         gpu_node_load(&nodes[ref], w);
         float tn[GPU_WIDTH];
-        const unsigned mask = ws->loose ? (box == GPU_TEST_WIDE ? gpu_node_hits_wide(w, r, ws->kn, ws->kf, tcull, tn)
-                                                                : gpu_node_hits_slack(w, r, ws->kn, ws->kf, tcull, tn))
+        const unsigned mask = ws->loose ? (box == GPU_TEST_WIDE ? gpu_node_hits_wide(w, r, tcull, tn)
+                                                                : gpu_node_hits_slack(w, r, tcull, tn))
                               : box != GPU_TEST_EXACT ? gpu_node_hits_fma(w, r, tcull, tn)
                                                       : gpu_node_hits(w, r, tcull, tn);
         if (!mask) goto pop;

@@ -216,8 +216,6 @@ static void check_box_tests(const built *b, const accel_input *in, rng *g, size_
         if (!gpu_ray_traceable((const pk_ray *)&r)) continue;
         gpu_ray q;
         gpu_ray_init(&q, (const pk_ray *)&r);
-        float kn[3], kf[3];
-        gpu_loose_terms(&q, kn, kf);
         const float tcull = kind == 4 ? INFINITY : rng_range(g, 0.0f, 3.0f) * (kind == 5 ? 1e6f : 1.0f);
         for (size_t j = 0; j < b->g.nnodes; j++) {
             const gpu_node *nd = &b->g.nodes[j];
@@ -226,8 +224,8 @@ static void check_box_tests(const built *b, const accel_input *in, rng *g, size_
             float t0[GPU_WIDTH], t1[GPU_WIDTH], t3[GPU_WIDTH], t4[GPU_WIDTH], t6[GPU_WIDTH];
             const unsigned m0 = gpu_node_hits_v0(nd, &q, tcull, t0), m1 = gpu_node_hits(w, &q, tcull, t1);
             const unsigned m3 = gpu_node_hits_fma(w, &q, tcull, t3);
-            const unsigned m4 = gpu_node_hits_slack(w, &q, kn, kf, tcull, t4);
-            const unsigned m6 = gpu_node_hits_wide(w, &q, kn, kf, tcull, t6);
+            const unsigned m4 = gpu_node_hits_slack(w, &q, tcull, t4);
+            const unsigned m6 = gpu_node_hits_wide(w, &q, tcull, t6);
             /* (gpu_trace_box uses it only for rays with every |1/d| < 2^64; here it is
              * tried on all, overflows included) */
             if (kind >= 4 && fabsf(q.rd[0]) < 0x1p64f && fabsf(q.rd[1]) < 0x1p64f && fabsf(q.rd[2]) < 0x1p64f) {
