@@ -1,8 +1,10 @@
 /*
  * bvh_gpu.h - the BVH as the GPU traverses it, and the traversal itself,
- * written once: plain C over plain structs (no intrinsics), PK_HD so that
- * nvcc compiles the same functions for the device (src/accel/cuda/trace.cu)
- * that the CPU tests call on the host (tests/unit/test_bvh_gpu.c).
+ * written once: plain C over plain structs, PK_HD so that nvcc compiles the
+ * same functions for the device (src/accel/cuda/trace.cu) that the CPU
+ * tests call on the host (tests/unit/test_bvh_gpu.c). The few intrinsics
+ * (16-byte __ldg loads, __byte_perm, __fmaf_rn) have host versions that
+ * compute the same bits.
  *
  * Layout (docs/gpu.md says why): the 8-wide tree of bvh.h, node for node,
  * with each node's eight child boxes quantised to 8 bits per plane in a
@@ -22,7 +24,9 @@
  * test over it, with the CPU's rounding slack, can only enter more boxes
  * than the CPU traversal does, never fewer, so no hit is lost; the closest
  * hit rule (smallest t, then smallest number) makes the answer independent
- * of the order in which leaves are visited.
+ * of the order in which leaves are visited (but for exact ties between
+ * different triangles, see docs/gpu.md; the exact box tests visit in the
+ * CPU's order).
  */
 #ifndef PK_BVH_GPU_H
 #define PK_BVH_GPU_H
@@ -272,7 +276,7 @@ done:
     return true;
 }
 
-/* ---- the traversal (kernels v1, v2; docs/gpu.md) ---------------------------
+/* ---- the traversal (kernels v1 to v9; docs/gpu.md) -------------------------
  * The same arithmetic and the same visiting order as gpu_trace_v0, so the
  * same answers bit for bit, arranged for the GPU:
  *  - a node is read as six 16-byte loads into 24 registers (gpu_node_load)
