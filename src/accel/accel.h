@@ -87,6 +87,16 @@ PK_HIDDEN void accel_trace_batch(const accel *a, const ray *rays, hit *hits, siz
 PK_HIDDEN pk_status accel_none_create(pk_context *ctx, const accel_input *in, accel **out);
 PK_HIDDEN pk_status accel_midpoint_create(pk_context *ctx, const accel_input *in, accel **out);
 PK_HIDDEN pk_status accel_bvh_create(pk_context *ctx, const accel_input *in, accel **out);
+/* The wide BVH with another cost model for collapsing the binary tree (the
+ * GPU's): a wide node visit costs `node` leaf tests, a leaf test covers
+ * `lanes` primitives (a leaf of n costs ceil(n / lanes) tests), leaves hold
+ * at most leaf_max primitives (4..16). NULL: the CPU's (accel_bvh_create). */
+typedef struct bvh_costs {
+    float node;
+    uint32_t lanes, leaf_max;
+} bvh_costs;
+PK_HIDDEN pk_status accel_bvh_create_costs(pk_context *ctx, const accel_input *in, const bvh_costs *costs,
+                                           accel **out);
 PK_HIDDEN pk_status accel_embree_create(pk_context *ctx, const accel_input *in, accel **out);
 PK_HIDDEN bool accel_embree_available(void);
 /* The GPU accelerator (cuda.c): built in? (a driver and a device are looked

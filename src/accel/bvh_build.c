@@ -702,9 +702,10 @@ static void init_node(bvh_node *wn)
  * (Ylitie, Karras and Laine 2017): for every binary node n and every
  * i = 1..BVH_WIDTH, cost[i-1] is the least SAH cost of representing n's
  * subtree by at most i slots of a wide node, each either a leaf (the whole
- * subtree, up to BVH_LEAF_MAX primitives of one kind, COST_BLOCK per block)
- * or a wide node (COST_NODE plus the best distribution of its children over
- * BVH_WIDTH slots). Costs are areas times the per-visit cost; the root's is
+ * subtree, up to costs->leaf_max primitives of one kind, COST_BLOCK per
+ * block of costs->lanes) or a wide node (costs->node plus the best
+ * distribution of its children over BVH_WIDTH slots). The CPU's costs:
+ * COST_NODE, blocks of BVH_TRI_LANES, BVH_LEAF_MAX. Costs are areas times the per-visit cost; the root's is
  * the tree's SAH cost in those units. */
 enum { DP_LEAF = 0, DP_NODE = 1, DP_FEWER = 0 };
 
@@ -716,7 +717,7 @@ typedef struct dp_entry {
     uint32_t size;           /* references in the subtree */
 } dp_entry;
 
-static void dp_solve(const builder *b, uint32_t nnodes, dp_entry *dp)
+static void dp_solve(const builder *b, const bvh_costs *costs, uint32_t nnodes, dp_entry *dp)
 {
     for (uint32_t ii = nnodes; ii-- > 0;) {
         const bnode *x = &b->nodes[ii];
@@ -732,9 +733,9 @@ static void dp_solve(const builder *b, uint32_t nnodes, dp_entry *dp)
         }
         const uint32_t size = e->size;
         const bool mixed = e->spheres != 0 && e->spheres != size;
-        const uint32_t lanes = e->spheres ? BVH_SPHERE_LANES : BVH_TRI_LANES;
+        const uint32_t lanes = e->spheres ? BVH_SPHERE_LANES : costs->lanes;
         /* a flag, not an infinite cost: areas overflow to inf in huge scenes */
-        const bool leaf_ok = size <= BVH_LEAF_MAX && !mixed;
+        const bool leaf_ok = size <= costs->leaf_max && !mixed;
         const float leaf = leaf_ok ? COST_BLOCK * (float)((size + lanes - 1) / lanes) * area : INFINITY;
         if (x->count) {
             for (int i = 0; i < BVH_WIDTH; i++) {
@@ -758,7 +759,7 @@ static void dp_solve(const builder *b, uint32_t nnodes, dp_entry *dp)
                 }
             }
         }
-        const float node = COST_NODE * area + dist[BVH_WIDTH];
+        const float node = costs->node * area + dist[BVH_WIDTH];
         e->split = distk[BVH_WIDTH];
         const bool as_leaf = leaf_ok && leaf <= node;
         e->cost[0] = as_leaf ? leaf : node;
@@ -860,7 +861,21 @@ static bool place_arrays(const pk_allocator *al, bvh *t, const collapser *c)
 
 pk_status accel_bvh_create(pk_context *ctx, const accel_input *in, accel **out)
 {
+    return accel_bvh_create_costs(ctx, in, NULL, out);
+}
+
+pk_status accel_bvh_create_costs(pk_context *ctx, const accel_input *in, const bvh_costs *costs, accel **out)
+{
     double t0 = time_now();
+    /* the CPU's: a node visit costs COST_NODE block tests of BVH_TRI_LANES triangles */
+    bvh_costs k = {COST_NODE, BVH_TRI_LANES, BVH_LEAF_MAX};
+    if (costs) {
+        k = *costs;
+        if (!(k.node > 0.0f) || k.lanes < 1 || k.leaf_max < BIN_LEAF_MAX || k.leaf_max > BVH_LEAF_MAX)
+            return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT,
+                             "BVH costs: node cost %g, %u lanes, %u primitives a leaf (%d to %d)", (double)k.node,
+                             k.lanes, k.leaf_max, BIN_LEAF_MAX, BVH_LEAF_MAX);
+    }
     const pk_allocator *al = &ctx->alloc;
     *out = NULL;
     size_t nprim_in = in->ntris + in->nspheres;
@@ -960,7 +975,7 @@ pk_status accel_bvh_create(pk_context *ctx, const accel_input *in, accel **out)
     } else {
         dp = mem_alloc(al, b.nnodes * sizeof *dp);
         if (!dp) goto nomem;
-        dp_solve(&b, b.nnodes, dp);
+        dp_solve(&b, &k, b.nnodes, dp);
         if (dp[0].how[0] == DP_LEAF) {
             init_node(&c.nodes[0]);
             c.nnodes = 1;

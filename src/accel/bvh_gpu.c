@@ -32,6 +32,9 @@ bool gpu_quantise(float org, unsigned ex, float lo, float hi, uint8_t *qlo, uint
     while (l > 0 && gpu_plane(org, (unsigned)l, s) > lo) l--;
     while (h < 255 && gpu_plane(org, (unsigned)h, s) < hi) h++;
     if (gpu_plane(org, (unsigned)l, s) > lo || gpu_plane(org, (unsigned)h, s) < hi) return false;
+    /* the fma form (gpu_node_hits_fma) rounds the same exact value once: the
+     * same planes unless q * scale overflows, which is then refused */
+    if (gpu_fma((float)l, s, org) > lo || gpu_fma((float)h, s, org) < hi) return false;
     *qlo = (uint8_t)l;
     *qhi = (uint8_t)h;
     return true;
@@ -195,7 +198,10 @@ bool gpu_layout_check_boxes(const gpu_layout *g, const accel *a, char *why, size
                 const float sc = gpu_scale(gn->ex[k]);
                 const float lo = gpu_plane(gn->org[k], gn->q[2 * k][s], sc);
                 const float hi = gpu_plane(gn->org[k], gn->q[2 * k + 1][s], sc);
-                if (!(lo <= cn->b[2 * k][s] && hi >= cn->b[2 * k + 1][s])) {
+                const float lo2 = gpu_fma((float)gn->q[2 * k][s], sc, gn->org[k]);
+                const float hi2 = gpu_fma((float)gn->q[2 * k + 1][s], sc, gn->org[k]);
+                if (!(lo <= cn->b[2 * k][s] && hi >= cn->b[2 * k + 1][s] && lo2 <= cn->b[2 * k][s] &&
+                      hi2 >= cn->b[2 * k + 1][s])) {
                     say(why, n, "node %zu slot %d axis %d: decoded [%a, %a] does not contain [%a, %a]", i, s, k,
                         (double)lo, (double)hi, (double)cn->b[2 * k][s], (double)cn->b[2 * k + 1][s]);
                     return false;

@@ -1,8 +1,10 @@
 /*
  * bvh_gpu.h - the BVH as the GPU traverses it, and the traversal itself,
- * written once: plain C over plain structs (no intrinsics), PK_HD so that
- * nvcc compiles the same functions for the device (src/accel/cuda/trace.cu)
- * that the CPU tests call on the host (tests/unit/test_bvh_gpu.c).
+ * written once: plain C over plain structs, PK_HD so that nvcc compiles the
+ * same functions for the device (src/accel/cuda/trace.cu) that the CPU
+ * tests call on the host (tests/unit/test_bvh_gpu.c). The few intrinsics
+ * (16-byte __ldg loads, __byte_perm, __fmaf_rn) have host versions that
+ * compute the same bits.
  *
  * Layout (docs/gpu.md says why): the 8-wide tree of bvh.h, node for node,
  * with each node's eight child boxes quantised to 8 bits per plane in a
@@ -22,7 +24,9 @@
  * test over it, with the CPU's rounding slack, can only enter more boxes
  * than the CPU traversal does, never fewer, so no hit is lost; the closest
  * hit rule (smallest t, then smallest number) makes the answer independent
- * of the order in which leaves are visited.
+ * of the order in which leaves are visited (but for exact ties between
+ * different triangles, see docs/gpu.md; the exact box tests visit in the
+ * CPU's order).
  */
 #ifndef PK_BVH_GPU_H
 #define PK_BVH_GPU_H
@@ -167,8 +171,9 @@ static inline PK_HD bool gpu_tri_intersect(const gpu_ray *r, const gpu_tri *tri,
 }
 
 /* Slots of node n whose decoded box the segment [tmin, tcull] touches, with
- * their entry distances in tn[]. */
-static inline PK_HD unsigned gpu_node_hits(const gpu_node *n, const gpu_ray *r, float tcull, float tn[GPU_WIDTH])
+ * their entry distances in tn[]: the first version (v0), reading the node
+ * byte by byte with the ray's plane rows as run-time indices. */
+static inline PK_HD unsigned gpu_node_hits_v0(const gpu_node *n, const gpu_ray *r, float tcull, float tn[GPU_WIDTH])
 {
     const float sx = gpu_scale(n->ex[0]), sy = gpu_scale(n->ex[1]), sz = gpu_scale(n->ex[2]);
     unsigned mask = 0;
@@ -198,11 +203,11 @@ typedef struct gpu_counters {
     uint64_t nodes, tests;
 } gpu_counters;
 
-/* Closest hit (any = false) or any hit (any = true) of *in against the
- * layout: fills *out (a miss: t = +inf, prim = PK_NO_HIT, u = v = 0) and
- * returns whether something was hit. The same closest hit as every CPU
- * accelerator; for any hit, some hit in [tmin, tmax] with its t, u, v. */
-static inline PK_HD bool gpu_trace(const gpu_node *nodes, const gpu_tri *tris, const pk_ray *in, bool any,
+/* The first traversal (kernel v0, kept to be timed against gpu_trace):
+ * gpu_node_hits_v0, every hit child pushed with an insertion sort and the
+ * nearest popped again, triangles read field by field. Same answers as
+ * gpu_trace, bit for bit (the same arithmetic, the same visiting order). */
+static inline PK_HD bool gpu_trace_v0(const gpu_node *nodes, const gpu_tri *tris, const pk_ray *in, bool any,
                                    pk_hit *out, gpu_counters *count)
 {
     out->t = INFINITY;
@@ -223,7 +228,7 @@ static inline PK_HD bool gpu_trace(const gpu_node *nodes, const gpu_tri *tris, c
             const gpu_node *n = &nodes[ref];
             if (count) count->nodes++;
             float tn[GPU_WIDTH];
-            unsigned mask = gpu_node_hits(n, &r, tcull, tn);
+            unsigned mask = gpu_node_hits_v0(n, &r, tcull, tn);
             if (!mask) goto pop;
             /* push every hit child, sort the run far to near, take the nearest */
             const int base = sp;
@@ -271,6 +276,454 @@ done:
     return true;
 }
 
+/* ---- the traversal (kernels v1 to v9; docs/gpu.md) -------------------------
+ * The same arithmetic and the same visiting order as gpu_trace_v0, so the
+ * same answers bit for bit, arranged for the GPU:
+ *  - a node is read as six 16-byte loads into 24 registers (gpu_node_load)
+ *    and its bytes are taken out with constant shifts: the ray's near and
+ *    far rows per axis are chosen by a select on the ray's direction signs,
+ *    never by indexing memory with a run-time row;
+ *  - the eight slots are unrolled, so the entry distances stay in
+ *    registers; the nearest hit child is kept in a register and goes next,
+ *    only the others are pushed (still sorted far to near);
+ *  - a triangle record is three 16-byte loads, its vertices permuted to the
+ *    ray's axes by selects. */
+
+#if defined(__CUDACC__)
+#define GPU_UNROLL _Pragma("unroll")
+#else
+#define GPU_UNROLL
+#endif
+
+static inline PK_HD float gpu_bits_float(uint32_t u)
+{
+#if defined(__CUDA_ARCH__)
+    return __uint_as_float(u);
+#else
+    float f;
+    memcpy(&f, &u, sizeof f);
+    return f;
+#endif
+}
+
+/* The 96 bytes of a node as 24 words: 0-2 org, 3 the exponents (byte k:
+ * axis k), 4 + 2 * row + (slot >= 4) the plane row's bytes of four slots
+ * (byte slot & 3), 16 + slot the child references. */
+static inline PK_HD void gpu_node_load(const gpu_node *n, uint32_t w[24])
+{
+#if defined(__CUDA_ARCH__)
+    const uint4 *p = (const uint4 *)n;
+    GPU_UNROLL
+    for (int i = 0; i < 6; i++) {
+        const uint4 v = __ldg(p + i);
+        w[4 * i] = v.x, w[4 * i + 1] = v.y, w[4 * i + 2] = v.z, w[4 * i + 3] = v.w;
+    }
+#else
+    memcpy(w, n, sizeof *n);
+#endif
+}
+
+/* Byte b (0..3, a constant) of word w as a float, exactly: the bits of
+ * 2^23 + byte, less 2^23 (one byte permute and one add on the GPU). */
+static inline PK_HD float gpu_byte_float(uint32_t w, int b)
+{
+#if defined(__CUDA_ARCH__)
+    return __uint_as_float(__byte_perm(w, 0x4B000000u, 0x7540u | (unsigned)b)) - 8388608.0f;
+#else
+    return gpu_bits_float(0x4B000000u | ((w >> (8 * b)) & 255u)) - 8388608.0f;
+#endif
+}
+
+/* Box tests on a node in registers (gpu_node_load). Each fills tn[] with
+ * the entry distances and returns the mask of the slots whose box the
+ * segment [tmin, tcull] touches; all enter every box the CPU's traversal
+ * enters (docs/gpu.md). GPU_BOX_INLINE lets the PTX check
+ * (tests/cuda/test_cuda_ptx.sh) keep them out of line, to see that their
+ * fused multiply-adds are the only ones. */
+#if defined(__CUDACC__) && defined(PK_GPU_BOX_NOINLINE)
+#define GPU_BOX_INLINE __noinline__
+#else
+#define GPU_BOX_INLINE inline
+#endif
+
+/* a * b + c rounded once (the GPU's fma instruction; C's fmaf on the host,
+ * also correctly rounded, so both compute the same bits). */
+static inline PK_HD float gpu_fma(float a, float b, float c)
+{
+#if defined(__CUDA_ARCH__)
+    return __fmaf_rn(a, b, c);
+#else
+    return fmaf(a, b, c);
+#endif
+}
+
+/* The plane rows of the node for this ray: per axis the near and the far
+ * row's two words (slots 0-3, 4-7), chosen by a select on the sign of 1/d. */
+typedef struct gpu_rows {
+    float org[3], sc[3];
+    uint32_t nw[3][2], fw[3][2];
+} gpu_rows;
+
+static inline PK_HD void gpu_node_rows(const uint32_t w[24], const gpu_ray *r, gpu_rows *x)
+{
+    GPU_UNROLL
+    for (int k = 0; k < 3; k++) {
+        x->org[k] = gpu_bits_float(w[k]);
+        x->sc[k] = gpu_scale((w[3] >> (8 * k)) & 255u);
+        const bool neg = (r->near[k] & 1) != 0; /* near row 2k+1 (hi) when 1/d < 0 */
+        const uint32_t lo0 = w[4 + 4 * k], lo1 = w[5 + 4 * k], hi0 = w[6 + 4 * k], hi1 = w[7 + 4 * k];
+        x->nw[k][0] = neg ? hi0 : lo0, x->nw[k][1] = neg ? hi1 : lo1;
+        x->fw[k][0] = neg ? lo0 : hi0, x->fw[k][1] = neg ? lo1 : hi1;
+    }
+}
+
+/* v1: gpu_node_hits_v0's planes and operations in the same order, so the
+ * same distances bit for bit. fmaxf/fminf instead of gpu_max/gpu_min: the
+ * second operand is never NaN here (tmin and tcull are not, nor is an
+ * fmaxf/fminf of them), and then the two agree but for the sign of a zero,
+ * which no comparison sees. */
+static GPU_BOX_INLINE PK_HD unsigned gpu_node_hits(const uint32_t w[24], const gpu_ray *r, float tcull,
+                                                   float tn[GPU_WIDTH])
+{
+    gpu_rows x;
+    gpu_node_rows(w, r, &x);
+    unsigned mask = 0;
+    GPU_UNROLL
+    for (int s = 0; s < GPU_WIDTH; s++) {
+        tn[s] = 0.0f;
+        if (w[16 + s] == GPU_EMPTY) continue;
+        const int h = s >> 2, b = s & 3;
+        float near = r->tmin, far = tcull;
+        GPU_UNROLL
+        for (int k = 2; k >= 0; k--) {
+            near = fmaxf((x.org[k] + gpu_byte_float(x.nw[k][h], b) * x.sc[k] - r->o[k]) * r->rd[k], near);
+            far = fminf((x.org[k] + gpu_byte_float(x.fw[k][h], b) * x.sc[k] - r->o[k]) * r->rdf[k], far);
+        }
+        tn[s] = near;
+        if (near <= far) mask |= 1u << s;
+    }
+    return mask;
+}
+
+/* v3: the same distances bit for bit with one operation less per plane:
+ * org + q * scale with q * scale exact is one fma (one rounding of the
+ * same exact value). The converter makes sure q * scale never overflows
+ * where it matters (gpu_quantise checks both forms). */
+static GPU_BOX_INLINE PK_HD unsigned gpu_node_hits_fma(const uint32_t w[24], const gpu_ray *r, float tcull,
+                                                       float tn[GPU_WIDTH])
+{
+    gpu_rows x;
+    gpu_node_rows(w, r, &x);
+    unsigned mask = 0;
+    GPU_UNROLL
+    for (int s = 0; s < GPU_WIDTH; s++) {
+        tn[s] = 0.0f;
+        if (w[16 + s] == GPU_EMPTY) continue;
+        const int h = s >> 2, b = s & 3;
+        float near = r->tmin, far = tcull;
+        GPU_UNROLL
+        for (int k = 2; k >= 0; k--) {
+            near = fmaxf((gpu_fma(gpu_byte_float(x.nw[k][h], b), x.sc[k], x.org[k]) - r->o[k]) * r->rd[k], near);
+            far = fminf((gpu_fma(gpu_byte_float(x.fw[k][h], b), x.sc[k], x.org[k]) - r->o[k]) * r->rdf[k], far);
+        }
+        tn[s] = near;
+        if (near <= far) mask |= 1u << s;
+    }
+    return mask;
+}
+
+/* v4: one fma per plane, t = q * S + A with S = scale / d and
+ * A = (org - o) / d per node and axis, moved out by a bound E on the
+ * rounding: near distances down, far ones up.
+ *
+ * Why it enters every box v1 enters (so every box the CPU enters). With
+ * u = 2^-24, P = org + q * scale (exact) and x = (P - o) * rd (exact):
+ * v1's distance fl(fl(fl(P) - o) * rd) is within
+ * u * (|org rd| + 3.01 * 255 |S| + 2.01 |A|) of x (three roundings, |P| <=
+ * |org| + 255 scale). Here S = scale * rd is exact (a power of
+ * two times rd; a subnormal S errs by at most 2^-150, covered by the
+ * 2^-100 below) and A = fl(fl(org - o) * rd) is within 2.0001 u |(org-o) rd|
+ * of its exact value; fl(q * S + fl(A - E)) is then within
+ * u * (2.0001 |(org-o) rd| + 2.0001 |A| + 255 |S| + 2.0001 E) of x - E.
+ * So it is below v1's distance when E >= u * (|org rd| + 1023 |S| + 6.03 |A|)
+ * (+ a little for E's own rounding); E = 2^-20 * (|A| + 255 |S| + |org rd|)
+ * + 2^-100 is twice that or more on every term. The far side is the same
+ * with rdf and + E. Nothing there uses the signs of q, S or A, so it holds
+ * for either row and either direction. Infinite or NaN values only loosen
+ * the test: 1/d = +-inf (d = 0) or an overflowing S, A or |org rd| makes E
+ * infinite, so every near distance of that axis is -inf or NaN and every
+ * far one +inf or NaN, and a NaN plane is no limit (fmaxf, fminf); 1/d NaN
+ * makes them all NaN, as in v1. (So that an axis-parallel ray is not slowed
+ * down by it, gpu_trace_box gives rays with a 1/d component of 2^64 or more
+ * gpu_node_hits_fma instead.) The cost: boxes are looser by 2^-20 of the
+ * distances involved, and of |org| / |d| (scenes far from the origin). The
+ * entry distances differ from v1's by as much, so children at nearly equal
+ * distances may be visited in another order: the closest hit is the same
+ * (smallest t, then smallest number), an any hit may be another. */
+#define GPU_LOOSE_REL 0x1p-20f
+#define GPU_LOOSE_ABS 0x1p-100f
+
+static GPU_BOX_INLINE PK_HD unsigned gpu_node_hits_slack(const uint32_t w[24], const gpu_ray *r, float tcull,
+                                                         float tn[GPU_WIDTH])
+{
+    gpu_rows x;
+    gpu_node_rows(w, r, &x);
+    float sn[3], an[3], sf[3], af[3];
+    GPU_UNROLL
+    for (int k = 0; k < 3; k++) {
+        const float d = x.org[k] - r->o[k];
+        const float a = d * r->rd[k], s = x.sc[k] * r->rd[k];
+        const float a2 = d * r->rdf[k], s2 = x.sc[k] * r->rdf[k];
+        const float g = fabsf(a) + fabsf(x.org[k] * r->rd[k]), g2 = fabsf(a2) + fabsf(x.org[k] * r->rdf[k]);
+        sn[k] = s, an[k] = a - gpu_fma(GPU_LOOSE_REL, gpu_fma(255.0f, fabsf(s), g), GPU_LOOSE_ABS);
+        sf[k] = s2, af[k] = a2 + gpu_fma(GPU_LOOSE_REL, gpu_fma(255.0f, fabsf(s2), g2), GPU_LOOSE_ABS);
+    }
+    unsigned mask = 0;
+    GPU_UNROLL
+    for (int s = 0; s < GPU_WIDTH; s++) {
+        tn[s] = 0.0f;
+        if (w[16 + s] == GPU_EMPTY) continue;
+        const int h = s >> 2, b = s & 3;
+        float near = r->tmin, far = tcull;
+        GPU_UNROLL
+        for (int k = 2; k >= 0; k--) {
+            near = fmaxf(gpu_fma(gpu_byte_float(x.nw[k][h], b), sn[k], an[k]), near);
+            far = fminf(gpu_fma(gpu_byte_float(x.fw[k][h], b), sf[k], af[k]), far);
+        }
+        tn[s] = near;
+        if (near <= far) mask |= 1u << s;
+    }
+    return mask;
+}
+
+/* Byte b (0..3, a constant) of word w as the float 2^23 + 256 * byte,
+ * exactly: its bits with the byte in bits 8-15 (one byte permute). */
+static inline PK_HD float gpu_byte_wide(uint32_t w, int b)
+{
+#if defined(__CUDA_ARCH__)
+    return __uint_as_float(__byte_perm(w, 0x4B000000u, 0x7504u | ((unsigned)b << 4)));
+#else
+    return gpu_bits_float(0x4B000000u | ((w >> (8 * b)) & 255u) << 8);
+#endif
+}
+
+/* v6: gpu_node_hits_slack without the add that turns the byte into a
+ * float: with m = 2^23 + 256 q (gpu_byte_wide, a byte permute),
+ * t = fma(m, S', A'') where S' = S * 2^-8 and A'' = fl(fl(A - E) - 2^15 S)
+ * (one fma: 2^23 * S' is exact), since m * S' = 2^15 S + q S. Against the
+ * bound of gpu_node_hits_slack this adds the rounding of A'' and of the
+ * extra subtraction, u * (2 |A| + 2 E + 2^15 |S|): v1's distance is then
+ * above this one when E >= u * (|org rd| + 7.02 |A| + 33791 |S|) (+ E's own
+ * rounding); E = 2^-20 * (|A| + |org rd|) + 2^-8 |S| + 2^-100 is 1.9 times
+ * that or more on every term (2^-8 |S| is 1/256 of a quantisation step). A
+ * subnormal S' errs by at most 2^-150, times m < 2^24: covered by 2^-100.
+ * Infinite and NaN values loosen the test as in gpu_node_hits_slack, and
+ * gpu_trace_box gives it the same rays (every |1/d| < 2^64). */
+static GPU_BOX_INLINE PK_HD unsigned gpu_node_hits_wide(const uint32_t w[24], const gpu_ray *r, float tcull,
+                                                        float tn[GPU_WIDTH])
+{
+    gpu_rows x;
+    gpu_node_rows(w, r, &x);
+    float sn[3], an[3], sf[3], af[3];
+    GPU_UNROLL
+    for (int k = 0; k < 3; k++) {
+        const float d = x.org[k] - r->o[k];
+        const float a = d * r->rd[k], s = x.sc[k] * r->rd[k];
+        const float a2 = d * r->rdf[k], s2 = x.sc[k] * r->rdf[k];
+        const float g = fabsf(a) + fabsf(x.org[k] * r->rd[k]), g2 = fabsf(a2) + fabsf(x.org[k] * r->rdf[k]);
+        const float e = gpu_fma(0x1p-8f, fabsf(s), gpu_fma(GPU_LOOSE_REL, g, GPU_LOOSE_ABS));
+        const float e2 = gpu_fma(0x1p-8f, fabsf(s2), gpu_fma(GPU_LOOSE_REL, g2, GPU_LOOSE_ABS));
+        sn[k] = s * 0x1p-8f, an[k] = gpu_fma(-0x1p23f, sn[k], a - e);
+        sf[k] = s2 * 0x1p-8f, af[k] = gpu_fma(-0x1p23f, sf[k], a2 + e2);
+    }
+    unsigned mask = 0;
+    GPU_UNROLL
+    for (int s = 0; s < GPU_WIDTH; s++) {
+        tn[s] = 0.0f;
+        if (w[16 + s] == GPU_EMPTY) continue;
+        const int h = s >> 2, b = s & 3;
+        float near = r->tmin, far = tcull;
+        GPU_UNROLL
+        for (int k = 2; k >= 0; k--) {
+            near = fmaxf(gpu_fma(gpu_byte_wide(x.nw[k][h], b), sn[k], an[k]), near);
+            far = fminf(gpu_fma(gpu_byte_wide(x.fw[k][h], b), sf[k], af[k]), far);
+        }
+        tn[s] = near;
+        if (near <= far) mask |= 1u << s;
+    }
+    return mask;
+}
+
+static inline PK_HD float gpu_sel3(const float v[3], int k) { return k == 0 ? v[0] : k == 1 ? v[1] : v[2]; }
+
+/* gpu_tri_intersect on a record read with three 16-byte loads; *prim is
+ * the record's triangle number. */
+static inline PK_HD bool gpu_tri_intersect_rec(const gpu_ray *r, const gpu_tri *tri, float tmax, float *t_out,
+                                               float *u_out, float *v_out, uint32_t *prim)
+{
+    float a[3], b[3], c[3];
+#if defined(__CUDA_ARCH__)
+    const float4 *p = (const float4 *)tri;
+    const float4 x = __ldg(p), y = __ldg(p + 1), z = __ldg(p + 2);
+    a[0] = x.x, a[1] = x.y, a[2] = x.z, *prim = __float_as_uint(x.w);
+    b[0] = y.x, b[1] = y.y, b[2] = y.z;
+    c[0] = z.x, c[1] = z.y, c[2] = z.z;
+#else
+    memcpy(a, tri->a, sizeof a), memcpy(b, tri->b, sizeof b), memcpy(c, tri->c, sizeof c);
+    *prim = tri->prim;
+#endif
+    const float ox = r->ox, oy = r->oy, oz = r->oz;
+    const int kx = r->kx, ky = r->ky, kz = r->kz;
+    return tri_test_watertight(gpu_sel3(a, kx) - ox, gpu_sel3(a, ky) - oy, gpu_sel3(a, kz) - oz, gpu_sel3(b, kx) - ox,
+                               gpu_sel3(b, ky) - oy, gpu_sel3(b, kz) - oz, gpu_sel3(c, kx) - ox, gpu_sel3(c, ky) - oy,
+                               gpu_sel3(c, kz) - oz, r->sx, r->sy, r->sz, r->tmin, tmax, t_out, u_out, v_out);
+}
+
+/* The traversal with box test box (a constant: GPU_TEST_EXACT, GPU_TEST_FMA,
+ * GPU_TEST_LOOSE or GPU_TEST_WIDE); gpu_trace below is the one to call. */
+enum { GPU_TEST_EXACT = 1, GPU_TEST_FMA = 3, GPU_TEST_LOOSE = 4, GPU_TEST_WIDE = 6 };
+/* One ray's traversal as a state that advances a step at a time: a step
+ * goes down to a leaf, tests its triangles and pops the next node, so that
+ * a kernel can give a lane whose ray is done a new ray between steps
+ * (gpu_walk_*; gpu_trace_box runs the steps in a loop). The stack is the
+ * caller's (GPU_STACK entries), sp and ref index into it. */
+typedef struct gpu_walk {
+    gpu_ray r;
+    float best_t, best_u, best_v, tcull;
+    uint32_t best_prim, ref;
+    int sp;
+    bool loose;             /* GPU_TEST_LOOSE or _WIDE for this ray */
+} gpu_walk;
+
+/* Starts *w on *in; false when there is nothing to trace (no hit). */
+static inline PK_HD bool gpu_walk_init(gpu_walk *w, const pk_ray *in, int box)
+{
+    w->best_t = in->tmax, w->best_u = w->best_v = 0.0f;
+    w->best_prim = PK_NO_HIT;
+    w->ref = 0, w->sp = 0;
+    if (!gpu_ray_traceable(in)) return false;
+    gpu_ray_init(&w->r, in);
+    w->tcull = gpu_cull_limit(w->best_t);
+    /* GPU_TEST_LOOSE's per-ray terms; a ray with a huge or infinite 1/d
+     * component (d = 0: axis-parallel) takes GPU_TEST_FMA instead, where
+     * the bound would be infinite and the axis would limit nothing */
+    w->loose = (box == GPU_TEST_LOOSE || box == GPU_TEST_WIDE) && fabsf(w->r.rd[0]) < 0x1p64f &&
+               fabsf(w->r.rd[1]) < 0x1p64f && fabsf(w->r.rd[2]) < 0x1p64f;
+    return true;
+}
+
+/* One step; true when the ray is done (gpu_walk_hit then has the answer). */
+static inline PK_HD bool gpu_walk_step(gpu_walk *ws, gpu_stack_entry *stack, const gpu_node *nodes,
+                                       const gpu_tri *tris, bool any, gpu_counters *count, int box)
+{
+    const gpu_ray *r = &ws->r;
+    uint32_t ref = ws->ref;
+    int sp = ws->sp;
+    float tcull = ws->tcull;
+    while (!(ref & GPU_LEAF)) {
+        if (count) count->nodes++;
+        uint32_t w[24];
+        gpu_node_load(&nodes[ref], w);
+        float tn[GPU_WIDTH];
+        const unsigned mask = ws->loose ? (box == GPU_TEST_WIDE ? gpu_node_hits_wide(w, r, tcull, tn)
+                                                                : gpu_node_hits_slack(w, r, tcull, tn))
+                              : box != GPU_TEST_EXACT ? gpu_node_hits_fma(w, r, tcull, tn)
+                                                      : gpu_node_hits(w, r, tcull, tn);
+        if (!mask) goto pop;
+        /* The order of gpu_trace_v0, which pushes every hit child with an
+         * insertion sort (a child goes above those nearer than it and above
+         * equals from lower slots) and pops the top: here the top, the
+         * nearest (the highest slot among equals), stays in cur. A child
+         * replacing cur is at least as near as every pushed one, and a
+         * pushed one as near as cur came from a lower slot, so the old cur
+         * goes straight on top; any other child is inserted. */
+        uint32_t cur = GPU_EMPTY;
+        float ct = 0.0f;
+        const int base = sp;
+        GPU_UNROLL
+        for (int k = 0; k < GPU_WIDTH; k++) {
+            if (!(mask >> k & 1u)) continue;
+            const uint32_t c = w[16 + k];
+            const float t = tn[k];
+            if (cur == GPU_EMPTY) {
+                cur = c, ct = t;
+            } else if (t <= ct) {
+                stack[sp].ref = cur, stack[sp].t = ct;
+                sp++;
+                cur = c, ct = t;
+            } else {
+                int j = sp++;
+                for (; j > base && stack[j - 1].t < t; j--) stack[j] = stack[j - 1];
+                stack[j].ref = c, stack[j].t = t;
+            }
+        }
+        ref = cur;
+    }
+    {
+        if (count) count->nodes++;
+        const uint32_t first = gpu_leaf_first(ref), cnt = gpu_leaf_count(ref);
+        for (uint32_t i = 0; i < cnt; i++) {
+            float t, u, v;
+            uint32_t prim;
+            if (count) count->tests++;
+            if (!gpu_tri_intersect_rec(r, &tris[first + i], ws->best_t, &t, &u, &v, &prim)) continue;
+            if (t < ws->best_t || (t == ws->best_t && prim < ws->best_prim)) {
+                ws->best_t = t, ws->best_prim = prim, ws->best_u = u, ws->best_v = v;
+                if (any) return true;
+            }
+        }
+        tcull = gpu_cull_limit(ws->best_t);
+    }
+pop:
+    for (;;) {
+        if (sp == 0) return true;
+        --sp;
+        if (stack[sp].t <= tcull) {
+            ref = stack[sp].ref;
+            break;
+        }
+    }
+    ws->ref = ref, ws->sp = sp, ws->tcull = tcull;
+    return false;
+}
+
+/* The answer of a finished walk (a miss: t = +inf, PK_NO_HIT, u = v = 0). */
+static inline PK_HD bool gpu_walk_hit(const gpu_walk *w, pk_hit *out)
+{
+    const bool found = w->best_prim != PK_NO_HIT;
+    out->t = found ? w->best_t : INFINITY;
+    out->prim = w->best_prim;
+    out->u = found ? w->best_u : 0.0f;
+    out->v = found ? w->best_v : 0.0f;
+    return found;
+}
+
+static inline PK_HD bool gpu_trace_box(const gpu_node *nodes, const gpu_tri *tris, const pk_ray *in, bool any,
+                                       pk_hit *out, gpu_counters *count, int box)
+{
+    gpu_walk w;
+    gpu_stack_entry stack[GPU_STACK];
+    if (gpu_walk_init(&w, in, box))
+        while (!gpu_walk_step(&w, stack, nodes, tris, any, count, box)) {
+        }
+    return gpu_walk_hit(&w, out);
+}
+
+/* Closest hit (any = false) or any hit (any = true) of *in against the
+ * layout: fills *out (a miss: t = +inf, prim = PK_NO_HIT, u = v = 0) and
+ * returns whether something was hit. The same closest hit as every CPU
+ * accelerator; for any hit, some hit in [tmin, tmax] with its t, u, v (the
+ * first found, leaves visited near first). Callable from other device code
+ * (one ray per thread; the stack is the thread's own). */
+#ifndef GPU_TRACE_BOX
+#define GPU_TRACE_BOX GPU_TEST_FMA
+#endif
+static inline PK_HD bool gpu_trace(const gpu_node *nodes, const gpu_tri *tris, const pk_ray *in, bool any,
+                                   pk_hit *out, gpu_counters *count)
+{
+    return gpu_trace_box(nodes, tris, in, any, out, count, GPU_TRACE_BOX);
+}
+
 #ifndef __CUDACC__
 /* ---- the host side: conversion and checks (bvh_gpu.c) -------------------- */
 
@@ -313,7 +766,8 @@ PK_HIDDEN bool gpu_layout_check_boxes(const gpu_layout *g, const struct accel *b
 PK_HIDDEN bool gpu_layout_check(const gpu_layout *g, const float *verts, char *why, size_t n);
 /* Quantises the interval [lo, hi] of a child within the frame (org, scale
  * 2^(ex-127)): *qlo, *qhi with gpu_plane(org, qlo) <= lo and
- * gpu_plane(org, qhi) >= hi; false when it does not fit in 0..255. */
+ * gpu_plane(org, qhi) >= hi, and the same of gpu_fma(q, scale, org); false
+ * when it does not fit in 0..255. */
 PK_HIDDEN bool gpu_quantise(float org, unsigned ex, float lo, float hi, uint8_t *qlo, uint8_t *qhi);
 #endif
 

@@ -55,6 +55,7 @@ enum {
     CUDA_ERROR_NO_DEVICE = 100,
     CUDA_ERROR_NO_BINARY_FOR_GPU = 209,
     CUDA_ERROR_UNSUPPORTED_PTX_VERSION = 222,
+    CU_DEVICE_ATTRIBUTE_MULTIPROCESSOR_COUNT = 16,
     CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MAJOR = 75,
     CU_DEVICE_ATTRIBUTE_COMPUTE_CAPABILITY_MINOR = 76
 };
@@ -178,9 +179,17 @@ static bool driver_loaded(void) { return pthread_once(&load_once, load_driver) =
 /* Ray and hit buffers hold at most this many rays; longer batches go in chunks. */
 #define CHUNK_RAYS ((size_t)1 << 24)
 
+/* The kernel versions of cuda/trace.cu; PAPRSEK_CUDA_KERNEL picks one by
+ * name (for timing them against each other: they give the same hits). */
+static const char *const kernel_names[] = {"v0", "v1", "v2", "v3", "v4", "v5", "v6", "v7", "v8", "v9"};
+#define KERNEL_DEFAULT 3
+/* v2, v5, v7, v8 and v9: persistent warps, a ray counter on the device */
+static bool kernel_persistent(int k) { return k == 2 || k == 5 || k >= 7; }
+
 /* Invariants:
  *  1. layout is the converted BVH; d_nodes and d_tris hold copies of its
- *     arrays on the device (structure_bytes in all);
+ *     arrays on the device (structure_bytes in all); d_counter is one word
+ *     for the persistent kernel's ray counter;
  *  2. d_rays and d_hits hold room for cap rays (0: not allocated yet);
  *  3. the primary context of dev is retained (released by destroy); lock
  *     serialises the batches (the buffers are shared). */
@@ -193,8 +202,10 @@ typedef struct cuda_accel {
     bool retained;
     CUmodule module;
     CUfunction k_closest, k_any;
+    int kernel;               /* index in kernel_names */
+    unsigned persistent_grid; /* blocks of a persistent launch: as many as the GPU holds at once */
     CUevent ev[4];
-    CUdeviceptr d_nodes, d_tris, d_rays, d_hits;
+    CUdeviceptr d_nodes, d_tris, d_rays, d_hits, d_counter;
     size_t cap;
     pthread_mutex_t lock;
     pk_accel_device_info stats;
@@ -210,6 +221,7 @@ static void cuda_destroy(accel *a)
         if (c->d_tris) cu.MemFree(c->d_tris);
         if (c->d_rays) cu.MemFree(c->d_rays);
         if (c->d_hits) cu.MemFree(c->d_hits);
+        if (c->d_counter) cu.MemFree(c->d_counter);
         for (int i = 0; i < 4; i++)
             if (c->ev[i]) cu.EventDestroy(c->ev[i]);
         if (c->module) cu.ModuleUnload(c->module);
@@ -306,11 +318,15 @@ static void cuda_trace_batch(const accel *a, const ray *rays, hit *hits, size_t 
     for (size_t lo = 0; st == PK_OK && lo < n; lo += chunk) {
         size_t m = n - lo < chunk ? n - lo : chunk;
         unsigned count = (unsigned)m;
-        void *params[] = {&c->d_nodes, &c->d_tris, &c->d_rays, &c->d_hits, &count};
-        const unsigned block = 128, grid = (unsigned)((m + block - 1) / block);
+        void *params[] = {&c->d_nodes, &c->d_tris, &c->d_rays, &c->d_hits, &count, &c->d_counter};
+        const unsigned block = 128;
+        unsigned grid = (unsigned)((m + block - 1) / block);
+        if (kernel_persistent(c->kernel) && c->persistent_grid < grid) grid = c->persistent_grid;
+        const uint32_t zero = 0;
         const char *what = "copying rays to the device";
         if ((e = cu.EventRecord(c->ev[0], NULL)) != CUDA_SUCCESS ||
             (e = cu.MemcpyHtoD(c->d_rays, rays + lo, m * sizeof(pk_ray))) != CUDA_SUCCESS ||
+            (e = cu.MemcpyHtoD(c->d_counter, &zero, sizeof zero)) != CUDA_SUCCESS ||
             (e = cu.EventRecord(c->ev[1], NULL)) != CUDA_SUCCESS) {
             st = cu_fail(c->ctx, what, e);
             break;
@@ -404,9 +420,17 @@ static pk_status cuda_setup(pk_context *ctx, cuda_accel *c)
                              drv % 1000 / 10, cu_error(e), PK_CUDA_VERSION_MAJOR, PK_CUDA_VERSION_MINOR);
         return cu_fail(ctx, "loading the kernels", e);
     }
-    if ((e = cu.ModuleGetFunction(&c->k_closest, c->module, "pk_trace_closest")) != CUDA_SUCCESS ||
-        (e = cu.ModuleGetFunction(&c->k_any, c->module, "pk_trace_any")) != CUDA_SUCCESS)
+    char kname[2][40];
+    snprintf(kname[0], sizeof kname[0], "pk_trace_closest_%s", kernel_names[c->kernel]);
+    snprintf(kname[1], sizeof kname[1], "pk_trace_any_%s", kernel_names[c->kernel]);
+    if ((e = cu.ModuleGetFunction(&c->k_closest, c->module, kname[0])) != CUDA_SUCCESS ||
+        (e = cu.ModuleGetFunction(&c->k_any, c->module, kname[1])) != CUDA_SUCCESS)
         return cu_fail(ctx, "finding the kernels", e);
+    /* a persistent launch: 2048 threads (16 blocks of 128) per multiprocessor */
+    int sms = 0;
+    if (cu.DeviceGetAttribute(&sms, CU_DEVICE_ATTRIBUTE_MULTIPROCESSOR_COUNT, c->dev) != CUDA_SUCCESS || sms < 1)
+        sms = 1;
+    c->persistent_grid = (unsigned)sms * 16u;
     for (int i = 0; i < 4; i++)
         if ((e = cu.EventCreate(&c->ev[i], 0)) != CUDA_SUCCESS) return cu_fail(ctx, "cuEventCreate", e);
     const size_t bn = c->layout.nnodes * sizeof(gpu_node), bt = (c->layout.ntris ? c->layout.ntris : 1) * sizeof(gpu_tri);
@@ -417,7 +441,8 @@ static pk_status cuda_setup(pk_context *ctx, cuda_accel *c)
                          "accelerator 'cuda': not enough device memory for the BVH: %s needed, %s free of %s",
                          size_str(bn + bt).s, size_str(free_b).s, size_str(total).s);
     double t0 = time_now();
-    if ((e = cu.MemAlloc(&c->d_nodes, bn)) != CUDA_SUCCESS || (e = cu.MemAlloc(&c->d_tris, bt)) != CUDA_SUCCESS)
+    if ((e = cu.MemAlloc(&c->d_nodes, bn)) != CUDA_SUCCESS || (e = cu.MemAlloc(&c->d_tris, bt)) != CUDA_SUCCESS ||
+        (e = cu.MemAlloc(&c->d_counter, sizeof(uint32_t))) != CUDA_SUCCESS)
         return ctx_error(ctx, PK_ERR_NOMEM, "accelerator 'cuda': cannot allocate %s for the BVH: %s",
                          size_str(bn + bt).s, cu_error(e));
     if ((e = cu.MemcpyHtoD(c->d_nodes, c->layout.nodes, bn)) != CUDA_SUCCESS ||
@@ -434,10 +459,33 @@ pk_status accel_cuda_create(pk_context *ctx, const accel_input *in, accel **out)
     if (in->nspheres)
         return ctx_error(ctx, PK_ERR_UNSUPPORTED, "accelerator 'cuda': the GPU traces triangles only (the scene has "
                                                   "%zu sphere%s)", in->nspheres, in->nspheres == 1 ? "" : "s");
+    /* PAPRSEK_CUDA_KERNEL=v0..v9 picks the kernel version (for timing) */
+    int kernel = KERNEL_DEFAULT;
+    const char *kv = getenv("PAPRSEK_CUDA_KERNEL");
+    if (kv && kv[0]) {
+        kernel = -1;
+        for (int i = 0; i < (int)(sizeof kernel_names / sizeof *kernel_names); i++)
+            if (strcmp(kv, kernel_names[i]) == 0) kernel = i;
+        if (kernel < 0)
+            return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT,
+                             "accelerator 'cuda': PAPRSEK_CUDA_KERNEL=%.40s is not a kernel version (v0 to v9)", kv);
+    }
+    /* PAPRSEK_CUDA_TREE=N collapses the binary tree for the GPU: a node visit
+     * costs N triangle tests (the CPU's tree when unset) */
+    bvh_costs costs = {0.0f, 1, GPU_LEAF_MAX};
+    const char *tv = getenv("PAPRSEK_CUDA_TREE");
+    if (tv && tv[0]) {
+        char *end = NULL;
+        const double v = strtod(tv, &end);
+        if (*end || !(v >= 0.25 && v <= 64.0))
+            return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT,
+                             "accelerator 'cuda': PAPRSEK_CUDA_TREE=%.40s is not a node cost from 0.25 to 64", tv);
+        costs.node = (float)v;
+    }
     if (!driver_loaded()) return ctx_error(ctx, PK_ERR_UNSUPPORTED, "accelerator 'cuda': %s", load_error);
     const double t0 = time_now();
     accel *b = NULL;
-    pk_status st = accel_bvh_create(ctx, in, &b);
+    pk_status st = accel_bvh_create_costs(ctx, in, costs.node > 0.0f ? &costs : NULL, &b);
     if (st != PK_OK) return st;
     const pk_allocator *al = &ctx->alloc;
     cuda_accel *c = mem_calloc(al, 1, sizeof *c);
@@ -449,6 +497,7 @@ pk_status accel_cuda_create(pk_context *ctx, const accel_input *in, accel **out)
     c->base.ops = &cuda_ops;
     c->base.alloc = al;
     c->ctx = ctx;
+    c->kernel = kernel;
     b->ntris = in->ntris; /* (accel_create sets these after the constructor) */
     b->nspheres = in->nspheres;
     st = gpu_layout_build(ctx, al, b, &c->layout);

@@ -69,6 +69,15 @@ PK_CUDA_STUB=nomem expect_failure "too little memory" "not enough device memory 
 PK_CUDA_STUB=kernelfail expect_failure "kernel failure" "the traversal kernel failed: unspecified launch failure" \
     "${rays[@]}"
 PK_CUDA_STUB=kernelfail expect_failure "kernel failure, any-hit" "the traversal kernel failed" "${rays[@]}" --any-hit
+# every kernel version goes as far as the launch; an unknown one is refused
+for v in v0 v1 v2 v3 v4 v5 v6 v7 v8 v9; do
+    PAPRSEK_CUDA_KERNEL=$v PK_CUDA_STUB=kernelfail expect_failure "kernel $v" "the traversal kernel failed" "${rays[@]}"
+done
+PAPRSEK_CUDA_TREE=4 PAPRSEK_CUDA_KERNEL=v6 PK_CUDA_STUB=kernelfail expect_failure "tree for the GPU" \
+    "the traversal kernel failed" "${rays[@]}"
+PAPRSEK_CUDA_TREE=0 expect_failure "bad tree cost" "PAPRSEK_CUDA_TREE=0 is not a node cost from 0.25 to 64$" "${rays[@]}"
+PAPRSEK_CUDA_KERNEL=v10 expect_failure "unknown kernel version" "PAPRSEK_CUDA_KERNEL=v10 is not a kernel version \\(v0 to v9\\)$" \
+    "${rays[@]}"
 # rendering on the GPU: the same messages, and no image written
 PK_CUDA_STUB=kernelfail expect_failure "render, kernel failure" "the kernel pk_path_[a-z]+ failed: unspecified launch failure$" \
     "$bin" render "$scene" -o "$tmp/h.hits.png" --device cuda --env 1 --width 8 --height 8

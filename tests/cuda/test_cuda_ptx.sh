@@ -1,13 +1,16 @@
 #!/usr/bin/env bash
 # test_cuda_ptx.sh - the kernels as nvcc compiles them with the build's
-# flags round like the CPU: no fused multiply-add (fma) and no approximate
-# division or square root in the PTX of src/accel/cuda/trace.cu, whose
-# float operations must be those of geom.h's triangle test one for one
-# (the traversal kernels alone: the path tracer's shading calls sinf, expf
-# and friends, whose library code uses fma on purpose; its traversal is the
-# same code compiled with the same flags).
-# Compiling it with fused multiply-adds allowed must show some, or the
-# check would prove nothing.
+# flags round like the CPU: no approximate division or square root in the
+# PTX of src/accel/cuda/trace.cu, and no fused multiply-add (fma) but the
+# ones the box tests ask for (gpu_fma): the triangle test's float operations
+# must be those of geom.h's one for one. The kernels without those box
+# tests (v0-v2) must have none at all; with the box tests kept out of line
+# (PK_GPU_BOX_NOINLINE) no kernel may have any outside them. Compiling with
+# fused multiply-adds allowed must show more, or the check would prove
+# nothing.
+# (The path tracer is left out, -DPK_TRAVERSAL_ONLY: its shading calls sinf,
+# expf and friends, whose library code uses fma on purpose; its traversal
+# is the same code compiled with the same flags.)
 # Usage: test_cuda_ptx.sh NVCC SOURCE_DIR FLAGS...
 set -u
 nvcc=$1
@@ -24,16 +27,35 @@ ptx() { # OUT FLAGS...
     "$nvcc" -ptx -arch=compute_90 "$@" -I"$src/src" -I"$src/include" -DPK_TRAVERSAL_ONLY -o "$out" "$src/src/accel/cuda/trace.cu"
 }
 ptx "$tmp/build.ptx" "$@" || { echo "FAIL: nvcc"; exit 1; }
+ptx "$tmp/apart.ptx" "$@" -DPK_GPU_BOX_NOINLINE || { echo "FAIL: nvcc -DPK_GPU_BOX_NOINLINE"; exit 1; }
+# fma count per function: "NAME COUNT" for entries and functions
+fma_by_function() {
+    awk '/^\.(visible|func|entry)/ { name = $0; sub(/\($/, "", name); n = split(name, a, /[ )]/); name = a[n]; c[name] += 0 }
+         /fma\./ { c[name]++ } END { for (k in c) print k, c[k] }' "$1"
+}
 n_fma=$(grep -c 'fma\.' "$tmp/build.ptx")
 n_approx=$(grep -Ec '(div|sqrt|rcp)\.(approx|full)' "$tmp/build.ptx")
 n_rn=$(grep -Ec '(mul|add|sub)\.rn\.f32' "$tmp/build.ptx")
-[ "$n_fma" = 0 ] || fail "$n_fma fused multiply-adds in the kernels' PTX"
+bad=$(fma_by_function "$tmp/build.ptx" | awk '$1 ~ /^pk_trace_[a-z]+_v[012]$/ && $2 > 0')
+[ -z "$bad" ] || fail "fused multiply-adds in kernels without fma box tests: $bad"
+bad=$(fma_by_function "$tmp/apart.ptx" | awk '$1 !~ /(gpu_node_hits_fma|gpu_node_hits_slack|gpu_node_hits_wide)/ && $2 > 0')
+[ -z "$bad" ] || fail "fused multiply-adds outside the box tests: $bad"
+n_box=$(fma_by_function "$tmp/apart.ptx" | awk '$1 ~ /(gpu_node_hits_fma|gpu_node_hits_slack|gpu_node_hits_wide)/ && $2 > 0' | wc -l)
+[ "$n_box" = 3 ] || fail "the box tests' fused multiply-adds are not where expected ($n_box functions)"
 [ "$n_approx" = 0 ] || fail "$n_approx approximate divisions or square roots in the kernels' PTX"
 [ "$n_rn" -gt 100 ] || fail "only $n_rn rounded float operations: is this the traversal?"
+# every kernel version that src/accel/cuda.c can ask for is there
+versions=$(sed -n 's/^static const char \*const kernel_names\[\] = {\(.*\)};$/\1/p' "$src/src/accel/cuda.c" | tr -d '"' | tr ',' ' ')
+[ -n "$versions" ] || fail "no kernel_names in src/accel/cuda.c"
+for v in $versions; do
+    for k in closest any; do
+        grep -q "^\.visible \.entry pk_trace_${k}_$v(" "$tmp/build.ptx" || fail "no kernel pk_trace_${k}_$v in the PTX"
+    done
+done
 # the same source with contraction allowed (nvcc's default) does fuse
 ptx "$tmp/fused.ptx" -O3 -std=c++17 -fmad=true || fail "nvcc -fmad=true"
 n_fused=$(grep -c 'fma\.' "$tmp/fused.ptx")
-[ "$n_fused" -gt 0 ] || fail "no fma even with -fmad=true: the check proves nothing"
-echo "PTX: $n_rn rounded float operations, $n_fma fma, $n_approx approximate (with -fmad=true: $n_fused fma)"
+[ "$n_fused" -gt "$n_fma" ] || fail "no more fma with -fmad=true: the check proves nothing"
+echo "PTX: $n_rn rounded float operations, $n_fma fma (box tests), $n_approx approximate (with -fmad=true: $n_fused fma)"
 [ "$fails" = 0 ] || exit 1
 echo "all ok"

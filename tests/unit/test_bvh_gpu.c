@@ -112,10 +112,12 @@ typedef struct built {
     gpu_layout g;
 } built;
 
-static bool build_all(pk_context *ctx, const accel_input *in, const char *name, built *b)
+/* costs: the collapse's cost model (NULL: the CPU's tree) */
+static bool build_tree(pk_context *ctx, const accel_input *in, const bvh_costs *costs, const char *name, built *b)
 {
     memset(b, 0, sizeof *b);
-    pk_status st = accel_create(ctx, PK_ACCEL_BVH, in, &b->cpu);
+    pk_status st = accel_bvh_create_costs(ctx, in, costs, &b->cpu);
+    if (st == PK_OK) b->cpu->ntris = in->ntris, b->cpu->nspheres = in->nspheres; /* (as accel_create does) */
     CHECKF(st == PK_OK, "%s: bvh: %s", name, pk_context_error(ctx));
     if (st != PK_OK) return false;
     REQUIRE(accel_create(ctx, PK_ACCEL_NONE, in, &b->none) == PK_OK);
@@ -126,6 +128,11 @@ static bool build_all(pk_context *ctx, const accel_input *in, const char *name, 
     CHECKF(gpu_layout_check(&b->g, (const float *)in->verts, why, sizeof why), "%s: gpu_layout_check: %s", name, why);
     CHECKF(gpu_layout_check_boxes(&b->g, b->cpu, why, sizeof why), "%s: gpu_layout_check_boxes: %s", name, why);
     return true;
+}
+
+static bool build_all(pk_context *ctx, const accel_input *in, const char *name, built *b)
+{
+    return build_tree(ctx, in, NULL, name, b);
 }
 
 static void free_all(pk_context *ctx, built *b)
@@ -189,19 +196,120 @@ static ray *make_rays(rng *g, const accel_input *in, size_t n)
     return rays;
 }
 
+/* The box tests on every node of b against gpu_node_hits_v0 (whose boxes
+ * contain the CPU's): GPU_TEST_EXACT and GPU_TEST_FMA give the same slots
+ * and the same entry distances, GPU_TEST_LOOSE at least the same slots with
+ * entry distances no larger. Rays from make_rays and harder ones: tiny and
+ * huge direction components (1/d overflowing or S = scale / d doing so),
+ * origins far away, and cull distances of every size. */
+static void check_box_tests(const built *b, const accel_input *in, rng *g, size_t nrays, const char *name)
+{
+    ray *rays = make_rays(g, in, nrays);
+    long bad_exact = 0, bad_fma = 0, bad_loose = 0, bad_wide = 0, entered = 0, extra = 0, extra6 = 0;
+    for (size_t i = 0; i < nrays; i++) {
+        ray r = rays[i];
+        const uint32_t kind = rng_u32(g) % 8;
+        if (kind == 0) r.d.x *= 1e-30f; /* 1/d huge */
+        if (kind == 1) r.d = v3_scale(r.d, 1e30f);
+        if (kind == 2) r.o = v3_scale(r.o, 1e5f);
+        if (kind == 3) r.d.y = 0x1p-149f;
+        if (!gpu_ray_traceable((const pk_ray *)&r)) continue;
+        gpu_ray q;
+        gpu_ray_init(&q, (const pk_ray *)&r);
+        const float tcull = kind == 4 ? INFINITY : rng_range(g, 0.0f, 3.0f) * (kind == 5 ? 1e6f : 1.0f);
+        for (size_t j = 0; j < b->g.nnodes; j++) {
+            const gpu_node *nd = &b->g.nodes[j];
+            uint32_t w[24];
+            gpu_node_load(nd, w);
+            float t0[GPU_WIDTH], t1[GPU_WIDTH], t3[GPU_WIDTH], t4[GPU_WIDTH], t6[GPU_WIDTH];
+            const unsigned m0 = gpu_node_hits_v0(nd, &q, tcull, t0), m1 = gpu_node_hits(w, &q, tcull, t1);
+            const unsigned m3 = gpu_node_hits_fma(w, &q, tcull, t3);
+            const unsigned m4 = gpu_node_hits_slack(w, &q, tcull, t4);
+            const unsigned m6 = gpu_node_hits_wide(w, &q, tcull, t6);
+            /* (gpu_trace_box uses it only for rays with every |1/d| < 2^64; here it is
+             * tried on all, overflows included) */
+            if (kind >= 4 && fabsf(q.rd[0]) < 0x1p64f && fabsf(q.rd[1]) < 0x1p64f && fabsf(q.rd[2]) < 0x1p64f) {
+                /* rays it is used for */
+                entered += __builtin_popcount(m0);
+                extra += __builtin_popcount(m4 & ~m0);
+                extra6 += __builtin_popcount(m6 & ~m0);
+            }
+            bad_exact += m1 != m0, bad_fma += m3 != m0, bad_loose += (m4 & m0) != m0, bad_wide += (m6 & m0) != m0;
+            for (int s = 0; s < GPU_WIDTH; s++) {
+                if (!(m0 >> s & 1u)) continue;
+                bad_exact += !(t1[s] == t0[s]);
+                bad_fma += !(t3[s] == t0[s]);
+                bad_loose += !(t4[s] <= t0[s]);
+                bad_wide += !(t6[s] <= t0[s]);
+            }
+        }
+    }
+    free(rays);
+    CHECKF(bad_exact == 0, "%s: GPU_TEST_EXACT differs from gpu_node_hits_v0 %ld times", name, bad_exact);
+    CHECKF(bad_fma == 0, "%s: GPU_TEST_FMA differs from gpu_node_hits_v0 %ld times", name, bad_fma);
+    CHECKF(bad_loose == 0, "%s: GPU_TEST_LOOSE misses a box or enters it later %ld times", name, bad_loose);
+    CHECKF(bad_wide == 0, "%s: GPU_TEST_WIDE misses a box or enters it later %ld times", name, bad_wide);
+    printf("%s: box tests: %ld boxes entered by ordinary rays, %ld more (%.3f%%) by GPU_TEST_LOOSE, %ld (%.3f%%) by "
+           "GPU_TEST_WIDE\n",
+           name, entered, extra, 100.0 * (double)extra / (double)(entered ? entered : 1), extra6,
+           100.0 * (double)extra6 / (double)(entered ? entered : 1));
+}
+
 /* Every ray: closest hit bit for bit against brute force (and against the
  * CPU BVH when cpu_too), any-hit agreeing on hit/miss with a real hit. */
 static void check_rays(const built *b, const accel_input *in, const ray *rays, size_t n, bool brute, const char *name)
 {
-    long bad_brute = 0, bad_cpu = 0, bad_any = 0, bad_anyhit = 0, nhits = 0, ties = 0;
+    long bad_brute = 0, bad_cpu = 0, bad_any = 0, bad_anyhit = 0, bad_v0 = 0, bad_loose = 0, nhits = 0, ties = 0;
+    long loose_ties = 0;
     const long nn = (long)n;
-#pragma omp parallel for schedule(dynamic, 64) reduction(+ : bad_brute, bad_cpu, bad_any, bad_anyhit, nhits, ties)
+#pragma omp parallel for schedule(dynamic, 64) reduction(+ : bad_brute, bad_cpu, bad_any, bad_anyhit, bad_v0, \
+                                                              bad_loose, nhits, ties, loose_ties)
     for (long i = 0; i < nn; i++) {
         const ray *r = &rays[i];
         pk_hit got, any;
         hit want, cpu;
         gpu_trace(b->g.nodes, b->g.tris, (const pk_ray *)r, false, &got, NULL);
         gpu_trace(b->g.nodes, b->g.tris, (const pk_ray *)r, true, &any, NULL);
+        /* every kernel's traversal: the first one's answers, any hits
+         * included where the box distances are the same (the same visiting
+         * order); the loosened boxes give the same closest hit (but for ties) */
+        pk_hit got0, any0, h;
+        const bool f0 = gpu_trace_v0(b->g.nodes, b->g.tris, (const pk_ray *)r, false, &got0, NULL);
+        const bool a0 = gpu_trace_v0(b->g.nodes, b->g.tris, (const pk_ray *)r, true, &any0, NULL);
+        bad_v0 += !same_hit(&got, &got0) || !same_hit(&any, &any0) || f0 != (got.prim != PK_NO_HIT) ||
+                  a0 != (any.prim != PK_NO_HIT);
+        const int exact[2] = {GPU_TEST_EXACT, GPU_TEST_FMA};
+        for (int m = 0; m < 2; m++) {
+            bool f = gpu_trace_box(b->g.nodes, b->g.tris, (const pk_ray *)r, false, &h, NULL, exact[m]);
+            bad_v0 += !same_hit(&h, &got0) || f != f0;
+            f = gpu_trace_box(b->g.nodes, b->g.tris, (const pk_ray *)r, true, &h, NULL, exact[m]);
+            bad_v0 += !same_hit(&h, &any0) || f != a0;
+        }
+        /* (the visiting order may differ: an exact tie in t may then go to
+         * another triangle, as between brute force and the CPU BVH) */
+        const int loose_modes[2] = {GPU_TEST_LOOSE, GPU_TEST_WIDE};
+        for (int lm = 0; lm < 2; lm++) {
+            bool fl = gpu_trace_box(b->g.nodes, b->g.tris, (const pk_ray *)r, false, &h, NULL, loose_modes[lm]);
+            if (fl != f0) bad_loose++;
+            else if (!same_hit(&h, &got0)) {
+                const vec3 *p = in->verts + 3 * (size_t)h.prim;
+                ray_pre pre = ray_prepare(r);
+                float t, u, v;
+                const bool tie = same_bits(h.t, got0.t) && h.prim < in->ntris &&
+                                 tri_intersect(&pre, p[0], p[1], p[2], r->tmax, &t, &u, &v) && same_bits(t, h.t);
+                loose_ties += tie;
+                bad_loose += !tie;
+            }
+            fl = gpu_trace_box(b->g.nodes, b->g.tris, (const pk_ray *)r, true, &h, NULL, loose_modes[lm]);
+            if (fl != a0) bad_loose++;
+            else if (fl) { /* some real hit in [tmin, tmax] */
+                const vec3 *p = in->verts + 3 * (size_t)h.prim;
+                ray_pre pre = ray_prepare(r);
+                float t, u, v;
+                bad_loose += !(h.prim < in->ntris && tri_intersect(&pre, p[0], p[1], p[2], r->tmax, &t, &u, &v) &&
+                               same_bits(t, h.t) && same_bits(u, h.u) && same_bits(v, h.v));
+            }
+        }
         accel_intersect(b->cpu, r, &cpu, NULL);
         bad_cpu += !same_hit(&got, (const pk_hit *)&cpu);
         if (brute) {
@@ -241,9 +349,15 @@ static void check_rays(const built *b, const accel_input *in, const ray *rays, s
     }
     CHECKF(bad_brute == 0, "%s: %ld of %zu closest hits differ from brute force", name, bad_brute, n);
     CHECKF(bad_cpu == 0, "%s: %ld of %zu closest hits differ from the CPU BVH", name, bad_cpu, n);
+    CHECKF(bad_v0 == 0, "%s: %ld of %zu hits differ between the exact box tests and gpu_trace_v0", name, bad_v0, n);
+    CHECKF(bad_loose == 0, "%s: %ld of %zu hits of the loosened box test (GPU_TEST_LOOSE) are wrong", name, bad_loose,
+           n);
     CHECKF(bad_any == 0, "%s: %ld of %zu any-hit answers disagree with the closest hit", name, bad_any, n);
     CHECKF(bad_anyhit == 0, "%s: %ld of %zu any-hit answers are not real hits", name, bad_anyhit, n);
     if (ties) printf("%s: %ld exact ties went to another triangle than brute force's\n", name, ties);
+    if (loose_ties)
+        printf("%s: %ld exact ties went to another triangle with GPU_TEST_LOOSE than with the CPU BVH\n", name,
+               loose_ties);
     if (in->ntris > 1 && n > 0) CHECKF(nhits > 0, "%s: no ray hit anything", name);
 }
 
@@ -253,6 +367,7 @@ static void check_input(pk_context *ctx, const accel_input *in, size_t nrays, si
     built b;
     if (build_all(ctx, in, name, &b)) {
         rng g = {seed};
+        check_box_tests(&b, in, &g, nrays / 40 + 10, name);
         ray *rays = make_rays(&g, in, nrays);
         check_rays(&b, in, rays, nbrute < nrays ? nbrute : nrays, true, name);
         if (nbrute < nrays) check_rays(&b, in, rays + nbrute, nrays - nbrute, false, name);
@@ -440,6 +555,23 @@ static void test_checker(pk_context *ctx)
 
 /* ---- shared scenes ---------------------------------------------------------- */
 
+/* Nodes visited, triangles tested and bytes read per ray (closest hit) on
+ * rays from inside the scene's box: what the tree costs the GPU (printed). */
+static void traffic(const built *b, const accel_input *in, const char *what, const char *name)
+{
+    rng g = {4242};
+    const size_t n = 20000;
+    ray *rays = make_rays(&g, in, n);
+    gpu_counters c = {0, 0};
+    for (size_t i = 0; i < n; i++) {
+        pk_hit h;
+        gpu_trace(b->g.nodes, b->g.tris, (const pk_ray *)&rays[i], false, &h, &c);
+    }
+    free(rays);
+    printf("%-44s %s: %.1f nodes and leaves, %.1f triangles, %.0f bytes a ray\n", name, what, (double)c.nodes / n,
+           (double)c.tests / n, ((double)c.nodes * sizeof(gpu_node) + (double)c.tests * sizeof(gpu_tri)) / n);
+}
+
 static void check_file(pk_context *ctx, const char *rel, size_t nrays, size_t nbrute)
 {
     char path[1024];
@@ -463,6 +595,7 @@ static void check_file(pk_context *ctx, const char *rel, size_t nrays, size_t nb
     built b;
     if (build_all(ctx, &in, rel, &b)) {
         rng g = {0x9e3779b97f4a7c15ull ^ s->ntris};
+        check_box_tests(&b, &in, &g, b.g.nnodes < 100 ? 20000 : (size_t)2e6 / b.g.nnodes, rel);
         ray *rays = make_rays(&g, &in, nrays);
         check_rays(&b, &in, rays, nbrute, true, rel);
         check_rays(&b, &in, rays + nbrute, nrays - nbrute, false, rel);
@@ -470,9 +603,29 @@ static void check_file(pk_context *ctx, const char *rel, size_t nrays, size_t nb
         printf("%-44s %7zu tris %6zu nodes %7zu records (%.1f MiB) stack %3u  %.2f s\n", rel, s->ntris, b.g.nnodes,
                b.g.ntris, (double)(b.g.nnodes * sizeof(gpu_node) + b.g.ntris * sizeof(gpu_tri)) / 1048576.0,
                b.g.stack_need, omp_get_wtime() - t0);
+        traffic(&b, &in, "the CPU's tree", rel);
     }
     free_all(ctx, &b);
     pk_context_clear_error(ctx);
+    /* trees collapsed for the GPU (PAPRSEK_CUDA_TREE): the same checks */
+    static const float node_costs[] = {2.0f, 4.0f, 8.0f};
+    for (size_t c = 0; c < sizeof node_costs / sizeof *node_costs; c++) {
+        const bvh_costs costs = {node_costs[c], 1, 16};
+        char what[64];
+        snprintf(what, sizeof what, "node cost %g", (double)costs.node);
+        if (build_tree(ctx, &in, &costs, rel, &b)) {
+            rng g = {77 + c};
+            ray *rays = make_rays(&g, &in, nrays / 4);
+            check_rays(&b, &in, rays, nbrute / 4, true, rel);
+            check_rays(&b, &in, rays + nbrute / 4, nrays / 4 - nbrute / 4, false, rel);
+            free(rays);
+            printf("%-44s %s: %6zu nodes %7zu records (%.1f MiB) stack %3u\n", rel, what, b.g.nnodes, b.g.ntris,
+                   (double)(b.g.nnodes * sizeof(gpu_node) + b.g.ntris * sizeof(gpu_tri)) / 1048576.0, b.g.stack_need);
+            traffic(&b, &in, what, rel);
+        }
+        free_all(ctx, &b);
+        pk_context_clear_error(ctx);
+    }
 
     /* the public door: without a driver or device a clean error; with one,
      * the GPU's hits against the host's */
@@ -493,16 +646,35 @@ static void check_file(pk_context *ctx, const char *rel, size_t nrays, size_t nb
         REQUIRE(dev && host);
         pk_accel *cpu = NULL;
         REQUIRE(pk_accel_create(ctx, s, PK_ACCEL_BVH, 2, &cpu) == PK_OK);
-        for (int any = 0; any < 2; any++) {
-            unsigned flags = any ? PK_TRACE_ANY_HIT : 0u;
-            pk_accel_trace(pa, (const pk_ray *)rays, dev, n, 0, flags, NULL);
-            CHECKF(pk_context_status(ctx) == PK_OK, "%s: device trace: %s", rel, pk_context_error(ctx));
-            pk_accel_trace(cpu, (const pk_ray *)rays, host, n, 0, flags, NULL);
-            size_t bad = 0;
-            for (size_t i = 0; i < n; i++)
-                bad += any ? (dev[i].prim != PK_NO_HIT) != (host[i].prim != PK_NO_HIT) : !same_hit(&dev[i], &host[i]);
-            CHECKF(bad == 0, "%s: %zu of %zu device %s hits differ from the CPU's", rel, bad, n, any ? "any" : "closest");
+        /* the default kernel, then every version (PAPRSEK_CUDA_KERNEL) */
+        static const char *const versions[] = {"", "v0", "v1", "v2", "v3", "v4", "v5", "v6", "v7", "v8", "v9"};
+        const char *keep = getenv("PAPRSEK_CUDA_KERNEL");
+        for (size_t ver = 0; ver < sizeof versions / sizeof *versions; ver++) {
+            pk_accel *pv = pa;
+            if (ver > 0) {
+                setenv("PAPRSEK_CUDA_KERNEL", versions[ver], 1);
+                st = pk_accel_create(ctx, s, PK_ACCEL_CUDA, 2, &pv);
+                CHECKF(st == PK_OK, "%s: kernel %s: %s", rel, versions[ver], pk_context_error(ctx));
+                if (st != PK_OK) {
+                    pk_context_clear_error(ctx);
+                    continue;
+                }
+            }
+            for (int any = 0; any < 2; any++) {
+                unsigned flags = any ? PK_TRACE_ANY_HIT : 0u;
+                pk_accel_trace(pv, (const pk_ray *)rays, dev, n, 0, flags, NULL);
+                CHECKF(pk_context_status(ctx) == PK_OK, "%s: device trace: %s", rel, pk_context_error(ctx));
+                pk_accel_trace(cpu, (const pk_ray *)rays, host, n, 0, flags, NULL);
+                size_t bad = 0;
+                for (size_t i = 0; i < n; i++)
+                    bad += any ? (dev[i].prim != PK_NO_HIT) != (host[i].prim != PK_NO_HIT) : !same_hit(&dev[i], &host[i]);
+                CHECKF(bad == 0, "%s: kernel %s: %zu of %zu device %s hits differ from the CPU's", rel,
+                       ver ? versions[ver] : "(default)", bad, n, any ? "any" : "closest");
+            }
+            if (ver > 0) pk_accel_destroy(pv);
         }
+        if (keep) setenv("PAPRSEK_CUDA_KERNEL", keep, 1);
+        else unsetenv("PAPRSEK_CUDA_KERNEL");
         pk_accel_device_info di;
         CHECK(pk_accel_get_device_info(pa, &di) == 1 && di.kernel_ms > 0.0 && di.structure_bytes > 0);
         CHECK(pk_accel_get_device_info(cpu, &di) == 0);

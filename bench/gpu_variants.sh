@@ -1,0 +1,91 @@
+#!/usr/bin/env bash
+# gpu_variants.sh - the versions of the GPU traversal kernel (PAPRSEK_CUDA_KERNEL,
+# see docs/gpu.md) against each other on the standard workloads of
+# spec/ray-benchmark.md at SIZE x SIZE rays: kernel Grays/s of each version,
+# and whether its hits agree with the CPU's (--accel bvh: closest hits bit for
+# bit, any hits on hit or miss). The CPU traces each ray file once; only the
+# GPU runs are repeated. Prints a markdown table; raw lines stay in
+# bench/out/gpu_variants/.
+#
+# usage: bench/gpu_variants.sh [SHARED_DIR [PAPRSEK]]   (defaults: ../shared, build/paprsek)
+# environment: SIZE (4096), REPS (3), THREADS (0 = all cores),
+#              VARIANTS (v0 v1 v3 v6 v7 v8 v9 v3/t4 v6/t4: kernel version, and /tN for a tree
+#              collapsed for the GPU with node cost N, PAPRSEK_CUDA_TREE=N),
+#              WORKLOADS (cornell-sphere bunny sponza), KINDS (primary diffuse diffuse-any)
+set -euo pipefail
+
+here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+repo=$(dirname "$here")
+shared=${1:-$repo/../shared}
+bin=${2:-$repo/build/paprsek}
+size=${SIZE:-4096}
+reps=${REPS:-3}
+threads=${THREADS:-0}
+variants=${VARIANTS:-v0 v1 v3 v6 v7 v8 v9 v3/t4 v6/t4}
+workloads=${WORKLOADS:-cornell-sphere bunny sponza}
+kinds=${KINDS:-primary diffuse diffuse-any}
+out=$here/out/gpu_variants
+mkdir -p "$out"
+rm -f "$out/err.log"
+die() { echo "gpu_variants.sh: $*" >&2; exit 1; }
+[ -x "$bin" ] || die "$bin is not there"
+
+scene_of() {
+    case $1 in
+    cornell-sphere) echo "$shared/scenes/cornell/CornellBox-Sphere.obj" ;;
+    bunny) echo "$shared/scenes/bench/stanford-bunny.obj" ;;
+    sponza) echo "$shared/scenes/bench/dabrovic-sponza/sponza.obj" ;;
+    *) die "unknown workload $1" ;;
+    esac
+}
+field() { awk -v k="$1" '{ for (i = 1; i <= NF; i++) { split($i, kv, "="); if (kv[1] == k) print kv[2] } }'; }
+
+echo "## GPU kernel versions: kernel Grays/s (hits agree with the CPU's: ok, or the number that differ)"
+echo
+echo "- GPU: $(nvidia-smi --query-gpu=name,driver_version,clocks.max.sm --format=csv,noheader 2>/dev/null || echo unknown)"
+echo "- ${size}x${size} rays, $reps passes (median kernel time)"
+echo
+printf '| workload |'; for v in $variants; do printf ' %s |' "$v"; done; echo
+printf '|---|'; for v in $variants; do printf -- '---|'; done; echo
+for wl in $workloads; do
+    scene=$(scene_of "$wl")
+    for kind in $kinds; do
+        base=${kind%-any}
+        rays=$out/$wl-$base-$size.rays
+        any=; [ "$kind" != "$base" ] && any=--any-hit
+        if [ ! -s "$rays" ]; then
+            "$bin" bench gen-rays --workload "$wl" --shared "$shared" --size "$size" --kind "$base" --seed 1 \
+                --threads "$threads" -o "$rays" 2>"$out/gen.err" || { echo "| $wl $kind | (no rays: $(head -1 "$out/gen.err")) |"; continue; }
+        fi
+        c=$("$bin" bench rays "$scene" "$rays" --accel bvh --threads "$threads" --reps 1 $any --hits "$out/cpu.hits" 2>>"$out/err.log") || c=
+        echo "$wl $kind CPU $c" >>"$out/raw.txt"
+        row="| $wl $kind |"
+        for v in $variants; do
+            tree=; case $v in */t*) tree=${v##*/t} ;; esac
+            g=$(PAPRSEK_CUDA_KERNEL=${v%%/*} PAPRSEK_CUDA_TREE=$tree "$bin" bench rays "$scene" "$rays" --accel cuda --reps "$reps" $any --hits "$out/gpu.hits" 2>>"$out/err.log") || g=
+            echo "$wl $kind $v $g" >>"$out/raw.txt"
+            kg=$(echo "$g" | field kernel_mrays_per_s)
+            if [ -z "$kg" ]; then
+                row="$row fail |"
+                continue
+            fi
+            cmp=$("$bin" bench compare "$out/cpu.hits" "$out/gpu.hits" $any --rays "$rays" 2>/dev/null || true)
+            echo "$wl $kind $v compare $cmp" >>"$out/raw.txt"
+            ag=$(echo "$cmp" | field agree)
+            [ "$ag" = yes ] && ag=ok || ag="$(echo "$cmp" | field mismatches) differ"
+            row="$row $(awk -v k="$kg" 'BEGIN { printf "%.2f", k / 1000 }') ($ag) |"
+            rm -f "$out/gpu.hits"
+        done
+        echo "$row"
+        rm -f "$out/cpu.hits"
+    done
+    rm -f "$out/$wl"-*.rays
+done
+echo
+echo "Grays/s: 10^9 rays per second of kernel time (CUDA events). Closest hits must agree bit for bit"
+echo "(t, triangle, u, v); any hits on hit or miss."
+if [ -s "$out/err.log" ]; then
+    echo
+    echo "Messages (counted):"
+    sort "$out/err.log" | uniq -c | sort -rn | head -5
+fi
