@@ -10,7 +10,7 @@
 # usage: bench/gpu_variants.sh [SHARED_DIR [PAPRSEK]]   (defaults: ../shared, build/paprsek)
 # environment: SIZE (4096), REPS (3), THREADS (0 = all cores),
 #              VARIANTS (v0 v1 v3 v6 v7 v8 v9 v3/t4 v6/t4: kernel version, and /tN for a tree
-#              collapsed for the GPU with node cost N, PAPRSEK_CUDA_TREE=N),
+#              collapsed for the GPU with node cost N, PAPRSEK_CUDA_TREE=N; without /tN the CPU's tree),
 #              WORKLOADS (cornell-sphere bunny sponza), KINDS (primary diffuse diffuse-any)
 set -euo pipefail
 
@@ -61,7 +61,7 @@ for wl in $workloads; do
         echo "$wl $kind CPU $c" >>"$out/raw.txt"
         row="| $wl $kind |"
         for v in $variants; do
-            tree=; case $v in */t*) tree=${v##*/t} ;; esac
+            tree=cpu; case $v in */t*) tree=${v##*/t} ;; esac
             g=$(PAPRSEK_CUDA_KERNEL=${v%%/*} PAPRSEK_CUDA_TREE=$tree "$bin" bench rays "$scene" "$rays" --accel cuda --reps "$reps" $any --hits "$out/gpu.hits" 2>>"$out/err.log") || g=
             echo "$wl $kind $v $g" >>"$out/raw.txt"
             kg=$(echo "$g" | field kernel_mrays_per_s)

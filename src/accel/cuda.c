@@ -182,7 +182,8 @@ static bool driver_loaded(void) { return pthread_once(&load_once, load_driver) =
 /* The kernel versions of cuda/trace.cu; PAPRSEK_CUDA_KERNEL picks one by
  * name (for timing them against each other: they give the same hits). */
 static const char *const kernel_names[] = {"v0", "v1", "v2", "v3", "v4", "v5", "v6", "v7", "v8", "v9"};
-#define KERNEL_DEFAULT 3
+#define GPU_TREE_NODE_COST 4.0f
+#define KERNEL_DEFAULT 6 /* v6: the fastest on the H100 (docs/gpu.md) */
 /* v2, v5, v7, v8 and v9: persistent warps, a ray counter on the device */
 static bool kernel_persistent(int k) { return k == 2 || k == 5 || k >= 7; }
 
@@ -470,11 +471,14 @@ pk_status accel_cuda_create(pk_context *ctx, const accel_input *in, accel **out)
             return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT,
                              "accelerator 'cuda': PAPRSEK_CUDA_KERNEL=%.40s is not a kernel version (v0 to v9)", kv);
     }
-    /* PAPRSEK_CUDA_TREE=N collapses the binary tree for the GPU: a node visit
-     * costs N triangle tests (the CPU's tree when unset) */
-    bvh_costs costs = {0.0f, 1, GPU_LEAF_MAX};
+    /* The binary tree collapsed for the GPU: a node visit costs N triangle
+     * tests, N = 4 (the fastest on the H100) unless PAPRSEK_CUDA_TREE=N says
+     * otherwise; PAPRSEK_CUDA_TREE=cpu takes the CPU's tree */
+    bvh_costs costs = {GPU_TREE_NODE_COST, 1, GPU_LEAF_MAX};
     const char *tv = getenv("PAPRSEK_CUDA_TREE");
-    if (tv && tv[0]) {
+    if (tv && strcmp(tv, "cpu") == 0) {
+        costs.node = 0.0f;
+    } else if (tv && tv[0]) {
         char *end = NULL;
         const double v = strtod(tv, &end);
         if (*end || !(v >= 0.25 && v <= 64.0))

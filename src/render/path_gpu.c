@@ -10,8 +10,6 @@
  */
 #include "path_gpu.h"
 
-#include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
 
 #define MAX_BUFFERS 64
@@ -255,11 +253,7 @@ pk_status path_gpu_render(path_gpu *g, const camera_frame *cf, const gpu_tile *t
         int accumulate = done > 0;
         void *params[] = {&g->d_pt, &cam, &g->d_tiles, &nthreads, &from, &n, &accumulate, &g->d_acc, &g->d_rays};
         double ms = 0.0;
-        const char *kv = getenv("PAPRSEK_CUDA_PATH_KERNEL"); /* (measurements) */
-        char kname[64];
-        snprintf(kname, sizeof kname, "pk_path_render%s%s", kv && kv[0] ? "_" : "", kv && kv[0] ? kv : "");
-        const unsigned block = 128;
-        if ((st = cuda_device_launch(g->a, kname, nthreads, block, params, &ms)) != PK_OK) return st;
+        if ((st = cuda_device_launch(g->a, "pk_path_render", nthreads, 128, params, &ms)) != PK_OK) return st;
         done += n;
         /* the next launch sized to take about LAUNCH_TARGET_MS */
         if (ms > 0.0) {

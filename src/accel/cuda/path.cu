@@ -9,8 +9,11 @@
 /* closest and any hit on the device BVH of the path tracer's copy */
 static __device__ __forceinline__ bool path_gpu_trace(const path_tracer *pt, const ray *r, hit *h, bool any)
 {
-    return gpu_trace((const gpu_node *)pt->gpu_nodes, (const gpu_tri *)pt->gpu_tris, (const pk_ray *)r, any,
-                     (pk_hit *)h, NULL);
+    /* the loosened box test of the fastest traversal kernel (v6): it enters
+     * every box the exact test enters (bvh_gpu.h), so the hits are the same
+     * but for exact ties between triangles */
+    return gpu_trace_box((const gpu_node *)pt->gpu_nodes, (const gpu_tri *)pt->gpu_tris, (const pk_ray *)r, any,
+                         (pk_hit *)h, NULL, GPU_TEST_WIDE);
 }
 static __device__ __forceinline__ bool path_gpu_occluded(const path_tracer *pt, const ray *r)
 {
@@ -39,16 +42,16 @@ extern "C" __global__ void pk_path_layout(unsigned long long *out)
 
 /* Samples first..first+n-1 of pixel (thread % 256) of tile (thread / 256):
  * their sum is written to (accumulate = 0) or added to acc; rays counts
- * camera, bounce and shadow rays. With regen, a thread starts its next
- * sample as soon as a path ends, one path_step at a time (Novak et al.
- * 2010: the lanes of a warp stay busy while paths of different lengths
- * end); without, each sample's path runs to its end before the next, and
- * a warp waits for its longest path. */
-template <bool regen>
-static __device__ __forceinline__ void path_render(const path_tracer *__restrict__ pt, const camera_frame &cf,
-                                                   const gpu_tile *__restrict__ tiles, unsigned nthreads, unsigned first,
-                                                   unsigned n, int accumulate, float *__restrict__ acc,
-                                                   unsigned long long *rays)
+ * camera, bounce and shadow rays. Each sample's path runs to its end before
+ * the next starts. (Starting a lane's next sample as soon as its path ends,
+ * one path_step at a time, measured slower on the H100: 195 against 208 M
+ * samples/s on CornellBox-Original; docs/gpu.md.) At most 80 registers a
+ * thread (6 blocks of 128 a multiprocessor): 259 M samples/s against 212 M
+ * with the compiler's 168 registers and fewer threads. */
+extern "C" __global__ void __launch_bounds__(128, 6)
+    pk_path_render(const path_tracer *__restrict__ pt, camera_frame cf, const gpu_tile *__restrict__ tiles,
+                   unsigned nthreads, unsigned first, unsigned n, int accumulate, float *__restrict__ acc,
+                   unsigned long long *rays)
 {
     const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
     if (i >= nthreads) return; /* (nthreads is a multiple of 256: whole warps) */
@@ -60,35 +63,14 @@ static __device__ __forceinline__ void path_render(const path_tracer *__restrict
     vec3 sum = v3s(0.0f);
     if (k < tl.w * tl.h) {
         const int px = tl.x + k % tl.w, py = tl.y + k / tl.w;
-        path_state ps;
-        bool active = false;
-        unsigned s = 0;
-        for (;;) {
-            if (!active) {
-                if (s == n) break;
-                const uint32_t index = first + s++;
-                const ray r = path_camera_ray(pt, &cf, px, py, index);
-                hit h;
-                const bool got = path_gpu_trace(pt, &r, &h, false);
-                t.rays_camera++;
-                vec3 bg;
-                if (!path_start(pt, px, py, index, &r, got ? &h : NULL, &ps, &bg)) {
-                    sum = v3_add(sum, bg);
-                    continue;
-                }
-                active = true;
-                if (!regen) {
-                    while (path_step(pt, &t, &ps)) {
-                    }
-                } else if (path_step(pt, &t, &ps)) {
-                    continue;
-                }
-            } else if (path_step(pt, &t, &ps)) {
-                continue;
-            }
+        for (unsigned s = 0; s < n; s++) {
+            const uint32_t index = first + s;
+            const ray r = path_camera_ray(pt, &cf, px, py, index);
+            hit h;
+            const bool got = path_gpu_trace(pt, &r, &h, false);
+            t.rays_camera++;
             vec3 c;
-            if (path_result(&ps, &c)) sum = v3_add(sum, c);
-            active = false;
+            if (path_camera_sample(pt, &t, px, py, index, &r, got ? &h : NULL, &c)) sum = v3_add(sum, c);
         }
     }
     float *a = &acc[3 * (size_t)i];
@@ -107,17 +89,3 @@ static __device__ __forceinline__ void path_render(const path_tracer *__restrict
         atomicAdd(&rays[2], c2);
     }
 }
-
-#define PATH_KERNEL(name, bounds, regen)                                                                         \
-    extern "C" __global__ void bounds name(const path_tracer *__restrict__ pt, camera_frame cf,                 \
-                                           const gpu_tile *__restrict__ tiles, unsigned nthreads, unsigned first, \
-                                           unsigned n, int accumulate, float *__restrict__ acc,                   \
-                                           unsigned long long *rays)                                              \
-    {                                                                                                            \
-        path_render<regen>(pt, cf, tiles, nthreads, first, n, accumulate, acc, rays);                            \
-    }
-PATH_KERNEL(pk_path_render, __launch_bounds__(128), true)
-PATH_KERNEL(pk_path_render_loop, __launch_bounds__(128), false)
-PATH_KERNEL(pk_path_render_o4, __launch_bounds__(128, 4), true)
-PATH_KERNEL(pk_path_render_o6, __launch_bounds__(128, 6), true)
-PATH_KERNEL(pk_path_render_loop6, __launch_bounds__(128, 6), false)
