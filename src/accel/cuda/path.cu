@@ -9,8 +9,8 @@
 /* The box test of the path tracer's traversal (bvh_gpu.h GPU_TEST_*): the
  * exact one. The loosened one of the fastest ray kernel (v6) measured
  * slower here on the H100 (220 against 250 M samples/s on
- * CornellBox-Original, 62 against 70 M on Sponza): in this larger kernel
- * its extra registers cost more than its operations save. */
+ * CornellBox-Original, 62 against 70 M on Sponza; not profiled, so why
+ * is open). */
 #ifndef PK_PATH_BOX
 #define PK_PATH_BOX GPU_TEST_FMA
 #endif
