@@ -352,11 +352,16 @@ void cli_print_stats(const char *scene, const pk_scene *sc, const pk_render_opti
                (unsigned long long)rays, (unsigned long long)st->rays_camera, (unsigned long long)st->rays_shadow,
                (unsigned long long)st->rays_reflection, (unsigned long long)st->rays_refraction);
     }
-    printf("%-28s %llu\n", "intersection tests", (unsigned long long)st->intersection_tests);
-    printf("%-28s %llu\n", "nodes traversed", (unsigned long long)st->nodes_visited);
-    printf("%-28s %.2f\n", "tests/ray", (double)st->intersection_tests / r);
-    printf("%-28s %.2f\n", "nodes/ray", (double)st->nodes_visited / r);
-    printf("%-28s %.4f\n", "traversal time/ray [us]", st->render_s * st->threads / r * 1e6);
+    if (ro->accel == PK_ACCEL_CUDA) { /* the GPU counts rays, not tests and nodes */
+        printf("%-28s %s\n", "intersection tests", "not counted on the GPU");
+        printf("%-28s %s\n", "nodes traversed", "not counted on the GPU");
+    } else {
+        printf("%-28s %llu\n", "intersection tests", (unsigned long long)st->intersection_tests);
+        printf("%-28s %llu\n", "nodes traversed", (unsigned long long)st->nodes_visited);
+        printf("%-28s %.2f\n", "tests/ray", (double)st->intersection_tests / r);
+        printf("%-28s %.2f\n", "nodes/ray", (double)st->nodes_visited / r);
+        printf("%-28s %.4f\n", "traversal time/ray [us]", st->render_s * st->threads / r * 1e6);
+    }
     printf("%-28s %.2f\n", "Mrays/s", st->render_s > 0 ? (double)rays / st->render_s / 1e6 : 0.0);
     printf("%-28s %d per pixel (film: 3 float sums + a count), peak resident %.1f MiB\n", "memory [bytes]",
            FILM_BYTES_PER_PIXEL, peak_rss_mib());
