@@ -12,14 +12,13 @@
 
 #include <string.h>
 
-#define MAX_BUFFERS 64
 #define LAUNCH_TARGET_MS 50.0 /* a launch takes about this long: progress and cancelling stay prompt */
 
 struct path_gpu {
     pk_context *ctx;
     const accel *a;         /* the CUDA accelerator (owns the device context and the BVH) */
-    uint64_t buf[MAX_BUFFERS + 16];
-    size_t nbuf;
+    uint64_t *buf;          /* device buffers to free */
+    size_t nbuf, cap_buf;
     uint64_t textures_buf;  /* device texture array (its levels are buffers too) */
     uint64_t d_pt;          /* the device's path_tracer */
     uint64_t d_tiles, d_acc, d_rays;
@@ -33,9 +32,14 @@ static pk_status upload(path_gpu *g, const void *src, size_t n, size_t size, uin
 {
     *out = 0;
     if (!src || n == 0) return PK_OK;
-    if (g->nbuf >= sizeof g->buf / sizeof g->buf[0])
-        return ctx_error(g->ctx, PK_ERR_LIMIT, "device 'cuda': too many device buffers");
     if (n > SIZE_MAX / size) return ctx_error(g->ctx, PK_ERR_LIMIT, "device 'cuda': buffer too large");
+    if (g->nbuf == g->cap_buf) {
+        const size_t cap = g->cap_buf ? 2 * g->cap_buf : 32;
+        uint64_t *nb = mem_realloc_array(&g->ctx->alloc, g->buf, cap, sizeof *nb);
+        if (!nb) return ctx_nomem(g->ctx);
+        g->buf = nb;
+        g->cap_buf = cap;
+    }
     pk_status st = cuda_device_alloc(g->a, src, n * size, out);
     if (st != PK_OK) return st;
     g->buf[g->nbuf++] = *out;
@@ -71,14 +75,6 @@ static pk_status upload_textures(path_gpu *g, const pk_scene *s, uint64_t *out)
     return st;
 }
 
-/* Counts the device buffers a scene needs (textures' levels included). */
-static size_t buffers_needed(const pk_scene *s)
-{
-    size_t n = 16;
-    for (size_t i = 0; i < s->ntextures; i++) n += (size_t)s->textures[i].nlevels;
-    return n;
-}
-
 static pk_status check_layout(path_gpu *g)
 {
     /* sizes of the shared structs as nvcc laid them out, against the host's */
@@ -111,9 +107,6 @@ pk_status path_gpu_create(pk_context *ctx, const path_tracer *pt, path_gpu **out
     if (s->nspheres)
         return ctx_error(ctx, PK_ERR_UNSUPPORTED, "device 'cuda': the GPU renders triangles only (the scene has %zu "
                          "sphere%s)", s->nspheres, s->nspheres == 1 ? "" : "s");
-    if (buffers_needed(s) > MAX_BUFFERS)
-        return ctx_error(ctx, PK_ERR_LIMIT, "device 'cuda': the scene has too many texture images for the GPU (%zu)",
-                         s->ntextures);
     path_gpu *g = mem_calloc(&ctx->alloc, 1, sizeof *g);
     if (!g) return ctx_nomem(ctx);
     g->ctx = ctx;
@@ -200,6 +193,7 @@ void path_gpu_destroy(path_gpu *g)
 {
     if (!g) return;
     for (size_t i = 0; i < g->nbuf; i++) cuda_device_free(g->a, g->buf[i]);
+    mem_free(&g->ctx->alloc, g->buf);
     cuda_device_free(g->a, g->d_tiles);
     cuda_device_free(g->a, g->d_acc);
     cuda_device_free(g->a, g->d_rays);
