@@ -1,11 +1,13 @@
 /*
  * renderer.c - render sessions: the frame is built once; each render splits
  * its regions into 16x16 tiles rendered in parallel (OpenMP, dynamic
- * scheduling), generates camera rays through pixel centres (stratified
- * jitter for spp > 1) in coherent batches, shades them with the Whitted
- * integrator and adds each finished tile to the film. Every pixel sample
- * seeds its own random numbers from (pixel, sample), so a pixel's value does
- * not depend on the threads, the tiles or the regions.
+ * scheduling), generates camera rays in coherent batches, shades them with
+ * the path tracer or the Whitted integrator and adds each finished tile to
+ * the film. With the cuda accelerator the path tracer's kernel renders all
+ * the tiles on the GPU instead (path_gpu.h) and the tiles go into the same
+ * film. Every pixel sample seeds its own random numbers from (pixel,
+ * sample), so a pixel's value does not depend on the threads, the tiles or
+ * the regions.
  */
 #include "render.h"
 
