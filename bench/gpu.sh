@@ -23,14 +23,7 @@ mkdir -p "$out"
 die() { echo "gpu.sh: $*" >&2; exit 1; }
 [ -x "$bin" ] || die "$bin is not there"
 
-scene_of() {
-    case $1 in
-    cornell-sphere) echo "$shared/scenes/cornell/CornellBox-Sphere.obj" ;;
-    bunny) echo "$shared/scenes/bench/stanford-bunny.obj" ;;
-    sponza) echo "$shared/scenes/bench/dabrovic-sponza/sponza.obj" ;;
-    esac
-}
-field() { awk -v k="$1" '{ for (i = 1; i <= NF; i++) { split($i, kv, "="); if (kv[1] == k) print kv[2] } }'; }
+. "$here/workloads.sh"
 
 echo "## GPU traversal: --accel cuda against the CPU"
 echo

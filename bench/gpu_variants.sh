@@ -30,15 +30,7 @@ rm -f "$out/err.log"
 die() { echo "gpu_variants.sh: $*" >&2; exit 1; }
 [ -x "$bin" ] || die "$bin is not there"
 
-scene_of() {
-    case $1 in
-    cornell-sphere) echo "$shared/scenes/cornell/CornellBox-Sphere.obj" ;;
-    bunny) echo "$shared/scenes/bench/stanford-bunny.obj" ;;
-    sponza) echo "$shared/scenes/bench/dabrovic-sponza/sponza.obj" ;;
-    *) die "unknown workload $1" ;;
-    esac
-}
-field() { awk -v k="$1" '{ for (i = 1; i <= NF; i++) { split($i, kv, "="); if (kv[1] == k) print kv[2] } }'; }
+. "$here/workloads.sh"
 
 echo "## GPU kernel versions: kernel Grays/s (hits agree with the CPU's: ok, or the number that differ)"
 echo

@@ -26,17 +26,7 @@ die() { echo "run.sh: $*" >&2; exit 1; }
 [ -d "$shared/scenes" ] || die "$shared/scenes is not there: pass the shared folder as the first argument"
 mkdir -p "$out"
 
-scene_of() {
-    case $1 in
-    cornell-sphere) echo "$shared/scenes/cornell/CornellBox-Sphere.obj" ;;
-    bunny) echo "$shared/scenes/bench/stanford-bunny.obj" ;;
-    sponza) echo "$shared/scenes/bench/dabrovic-sponza/sponza.obj" ;;
-    *) die "unknown workload $1" ;;
-    esac
-}
-
-# value of key in a `key=value ...` line
-field() { awk -v k="$1" '{ for (i = 1; i <= NF; i++) { split($i, kv, "="); if (kv[1] == k) print kv[2] } }'; }
+. "$here/workloads.sh"
 
 # ---- machine -----------------------------------------------------------------
 cpu=$(awk -F': ' '/^model name/ { print $2; exit }' /proc/cpuinfo 2>/dev/null || true)
