@@ -140,16 +140,20 @@ int main(int argc, char **argv)
         if (pk_context_create(NULL, &ctx) != PK_OK) return 1;
         if (pk_scene_load_file(ctx, argv[a], &sc) != PK_OK) {
             fprintf(stderr, "%s: %s\n", argv[a], pk_context_error(ctx));
+            pk_context_destroy(ctx);
             return 1;
         }
         static double m[2][K][GRID * GRID * 3];
-        for (int d = 0; d < 2; d++)
-            for (int k = 0; k < K; k++)
+        int rendered = 1;
+        for (int d = 0; d < 2 && rendered; d++)
+            for (int k = 0; k < K && rendered; k++)
                 /* independent seeds: 1..K on the CPU, K+1..2K on the GPU */
-                if (!render_means(ctx, sc, d ? PK_ACCEL_CUDA : PK_ACCEL_BVH, 1 + d * K + k, m[d][k], &skipped)) {
-                    if (skipped) return 77;
-                    return 1;
-                }
+                rendered = render_means(ctx, sc, d ? PK_ACCEL_CUDA : PK_ACCEL_BVH, 1 + d * K + k, m[d][k], &skipped);
+        if (!rendered) {
+            pk_scene_destroy(sc);
+            pk_context_destroy(ctx);
+            return skipped ? 77 : 1;
+        }
         double worst_p = 1.0, sum_cpu = 0.0, sum_gpu = 0.0;
         int worst = 0;
         for (int i = 0; i < ncmp; i++) {
