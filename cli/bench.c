@@ -313,6 +313,8 @@ static int bench_rays(int argc, char **argv)
            " sah_cost=%.3f",
            tmin, reps, any_hit ? "any" : "closest", packets, info.nodes, info.leaves, info.bytes,
            bytes_per_tri, info.sah_cost);
+    const char *isa = pk_accel_isa(accel);
+    if (isa) printf(" isa=%s", isa);
     if (info.name && strcmp(info.name, "embree") == 0) {
         const char *q = getenv("PAPRSEK_EMBREE_QUALITY");
         printf(" embree_quality=%s", q && q[0] ? q : "medium");

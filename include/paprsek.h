@@ -479,6 +479,12 @@ PK_API pk_status pk_accel_create(pk_context *ctx, const pk_scene *scene, pk_acce
                                  int threads, pk_accel **out);
 PK_API void pk_accel_destroy(pk_accel *accel);
 PK_API void pk_accel_get_info(const pk_accel *accel, pk_accel_info *info);
+/* The SIMD instruction set of the CPU kernels accel traces with, where the
+ * library chose one for this CPU: "avx512" or "avx2" for PK_ACCEL_BVH
+ * (AVX-512 where the CPU has it; the environment variable
+ * PAPRSEK_CPU_ISA=avx2, read when the accelerator is created, forces AVX2).
+ * Both find the same hits. NULL for the other accelerators. */
+PK_API const char *pk_accel_isa(const pk_accel *accel);
 /* Traces n rays with up to threads threads; hits[i] answers rays[i].
  * counters may be NULL (nothing is counted then). A device accelerator
  * (PK_ACCEL_CUDA) that fails (a kernel error) latches the error in the

@@ -527,6 +527,11 @@ void pk_accel_get_info(const pk_accel *pa, pk_accel_info *info)
     *info = pa->a->info;
 }
 
+const char *pk_accel_isa(const pk_accel *pa)
+{
+    return pa ? pa->a->isa : NULL;
+}
+
 void pk_accel_trace(const pk_accel *pa, const pk_ray *rays, pk_hit *hits, size_t n, int threads, unsigned flags,
                     pk_trace_counters *counters)
 {

@@ -59,6 +59,7 @@ struct accel {
     const accel_ops *ops;
     const pk_allocator *alloc;
     pk_accel_info info;      /* name, build_ms, nodes, leaves, bytes, sah_cost */
+    const char *isa;         /* the CPU kernels' instruction set where there is a choice, else NULL */
     size_t ntris, nspheres;
 };
 

@@ -118,11 +118,35 @@ typedef struct bvh {
     int depth;                  /* levels of the wide tree (root = 1) */
 } bvh;
 
-/* Traversal entry points (bvh_traverse.c, bvh_packet.c). */
+/* Traversal entry points (bvh_traverse.c, bvh_packet.c). Those files are
+ * compiled twice: for the baseline (AVX2, x86-64-v3) and, where the compiler
+ * can (PK_HAVE_AVX512_KERNELS), for AVX-512 (x86-64-v4) through
+ * bvh_traverse_avx512.c and bvh_packet_avx512.c, which define BVH_AVX512
+ * and so name their functions with BVH_FN's suffix. The same source and the
+ * same float operations (no fused multiply-adds) give the same hits; only
+ * the compiler's register allocation and instruction choice differ (32
+ * vector registers and mask registers: fewer spills and moves). The
+ * accelerator picks its set when it is built (bvh_use_avx512). */
+#ifdef BVH_AVX512
+#define BVH_FN(name) name##_avx512
+#else
+#define BVH_FN(name) name
+#endif
 PK_HIDDEN bool bvh_intersect(const accel *a, const ray *r, hit *h, accel_counters *c);
 PK_HIDDEN bool bvh_occluded(const accel *a, const ray *r, hit *h, accel_counters *c);
 PK_HIDDEN void bvh_intersect_packet(const accel *a, const ray *r, hit *h, size_t n, bool any_hit,
                                     accel_counters *c);
+#if PK_HAVE_AVX512_KERNELS
+PK_HIDDEN bool bvh_intersect_avx512(const accel *a, const ray *r, hit *h, accel_counters *c);
+PK_HIDDEN bool bvh_occluded_avx512(const accel *a, const ray *r, hit *h, accel_counters *c);
+PK_HIDDEN void bvh_intersect_packet_avx512(const accel *a, const ray *r, hit *h, size_t n, bool any_hit,
+                                           accel_counters *c);
+#endif
+/* True when accelerators built now use the AVX-512 kernels: they are built
+ * in, the CPU and the operating system support AVX-512 F, CD, BW, DQ and VL,
+ * and the environment variable PAPRSEK_CPU_ISA is not "avx2" (which forces
+ * the baseline, for comparisons). */
+PK_HIDDEN bool bvh_use_avx512(void);
 
 /* Tests the invariants above; false with a reason in why (may be NULL). */
 PK_HIDDEN bool bvh_check(const accel *a, char *why, size_t n);

@@ -823,6 +823,27 @@ static void bvh_destroy(accel *a)
 }
 
 static const accel_ops bvh_ops = {bvh_destroy, bvh_intersect, bvh_occluded, bvh_intersect_packet, NULL, NULL};
+#if PK_HAVE_AVX512_KERNELS
+static const accel_ops bvh_ops_avx512 = {bvh_destroy, bvh_intersect_avx512, bvh_occluded_avx512,
+                                         bvh_intersect_packet_avx512, NULL, NULL};
+#endif
+
+bool bvh_use_avx512(void)
+{
+#if PK_HAVE_AVX512_KERNELS
+    /* __builtin_cpu_supports also asks the OS (XCR0) whether it saves the
+     * AVX-512 state */
+    __builtin_cpu_init();
+    if (!(__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512cd") &&
+          __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq") &&
+          __builtin_cpu_supports("avx512vl")))
+        return false;
+    const char *isa = getenv("PAPRSEK_CPU_ISA");
+    return !(isa && strcmp(isa, "avx2") == 0);
+#else
+    return false;
+#endif
+}
 
 /* Nodes, triangle and sphere blocks in one block of memory; large ones start
  * on a 2 MiB boundary and ask for transparent huge pages, which saves TLB
@@ -998,6 +1019,10 @@ pk_status accel_bvh_create_costs(pk_context *ctx, const accel_input *in, const b
     }
 
     t->base.ops = &bvh_ops;
+    t->base.isa = "avx2";
+#if PK_HAVE_AVX512_KERNELS
+    if (bvh_use_avx512()) t->base.ops = &bvh_ops_avx512, t->base.isa = "avx512";
+#endif
     t->base.alloc = al;
     t->base.ntris = in->ntris;
     t->base.nspheres = in->nspheres;

@@ -346,7 +346,7 @@ static inline unsigned octant(const ray *r)
     return (signbit(r->d.x) ? 1u : 0u) | (signbit(r->d.y) ? 2u : 0u) | (signbit(r->d.z) ? 4u : 0u);
 }
 
-void bvh_intersect_packet(const accel *a, const ray *r, hit *h, size_t n, bool any_hit,
+void BVH_FN(bvh_intersect_packet)(const accel *a, const ray *r, hit *h, size_t n, bool any_hit,
                           accel_counters *c)
 {
     const bvh *t = (const bvh *)a;
@@ -358,8 +358,8 @@ void bvh_intersect_packet(const accel *a, const ray *r, hit *h, size_t n, bool a
         while (oct < 8 && m < PACKET && i + (size_t)m < n && octant(&r[i + (size_t)m]) == oct) m++;
         if (m < PACKET_MIN) {
             for (int k = 0; k < m; k++) {
-                if (any_hit) bvh_occluded(a, &r[i + (size_t)k], &h[i + (size_t)k], c);
-                else bvh_intersect(a, &r[i + (size_t)k], &h[i + (size_t)k], c);
+                if (any_hit) BVH_FN(bvh_occluded)(a, &r[i + (size_t)k], &h[i + (size_t)k], c);
+                else BVH_FN(bvh_intersect)(a, &r[i + (size_t)k], &h[i + (size_t)k], c);
             }
             i += (size_t)m;
             continue;

@@ -221,13 +221,13 @@ static bool intersect_plain(const bvh *t, const ray *r, hit *h)
     return traverse(t, r, h, NULL, false, false);
 }
 
-bool bvh_intersect(const accel *a, const ray *r, hit *h, accel_counters *c)
+bool BVH_FN(bvh_intersect)(const accel *a, const ray *r, hit *h, accel_counters *c)
 {
     const bvh *t = (const bvh *)a;
     return c ? intersect_counted(t, r, h, c) : intersect_plain(t, r, h);
 }
 
-bool bvh_occluded(const accel *a, const ray *r, hit *out, accel_counters *c)
+bool BVH_FN(bvh_occluded)(const accel *a, const ray *r, hit *out, accel_counters *c)
 {
     const bvh *t = (const bvh *)a;
     hit h;

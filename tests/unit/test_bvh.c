@@ -372,6 +372,13 @@ static accel *build(pk_context *ctx, const accel_input *in, const char *name)
     CHECKF(a->info.primitives == valid, "%s: %zu primitives in the tree, %zu valid", name, a->info.primitives, valid);
     CHECK(strcmp(a->info.name, "bvh") == 0);
     CHECK(a->info.nodes >= 1 && a->info.bytes > 0);
+    /* the kernels this run tests: AVX-512 where the CPU has them, unless
+     * PAPRSEK_CPU_ISA=avx2 (ctest runs this file both ways: test_bvh_avx2) */
+    const char *env = getenv("PAPRSEK_CPU_ISA");
+    const bool forced = env && strcmp(env, "avx2") == 0;
+    CHECKF(a->isa && strcmp(a->isa, bvh_use_avx512() ? "avx512" : "avx2") == 0, "%s: kernels %s", name,
+           a->isa ? a->isa : "(none)");
+    CHECK(!forced || strcmp(a->isa, "avx2") == 0);
     return a;
 }
 
@@ -457,6 +464,8 @@ static void check_file(pk_context *ctx, const char *rel, size_t nrays)
         pk_accel_info info;
         pk_accel_get_info(pa, &info);
         CHECK(strcmp(info.name, "bvh") == 0);
+        const char *isa = pk_accel_isa(pa);
+        CHECK(isa && strcmp(isa, bvh_use_avx512() ? "avx512" : "avx2") == 0);
         size_t nc;
         ray *cam = camera_rays(input_bounds(&in), 32, &nc);
         pk_hit *h1 = malloc(nc * sizeof *h1), *h2 = malloc(nc * sizeof *h2);
@@ -471,6 +480,10 @@ static void check_file(pk_context *ctx, const char *rel, size_t nrays)
         free(h1), free(h2), free(cam);
         pk_accel_destroy(pa);
     }
+    /* an accelerator without a choice of kernels has no ISA to report */
+    st = pk_accel_create(ctx, s, PK_ACCEL_NONE, 1, &pa);
+    CHECK(st == PK_OK && pa && pk_accel_isa(pa) == NULL);
+    pk_accel_destroy(pa);
     free(verts);
     free(sph);
     pk_scene_destroy(s);
@@ -861,6 +874,11 @@ int main(void)
 {
     pk_context *ctx = NULL;
     REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
+    const char *env = getenv("PAPRSEK_CPU_ISA");
+    printf("BVH kernels: %s%s\n", bvh_use_avx512() ? "avx512" : "avx2",
+           bvh_use_avx512() || (env && strcmp(env, "avx2") == 0)
+               ? ""
+               : " (this CPU or build has no AVX-512 kernels: only the AVX2 ones are tested)");
     double t0 = omp_get_wtime();
     check_synthetic(ctx);
     printf("synthetic cases: %.2f s\n", omp_get_wtime() - t0);
