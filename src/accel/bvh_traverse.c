@@ -77,7 +77,15 @@ static inline unsigned node_hits(uint32_t ref, const node_ray *r, float tcull, v
 }
 
 /* Tests leaf ref; closest: updates *best; any: true on the first hit. */
-static __attribute__((noinline)) bool leaf(const bvh *t, uint32_t ref, const bvh_ray *r, hit *best,
+/* The leaf test is a call in the AVX2 kernels and inlined in the AVX-512
+ * ones, where that measured 0-8 % faster (with 32 vector registers the node
+ * loop's values need not be saved around a call). */
+#ifdef BVH_AVX512
+#define LEAF_INLINE __attribute__((always_inline)) inline
+#else
+#define LEAF_INLINE __attribute__((noinline))
+#endif
+static LEAF_INLINE bool leaf(const bvh *t, uint32_t ref, const bvh_ray *r, hit *best,
                                                        uint64_t *tests, const bool any, const bool count)
 {
     const uint32_t nb = bvh_leaf_blocks(ref);
