@@ -232,35 +232,23 @@ typedef struct bvh_tri_ray {
 } bvh_tri_ray;
 
 typedef struct bvh_ray {
-    ray_pre pre;            /* geom.h's, for the sphere test */
+    ray_pre pre;            /* geom.h's, for the sphere test and the box test's 1/d */
     bvh_tri_ray tri;
-    float org[3];           /* origin, world space */
-    float rd[3];            /* 1/d per axis: +-inf for zero components */
-    float rdf[3];           /* rd * (1 + BVH_BOX_SLACK), for far planes */
-    int near[3], far[3];    /* box plane rows: 2*axis + (rd < 0), and the other */
-    float tmin;
 } bvh_ray;
 
+/* Written component by component (no arrays of three floats: the compiler
+ * would store them in pieces and reload them whole, which stalls store
+ * forwarding at the start of every ray). */
 static inline void bvh_ray_init(bvh_ray *br, const ray *r)
 {
     br->pre = ray_prepare(r);
-    const float o[3] = {r->o.x, r->o.y, r->o.z};
-    const float rd[3] = {br->pre.inv_d.x, br->pre.inv_d.y, br->pre.inv_d.z};
-    for (int k = 0; k < 3; k++) {
-        br->org[k] = o[k];
-        br->rd[k] = rd[k];
-        br->rdf[k] = rd[k] * (1.0f + BVH_BOX_SLACK);
-        int neg = signbit(rd[k]) ? 1 : 0;
-        br->near[k] = 2 * k + neg;
-        br->far[k] = 2 * k + 1 - neg;
-    }
-    br->tmin = r->tmin;
     bvh_tri_ray *t = &br->tri;
-    t->ox = o[br->pre.kx], t->oy = o[br->pre.ky], t->oz = o[br->pre.kz];
+    const int kx = br->pre.kx, ky = br->pre.ky, kz = br->pre.kz;
+    t->ox = v3_get(r->o, kx), t->oy = v3_get(r->o, ky), t->oz = v3_get(r->o, kz);
     t->sx = br->pre.sx, t->sy = br->pre.sy, t->sz = br->pre.sz;
     t->tmin = r->tmin;
     const uint32_t row = sizeof(float) * BVH_TRI_LANES;
-    t->rowx = (uint32_t)br->pre.kx * row, t->rowy = (uint32_t)br->pre.ky * row, t->rowz = (uint32_t)br->pre.kz * row;
+    t->rowx = (uint32_t)kx * row, t->rowy = (uint32_t)ky * row, t->rowz = (uint32_t)kz * row;
 }
 
 /* Lanes in zm have an edge function that is exactly 0: recompute U, V, W

@@ -43,18 +43,21 @@ typedef struct node_ray {
     const char *nx, *ny, *nz, *fx, *fy, *fz;
 } node_ray;
 
-static inline void node_ray_init(node_ray *nr, const bvh_ray *r, const bvh *t)
+static inline void node_ray_init(node_ray *nr, const ray *r, const ray_pre *pre, const bvh *t)
 {
-    nr->ox = VF_SET1(r->org[0]), nr->oy = VF_SET1(r->org[1]), nr->oz = VF_SET1(r->org[2]);
-    nr->rdx = VF_SET1(r->rd[0]), nr->rdy = VF_SET1(r->rd[1]), nr->rdz = VF_SET1(r->rd[2]);
-    nr->rfx = VF_SET1(r->rdf[0]), nr->rfy = VF_SET1(r->rdf[1]), nr->rfz = VF_SET1(r->rdf[2]);
+    const vec3 rd = pre->inv_d;
+    nr->ox = VF_SET1(r->o.x), nr->oy = VF_SET1(r->o.y), nr->oz = VF_SET1(r->o.z);
+    nr->rdx = VF_SET1(rd.x), nr->rdy = VF_SET1(rd.y), nr->rdz = VF_SET1(rd.z);
+    nr->rfx = VF_SET1(rd.x * (1.0f + BVH_BOX_SLACK)), nr->rfy = VF_SET1(rd.y * (1.0f + BVH_BOX_SLACK));
+    nr->rfz = VF_SET1(rd.z * (1.0f + BVH_BOX_SLACK));
     nr->tmin = VF_SET1(r->tmin);
+    /* the near plane of axis k is row 2k (lo) when 1/d >= 0, else 2k + 1 (hi) */
     const char *base = (const char *)t->nodes->b;
     const size_t row = sizeof(float) * BVH_WIDTH;
-    nr->nx = base + (size_t)r->near[0] * row, nr->ny = base + (size_t)r->near[1] * row;
-    nr->nz = base + (size_t)r->near[2] * row;
-    nr->fx = base + (size_t)r->far[0] * row, nr->fy = base + (size_t)r->far[1] * row;
-    nr->fz = base + (size_t)r->far[2] * row;
+    const size_t sx = signbit(rd.x) ? 1 : 0, sy = signbit(rd.y) ? 1 : 0, sz = signbit(rd.z) ? 1 : 0;
+    nr->nx = base + sx * row, nr->fx = base + (1 - sx) * row;
+    nr->ny = base + (2 + sy) * row, nr->fy = base + (3 - sy) * row;
+    nr->nz = base + (4 + sz) * row, nr->fz = base + (5 - sz) * row;
 }
 
 /* Mask of the slots of the node at ref whose box the segment [tmin, tcull]
@@ -128,7 +131,7 @@ static inline __attribute__((always_inline)) bool traverse(const bvh *t, const r
     bvh_ray r;
     bvh_ray_init(&r, rr);
     node_ray nr;
-    node_ray_init(&nr, &r, t);
+    node_ray_init(&nr, rr, &r.pre, t);
     hit best = {rr->tmax, PK_NO_HIT, 0.0f, 0.0f};
     float tcull = bvh_cull_limit(best.t);
     const char *const children = (const char *)t->nodes->child;
