@@ -16,5 +16,9 @@
 #if defined(__cplusplus) && !defined(_Static_assert)
 #define _Static_assert static_assert
 #endif
+/* and C11's alignment specifier */
+#if defined(__cplusplus) && !defined(_Alignas)
+#define _Alignas(n) alignas(n)
+#endif
 
 #endif

@@ -27,8 +27,12 @@ typedef struct path_tracer {
     const void *gpu_nodes, *gpu_tris;  /* in the GPU's copy only: the device BVH (bvh_gpu.h) */
 } path_tracer;
 
+/* One per worker thread, each on cache lines of its own (the renderer
+ * allocates them 64-byte aligned): the threads update their counters all
+ * the time, and entries sharing a line would make it bounce between cores. */
 typedef struct path_thread {
-    uint64_t rays_camera, rays_bounce, rays_shadow;
+    _Alignas(64) uint64_t rays_camera;
+    uint64_t rays_bounce, rays_shadow;
     accel_counters counters;
     accel_counters *cp;  /* &counters when statistics are on, else NULL */
 } path_thread;

@@ -103,6 +103,17 @@ static void warn_facing(pk_context *ctx, const pk_scene *s, const accel *a)
                  "material \"two_sided\": true in a JSON scene", s->name);
 }
 
+/* n zeroed entries of size bytes (a multiple of 64) starting on a cache
+ * line, so that no two threads' entries share one; free with
+ * mem_free_aligned. */
+static void *calloc_lines(const pk_allocator *al, size_t n, size_t size)
+{
+    if (n == 0 || size > SIZE_MAX / n) return NULL;
+    void *p = mem_alloc_aligned(al, n * size, 64);
+    if (p) memset(p, 0, n * size);
+    return p;
+}
+
 pk_status renderer_create(pk_context *ctx, const pk_scene *s, const pk_render_options *opt, const pk_camera *cam,
                           pk_renderer **out)
 {
@@ -122,8 +133,8 @@ pk_status renderer_create(pk_context *ctx, const pk_scene *s, const pk_render_op
     /* the ray cone of a pixel: its angle, which texture filtering widens with distance */
     const float spread = 2.0f * tanf(0.5f * cam->fov_deg * PK_PI / 180.0f) / (float)opt->height;
     r->w = (whitted){&r->fr, opt->light_samples, pk_render_options_max_depth(opt), opt->fresnel != 0, spread};
-    r->ts = mem_calloc(&ctx->alloc, (size_t)r->nt, sizeof *r->ts);
-    r->pts = mem_calloc(&ctx->alloc, (size_t)r->nt, sizeof *r->pts);
+    r->ts = calloc_lines(&ctx->alloc, (size_t)r->nt, sizeof *r->ts);
+    r->pts = calloc_lines(&ctx->alloc, (size_t)r->nt, sizeof *r->pts);
     if (!r->ts || !r->pts) {
         renderer_destroy(r);
         return ctx_nomem(ctx);
@@ -161,8 +172,8 @@ void renderer_destroy(pk_renderer *r)
     const pk_allocator *al = &r->ctx->alloc;
     if (r->ts)
         for (int t = 0; t < r->nt; t++) whitted_thread_free(al, &r->ts[t]);
-    mem_free(al, r->ts);
-    mem_free(al, r->pts);
+    mem_free_aligned(al, r->ts);
+    mem_free_aligned(al, r->pts);
     path_gpu_destroy(r->gpu);
     path_free(al, &r->pt);
     frame_free(al, &r->fr);

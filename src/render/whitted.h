@@ -29,8 +29,9 @@ typedef struct whitted {
 } whitted;
 
 /* Per-thread scratch, allocated once per renderer. */
+/* One per worker thread, on cache lines of its own (as path_thread). */
 typedef struct whitted_thread {
-    uint64_t rays[RAY_KINDS];
+    _Alignas(64) uint64_t rays[RAY_KINDS];
     accel_counters counters;
     accel_counters *cp;  /* &counters when statistics are on, else NULL */
     ray *shadow_rays;    /* light_samples + point lights entries */
