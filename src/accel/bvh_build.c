@@ -600,6 +600,7 @@ typedef struct collapser {
     size_t leaves;
     double sah;       /* sum of areas, normalised at the end */
     int depth;
+    float grow;       /* every slot's box grows by this much on each side (scene_grow) */
 } collapser;
 
 /* The primitives of binary subtree bi (at most BVH_LEAF_MAX references). */
@@ -678,9 +679,39 @@ static uint32_t make_leaf(collapser *c, uint32_t bi)
     return bvh_leaf_ref(false, first, nb);
 }
 
-static void set_slot_box(bvh_node *wn, int k, sbox box)
+/* How far every box of the tree reaches beyond its primitives, for a scene
+ * whose bounding box has diagonal diag: 2^-18 diag (4 mm in a 1 km scene).
+ * The triangle test's t is exact only up to rounding relative to the
+ * vertices' distances from the ray's origin, not to t: a large triangle hit
+ * near the origin can report a t below the entry distance of its own leaf's
+ * box, and the search, which skips boxes entered beyond the closest t so
+ * far, would then miss it where brute force finds it. The test's t is a
+ * weighted mean of the vertices' distances along the ray, each within a few
+ * ulps (2^-24 relative) of the vertices' distances from the origin, at most
+ * the diagonal (bounded here by the sum of the extents) for an origin in the
+ * scene; boxes this much larger contain
+ * every hit point the test can report. (Rays from farther away hit at
+ * distances comparable to their distance from the scene, which the relative
+ * BVH_BOX_SLACK covers.) */
+static float scene_grow(sbox root)
+{
+    const aabb a = sbox_aabb(root);
+    /* the sum of the extents bounds the diagonal without squaring (no overflow for huge scenes) */
+    const vec3 e = v3_sub(a.hi, a.lo);
+    const float d = e.x + e.y + e.z;
+    return d > 0.0f ? d * 0x1p-18f : 0.0f; /* an empty scene: 0 (NaN fails the test too) */
+}
+
+/* lo - g and hi + g, rounded outward (monotone in lo and hi, so that nested
+ * boxes stay nested) */
+static float grow_lo(float lo, float g) { return g > 0.0f ? nextafterf(lo - g, -INFINITY) : lo; }
+static float grow_hi(float hi, float g) { return g > 0.0f ? nextafterf(hi + g, INFINITY) : hi; }
+
+static void set_slot_box(bvh_node *wn, int k, sbox box, float g)
 {
     aabb a = sbox_aabb(box);
+    a.lo = v3(grow_lo(a.lo.x, g), grow_lo(a.lo.y, g), grow_lo(a.lo.z, g));
+    a.hi = v3(grow_hi(a.hi.x, g), grow_hi(a.hi.y, g), grow_hi(a.hi.z, g));
     wn->b[BVH_LO_X][k] = a.lo.x;
     wn->b[BVH_HI_X][k] = a.hi.x;
     wn->b[BVH_LO_Y][k] = a.lo.y;
@@ -806,7 +837,7 @@ static uint32_t collapse(collapser *c, const dp_entry *dp, uint32_t bi, int dept
                                                      : bvh_node_ref(collapse(c, dp, kids[q], depth + 1));
         bvh_node *wn = &c->nodes[wi]; /* index, not pointer, across recursion */
         wn->child[q] = ref;
-        set_slot_box(wn, q, x->box);
+        set_slot_box(wn, q, x->box, c->grow);
     }
     return wi;
 }
@@ -984,6 +1015,7 @@ pk_status accel_bvh_create_costs(pk_context *ctx, const accel_input *in, const b
     size_t binner_count = (b.nnodes - 1) / 2 + 1;
     c.b = &b;
     c.in = in;
+    c.grow = scene_grow(root);
     c.cap_nodes = binner_count + 1;
     c.nodes = mem_alloc_aligned(al, c.cap_nodes * sizeof(bvh_node), 64);
     c.tris = mem_alloc_aligned(al, (tblocks + 1) * sizeof(bvh_tri_block), 64);
@@ -1003,7 +1035,7 @@ pk_status accel_bvh_create_costs(pk_context *ctx, const accel_input *in, const b
             c.depth = 1;
             c.sah += (double)sbox_half_area(bnodes[0].box);
             c.nodes[0].child[0] = make_leaf(&c, 0);
-            set_slot_box(&c.nodes[0], 0, bnodes[0].box);
+            set_slot_box(&c.nodes[0], 0, bnodes[0].box, c.grow);
         } else {
             collapse(&c, dp, 0, 1);
         }

@@ -328,6 +328,42 @@ static ray *make_rays(rng *g, aabb box, const accel_input *in, size_t n)
     return rays;
 }
 
+/* Shadow rays: groups of 32 from one origin (inside the box grown by 20 %,
+ * or on a triangle) toward vertices, edge points and interior points of
+ * triangles, stopping short of the target or not, so that the packets of
+ * rays sharing their origin meet the watertight test's edge cases. */
+static ray *shadow_rays(rng *g, aabb box, const accel_input *in, size_t n)
+{
+    ray *rays = malloc(n * sizeof *rays);
+    REQUIRE(rays);
+    vec3 ext = aabb_extent(box);
+    aabb big = {v3_sub(box.lo, v3_scale(ext, 0.2f)), v3_add(box.hi, v3_scale(ext, 0.2f))};
+    vec3 o = box.lo;
+    for (size_t i = 0; i < n; i++) {
+        if (i % 32 == 0) {
+            if (in->ntris && (rng_u32(g) & 1)) {
+                const vec3 *p = in->verts + 3 * (rng_u32(g) % in->ntris);
+                o = v3_lerp(v3_lerp(p[0], p[1], rng_f(g)), p[2], 0.5f * rng_f(g));
+            } else {
+                o = v3(rng_range(g, big.lo.x, big.hi.x), rng_range(g, big.lo.y, big.hi.y),
+                       rng_range(g, big.lo.z, big.hi.z));
+            }
+        }
+        vec3 target = v3(rng_range(g, big.lo.x, big.hi.x), rng_range(g, big.lo.y, big.hi.y),
+                         rng_range(g, big.lo.z, big.hi.z));
+        if (in->ntris) {
+            const vec3 *p = in->verts + 3 * (rng_u32(g) % in->ntris);
+            uint32_t w = rng_u32(g) % 3;
+            target = w == 0 ? p[rng_u32(g) % 3] : w == 1 ? v3_lerp(p[0], p[1], rng_f(g))
+                                                       : v3_lerp(v3_lerp(p[0], p[1], rng_f(g)), p[2], 0.5f);
+        }
+        ray r = {o, 0.0f, v3_sub(target, o), (rng_u32(g) & 1) ? 1.0f - 1e-3f : INFINITY};
+        if (!(v3_len2(r.d) > 0.0f)) r.d = rng_dir(g);
+        rays[i] = r;
+    }
+    return rays;
+}
+
 /* Camera rays of a w x w image in 4x4 tiles (coherent, for the packets). */
 static ray *camera_rays(aabb box, int w, size_t *n_out)
 {
@@ -423,6 +459,9 @@ static void check_input(pk_context *ctx, const accel_input *in, size_t nrays, bo
     ray *rays = make_rays(&g, box, in, nrays);
     check_rays(a, &b, rays, nrays, name);
     free(rays);
+    ray *shadow = shadow_rays(&g, box, in, nrays / 4 + 32);
+    check_rays(a, &b, shadow, nrays / 4 + 32, name);
+    free(shadow);
     size_t nc;
     ray *cam = camera_rays(box, 64, &nc);
     check_rays(a, &b, cam, nc, name);
