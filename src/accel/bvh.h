@@ -269,8 +269,15 @@ static __attribute__((noinline, cold)) void bvh_tri_recompute(int zm, tvec ax, t
     *U = TV_LOADU(fu), *V = TV_LOADU(fv), *W = TV_LOADU(fw);
 }
 
-static inline int bvh_tri_test(const bvh_tri_block *blk, const bvh_tri_ray *r, float tmax, tvec *t_out,
-                               tvec *rcp_out, tvec *V_out, tvec *W_out)
+/* A vertex row of the block less the ray's origin component o; rel: the
+ * block holds vertices already less the origin (bvh_tri_block_rel), so the
+ * row is the difference. */
+#define BVH_TRI_ROW(base, row, o, rel) \
+    ((rel) ? TV_LOAD((const float *)((base) + (row))) : TV_SUB(TV_LOAD((const float *)((base) + (row))), (o)))
+
+static inline __attribute__((always_inline)) int bvh_tri_test_x(const bvh_tri_block *blk, const bvh_tri_ray *r,
+                                                                float tmax, tvec *t_out, tvec *rcp_out,
+                                                                tvec *V_out, tvec *W_out, const bool rel)
 {
     const char *va = (const char *)blk->v[0], *vb = (const char *)blk->v[1], *vc = (const char *)blk->v[2];
     const tvec ox = TV_SET1(r->ox), oy = TV_SET1(r->oy);
@@ -278,15 +285,15 @@ static inline int bvh_tri_test(const bvh_tri_block *blk, const bvh_tri_ray *r, f
     tvec ax, ay, bx, by, cx, cy;
     {
         const tvec oz = TV_SET1(r->oz);
-        const tvec az0 = TV_SUB(TV_LOAD((const float *)(va + r->rowz)), oz);
-        ax = TV_SUB(TV_SUB(TV_LOAD((const float *)(va + r->rowx)), ox), TV_MUL(sx, az0));
-        ay = TV_SUB(TV_SUB(TV_LOAD((const float *)(va + r->rowy)), oy), TV_MUL(sy, az0));
-        const tvec bz0 = TV_SUB(TV_LOAD((const float *)(vb + r->rowz)), oz);
-        bx = TV_SUB(TV_SUB(TV_LOAD((const float *)(vb + r->rowx)), ox), TV_MUL(sx, bz0));
-        by = TV_SUB(TV_SUB(TV_LOAD((const float *)(vb + r->rowy)), oy), TV_MUL(sy, bz0));
-        const tvec cz0 = TV_SUB(TV_LOAD((const float *)(vc + r->rowz)), oz);
-        cx = TV_SUB(TV_SUB(TV_LOAD((const float *)(vc + r->rowx)), ox), TV_MUL(sx, cz0));
-        cy = TV_SUB(TV_SUB(TV_LOAD((const float *)(vc + r->rowy)), oy), TV_MUL(sy, cz0));
+        const tvec az0 = BVH_TRI_ROW(va, r->rowz, oz, rel);
+        ax = TV_SUB(BVH_TRI_ROW(va, r->rowx, ox, rel), TV_MUL(sx, az0));
+        ay = TV_SUB(BVH_TRI_ROW(va, r->rowy, oy, rel), TV_MUL(sy, az0));
+        const tvec bz0 = BVH_TRI_ROW(vb, r->rowz, oz, rel);
+        bx = TV_SUB(BVH_TRI_ROW(vb, r->rowx, ox, rel), TV_MUL(sx, bz0));
+        by = TV_SUB(BVH_TRI_ROW(vb, r->rowy, oy, rel), TV_MUL(sy, bz0));
+        const tvec cz0 = BVH_TRI_ROW(vc, r->rowz, oz, rel);
+        cx = TV_SUB(BVH_TRI_ROW(vc, r->rowx, ox, rel), TV_MUL(sx, cz0));
+        cy = TV_SUB(BVH_TRI_ROW(vc, r->rowy, oy, rel), TV_MUL(sy, cz0));
     }
     tvec U = TV_SUB(TV_MUL(cx, by), TV_MUL(cy, bx));
     tvec V = TV_SUB(TV_MUL(ax, cy), TV_MUL(ay, cx));
@@ -303,9 +310,9 @@ static inline int bvh_tri_test(const bvh_tri_block *blk, const bvh_tri_ray *r, f
     if (!m) return 0;
     /* the z differences again (recomputed rather than kept: fewer live registers) */
     const tvec oz = TV_SET1(r->oz), sz = TV_SET1(r->sz);
-    const tvec az = TV_MUL(sz, TV_SUB(TV_LOAD((const float *)(va + r->rowz)), oz));
-    const tvec bz = TV_MUL(sz, TV_SUB(TV_LOAD((const float *)(vb + r->rowz)), oz));
-    const tvec cz = TV_MUL(sz, TV_SUB(TV_LOAD((const float *)(vc + r->rowz)), oz));
+    const tvec az = TV_MUL(sz, BVH_TRI_ROW(va, r->rowz, oz, rel));
+    const tvec bz = TV_MUL(sz, BVH_TRI_ROW(vb, r->rowz, oz, rel));
+    const tvec cz = TV_MUL(sz, BVH_TRI_ROW(vc, r->rowz, oz, rel));
     const tvec T = TV_ADD(TV_ADD(TV_MUL(U, az), TV_MUL(V, bz)), TV_MUL(W, cz));
     const tvec rcp = TV_DIV(TV_SET1(1.0f), det);
     const tvec t = TV_MUL(T, rcp);
@@ -318,11 +325,13 @@ static inline int bvh_tri_test(const bvh_tri_block *blk, const bvh_tri_ray *r, f
     return m;
 }
 
-/* Closest-hit update from one triangle block; true when *h changed. */
-static inline bool bvh_tri_closest(const bvh_tri_block *blk, const bvh_tri_ray *r, hit *h)
+/* Closest-hit update from one triangle block; true when *h changed. rel:
+ * blk's vertices are relative to the ray's origin (bvh_tri_block_rel). */
+static inline __attribute__((always_inline)) bool bvh_tri_closest_x(const bvh_tri_block *blk, const bvh_tri_ray *r,
+                                                                    hit *h, const bool rel)
 {
     tvec t, rcp, V, W;
-    int m = bvh_tri_test(blk, r, h->t, &t, &rcp, &V, &W);
+    int m = bvh_tri_test_x(blk, r, h->t, &t, &rcp, &V, &W, rel);
     if (!m) return false;
     float ft[BVH_TRI_LANES];
     TV_STOREU(ft, t);
@@ -345,11 +354,17 @@ static inline bool bvh_tri_closest(const bvh_tri_block *blk, const bvh_tri_ray *
     return true;
 }
 
+static inline bool bvh_tri_closest(const bvh_tri_block *blk, const bvh_tri_ray *r, hit *h)
+{
+    return bvh_tri_closest_x(blk, r, h, false);
+}
+
 /* Any-hit: true (with h->t, h->prim of one hit) when a lane hits. */
-static inline bool bvh_tri_any(const bvh_tri_block *blk, const bvh_tri_ray *r, hit *h)
+static inline __attribute__((always_inline)) bool bvh_tri_any_x(const bvh_tri_block *blk, const bvh_tri_ray *r,
+                                                                hit *h, const bool rel)
 {
     tvec t, rcp, V, W;
-    int m = bvh_tri_test(blk, r, h->t, &t, &rcp, &V, &W);
+    int m = bvh_tri_test_x(blk, r, h->t, &t, &rcp, &V, &W, rel);
     if (!m) return false;
     float ft[BVH_TRI_LANES];
     TV_STOREU(ft, t);
@@ -357,6 +372,22 @@ static inline bool bvh_tri_any(const bvh_tri_block *blk, const bvh_tri_ray *r, h
     h->t = ft[l];
     h->prim = blk->prim[l];
     return true;
+}
+
+static inline bool bvh_tri_any(const bvh_tri_block *blk, const bvh_tri_ray *r, hit *h)
+{
+    return bvh_tri_any_x(blk, r, h, false);
+}
+
+/* *out = blk with every vertex less the origin o (as the test subtracts it:
+ * the same differences, so a test on out with rel = true gives the same
+ * hits as on blk), for rays that share o. */
+static inline void bvh_tri_block_rel(const bvh_tri_block *blk, float ox, float oy, float oz, bvh_tri_block *out)
+{
+    const tvec o[3] = {TV_SET1(ox), TV_SET1(oy), TV_SET1(oz)};
+    for (int v = 0; v < 3; v++)
+        for (int k = 0; k < 3; k++) TV_STOREU(out->v[v][k], TV_SUB(TV_LOAD(blk->v[v][k]), o[k]));
+    memcpy(out->prim, blk->prim, sizeof out->prim);
 }
 
 static inline bool bvh_sphere_block_closest(const bvh_sphere_block *blk, const ray_pre *r, hit *h)

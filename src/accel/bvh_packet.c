@@ -24,6 +24,7 @@ typedef struct packet {
     const ray *rays;
     int n;
     uint32_t live;                 /* rays still traced (any-hit drops the occluded) */
+    bool shared;                   /* every ray starts at the same point (shadow rays from one point) */
     int near[3], far[3];           /* box plane rows, shared by every ray */
     /* per ray, SoA: the box test's origin and 1/d, and tri_intersect's constants */
     _Alignas(32) float ox[PACKET], oy[PACKET], oz[PACKET];
@@ -221,6 +222,11 @@ static void packet_init(packet *p, const ray *r, int n, unsigned oct)
         p->rflo[k] = _mm256_set1_ps(hmin8(fmin[k])), p->rfhi[k] = _mm256_set1_ps(hmax8(fmax[k]));
     }
     p->tmin_lo = _mm256_set1_ps(hmin8(tmin));
+    /* the origin bounds are one point: the same bits (not merely ==, which
+     * would take -0 for 0) in every ray */
+    p->shared = true;
+    for (int i = 1; i < n && p->shared; i++)
+        p->shared = memcmp(&r[i].o, &r[0].o, sizeof r[0].o) == 0;
     for (int i = 0; i < n; i++) p->best[i] = (hit){r[i].tmax, PK_NO_HIT, 0.0f, 0.0f};
 }
 
@@ -231,12 +237,48 @@ static inline float packet_tcull(const packet *p)
     return m;
 }
 
+/* The rays in mask of a packet whose rays share their origin against the
+ * triangle leaf at off with nb blocks: each block is translated to the
+ * origin once, and each ray's test skips its subtractions (the same
+ * differences, the same hits). Each ray meets the blocks in order, as in
+ * packet_leaf. */
+static inline void packet_leaf_shared(const bvh *t, packet *p, size_t off, uint32_t nb, uint32_t mask, bool any,
+                                      uint64_t *tests, const bool count)
+{
+    const bvh_tri_block *tb = (const bvh_tri_block *)((const char *)t->tris + off);
+    _Alignas(64) bvh_tri_block rel;
+    uint32_t found = 0;
+    for (uint32_t b = 0; b < nb && mask; b++) {
+        bvh_tri_block_rel(tb + b, p->ox[0], p->oy[0], p->oz[0], &rel);
+        if (count) *tests += (uint64_t)bvh_tri_block_count(&rel) * (uint64_t)__builtin_popcount(mask);
+        for (uint32_t m = mask; m; m &= m - 1) {
+            const int i = __builtin_ctz(m);
+            const bvh_tri_ray tr = {0.0f, 0.0f, 0.0f, p->tsx[i], p->tsy[i], p->tsz[i],
+                                    p->tmin[i], p->rowx[i], p->rowy[i], p->rowz[i]};
+            if (any) {
+                if (bvh_tri_any_x(&rel, &tr, &p->best[i], true)) found |= 1u << i, mask &= ~(1u << i);
+            } else if (bvh_tri_closest_x(&rel, &tr, &p->best[i], true)) {
+                found |= 1u << i;
+            }
+        }
+    }
+    for (; found; found &= found - 1) {
+        const int i = __builtin_ctz(found);
+        if (any) p->live &= ~(1u << i);
+        else p->tcull[i] = bvh_cull_limit(p->best[i].t);
+    }
+}
+
 /* Tests the rays in mask against leaf ref. */
 static inline void packet_leaf(const bvh *t, packet *p, uint32_t ref, uint32_t mask, bool any,
                                uint64_t *tests, const bool count)
 {
     const uint32_t nb = bvh_leaf_blocks(ref);
     const size_t off = bvh_ref_offset(ref);
+    if (p->shared && !(ref & BVH_SPHERE_LEAF)) {
+        packet_leaf_shared(t, p, off, nb, mask, any, tests, count);
+        return;
+    }
     for (; mask; mask &= mask - 1) {
         const int i = __builtin_ctz(mask);
         hit *h = &p->best[i];
