@@ -23,10 +23,16 @@ cornell=$shared/scenes/cornell
 "$bin" render --accel embree --width 8 --height 8 -o "$out/probe.png" >/dev/null 2>&1 ||
     die "this build has no Embree (--accel embree)"
 
-# name | scene | options
+# name | scene | options: both integrators on CornellBox-Sphere, CornellBox-Original
+# (the standard camera) and Sponza with an area light; Whitted at 1 sample
+# per pixel and 32 light samples, the path tracer at 4 (Sponza: 2)
 cases() {
     local cam="--look-from 0,1,3.9 --look-at 0,1,0 --fov 39.3"
-    echo "whitted-cornell-sphere|$cornell/CornellBox-Sphere.obj|--integrator whitted --light-samples 32 --spp 1 $cam"
+    local whitted="--integrator whitted --light-samples 32 --spp 1"
+    echo "whitted-cornell-sphere|$cornell/CornellBox-Sphere.obj|$whitted $cam"
+    echo "whitted-cornell-original|$cornell/CornellBox-Original.obj|$whitted $cam"
+    echo "whitted-sponza-area-light|$here/sponza-area-light.json|$whitted"
+    echo "path-cornell-sphere|$cornell/CornellBox-Sphere.obj|--integrator path --spp 4 $cam"
     echo "path-cornell-original|$cornell/CornellBox-Original.obj|--integrator path --spp 4 $cam"
     echo "path-sponza-area-light|$here/sponza-area-light.json|--integrator path --spp 2"
 }

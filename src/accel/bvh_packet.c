@@ -230,11 +230,19 @@ static void packet_init(packet *p, const ray *r, int n, unsigned oct)
     for (int i = 0; i < n; i++) p->best[i] = (hit){r[i].tmax, PK_NO_HIT, 0.0f, 0.0f};
 }
 
+/* The largest tcull of the live rays (-inf when none is live): eight lanes
+ * at a time, the dead ones masked to -inf. */
 static inline float packet_tcull(const packet *p)
 {
-    float m = -INFINITY;
-    for (uint32_t live = p->live; live; live &= live - 1) m = fmax2(m, p->tcull[__builtin_ctz(live)]);
-    return m;
+    const __m256i bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+    const __m256 ninf = _mm256_set1_ps(-INFINITY);
+    __m256 m = ninf;
+    for (int g = 0; g < GROUPS; g++) {
+        const __m256i lm = _mm256_set1_epi32((int)((p->live >> (8 * g)) & 0xFFu));
+        const __m256 on = _mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(lm, bits), bits));
+        m = _mm256_max_ps(m, _mm256_blendv_ps(ninf, _mm256_load_ps(p->tcull + 8 * g), on));
+    }
+    return hmax8(m);
 }
 
 /* The rays in mask of a packet whose rays share their origin against the
