@@ -35,13 +35,20 @@ typedef __m128 vfloat;
 #error "BVH_WIDTH must be 4 or 8"
 #endif
 
-/* The ray as the node test wants it: broadcast origin and 1/d, and
- * pointers to the near and far plane rows of node 0 (the rows are chosen by
- * the sign of 1/d), so that a node's rows are these plus its reference. */
+/* The ray as the node test wants it: broadcast origin and 1/d, the address
+ * of node 0's box rows, and per axis the byte offset within a node of the
+ * near plane's row (row 2k when 1/d >= 0, else 2k + 1); the far row is the
+ * other one of the pair, at the offset with bit 5 flipped (rows are 32
+ * bytes). Three offsets instead of six row pointers leave the node loop
+ * fewer registers to spill. */
 typedef struct node_ray {
     vfloat ox, oy, oz, rdx, rdy, rdz, rfx, rfy, rfz, tmin;
-    const char *nx, *ny, *nz, *fx, *fy, *fz;
+    const char *rows;
+    size_t nx, ny, nz;
 } node_ray;
+
+#define ROW_BYTES (sizeof(float) * BVH_WIDTH)
+_Static_assert(ROW_BYTES == 32 || ROW_BYTES == 16, "the far row's offset flips one bit");
 
 static inline void node_ray_init(node_ray *nr, const ray *r, const ray_pre *pre, const bvh *t)
 {
@@ -51,13 +58,10 @@ static inline void node_ray_init(node_ray *nr, const ray *r, const ray_pre *pre,
     nr->rfx = VF_SET1(rd.x * (1.0f + BVH_BOX_SLACK)), nr->rfy = VF_SET1(rd.y * (1.0f + BVH_BOX_SLACK));
     nr->rfz = VF_SET1(rd.z * (1.0f + BVH_BOX_SLACK));
     nr->tmin = VF_SET1(r->tmin);
-    /* the near plane of axis k is row 2k (lo) when 1/d >= 0, else 2k + 1 (hi) */
-    const char *base = (const char *)t->nodes->b;
-    const size_t row = sizeof(float) * BVH_WIDTH;
-    const size_t sx = signbit(rd.x) ? 1 : 0, sy = signbit(rd.y) ? 1 : 0, sz = signbit(rd.z) ? 1 : 0;
-    nr->nx = base + sx * row, nr->fx = base + (1 - sx) * row;
-    nr->ny = base + (2 + sy) * row, nr->fy = base + (3 - sy) * row;
-    nr->nz = base + (4 + sz) * row, nr->fz = base + (5 - sz) * row;
+    nr->rows = (const char *)t->nodes->b;
+    nr->nx = (size_t)(0 + (signbit(rd.x) ? 1 : 0)) * ROW_BYTES;
+    nr->ny = (size_t)(2 + (signbit(rd.y) ? 1 : 0)) * ROW_BYTES;
+    nr->nz = (size_t)(4 + (signbit(rd.z) ? 1 : 0)) * ROW_BYTES;
 }
 
 /* Mask of the slots of the node at ref whose box the segment [tmin, tcull]
@@ -67,12 +71,15 @@ static inline void node_ray_init(node_ray *nr, const ray *r, const ray_pre *pre,
  * limit the segment. */
 static inline unsigned node_hits(uint32_t ref, const node_ray *r, float tcull, vfloat *tn)
 {
-    const vfloat tnx = VF_MUL(VF_SUB(VF_LOAD((const float *)(r->nx + ref)), r->ox), r->rdx);
-    const vfloat tny = VF_MUL(VF_SUB(VF_LOAD((const float *)(r->ny + ref)), r->oy), r->rdy);
-    const vfloat tnz = VF_MUL(VF_SUB(VF_LOAD((const float *)(r->nz + ref)), r->oz), r->rdz);
-    const vfloat tfx = VF_MUL(VF_SUB(VF_LOAD((const float *)(r->fx + ref)), r->ox), r->rfx);
-    const vfloat tfy = VF_MUL(VF_SUB(VF_LOAD((const float *)(r->fy + ref)), r->oy), r->rfy);
-    const vfloat tfz = VF_MUL(VF_SUB(VF_LOAD((const float *)(r->fz + ref)), r->oz), r->rfz);
+    const char *p = r->rows + ref;
+#define NODE_ROW(off) VF_LOAD((const float *)(p + (off)))
+    const vfloat tnx = VF_MUL(VF_SUB(NODE_ROW(r->nx), r->ox), r->rdx);
+    const vfloat tny = VF_MUL(VF_SUB(NODE_ROW(r->ny), r->oy), r->rdy);
+    const vfloat tnz = VF_MUL(VF_SUB(NODE_ROW(r->nz), r->oz), r->rdz);
+    const vfloat tfx = VF_MUL(VF_SUB(NODE_ROW(r->nx ^ ROW_BYTES), r->ox), r->rfx);
+    const vfloat tfy = VF_MUL(VF_SUB(NODE_ROW(r->ny ^ ROW_BYTES), r->oy), r->rfy);
+    const vfloat tfz = VF_MUL(VF_SUB(NODE_ROW(r->nz ^ ROW_BYTES), r->oz), r->rfz);
+#undef NODE_ROW
     const vfloat near = VF_MAX(tnx, VF_MAX(tny, VF_MAX(tnz, r->tmin)));
     const vfloat far = VF_MIN(tfx, VF_MIN(tfy, VF_MIN(tfz, VF_SET1(tcull))));
     *tn = near;
