@@ -74,7 +74,7 @@ const cli_option *cli_render_options(size_t *n)
             add(o);
         }
         add((cli_option){.name = "accel", .id = OPT_ACCEL, .kind = CLI_STRING, .arg = "NAME",
-                         .help = "the acceleration structure: bvh (default: binned SAH, wide SIMD BVH), midpoint "
+                         .help = "the acceleration structure: bvh (default: binned SAH, wide SIMD BVH, AVX-512 where the CPU has it), midpoint "
                                  "(simple BVH, for comparison), none (every ray tests every primitive), embree "
                                  "(Embree 3, when built with it); all give the same image; cuda: render on the "
                                  "GPU (as --device cuda)"});
