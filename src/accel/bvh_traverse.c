@@ -160,19 +160,31 @@ static inline __attribute__((always_inline)) bool traverse(const bvh *t, const r
                 ref = child[k0];
                 continue;
             }
-            if (any) {
-                /* occlusion: any hit ends the search, so the order of the
-                 * children matters less than the cost of sorting them */
-                ref = child[k0];
-                do {
-                    unsigned k = (unsigned)__builtin_ctz(mask);
-                    mask &= mask - 1;
-                    *sp++ = (stack_entry){child[k], -INFINITY};
-                } while (mask);
-                continue;
-            }
             _Alignas(32) float tn[BVH_WIDTH];
             VF_STORE(tn, tnv);
+            if (any) {
+                /* occlusion: any hit ends the search. The farthest child
+                 * first: a ray that starts on a surface leaves the boxes
+                 * around its origin without a hit, and whatever blocks it
+                 * lies beyond; the others are pushed unsorted (sorting
+                 * costs more than it saves) */
+                unsigned kf = k0;
+                float tf = tn[k0];
+                do {
+                    const unsigned k = (unsigned)__builtin_ctz(mask);
+                    mask &= mask - 1;
+                    const float tk = tn[k];
+                    const bool farther = tk > tf;
+                    /* push the nearer of the two, keep the farther (no branch) */
+                    sp->ref = child[farther ? kf : k];
+                    sp->t = -INFINITY;
+                    sp++;
+                    kf = farther ? k : kf;
+                    tf = farther ? tk : tf;
+                } while (mask);
+                ref = child[kf];
+                continue;
+            }
             unsigned k1 = (unsigned)__builtin_ctz(mask);
             mask &= mask - 1;
             if (!mask) {
