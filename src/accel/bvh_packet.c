@@ -96,7 +96,6 @@ static inline uint32_t rays_hit_slot(const bvh_node *n, int s, const packet *p, 
 }
 
 /* No NaN reaches these (octant keeps such rays out of packets). */
-static inline float fmax2(float a, float b) { return b > a ? b : a; }
 static inline float hmin8(__m256 v)
 {
     __m128 a = _mm_min_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));

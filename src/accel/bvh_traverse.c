@@ -1,8 +1,9 @@
 /*
  * bvh_traverse.c - single-ray traversal of the wide BVH: all children's
  * boxes tested at once (robust slab test), hit children visited near to far
- * from a fixed-size stack, leaves tested with the SIMD watertight test that
- * is bit-identical to geom.h's. Counting is compiled in only where asked.
+ * (any-hit: the farthest first) from a fixed-size stack, leaves tested with
+ * the SIMD watertight test that is bit-identical to geom.h's. Counting is
+ * compiled in only where asked. Compiled twice, for AVX2 and AVX-512 (bvh.h).
  */
 #include "bvh.h"
 
