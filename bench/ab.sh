@@ -13,6 +13,7 @@
 # The ray files are bench/run.sh's (bench/out/WORKLOAD-KIND-SIZE.rays): run it once first.
 set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+# shellcheck disable=SC2034 # read by workloads.sh
 shared=${SHARED:-$here/../../shared}
 die() { echo "ab.sh: $*" >&2; exit 1; }
 # shellcheck source=workloads.sh
