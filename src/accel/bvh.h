@@ -300,7 +300,13 @@ static inline __attribute__((always_inline)) int bvh_tri_test_x(const bvh_tri_bl
     tvec W = TV_SUB(TV_MUL(bx, ay), TV_MUL(by, ax));
     const tvec zero = TV_ZERO();
     const int zm = TV_MASK(TV_OR(TV_OR(TV_EQ(U, zero), TV_EQ(V, zero)), TV_EQ(W, zero)));
-    if (PK_UNLIKELY(zm)) bvh_tri_recompute(zm, ax, ay, bx, by, cx, cy, &U, &V, &W);
+    if (PK_UNLIKELY(zm)) {
+        /* copies, so that only they have their address taken: U, V and W
+         * can then stay in registers on the common path */
+        tvec u = U, v = V, w = W;
+        bvh_tri_recompute(zm, ax, ay, bx, by, cx, cy, &u, &v, &w);
+        U = u, V = v, W = w;
+    }
     /* reject mixed signs; a lane with a NaN edge function fails below
      * anyway (det and t are NaN), so min/max may drop NaNs here */
     const tvec neg = TV_LT(TV_MIN(TV_MIN(U, V), W), zero);
