@@ -8,7 +8,7 @@
 
 #include "accel/accel.h"
 #include "image/image.h"
-#include "io/image.h"
+#include "image/image_write.h"
 #include "render/render.h"
 #include "scene/camera.h"
 #include "scene/scene.h"

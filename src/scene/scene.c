@@ -5,7 +5,7 @@
  */
 #include "scene.h"
 
-#include "../io/image_read.h"
+#include "../image/image_read.h"
 
 #include <stdio.h>
 #include <string.h>

@@ -5,8 +5,8 @@
  */
 #include "texture.h"
 
-#include "../io/image.h"
-#include "../io/image_read.h"
+#include "../image/image_write.h"
+#include "../image/image_read.h"
 #include "scene.h"
 
 #include <math.h>

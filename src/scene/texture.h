@@ -15,7 +15,7 @@
 #define PK_TEXTURE_H
 
 #include "../math/vec3.h"
-#include "../io/srgb_table.h"
+#include "../image/srgb_table.h"
 #include "../paprsek_internal.h"
 
 #include <math.h>

@@ -5,7 +5,7 @@
  * finite, and lookups stay finite. */
 #include "fuzz.h"
 
-#include "io/image_read.h"
+#include "image/image_read.h"
 #include "scene/texture.h"
 
 #include <math.h>

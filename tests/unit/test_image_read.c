@@ -11,8 +11,8 @@
 #include "test.h"
 
 #include "paprsek.h"
-#include "io/image.h"
-#include "io/image_read.h"
+#include "image/image_write.h"
+#include "image/image_read.h"
 
 #include <fcntl.h>
 #include <jpeglib.h>

@@ -12,7 +12,7 @@
 #include "test.h"
 
 #include "paprsek.h"
-#include "io/image.h"
+#include "image/image_write.h"
 
 #include <dirent.h>
 #include <fcntl.h>

@@ -11,7 +11,7 @@
 #include "test.h"
 
 #include "paprsek.h"
-#include "io/image_read.h"
+#include "image/image_read.h"
 #include "render/frame.h"
 #include "render/surface.h"
 #include "scene/scene.h"

@@ -1,12 +1,12 @@
 /*
- * image.h - image writers (PNG 8-bit sRGB, PFM linear float, OpenEXR linear
+ * image_write.h - image writers (PNG 8-bit sRGB, PFM linear float, OpenEXR linear
  * float). Every writer writes to a temporary file in the target's folder and
  * renames it into place.
  */
-#ifndef PK_IMAGE_H
-#define PK_IMAGE_H
+#ifndef PK_IMAGE_WRITE_H
+#define PK_IMAGE_WRITE_H
 
-#include "../image/image.h"
+#include "image.h"
 
 /* Writes img by the extension of path (.png, .pfm, .exr) with the default
  * options. */

@@ -14,7 +14,7 @@
  * or removes files itself; its messages come back through an error callback
  * instead of being printed.
  */
-#include "image.h"
+#include "image_write.h"
 
 #include <errno.h>
 #include <limits.h>

@@ -4,7 +4,7 @@
  * writes to a temporary file beside the target and renames it into place,
  * so an existing image is only ever replaced by a complete one.
  */
-#include "image.h"
+#include "image_write.h"
 
 #include <errno.h>
 #include <math.h>
