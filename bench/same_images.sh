@@ -63,7 +63,7 @@ render() { # bin dir name scene integrator options...
     # shellcheck disable=SC2086
     "$bin" "${args[@]}" -o "$dir/$name.$integ.pfm" --width "$size" --height "$size" \
         --spp "$spp" --threads "$threads" --integrator "$integ" \
-        --aov albedo,normal,depth -q "$@" $extra >"$dir/$name.$integ.log" 2>&1
+        --aov albedo,normal,depth,heatmap -q "$@" $extra >"$dir/$name.$integ.log" 2>&1
     echo "exit $?" >>"$dir/$name.$integ.log"
 }
 

@@ -24,13 +24,55 @@ pk_status path_init(pk_context *ctx, path_tracer *pt, const frame *f, const pk_r
 
 void path_free(const pk_allocator *al, path_tracer *pt) { light_set_free(al, &pt->lights); }
 
-ray path_camera(const path_tracer *pt, const camera_frame *cf, int px, int py, uint32_t index)
+/* ---- the integrator interface (integrator.h) ------------------------------------ */
+
+static pk_status ig_init(pk_context *ctx, void *self, const frame *f, const pk_render_options *opt)
 {
-    return path_camera_ray(pt, cf, px, py, index);
+    return path_init(ctx, self, f, opt);
 }
 
-bool path_sample(const path_tracer *pt, path_thread *t, int px, int py, uint32_t index, const ray *r, const hit *h,
-                 vec3 *out)
+static void ig_free(const pk_allocator *al, void *self) { path_free(al, self); }
+
+static pk_status ig_thread_init(pk_context *ctx, const void *self, void *ts, bool stats)
 {
-    return path_camera_sample(pt, t, px, py, index, r, h, out);
+    (void)ctx, (void)self;
+    path_thread *t = ts;
+    memset(t, 0, sizeof *t);
+    t->cp = stats ? &t->counters : NULL;
+    return PK_OK;
 }
+
+static void ig_thread_free(const pk_allocator *al, void *ts) { (void)al, (void)ts; }
+
+static void ig_set_camera(void *self, const camera_frame *cf) { ((path_tracer *)self)->spread = cf->spread; }
+
+static camera_sample ig_camera_sample(const void *self, int px, int py, uint64_t index, int smp, int spp)
+{
+    (void)smp, (void)spp;
+    return path_camera_place(self, px, py, (uint32_t)index); /* the sampler's indices wrap at 2^32 */
+}
+
+static bool ig_sample(const void *self, void *ts, int px, int py, uint64_t index, const ray *r, const hit *h, vec3 *L,
+                      aov_sample *aov)
+{
+    return path_camera_sample_aov(self, ts, px, py, (uint32_t)index, r, h, L, aov);
+}
+
+static void ig_take_counters(void *ts, pk_stats *st)
+{
+    path_thread *t = ts;
+    st->rays_camera += t->rays_camera;
+    st->rays_bounce += t->rays_bounce;
+    st->rays_shadow += t->rays_shadow;
+    st->intersection_tests += t->counters.tests;
+    st->nodes_visited += t->counters.nodes;
+    t->rays_camera = t->rays_bounce = t->rays_shadow = 0;
+    t->counters = (accel_counters){0, 0};
+}
+
+_Static_assert(sizeof(path_thread) % 64 == 0, "path_thread: whole cache lines");
+
+const integrator_ops integrator_path = {
+    "path", sizeof(path_tracer), sizeof(path_thread), ig_init, ig_free, ig_thread_init, ig_thread_free,
+    ig_set_camera, ig_camera_sample, ig_sample, ig_take_counters,
+};

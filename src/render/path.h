@@ -31,21 +31,15 @@ typedef struct path_tracer {
  * allocates them 64-byte aligned): the threads update their counters all
  * the time, and entries sharing a line would make it bounce between cores. */
 typedef struct path_thread {
-    _Alignas(64) uint64_t rays_camera;
+    _Alignas(64) uint64_t rays_camera; /* the GPU's count; on the CPU the renderer counts camera rays */
     uint64_t rays_bounce, rays_shadow;
     accel_counters counters;
     accel_counters *cp;  /* &counters when statistics are on, else NULL */
 } path_thread;
 
+/* The path tracer's integrator (integrator.h) is integrator_path; its self
+ * is a path_tracer, its thread state a path_thread. */
 PK_HIDDEN pk_status path_init(pk_context *ctx, path_tracer *pt, const frame *f, const pk_render_options *opt);
 PK_HIDDEN void path_free(const pk_allocator *al, path_tracer *pt);
-/* The camera ray of sample index (counted over all passes) of pixel
- * (px, py), placed in the pixel by the sampler's first two dimensions. */
-PK_HIDDEN ray path_camera(const path_tracer *pt, const camera_frame *cf, int px, int py, uint32_t index);
-/* The radiance that sample arrives with along its camera ray r (path_camera's),
- * whose closest hit is *h, or NULL when it missed (the surroundings).
- * False for a lost sample (not finite), to be left out. */
-PK_HIDDEN bool path_sample(const path_tracer *pt, path_thread *t, int px, int py, uint32_t index, const ray *r,
-                           const hit *h, vec3 *out);
 
 #endif

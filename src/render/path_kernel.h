@@ -27,6 +27,7 @@
 
 #include "../math/frame.h"
 #include "camera.h"
+#include "integrator.h"
 #include "path.h"
 #include "pbsdf.h"
 #include "sampler.h"
@@ -351,7 +352,7 @@ static inline PK_HD void path_begin(path_state *ps, const ray *r, const hit *h, 
  * then the next direction and its closest hit. False when the path has
  * ended (ps->L is then its radiance). The CPU loops over it per sample; GPU
  * threads that start a new path as soon as one ends run the same steps. */
-static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_state *ps)
+static inline PK_HD bool path_step_aov(const path_tracer *pt, path_thread *t, path_state *ps, aov_sample *aov)
 {
     const frame *fr = pt->f;
     const pk_scene *s = fr->s;
@@ -366,6 +367,7 @@ static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_s
         ps->cone += pt->spread * ps->h.t * v3_len(ps->r.d);
         if (sf.m->textured) sf = surface_texture(s, &ps->r, &ps->h, ps->cone, sf, &textured);
     }
+    if (aov && ps->depth == 0) aov_from_surface(&sf, &ps->r, &ps->h, aov);
     const vec3 wo = v3_neg(v3_norm(ps->r.d));
     /* emission reached by the path */
     vec3 le = emitted(&sf);
@@ -437,16 +439,29 @@ static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_s
     return true;
 }
 
+static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_state *ps)
+{
+    return path_step_aov(pt, t, ps, NULL);
+}
+
 /* ---- camera samples -------------------------------------------------------------- */
 
-/* The camera ray of sample index of pixel (px, py): the sampler's first two
- * dimensions place it in the pixel. */
-static inline PK_HD ray path_camera_ray(const path_tracer *pt, const camera_frame *cf, int px, int py, uint32_t index)
+/* Where sample index of pixel (px, py) lies: the sampler's film dimensions
+ * place it in the pixel. */
+static inline PK_HD camera_sample path_camera_place(const path_tracer *pt, int px, int py, uint32_t index)
 {
     sampler sm = sampler_start((uint32_t)px, (uint32_t)py, index, pt->seed);
     float jx, jy;
-    sampler_2d(&sm, &jx, &jy);
-    return camera_ray(cf, (float)px + jx, (float)py + jy);
+    sampler_2d(&sm, &jx, &jy); /* SAMPLER_DIM_FILM */
+    const camera_sample cs = {(float)px + jx, (float)py + jy, 0.5f, 0.5f};
+    return cs;
+}
+
+/* The camera ray of sample index of pixel (px, py). */
+static inline PK_HD ray path_camera_ray(const path_tracer *pt, const camera_frame *cf, int px, int py, uint32_t index)
+{
+    const camera_sample cs = path_camera_place(pt, px, py, index);
+    return camera_ray(cf, &cs);
 }
 
 /* Starts sample index of pixel (px, py) along its camera ray r, whose
@@ -460,7 +475,7 @@ static inline PK_HD bool path_start(const path_tracer *pt, int px, int py, uint3
         return false;
     }
     sampler sm = sampler_start((uint32_t)px, (uint32_t)py, index, pt->seed);
-    sm.dim = 2; /* the pixel position */
+    sm.dim = SAMPLER_DIM_PATH(false); /* past the camera's dimensions (a pinhole: the film's) */
     path_begin(ps, r, h, &sm);
     return true;
 }
@@ -476,14 +491,22 @@ static inline PK_HD bool path_result(const path_state *ps, vec3 *out)
 
 /* What sample index of pixel (px, py) sees along its camera ray r (path_start's
  * arguments); false for a lost sample. */
-static inline PK_HD bool path_camera_sample(const path_tracer *pt, path_thread *t, int px, int py, uint32_t index,
-                                            const ray *r, const hit *h, vec3 *out)
+static inline PK_HD bool path_camera_sample_aov(const path_tracer *pt, path_thread *t, int px, int py,
+                                                uint32_t index, const ray *r, const hit *h, vec3 *out,
+                                                aov_sample *aov)
 {
     path_state ps;
     if (!path_start(pt, px, py, index, r, h, &ps, out)) return true;
-    while (path_step(pt, t, &ps)) {
-    }
+    if (path_step_aov(pt, t, &ps, aov))
+        while (path_step(pt, t, &ps)) {
+        }
     return path_result(&ps, out);
+}
+
+static inline PK_HD bool path_camera_sample(const path_tracer *pt, path_thread *t, int px, int py, uint32_t index,
+                                            const ray *r, const hit *h, vec3 *out)
+{
+    return path_camera_sample_aov(pt, t, px, py, index, r, h, out, NULL);
 }
 
 #endif

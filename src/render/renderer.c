@@ -1,9 +1,10 @@
 /*
  * renderer.c - render sessions: the frame is built once; each render splits
  * its regions into 16x16 tiles rendered in parallel (OpenMP, dynamic
- * scheduling), generates camera rays in coherent batches, shades them with
- * the path tracer or the Whitted integrator and adds each finished tile to
- * the film. With the cuda accelerator the path tracer's kernel renders all
+ * scheduling), generates camera rays in coherent batches, has the
+ * integrator (integrator.h: the path tracer or the Whitted integrator) shade
+ * them, with the AOVs of what they see, and adds each finished tile to the
+ * film. With the cuda accelerator the path tracer's kernel renders all
  * the tiles on the GPU instead (path_gpu.h) and the tiles go into the same
  * film. Every pixel sample seeds its own random numbers from (pixel,
  * sample), so a pixel's value does not depend on the threads, the tiles or
@@ -12,11 +13,11 @@
 #include "render.h"
 
 #include "camera.h"
+#include "integrator.h"
 #include "path.h"
 #include "path_gpu.h"
 #include "sampling.h"
 #include "surface.h"
-#include "whitted.h"
 
 #include <omp.h>
 #include <stdatomic.h>
@@ -26,16 +27,25 @@
 #define BATCH (TILE * TILE)
 #define PROGRESS_INTERVAL_S 0.25 /* at most 4 progress reports a second */
 
+/* What the renderer itself counts in each thread: its camera rays and
+ * their traversal work. On cache lines of its own (as the integrators'
+ * thread states). */
+typedef struct worker {
+    _Alignas(64) uint64_t rays_camera;
+    accel_counters counters;
+    accel_counters *cp;     /* &counters when statistics are on, else NULL */
+} worker;
+
 struct pk_renderer {
     pk_context *ctx;
     pk_render_options opt;
     int nt;                 /* threads */
     frame fr;
-    bool path;              /* the path tracer, else the Whitted integrator */
-    whitted w;
-    whitted_thread *ts;     /* nt entries */
-    path_tracer pt;
-    path_thread *pts;       /* nt entries */
+    const integrator_ops *ig;
+    void *self;             /* the integrator (ig->self_size bytes) */
+    unsigned char *its;     /* nt thread states of ig->thread_size bytes */
+    size_t nits;            /* how many of them are initialised */
+    worker *ws;             /* nt entries */
     path_gpu *gpu;          /* the path tracer on the GPU (accel PK_ACCEL_CUDA), else NULL */
     pk_camera cam;
     uint32_t pass;          /* sample numbers start at pass * spp */
@@ -114,6 +124,8 @@ static void *calloc_lines(const pk_allocator *al, size_t n, size_t size)
     return p;
 }
 
+static void *thread_state(const pk_renderer *r, int t) { return r->its + (size_t)t * r->ig->thread_size; }
+
 pk_status renderer_create(pk_context *ctx, const pk_scene *s, const pk_render_options *opt, const pk_camera *cam,
                           pk_renderer **out)
 {
@@ -129,39 +141,38 @@ pk_status renderer_create(pk_context *ctx, const pk_scene *s, const pk_render_op
         mem_free(&ctx->alloc, r);
         return st;
     }
-    r->path = opt->integrator != PK_INTEGRATOR_WHITTED;
-    /* the ray cone of a pixel: its angle, which texture filtering widens with distance */
-    const float spread = 2.0f * tanf(0.5f * cam->fov_deg * PK_PI / 180.0f) / (float)opt->height;
-    r->w = (whitted){&r->fr, opt->light_samples, pk_render_options_max_depth(opt), opt->fresnel != 0, spread};
-    r->ts = calloc_lines(&ctx->alloc, (size_t)r->nt, sizeof *r->ts);
-    r->pts = calloc_lines(&ctx->alloc, (size_t)r->nt, sizeof *r->pts);
-    if (!r->ts || !r->pts) {
+    const bool path = opt->integrator != PK_INTEGRATOR_WHITTED;
+    r->ig = path ? &integrator_path : &integrator_whitted;
+    r->self = mem_calloc(&ctx->alloc, 1, r->ig->self_size);
+    r->its = calloc_lines(&ctx->alloc, (size_t)r->nt, r->ig->thread_size);
+    r->ws = calloc_lines(&ctx->alloc, (size_t)r->nt, sizeof *r->ws);
+    if (!r->self || !r->its || !r->ws) {
         renderer_destroy(r);
         return ctx_nomem(ctx);
     }
-    if (r->path) {
-        if ((st = path_init(ctx, &r->pt, &r->fr, opt)) != PK_OK) {
+    if ((st = r->ig->init(ctx, r->self, &r->fr, opt)) != PK_OK) {
+        renderer_destroy(r); /* ig->free takes what a failed init left */
+        return st;
+    }
+    const camera_frame cf = camera_setup(cam, opt->width, opt->height);
+    r->ig->set_camera(r->self, &cf);
+    for (int t = 0; t < r->nt; t++) {
+        r->ws[t].cp = opt->collect_stats ? &r->ws[t].counters : NULL;
+        if ((st = r->ig->thread_init(ctx, r->self, thread_state(r, t), opt->collect_stats != 0)) != PK_OK) {
             renderer_destroy(r);
             return st;
         }
-        r->pt.spread = spread;
-        for (int t = 0; t < r->nt; t++) r->pts[t].cp = opt->collect_stats ? &r->pts[t].counters : NULL;
-        if (opt->accel == PK_ACCEL_CUDA && (st = path_gpu_create(ctx, &r->pt, &r->gpu)) != PK_OK) {
-            renderer_destroy(r);
-            return st;
-        }
-    } else {
-        for (int t = 0; t < r->nt; t++)
-            if ((st = whitted_thread_init(ctx, &r->w, &r->ts[t], opt->collect_stats != 0)) != PK_OK) {
-                renderer_destroy(r);
-                return st;
-            }
+        r->nits++;
+    }
+    if (path && opt->accel == PK_ACCEL_CUDA && (st = path_gpu_create(ctx, r->self, &r->gpu)) != PK_OK) {
+        renderer_destroy(r);
+        return st;
     }
     r->total.build_us = r->fr.build_s * 1e6;
     r->total.threads = r->nt;
     r->total.accel_builds = 1;
-    warn_lighting(ctx, s, &r->fr.env, r->path);
-    if (r->path) warn_facing(ctx, s, r->fr.a);
+    warn_lighting(ctx, s, &r->fr.env, path);
+    if (path) warn_facing(ctx, s, r->fr.a);
     *out = r;
     return PK_OK;
 }
@@ -170,22 +181,30 @@ void renderer_destroy(pk_renderer *r)
 {
     if (!r) return;
     const pk_allocator *al = &r->ctx->alloc;
-    if (r->ts)
-        for (int t = 0; t < r->nt; t++) whitted_thread_free(al, &r->ts[t]);
-    mem_free_aligned(al, r->ts);
-    mem_free_aligned(al, r->pts);
+    for (size_t t = 0; t < r->nits; t++) r->ig->thread_free(al, thread_state(r, (int)t));
+    mem_free_aligned(al, r->its);
+    mem_free_aligned(al, r->ws);
     path_gpu_destroy(r->gpu);
-    path_free(al, &r->pt);
+    if (r->self) r->ig->free(al, r->self);
+    mem_free(al, r->self);
     frame_free(al, &r->fr);
     mem_free(al, r);
 }
 
 pk_context *renderer_context(const pk_renderer *r) { return r->ctx; }
 const pk_render_options *renderer_options(const pk_renderer *r) { return &r->opt; }
-void renderer_set_camera(pk_renderer *r, const pk_camera *cam) { r->cam = *cam; }
+void renderer_set_camera(pk_renderer *r, const pk_camera *cam)
+{
+    r->cam = *cam;
+    const camera_frame cf = camera_setup(cam, r->opt.width, r->opt.height);
+    r->ig->set_camera(r->self, &cf);
+}
 const pk_camera *renderer_camera(const pk_renderer *r) { return &r->cam; }
 void renderer_stats(const pk_renderer *r, pk_stats *stats) { *stats = r->total; }
-void renderer_set_path_strategy(pk_renderer *r, int strategy) { r->pt.strategy = strategy; }
+void renderer_set_path_strategy(pk_renderer *r, int strategy)
+{
+    if (r->ig == &integrator_path) ((path_tracer *)r->self)->strategy = strategy;
+}
 void renderer_set_pass(pk_renderer *r, uint32_t pass) { r->pass = pass; }
 
 typedef gpu_tile tile; /* x, y, w, h: at most TILE x TILE */
@@ -237,66 +256,65 @@ static pk_status check_regions(pk_context *ctx, const pk_region *reg, size_t n, 
     return PK_OK;
 }
 
-/* Renders one tile into acc (3 floats per pixel, the sums of spp samples);
- * false when the render was cancelled before the tile finished. */
 /* The camera ray of sample smp (0..spp-1 of the current pass) of pixel
- * (px, py): the path tracer's from its sampler's first two dimensions, the
- * Whitted integrator's through the pixel centre at 1 spp and jittered in
- * sx x sy strata above. Both tile loops and the AOVs take their rays here. */
+ * (px, py), placed on the film by the integrator. */
 static inline ray sample_camera_ray(const pk_renderer *r, const camera_frame *cf, int px, int py, int smp)
 {
     const int spp = r->opt.spp;
-    float jx = 0.5f, jy = 0.5f;
-    if (r->path) return path_camera(&r->pt, cf, px, py, r->pass * (uint32_t)spp + (uint32_t)smp);
-    if (spp > 1) {
-        const int sx = (int)ceilf(sqrtf((float)spp)), sy = (spp + sx - 1) / sx;
-        const uint64_t first = (uint64_t)r->pass * (uint64_t)spp;
-        rng jr = rng_seed(((uint64_t)py << 32) | (uint32_t)px, (first + (uint64_t)smp) * 2 + 1);
-        jx = ((float)(smp % sx) + rng_float(&jr)) / (float)sx;
-        jy = ((float)(smp / sx) + rng_float(&jr)) / (float)sy;
-    }
-    return camera_ray(cf, (float)px + jx, (float)py + jy);
+    const uint64_t index = (uint64_t)r->pass * (uint64_t)spp + (uint64_t)smp;
+    const camera_sample cs = r->ig->camera_sample(r->self, px, py, index, smp, spp);
+    return camera_ray(cf, &cs);
 }
 
-/* Renders the samples of tile tl into acc (3 floats a pixel): camera rays
- * traced as one batch, then each sample shaded by the renderer's integrator
- * (the path tracer takes the pixel position from its sampler's first two
- * dimensions; the Whitted integrator draws from a PCG stream seeded by pixel
- * and sample). Camera rays that miss see the environment. Returns false when
+/* Nodes visited + primitives tested by camera ray r alone (the heat map). */
+static float camera_ray_heat(const pk_renderer *r, const ray *cr)
+{
+    accel_counters c = {0, 0};
+    hit h;
+    r->fr.a->ops->intersect(r->fr.a, cr, &h, &c);
+    return (float)(c.nodes + c.tests);
+}
+
+/* Renders the samples of tile tl into acc (3 floats a pixel) and, when the
+ * film holds AOVs, their sums into aovs: camera rays traced as one batch,
+ * then each sample shaded by the renderer's integrator. Returns false when
  * cancelled before the last sample. */
 static bool render_tile(const pk_renderer *r, int tid, const camera_frame *cf, const tile *tl, float *acc,
-                        volatile const int *cancel, atomic_int *stop)
+                        float (*aovs)[BATCH * 3], unsigned aov_mask, volatile const int *cancel, atomic_int *stop)
 {
     const int spp = r->opt.spp;
     const uint64_t first = (uint64_t)r->pass * (uint64_t)spp; /* the pass's first sample number */
     const int tw = tl->w, n = tl->w * tl->h;
-    path_thread *pt = &r->pts[tid];
-    whitted_thread *wt = &r->ts[tid];
+    worker *wk = &r->ws[tid];
+    void *ts = thread_state(r, tid);
+    const bool want_aov = (aov_mask & (PK_AOV_ALBEDO | PK_AOV_NORMAL | PK_AOV_DEPTH)) != 0;
     ray rays[BATCH];
     hit hits[BATCH];
     memset(acc, 0, sizeof(float) * 3 * (size_t)n);
+    if (aov_mask) memset(aovs, 0, sizeof(float) * FILM_AOVS * BATCH * 3);
     for (int smp = 0; smp < spp; smp++) {
         /* also between samples: a tile at many samples may take long */
         if (smp > 0 && ((cancel && *cancel) || atomic_load_explicit(stop, memory_order_relaxed))) return false;
         for (int i = 0; i < n; i++) rays[i] = sample_camera_ray(r, cf, tl->x + i % tw, tl->y + i / tw, smp);
-        if (r->path) pt->rays_camera += (uint64_t)n;
-        else wt->rays[RAY_CAMERA] += (uint64_t)n;
-        accel_intersect_many(r->fr.a, rays, hits, (size_t)n, false, r->path ? pt->cp : wt->cp);
+        wk->rays_camera += (uint64_t)n;
+        accel_intersect_many(r->fr.a, rays, hits, (size_t)n, false, wk->cp);
         for (int i = 0; i < n; i++) {
             vec3 c;
+            aov_sample av = {{0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f}, 0.0f};
             const int px = tl->x + i % tw, py = tl->y + i / tw;
-            if (r->path) {
-                if (!path_sample(&r->pt, pt, px, py, (uint32_t)(first + (uint64_t)smp), &rays[i],
-                                 hits[i].prim == PK_NO_HIT ? NULL : &hits[i], &c))
-                    continue; /* a lost sample, not a poisoned pixel */
-            } else if (hits[i].prim == PK_NO_HIT) {
-                c = env_background(&r->fr.env, v3_norm(rays[i].d));
-            } else {
-                wt->rng = rng_seed(((uint64_t)py << 32) | (uint32_t)px, (first + (uint64_t)smp) * 2);
-                wt->ray_budget = WHITTED_RAY_BUDGET;
-                wt->cone = 0.0f;
-                c = whitted_shade(&r->w, wt, &rays[i], &hits[i], 0);
+            if (aov_mask & PK_AOV_HEATMAP) {
+                const float heat = camera_ray_heat(r, &rays[i]);
+                for (int k = 0; k < 3; k++) aovs[3][3 * i + k] += heat;
             }
+            const bool kept = r->ig->sample(r->self, ts, px, py, first + (uint64_t)smp, &rays[i],
+                                            hits[i].prim == PK_NO_HIT ? NULL : &hits[i], &c, want_aov ? &av : NULL);
+            if (want_aov) {
+                const float *v[3] = {&av.albedo.x, &av.normal.x, NULL};
+                for (int k = 0; k < 2; k++)
+                    for (int j = 0; j < 3; j++) aovs[k][3 * i + j] += v[k][j];
+                for (int j = 0; j < 3; j++) aovs[2][3 * i + j] += av.depth;
+            }
+            if (!kept) continue; /* a lost sample, not a poisoned pixel */
             acc[3 * i] += c.x;
             acc[3 * i + 1] += c.y;
             acc[3 * i + 2] += c.z;
@@ -305,14 +323,22 @@ static bool render_tile(const pk_renderer *r, int tid, const camera_frame *cf, c
     return true;
 }
 
-/* The AOVs of a finished tile, from the camera rays of its samples (traced
- * again, one at a time, so that each ray's nodes and tests are its own). */
-static void render_tile_aovs(const pk_renderer *r, const camera_frame *cf, const tile *tl, pk_film *film)
+/* Adds a finished tile's AOV sums to the film. */
+static void film_add_aovs(pk_film *film, const tile *tl, float (*aovs)[BATCH * 3])
+{
+    for (int k = 0; k < FILM_AOVS; k++)
+        if (film->aovs & (1u << k)) film_add_aov_block(film, k, tl->x, tl->y, tl->w, tl->h, aovs[k]);
+}
+
+/* The AOVs of a tile the GPU rendered, from its camera rays traced again on
+ * the CPU, one at a time, and shaded as the path tracer's first vertex. */
+static void render_tile_aovs_cpu(const pk_renderer *r, const camera_frame *cf, const tile *tl, pk_film *film)
 {
     const pk_scene *s = r->fr.s;
     const int tw = tl->w, n = tl->w * tl->h;
     float v[FILM_AOVS][BATCH * 3];
     memset(v, 0, sizeof v);
+    const float spread = cf->spread;
     for (int smp = 0; smp < r->opt.spp; smp++)
         for (int i = 0; i < n; i++) {
             ray cr = sample_camera_ray(r, cf, tl->x + i % tw, tl->y + i / tw, smp);
@@ -325,14 +351,14 @@ static void render_tile_aovs(const pk_renderer *r, const camera_frame *cf, const
             if (!got || (s->has_cutout && !trace_past_holes(r->fr.a, s, &cr, &h, NULL))) continue;
             surface sf = surface_at(s, &cr, &h);
             material textured;
-            if (sf.m->textured) sf = surface_texture(s, &cr, &h, r->w.spread * h.t * v3_len(cr.d), sf, &textured);
-            a[0] += sf.m->kd.x, a[1] += sf.m->kd.y, a[2] += sf.m->kd.z;
-            nn[0] += sf.ns.x, nn[1] += sf.ns.y, nn[2] += sf.ns.z;
-            const float dist = h.t * v3_len(cr.d);
-            d[0] += dist, d[1] += dist, d[2] += dist;
+            if (sf.m->textured) sf = surface_texture(s, &cr, &h, spread * h.t * v3_len(cr.d), sf, &textured);
+            aov_sample av;
+            aov_from_surface(&sf, &cr, &h, &av);
+            a[0] += av.albedo.x, a[1] += av.albedo.y, a[2] += av.albedo.z;
+            nn[0] += av.normal.x, nn[1] += av.normal.y, nn[2] += av.normal.z;
+            d[0] += av.depth, d[1] += av.depth, d[2] += av.depth;
         }
-    for (int k = 0; k < FILM_AOVS; k++)
-        if (film->aovs & (1u << k)) film_add_aov_block(film, k, tl->x, tl->y, tl->w, tl->h, v[k]);
+    film_add_aovs(film, tl, v);
 }
 
 /* ---- on the GPU ------------------------------------------------------------------ */
@@ -372,16 +398,16 @@ static pk_status render_gpu(pk_renderer *r, const tile *tiles, size_t ntiles, co
     uint64_t rays[3] = {0, 0, 0};
     pk_status st = path_gpu_render(r->gpu, cf, tiles, ntiles, r->pass * (uint32_t)opt->spp, opt->spp, acc, rays,
                                    gpu_progress_fn, &gp);
-    r->pts[0].rays_camera += rays[0];
-    r->pts[0].rays_bounce += rays[1];
-    r->pts[0].rays_shadow += rays[2];
+    r->total.rays_camera += rays[0];
+    r->total.rays_bounce += rays[1];
+    r->total.rays_shadow += rays[2];
     if (st == PK_OK) {
         const long n = (long)ntiles;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(r->nt)
         for (long i = 0; i < n; i++) {
             const tile *tl = &tiles[i];
             film_add_block(film, tl->x, tl->y, tl->w, tl->h, &acc[(size_t)i * GPU_TILE_PIXELS * 3], (uint32_t)opt->spp);
-            if (film->aovs) render_tile_aovs(r, cf, tl, film);
+            if (film->aovs) render_tile_aovs_cpu(r, cf, tl, film);
         }
     }
     mem_free(&r->ctx->alloc, acc);
@@ -420,11 +446,10 @@ pk_status renderer_render(pk_renderer *r, const pk_region *regions, size_t nregi
     }
 
     for (int t = 0; t < r->nt; t++) {
-        memset(r->ts[t].rays, 0, sizeof r->ts[t].rays);
-        r->ts[t].counters = (accel_counters){0, 0};
-        accel_counters *cp = r->pts[t].cp;
-        memset(&r->pts[t], 0, sizeof r->pts[t]);
-        r->pts[t].cp = cp;
+        pk_stats drop;
+        r->ig->take_counters(thread_state(r, t), &drop); /* zeroes them */
+        r->ws[t].rays_camera = 0;
+        r->ws[t].counters = (accel_counters){0, 0};
     }
     const camera_frame cf = camera_setup(&r->cam, opt->width, opt->height);
     if (r->gpu) {
@@ -433,9 +458,6 @@ pk_status renderer_render(pk_renderer *r, const pk_region *regions, size_t nregi
         const double render_s = time_now() - t0;
         mem_free(&ctx->alloc, tiles);
         if (opt->progress && st == PK_OK) opt->progress(opt->progress_user, (uint64_t)ntiles, (uint64_t)ntiles, render_s);
-        r->total.rays_camera += r->pts[0].rays_camera;
-        r->total.rays_bounce += r->pts[0].rays_bounce;
-        r->total.rays_shadow += r->pts[0].rays_shadow;
         r->total.render_s += render_s;
         if (st == PK_OK) r->total.pixels += pixels;
         if (st == PK_ERR_CANCELLED) return ctx_error(ctx, PK_ERR_CANCELLED, "render cancelled");
@@ -453,6 +475,7 @@ pk_status renderer_render(pk_renderer *r, const pk_region *regions, size_t nregi
     {
         const int tid = omp_get_thread_num();
         float acc[BATCH * 3];
+        float aovs[FILM_AOVS][BATCH * 3];
 #pragma omp for schedule(dynamic, 1)
         for (int ti = 0; ti < nt_total; ti++) {
             if ((cancel && *cancel) || atomic_load_explicit(&stop, memory_order_relaxed)) {
@@ -461,14 +484,14 @@ pk_status renderer_render(pk_renderer *r, const pk_region *regions, size_t nregi
                 continue;
             }
             const tile *tl = &tiles[ti];
-            const bool finished = render_tile(r, tid, &cf, tl, acc, cancel, &stop);
+            const bool finished = render_tile(r, tid, &cf, tl, acc, aovs, film->aovs, cancel, &stop);
             if (!finished) { /* an unfinished tile stays black */
 #pragma omp atomic write
                 cancelled = 1;
                 continue;
             }
             film_add_block(film, tl->x, tl->y, tl->w, tl->h, acc, (uint32_t)opt->spp);
-            if (film->aovs) render_tile_aovs(r, &cf, tl, film);
+            if (film->aovs) film_add_aovs(film, tl, aovs);
             const long d = atomic_fetch_add_explicit(&done, 1, memory_order_relaxed) + 1;
             /* progress reports come from the calling thread only (OpenMP thread 0) */
             if (tid == 0 && opt->progress) {
@@ -487,17 +510,10 @@ pk_status renderer_render(pk_renderer *r, const pk_region *regions, size_t nregi
 
     pk_stats *s = &r->total;
     for (int t = 0; t < r->nt; t++) {
-        s->rays_camera += r->ts[t].rays[RAY_CAMERA];
-        s->rays_shadow += r->ts[t].rays[RAY_SHADOW];
-        s->rays_reflection += r->ts[t].rays[RAY_REFLECTION];
-        s->rays_refraction += r->ts[t].rays[RAY_REFRACTION];
-        s->intersection_tests += r->ts[t].counters.tests;
-        s->nodes_visited += r->ts[t].counters.nodes;
-        s->rays_camera += r->pts[t].rays_camera;
-        s->rays_bounce += r->pts[t].rays_bounce;
-        s->rays_shadow += r->pts[t].rays_shadow;
-        s->intersection_tests += r->pts[t].counters.tests;
-        s->nodes_visited += r->pts[t].counters.nodes;
+        r->ig->take_counters(thread_state(r, t), s);
+        s->rays_camera += r->ws[t].rays_camera;
+        s->intersection_tests += r->ws[t].counters.tests;
+        s->nodes_visited += r->ws[t].counters.nodes;
     }
     s->render_s += render_s;
     s->pixels += pixels;

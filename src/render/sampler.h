@@ -91,6 +91,12 @@ static inline PK_HD float smp_to_float(uint32_t x)
     return (float)(x >> 8) * 0x1p-24f; /* [0, 1): 24 bits, never rounds up to 1 */
 }
 
+/* The dimension plan of a camera sample: dimensions 0 and 1 place it in the
+ * pixel (the film), 2 and 3 on the lens, for cameras that have one, and the
+ * path takes every dimension after the camera's. */
+enum { SAMPLER_DIM_FILM = 0, SAMPLER_DIM_LENS = 2 };
+#define SAMPLER_DIM_PATH(has_lens) (SAMPLER_DIM_LENS + ((has_lens) ? 2u : 0u))
+
 typedef struct sampler {
     uint32_t pixel_seed;  /* from the pixel and the user's seed */
     uint32_t index;       /* sample index within the pixel */

@@ -11,7 +11,9 @@
 
 #include <string.h>
 
-pk_status whitted_thread_init(pk_context *ctx, const whitted *w, whitted_thread *t, bool stats)
+static void whitted_thread_free(const pk_allocator *al, whitted_thread *t);
+
+static pk_status whitted_thread_init(pk_context *ctx, const whitted *w, whitted_thread *t, bool stats)
 {
     memset(t, 0, sizeof *t);
     const pk_allocator *al = &ctx->alloc;
@@ -29,7 +31,7 @@ pk_status whitted_thread_init(pk_context *ctx, const whitted *w, whitted_thread 
     return PK_OK;
 }
 
-void whitted_thread_free(const pk_allocator *al, whitted_thread *t)
+static void whitted_thread_free(const pk_allocator *al, whitted_thread *t)
 {
     mem_free(al, t->shadow_rays);
     mem_free(al, t->shadow_hits);
@@ -39,6 +41,9 @@ void whitted_thread_free(const pk_allocator *al, whitted_thread *t)
     t->shadow_weight = NULL;
 }
 
+static vec3 whitted_shade(const whitted *w, whitted_thread *t, const ray *r, const hit *h, int depth,
+                          aov_sample *aov);
+
 static vec3 trace(const whitted *w, whitted_thread *ts, const ray *r, int depth, int kind)
 {
     if (depth > w->max_depth || ts->ray_budget == 0) return v3s(0.0f);
@@ -46,7 +51,7 @@ static vec3 trace(const whitted *w, whitted_thread *ts, const ray *r, int depth,
     ts->rays[kind]++;
     hit h;
     if (!accel_intersect(w->f->a, r, &h, ts->cp)) return env_background(&w->f->env, v3_norm(r->d));
-    return whitted_shade(w, ts, r, &h, depth);
+    return whitted_shade(w, ts, r, &h, depth, NULL);
 }
 
 static vec3 direct_light(const whitted *w, whitted_thread *ts, const surface *sf, vec3 wo)
@@ -144,13 +149,14 @@ static vec3 direct_light(const whitted *w, whitted_thread *ts, const surface *sf
     return L;
 }
 
-static vec3 shade_opaque(const whitted *w, whitted_thread *ts, const ray *r, const hit *h, int depth)
+static vec3 shade_opaque(const whitted *w, whitted_thread *ts, const ray *r, const hit *h, int depth, aov_sample *aov)
 {
     const frame *fr = w->f;
     surface sf = surface_at(fr->s, r, h);
     const float cone = fr->s->has_textured ? ts->cone + w->spread * h->t * v3_len(r->d) : 0.0f;
     material textured;
     if (sf.m->textured) sf = surface_texture(fr->s, r, h, cone, sf, &textured);
+    if (aov) aov_from_surface(&sf, r, h, aov);
     const material *m = sf.m;
     vec3 wo = v3_neg(v3_norm(r->d));
     vec3 L = m->ke; /* emitters are two-sided */
@@ -208,14 +214,89 @@ static vec3 shade_opaque(const whitted *w, whitted_thread *ts, const ray *r, con
     return L;
 }
 
-vec3 whitted_shade(const whitted *w, whitted_thread *ts, const ray *r, const hit *h, int depth)
+/* Radiance arriving along r that hit h (r traced already, depth 0 for camera
+ * rays, with t->ray_budget set to WHITTED_RAY_BUDGET before each). */
+static vec3 whitted_shade(const whitted *w, whitted_thread *ts, const ray *r, const hit *h, int depth,
+                          aov_sample *aov)
 {
     const pk_scene *s = w->f->s;
     if (s->has_cutout && surface_is_hole(s, r, h)) { /* map_d holes: what lies behind */
         ray rr = *r;
         hit hh = *h;
         if (!trace_past_holes(w->f->a, s, &rr, &hh, ts->cp)) return env_background(&w->f->env, v3_norm(rr.d));
-        return shade_opaque(w, ts, &rr, &hh, depth);
+        return shade_opaque(w, ts, &rr, &hh, depth, aov);
     }
-    return shade_opaque(w, ts, r, h, depth);
+    return shade_opaque(w, ts, r, h, depth, aov);
 }
+
+/* ---- the integrator interface (integrator.h) ------------------------------------ */
+
+static pk_status ig_init(pk_context *ctx, void *self, const frame *f, const pk_render_options *opt)
+{
+    (void)ctx;
+    *(whitted *)self = (whitted){f, opt->light_samples, pk_render_options_max_depth(opt), opt->fresnel != 0, 0.0f};
+    return PK_OK;
+}
+
+static void ig_free(const pk_allocator *al, void *self) { (void)al, (void)self; }
+
+static pk_status ig_thread_init(pk_context *ctx, const void *self, void *t, bool stats)
+{
+    return whitted_thread_init(ctx, self, t, stats);
+}
+
+static void ig_thread_free(const pk_allocator *al, void *t) { whitted_thread_free(al, t); }
+
+static void ig_set_camera(void *self, const camera_frame *cf) { ((whitted *)self)->spread = cf->spread; }
+
+/* Through the pixel centre at 1 sample per pixel, above that jittered in
+ * sx x sy strata of the pixel (a PCG stream seeded by pixel and sample). */
+static camera_sample ig_camera_sample(const void *self, int px, int py, uint64_t index, int smp, int spp)
+{
+    (void)self;
+    float jx = 0.5f, jy = 0.5f;
+    if (spp > 1) {
+        const int sx = (int)ceilf(sqrtf((float)spp)), sy = (spp + sx - 1) / sx;
+        rng jr = rng_seed(((uint64_t)py << 32) | (uint32_t)px, index * 2 + 1);
+        jx = ((float)(smp % sx) + rng_float(&jr)) / (float)sx;
+        jy = ((float)(smp / sx) + rng_float(&jr)) / (float)sy;
+    }
+    const camera_sample cs = {(float)px + jx, (float)py + jy, 0.5f, 0.5f};
+    return cs;
+}
+
+static bool ig_sample(const void *self, void *t, int px, int py, uint64_t index, const ray *r, const hit *h, vec3 *L,
+                      aov_sample *aov)
+{
+    const whitted *w = self;
+    whitted_thread *ts = t;
+    if (!h) {
+        *L = env_background(&w->f->env, v3_norm(r->d));
+        return true;
+    }
+    ts->rng = rng_seed(((uint64_t)py << 32) | (uint32_t)px, index * 2);
+    ts->ray_budget = WHITTED_RAY_BUDGET;
+    ts->cone = 0.0f;
+    *L = whitted_shade(w, ts, r, h, 0, aov);
+    return true;
+}
+
+static void ig_take_counters(void *t, pk_stats *st)
+{
+    whitted_thread *ts = t;
+    st->rays_camera += ts->rays[RAY_CAMERA];
+    st->rays_shadow += ts->rays[RAY_SHADOW];
+    st->rays_reflection += ts->rays[RAY_REFLECTION];
+    st->rays_refraction += ts->rays[RAY_REFRACTION];
+    st->intersection_tests += ts->counters.tests;
+    st->nodes_visited += ts->counters.nodes;
+    memset(ts->rays, 0, sizeof ts->rays);
+    ts->counters = (accel_counters){0, 0};
+}
+
+_Static_assert(sizeof(whitted_thread) % 64 == 0, "whitted_thread: whole cache lines");
+
+const integrator_ops integrator_whitted = {
+    "whitted", sizeof(whitted), sizeof(whitted_thread), ig_init, ig_free, ig_thread_init, ig_thread_free,
+    ig_set_camera, ig_camera_sample, ig_sample, ig_take_counters,
+};

@@ -8,6 +8,7 @@
 #define PK_WHITTED_H
 
 #include "frame.h"
+#include "integrator.h"
 #include "sampling.h"
 
 /* Secondary rays (reflection, refraction, dissolve) traced for one camera
@@ -42,10 +43,7 @@ typedef struct whitted_thread {
     float cone;          /* ray cone width at the origin of the ray being shaded (0 for camera rays) */
 } whitted_thread;
 
-PK_HIDDEN pk_status whitted_thread_init(pk_context *ctx, const whitted *w, whitted_thread *t, bool stats);
-PK_HIDDEN void whitted_thread_free(const pk_allocator *al, whitted_thread *t);
-/* Radiance arriving along r that hit h (r traced already, depth 0 for camera
- * rays; set t->ray_budget = WHITTED_RAY_BUDGET before each camera ray). */
-PK_HIDDEN vec3 whitted_shade(const whitted *w, whitted_thread *t, const ray *r, const hit *h, int depth);
+/* The Whitted integrator (integrator.h) is integrator_whitted; its self is a
+ * whitted, its thread state a whitted_thread. */
 
 #endif
