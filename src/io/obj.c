@@ -33,8 +33,8 @@ typedef struct obj_state {
     uint32_t material;           /* current usemtl, 0 = default */
     int undefined_warnings;
     bool has_xform;
-    float m[12];                 /* rows 0..2 of the position transform */
-    float nm[9];                 /* cofactor matrix (inverse transpose up to scale) */
+    xform m;                     /* the position transform */
+    float nm[9];                 /* its normal matrix (xform_normal_matrix) */
     corner inline_corners[OBJ_INLINE_CORNERS];
     corner *heap_corners;
     size_t cap_corners;
@@ -42,43 +42,15 @@ typedef struct obj_state {
 
 /* ---- transform ---------------------------------------------------------- */
 
-static pk_status setup_xform(obj_state *st, const float *x)
+static pk_status setup_xform(obj_state *st, const xform *x)
 {
-    for (int i = 0; i < 16; i++)
-        if (!isfinite(x[i]))
-            return ctx_error(st->r.ctx, PK_ERR_INVALID_ARGUMENT, "%s: transform is not finite", st->r.name);
-    memcpy(st->m, x, 12 * sizeof(float));
-    double a = (double)x[0], b = (double)x[1], c = (double)x[2];
-    double d = (double)x[4], e = (double)x[5], f = (double)x[6];
-    double g = (double)x[8], h = (double)x[9], i = (double)x[10];
-    double cof[9] = {e * i - f * h, f * g - d * i, d * h - e * g,
-                     c * h - b * i, a * i - c * g, b * g - a * h,
-                     b * f - c * e, c * d - a * f, a * e - b * d};
-    double det = a * cof[0] + b * cof[1] + c * cof[2];
-    if (!(fabs(det) > 0.0) || !isfinite(det))
+    if (!xform_finite(x))
+        return ctx_error(st->r.ctx, PK_ERR_INVALID_ARGUMENT, "%s: transform is not finite", st->r.name);
+    st->m = *x;
+    if (!xform_normal_matrix(x, st->nm))
         return ctx_error(st->r.ctx, PK_ERR_INVALID_ARGUMENT, "%s: transform is singular", st->r.name);
-    /* inverse transpose = cofactor / det; normals are renormalised, so only
-     * det's sign matters: scale by the largest entry to stay in float range */
-    double big = 0.0;
-    for (int k = 0; k < 9; k++) big = fmax(big, fabs(cof[k]));
-    double scale = (det < 0.0 ? -1.0 : 1.0) / big;
-    for (int k = 0; k < 9; k++) st->nm[k] = (float)(cof[k] * scale);
     st->has_xform = true;
     return PK_OK;
-}
-
-static vec3 xform_point(const float *m, vec3 p)
-{
-    return v3(m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3],
-              m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7],
-              m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]);
-}
-
-static vec3 xform_normal(const float *n, vec3 p)
-{
-    return v3(n[0] * p.x + n[1] * p.y + n[2] * p.z,
-              n[3] * p.x + n[4] * p.y + n[5] * p.z,
-              n[6] * p.x + n[7] * p.y + n[8] * p.z);
 }
 
 /* ---- statements --------------------------------------------------------- */
@@ -95,7 +67,7 @@ static pk_status parse_v(obj_state *st, const char *p, const char *le)
                         n == 7 ? "more than " : "", n);
     vec3 pos = v3(c[0], c[1], c[2]);
     if (st->has_xform) {
-        pos = xform_point(st->m, pos);
+        pos = xform_point(&st->m, pos);
         if (!v3_finite(pos)) return io_error(&st->r, PK_ERR_PARSE, "transformed vertex is not finite");
     }
     return scene_add_position(st->r.ctx, st->s, pos);
@@ -110,7 +82,7 @@ static pk_status parse_vn(obj_state *st, const char *p, const char *le)
     if (n < 3) return io_error(&st->r, PK_ERR_PARSE, "vn needs 3 coordinates, found %d", n);
     if (!io_at_end(p, le)) return io_error(&st->r, PK_ERR_PARSE, "vn takes 3 coordinates, found more");
     vec3 nv = v3(c[0], c[1], c[2]);
-    if (st->has_xform) nv = xform_normal(st->nm, nv);
+    if (st->has_xform) nv = xform_apply3(st->nm, nv);
     /* Renormalised in double so that huge or tiny finite inputs stay finite. */
     double x = (double)nv.x, y = (double)nv.y, z = (double)nv.z;
     double l2 = x * x + y * y + z * z;
@@ -386,7 +358,7 @@ static pk_status parse_statement(obj_state *st, const char *ls, const char *le)
 }
 
 pk_status obj_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size, const char *name,
-                    const char *base_dir, const float *xform)
+                    const char *base_dir, const xform *xf)
 {
     obj_state *st = mem_alloc(&ctx->alloc, sizeof *st);
     if (!st) return ctx_nomem(ctx);
@@ -398,7 +370,7 @@ pk_status obj_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,
     st->nrm_base = s->nnormals;
     st->uv_base = s->nuvs;
 
-    pk_status rc = xform ? setup_xform(st, xform) : PK_OK;
+    pk_status rc = xf ? setup_xform(st, xf) : PK_OK;
     const char *ls, *le;
     int got;
     while (rc == PK_OK && (got = io_next_line(&st->r, &ls, &le)) != 0) {

@@ -6,6 +6,7 @@
  * so a line is found by a scan of the text that numbers values in the same
  * pre-order as the parsed tree.
  */
+#include "../math/xform.h"
 #include "../options.h"
 #include "../scene/camera.h"
 #include "../scene/scene.h"
@@ -852,33 +853,15 @@ static pk_status parse_render(jp *p, const cJSON *it)
 
 /* ---- meshes ---------------------------------------------------------------- */
 
-static void mat_identity(float m[16])
-{
-    for (int i = 0; i < 16; i++) m[i] = (i % 5 == 0) ? 1.0f : 0.0f;
-}
-
-static void mat_mul(const float a[16], const float b[16], float out[16])
-{
-    float r[16];
-    for (int i = 0; i < 4; i++)
-        for (int j = 0; j < 4; j++) {
-            float sum = 0.0f;
-            for (int k = 0; k < 4; k++) sum += a[i * 4 + k] * b[k * 4 + j];
-            r[i * 4 + j] = sum;
-        }
-    memcpy(out, r, sizeof r);
-}
-
 /* A 4x4 row-major affine transform from 16 numbers or from
  * {"translate", "scale", "rotate"} composed as T * R * S. */
-static pk_status parse_transform(jp *p, const cJSON *it, const char *path, float m[16])
+static pk_status parse_transform(jp *p, const cJSON *it, const char *path, xform *m)
 {
     pk_status st;
     char fp[JP_PATH_MAX];
     if (cJSON_IsArray(it)) {
-        if ((st = get_floats(p, it, path, m, 16))) return st;
-        if (m[12] != 0.0f || m[13] != 0.0f || m[14] != 0.0f || m[15] != 1.0f)
-            return jfail(p, PK_ERR_PARSE, it, path, "the last row must be 0 0 0 1");
+        if ((st = get_floats(p, it, path, m->m, 16))) return st;
+        if (!xform_is_affine(m)) return jfail(p, PK_ERR_PARSE, it, path, "the last row must be 0 0 0 1");
     } else {
         enum { T_TRANSLATE, T_SCALE, T_ROTATE, T_COUNT };
         static const char *const keys[T_COUNT] = {"translate", "scale", "rotate"};
@@ -887,15 +870,12 @@ static pk_status parse_transform(jp *p, const cJSON *it, const char *path, float
             return jfail(p, PK_ERR_PARSE, it, path,
                          "must be an array of 16 numbers or an object with translate, scale, rotate");
         if ((st = object_fields(p, it, path, keys, T_COUNT, f))) return st;
-        float t[16], r[16], s[16];
-        mat_identity(t);
-        mat_identity(r);
-        mat_identity(s);
+        xform t = xform_identity(), r = xform_identity(), s = xform_identity();
         if (f[T_TRANSLATE]) {
             vec3 v;
             path_key(fp, path, "translate");
             if ((st = get_vec3(p, f[T_TRANSLATE], fp, &v))) return st;
-            t[3] = v.x, t[7] = v.y, t[11] = v.z;
+            t = xform_translate(v);
         }
         if (f[T_SCALE]) {
             vec3 v;
@@ -910,7 +890,7 @@ static pk_status parse_transform(jp *p, const cJSON *it, const char *path, float
             }
             if (v.x == 0.0f || v.y == 0.0f || v.z == 0.0f)
                 return jfail(p, PK_ERR_PARSE, f[T_SCALE], fp, "must not be zero");
-            s[0] = v.x, s[5] = v.y, s[10] = v.z;
+            s = xform_scale(v);
         }
         if (f[T_ROTATE]) {
             float a[4];
@@ -919,22 +899,16 @@ static pk_status parse_transform(jp *p, const cJSON *it, const char *path, float
             vec3 ax = v3(a[1], a[2], a[3]);
             if (!(v3_len2(ax) > 0.0f) || !isfinite(v3_len2(ax)))
                 return jfail(p, PK_ERR_PARSE, f[T_ROTATE], fp, "the axis must not be zero");
-            ax = v3_norm(ax);
-            float rad = a[0] * (PK_PI / 180.0f), c = cosf(rad), sn = sinf(rad), k = 1.0f - c;
-            r[0] = k * ax.x * ax.x + c, r[1] = k * ax.x * ax.y - sn * ax.z, r[2] = k * ax.x * ax.z + sn * ax.y;
-            r[4] = k * ax.x * ax.y + sn * ax.z, r[5] = k * ax.y * ax.y + c, r[6] = k * ax.y * ax.z - sn * ax.x;
-            r[8] = k * ax.x * ax.z - sn * ax.y, r[9] = k * ax.y * ax.z + sn * ax.x, r[10] = k * ax.z * ax.z + c;
+            r = xform_rotate(v3_norm(ax), a[0]);
         }
-        mat_mul(r, s, m);
-        mat_mul(t, m, m);
+        /* (each product of T R S has one non-zero term, so the sums in double
+         * of xform_mul give the float products these were written with) */
+        xform rs = xform_mul(&r, &s);
+        *m = xform_mul(&t, &rs);
     }
-    double d[9];
-    for (int i = 0; i < 9; i++) d[i] = (double)m[(i / 3) * 4 + i % 3];
-    double det = d[0] * (d[4] * d[8] - d[5] * d[7]) - d[1] * (d[3] * d[8] - d[5] * d[6]) +
-                 d[2] * (d[3] * d[7] - d[4] * d[6]);
+    double det = xform_det3(m);
     if (!(det != 0.0) || !isfinite(det)) return jfail(p, PK_ERR_PARSE, it, path, "the transform is singular");
-    for (int i = 0; i < 16; i++)
-        if (!isfinite(m[i])) return jfail(p, PK_ERR_PARSE, it, path, "the transform is not finite");
+    if (!xform_finite(m)) return jfail(p, PK_ERR_PARSE, it, path, "the transform is not finite");
     return PK_OK;
 }
 
@@ -944,7 +918,7 @@ static pk_status parse_mesh(jp *p, const cJSON *it, const char *path)
     static const char *const keys[M_COUNT] = {"obj", "transform"};
     const cJSON *f[M_COUNT];
     char fp[JP_PATH_MAX];
-    float xf[16];
+    xform xf;
     pk_status st = object_fields(p, it, path, keys, M_COUNT, f);
     if (st) return st;
     if (!f[M_OBJ]) return jfail(p, PK_ERR_PARSE, it, path, "missing \"obj\"");
@@ -954,7 +928,7 @@ static pk_status parse_mesh(jp *p, const cJSON *it, const char *path)
     if (f[M_TRANSFORM]) {
         char tp[JP_PATH_MAX];
         path_key(tp, path, "transform");
-        if ((st = parse_transform(p, f[M_TRANSFORM], tp, xf))) return st;
+        if ((st = parse_transform(p, f[M_TRANSFORM], tp, &xf))) return st;
     }
 
     const pk_allocator *a = &p->ctx->alloc;
@@ -981,7 +955,7 @@ static pk_status parse_mesh(jp *p, const cJSON *it, const char *path)
         jfail(p, st, f[M_OBJ], fp, "%s", scratch.message);
         goto out;
     }
-    st = obj_parse(p->ctx, p->s, data, size, full, dir, f[M_TRANSFORM] ? xf : NULL);
+    st = obj_parse(p->ctx, p->s, data, size, full, dir, f[M_TRANSFORM] ? &xf : NULL);
 out:
     mem_free(a, data);
     mem_free(a, dir);

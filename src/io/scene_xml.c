@@ -13,6 +13,7 @@
  */
 #include "io_util.h"
 #include "ply.h"
+#include "../math/xform.h"
 #include "../options.h"
 #include "../scene/camera.h"
 #include "../scene/scene.h"
@@ -959,52 +960,6 @@ static pk_status get_scalar(xp *p, xnode *plugin, const char *name, float *out)
 
 /* ---- transforms ---------------------------------------------------------------------------- */
 
-static void m_identity(float m[16])
-{
-    for (int i = 0; i < 16; i++) m[i] = (i % 5 == 0) ? 1.0f : 0.0f;
-}
-
-static void m_mul(const float a[16], const float b[16], float out[16])
-{
-    double r[16];
-    for (int i = 0; i < 4; i++)
-        for (int j = 0; j < 4; j++) {
-            double sum = 0.0;
-            for (int k = 0; k < 4; k++) sum += (double)a[i * 4 + k] * (double)b[k * 4 + j];
-            r[i * 4 + j] = sum;
-        }
-    for (int i = 0; i < 16; i++) out[i] = (float)r[i];
-}
-
-static vec3 m_point(const float m[16], vec3 p)
-{
-    return v3(m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3], m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7],
-              m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]);
-}
-
-static vec3 m_dir(const float m[16], vec3 d)
-{
-    return v3(m[0] * d.x + m[1] * d.y + m[2] * d.z, m[4] * d.x + m[5] * d.y + m[6] * d.z,
-              m[8] * d.x + m[9] * d.y + m[10] * d.z);
-}
-
-static double m_det3(const float m[16])
-{
-    double a = m[0], b = m[1], c = m[2], d = m[4], e = m[5], f = m[6], g = m[8], h = m[9], i = m[10];
-    return a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g);
-}
-
-/* Right-handed rotation by deg degrees about axis (not zero). */
-static void m_rotate(vec3 axis, float deg, float r[16])
-{
-    m_identity(r);
-    vec3 ax = v3_norm_scaled(axis);
-    float rad = deg * (PK_PI / 180.0f), c = cosf(rad), sn = sinf(rad), k = 1.0f - c;
-    r[0] = k * ax.x * ax.x + c, r[1] = k * ax.x * ax.y - sn * ax.z, r[2] = k * ax.x * ax.z + sn * ax.y;
-    r[4] = k * ax.x * ax.y + sn * ax.z, r[5] = k * ax.y * ax.y + c, r[6] = k * ax.y * ax.z - sn * ax.x;
-    r[8] = k * ax.x * ax.z - sn * ax.y, r[9] = k * ax.y * ax.z + sn * ax.x, r[10] = k * ax.z * ax.z + c;
-}
-
 /* An attribute holding 3 numbers (origin="x, y, z"). */
 static pk_status attr_vec3(xp *p, const xnode *n, const char *name, vec3 *out, bool *found)
 {
@@ -1023,15 +978,14 @@ static pk_status attr_vec3(xp *p, const xnode *n, const char *name, vec3 *out, b
 
 /* <transform>: its elements applied in order, each one after (to the left
  * of) those before, as Mitsuba composes them. */
-static pk_status parse_transform(xp *p, xnode *t, float m[16])
+static pk_status parse_transform(xp *p, xnode *t, xform *m)
 {
     pk_status st;
-    m_identity(m);
+    *m = xform_identity();
     if (strcmp(t->tag, "transform") != 0)
         return xfail(p, PK_ERR_PARSE, t, "expected a <transform>, found <%.32s>", t->tag);
     for (xnode *c = t->child; c; c = c->next) {
-        float e[16];
-        m_identity(e);
+        xform e = xform_identity();
         if (strcmp(c->tag, "matrix") == 0) {
             const char *v;
             if ((st = value_attr(p, c, &v))) return st;
@@ -1039,24 +993,24 @@ static pk_status parse_transform(xp *p, xnode *t, float m[16])
             int k;
             if ((st = numbers(p, c, "matrix", v, f, 16, &k))) return st;
             if (k == 16) {
-                memcpy(e, f, sizeof e);
-                if (e[12] != 0.0f || e[13] != 0.0f || e[14] != 0.0f || e[15] != 1.0f)
+                memcpy(e.m, f, sizeof e.m);
+                if (!xform_is_affine(&e))
                     return xfail(p, PK_ERR_PARSE, c, "matrix: projective matrices are not supported (last row must "
                                                     "be 0 0 0 1)");
             } else if (k == 9) {
                 for (int i = 0; i < 3; i++)
-                    for (int j = 0; j < 3; j++) e[4 * i + j] = f[3 * i + j];
+                    for (int j = 0; j < 3; j++) e.m[4 * i + j] = f[3 * i + j];
             } else {
                 return xfail(p, PK_ERR_PARSE, c, "matrix needs 16 (or 9) numbers, found %d", k);
             }
         } else if (strcmp(c->tag, "translate") == 0) {
             vec3 d;
             if ((st = attr_xyz(p, c, 0.0f, &d))) return st;
-            e[3] = d.x, e[7] = d.y, e[11] = d.z;
+            e = xform_translate(d);
         } else if (strcmp(c->tag, "scale") == 0) {
             vec3 d;
             if ((st = attr_xyz(p, c, 1.0f, &d))) return st;
-            e[0] = d.x, e[5] = d.y, e[10] = d.z;
+            e = xform_scale(d);
         } else if (strcmp(c->tag, "rotate") == 0) {
             vec3 axis;
             float angle = 0.0f;
@@ -1069,7 +1023,7 @@ static pk_status parse_transform(xp *p, xnode *t, float m[16])
             }
             if ((st = attr_xyz(p, c, 0.0f, &axis))) return st;
             if (!(v3_len2(axis) > 0.0f)) return xfail(p, PK_ERR_PARSE, c, "rotate: the axis must not be zero");
-            m_rotate(axis, angle, e);
+            e = xform_rotate(v3_norm_scaled(axis), angle);
         } else if (strcmp(c->tag, "lookat") == 0 || strcmp(c->tag, "lookAt") == 0) {
             vec3 o = v3s(0.0f), tg = v3(0.0f, 0.0f, 1.0f), up = v3(0.0f, 1.0f, 0.0f);
             bool has_o, has_t, has_up;
@@ -1077,38 +1031,27 @@ static pk_status parse_transform(xp *p, xnode *t, float m[16])
             if ((st = attr_vec3(p, c, "target", &tg, &has_t))) return st;
             if ((st = attr_vec3(p, c, "up", &up, &has_up))) return st;
             if (!has_o || !has_t) return xfail(p, PK_ERR_PARSE, c, "lookat needs origin and target");
-            vec3 dir = v3_sub(tg, o);
-            if (!(v3_len2(dir) > 0.0f) || !v3_finite(dir))
+            xform_lookat_status ls = xform_lookat(o, tg, up, has_up, &e);
+            if (ls == XFORM_LOOKAT_SAME_POINT)
                 return xfail(p, PK_ERR_PARSE, c, "lookat: origin and target are the same point");
-            dir = v3_norm_scaled(dir);
-            vec3 left = v3_cross(v3_norm_scaled(up), dir);
-            if (!(v3_len(left) > 1e-4f)) {
-                if (has_up) return xfail(p, PK_ERR_PARSE, c, "lookat: up is zero or parallel to the view direction");
-                left = v3_cross(v3(0.0f, 0.0f, 1.0f), dir); /* looking along y */
-            }
-            left = v3_norm(left);
-            vec3 nup = v3_cross(dir, left);
-            e[0] = left.x, e[4] = left.y, e[8] = left.z;
-            e[1] = nup.x, e[5] = nup.y, e[9] = nup.z;
-            e[2] = dir.x, e[6] = dir.y, e[10] = dir.z;
-            e[3] = o.x, e[7] = o.y, e[11] = o.z;
+            if (ls == XFORM_LOOKAT_BAD_UP)
+                return xfail(p, PK_ERR_PARSE, c, "lookat: up is zero or parallel to the view direction");
         } else {
             char tg[40];
             shown(tg, sizeof tg, c->tag);
             xwarn(p, c, "<%s> in a transform is not supported; ignored", tg);
             continue;
         }
-        m_mul(e, m, m);
+        *m = xform_mul(&e, m);
     }
-    for (int i = 0; i < 16; i++)
-        if (!isfinite(m[i])) return xfail(p, PK_ERR_PARSE, t, "the transform is not finite");
+    if (!xform_finite(m)) return xfail(p, PK_ERR_PARSE, t, "the transform is not finite");
     return PK_OK;
 }
 
 /* The to_world of a plugin (identity when absent); *found says whether given. */
-static pk_status get_to_world(xp *p, xnode *plugin, float m[16], bool *found)
+static pk_status get_to_world(xp *p, xnode *plugin, xform *m, bool *found)
 {
-    m_identity(m);
+    *m = xform_identity();
     xnode *t = prop(p, plugin, "to_world");
     if (found) *found = t != NULL;
     if (!t) return PK_OK;
@@ -1562,28 +1505,19 @@ static void warn_unused(xp *p, xnode *plugin, const char *kind, const char *cons
  * flip reverses the winding; normals (optional, local) are transformed by
  * the inverse transpose; uv (optional) holds 2 texture coordinates a vertex. */
 static pk_status add_mesh(xp *p, const vec3 *pos, const vec3 *nrm, const float *uv, size_t npos, const uint32_t *tris,
-                          size_t ntris, const float m[16], bool flip, uint32_t mat)
+                          size_t ntris, const xform *m, bool flip, uint32_t mat)
 {
     pk_scene *s = p->s;
     size_t pbase = s->npositions, nbase = s->nnormals, tbase = s->nuvs;
     pk_status st;
     float cof[9] = {0};
-    if (nrm) {
-        const float a = m[0], b = m[1], c = m[2], d = m[4], e = m[5], f = m[6], g = m[8], h = m[9], i = m[10];
-        const float cf[9] = {e * i - f * h, f * g - d * i, d * h - e * g, c * h - b * i, a * i - c * g,
-                             b * g - a * h, b * f - c * e, c * d - a * f, a * e - b * d};
-        float sign = m_det3(m) < 0.0 ? -1.0f : 1.0f;
-        for (int k = 0; k < 9; k++) cof[k] = sign * cf[k];
-    }
+    if (nrm) xform_normal_cofactors(m, cof);
     for (size_t i = 0; i < npos; i++) {
-        vec3 q = m_point(m, pos[i]);
+        vec3 q = xform_point(m, pos[i]);
         if (!v3_finite(q)) return ctx_error(p->ctx, PK_ERR_PARSE, "%s: a transformed vertex is not finite", s->name);
         if ((st = scene_add_position(p->ctx, s, q))) return st;
         if (nrm) {
-            vec3 n = v3(cof[0] * nrm[i].x + cof[1] * nrm[i].y + cof[2] * nrm[i].z,
-                        cof[3] * nrm[i].x + cof[4] * nrm[i].y + cof[5] * nrm[i].z,
-                        cof[6] * nrm[i].x + cof[7] * nrm[i].y + cof[8] * nrm[i].z);
-            n = v3_norm_scaled(n);
+            vec3 n = v3_norm_scaled(xform_apply3(cof, nrm[i]));
             if (!v3_finite(n)) n = v3s(0.0f);
             if ((st = scene_add_normal(p->ctx, s, n))) return st;
         }
@@ -1610,7 +1544,7 @@ static pk_status add_mesh(xp *p, const vec3 *pos, const vec3 *nrm, const float *
 }
 
 /* The unit square [-1, 1]^2 at z = 0, facing +z. */
-static pk_status shape_rectangle(xp *p, const float m[16], bool flip, uint32_t mat)
+static pk_status shape_rectangle(xp *p, const xform *m, bool flip, uint32_t mat)
 {
     static const vec3 pos[4] = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
     static const uint32_t tris[6] = {0, 1, 2, 2, 3, 0};
@@ -1619,7 +1553,7 @@ static pk_status shape_rectangle(xp *p, const float m[16], bool flip, uint32_t m
 }
 
 /* The cube [-1, 1]^3, faces wound outward. */
-static pk_status shape_cube(xp *p, const float m[16], bool flip, uint32_t mat)
+static pk_status shape_cube(xp *p, const xform *m, bool flip, uint32_t mat)
 {
     vec3 pos[8];
     for (int i = 0; i < 8; i++) pos[i] = v3(i & 1 ? 1.0f : -1.0f, i & 2 ? 1.0f : -1.0f, i & 4 ? 1.0f : -1.0f);
@@ -1636,7 +1570,7 @@ static pk_status shape_cube(xp *p, const float m[16], bool flip, uint32_t mat)
 }
 
 /* The unit disk at z = 0, facing +z, as a fan of XML_DISK_SEGMENTS triangles. */
-static pk_status shape_disk(xp *p, const float m[16], bool flip, uint32_t mat)
+static pk_status shape_disk(xp *p, const xform *m, bool flip, uint32_t mat)
 {
     vec3 pos[XML_DISK_SEGMENTS + 1];
     float uv[2 * (XML_DISK_SEGMENTS + 1)];
@@ -1655,7 +1589,7 @@ static pk_status shape_disk(xp *p, const float m[16], bool flip, uint32_t mat)
 
 /* The unit sphere as a latitude-longitude mesh with vertex normals, wound
  * outward (inward with flip). */
-static pk_status shape_sphere_mesh(xp *p, const float m[16], bool flip, uint32_t mat)
+static pk_status shape_sphere_mesh(xp *p, const xform *m, bool flip, uint32_t mat)
 {
     enum { R = XML_SPHERE_RINGS, S = XML_SPHERE_SEGMENTS, NV = (R + 1) * (S + 1), NT = 2 * R * S };
     const pk_allocator *a = &p->ctx->alloc;
@@ -1753,7 +1687,7 @@ static void finish_mesh(xp *p, size_t t0, bool face_normals, bool flip)
     }
 }
 
-static pk_status shape_obj(xp *p, xnode *sh, const float m[16], bool flip, bool has_bsdf, uint32_t mat)
+static pk_status shape_obj(xp *p, xnode *sh, const xform *m, bool flip, bool has_bsdf, uint32_t mat)
 {
     pk_status st;
     const char *fn = NULL;
@@ -1793,7 +1727,7 @@ out:
     return st;
 }
 
-static pk_status shape_ply(xp *p, xnode *sh, const float m[16], bool flip, uint32_t mat)
+static pk_status shape_ply(xp *p, xnode *sh, const xform *m, bool flip, uint32_t mat)
 {
     pk_status st;
     const char *fn = NULL;
@@ -1852,8 +1786,8 @@ static pk_status parse_shape(xp *p, xnode *sh)
     if (st) return st;
     if (id && (st = id_add(p, id, sh))) return st;
 
-    float m[16];
-    if ((st = get_to_world(p, sh, m, NULL))) return st;
+    xform m;
+    if ((st = get_to_world(p, sh, &m, NULL))) return st;
     bool flip = false;
     if ((st = get_bool(p, sh, "flip_normals", &flip))) return st;
 
@@ -1934,13 +1868,13 @@ static pk_status parse_shape(xp *p, xnode *sh)
     /* Mitsuba orients an analytic shape's normal by the inverse transpose
      * of to_world, so a mirroring transform keeps it: the winding, which
      * such a transform reverses, is turned back. */
-    bool mirror = m_det3(m) < 0.0;
+    bool mirror = xform_det3(&m) < 0.0;
     switch (kind) {
-    case SH_OBJ: st = shape_obj(p, sh, m, flip, has_bsdf, mat); break;
-    case SH_PLY: st = shape_ply(p, sh, m, flip, mat); break;
-    case SH_RECT: st = shape_rectangle(p, m, flip != mirror, mat); break;
-    case SH_CUBE: st = shape_cube(p, m, flip != mirror, mat); break;
-    case SH_DISK: st = shape_disk(p, m, flip != mirror, mat); break;
+    case SH_OBJ: st = shape_obj(p, sh, &m, flip, has_bsdf, mat); break;
+    case SH_PLY: st = shape_ply(p, sh, &m, flip, mat); break;
+    case SH_RECT: st = shape_rectangle(p, &m, flip != mirror, mat); break;
+    case SH_CUBE: st = shape_cube(p, &m, flip != mirror, mat); break;
+    case SH_DISK: st = shape_disk(p, &m, flip != mirror, mat); break;
     case SH_SPHERE: {
         vec3 center = v3s(0.0f);
         float radius = 1.0f;
@@ -1948,20 +1882,18 @@ static pk_status parse_shape(xp *p, xnode *sh)
         if ((st = get_float(p, sh, "radius", &radius))) return st;
         if (!(radius > 0.0f)) return xfail(p, PK_ERR_PARSE, sh, "sphere: radius must be positive");
         /* to_world * translate(center) * scale(radius) */
-        float local[16], full[16];
-        m_identity(local);
-        local[0] = local[5] = local[10] = radius;
-        local[3] = center.x, local[7] = center.y, local[11] = center.z;
-        m_mul(m, local, full);
+        xform local = xform_scale(v3s(radius));
+        local.m[3] = center.x, local.m[7] = center.y, local.m[11] = center.z;
+        xform full = xform_mul(&m, &local);
         /* analytic when full is a similarity (rotation, uniform scale, translation) */
-        vec3 cx = v3(full[0], full[4], full[8]), cy = v3(full[1], full[5], full[9]);
-        vec3 cz = v3(full[2], full[6], full[10]);
+        vec3 cx = v3(full.m[0], full.m[4], full.m[8]), cy = v3(full.m[1], full.m[5], full.m[9]);
+        vec3 cz = v3(full.m[2], full.m[6], full.m[10]);
         float lx = v3_len(cx), ly = v3_len(cy), lz = v3_len(cz);
         float tol = 1e-4f * lx;
         bool similar = fabsf(lx - ly) <= tol && fabsf(lx - lz) <= tol && fabsf(v3_dot(cx, cy)) <= tol * lx &&
                        fabsf(v3_dot(cx, cz)) <= tol * lx && fabsf(v3_dot(cy, cz)) <= tol * lx;
         if (similar && !flip) {
-            sphere sp = {m_point(full, v3s(0.0f)), lx, mat};
+            sphere sp = {xform_point(&full, v3s(0.0f)), lx, mat};
             if (!v3_finite(sp.center) || !(sp.radius > 0.0f) || !isfinite(sp.radius))
                 return xfail(p, PK_ERR_PARSE, sh, "sphere: the transformed sphere is not finite");
             st = scene_add_sphere(p->ctx, p->s, &sp);
@@ -1969,7 +1901,7 @@ static pk_status parse_shape(xp *p, xnode *sh)
             if (!similar && first_time(p, "sphere-mesh"))
                 xwarn(p, sh, "sphere with a non-uniform to_world: tessellated into %d triangles",
                       2 * XML_SPHERE_SEGMENTS * (XML_SPHERE_RINGS - 1));
-            st = shape_sphere_mesh(p, full, flip != mirror, mat);
+            st = shape_sphere_mesh(p, &full, flip != mirror, mat);
         }
         break;
     }
@@ -2025,8 +1957,8 @@ static pk_status parse_emitter(xp *p, xnode *e)
         point_light l;
         vec3 pos = v3s(0.0f), intensity = v3s(1.0f);
         bool has_pos;
-        float m[16];
-        if ((st = get_to_world(p, e, m, NULL))) return st;
+        xform m;
+        if ((st = get_to_world(p, e, &m, NULL))) return st;
         if ((st = get_vec(p, e, "position", &pos, &has_pos))) return st;
         if ((st = get_color(p, e, "intensity", &intensity))) return st;
         if (type[0] == 's') {
@@ -2035,7 +1967,7 @@ static pk_status parse_emitter(xp *p, xnode *e)
             if ((st = get_float(p, e, "beam_width", &beam))) return st;
             xwarn(p, e, "spot light rendered as a point light shining in every direction");
         }
-        l.position = has_pos ? pos : m_point(m, v3s(0.0f));
+        l.position = has_pos ? pos : xform_point(&m, v3s(0.0f));
         l.intensity = intensity;
         if (!v3_finite(l.position) || !v3_finite(l.intensity))
             return xfail(p, PK_ERR_PARSE, e, "point light: position and intensity must be finite");
@@ -2050,11 +1982,12 @@ static pk_status parse_emitter(xp *p, xnode *e)
     } else if (strcmp(type, "envmap") == 0) {
         const char *fn = NULL;
         xnode *at;
-        float scale = 1.0f, m[16];
+        float scale = 1.0f;
+        xform m;
         if ((st = get_string(p, e, "filename", &fn, &at))) return st;
         if (!fn) return xfail(p, PK_ERR_PARSE, e, "envmap needs a filename");
         if ((st = get_float(p, e, "scale", &scale))) return st;
-        if ((st = get_to_world(p, e, m, NULL))) return st;
+        if ((st = get_to_world(p, e, &m, NULL))) return st;
         if (env->map) {
             xwarn(p, e, "a second envmap is not supported; ignored");
         } else {
@@ -2063,7 +1996,7 @@ static pk_status parse_emitter(xp *p, xnode *e)
             env->map_scale = scale;
             /* the rotation part, columns normalised (a scale means nothing here) */
             for (int c = 0; c < 3; c++) {
-                vec3 col = v3_norm_scaled(v3(m[c], m[4 + c], m[8 + c]));
+                vec3 col = v3_norm_scaled(v3(m.m[c], m.m[4 + c], m.m[8 + c]));
                 env->to_world[c] = col.x, env->to_world[3 + c] = col.y, env->to_world[6 + c] = col.z;
             }
             /* read now, so that a bad map is reported at its element */
@@ -2127,11 +2060,11 @@ static pk_status parse_emitter(xp *p, xnode *e)
     } else if (strcmp(type, "directional") == 0 || strcmp(type, "distant") == 0) {
         vec3 dir = v3(0.0f, 0.0f, 1.0f), irr = v3s(1.0f);
         bool has_dir;
-        float m[16];
+        xform m;
         bool has_m;
-        if ((st = get_to_world(p, e, m, &has_m))) return st;
+        if ((st = get_to_world(p, e, &m, &has_m))) return st;
         if ((st = get_vec(p, e, "direction", &dir, &has_dir))) return st;
-        if (!has_dir && has_m) dir = m_dir(m, v3(0.0f, 0.0f, 1.0f));
+        if (!has_dir && has_m) dir = xform_vector(&m, v3(0.0f, 0.0f, 1.0f));
         if ((st = get_color(p, e, "irradiance", &irr))) return st;
         if (!(v3_len2(dir) > 0.0f)) return xfail(p, PK_ERR_PARSE, e, "direction must not be zero");
         /* a sun of 0.1 degrees with the same irradiance */
@@ -2232,9 +2165,9 @@ static pk_status parse_sensor(xp *p, xnode *sn)
                 if (is_property_tag(c->tag) && strcmp(c->tag, "transform") != 0) c->used = true;
         }
     }
-    float m[16];
+    xform m;
     bool has_m;
-    if ((st = get_to_world(p, sn, m, &has_m))) return st;
+    if ((st = get_to_world(p, sn, &m, &has_m))) return st;
     float fov = XML_DEFAULT_FOV;
     xnode *fn = prop(p, sn, "fov");
     if (fn && (st = node_float(p, fn, &fov))) return st;
@@ -2254,10 +2187,10 @@ static pk_status parse_sensor(xp *p, xnode *sn)
     /* Mitsuba's camera looks along +z of its frame with +y up; its image x
      * runs along -x (so a right-handed frame has the image's right on the
      * right). */
-    vec3 o = m_point(m, v3s(0.0f));
-    vec3 fwd = v3_norm_scaled(m_dir(m, v3(0.0f, 0.0f, 1.0f)));
-    vec3 up = v3_norm_scaled(m_dir(m, v3(0.0f, 1.0f, 0.0f)));
-    vec3 right = v3_neg(m_dir(m, v3(1.0f, 0.0f, 0.0f)));
+    vec3 o = xform_point(&m, v3s(0.0f));
+    vec3 fwd = v3_norm_scaled(xform_vector(&m, v3(0.0f, 0.0f, 1.0f)));
+    vec3 up = v3_norm_scaled(xform_vector(&m, v3(0.0f, 1.0f, 0.0f)));
+    vec3 right = v3_neg(xform_vector(&m, v3(1.0f, 0.0f, 0.0f)));
     if (v3_dot(v3_cross(fwd, up), right) < 0.0f)
         xwarn(p, sn, "the camera's to_world mirrors the image; rendered unmirrored");
     vec3 at = v3_add(o, fwd);

@@ -9,6 +9,7 @@
 
 #include "../math/tri.h"
 #include "../math/vec3.h"
+#include "../math/xform.h"
 #include "../paprsek_internal.h"
 #include "texture.h"
 
@@ -207,10 +208,10 @@ static inline PK_HD void scene_tri_verts(const pk_scene *s, size_t k, vec3 *a, v
 
 /* Parses OBJ text into s, appending its triangles after those already there.
  * name: for messages; base_dir: where mtllib files are read from (NULL: not read).
- * xform: optional 4x4 row-major affine transform applied to positions (and its
- * inverse transpose to normals); NULL = identity. Does not commit. */
+ * xf: optional affine transform applied to positions (and its inverse
+ * transpose to normals); NULL = identity. Does not commit. */
 PK_HIDDEN pk_status obj_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,
-                              const char *name, const char *base_dir, const float *xform);
+                              const char *name, const char *base_dir, const xform *xf);
 /* Parses MTL text, adding its materials to s. Texture maps are parsed but
  * not loaded. */
 PK_HIDDEN pk_status mtl_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,

@@ -50,12 +50,12 @@ static pk_scene *new_scene(pk_context *ctx)
 /* Parses text from an exact-size heap copy (no NUL after it), so that a read
  * past the end shows under AddressSanitizer. */
 static pk_status parse_text(pk_context *ctx, pk_scene *s, const char *text, size_t len, const char *name,
-                            const float *xform)
+                            const xform *xf)
 {
     char *buf = malloc(len ? len : 1);
     REQUIRE(buf);
     memcpy(buf, text, len);
-    pk_status st = obj_parse(ctx, s, buf, len, name, PK_TEST_DATA, xform);
+    pk_status st = obj_parse(ctx, s, buf, len, name, PK_TEST_DATA, xf);
     free(buf);
     return st;
 }
@@ -65,7 +65,7 @@ static pk_status parse_str(pk_context *ctx, pk_scene *s, const char *text, const
     return parse_text(ctx, s, text, strlen(text), name, NULL);
 }
 
-static pk_status parse_file(pk_context *ctx, pk_scene *s, const char *dir, const char *file, const float *xform)
+static pk_status parse_file(pk_context *ctx, pk_scene *s, const char *dir, const char *file, const xform *xf)
 {
     char path[1024];
     if (snprintf(path, sizeof path, "%s/%s", dir, file) >= (int)sizeof path) return PK_ERR_INVALID_ARGUMENT;
@@ -73,7 +73,7 @@ static pk_status parse_file(pk_context *ctx, pk_scene *s, const char *dir, const
     size_t size;
     pk_status st = file_read_all(ctx, path, &data, &size);
     if (st != PK_OK) return st;
-    st = obj_parse(ctx, s, data, size, file, dir, xform);
+    st = obj_parse(ctx, s, data, size, file, dir, xf);
     mem_free(&ctx->alloc, data);
     return st;
 }
@@ -571,10 +571,10 @@ static void test_xform(void)
 {
     pk_context *ctx = new_ctx(NULL);
     /* scale x by 2, mirror z, then translate (1, 2, 3) */
-    const float m[16] = {2, 0, 0, 1, 0, 1, 0, 2, 0, 0, -1, 3, 0, 0, 0, 1};
+    const xform m = {{2, 0, 0, 1, 0, 1, 0, 2, 0, 0, -1, 3, 0, 0, 0, 1}};
     pk_scene *s = new_scene(ctx);
     const char *t = "v 1 1 1\nv 0 0 0\nv 1 0 0\nvn 1 1 0\nvn 0 0 1\nf 1//1 2//2 3//1\n";
-    CHECK(parse_text(ctx, s, t, strlen(t), "x.obj", m) == PK_OK);
+    CHECK(parse_text(ctx, s, t, strlen(t), "x.obj", &m) == PK_OK);
     REQUIRE(s->npositions == 3 && s->nnormals == 2);
     CHECK(s->positions[0].x == 3.0f && s->positions[0].y == 3.0f && s->positions[0].z == 2.0f);
     CHECK(s->positions[1].x == 1.0f && s->positions[1].y == 2.0f && s->positions[1].z == 3.0f);
@@ -586,25 +586,25 @@ static void test_xform(void)
     scene_destroy(s);
 
     /* A rotation about z by 90 degrees keeps normals rotating with the surface. */
-    const float r[16] = {0, -1, 0, 0, 1, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    const xform r = {{0, -1, 0, 0, 1, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}};
     s = new_scene(ctx);
     t = "vn 1 0 0\n";
-    CHECK(parse_text(ctx, s, t, strlen(t), "r.obj", r) == PK_OK);
+    CHECK(parse_text(ctx, s, t, strlen(t), "r.obj", &r) == PK_OK);
     CHECK_NEAR(s->normals[0].x, 0.0, 1e-7);
     CHECK_NEAR(s->normals[0].y, 1.0, 1e-7);
     scene_destroy(s);
 
-    const float sing[16] = {1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    const xform sing = {{1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}};
     s = new_scene(ctx);
-    CHECK(parse_text(ctx, s, t, strlen(t), "sing.obj", sing) == PK_ERR_INVALID_ARGUMENT);
+    CHECK(parse_text(ctx, s, t, strlen(t), "sing.obj", &sing) == PK_ERR_INVALID_ARGUMENT);
     CHECKF(strcmp(pk_context_error(ctx), "sing.obj: transform is singular") == 0, "%s", pk_context_error(ctx));
     pk_context_clear_error(ctx);
     scene_destroy(s);
 
-    const float huge[16] = {1e30f, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    const xform huge = {{1e30f, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}};
     s = new_scene(ctx);
     t = "v 1e10 0 0\n";
-    CHECK(parse_text(ctx, s, t, strlen(t), "huge.obj", huge) == PK_ERR_PARSE);
+    CHECK(parse_text(ctx, s, t, strlen(t), "huge.obj", &huge) == PK_ERR_PARSE);
     CHECKF(strcmp(pk_context_error(ctx), "huge.obj:1: transformed vertex is not finite") == 0, "%s",
            pk_context_error(ctx));
     pk_context_clear_error(ctx);
