@@ -127,6 +127,11 @@ typedef struct pk_camera {
     float fov_deg;
 } pk_camera;
 
+/* Sets every field to its default: at the origin, looking along -z
+ * (look_at 0,0,-1), up +y, fov_deg 45. Start from it, then set what you
+ * need, so that fields added in later versions get their defaults. */
+PK_API void pk_camera_init(pk_camera *cam);
+
 typedef enum pk_accel_kind {
     PK_ACCEL_DEFAULT = 0,  /* the best built in (PK_ACCEL_BVH) */
     PK_ACCEL_NONE = 1,     /* every ray tests every primitive */

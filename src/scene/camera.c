@@ -3,6 +3,8 @@
  */
 #include "camera.h"
 
+#include <string.h>
+
 camera_problem camera_check(const pk_camera *cam)
 {
     vec3 from = v3(cam->look_from[0], cam->look_from[1], cam->look_from[2]);
@@ -41,6 +43,13 @@ pk_status camera_validate(pk_context *ctx, const pk_camera *cam, const char *wha
     return PK_ERR_INVALID_ARGUMENT;
 }
 
+void pk_camera_init(pk_camera *cam)
+{
+    if (!cam) return;
+    const pk_camera k = {{0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, -1.0f}, {0.0f, 1.0f, 0.0f}, 45.0f};
+    *cam = k;
+}
+
 void scene_camera(const pk_scene *s, pk_camera *cam)
 {
     if (s->has_camera) {
@@ -56,6 +65,9 @@ void scene_camera(const pk_scene *s, pk_camera *cam)
     float half = 0.5f * fmaxf(e.x, e.y) * 1.08f;
     if (!(half > 0.0f)) half = fmaxf(0.5f * e.z, 1.0f);
     float dist = half / tanf(0.5f * fov * PK_PI / 180.0f) + 0.5f * e.z;
-    pk_camera k = {{c.x, c.y, c.z + dist}, {c.x, c.y, c.z}, {0.0f, 1.0f, 0.0f}, fov};
-    *cam = k;
+    pk_camera_init(cam);
+    const float from[3] = {c.x, c.y, c.z + dist}, at[3] = {c.x, c.y, c.z};
+    memcpy(cam->look_from, from, sizeof from);
+    memcpy(cam->look_at, at, sizeof at);
+    cam->fov_deg = fov;
 }
