@@ -17,6 +17,7 @@
 #include "../options.h"
 #include "../scene/camera.h"
 #include "../scene/scene.h"
+#include "../scene/spectra.h"
 #include "../scene/texture.h"
 
 #include <expat.h>
@@ -614,54 +615,6 @@ static float srgb_to_linear(float c)
     return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
 }
 
-/* CIE 1931 colour matching functions, the multi-lobe Gaussian fit of Wyman,
- * Sloan and Shirley (2013). */
-static float gauss_lobe(float x, float mu, float s1, float s2)
-{
-    float t = (x - mu) / (x < mu ? s1 : s2);
-    return expf(-0.5f * t * t);
-}
-
-static void cie_xyz(float nm, float *x, float *y, float *z)
-{
-    *x = 1.056f * gauss_lobe(nm, 599.8f, 37.9f, 31.0f) + 0.362f * gauss_lobe(nm, 442.0f, 16.0f, 26.7f) -
-         0.065f * gauss_lobe(nm, 501.1f, 20.4f, 26.2f);
-    *y = 0.821f * gauss_lobe(nm, 568.8f, 46.9f, 40.5f) + 0.286f * gauss_lobe(nm, 530.9f, 16.3f, 31.1f);
-    *z = 1.217f * gauss_lobe(nm, 437.0f, 11.8f, 36.0f) + 0.681f * gauss_lobe(nm, 459.0f, 26.0f, 13.8f);
-}
-
-/* Linear sRGB of a spectrum given as samples (nm ascending, value), linear
- * between them and constant beyond: XYZ by the colour matching functions
- * over 360..830 nm, then the sRGB matrix, divided per channel by what a
- * constant spectrum of 1 gives, so that a flat reflectance of r is grey r. */
-static vec3 spectrum_to_rgb(const float *nm, const float *val, int n)
-{
-    double X = 0, Y = 0, Z = 0, X1 = 0, Y1 = 0, Z1 = 0;
-    int j = 0;
-    for (float l = 360.0f; l <= 830.0f; l += 1.0f) {
-        while (j + 1 < n && nm[j + 1] < l) j++;
-        float v;
-        if (l <= nm[0]) v = val[0];
-        else if (l >= nm[n - 1]) v = val[n - 1];
-        else {
-            float t = (l - nm[j]) / (nm[j + 1] - nm[j]);
-            v = val[j] + t * (val[j + 1] - val[j]);
-        }
-        float x, y, z;
-        cie_xyz(l, &x, &y, &z);
-        X += (double)(x * v), Y += (double)(y * v), Z += (double)(z * v);
-        X1 += (double)x, Y1 += (double)y, Z1 += (double)z;
-    }
-    const double m[9] = {3.2404542, -1.5371385, -0.4985314, -0.9692660, 1.8760108,
-                         0.0415560, 0.0556434,  -0.2040259, 1.0572252};
-    double c[3], w[3];
-    for (int i = 0; i < 3; i++) {
-        c[i] = m[3 * i] * X + m[3 * i + 1] * Y + m[3 * i + 2] * Z;
-        w[i] = m[3 * i] * X1 + m[3 * i + 1] * Y1 + m[3 * i + 2] * Z1;
-    }
-    return v3((float)fmax(c[0] / w[0], 0.0), (float)fmax(c[1] / w[1], 0.0), (float)fmax(c[2] / w[2], 0.0));
-}
-
 /* <spectrum value="..."/>: one number (grey), three numbers (RGB, as
  * Mitsuba 0.x's RGB mode reads them) or wavelength:value pairs. */
 static pk_status node_spectrum(xp *p, const xnode *n, vec3 *out)
@@ -722,8 +675,7 @@ static int hexval(char c)
     return -1;
 }
 
-/* <blackbody temperature="5000K" scale=/>: Planck's spectral radiance of
- * that temperature in W m^-2 sr^-1 nm^-1, reduced to RGB like a spectrum. */
+/* <blackbody temperature="5000K" scale=/>: blackbody_rgb (spectra.h) times scale. */
 static pk_status node_blackbody(xp *p, const xnode *n, vec3 *out)
 {
     pk_status st;
@@ -742,15 +694,7 @@ static pk_status node_blackbody(xp *p, const xnode *n, vec3 *out)
         int k;
         if ((st = numbers(p, n, "scale", sc, &scale, 1, &k))) return st;
     }
-    enum { N = 95 };
-    float nm[N], val[N];
-    for (int i = 0; i < N; i++) {
-        double l = (360.0 + 5.0 * i) * 1e-9, h = 6.62607015e-34, c = 299792458.0, kb = 1.380649e-23;
-        double b = 2.0 * h * c * c / (l * l * l * l * l) / expm1(h * c / (l * kb * (double)kelvin));
-        nm[i] = (float)(360.0 + 5.0 * i);
-        val[i] = (float)(b * 1e-9); /* per metre -> per nanometre */
-    }
-    *out = v3_scale(spectrum_to_rgb(nm, val, N), scale);
+    *out = v3_scale(blackbody_rgb(kelvin), scale);
     if (!v3_finite(*out)) return xfail(p, PK_ERR_PARSE, n, "<blackbody> radiance is not finite");
     return PK_OK;
 }
@@ -1060,36 +1004,6 @@ static pk_status get_to_world(xp *p, xnode *plugin, xform *m, bool *found)
 
 /* ---- materials ------------------------------------------------------------------------------- */
 
-typedef struct metal {
-    const char *name;
-    float eta[3], k[3];
-} metal;
-
-/* Complex indices of refraction of a few metals at the red, green and blue
- * primaries (docs/scene-format.md); the names of Mitsuba's material table. */
-static const metal metals[] = {
-    {"Cu", {0.200438f, 0.924033f, 1.10221f}, {3.91295f, 2.45285f, 2.14219f}},
-    {"Au", {0.143119f, 0.374957f, 1.44248f}, {3.98316f, 2.38572f, 1.60322f}},
-    {"Ag", {0.155265f, 0.116723f, 0.138342f}, {4.82835f, 3.12225f, 2.14696f}},
-    {"Al", {1.65746f, 0.880369f, 0.521229f}, {9.22387f, 6.26952f, 4.837f}},
-    {"Cr", {4.36968f, 2.9167f, 1.6547f}, {5.20643f, 4.23136f, 3.75495f}},
-};
-
-typedef struct ior_name {
-    const char *name;
-    float ior;
-} ior_name;
-
-/* Mitsuba's named indices of refraction. */
-static const ior_name iors[] = {
-    {"vacuum", 1.0f},         {"helium", 1.000036f},     {"hydrogen", 1.000132f},     {"air", 1.000277f},
-    {"carbon dioxide", 1.00045f}, {"water", 1.3330f},    {"acetone", 1.36f},          {"ethanol", 1.361f},
-    {"carbon tetrachloride", 1.461f}, {"glycerol", 1.4729f}, {"benzene", 1.501f},     {"silicone oil", 1.52045f},
-    {"bromine", 1.661f},      {"water ice", 1.31f},      {"fused quartz", 1.458f},    {"pyrex", 1.470f},
-    {"acrylic glass", 1.49f}, {"polypropylene", 1.49f},  {"bk7", 1.5046f},            {"sodium chloride", 1.544f},
-    {"amber", 1.55f},         {"pet", 1.5750f},          {"diamond", 2.419f},
-};
-
 /* An index of refraction: a number or one of Mitsuba's names. */
 static pk_status get_ior(xp *p, xnode *plugin, const char *name, float *out)
 {
@@ -1099,11 +1013,7 @@ static pk_status get_ior(xp *p, xnode *plugin, const char *name, float *out)
     if (strcmp(c->tag, "string") == 0) {
         const char *v;
         if ((st = value_attr(p, c, &v))) return st;
-        for (size_t i = 0; i < sizeof iors / sizeof iors[0]; i++)
-            if (strcmp(iors[i].name, v) == 0) {
-                *out = iors[i].ior;
-                return PK_OK;
-            }
+        if (spectra_named_ior(v, out)) return PK_OK;
         float f;
         const char *e = v + strlen(v);
         if (io_parse_float(v, e, &f) == e && f > 0.0f && isfinite(f)) { /* a number written as a string */
@@ -1304,13 +1214,8 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
         xnode *mat_at;
         if ((st = get_string(p, b, "material", &mat, &mat_at))) return st;
         if (mat) {
-            size_t i = 0;
-            while (i < sizeof metals / sizeof metals[0] && strcmp(metals[i].name, mat) != 0) i++;
             if (strcmp(mat, "none") == 0) none = true;
-            else if (i < sizeof metals / sizeof metals[0]) {
-                eta = v3(metals[i].eta[0], metals[i].eta[1], metals[i].eta[2]);
-                k = v3(metals[i].k[0], metals[i].k[1], metals[i].k[2]);
-            } else {
+            else if (!spectra_named_metal(mat, &eta, &k)) {
                 char sm[40];
                 shown(sm, sizeof sm, mat);
                 xwarn(p, mat_at, "conductor material \"%s\" is not in the table (Cu, Au, Ag, Al, Cr, none); using Cu",
