@@ -84,6 +84,25 @@ int main(void)
     REQUIRE(pk_scene_load_json_memory(ctx, json, strlen(json), "direct.json", PK_TEST_DATA, &s) == PK_OK);
     check("floor, spheres, two-sided lamp", s);
     pk_scene_destroy(s);
+    /* Every kind of light at once, as the Whitted integrator samples them from
+     * the one light set (by power, stratified) and the path tracer too: a
+     * two-sided lamp, two point lights of different power, a constant
+     * environment and the sun. */
+    const char *mixed =
+        "{\"materials\": {\"white\": {\"kd\": [0.7, 0.7, 0.7]}, \"red\": {\"kd\": [0.6, 0.1, 0.1]},"
+        " \"lamp\": {\"kd\": [0.3, 0.3, 0.3], \"ke\": [4, 3.5, 3], \"two_sided\": true}},"
+        " \"camera\": {\"look_from\": [0, 1.5, 4], \"look_at\": [0, 0.5, 0], \"fov\": 45},"
+        " \"meshes\": [{\"obj\": \"json_floor.obj\", \"transform\": {\"scale\": [4, 1, 4]}},"
+        "   {\"obj\": \"json_lamp.obj\", \"transform\": {\"translate\": [0.4, 1.6, 0], \"scale\": [0.5, 1, 0.5]}}],"
+        " \"spheres\": [{\"center\": [-0.4, 0.5, 0], \"radius\": 0.5, \"material\": \"red\"},"
+        "   {\"center\": [0.7, 0.25, 0.6], \"radius\": 0.25, \"material\": \"white\"}],"
+        " \"lights\": [{\"position\": [-1.5, 2, 1], \"intensity\": 3},"
+        "   {\"position\": [1.5, 1.2, 1.5], \"intensity\": 1, \"color\": [1, 0.6, 0.3]}],"
+        " \"environment\": {\"radiance\": [0.2, 0.25, 0.3],"
+        "   \"sun\": {\"direction\": [1, 2, 1], \"irradiance\": [1, 1, 1], \"angle\": 2}}}";
+    REQUIRE(pk_scene_load_json_memory(ctx, mixed, strlen(mixed), "mixed.json", PK_TEST_DATA, &s) == PK_OK);
+    check("lamp, point lights, environment and sun", s);
+    pk_scene_destroy(s);
     pk_context_destroy(ctx);
     return test_done("test_direct");
 }
