@@ -331,3 +331,11 @@ void io_warn_unknown(io_reader *r, const char *kw, size_t len)
     snprintf(what, sizeof what, "unknown statement '%.*s' ignored", len > 40 ? 40 : (int)len, kw);
     io_warn_once(r, kw, len, what);
 }
+
+bool io_demote_error(pk_context *ctx, pk_status st, bool was_ok, char *why, size_t nwhy)
+{
+    if (st == PK_OK || st == PK_ERR_NOMEM || !was_ok) return false;
+    snprintf(why, nwhy, "%s", ctx->message);
+    pk_context_clear_error(ctx);
+    return true;
+}

@@ -89,6 +89,16 @@ PK_HIDDEN void io_warn_unknown(io_reader *r, const char *kw, size_t len);
 /* Same, with a caller's text after the kind: "name:line: <what> ..." once per kind. */
 PK_HIDDEN void io_warn_once(io_reader *r, const char *kind, size_t len, const char *what);
 
+/* A soft failure: something a reader can do without (a texture, a material
+ * library) failed with st. When st is a failure other than PK_ERR_NOMEM and
+ * the context held no error before the attempt (was_ok: ctx->status was
+ * PK_OK), the latched message is moved into why (nwhy bytes; PK_ERRMSG_MAX
+ * holds any), the error is cleared and true returned: the caller warns with
+ * why, saying where and what is used instead, and goes on. Otherwise false:
+ * st stands (out of memory, or an earlier error that is not the reader's to
+ * clear). */
+PK_HIDDEN bool io_demote_error(pk_context *ctx, pk_status st, bool was_ok, char *why, size_t nwhy);
+
 /* Printing width for a token in a message (long tokens are cut). */
 static inline int io_tok_len(const char *s, const char *e)
 {

@@ -237,12 +237,12 @@ static pk_status parse_map(mtl_state *st, const char *kw, size_t kn, const char 
             io_warn_once(r, "bump normal map", 15, "a bump map that holds normals (bluish RGB) is read as a normal map");
         }
         *ref = nr;
-    } else if (rc != PK_ERR_NOMEM && was_ok) {
+    } else {
         char why[PK_ERRMSG_MAX];
-        snprintf(why, sizeof why, "%s", ctx->message);
-        pk_context_clear_error(ctx);
-        io_warn(r, "texture '%s' not used (%s); %s", rel, why, constant);
-        rc = PK_OK;
+        if (io_demote_error(ctx, rc, was_ok, why, sizeof why)) {
+            io_warn(r, "texture '%s' not used (%s); %s", rel, why, constant);
+            rc = PK_OK;
+        }
     }
     mem_free(&ctx->alloc, path);
     mem_free(&ctx->alloc, rel);

@@ -242,12 +242,12 @@ static pk_status read_library(obj_state *st, const char *rel)
         rc = dir ? mtl_parse_dir(r->ctx, st->s, data, size, rel, dir) : ctx_nomem(r->ctx);
         mem_free(&r->ctx->alloc, dir);
         mem_free(&r->ctx->alloc, data);
-    } else if (rc != PK_ERR_NOMEM && was_ok) {
+    } else {
         char why[PK_ERRMSG_MAX];
-        snprintf(why, sizeof why, "%s", r->ctx->message);
-        pk_context_clear_error(r->ctx);
-        io_warn(r, "cannot read material library '%s' (%s); its materials are not defined", rel, why);
-        rc = PK_OK;
+        if (io_demote_error(r->ctx, rc, was_ok, why, sizeof why)) {
+            io_warn(r, "cannot read material library '%s' (%s); its materials are not defined", rel, why);
+            rc = PK_OK;
+        }
     }
     mem_free(&r->ctx->alloc, path);
     return rc;

@@ -6,6 +6,7 @@
  * so a line is found by a scan of the text that numbers values in the same
  * pre-order as the parsed tree.
  */
+#include "io_util.h"
 #include "../math/xform.h"
 #include "../options.h"
 #include "../scene/camera.h"
@@ -346,14 +347,14 @@ static pk_status get_texture(jp *p, const cJSON *it, const char *path, bool colo
         r.tex = idx;
         *ref = r;
         *loaded = true;
-    } else if (st != PK_ERR_NOMEM && was_ok) {
+    } else {
         char why[PK_ERRMSG_MAX], name[128];
-        snprintf(why, sizeof why, "%s", p->ctx->message);
-        sanitize(name, sizeof name, f[TX_TEXTURE]->valuestring);
-        pk_context_clear_error(p->ctx);
-        ctx_warn(p->ctx, "%s:%d: %s: texture '%s' not used (%s); the constant value is used", p->name,
-                 item_line(p, f[TX_TEXTURE]), fp, name, why);
-        st = PK_OK;
+        if (io_demote_error(p->ctx, st, was_ok, why, sizeof why)) {
+            sanitize(name, sizeof name, f[TX_TEXTURE]->valuestring);
+            ctx_warn(p->ctx, "%s:%d: %s: texture '%s' not used (%s); the constant value is used", p->name,
+                     item_line(p, f[TX_TEXTURE]), fp, name, why);
+            st = PK_OK;
+        }
     }
     return st;
 }

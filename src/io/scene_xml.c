@@ -765,11 +765,9 @@ static pk_status texture_param(xp *p, const xnode *tex, const char *param, const
         int32_t idx;
         const bool was_ok = p->ctx->status == PK_OK;
         pk_status st = texture_load(p->ctx, p->s, file, true, &idx);
-        if (st == PK_ERR_NOMEM) return st;
         if (st != PK_OK) {
             char why[PK_ERRMSG_MAX];
-            snprintf(why, sizeof why, "%s", p->ctx->message);
-            if (was_ok) pk_context_clear_error(p->ctx);
+            if (!io_demote_error(p->ctx, st, was_ok, why, sizeof why)) return st;
             xwarn(p, tex, "texture not used (%s); using the constant %g %g %g for %s", why, (double)fallback.x,
                   (double)fallback.y, (double)fallback.z, what);
             return PK_OK;
