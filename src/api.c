@@ -9,6 +9,7 @@
 #include "accel/accel.h"
 #include "image/image.h"
 #include "image/image_write.h"
+#include "io/readers.h"
 #include "render/render.h"
 #include "scene/camera.h"
 #include "scene/scene.h"

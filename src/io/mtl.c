@@ -8,6 +8,7 @@
  * as several exporters write them differently.
  */
 #include "io_util.h"
+#include "readers.h"
 #include "../scene/scene.h"
 
 #include <math.h>

@@ -6,6 +6,7 @@
  * once per kind.
  */
 #include "io_util.h"
+#include "readers.h"
 #include "../scene/scene.h"
 
 #include <math.h>

@@ -1,7 +1,7 @@
 /*
  * ply.c - the PLY reader of ply.h.
  */
-#include "ply.h"
+#include "readers.h"
 
 #include "io_util.h"
 

@@ -7,6 +7,7 @@
  * pre-order as the parsed tree.
  */
 #include "io_util.h"
+#include "readers.h"
 #include "../math/xform.h"
 #include "../options.h"
 #include "../scene/camera.h"

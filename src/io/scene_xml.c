@@ -12,7 +12,7 @@
  * context's allocator.
  */
 #include "io_util.h"
-#include "ply.h"
+#include "readers.h"
 #include "../math/xform.h"
 #include "../options.h"
 #include "../scene/camera.h"

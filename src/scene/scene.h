@@ -9,7 +9,6 @@
 
 #include "../math/tri.h"
 #include "../math/vec3.h"
-#include "../math/xform.h"
 #include "../paprsek_internal.h"
 #include "texture.h"
 
@@ -204,32 +203,8 @@ static inline PK_HD void scene_tri_verts(const pk_scene *s, size_t k, vec3 *a, v
     *c = s->positions[t->v[2]];
 }
 
-/* ---- loaders (io/) ----------------------------------------------------- */
+/* ---- the built-in scene (the file readers are in io/readers.h) ---- */
 
-/* Parses OBJ text into s, appending its triangles after those already there.
- * name: for messages; base_dir: where mtllib files are read from (NULL: not read).
- * xf: optional affine transform applied to positions (and its inverse
- * transpose to normals); NULL = identity. Does not commit. */
-PK_HIDDEN pk_status obj_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,
-                              const char *name, const char *base_dir, const xform *xf);
-/* Parses MTL text, adding its materials to s. Texture maps are parsed but
- * not loaded. */
-PK_HIDDEN pk_status mtl_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,
-                              const char *name);
-/* The same, loading the texture maps from files relative to tex_dir (NULL:
- * not loaded). A texture that cannot be used is a warning. */
-PK_HIDDEN pk_status mtl_parse_dir(pk_context *ctx, pk_scene *s, const char *data, size_t size,
-                                  const char *name, const char *tex_dir);
-/* Parses a JSON scene into s (meshes are loaded relative to base_dir). Does not commit. */
-PK_HIDDEN pk_status scene_json_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,
-                                     const char *name, const char *base_dir);
-/* Parses a Mitsuba XML scene into s (files are read relative to base_dir;
- * docs/scene-format.md, "Mitsuba XML"). params (nparams strings
- * "name=value", may be NULL) set $name before the file's <default>s, which
- * then do not change them. Does not commit. */
-PK_HIDDEN pk_status scene_xml_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,
-                                    const char *name, const char *base_dir, const char *const *params,
-                                    size_t nparams);
 /* Fills s with the built-in Cornell box. Does not commit. */
 PK_HIDDEN pk_status scene_build_cornell(pk_context *ctx, pk_scene *s);
 

@@ -3,6 +3,7 @@
  * can name real files. */
 #include "fuzz.h"
 
+#include "io/readers.h"
 #include "scene/scene.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)

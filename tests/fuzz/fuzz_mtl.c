@@ -1,6 +1,7 @@
 /* fuzz_mtl.c - the MTL parser through its (buffer, size) entry point. */
 #include "fuzz.h"
 
+#include "io/readers.h"
 #include "scene/scene.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)

@@ -2,6 +2,7 @@
  * the scene commit; mtllib files are looked up in tests/data. */
 #include "fuzz.h"
 
+#include "io/readers.h"
 #include "scene/scene.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)

@@ -6,6 +6,7 @@
  */
 #include "test.h"
 
+#include "io/readers.h"
 #include "scene/scene.h"
 
 #define NAME "scene.json"

@@ -6,6 +6,7 @@
  * shared Cornell boxes, the bunny and Sponza (with a load-time print).
  */
 #include "io/io_util.h"
+#include "io/readers.h"
 #include "scene/scene.h"
 #include "test.h"
 

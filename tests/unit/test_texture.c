@@ -14,6 +14,7 @@
 #include "image/image_read.h"
 #include "render/frame.h"
 #include "render/surface.h"
+#include "io/readers.h"
 #include "scene/scene.h"
 #include "scene/texture.h"
 

@@ -7,7 +7,7 @@
  */
 #include "test.h"
 
-#include "io/ply.h"
+#include "io/readers.h"
 #include "scene/scene.h"
 #include "scene/texture.h"
 

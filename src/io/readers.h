@@ -1,0 +1,63 @@
+/*
+ * readers.h - the scene file readers, one door each: OBJ (obj.c) and its MTL
+ * libraries (mtl.c), the JSON scene (scene_json.c), Mitsuba XML
+ * (scene_xml.c) and the PLY meshes it names (ply.c). Every reader parses a
+ * (data, size) buffer, reads any further file through file_read_all, and
+ * reports a bad input as "file:line: what is wrong" latched in the context;
+ * none prints, exits or commits the scene.
+ */
+#ifndef PK_READERS_H
+#define PK_READERS_H
+
+#include "../math/vec3.h"
+#include "../math/xform.h"
+#include "../paprsek_internal.h"
+#include "../scene/scene.h"
+
+/* Parses OBJ text into s, appending its triangles after those already there.
+ * name: for messages; base_dir: where mtllib files are read from (NULL: not read).
+ * xf: optional affine transform applied to positions (and its inverse
+ * transpose to normals); NULL = identity. Does not commit. */
+PK_HIDDEN pk_status obj_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,
+                              const char *name, const char *base_dir, const xform *xf);
+/* Parses MTL text, adding its materials to s. Texture maps are parsed but
+ * not loaded. */
+PK_HIDDEN pk_status mtl_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,
+                              const char *name);
+/* The same, loading the texture maps from files relative to tex_dir (NULL:
+ * not loaded). A texture that cannot be used is a warning. */
+PK_HIDDEN pk_status mtl_parse_dir(pk_context *ctx, pk_scene *s, const char *data, size_t size,
+                                  const char *name, const char *tex_dir);
+/* Parses a JSON scene into s (meshes are loaded relative to base_dir). Does not commit. */
+PK_HIDDEN pk_status scene_json_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,
+                                     const char *name, const char *base_dir);
+/* Parses a Mitsuba XML scene into s (files are read relative to base_dir;
+ * docs/scene-format.md, "Mitsuba XML"). params (nparams strings
+ * "name=value", may be NULL) set $name before the file's <default>s, which
+ * then do not change them. Does not commit. */
+PK_HIDDEN pk_status scene_xml_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,
+                                    const char *name, const char *base_dir, const char *const *params,
+                                    size_t nparams);
+
+/* ---- PLY meshes (Stanford polygon files): ascii, binary little and big
+ * endian; vertex positions, optional normals and texture coordinates, and
+ * faces as lists of vertex indices (fan-triangulated). Other elements and
+ * properties are read past and ignored. Bounded by the size of the data:
+ * no count is believed beyond what the bytes can hold. ---- */
+
+typedef struct ply_mesh {
+    vec3 *positions;      /* nvertices */
+    vec3 *normals;        /* nvertices, or NULL when the file has none */
+    float *uvs;           /* 2 * nvertices, or NULL when the file has none */
+    size_t nvertices;
+    uint32_t *indices;    /* 3 * ntriangles, each < nvertices */
+    size_t ntriangles;
+} ply_mesh;
+
+/* Parses a PLY file held in (data, size) into *out (zeroed first; free it
+ * with ply_mesh_free, also after a failure). name is used in messages
+ * ("name: what" or "name:line: what" in the header). */
+PK_HIDDEN pk_status ply_parse(pk_context *ctx, const char *data, size_t size, const char *name, ply_mesh *out);
+PK_HIDDEN void ply_mesh_free(pk_context *ctx, ply_mesh *m);
+
+#endif
