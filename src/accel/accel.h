@@ -65,7 +65,12 @@ struct accel {
 
 /* Builds kind over in. Errors (NOMEM, UNSUPPORTED) are latched in ctx. */
 PK_HIDDEN pk_status accel_create(pk_context *ctx, pk_accel_kind kind, const accel_input *in, accel **out);
-PK_HIDDEN void accel_destroy(accel *a);
+/* Inline, so that an accelerator built on another (cuda.c on the BVH)
+ * needs nothing of registry.c. NULL is ignored. */
+static inline void accel_destroy(accel *a)
+{
+    if (a) a->ops->destroy(a);
+}
 
 static inline bool accel_intersect(const accel *a, const ray *r, hit *h, accel_counters *c)
 {

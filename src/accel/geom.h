@@ -33,8 +33,17 @@ typedef struct hit {
     float u, v;
 } hit;
 
+/* The public records are cast to these (api.c, cuda.c, bvh_gpu.h): the same
+ * fields at the same offsets. */
 _Static_assert(sizeof(ray) == 32 && sizeof(pk_ray) == 32, "ray layout");
+_Static_assert(offsetof(ray, o) == offsetof(pk_ray, org) && offsetof(ray, tmin) == offsetof(pk_ray, tmin) &&
+                   offsetof(ray, d) == offsetof(pk_ray, dir) && offsetof(ray, tmax) == offsetof(pk_ray, tmax) &&
+                   sizeof(vec3) == 3 * sizeof(float),
+               "ray fields at pk_ray's offsets");
 _Static_assert(sizeof(hit) == 16 && sizeof(pk_hit) == 16, "hit layout");
+_Static_assert(offsetof(hit, t) == offsetof(pk_hit, t) && offsetof(hit, prim) == offsetof(pk_hit, prim) &&
+                   offsetof(hit, u) == offsetof(pk_hit, u) && offsetof(hit, v) == offsetof(pk_hit, v),
+               "hit fields at pk_hit's offsets");
 
 static inline PK_HD void hit_clear(hit *h)
 {

@@ -28,11 +28,6 @@ pk_status accel_create(pk_context *ctx, pk_accel_kind kind, const accel_input *i
     return st;
 }
 
-void accel_destroy(accel *a)
-{
-    if (a) a->ops->destroy(a);
-}
-
 void accel_intersect_many(const accel *a, const ray *r, hit *h, size_t n, bool any_hit, accel_counters *c)
 {
     if (a->ops->intersect_packet) {

@@ -13,7 +13,6 @@
  */
 #include "io_util.h"
 #include "readers.h"
-#include "scene_build.h"
 #include "../math/xform.h"
 #include "../options.h"
 #include "../scene/camera.h"
@@ -106,7 +105,6 @@ typedef struct xp {
     /* where the colour property being read may put a texture (the diffuse
      * reflectances); NULL: textures stand in as constants */
     tex_ref *want_tex;
-    scene_builder sb;     /* every shape's triangles go in through it */
 } xp;
 
 /* expat's side of building one tree */
@@ -1406,17 +1404,46 @@ static void warn_unused(xp *p, xnode *plugin, const char *kind, const char *cons
 
 /* ---- meshes ---------------------------------------------------------------------------------- */
 
-/* Appends triangles (tris: 3 indices each into pos) transformed by m, with
- * material mat (sb_add_mesh). flip reverses the winding; normals (optional,
- * local) are transformed by the inverse transpose; uv (optional) holds 2
- * texture coordinates a vertex. */
+/* Appends triangles (tris: 3 indices each into pos) transformed by m.
+ * flip reverses the winding; normals (optional, local) are transformed by
+ * the inverse transpose; uv (optional) holds 2 texture coordinates a vertex. */
 static pk_status add_mesh(xp *p, const vec3 *pos, const vec3 *nrm, const float *uv, size_t npos, const uint32_t *tris,
                           size_t ntris, const xform *m, bool flip, uint32_t mat)
 {
-    sb_set_transform(&p->sb, m);
-    sb_set_material(&p->sb, mat);
-    const sb_mesh mesh = {pos, nrm, uv, npos, tris, ntris, flip};
-    return sb_add_mesh(&p->sb, &mesh);
+    pk_scene *s = p->s;
+    size_t pbase = s->npositions, nbase = s->nnormals, tbase = s->nuvs;
+    pk_status st;
+    float cof[9] = {0};
+    if (nrm) xform_normal_cofactors(m, cof);
+    for (size_t i = 0; i < npos; i++) {
+        vec3 q = xform_point(m, pos[i]);
+        if (!v3_finite(q)) return ctx_error(p->ctx, PK_ERR_PARSE, "%s: a transformed vertex is not finite", s->name);
+        if ((st = scene_add_position(p->ctx, s, q))) return st;
+        if (nrm) {
+            vec3 n = v3_norm_scaled(xform_apply3(cof, nrm[i]));
+            if (!v3_finite(n)) n = v3s(0.0f);
+            if ((st = scene_add_normal(p->ctx, s, n))) return st;
+        }
+        if (uv) {
+            uv2 t = {uv[2 * i], uv[2 * i + 1]};
+            if (!isfinite(t.u) || !isfinite(t.v)) t.u = t.v = 0.0f;
+            if ((st = scene_add_uv(p->ctx, s, t))) return st;
+        }
+    }
+    for (size_t t = 0; t < ntris; t++) {
+        triangle tr;
+        uint32_t a = tris[3 * t], b = tris[3 * t + 1], c = tris[3 * t + 2];
+        if (flip) {
+            uint32_t x = b;
+            b = c, c = x;
+        }
+        tr.v[0] = (uint32_t)(pbase + a), tr.v[1] = (uint32_t)(pbase + b), tr.v[2] = (uint32_t)(pbase + c);
+        for (int k = 0; k < 3; k++) tr.n[k] = nrm ? (int32_t)(nbase + tr.v[k] - pbase) : -1;
+        for (int k = 0; k < 3; k++) tr.t[k] = uv ? (int32_t)(tbase + tr.v[k] - pbase) : -1;
+        tr.material = mat;
+        if ((st = scene_add_triangle(p->ctx, s, &tr))) return st;
+    }
+    return PK_OK;
 }
 
 /* The unit square [-1, 1]^2 at z = 0, facing +z. */
@@ -2272,7 +2299,6 @@ pk_status scene_xml_parse(pk_context *ctx, pk_scene *s, const char *data, size_t
     if (!p) return ctx_nomem(ctx);
     p->ctx = ctx;
     p->s = s;
-    sb_init(&p->sb, ctx, s);
     xml_file top = {name ? name : "scene.xml", base_dir ? base_dir : "."};
     xnode *root;
     pk_status st = PK_OK;
