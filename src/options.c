@@ -16,7 +16,8 @@ static const pk_int_option table[] = {
     OPT(height, "height", 1, PK_MAX_IMAGE_SIDE, 512, "image height in pixels"),
     OPT(spp, "samples per pixel", 1, PK_MAX_SPP, 1, "samples per pixel (stratified jitter; 1 = pixel centres)"),
     OPT(light_samples, "light samples", 0, PK_MAX_LIGHT_SAMPLES, 32,
-        "shadow samples per shading point over the area lights (0 = point lights only)"),
+        "shadow samples per shading point over the area lights and the environment (0 = point lights "
+        "and the sun only)"),
     OPT(max_depth, "max depth", -1, PK_MAX_DEPTH, -1,
         "path length in bounces (path) or reflection and refraction depth (whitted); -1 = the integrator's "
         "default, 64 for path and 8 for whitted"),

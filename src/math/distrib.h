@@ -1,6 +1,6 @@
 /*
  * distrib.h - picking from a discrete distribution by its cumulative
- * distribution function: the light tables (render/lights.h) and the rows and
+ * distribution function: the light set (render/lights.h) and the rows and
  * columns of an environment map (render/env.c).
  */
 #ifndef PK_MATH_DISTRIB_H

@@ -66,12 +66,7 @@ pk_status frame_init(pk_context *ctx, frame *f, const pk_scene *s, pk_accel_kind
     f->build_s = f->a->info.build_ms > 0.0 ? f->a->info.build_ms * 1e-3 : time_now() - t0;
     vec3 ext = aabb_extent(s->bounds);
     f->eps = 1e-5f * fmaxf(v3_max_comp(ext), 1e-6f);
-    st = lights_build(ctx, s, &f->lights);
-    if (st != PK_OK) {
-        frame_free(&ctx->alloc, f);
-        return st;
-    }
-    if ((st = frame_env(ctx, f, s)) != PK_OK) {
+    if ((st = frame_env(ctx, f, s)) != PK_OK || (st = light_set_build(ctx, s, &f->env, &f->lights)) != PK_OK) {
         frame_free(&ctx->alloc, f);
         return st;
     }
@@ -80,7 +75,7 @@ pk_status frame_init(pk_context *ctx, frame *f, const pk_scene *s, pk_accel_kind
 
 void frame_free(const pk_allocator *al, frame *f)
 {
-    lights_free(al, &f->lights);
+    light_set_free(al, &f->lights);
     env_free(al, &f->env);
     accel_destroy(f->a);
     f->a = NULL;

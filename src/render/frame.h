@@ -1,6 +1,7 @@
 /*
  * frame.h - what a renderer builds once for a scene and then only reads:
- * the acceleration structure, the light table and the ray offset scale.
+ * the acceleration structure, the environment, the light set and the ray
+ * offset scale.
  */
 #ifndef PK_FRAME_H
 #define PK_FRAME_H
@@ -12,8 +13,8 @@
 typedef struct frame {
     const pk_scene *s;
     accel *a;
-    light_table lights;
     env_light env;       /* the surroundings: environment and sun */
+    light_set lights;    /* every light, the environment's and the sun's included */
     float eps;           /* base offset for spawned rays, world units */
     double build_s;      /* acceleration build, seconds */
 } frame;
@@ -22,7 +23,7 @@ typedef struct frame {
  * up to threads threads (0 = all). */
 PK_HIDDEN pk_status frame_build_accel(pk_context *ctx, const pk_scene *s, pk_accel_kind kind, int threads,
                                       accel **out);
-/* The accelerator, the light table, the environment and eps. A scene
+/* The accelerator, the environment, the light set and eps. A scene
  * without any light and without an environment of its own is lit by a
  * uniform white environment of radiance 1 (with a warning). */
 PK_HIDDEN pk_status frame_init(pk_context *ctx, frame *f, const pk_scene *s, pk_accel_kind kind, int threads);

@@ -1,30 +1,19 @@
 /*
- * lights.h - the light table of a frame: the emissive triangles with their
- * areas, unit normals and a CDF over emitted power (luminance x area), built
- * once per renderer and shared by the integrators.
+ * lights.h - every light of a frame in one set (emissive triangles and
+ * spheres, point lights, the environment, the sun), chosen in proportion to
+ * emitted power, and each light's sampling: a direction toward it from a
+ * shading context, with its radiance and solid-angle pdf, and that pdf for
+ * a direction found otherwise (MIS). Built once per renderer; every
+ * function below is PK_HD, so the GPU's path tracer runs the same code.
  */
 #ifndef PK_LIGHTS_H
 #define PK_LIGHTS_H
 
+#include "../accel/geom.h"
 #include "../math/distrib.h"
 #include "../scene/scene.h"
 #include "env.h"
-
-typedef struct light_table {
-    size_t n;            /* the scene's emissive triangles (s->emissive) */
-    float *cdf;          /* n entries, cumulative power, last = 1 */
-    float *area;         /* area of each emissive triangle */
-    vec3 *normal;        /* unit geometric normal of each emissive triangle */
-    float power;         /* total emitted power (luminance * area) */
-} light_table;
-
-PK_HIDDEN pk_status lights_build(pk_context *ctx, const pk_scene *s, light_table *lt);
-PK_HIDDEN void lights_free(const pk_allocator *al, light_table *lt);
-
-/* The light whose CDF interval holds u in [0, 1) (lt->n > 0). */
-static inline PK_HD size_t light_pick(const light_table *lt, float u) { return cdf_pick(lt->cdf, lt->n, u); }
-
-/* ---- every light, for the path tracer ------------------------------------ */
+#include "sampling.h"
 
 enum { LIGHT_TRIANGLE, LIGHT_SPHERE, LIGHT_POINT, LIGHT_ENV, LIGHT_SUN };
 
@@ -51,5 +40,151 @@ PK_HIDDEN pk_status light_set_build(pk_context *ctx, const pk_scene *s, const en
 PK_HIDDEN void light_set_free(const pk_allocator *al, light_set *ls);
 
 static inline PK_HD size_t light_set_pick(const light_set *ls, float u) { return cdf_pick(ls->cdf, ls->n, u); }
+
+/* ---- sampling ------------------------------------------------------------ */
+
+#define SHADOW_SHORTEN 1e-3f  /* shadow rays toward area lights stop this fraction short of them */
+
+/* Where light is gathered: the shading point p, its geometric normal n
+ * (zero for a point in a medium), o where shadow rays leave (p moved off
+ * the surface), and whether every emitter counts as two-sided (the Whitted
+ * integrator's rule; else a material's two_sided says). */
+typedef struct light_ctx {
+    vec3 p, n, o;
+    bool two_sided;
+} light_ctx;
+
+typedef struct light_sample {
+    vec3 wi;       /* unit direction from p to the light */
+    vec3 le;       /* radiance (or intensity / dist^2 for point lights) arriving at p */
+    float pdf;     /* solid angle (1 for point lights); light_sample_li: the light's choice included */
+    bool delta;
+    ray shadow;
+} light_sample;
+
+/* Solid-angle pdf of light l (a triangle or sphere of s) sampling the point
+ * q, of normal nq, from p, the choice of the light excluded. */
+static inline PK_HD float light_pdf_li(const pk_scene *s, const light *l, vec3 p, vec3 q, vec3 nq)
+{
+    vec3 d = v3_sub(q, p);
+    float dist2 = v3_len2(d);
+    if (!(dist2 > 0.0f)) return 0.0f;
+    if (l->kind == LIGHT_SPHERE) {
+        const sphere *sp = &s->spheres[l->index];
+        float dc2 = v3_len2(v3_sub(sp->center, p)), r2 = sp->radius * sp->radius;
+        if (dc2 > r2 * 1.0001f) { /* outside: uniform in the cone of the sphere */
+            float sin2 = r2 / dc2, cos_max = sqrtf(fmaxf(0.0f, 1.0f - sin2));
+            float one_minus = sin2 / (1.0f + cos_max);
+            return 1.0f / (2.0f * PK_PI * one_minus);
+        }
+    }
+    /* uniform by area, converted to solid angle */
+    float cos_l = fabsf(v3_dot(nq, v3_scale(d, 1.0f / sqrtf(dist2))));
+    if (!(cos_l > 0.0f) || !(l->area > 0.0f)) return 0.0f;
+    return dist2 / (cos_l * l->area);
+}
+
+/* Samples light li of the set from lc with (u1, u2): false when it sends
+ * nothing toward lc->p. ls->pdf excludes the light's choice. */
+static inline PK_HD bool light_sample_one(const light_set *set, const pk_scene *s, const env_light *e, size_t li,
+                                          const light_ctx *lc, float u1, float u2, light_sample *ls)
+{
+    const light *l = &set->lights[li];
+    const vec3 o = lc->o, p = lc->p;
+    vec3 q, nq, le;
+    float pdf;
+    if (l->kind == LIGHT_ENV || l->kind == LIGHT_SUN) { /* a direction toward the surroundings */
+        vec3 d;
+        if (l->kind == LIGHT_ENV) {
+            if (!env_sample(e, u1, u2, &d, &le, &pdf)) return false;
+        } else {
+            d = sun_sample(e, u1, u2);
+            le = e->sun_le, pdf = sun_pdf(e);
+        }
+        ls->wi = d;
+        ls->le = le;
+        ls->pdf = pdf;
+        ls->delta = false;
+        ls->shadow = (ray){o, 0.0f, d, INFINITY};
+        return true;
+    }
+    if (l->kind == LIGHT_POINT) {
+        const point_light *pl = &s->lights[l->index];
+        vec3 d = v3_sub(pl->position, o);
+        float dist2 = v3_len2(d);
+        if (!(dist2 > 0.0f)) return false;
+        ls->wi = v3_scale(d, 1.0f / sqrtf(dist2));
+        ls->le = v3_scale(pl->intensity, 1.0f / dist2);
+        ls->pdf = 1.0f;
+        ls->delta = true;
+        ls->shadow = (ray){o, 0.0f, d, 1.0f};
+        return true;
+    }
+    const material *m;
+    if (l->kind == LIGHT_TRIANGLE) {
+        vec3 a, b, c;
+        scene_tri_verts(s, l->index, &a, &b, &c);
+        q = sample_triangle(a, b, c, u1, u2);
+        nq = l->normal;
+        m = &s->materials[s->tris[l->index].material];
+        vec3 toward = v3_sub(p, q);
+        bool front = v3_dot(nq, toward) > 0.0f;
+        if (!front && !m->two_sided && !lc->two_sided) return false;
+    } else {
+        const sphere *sp = &s->spheres[l->index];
+        m = &s->materials[sp->material];
+        vec3 dc = v3_sub(sp->center, p);
+        float dc2 = v3_len2(dc), r2 = sp->radius * sp->radius;
+        if (dc2 > r2 * 1.0001f) {
+            /* a direction uniform in the cone, then the point where it meets the sphere */
+            float dcl = sqrtf(dc2), sin2 = r2 / dc2, cos_max = sqrtf(fmaxf(0.0f, 1.0f - sin2));
+            float one_minus = sin2 / (1.0f + cos_max);
+            float cos_t = 1.0f - u1 * one_minus, sin_t = sqrtf(fmaxf(0.0f, 1.0f - cos_t * cos_t));
+            float phi = 2.0f * PK_PI * u2;
+            vec3 w = v3_scale(dc, 1.0f / dcl);
+            vec3 t = fabsf(w.x) > 0.5f ? v3(-w.y, w.x, 0.0f) : v3(0.0f, -w.z, w.y);
+            t = v3_norm(t);
+            vec3 bb = v3_cross(w, t);
+            vec3 dir = v3_add(v3_add(v3_scale(t, sin_t * cosf(phi)), v3_scale(bb, sin_t * sinf(phi))), v3_scale(w, cos_t));
+            /* nearest intersection of p + s dir with the sphere */
+            float bq = v3_dot(dir, dc), disc = bq * bq - (dc2 - r2);
+            float sdist = bq - sqrtf(fmaxf(0.0f, disc));
+            q = v3_add(p, v3_scale(dir, sdist));
+            nq = v3_norm_scaled(v3_sub(q, sp->center)); /* seen from outside: the emitting side */
+        } else {
+            /* inside: uniform on the sphere, seen from within (its back) */
+            float z = 1.0f - 2.0f * u1, rr = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = 2.0f * PK_PI * u2;
+            nq = v3(rr * cosf(phi), rr * sinf(phi), z);
+            q = v3_add(sp->center, v3_scale(nq, sp->radius));
+            if (!m->two_sided && !lc->two_sided) return false;
+        }
+    }
+    le = m->ke;
+    pdf = light_pdf_li(s, l, p, q, nq);
+    if (!(pdf > 0.0f) || !isfinite(pdf)) return false;
+    vec3 d = v3_sub(q, o);
+    float dist2 = v3_len2(d);
+    if (!(dist2 > 0.0f)) return false;
+    ls->wi = v3_scale(d, 1.0f / sqrtf(dist2));
+    ls->le = le;
+    ls->pdf = pdf;
+    ls->delta = false;
+    ls->shadow = (ray){o, 0.0f, d, 1.0f - SHADOW_SHORTEN};
+    return true;
+}
+
+/* One light chosen by power with u0, then sampled with (u1, u2); ls->pdf
+ * includes the choice. */
+static inline PK_HD bool light_sample_li(const light_set *set, const pk_scene *s, const env_light *e,
+                                         const light_ctx *lc, float u0, float u1, float u2, light_sample *ls)
+{
+    if (set->n == 0) return false;
+    size_t li = light_set_pick(set, u0);
+    const float psel = set->pmf[li];
+    if (!(psel > 0.0f)) return false;
+    if (!light_sample_one(set, s, e, li, lc, u1, u2, ls)) return false;
+    ls->pdf = psel * ls->pdf;
+    return true;
+}
 
 #endif

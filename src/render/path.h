@@ -19,6 +19,8 @@ enum { PATH_MIS, PATH_LIGHTS_ONLY, PATH_BSDF_ONLY };
 /* Read-only during a render. */
 typedef struct path_tracer {
     const frame *f;
+    /* the frame's light set (a copy of the struct, not of its arrays: the
+     * GPU's copy points at device arrays while the frame's stays the host's) */
     light_set lights;
     int max_depth;       /* bounces after the camera ray */
     uint32_t seed;

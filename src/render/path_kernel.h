@@ -35,7 +35,6 @@
 #include "surface.h"
 
 #define RR_START 3            /* Russian roulette from this bounce on */
-#define SHADOW_SHORTEN 1e-3f  /* shadow rays stop this fraction short of the light */
 
 /* ---- rays through map_d holes ------------------------------------------------- */
 
@@ -163,129 +162,6 @@ static inline PK_HD bool shading_sample(const surface *sf, const shading *sh, ve
 
 /* ---- lights ------------------------------------------------------------------- */
 
-/* Solid-angle pdf of sampling the point q (normal nq, on light l) from p by
- * light sampling, the choice of the light excluded. */
-static inline PK_HD float light_pdf_dir(const path_tracer *pt, const light *l, vec3 p, vec3 q, vec3 nq)
-{
-    const pk_scene *s = pt->f->s;
-    vec3 d = v3_sub(q, p);
-    float dist2 = v3_len2(d);
-    if (!(dist2 > 0.0f)) return 0.0f;
-    if (l->kind == LIGHT_SPHERE) {
-        const sphere *sp = &s->spheres[l->index];
-        float dc2 = v3_len2(v3_sub(sp->center, p)), r2 = sp->radius * sp->radius;
-        if (dc2 > r2 * 1.0001f) { /* outside: uniform in the cone of the sphere */
-            float sin2 = r2 / dc2, cos_max = sqrtf(fmaxf(0.0f, 1.0f - sin2));
-            float one_minus = sin2 / (1.0f + cos_max);
-            return 1.0f / (2.0f * PK_PI * one_minus);
-        }
-    }
-    /* uniform by area, converted to solid angle */
-    float cos_l = fabsf(v3_dot(nq, v3_scale(d, 1.0f / sqrtf(dist2))));
-    if (!(cos_l > 0.0f) || !(l->area > 0.0f)) return 0.0f;
-    return dist2 / (cos_l * l->area);
-}
-
-typedef struct light_sample {
-    vec3 wi;       /* unit direction from p to the light */
-    vec3 le;       /* radiance (or intensity / dist^2 for point lights) arriving at p */
-    float pdf;     /* solid angle, the light's choice included; 1 for point lights */
-    bool delta;
-    ray shadow;
-} light_sample;
-
-static inline PK_HD bool sample_light(const path_tracer *pt, vec3 o, vec3 p, float u0, float u1, float u2, light_sample *ls)
-{
-    const light_set *set = &pt->lights;
-    const pk_scene *s = pt->f->s;
-    if (set->n == 0) return false;
-    size_t li = light_set_pick(set, u0);
-    const light *l = &set->lights[li];
-    const float psel = set->pmf[li];
-    if (!(psel > 0.0f)) return false;
-    vec3 q, nq, le;
-    float pdf;
-    if (l->kind == LIGHT_ENV || l->kind == LIGHT_SUN) { /* a direction toward the surroundings */
-        const env_light *e = &pt->f->env;
-        vec3 d;
-        if (l->kind == LIGHT_ENV) {
-            if (!env_sample(e, u1, u2, &d, &le, &pdf)) return false;
-        } else {
-            d = sun_sample(e, u1, u2);
-            le = e->sun_le, pdf = sun_pdf(e);
-        }
-        ls->wi = d;
-        ls->le = le;
-        ls->pdf = psel * pdf;
-        ls->delta = false;
-        ls->shadow = (ray){o, 0.0f, d, INFINITY};
-        return true;
-    }
-    if (l->kind == LIGHT_POINT) {
-        const point_light *pl = &s->lights[l->index];
-        vec3 d = v3_sub(pl->position, o);
-        float dist2 = v3_len2(d);
-        if (!(dist2 > 0.0f)) return false;
-        ls->wi = v3_scale(d, 1.0f / sqrtf(dist2));
-        ls->le = v3_scale(pl->intensity, 1.0f / dist2);
-        ls->pdf = psel;
-        ls->delta = true;
-        ls->shadow = (ray){o, 0.0f, d, 1.0f};
-        return true;
-    }
-    const material *m;
-    if (l->kind == LIGHT_TRIANGLE) {
-        vec3 a, b, c;
-        scene_tri_verts(s, l->index, &a, &b, &c);
-        q = sample_triangle(a, b, c, u1, u2);
-        nq = l->normal;
-        m = &s->materials[s->tris[l->index].material];
-        vec3 toward = v3_sub(p, q);
-        bool front = v3_dot(nq, toward) > 0.0f;
-        if (!front && !m->two_sided) return false;
-    } else {
-        const sphere *sp = &s->spheres[l->index];
-        m = &s->materials[sp->material];
-        vec3 dc = v3_sub(sp->center, p);
-        float dc2 = v3_len2(dc), r2 = sp->radius * sp->radius;
-        if (dc2 > r2 * 1.0001f) {
-            /* a direction uniform in the cone, then the point where it meets the sphere */
-            float dcl = sqrtf(dc2), sin2 = r2 / dc2, cos_max = sqrtf(fmaxf(0.0f, 1.0f - sin2));
-            float one_minus = sin2 / (1.0f + cos_max);
-            float cos_t = 1.0f - u1 * one_minus, sin_t = sqrtf(fmaxf(0.0f, 1.0f - cos_t * cos_t));
-            float phi = 2.0f * PK_PI * u2;
-            vec3 w = v3_scale(dc, 1.0f / dcl);
-            vec3 t = fabsf(w.x) > 0.5f ? v3(-w.y, w.x, 0.0f) : v3(0.0f, -w.z, w.y);
-            t = v3_norm(t);
-            vec3 bb = v3_cross(w, t);
-            vec3 dir = v3_add(v3_add(v3_scale(t, sin_t * cosf(phi)), v3_scale(bb, sin_t * sinf(phi))), v3_scale(w, cos_t));
-            /* nearest intersection of p + s dir with the sphere */
-            float bq = v3_dot(dir, dc), disc = bq * bq - (dc2 - r2);
-            float sdist = bq - sqrtf(fmaxf(0.0f, disc));
-            q = v3_add(p, v3_scale(dir, sdist));
-            nq = v3_norm_scaled(v3_sub(q, sp->center)); /* seen from outside: the emitting side */
-        } else {
-            /* inside: uniform on the sphere, seen from within (its back) */
-            float z = 1.0f - 2.0f * u1, rr = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = 2.0f * PK_PI * u2;
-            nq = v3(rr * cosf(phi), rr * sinf(phi), z);
-            q = v3_add(sp->center, v3_scale(nq, sp->radius));
-            if (!m->two_sided) return false;
-        }
-    }
-    le = m->ke;
-    pdf = light_pdf_dir(pt, l, p, q, nq);
-    if (!(pdf > 0.0f) || !isfinite(pdf)) return false;
-    vec3 d = v3_sub(q, o);
-    float dist2 = v3_len2(d);
-    if (!(dist2 > 0.0f)) return false;
-    ls->wi = v3_scale(d, 1.0f / sqrtf(dist2));
-    ls->le = le;
-    ls->pdf = psel * pdf;
-    ls->delta = false;
-    ls->shadow = (ray){o, 0.0f, d, 1.0f - SHADOW_SHORTEN};
-    return true;
-}
-
 /* What a path leaving the scene toward d (unit) gathers from the
  * environment and the sun, each weighted by MIS against its light
  * sampling when the last bounce was not a delta one. */
@@ -378,8 +254,8 @@ static inline PK_HD bool path_step_aov(const path_tracer *pt, path_thread *t, pa
             int32_t li = pt->lights.of_prim[ps->h.prim];
             if (li >= 0) {
                 const light *l = &pt->lights.lights[li];
-                float pl = pt->lights.pmf[li] * light_pdf_dir(pt, l, ps->prev_p, sf.p,
-                                                               l->kind == LIGHT_TRIANGLE ? l->normal : sf.ng);
+                float pl = pt->lights.pmf[li] * light_pdf_li(s, l, ps->prev_p, sf.p,
+                                                              l->kind == LIGHT_TRIANGLE ? l->normal : sf.ng);
                 w = power_heuristic(ps->prev_pdf, pl);
             }
         }
@@ -394,8 +270,8 @@ static inline PK_HD bool path_step_aov(const path_tracer *pt, path_thread *t, pa
     /* next-event estimation: one light, chosen by power */
     if (sh.nondelta && pt->lights.n && pt->strategy != PATH_BSDF_ONLY) {
         light_sample ls;
-        vec3 o = offset_origin(fr->eps, sf.p, sf.ng);
-        if (sample_light(pt, o, sf.p, u0, u1, u2, &ls)) {
+        const light_ctx lc = {sf.p, sf.ng, offset_origin(fr->eps, sf.p, sf.ng), false};
+        if (light_sample_li(&pt->lights, s, &fr->env, &lc, u0, u1, u2, &ls)) {
             float pb;
             vec3 f = shading_eval(&sf, &sh, wo, ls.wi, &pb);
             if (!black(f)) {

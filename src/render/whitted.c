@@ -1,8 +1,9 @@
 /*
  * whitted.c - the Whitted integrator: emission, direct light from point
- * lights and area lights (emissive triangles sampled by power with
- * stratified samples and any-hit shadow rays), Lambert + Phong, recursive
- * mirror reflection and refraction with exact Fresnel (or fixed weights).
+ * lights and from the frame's light set (emissive triangles, environment,
+ * sun: sampled by power with stratified samples and any-hit shadow rays),
+ * Lambert + Phong, recursive mirror reflection and refraction with exact
+ * Fresnel (or fixed weights).
  */
 #include "whitted.h"
 
@@ -17,8 +18,8 @@ static pk_status whitted_thread_init(pk_context *ctx, const whitted *w, whitted_
 {
     memset(t, 0, sizeof *t);
     const pk_allocator *al = &ctx->alloc;
-    /* area-light and environment samples, point lights and the sun */
-    size_t nshadow = 2 * (size_t)w->light_samples + w->f->s->nlights + 1;
+    /* light samples, point lights and the sun */
+    size_t nshadow = (size_t)w->light_samples + w->f->s->nlights + 1;
     if (nshadow == 0) nshadow = 1;
     t->cp = stats ? &t->counters : NULL;
     t->shadow_rays = mem_realloc_array(al, NULL, nshadow, sizeof(ray));
@@ -54,84 +55,50 @@ static vec3 trace(const whitted *w, whitted_thread *ts, const ray *r, int depth,
     return whitted_shade(w, ts, r, &h, depth, NULL);
 }
 
+/* Direct light at sf toward wo: every point light and the sun with a
+ * shadow ray of its own, and light_samples samples of the other lights of
+ * the frame's light set (emissive triangles and the environment; emissive
+ * spheres are not lights here) chosen by the set's weights, stratified in
+ * the choice; the offset within the chosen light's stratum is reused as its
+ * first coordinate. Every emitter is two-sided here. Shadow rays go to the
+ * accelerator as one batch. */
 static vec3 direct_light(const whitted *w, whitted_thread *ts, const surface *sf, vec3 wo)
 {
     const frame *fr = w->f;
     const pk_scene *s = fr->s;
-    const light_table *lt = &fr->lights;
+    const light_set *set = &fr->lights;
     vec3 L = v3s(0.0f);
-    vec3 o = offset_origin(fr->eps, sf->p, sf->ng);
+    const light_ctx lc = {sf->p, sf->ng, offset_origin(fr->eps, sf->p, sf->ng), true};
     size_t n = 0;
-    /* point lights */
-    for (size_t i = 0; i < s->nlights; i++) {
-        vec3 d = v3_sub(s->lights[i].position, o);
-        float dist2 = v3_len2(d);
-        if (!(dist2 > 0.0f)) continue;
-        vec3 wi = v3_scale(d, 1.0f / sqrtf(dist2));
-        vec3 f = brdf_cos(sf, wo, wi);
+    light_sample ls;
+    /* point lights and the sun: one shadow ray each */
+    for (size_t li = 0; li < set->n; li++) {
+        const uint32_t kind = set->lights[li].kind;
+        if (kind != LIGHT_POINT && kind != LIGHT_SUN) continue;
+        const float u1 = kind == LIGHT_SUN ? rng_float(&ts->rng) : 0.5f, u2 = kind == LIGHT_SUN ? rng_float(&ts->rng) : 0.5f;
+        if (!light_sample_one(set, s, &fr->env, li, &lc, u1, u2, &ls)) continue;
+        vec3 f = brdf_cos(sf, wo, ls.wi);
         if (is_black(f)) continue;
-        ts->shadow_weight[n] = v3_scale(v3_mul(f, s->lights[i].intensity), 1.0f / dist2);
-        ts->shadow_rays[n] = (ray){o, 0.0f, d, 1.0f};
+        ts->shadow_weight[n] = v3_scale(v3_mul(f, ls.le), 1.0f / ls.pdf);
+        ts->shadow_rays[n] = ls.shadow;
         n++;
     }
-    /* area lights: stratified in the power CDF; the offset within the chosen
-     * triangle's stratum is reused as the first triangle coordinate */
-    int ns = w->light_samples;
-    if (lt->n && ns > 0) {
-        float inv_n = 1.0f / (float)ns;
+    const int ns = w->light_samples;
+    if (w->nsampled && ns > 0) {
+        const float inv_n = 1.0f / (float)ns;
         for (int k = 0; k < ns; k++) {
             float u = ((float)k + rng_float(&ts->rng)) * inv_n;
             if (u >= 1.0f) u = 0x1.fffffep-1f;
-            size_t li = light_pick(lt, u);
-            float lo = li ? lt->cdf[li - 1] : 0.0f;
-            float p_tri = lt->cdf[li] - lo;
-            float u1 = (u - lo) / p_tri;
+            const size_t j = cdf_pick(w->cdf, w->nsampled, u);
+            const float lo = j ? w->cdf[j - 1] : 0.0f, p_pick = w->cdf[j] - lo;
+            float u1 = (u - lo) / p_pick;
             u1 = u1 > 0.0f ? (u1 < 0x1.fffffep-1f ? u1 : 0x1.fffffep-1f) : 0.0f;
-            float u2 = rng_float(&ts->rng);
-            uint32_t tri = s->emissive[li];
-            vec3 a, b, c;
-            scene_tri_verts(s, tri, &a, &b, &c);
-            vec3 lp = sample_triangle(a, b, c, u1, u2);
-            vec3 d = v3_sub(lp, o);
-            float dist2 = v3_len2(d);
-            if (!(dist2 > 0.0f)) continue;
-            vec3 wi = v3_scale(d, 1.0f / sqrtf(dist2));
-            vec3 nl = lt->normal[li];
-            float cos_l = fabsf(v3_dot(nl, wi)); /* emitters are two-sided */
-            vec3 f = brdf_cos(sf, wo, wi);
-            if (is_black(f) || cos_l <= 0.0f) continue;
-            float pdf_area = p_tri / lt->area[li];
-            vec3 le = s->materials[s->tris[tri].material].ke;
-            ts->shadow_weight[n] = v3_scale(v3_mul(f, le), cos_l / (dist2 * pdf_area) * inv_n);
-            /* stop just short of the light so the emitter itself does not occlude */
-            ts->shadow_rays[n] = (ray){o, 0.0f, d, 1.0f - 1e-3f};
-            n++;
-        }
-    }
-    /* the environment: light_samples directions drawn from it, and one
-     * toward the sun's disc */
-    const env_light *e = &fr->env;
-    if (e->active && ns > 0) {
-        float inv_n = 1.0f / (float)ns;
-        for (int k = 0; k < ns; k++) {
-            vec3 wi, le;
-            float pdf;
-            float u1 = rng_float(&ts->rng), u2 = rng_float(&ts->rng);
-            if (!env_sample(e, u1, u2, &wi, &le, &pdf)) continue;
-            vec3 f = brdf_cos(sf, wo, wi);
+            const float u2 = rng_float(&ts->rng);
+            if (!(p_pick > 0.0f) || !light_sample_one(set, s, &fr->env, w->sampled[j], &lc, u1, u2, &ls)) continue;
+            vec3 f = brdf_cos(sf, wo, ls.wi);
             if (is_black(f)) continue;
-            ts->shadow_weight[n] = v3_scale(v3_mul(f, le), inv_n / pdf);
-            ts->shadow_rays[n] = (ray){o, 0.0f, wi, INFINITY};
-            n++;
-        }
-    }
-    if (e->sun) {
-        float u1 = rng_float(&ts->rng), u2 = rng_float(&ts->rng);
-        vec3 wi = sun_sample(e, u1, u2);
-        vec3 f = brdf_cos(sf, wo, wi);
-        if (!is_black(f)) {
-            ts->shadow_weight[n] = v3_scale(v3_mul(f, e->sun_le), 1.0f / sun_pdf(e));
-            ts->shadow_rays[n] = (ray){o, 0.0f, wi, INFINITY};
+            ts->shadow_weight[n] = v3_scale(v3_mul(f, ls.le), inv_n / (p_pick * ls.pdf));
+            ts->shadow_rays[n] = ls.shadow;
             n++;
         }
     }
@@ -233,12 +200,33 @@ static vec3 whitted_shade(const whitted *w, whitted_thread *ts, const ray *r, co
 
 static pk_status ig_init(pk_context *ctx, void *self, const frame *f, const pk_render_options *opt)
 {
-    (void)ctx;
-    *(whitted *)self = (whitted){f, opt->light_samples, pk_render_options_max_depth(opt), opt->fresnel != 0, 0.0f};
+    whitted *w = self;
+    *w = (whitted){f, opt->light_samples, pk_render_options_max_depth(opt), opt->fresnel != 0, 0.0f, 0, NULL, NULL};
+    const light_set *set = &f->lights;
+    if (set->n == 0) return PK_OK;
+    w->sampled = mem_realloc_array(&ctx->alloc, NULL, set->n, sizeof *w->sampled);
+    w->cdf = mem_realloc_array(&ctx->alloc, NULL, set->n, sizeof *w->cdf);
+    if (!w->sampled || !w->cdf) return ctx_nomem(ctx);
+    double total = 0.0;
+    for (size_t i = 0; i < set->n; i++) {
+        const uint32_t kind = set->lights[i].kind;
+        if (kind == LIGHT_POINT || kind == LIGHT_SUN || kind == LIGHT_SPHERE || !(set->pmf[i] > 0.0f)) continue;
+        total += (double)set->pmf[i];
+        w->sampled[w->nsampled] = (uint32_t)i;
+        w->cdf[w->nsampled++] = (float)total;
+    }
+    for (size_t k = 0; k < w->nsampled; k++) w->cdf[k] = (float)((double)w->cdf[k] / total);
+    if (w->nsampled) w->cdf[w->nsampled - 1] = 1.0f;
     return PK_OK;
 }
 
-static void ig_free(const pk_allocator *al, void *self) { (void)al, (void)self; }
+static void ig_free(const pk_allocator *al, void *self)
+{
+    whitted *w = self;
+    mem_free(al, w->sampled);
+    mem_free(al, w->cdf);
+    w->sampled = NULL, w->cdf = NULL;
+}
 
 static pk_status ig_thread_init(pk_context *ctx, const void *self, void *t, bool stats)
 {

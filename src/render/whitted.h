@@ -1,7 +1,7 @@
 /*
  * whitted.h - the Whitted integrator: direct light from point lights and
  * area lights with shadow rays, Lambert + Phong, recursive mirror reflection
- * and refraction. Built on the frame (accelerator, light table), surface.h
+ * and refraction. Built on the frame (accelerator, light set), surface.h
  * and bsdf.h, which a second integrator shares.
  */
 #ifndef PK_WHITTED_H
@@ -27,6 +27,13 @@ typedef struct whitted {
     int light_samples, max_depth;
     bool fresnel;
     float spread;        /* ray cone spread angle: the camera's pixel angle (textures) */
+    /* The lights it samples: those of the frame's light set that are not
+     * point lights or the sun (each gets a shadow ray of its own) or
+     * emissive spheres (not lights for this integrator), with the set's
+     * weights renormalised over them. */
+    size_t nsampled;
+    uint32_t *sampled;   /* their numbers in the set */
+    float *cdf;          /* nsampled entries, last = 1 */
 } whitted;
 
 /* Per-thread scratch, allocated once per renderer. */
