@@ -13,6 +13,7 @@
  */
 #include "io_util.h"
 #include "readers.h"
+#include "scene_build.h"
 #include "../math/xform.h"
 #include "../options.h"
 #include "../scene/camera.h"
@@ -61,6 +62,7 @@ typedef struct xnode {
     const xml_file *file;
     unsigned long line;
     int64_t mat;         /* material made of this bsdf, -1 before */
+    int64_t mesh;        /* mesh made of this shapegroup, -1 before */
     bool used;           /* a property that a plugin read */
     bool busy;           /* a bsdf being converted (reference cycles) */
 } xnode;
@@ -105,6 +107,7 @@ typedef struct xp {
     /* where the colour property being read may put a texture (the diffuse
      * reflectances); NULL: textures stand in as constants */
     tex_ref *want_tex;
+    scene_builder sb;     /* every shape's triangles go in through it */
 } xp;
 
 /* expat's side of building one tree */
@@ -248,6 +251,7 @@ static void XMLCALL on_start(void *user, const XML_Char *name, const XML_Char **
     n->file = b->file;
     n->line = line;
     n->mat = -1;
+    n->mesh = -1;
     n->parent = b->cur;
     if (b->cur) {
         if (b->cur->last) b->cur->last->next = n;
@@ -1404,46 +1408,17 @@ static void warn_unused(xp *p, xnode *plugin, const char *kind, const char *cons
 
 /* ---- meshes ---------------------------------------------------------------------------------- */
 
-/* Appends triangles (tris: 3 indices each into pos) transformed by m.
- * flip reverses the winding; normals (optional, local) are transformed by
- * the inverse transpose; uv (optional) holds 2 texture coordinates a vertex. */
+/* Appends triangles (tris: 3 indices each into pos) transformed by m, with
+ * material mat (sb_add_mesh). flip reverses the winding; normals (optional,
+ * local) are transformed by the inverse transpose; uv (optional) holds 2
+ * texture coordinates a vertex. */
 static pk_status add_mesh(xp *p, const vec3 *pos, const vec3 *nrm, const float *uv, size_t npos, const uint32_t *tris,
                           size_t ntris, const xform *m, bool flip, uint32_t mat)
 {
-    pk_scene *s = p->s;
-    size_t pbase = s->npositions, nbase = s->nnormals, tbase = s->nuvs;
-    pk_status st;
-    float cof[9] = {0};
-    if (nrm) xform_normal_cofactors(m, cof);
-    for (size_t i = 0; i < npos; i++) {
-        vec3 q = xform_point(m, pos[i]);
-        if (!v3_finite(q)) return ctx_error(p->ctx, PK_ERR_PARSE, "%s: a transformed vertex is not finite", s->name);
-        if ((st = scene_add_position(p->ctx, s, q))) return st;
-        if (nrm) {
-            vec3 n = v3_norm_scaled(xform_apply3(cof, nrm[i]));
-            if (!v3_finite(n)) n = v3s(0.0f);
-            if ((st = scene_add_normal(p->ctx, s, n))) return st;
-        }
-        if (uv) {
-            uv2 t = {uv[2 * i], uv[2 * i + 1]};
-            if (!isfinite(t.u) || !isfinite(t.v)) t.u = t.v = 0.0f;
-            if ((st = scene_add_uv(p->ctx, s, t))) return st;
-        }
-    }
-    for (size_t t = 0; t < ntris; t++) {
-        triangle tr;
-        uint32_t a = tris[3 * t], b = tris[3 * t + 1], c = tris[3 * t + 2];
-        if (flip) {
-            uint32_t x = b;
-            b = c, c = x;
-        }
-        tr.v[0] = (uint32_t)(pbase + a), tr.v[1] = (uint32_t)(pbase + b), tr.v[2] = (uint32_t)(pbase + c);
-        for (int k = 0; k < 3; k++) tr.n[k] = nrm ? (int32_t)(nbase + tr.v[k] - pbase) : -1;
-        for (int k = 0; k < 3; k++) tr.t[k] = uv ? (int32_t)(tbase + tr.v[k] - pbase) : -1;
-        tr.material = mat;
-        if ((st = scene_add_triangle(p->ctx, s, &tr))) return st;
-    }
-    return PK_OK;
+    sb_set_transform(&p->sb, m);
+    sb_set_material(&p->sb, mat);
+    const sb_mesh mesh = {pos, nrm, uv, npos, tris, ntris, flip};
+    return sb_add_mesh(&p->sb, &mesh);
 }
 
 /* The unit square [-1, 1]^2 at z = 0, facing +z. */
@@ -1669,12 +1644,79 @@ static pk_status parse_emitter_area(xp *p, xnode *e, vec3 *radiance)
     return PK_OK;
 }
 
+static pk_status parse_shape(xp *p, xnode *sh);
+
+/* <shape type="shapegroup" id="...">: its shapes, read as any others, become
+ * one mesh in the space their to_world give them, placed by instances. */
+static pk_status parse_shapegroup(xp *p, xnode *sh)
+{
+    pk_status st;
+    const char *id = attr_st(p, sh, "id", &st);
+    if (st) return st;
+    if (!id) return xfail(p, PK_ERR_PARSE, sh, "a shapegroup needs an id (instances refer to it)");
+    if (!sb_begin_object(&p->sb)) return xfail(p, PK_ERR_PARSE, sh, "a shapegroup inside a shapegroup");
+    if ((st = id_add(p, id, sh))) return st;
+    for (xnode *c = sh->child; c; c = c->next) {
+        if (strcmp(c->tag, "shape") == 0) {
+            if ((st = parse_shape(p, c))) return st;
+        } else {
+            char tg[40];
+            shown(tg, sizeof tg, c->tag);
+            xwarn(p, c, "<%s> in a shapegroup is not supported (only shapes); ignored", tg);
+        }
+    }
+    uint32_t mesh;
+    if ((st = sb_end_object(&p->sb, &mesh))) return st;
+    sh->mesh = mesh;
+    return PK_OK;
+}
+
+/* <shape type="instance">: <ref id="..."/> to a shapegroup defined before
+ * it, placed by its to_world. */
+static pk_status parse_instance(xp *p, xnode *sh)
+{
+    pk_status st;
+    if (p->sb.in_object) return xfail(p, PK_ERR_PARSE, sh, "an instance inside a shapegroup");
+    const char *id = attr_st(p, sh, "id", &st);
+    if (st) return st;
+    if (id && (st = id_add(p, id, sh))) return st;
+    xform m;
+    if ((st = get_to_world(p, sh, &m, NULL))) return st;
+    xnode *group = NULL, *ref = NULL;
+    for (xnode *c = sh->child; c; c = c->next) {
+        if (strcmp(c->tag, "ref") != 0) continue;
+        c->used = true;
+        if (ref) {
+            xwarn(p, c, "an instance takes one shapegroup; this one is ignored");
+            continue;
+        }
+        ref = c;
+        const char *rid = attr_st(p, c, "id", &st);
+        if (st) return st;
+        if (!rid) return xfail(p, PK_ERR_PARSE, c, "<ref> needs an id");
+        group = id_find(p, rid);
+        char sid[48];
+        shown(sid, sizeof sid, rid);
+        if (!group) return xfail(p, PK_ERR_PARSE, c, "instance: no shapegroup \"%s\" before it", sid);
+        if (group->mesh < 0) return xfail(p, PK_ERR_PARSE, c, "instance: \"%s\" is not a shapegroup", sid);
+    }
+    if (!ref) return xfail(p, PK_ERR_PARSE, sh, "an instance needs a <ref id=\"...\"/> to a shapegroup");
+    double det = xform_det3(&m);
+    if (!(det != 0.0) || !isfinite(det)) return xfail(p, PK_ERR_PARSE, sh, "instance: to_world is singular");
+    sb_set_transform(&p->sb, &m);
+    if ((st = sb_add_instance(&p->sb, (uint32_t)group->mesh))) return st;
+    warn_unused(p, sh, "shape \"instance\"", NULL);
+    return PK_OK;
+}
+
 static pk_status parse_shape(xp *p, xnode *sh)
 {
     pk_status st;
     const char *type = attr_st(p, sh, "type", &st);
     if (st) return st;
     if (!type) return xfail(p, PK_ERR_PARSE, sh, "<shape> needs a type");
+    if (strcmp(type, "shapegroup") == 0) return parse_shapegroup(p, sh);
+    if (strcmp(type, "instance") == 0) return parse_instance(p, sh);
     char ty[40];
     shown(ty, sizeof ty, type);
     enum { SH_OBJ, SH_PLY, SH_RECT, SH_CUBE, SH_DISK, SH_SPHERE, SH_OTHER } kind = SH_OTHER;
@@ -1795,7 +1837,7 @@ static pk_status parse_shape(xp *p, xnode *sh)
         float tol = 1e-4f * lx;
         bool similar = fabsf(lx - ly) <= tol && fabsf(lx - lz) <= tol && fabsf(v3_dot(cx, cy)) <= tol * lx &&
                        fabsf(v3_dot(cx, cz)) <= tol * lx && fabsf(v3_dot(cy, cz)) <= tol * lx;
-        if (similar && !flip) {
+        if (similar && !flip && !p->sb.in_object) { /* (a shapegroup's spheres are meshes) */
             sphere sp = {xform_point(&full, v3s(0.0f)), lx, mat};
             if (!v3_finite(sp.center) || !(sp.radius > 0.0f) || !isfinite(sp.radius))
                 return xfail(p, PK_ERR_PARSE, sh, "sphere: the transformed sphere is not finite");
@@ -2299,6 +2341,7 @@ pk_status scene_xml_parse(pk_context *ctx, pk_scene *s, const char *data, size_t
     if (!p) return ctx_nomem(ctx);
     p->ctx = ctx;
     p->s = s;
+    sb_init(&p->sb, ctx, s);
     xml_file top = {name ? name : "scene.xml", base_dir ? base_dir : "."};
     xnode *root;
     pk_status st = PK_OK;

@@ -99,6 +99,12 @@ void scene_destroy(pk_scene *s)
     mem_free(a, s->lights);
     mem_free(a, s->degenerate);
     mem_free(a, s->emissive);
+    mem_free(a, s->mesh_positions);
+    mem_free(a, s->mesh_normals);
+    mem_free(a, s->mesh_uvs);
+    mem_free(a, s->mesh_tris);
+    mem_free(a, s->meshes);
+    mem_free(a, s->instances);
     scene_env_clear(a, &s->env);
     mem_free(a, s->name);
     pk_allocator copy = *a;
@@ -207,11 +213,155 @@ int64_t scene_find_material(const pk_scene *s, const char *name)
     return -1;
 }
 
+/* ---- meshes and instances ---------------------------------------------- */
+
+/* Appends n elements of size elem from src to *arr (count *len, capacity *cap). */
+static bool append_n(const pk_allocator *a, void **arr, size_t *len, size_t *cap, const void *src, size_t n,
+                     size_t elem)
+{
+    if (!n) return true;
+    if (!mem_grow(a, arr, cap, *len + n, elem)) return false;
+    memcpy((char *)*arr + *len * elem, src, n * elem);
+    *len += n;
+    return true;
+}
+
+pk_status scene_capture_mesh(pk_context *ctx, pk_scene *s, size_t pos0, size_t nrm0, size_t uv0, size_t tri0,
+                             uint32_t *mesh)
+{
+    if (pos0 > s->npositions || nrm0 > s->nnormals || uv0 > s->nuvs || tri0 > s->ntris)
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: a mesh begins past the end of the scene", s->name);
+    if (s->ninstances > s->nflattened && s->instances[s->ninstances - 1].at > tri0)
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: an instance inside a mesh being defined", s->name);
+    if (s->nmeshes >= SCENE_MAX_PRIMS)
+        return ctx_error(ctx, PK_ERR_LIMIT, "%s: more than %zu meshes in one scene", s->name, (size_t)SCENE_MAX_PRIMS);
+    scene_mesh m = {s->nmesh_positions, s->npositions - pos0, s->nmesh_normals, s->nnormals - nrm0,
+                    s->nmesh_uvs,       s->nuvs - uv0,        s->nmesh_tris,    s->ntris - tri0};
+    for (size_t k = tri0; k < s->ntris; k++) {
+        const triangle *t = &s->tris[k];
+        for (int j = 0; j < 3; j++)
+            if (t->v[j] < pos0 || t->v[j] >= s->npositions || (t->n[j] >= 0 && (size_t)t->n[j] < nrm0) ||
+                (t->t[j] >= 0 && (size_t)t->t[j] < uv0))
+                return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: a mesh's triangle uses a vertex from outside it",
+                                 s->name);
+    }
+    const pk_allocator *a = &s->alloc;
+    if (!mem_grow(a, (void **)&s->meshes, &s->cap_meshes, s->nmeshes + 1, sizeof *s->meshes) ||
+        !append_n(a, (void **)&s->mesh_positions, &s->nmesh_positions, &s->cap_mesh_positions, s->positions + pos0,
+                  m.npos, sizeof(vec3)) ||
+        !append_n(a, (void **)&s->mesh_normals, &s->nmesh_normals, &s->cap_mesh_normals, s->normals + nrm0, m.nnrm,
+                  sizeof(vec3)) ||
+        !append_n(a, (void **)&s->mesh_uvs, &s->nmesh_uvs, &s->cap_mesh_uvs, s->uvs + uv0, m.nuv, sizeof(uv2)) ||
+        !mem_grow(a, (void **)&s->mesh_tris, &s->cap_mesh_tris, s->nmesh_tris + m.ntris, sizeof(triangle))) {
+        /* undo the partial appends: the mesh is not there */
+        s->nmesh_positions = m.first_pos, s->nmesh_normals = m.first_nrm, s->nmesh_uvs = m.first_uv;
+        return ctx_nomem(ctx);
+    }
+    for (size_t k = tri0; k < s->ntris; k++) {
+        triangle t = s->tris[k];
+        for (int j = 0; j < 3; j++) {
+            t.v[j] = (uint32_t)(t.v[j] - pos0);
+            if (t.n[j] >= 0) t.n[j] = (int32_t)((size_t)t.n[j] - nrm0);
+            if (t.t[j] >= 0) t.t[j] = (int32_t)((size_t)t.t[j] - uv0);
+        }
+        s->mesh_tris[s->nmesh_tris++] = t;
+    }
+    s->npositions = pos0, s->nnormals = nrm0, s->nuvs = uv0, s->ntris = tri0;
+    *mesh = (uint32_t)s->nmeshes;
+    s->meshes[s->nmeshes++] = m;
+    s->committed = false;
+    return PK_OK;
+}
+
+pk_status scene_add_instance(pk_context *ctx, pk_scene *s, uint32_t mesh, const xform *to_world, uint32_t mat)
+{
+    if (mesh >= s->nmeshes)
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: instance of mesh %u, which does not exist", s->name, mesh);
+    if (mat != SCENE_MESH_MATERIAL && mat >= s->nmaterials)
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: instance material %u does not exist", s->name, mat);
+    double det = xform_det3(to_world);
+    if (!xform_finite(to_world) || !xform_is_affine(to_world) || !(det != 0.0) || !isfinite(det))
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: an instance's transform is not finite, affine and invertible",
+                         s->name);
+    scene_instance in = {mesh, mat, *to_world, s->ntris};
+    APPEND(ctx, s, instances, ninstances, cap_instances, in, SCENE_MAX_PRIMS, "instances");
+}
+
+/* Appends instance in's vertices to the world arrays and its triangles to
+ * out[*o ...]. */
+static pk_status place_instance(pk_context *ctx, pk_scene *s, const scene_instance *in, triangle *out, size_t *o)
+{
+    const scene_mesh *m = &s->meshes[in->mesh];
+    size_t pbase = s->npositions, nbase = s->nnormals, tbase = s->nuvs;
+    pk_status st;
+    float nm[9] = {0};
+    if (m->nnrm && !xform_normal_matrix(&in->to_world, nm))
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: an instance's transform is singular", s->name);
+    for (size_t i = 0; i < m->npos; i++) {
+        vec3 q = xform_point(&in->to_world, s->mesh_positions[m->first_pos + i]);
+        if (!v3_finite(q)) return ctx_error(ctx, PK_ERR_PARSE, "%s: a transformed vertex is not finite", s->name);
+        if ((st = scene_add_position(ctx, s, q))) return st;
+    }
+    for (size_t i = 0; i < m->nnrm; i++) {
+        vec3 n = v3_norm_scaled(xform_apply3(nm, s->mesh_normals[m->first_nrm + i]));
+        if (!v3_finite(n)) n = v3s(0.0f);
+        if ((st = scene_add_normal(ctx, s, n))) return st;
+    }
+    for (size_t i = 0; i < m->nuv; i++)
+        if ((st = scene_add_uv(ctx, s, s->mesh_uvs[m->first_uv + i]))) return st;
+    for (size_t k = 0; k < m->ntris; k++) {
+        triangle t = s->mesh_tris[m->first_tri + k];
+        for (int j = 0; j < 3; j++) {
+            t.v[j] = (uint32_t)(t.v[j] + pbase);
+            if (t.n[j] >= 0) t.n[j] = (int32_t)((size_t)t.n[j] + nbase);
+            if (t.t[j] >= 0) t.t[j] = (int32_t)((size_t)t.t[j] + tbase);
+        }
+        if (in->material != SCENE_MESH_MATERIAL) t.material = in->material;
+        out[(*o)++] = t;
+    }
+    return PK_OK;
+}
+
+/* Instances [nflattened, ninstances) into the triangle list, each at its place. */
+static pk_status flatten_instances(pk_context *ctx, pk_scene *s)
+{
+    size_t first = s->nflattened, n = s->ninstances;
+    if (first == n) return PK_OK;
+    size_t extra = 0;
+    for (size_t i = first; i < n; i++) {
+        extra += s->meshes[s->instances[i].mesh].ntris;
+        if (extra > SCENE_MAX_PRIMS) break;
+    }
+    if (extra > SCENE_MAX_PRIMS || s->ntris + extra > SCENE_MAX_PRIMS)
+        return ctx_error(ctx, PK_ERR_LIMIT, "%s: more than %zu triangles in one scene", s->name,
+                         (size_t)SCENE_MAX_PRIMS);
+    size_t total = s->ntris + extra;
+    triangle *out = mem_realloc_array(&s->alloc, NULL, total ? total : 1, sizeof *out);
+    if (!out) return ctx_nomem(ctx);
+    size_t o = 0, i = first;
+    pk_status st = PK_OK;
+    for (size_t k = 0; k <= s->ntris && st == PK_OK; k++) {
+        for (; i < n && s->instances[i].at <= k && st == PK_OK; i++) st = place_instance(ctx, s, &s->instances[i], out, &o);
+        if (k < s->ntris) out[o++] = s->tris[k];
+    }
+    if (st) {
+        mem_free(&s->alloc, out);
+        return st;
+    }
+    mem_free(&s->alloc, s->tris);
+    s->tris = out;
+    s->ntris = s->cap_tris = total;
+    s->nflattened = n;
+    return PK_OK;
+}
+
 static bool material_emits(const material *m) { return m->ke.x > 0.0f || m->ke.y > 0.0f || m->ke.z > 0.0f; }
 
 pk_status scene_commit(pk_context *ctx, pk_scene *s)
 {
     char why[256];
+    pk_status fst = flatten_instances(ctx, s);
+    if (fst != PK_OK) return fst;
     if (!scene_check(s, why, sizeof why))
         return ctx_error(ctx, PK_ERR_PARSE, "%s: invalid scene: %s", s->name, why);
     pk_status est = scene_env_load(ctx, &s->env);
@@ -316,6 +466,25 @@ bool scene_check(const pk_scene *s, char *why, size_t n)
     for (size_t i = 0; i < s->nlights; i++)
         if (!v3_finite(s->lights[i].position) || !v3_finite(s->lights[i].intensity))
             FAIL("light %zu is not finite", i);
+    for (size_t i = 0; i < s->nmeshes; i++) {
+        const scene_mesh *m = &s->meshes[i];
+        if (m->first_pos + m->npos > s->nmesh_positions || m->first_nrm + m->nnrm > s->nmesh_normals ||
+            m->first_uv + m->nuv > s->nmesh_uvs || m->first_tri + m->ntris > s->nmesh_tris)
+            FAIL("mesh %zu: range out of bounds", i);
+        for (size_t k = m->first_tri; k < m->first_tri + m->ntris; k++) {
+            const triangle *t = &s->mesh_tris[k];
+            for (int j = 0; j < 3; j++)
+                if (t->v[j] >= m->npos || (t->n[j] >= 0 && (size_t)t->n[j] >= m->nnrm) ||
+                    (t->t[j] >= 0 && (size_t)t->t[j] >= m->nuv) || t->n[j] < -1 || t->t[j] < -1)
+                    FAIL("mesh %zu: triangle %zu: index out of range", i, k - m->first_tri);
+            if (t->material >= s->nmaterials) FAIL("mesh %zu: triangle %zu: material out of range", i, k - m->first_tri);
+        }
+    }
+    for (size_t i = 0; i < s->ninstances; i++)
+        if (s->instances[i].mesh >= s->nmeshes ||
+            (s->instances[i].material != SCENE_MESH_MATERIAL && s->instances[i].material >= s->nmaterials))
+            FAIL("instance %zu: mesh or material out of range", i);
+    if (s->committed && s->nflattened != s->ninstances) FAIL("instances not flattened");
     return true;
 #undef FAIL
 }

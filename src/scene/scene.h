@@ -1,14 +1,17 @@
 /*
  * scene.h - the in-memory scene: positions, normals, triangles in file order,
- * analytic spheres, materials, point lights, camera and render settings.
- * Loaders (io/) fill it through the scene_add_* builders and then call
- * scene_commit, which validates it and derives what rendering needs.
+ * analytic spheres, materials, point lights, camera and render settings, and
+ * object-space meshes with their instances. Loaders (io/) fill it through
+ * the scene_add_* builders and then call scene_commit, which flattens the
+ * instances into the triangle list, validates the scene and derives what
+ * rendering needs.
  */
 #ifndef PK_SCENE_H
 #define PK_SCENE_H
 
 #include "../math/tri.h"
 #include "../math/vec3.h"
+#include "../math/xform.h"
 #include "../paprsek_internal.h"
 #include "texture.h"
 
@@ -104,6 +107,29 @@ typedef struct scene_environment {
     float sky_scale;      /* multiplies the sky (1) */
 } scene_environment;
 
+/* An object-space mesh: ranges of the scene's mesh_* arrays. Its triangles'
+ * indices are relative to the mesh's own first position, normal and uv
+ * (-1: none); their materials are scene materials. */
+typedef struct scene_mesh {
+    size_t first_pos, npos;
+    size_t first_nrm, nnrm;
+    size_t first_uv, nuv;
+    size_t first_tri, ntris;
+} scene_mesh;
+
+/* The material of an instance that keeps each triangle's own. */
+#define SCENE_MESH_MATERIAL UINT32_MAX
+
+/* A mesh placed in the world. at is the number of world triangles added
+ * before it: scene_commit puts its triangles there, so that they keep the
+ * file's order among the others. */
+typedef struct scene_instance {
+    uint32_t mesh;
+    uint32_t material;   /* SCENE_MESH_MATERIAL, or a material for all its triangles */
+    xform to_world;      /* finite, affine, not singular */
+    size_t at;
+} scene_instance;
+
 /* Render settings a scene file may carry; a field is set when its has_ flag is. */
 typedef struct scene_render_settings {
     pk_render_options opt;
@@ -122,7 +148,11 @@ typedef struct scene_render_settings {
  *  5. after commit, degenerate[k] says whether triangle k can never be hit,
  *     and emissive lists the triangles whose material has ke > 0 (non-degenerate);
  *  6. the name index finds, for every material's name, a material of that name
- *     that is not older (the newest, by construction). */
+ *     that is not older (the newest, by construction);
+ *  8. every mesh's ranges lie in the mesh_* arrays and its triangles' indices
+ *     within its own ranges; every instance names a mesh < nmeshes and a
+ *     material < nmaterials (or SCENE_MESH_MATERIAL); after commit every
+ *     instance is in the triangle list (nflattened == ninstances). */
 struct pk_scene {
     pk_allocator alloc;
     char *name;             /* file name for messages and statistics */
@@ -157,6 +187,17 @@ struct pk_scene {
     uint32_t *emissive;     /* indices of emissive triangles */
     size_t nemissive;
     aabb bounds;
+
+    /* Object-space meshes and their instances (scene_capture_mesh,
+     * scene_add_instance). scene_commit flattens instances [nflattened,
+     * ninstances) into the world arrays above: renderers see triangles only. */
+    vec3 *mesh_positions; size_t nmesh_positions, cap_mesh_positions;
+    vec3 *mesh_normals;   size_t nmesh_normals, cap_mesh_normals;
+    uv2 *mesh_uvs;        size_t nmesh_uvs, cap_mesh_uvs;
+    triangle *mesh_tris;  size_t nmesh_tris, cap_mesh_tris;
+    scene_mesh *meshes;   size_t nmeshes, cap_meshes;
+    scene_instance *instances; size_t ninstances, cap_instances;
+    size_t nflattened;
 };
 
 /* An empty scene with the default material 0 ("default", grey 0.5 diffuse). */
@@ -188,7 +229,25 @@ PK_HIDDEN void scene_env_clear(const pk_allocator *a, scene_environment *env);
 /* Loads env->map into map_rgb unless loaded (a no-op without a map). */
 PK_HIDDEN pk_status scene_env_load(pk_context *ctx, scene_environment *env);
 
-/* Validates and derives (degenerate flags, emissive list, bounds).
+/* Meshes and instances (step one: scene_commit flattens them; renderers see
+ * triangles). scene_capture_mesh turns the world geometry added since
+ * (pos0, nrm0, uv0, tri0) - the counts of positions, normals, uvs and
+ * triangles when the reader began the object - into a new mesh *mesh, in
+ * the space it was written in, and removes it from the world arrays. Its
+ * triangles must use only the vertices added since; no instance may have
+ * been added in between. */
+PK_HIDDEN pk_status scene_capture_mesh(pk_context *ctx, pk_scene *s, size_t pos0, size_t nrm0, size_t uv0,
+                                       size_t tri0, uint32_t *mesh);
+/* Places mesh by to_world (finite, affine, not singular: else
+ * PK_ERR_INVALID_ARGUMENT), with material mat for all its triangles or
+ * SCENE_MESH_MATERIAL for their own. Its triangles take their place after
+ * the triangles added so far. */
+PK_HIDDEN pk_status scene_add_instance(pk_context *ctx, pk_scene *s, uint32_t mesh, const xform *to_world,
+                                       uint32_t mat);
+
+/* Flattens the instances not yet flattened (positions by to_world, normals
+ * by its inverse transpose, renormalised), then validates and derives
+ * (degenerate flags, emissive list, bounds).
  * PK_ERR_EMPTY_SCENE when nothing can be hit. Warns about degenerate triangles. */
 PK_HIDDEN pk_status scene_commit(pk_context *ctx, pk_scene *s);
 /* Tests the invariants above; returns false and fills why (if non-NULL). */

@@ -788,6 +788,86 @@ static void test_errors(void)
     load_fails("<sensor type=\"perspective\"/>", true, "");
 }
 
+/* shapegroup and instance: the group's shapes become one mesh in the
+ * group's space, each instance places it; the triangles come in file order,
+ * an instance's where it stands in the file */
+static bool tri_within(const pk_scene *s, size_t k, vec3 lo, vec3 hi)
+{
+    vec3 v[3];
+    scene_tri_verts(s, k, &v[0], &v[1], &v[2]);
+    for (int i = 0; i < 3; i++)
+        if (v[i].x < lo.x || v[i].y < lo.y || v[i].z < lo.z || v[i].x > hi.x || v[i].y > hi.y || v[i].z > hi.z)
+            return false;
+    return true;
+}
+
+static void test_instances(void)
+{
+    pk_scene *s = load_ok("<shape type=\"rectangle\"/>\n"
+                          "<shape type=\"shapegroup\" id=\"g\">\n"
+                          "  <shape type=\"rectangle\">\n"
+                          "    <transform name=\"to_world\"><scale value=\"2\"/></transform>\n"
+                          "  </shape>\n"
+                          "</shape>\n"
+                          "<shape type=\"instance\"><ref id=\"g\"/>\n"
+                          "  <transform name=\"to_world\"><translate x=\"10\"/></transform>\n"
+                          "</shape>\n"
+                          "<shape type=\"instance\"><ref id=\"g\"/>\n"
+                          "  <transform name=\"to_world\"><rotate z=\"1\" angle=\"90\"/><translate y=\"-10\"/></transform>\n"
+                          "</shape>\n"
+                          "<shape type=\"cube\"/>\n");
+    if (s) {
+        CHECK(s->nmeshes == 1 && s->ninstances == 2 && s->nflattened == 2);
+        REQUIRE(s->ntris == 2 + 2 + 2 + 12);
+        CHECK(tri_within(s, 0, v3(-1, -1, 0), v3(1, 1, 0)) && tri_within(s, 1, v3(-1, -1, 0), v3(1, 1, 0)));
+        /* the first instance: the group's 4x4 square moved to x = 10 */
+        for (size_t k = 2; k < 4; k++) CHECK(tri_within(s, k, v3(8, -2, 0), v3(12, 2, 0)));
+        vec3 a, b, c;
+        scene_tri_verts(s, 2, &a, &b, &c);
+        CHECK(a.x == 8.0f && a.y == -2.0f && a.z == 0.0f); /* (-1,-1) scaled by 2, then moved */
+        /* the second: turned about z (exactly a square again), then moved to y = -10 */
+        for (size_t k = 4; k < 6; k++) CHECK(tri_within(s, k, v3(-2.0001f, -12.0001f, 0), v3(2.0001f, -7.9999f, 0)));
+        for (size_t k = 6; k < 18; k++) CHECK(tri_within(s, k, v3s(-1), v3s(1)));
+        CHECK_NEAR(total_area(s), 4.0 + 16.0 + 16.0 + 24.0, 1e-3);
+        vec3 n;
+        tri_area(s, 4, &n);
+        CHECK(near3(n, v3(0, 0, 1), 1e-6f));
+    }
+    pk_scene_destroy(s);
+
+    /* a group's sphere is tessellated (instances place meshes); an area
+     * emitter in a group makes every instance emit; a group never
+     * instanced adds nothing */
+    s = load_ok("<shape type=\"shapegroup\" id=\"ball\">\n"
+                "  <shape type=\"sphere\"><emitter type=\"area\"><rgb name=\"radiance\" value=\"1\"/></emitter></shape>\n"
+                "</shape>\n"
+                "<shape type=\"shapegroup\" id=\"unused\"><shape type=\"cube\"/></shape>\n"
+                "<shape type=\"instance\"><ref id=\"ball\"/></shape>\n"
+                "<shape type=\"instance\"><ref id=\"ball\"/>\n"
+                "  <transform name=\"to_world\"><translate x=\"5\"/></transform></shape>\n");
+    if (s) {
+        size_t per = 2 * 64 * (32 - 1);
+        CHECK(s->nspheres == 0);
+        CHECK(s->ntris == 2 * per);
+        CHECK(s->nemissive == 2 * per);
+        CHECK(tri_within(s, per, v3(4, -1, -1), v3(6, 1, 1)));
+    }
+    pk_scene_destroy(s);
+
+    load_fails("<shape type=\"shapegroup\"><shape type=\"cube\"/></shape>", true, "scene.xml:2: a shapegroup needs an id");
+    load_fails("<shape type=\"instance\"><ref id=\"nothing\"/></shape>", true,
+               "scene.xml:2: instance: no shapegroup \"nothing\" before it");
+    load_fails("<bsdf type=\"diffuse\" id=\"d\"/>\n<shape type=\"instance\"><ref id=\"d\"/></shape>", true,
+               "scene.xml:3: instance: \"d\" is not a shapegroup");
+    load_fails("<shape type=\"instance\"/>", true, "scene.xml:2: an instance needs a <ref");
+    load_fails("<shape type=\"shapegroup\" id=\"a\"><shape type=\"shapegroup\" id=\"b\"/></shape>", true,
+               "scene.xml:2: a shapegroup inside a shapegroup");
+    load_fails("<shape type=\"shapegroup\" id=\"a\"><shape type=\"cube\"/></shape>\n"
+               "<shape type=\"instance\"><ref id=\"a\"/>"
+               "<transform name=\"to_world\"><scale x=\"0\"/></transform></shape>",
+               true, "scene.xml:3: instance: to_world is singular");
+}
+
 int main(void)
 {
     snprintf(tmpdir, sizeof tmpdir, "%s", "/tmp/pk_test_xml_XXXXXX");
@@ -804,6 +884,7 @@ int main(void)
     test_sensor();
     test_handedness();
     test_errors();
+    test_instances();
     pk_context_destroy(ctx);
     char cmd[600];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
