@@ -1,0 +1,113 @@
+/*
+ * shading.h - the material at a hit as a BSDF: the one place where a
+ * material record (scene/scene.h) becomes a physically based scattering
+ * function (pbsdf.h) for any integrator, on the CPU and the GPU (PK_HD).
+ * The MTL illumination models are decoded here (docs/materials.md): Kd
+ * diffuse; Ks with Ns a GGX lobe over it (illum 2); illum 3 an ideal mirror
+ * weighted by Ks over the diffuse part, illum 5 a mirror with Fresnel;
+ * illum 4, 6, 7 smooth dielectrics (Ni, Tf) with exact Fresnel; dissolve
+ * d < 1 lets a fraction of the light pass straight through. The physically
+ * based types (diffuse, conductor, dielectric, plastic) map to their pbsdf
+ * directly. Directions are world space, unit, pointing away from the
+ * surface.
+ */
+#ifndef PK_SHADING_H
+#define PK_SHADING_H
+
+#include "../math/frame.h"
+#include "pbsdf.h"
+#include "surface.h"
+
+static inline PK_HD bool black(vec3 c) { return !(c.x > 0.0f || c.y > 0.0f || c.z > 0.0f); }
+
+/* The BSDF at a surface, its frame, and the dissolve: with probability
+ * 1 - opaque the path passes straight through (a delta lobe of its own). */
+typedef struct shading {
+    pbsdf b;
+    onb frame;           /* z = the shading normal; for dielectrics the outward one */
+    float opaque;
+    bool nondelta;       /* the BSDF has a part that light sampling can reach */
+} shading;
+
+static inline PK_HD shading shading_at(const surface *sf)
+{
+    const material *m = sf->m;
+    shading sh;
+    const bool glass = m->type == MAT_MTL && (m->illum == 4 || m->illum == 6 || m->illum == 7);
+    sh.opaque = glass || m->type == MAT_DIELECTRIC ? 1.0f : fminf(fmaxf(m->d, 0.0f), 1.0f);
+    vec3 n = sf->ns;
+    if (m->type != MAT_MTL) { /* the physically based types of JSON scenes */
+        switch (m->type) {
+        case MAT_CONDUCTOR:
+            sh.b = m->schlick ? pbsdf_conductor_schlick(m->ks, m->alpha) : pbsdf_conductor(m->eta, m->k, m->alpha);
+            break;
+        case MAT_DIELECTRIC:
+            sh.b = pbsdf_dielectric(m->ni, m->alpha, sf->front ? m->tf : v3s(1.0f));
+            if (!sf->front) n = v3_neg(n); /* the outward normal: wo.z < 0 inside */
+            break;
+        case MAT_PLASTIC: sh.b = pbsdf_plastic(m->kd, m->ni, m->alpha); break;
+        default: sh.b = pbsdf_diffuse(m->kd); break;
+        }
+    } else if (glass) {
+        /* Tf: the hue of what enters, normalised to the brightest channel
+         * (exporters write grey Tf of any strength for clear glass) */
+        float tmax_c = v3_max_comp(m->tf);
+        vec3 tint = tmax_c > 0.0f ? v3_scale(m->tf, 1.0f / tmax_c) : v3s(1.0f);
+        sh.b = pbsdf_dielectric(m->ni, 0.0f, sf->front ? tint : v3s(1.0f));
+        if (!sf->front) n = v3_neg(n); /* the outward normal: wo.z < 0 inside */
+    } else if (m->illum == 5) {
+        sh.b = pbsdf_conductor_schlick(m->ks, 0.0f); /* a mirror with Fresnel */
+    } else if (m->illum == 3) {
+        sh.b = pbsdf_glossy(m->kd, m->ks, 0.0f); /* diffuse + an ideal mirror weighted by Ks */
+    } else if (m->illum == 2 && (m->ks.x > 0.0f || m->ks.y > 0.0f || m->ks.z > 0.0f)) {
+        sh.b = pbsdf_glossy_mtl(m->kd, m->ks, m->ns);
+    } else {
+        sh.b = pbsdf_diffuse(m->kd);
+    }
+    sh.frame = onb_from_normal(n);
+    sh.nondelta = sh.opaque > 0.0f && pbsdf_has_nondelta(&sh.b) &&
+                  (sh.b.type != PBSDF_DIFFUSE || !black(sh.b.albedo));
+    return sh;
+}
+
+/* f * cos toward wi (world, unit) and its pdf, the dissolve included; zero
+ * where the geometric normal says the light comes through the surface. */
+static inline PK_HD vec3 shading_eval(const surface *sf, const shading *sh, vec3 wo, vec3 wi, float *pdf)
+{
+    *pdf = 0.0f;
+    const float side = v3_dot(wi, sf->ng), shade = v3_dot(wi, sf->ns);
+    if (sh->b.type != PBSDF_DIELECTRIC && (side <= 0.0f || shade <= 0.0f)) return v3s(0.0f);
+    vec3 lo = onb_to_local(sh->frame, wo), li = onb_to_local(sh->frame, wi);
+    *pdf = sh->opaque * pbsdf_pdf(&sh->b, lo, li);
+    return v3_scale(pbsdf_eval(&sh->b, lo, li), sh->opaque);
+}
+
+/* Samples the next direction. Returns false when the path ends. */
+static inline PK_HD bool shading_sample(const surface *sf, const shading *sh, vec3 wo, float u0, float u1, float u2, vec3 *wi,
+                           vec3 *weight, float *pdf, bool *delta)
+{
+    if (u0 >= sh->opaque) { /* straight through (dissolve) */
+        *wi = v3_neg(wo);
+        *weight = v3s(1.0f);
+        *pdf = 0.0f;
+        *delta = true;
+        return true;
+    }
+    const float u[3] = {u0 / sh->opaque, u1, u2};
+    vec3 lo = onb_to_local(sh->frame, wo), li, w;
+    float p;
+    bool d;
+    if (!pbsdf_sample(&sh->b, lo, u, &li, &w, &p, &d)) return false;
+    vec3 out = v3_norm(onb_to_world(sh->frame, li));
+    /* reflection stays on the side of the incoming ray, transmission crosses:
+     * by the geometric normal, so that shading normals never leak light */
+    const bool transmit = li.z * lo.z < 0.0f;
+    if (transmit ? v3_dot(out, sf->ng) >= 0.0f : v3_dot(out, sf->ng) <= 0.0f) return false;
+    *wi = out;
+    *weight = w;
+    *pdf = d ? 0.0f : p * sh->opaque;
+    *delta = d;
+    return true;
+}
+
+#endif
