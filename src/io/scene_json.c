@@ -385,16 +385,6 @@ static pk_status get_unit(jp *p, const cJSON *it, const char *path, float *out)
     return st;
 }
 
-/* Fresnel reflectance at normal incidence from a dielectric of index ior. */
-static float f0_dielectric(float ior)
-{
-    float r = (ior - 1.0f) / (ior + 1.0f);
-    return r * r;
-}
-
-/* The MTL Phong exponent whose path tracer alpha (sqrt(2/(Ns+2))) is alpha. */
-static float ns_from_alpha(float alpha) { return alpha < 1e-3f ? 1000.0f : fmaxf(2.0f / (alpha * alpha) - 2.0f, 0.0f); }
-
 /* The physically based material types (docs/materials.md). The keys of each:
  * the common ones ("type", "two_sided") and the type's parameters. */
 enum { TP_ALBEDO, TP_SPECULAR, TP_ETA, TP_K, TP_ROUGHNESS, TP_ALPHA, TP_IOR, TP_TRANSMITTANCE, TP_RADIANCE, TP_BSDF, TP_COUNT };
@@ -544,16 +534,14 @@ static pk_status read_typed_material(jp *p, const cJSON *obj, const cJSON *type_
         }
         return PK_OK;
     }
-    /* the MTL fields: what the Whitted integrator renders of each type */
+    /* the material model's constructors (scene/material.h) */
     switch (t) {
     case 0: /* diffuse */
-        m->type = MAT_DIFFUSE;
-        m->kd = albedo;
+        material_diffuse(m, albedo);
         break;
     case 1: { /* conductor */
-        m->type = MAT_CONDUCTOR;
-        m->eta = v3(0.2f, 0.92f, 1.1f), m->k = v3(3.9f, 2.45f, 2.14f); /* copper, as pbrt */
-        vec3 f0;
+        vec3 eta = v3(0.2f, 0.92f, 1.1f), k = v3(3.9f, 2.45f, 2.14f); /* copper, as pbrt */
+        vec3 f0 = v3s(-1.0f); /* set: Schlick's Fresnel of this reflectance */
         if (pv[TP_SPECULAR]) {
             const cJSON *other = pv[TP_ETA] ? pv[TP_ETA] : pv[TP_K];
             if (other) {
@@ -562,44 +550,29 @@ static pk_status read_typed_material(jp *p, const cJSON *obj, const cJSON *type_
                 return jfail(p, PK_ERR_PARSE, other, op, "give \"eta\" and \"k\" or \"specular\", not both");
             }
             if ((st = get_reflectance(p, pv[TP_SPECULAR], pp[TP_SPECULAR], &f0))) return st;
-            m->schlick = true;
         } else if (tex_specular.x >= 0.0f) {
             f0 = tex_specular;
-            m->schlick = true;
         } else {
             if (pv[TP_ETA]) {
-                if ((st = get_vec3(p, pv[TP_ETA], pp[TP_ETA], &m->eta))) return st;
-                if (!(m->eta.x > 0.0f && m->eta.y > 0.0f && m->eta.z > 0.0f))
+                if ((st = get_vec3(p, pv[TP_ETA], pp[TP_ETA], &eta))) return st;
+                if (!(eta.x > 0.0f && eta.y > 0.0f && eta.z > 0.0f))
                     return jfail(p, PK_ERR_PARSE, pv[TP_ETA], pp[TP_ETA], "components must be positive");
             }
             if (pv[TP_K]) {
-                if ((st = get_vec3(p, pv[TP_K], pp[TP_K], &m->k))) return st;
-                if (!(m->k.x >= 0.0f && m->k.y >= 0.0f && m->k.z >= 0.0f))
+                if ((st = get_vec3(p, pv[TP_K], pp[TP_K], &k))) return st;
+                if (!(k.x >= 0.0f && k.y >= 0.0f && k.z >= 0.0f))
                     return jfail(p, PK_ERR_PARSE, pv[TP_K], pp[TP_K], "components must not be negative");
             }
-            /* normal incidence: ((eta - 1)^2 + k^2) / ((eta + 1)^2 + k^2) */
-            const float e[3] = {m->eta.x, m->eta.y, m->eta.z}, k[3] = {m->k.x, m->k.y, m->k.z};
-            float r[3];
-            for (int c = 0; c < 3; c++)
-                r[c] = ((e[c] - 1.0f) * (e[c] - 1.0f) + k[c] * k[c]) / ((e[c] + 1.0f) * (e[c] + 1.0f) + k[c] * k[c]);
-            f0 = v3(r[0], r[1], r[2]);
         }
-        m->kd = v3s(0.0f), m->ks = f0;
-        if (alpha < 1e-3f) m->illum = 3; /* a mirror weighted by the normal reflectance */
-        else m->ns = ns_from_alpha(alpha);
+        if (f0.x >= 0.0f) material_conductor_f0(m, f0, alpha);
+        else material_conductor(m, eta, k, alpha);
         break;
     }
     case 2: /* dielectric */
-        m->type = MAT_DIELECTRIC;
-        m->ni = ior, m->tf = transmittance;
-        m->kd = v3s(0.0f), m->ks = v3s(f0_dielectric(ior));
-        m->illum = 7;
+        material_dielectric(m, ior, alpha, transmittance);
         break;
     case 3: /* plastic */
-        m->type = MAT_PLASTIC;
-        m->ni = ior, m->kd = albedo, m->ks = v3s(f0_dielectric(ior));
-        if (alpha < 1e-3f) m->illum = 3;
-        else m->ns = ns_from_alpha(alpha);
+        material_plastic(m, albedo, ior, alpha);
         break;
     default: { /* emitter: black diffuse, or the surface its "bsdf" describes */
         vec3 ke = v3s(1.0f);
@@ -617,8 +590,7 @@ static pk_status read_typed_material(jp *p, const cJSON *obj, const cJSON *type_
             }
             if ((st = read_typed_material(p, pv[TP_BSDF], bt, pp[TP_BSDF], false, m, NULL))) return st;
         } else {
-            m->type = MAT_DIFFUSE;
-            m->kd = v3s(0.0f);
+            material_diffuse(m, v3s(0.0f));
         }
         m->ke = ke;
         break;

@@ -1031,14 +1031,6 @@ static pk_status get_ior(xp *p, xnode *plugin, const char *name, float *out)
     return PK_OK;
 }
 
-static float f0_dielectric(float ior)
-{
-    float r = (ior - 1.0f) / (ior + 1.0f);
-    return r * r;
-}
-
-static float ns_from_alpha(float alpha) { return alpha < 1e-3f ? 1000.0f : fmaxf(2.0f / (alpha * alpha) - 2.0f, 0.0f); }
-
 static float clamp01(float x) { return x > 0.0f ? (x < 1.0f ? x : 1.0f) : 0.0f; }
 static vec3 clamp01v(vec3 c) { return v3(clamp01(c.x), clamp01(c.y), clamp01(c.z)); }
 
@@ -1138,8 +1130,7 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
         if (inner) {
             if ((st = bsdf_resolve(p, inner, m))) return st;
         } else {
-            m->type = MAT_DIFFUSE;
-            m->kd = v3s(0.5f);
+            material_diffuse(m, v3s(0.5f));
         }
         if (m->type != MAT_DIELECTRIC) m->d = clamp01(opacity);
         warn_unused(p, b, "mask", quiet);
@@ -1158,11 +1149,8 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
             vec3 kd = m->kd;
             float d = m->d;
             material_init(m);
-            m->type = MAT_PLASTIC;
-            m->kd = kd, m->d = d, m->ni = ior, m->alpha = alpha;
-            m->ks = v3s(f0_dielectric(ior));
-            if (alpha < 1e-3f) m->illum = 3;
-            else m->ns = ns_from_alpha(alpha);
+            m->d = d;
+            material_plastic(m, kd, ior, alpha);
             static const char *const q[] = {"distribution", NULL};
             warn_unused(p, b, type[0] == 'r' ? "bsdf \"roughcoating\"" : "bsdf \"coating\"", q);
             return PK_OK;
@@ -1171,8 +1159,7 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
         if (!inner) {
             xwarn(p, b, "bsdf \"%s\" without a nested bsdf; using a grey diffuse material", ty);
             material_init(m);
-            m->type = MAT_DIFFUSE;
-            m->kd = v3s(0.5f);
+            material_diffuse(m, v3s(0.5f));
             return PK_OK;
         }
         xwarn(p, b, "bsdf \"%s\" over a non-diffuse bsdf is not supported; using its nested bsdf alone", ty);
@@ -1185,8 +1172,7 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
         for (xnode *c = b->child; c; c = c->next) c->used = true;
         if (!inner) {
             xwarn(p, b, "bsdf \"%s\" is not supported; using a grey diffuse material", ty);
-            m->type = MAT_DIFFUSE;
-            m->kd = v3s(0.5f);
+            material_diffuse(m, v3s(0.5f));
             return PK_OK;
         }
         xwarn(p, b, "bsdf \"%s\" is not supported; using its nested bsdf alone", ty);
@@ -1203,8 +1189,7 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
             if (first_time(p, "roughdiffuse"))
                 xwarn(p, b, "roughdiffuse is rendered as diffuse (Lambert), without the Oren-Nayar roughness");
         }
-        m->type = MAT_DIFFUSE;
-        m->kd = clamp01v(r);
+        material_diffuse(m, clamp01v(r));
     } else if (strcmp(type, "conductor") == 0 || strcmp(type, "roughconductor") == 0) {
         bool rough = type[0] == 'r';
         if (rough && (st = get_alpha(p, b, 0.1f, &alpha))) return st;
@@ -1228,30 +1213,17 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
         if ((st = get_color(p, b, "k", &k))) return st;
         if ((st = get_ior(p, b, "ext_eta", &ext))) return st;
         if ((st = get_color(p, b, "specular_reflectance", &spec))) return st;
-        m->type = MAT_CONDUCTOR;
-        m->alpha = alpha;
         eta = v3_scale(eta, 1.0f / ext), k = v3_scale(k, 1.0f / ext);
         eta = v3(fmaxf(eta.x, 1e-4f), fmaxf(eta.y, 1e-4f), fmaxf(eta.z, 1e-4f));
         k = v3(fmaxf(k.x, 0.0f), fmaxf(k.y, 0.0f), fmaxf(k.z, 0.0f));
-        const float e[3] = {eta.x, eta.y, eta.z}, kk[3] = {k.x, k.y, k.z};
-        float r[3];
-        for (int c = 0; c < 3; c++)
-            r[c] = ((e[c] - 1.0f) * (e[c] - 1.0f) + kk[c] * kk[c]) / ((e[c] + 1.0f) * (e[c] + 1.0f) + kk[c] * kk[c]);
-        vec3 f0 = none ? v3s(1.0f) : v3(r[0], r[1], r[2]);
         spec = clamp01v(spec);
         if (none || spec.x != 1.0f || spec.y != 1.0f || spec.z != 1.0f) {
             /* a scaled Fresnel term: Schlick's with the scaled normal reflectance */
-            m->schlick = true;
-            m->ks = v3_mul(f0, spec);
+            const vec3 f0 = none ? v3s(1.0f) : material_f0_conductor(eta, k);
+            material_conductor_f0(m, clamp01v(v3_mul(f0, spec)), alpha);
         } else {
-            m->eta = eta, m->k = k;
-            m->ks = f0;
+            material_conductor(m, eta, k, alpha);
         }
-        m->kd = v3s(0.0f);
-        if (alpha < 1e-3f) m->illum = 3;
-        else m->ns = ns_from_alpha(alpha);
-        if (!m->schlick) m->ks = f0;
-        else m->ks = clamp01v(m->ks);
     } else if (strcmp(type, "dielectric") == 0 || strcmp(type, "roughdielectric") == 0 ||
                strcmp(type, "thindielectric") == 0) {
         float in = 1.5046f, ext = 1.000277f;
@@ -1271,10 +1243,7 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
             ior = 1.0f;
         }
         if (ior == 1.0f && alpha > 0.0f) alpha = 0.0f;
-        m->type = MAT_DIELECTRIC;
-        m->ni = ior, m->alpha = alpha, m->tf = clamp01v(tr);
-        m->kd = v3s(0.0f), m->ks = v3s(f0_dielectric(ior));
-        m->illum = 7;
+        material_dielectric(m, ior, alpha, clamp01v(tr));
     } else if (strcmp(type, "plastic") == 0 || strcmp(type, "roughplastic") == 0) {
         float in = 1.49f, ext = 1.000277f;
         vec3 kd = v3s(0.5f), spec = v3s(1.0f);
@@ -1287,11 +1256,7 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
             xwarn(p, b, "%s: specular_reflectance other than 1 is not supported; ignored", ty);
         float ior = in / ext;
         if (!(ior > 0.0f) || ior == 1.0f) ior = 1.49f;
-        m->type = MAT_PLASTIC;
-        m->kd = clamp01v(kd), m->ni = ior, m->alpha = alpha;
-        m->ks = v3s(f0_dielectric(ior));
-        if (alpha < 1e-3f) m->illum = 3;
-        else m->ns = ns_from_alpha(alpha);
+        material_plastic(m, clamp01v(kd), ior, alpha);
     } else if (strcmp(type, "principled") == 0 || strcmp(type, "principledthin") == 0) {
         /* Disney's model by its main parameters: a metal (Schlick, F0 =
          * base_color) when metallic > 0.5, else a plastic of base_color */
@@ -1306,28 +1271,14 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
             xwarn(p, b, "principled is approximated by a %s of its base_color and roughness",
                   metallic > 0.5f ? "metal" : "plastic");
         alpha = clamp01(roughness) * clamp01(roughness);
-        if (metallic > 0.5f) {
-            m->type = MAT_CONDUCTOR;
-            m->schlick = true;
-            m->ks = clamp01v(base), m->kd = v3s(0.0f);
-        } else {
-            m->type = MAT_PLASTIC;
-            m->kd = clamp01v(base);
-            m->ni = eta > 1.0f ? eta : 1.5f;
-            m->ks = v3s(f0_dielectric(m->ni));
-        }
-        m->alpha = alpha;
-        if (alpha < 1e-3f) m->illum = 3;
-        else m->ns = ns_from_alpha(alpha);
+        if (metallic > 0.5f) material_conductor_f0(m, clamp01v(base), alpha);
+        else material_plastic(m, clamp01v(base), eta > 1.0f ? eta : 1.5f, alpha);
     } else if (strcmp(type, "null") == 0) {
-        m->type = MAT_DIELECTRIC; /* index 1: light passes straight through */
-        m->ni = 1.0f, m->tf = v3s(1.0f), m->kd = v3s(0.0f), m->ks = v3s(0.0f);
-        m->illum = 7;
+        material_dielectric(m, 1.0f, 0.0f, v3s(1.0f)); /* index 1: light passes straight through */
     } else {
         for (xnode *c = b->child; c; c = c->next) c->used = true;
         xwarn(p, b, "bsdf \"%s\" is not supported; using a grey diffuse material", ty);
-        m->type = MAT_DIFFUSE;
-        m->kd = v3s(0.5f);
+        material_diffuse(m, v3s(0.5f));
         return PK_OK;
     }
     char kind[64];
@@ -1778,9 +1729,7 @@ static pk_status parse_shape(xp *p, xnode *sh)
         if (d < 0) {
             uint32_t idx;
             if ((st = scene_add_material(p->ctx, p->s, "mitsuba-default-diffuse", &idx))) return st;
-            material *dm = &p->s->materials[idx];
-            dm->type = MAT_DIFFUSE;
-            dm->kd = v3s(0.5f);
+            material_diffuse(&p->s->materials[idx], v3s(0.5f));
             d = idx;
         }
         mat = (uint32_t)d;

@@ -13,24 +13,6 @@
 #define SCENE_MAX_PRIMS ((size_t)1 << 30) /* triangle numbers fit uint32 with room */
 #define SCENE_MAX_MATERIALS ((size_t)1 << 24)
 
-void material_init(material *m)
-{
-    memset(m, 0, sizeof *m);
-    m->kd = v3s(0.8f);
-    m->tf = v3s(1.0f);
-    m->ns = 1.0f;
-    m->ni = 1.0f;
-    m->d = 1.0f;
-    m->illum = 2;
-    tex_ref_init(&m->map_kd);
-    tex_ref_init(&m->map_ks);
-    tex_ref_init(&m->map_ns);
-    tex_ref_init(&m->map_d);
-    tex_ref_init(&m->map_alpha);
-    tex_ref_init(&m->map_bump);
-    tex_ref_init(&m->map_norm);
-}
-
 void scene_env_init(scene_environment *env)
 {
     memset(env, 0, sizeof *env);

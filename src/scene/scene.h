@@ -13,52 +13,8 @@
 #include "../math/vec3.h"
 #include "../math/xform.h"
 #include "../paprsek_internal.h"
+#include "material.h"
 #include "texture.h"
-
-/* Material as read from MTL (or JSON); colours are linear RGB.
- * illum follows the MTL convention: 3/5 add mirror reflection weighted by ks,
- * 4/6/7 make the surface a dielectric of index ni tinted by tf. */
-typedef struct material {
-    char *name;    /* owned */
-    vec3 kd;       /* diffuse albedo */
-    vec3 ks;       /* specular (Phong lobe, or mirror weight) */
-    vec3 ke;       /* emitted radiance; non-zero makes every triangle an area light */
-    vec3 tf;       /* transmission filter for refraction */
-    vec3 ka;       /* ambient; only used when the scene sets an ambient light */
-    float ns;      /* Phong exponent */
-    float ni;      /* index of refraction */
-    float d;       /* dissolve, 1 = opaque (Tr = 1 - d) */
-    int illum;
-    /* Emission on both sides (the path tracer; area lights are one-sided by
-     * default, emitting on the side of the winding normal, counter-clockwise
-     * v0 v1 v2, and of a sphere's outward normal). The Whitted integrator
-     * treats every emitter as two-sided. */
-    bool two_sided;
-    /* The physically based types of JSON scenes (docs/materials.md). MAT_MTL
-     * (material_init's default, every MTL material) is the MTL model of the
-     * fields above. The others are for the path tracer: MAT_DIFFUSE has the
-     * albedo kd; MAT_CONDUCTOR the complex index eta + i k, or with
-     * schlick the normal-incidence reflectance ks (Schlick's Fresnel);
-     * MAT_DIELECTRIC the index ni and the transmittance tf; MAT_PLASTIC the
-     * albedo kd under a coating of index ni. alpha is the GGX roughness of
-     * the conductor, dielectric and plastic (0 = smooth). The JSON reader
-     * also sets the MTL fields to a Whitted approximation of each type. */
-    int type;      /* material_type */
-    float alpha;
-    vec3 eta, k;
-    bool schlick;
-    /* Texture maps (docs/materials.md), kind TEX_NONE when absent. A map's
-     * value multiplies its constant: map_kd kd, map_ks ks, map_ns ns,
-     * map_alpha alpha. map_d cuts holes: where its opacity is below 0.5 the
-     * surface is not there for any ray (the constant d still dissolves the
-     * rest). map_bump is a height field (heights times bm, in scene units);
-     * map_norm a tangent-space normal map. */
-    tex_ref map_kd, map_ks, map_ns, map_d, map_alpha, map_bump, map_norm;
-    bool textured;   /* derived by scene_commit: a map other than map_d is set */
-    bool cutout;     /* derived by scene_commit: map_d is set */
-} material;
-
-typedef enum material_type { MAT_MTL, MAT_DIFFUSE, MAT_CONDUCTOR, MAT_DIELECTRIC, MAT_PLASTIC } material_type;
 
 /* Triangle k is the k-th triangle the file produced (fan order). */
 typedef struct triangle {
@@ -219,7 +175,6 @@ PK_HIDDEN pk_status scene_add_material(pk_context *ctx, pk_scene *s, const char 
  * (a hash index), so that files with many materials and usemtl statements
  * do not take quadratic time. */
 PK_HIDDEN int64_t scene_find_material(const pk_scene *s, const char *name);
-PK_HIDDEN void material_init(material *m);
 /* The empty environment (nothing set, identity rotation, scales 1, sun 0.53 degrees). */
 PK_HIDDEN void scene_env_init(scene_environment *env);
 /* Sets env's map rotation to deg degrees about +y (counter-clockwise seen from above). */

@@ -1,0 +1,92 @@
+/*
+ * material.c - the material model's constructors (see material.h).
+ */
+#include "material.h"
+
+#include <string.h>
+
+void material_init(material *m)
+{
+    memset(m, 0, sizeof *m);
+    m->kd = v3s(0.8f);
+    m->tf = v3s(1.0f);
+    m->ns = 1.0f;
+    m->ni = 1.0f;
+    m->d = 1.0f;
+    m->illum = 2;
+    tex_ref_init(&m->map_kd);
+    tex_ref_init(&m->map_ks);
+    tex_ref_init(&m->map_ns);
+    tex_ref_init(&m->map_d);
+    tex_ref_init(&m->map_alpha);
+    tex_ref_init(&m->map_bump);
+    tex_ref_init(&m->map_norm);
+}
+
+float material_f0_dielectric(float ior)
+{
+    float r = (ior - 1.0f) / (ior + 1.0f);
+    return r * r;
+}
+
+vec3 material_f0_conductor(vec3 eta, vec3 k)
+{
+    /* ((eta - 1)^2 + k^2) / ((eta + 1)^2 + k^2) */
+    const float e[3] = {eta.x, eta.y, eta.z}, kk[3] = {k.x, k.y, k.z};
+    float r[3];
+    for (int c = 0; c < 3; c++)
+        r[c] = ((e[c] - 1.0f) * (e[c] - 1.0f) + kk[c] * kk[c]) / ((e[c] + 1.0f) * (e[c] + 1.0f) + kk[c] * kk[c]);
+    return v3(r[0], r[1], r[2]);
+}
+
+/* The MTL Phong exponent whose path tracer alpha (sqrt(2/(Ns+2))) is alpha. */
+static float ns_from_alpha(float alpha) { return alpha < 1e-3f ? 1000.0f : fmaxf(2.0f / (alpha * alpha) - 2.0f, 0.0f); }
+
+/* The Whitted approximation of a glossy lobe of roughness alpha over the
+ * weight ks already set: an ideal mirror (illum 3) when it is smooth, else
+ * the Phong lobe (illum 2) of matching width. */
+static void whitted_gloss(material *m, float alpha)
+{
+    if (alpha < 1e-3f) m->illum = 3;
+    else m->ns = ns_from_alpha(alpha);
+}
+
+void material_diffuse(material *m, vec3 albedo)
+{
+    m->type = MAT_DIFFUSE;
+    m->kd = albedo;
+}
+
+void material_conductor(material *m, vec3 eta, vec3 k, float alpha)
+{
+    m->type = MAT_CONDUCTOR;
+    m->schlick = false;
+    m->eta = eta, m->k = k, m->alpha = alpha;
+    m->kd = v3s(0.0f), m->ks = material_f0_conductor(eta, k);
+    whitted_gloss(m, alpha);
+}
+
+void material_conductor_f0(material *m, vec3 f0, float alpha)
+{
+    m->type = MAT_CONDUCTOR;
+    m->schlick = true;
+    m->alpha = alpha;
+    m->kd = v3s(0.0f), m->ks = f0;
+    whitted_gloss(m, alpha);
+}
+
+void material_dielectric(material *m, float ior, float alpha, vec3 transmittance)
+{
+    m->type = MAT_DIELECTRIC;
+    m->ni = ior, m->alpha = alpha, m->tf = transmittance;
+    m->kd = v3s(0.0f), m->ks = v3s(material_f0_dielectric(ior));
+    m->illum = 7;
+}
+
+void material_plastic(material *m, vec3 albedo, float ior, float alpha)
+{
+    m->type = MAT_PLASTIC;
+    m->kd = albedo, m->ni = ior, m->alpha = alpha;
+    m->ks = v3s(material_f0_dielectric(ior));
+    whitted_gloss(m, alpha);
+}

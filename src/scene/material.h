@@ -1,0 +1,92 @@
+/*
+ * material.h - the material model: one record per material with a closed
+ * set of kinds, and one constructor per kind that fills the physically
+ * based parameters and, in this one place, the MTL fields that the Whitted
+ * integrator renders as an approximation of the kind. Readers (JSON,
+ * Mitsuba XML, and those to come) describe what a file says by calling the
+ * constructors; they never write a kind's approximation themselves. The
+ * path tracer turns a record into a BSDF in render/shading.h.
+ *
+ * Kinds: MAT_MTL (an MTL material: Kd, Ks, Ns, Ni, Tf, d and the illum code,
+ * set field by field by the MTL reader), diffuse, conductor (a complex
+ * index or a normal-incidence reflectance), dielectric, plastic (a diffuse
+ * base under a dielectric coat). Emission (ke) and two-sidedness go with
+ * any kind; texture maps (texture.h) scale the constants.
+ */
+#ifndef PK_MATERIAL_H
+#define PK_MATERIAL_H
+
+#include "../math/vec3.h"
+#include "texture.h"
+
+#include <stdbool.h>
+
+typedef enum material_type { MAT_MTL, MAT_DIFFUSE, MAT_CONDUCTOR, MAT_DIELECTRIC, MAT_PLASTIC } material_type;
+
+/* Colours are linear RGB. illum follows the MTL convention: 3/5 add mirror
+ * reflection weighted by ks, 4/6/7 make the surface a dielectric of index
+ * ni tinted by tf. */
+typedef struct material {
+    char *name;    /* owned */
+    vec3 kd;       /* diffuse albedo */
+    vec3 ks;       /* specular (Phong lobe, or mirror weight) */
+    vec3 ke;       /* emitted radiance; non-zero makes every triangle an area light */
+    vec3 tf;       /* transmission filter for refraction */
+    vec3 ka;       /* ambient; only used when the scene sets an ambient light */
+    float ns;      /* Phong exponent */
+    float ni;      /* index of refraction */
+    float d;       /* dissolve, 1 = opaque (Tr = 1 - d) */
+    int illum;
+    /* Emission on both sides (the path tracer; area lights are one-sided by
+     * default, emitting on the side of the winding normal, counter-clockwise
+     * v0 v1 v2, and of a sphere's outward normal). The Whitted integrator
+     * treats every emitter as two-sided. */
+    bool two_sided;
+    /* The kind (material_type). MAT_MTL (material_init's default, every MTL
+     * material) is the MTL model of the fields above. The others are for
+     * the path tracer: MAT_DIFFUSE has the albedo kd; MAT_CONDUCTOR the
+     * complex index eta + i k, or with schlick the normal-incidence
+     * reflectance ks (Schlick's Fresnel); MAT_DIELECTRIC the index ni and
+     * the transmittance tf; MAT_PLASTIC the albedo kd under a coating of
+     * index ni. alpha is the GGX roughness of the conductor, dielectric and
+     * plastic (0 = smooth). Their constructors also set the MTL fields to
+     * what the Whitted integrator renders of them. */
+    int type;
+    float alpha;
+    vec3 eta, k;
+    bool schlick;
+    /* Texture maps (docs/materials.md), kind TEX_NONE when absent. A map's
+     * value multiplies its constant: map_kd kd, map_ks ks, map_ns ns,
+     * map_alpha alpha. map_d cuts holes: where its opacity is below 0.5 the
+     * surface is not there for any ray (the constant d still dissolves the
+     * rest). map_bump is a height field (heights times bm, in scene units);
+     * map_norm a tangent-space normal map. */
+    tex_ref map_kd, map_ks, map_ns, map_d, map_alpha, map_bump, map_norm;
+    bool textured;   /* derived by scene_commit: a map other than map_d is set */
+    bool cutout;     /* derived by scene_commit: map_d is set */
+} material;
+
+/* The MTL defaults (Kd 0.8, illum 2, opaque, no maps, no name). */
+PK_HIDDEN void material_init(material *m);
+
+/* The constructors set the kind, its parameters and its Whitted
+ * approximation, and nothing else (name, maps, dissolve, emission and
+ * two-sidedness stay as they were). alpha is the GGX roughness, 0 smooth. */
+
+/* Lambert of albedo kd. */
+PK_HIDDEN void material_diffuse(material *m, vec3 albedo);
+/* A metal of complex index eta + i k (relative to the outside). */
+PK_HIDDEN void material_conductor(material *m, vec3 eta, vec3 k, float alpha);
+/* A metal by its normal-incidence reflectance f0 (Schlick's Fresnel). */
+PK_HIDDEN void material_conductor_f0(material *m, vec3 f0, float alpha);
+/* Glass of relative index ior; transmittance tints the light that enters. */
+PK_HIDDEN void material_dielectric(material *m, float ior, float alpha, vec3 transmittance);
+/* A diffuse base of albedo under a dielectric coat of index ior. */
+PK_HIDDEN void material_plastic(material *m, vec3 albedo, float ior, float alpha);
+
+/* Fresnel reflectance at normal incidence of a dielectric of index ior,
+ * and of a conductor of index eta + i k (per channel). */
+PK_HIDDEN float material_f0_dielectric(float ior);
+PK_HIDDEN vec3 material_f0_conductor(vec3 eta, vec3 k);
+
+#endif
