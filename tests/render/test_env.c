@@ -17,6 +17,7 @@
  * integrators, and the path tracer's three light strategies.
  */
 #include "test.h"
+#include "warnings.h"
 
 #include "chi2.h"
 #include "paprsek.h"
@@ -414,19 +415,14 @@ static void test_renders(const char *dir)
 }
 
 /* A scene without lights gets the white environment of radiance 1. */
-static int warnings;
-static void count_warning(void *user, const char *message)
-{
-    (void)user;
-    if (strstr(message, "uniform white environment")) warnings++;
-}
+static warning_log warnings;
 
 static void test_default(const char *dir)
 {
     pk_scene *s = quad_scene(dir, 0.5f);
-    pk_context_set_warning_handler(ctx, count_warning, NULL);
+    warning_log_attach(ctx, &warnings);
     expect_mean("default white environment, path", s, PK_INTEGRATOR_PATH, PATH_MIS, 8, 0.5);
-    CHECK(warnings == 1);
+    CHECK(warning_log_count(&warnings, "uniform white environment") == 1);
     pk_context_set_warning_handler(ctx, NULL, NULL);
     pk_scene_destroy(s);
 }

@@ -14,6 +14,7 @@
  * passes of fewer samples added into one film.
  */
 #include "test.h"
+#include "warnings.h"
 
 #include "paprsek.h"
 
@@ -187,12 +188,6 @@ static void check_determinism(void)
     pk_scene_destroy(s);
 }
 
-static int g_facing_warnings;
-static void count_facing(void *user, const char *message)
-{
-    (void)user;
-    if (strstr(message, "every area light faces away from the scene")) g_facing_warnings++;
-}
 
 /* A floor under a light quad: wound to face the floor, no warning; wound to
  * face the sky, the warning that it faces away from the scene. */
@@ -213,11 +208,12 @@ static void check_facing_warning(const char *dir)
         write_file(path, text);
         pk_scene *s = NULL;
         REQUIRE(pk_scene_load_file(ctx, path, &s) == PK_OK);
-        g_facing_warnings = 0;
-        pk_context_set_warning_handler(ctx, count_facing, NULL);
+        warning_log w;
+        warning_log_attach(ctx, &w);
         pk_image *img = render_path(s, 8, 1, 1, 0);
         pk_context_set_warning_handler(ctx, NULL, NULL);
-        CHECKF(g_facing_warnings == up, "lamp wound to face %s: %d warnings", up ? "up" : "down", g_facing_warnings);
+        const int facing = warning_log_count(&w, "every area light faces away from the scene");
+        CHECKF(facing == up, "lamp wound to face %s: %d warnings", up ? "up" : "down", facing);
         pk_image_destroy(img);
         pk_scene_destroy(s);
         remove(path);

@@ -7,16 +7,11 @@
  * ../shared is absent.
  */
 #include "test.h"
+#include "warnings.h"
 
 #include "paprsek.h"
 
-static int nwarnings;
-static void on_warning(void *user, const char *message)
-{
-    (void)user;
-    fprintf(stderr, "  warning: %s\n", message);
-    nwarnings++;
-}
+static warning_log warnings;
 
 /* Loads rel, renders it at w x h with spp samples; NULL image on failure. */
 static pk_image *render(pk_context *ctx, const char *rel, int w, int h, int spp, pk_scene_info *info)
@@ -24,7 +19,7 @@ static pk_image *render(pk_context *ctx, const char *rel, int w, int h, int spp,
     char path[1024];
     snprintf(path, sizeof path, "%s/%s", PK_SHARED_DIR, rel);
     pk_scene *s = NULL;
-    nwarnings = 0;
+    warning_log_clear(&warnings);
     if (pk_scene_load_file(ctx, path, &s) != PK_OK) {
         fprintf(stderr, "%s: %s\n", rel, pk_context_error(ctx));
         test_failures++;
@@ -77,14 +72,15 @@ int main(void)
     shared_path(buf, sizeof buf, "scenes/bitterli/cornell-box/scene_v3.xml");
     pk_context *ctx = NULL;
     REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
-    pk_context_set_warning_handler(ctx, on_warning, NULL);
+    warning_log_attach(ctx, &warnings);
+    warnings.echo = true;
     pk_scene_info info;
 
     pk_image *img = render(ctx, "scenes/bitterli/cornell-box/scene_v3.xml", 64, 64, 16, &info);
     if (img) {
         /* 6 rectangles and 2 cubes: 6 * 2 + 2 * 12 triangles, the lamp's 2 emissive */
         CHECK(info.triangles == 36 && info.emissive_triangles == 2 && info.has_camera);
-        CHECK(nwarnings == 0);
+        CHECK(warnings.count == 0);
         check_values(img, "cornell-box");
         double left[3], right[3], lamp[3];
         region(img, 1, 8, 16, 48, left);
@@ -100,7 +96,7 @@ int main(void)
     img = render(ctx, "scenes/bitterli/veach-mis/scene.xml", 64, 36, 4, &info);
     if (img) {
         /* 4 cubes and 2 rectangles; the 3 lamps are spheres */
-        CHECK(info.triangles == 4 * 12 + 2 * 2 && info.spheres == 3 && nwarnings == 0);
+        CHECK(info.triangles == 4 * 12 + 2 * 2 && info.spheres == 3 && warnings.count == 0);
         CHECK(check_values(img, "veach-mis") > 0.01);
         pk_image_destroy(img);
     }
