@@ -31,12 +31,17 @@ static const char usage_text[] =
 
 enum {
     B_ACCEL = 1, B_THREADS, B_REPS, B_HITS, B_ANY_HIT, B_PACKETS, B_STATS, B_HELP,
-    B_OUTPUT, B_LOOK_FROM, B_LOOK_AT, B_FOV, B_SIZE, B_KIND, B_SEED, B_WORKLOAD, B_SHARED, B_RAYS
+    B_OUTPUT, B_LOOK_FROM, B_LOOK_AT, B_FOV, B_SIZE, B_KIND, B_SEED, B_WORKLOAD, B_SHARED, B_RAYS, B_CONFIG
 };
 
 #define ACCEL_HELP "none, midpoint, bvh (default), embree or cuda (an NVIDIA GPU)"
 #define OPT_FLAG(n, i, h) {.name = n, .id = i, .kind = CLI_FLAG, .help = h}
 #define OPT_STR(n, i, a, h) {.name = n, .id = i, .kind = CLI_STRING, .arg = a, .help = h}
+#define CONFIG_HELP                                                                                          \
+    "settings of the library's back ends: cpu.isa=auto|avx2, bvh.quality=high|fast, "                       \
+    "embree.quality=low|medium|high, embree.library=FILE, cuda.library=FILE (README, Configuration); they " \
+    "override the environment variables PAPRSEK_CPU_ISA, PAPRSEK_BVH_QUALITY, PAPRSEK_EMBREE_QUALITY, "     \
+    "PAPRSEK_EMBREE_LIBRARY and PAPRSEK_CUDA_LIBRARY, which are passed on as these keys"
 
 static cli_option rays_opts[] = {
     OPT_STR("accel", B_ACCEL, "NAME", "the acceleration structure: " ACCEL_HELP),
@@ -47,6 +52,7 @@ static cli_option rays_opts[] = {
     OPT_FLAG("any-hit", B_ANY_HIT, "occlusion rays: any hit, not the closest"),
     OPT_FLAG("packets", B_PACKETS, "trace coherent groups of rays as packets"),
     OPT_FLAG("stats", B_STATS, "count nodes and tests per ray in one more, untimed pass"),
+    OPT_STR("config", B_CONFIG, "KEY=VALUE,...", CONFIG_HELP),
     {.name = "help", .short_name = 'h', .id = B_HELP, .kind = CLI_FLAG, .help = "this text"},
 };
 
@@ -65,6 +71,7 @@ static cli_option gen_opts[] = {
     OPT_STR("workload", B_WORKLOAD, "NAME", "a standard workload's scene and camera: cornell-sphere, bunny, sponza"),
     OPT_STR("shared", B_SHARED, "DIR", "where the workloads' scenes are (default ../shared)"),
     OPT_STR("accel", B_ACCEL, "NAME", "the acceleration structure for diffuse rays: " ACCEL_HELP),
+    OPT_STR("config", B_CONFIG, "KEY=VALUE,...", CONFIG_HELP),
     {.name = "threads", .id = B_THREADS},
     {.name = "help", .short_name = 'h', .id = B_HELP, .kind = CLI_FLAG, .help = "this text"},
 };
@@ -201,22 +208,45 @@ static double median(double *v, int n)
 
 static int is_hit(const pk_hit *h) { return h->prim != PK_NO_HIT || h->t < INFINITY; }
 
-static pk_context *new_context(void)
+/* A context with the config of the environment and --config (config);
+ * NULL after a message (*rc: the exit status). */
+static pk_context *new_context(const char *config, int *rc)
 {
     pk_context *ctx = NULL;
     if (pk_context_create(NULL, &ctx) != PK_OK) {
         fprintf(stderr, "paprsek: out of memory\n");
+        *rc = 1;
         return NULL;
     }
     pk_context_set_warning_handler(ctx, cli_print_warning, NULL);
+    if ((*rc = cli_configure(ctx, config)) != 0) {
+        pk_context_destroy(ctx);
+        return NULL;
+    }
     return ctx;
+}
+
+/* The value of key in ctx's effective config ("medium" for embree.quality). */
+static const char *config_value(pk_context *ctx, const char *key, char *buf, size_t cap)
+{
+    char all[1024];
+    pk_context_get_config(ctx, all, sizeof all);
+    const size_t kl = strlen(key);
+    buf[0] = '\0';
+    for (const char *p = all; p && *p; p = strchr(p, ',') ? strchr(p, ',') + 1 : NULL)
+        if (strncmp(p, key, kl) == 0 && p[kl] == '=') {
+            const char *v = p + kl + 1, *e = strchr(v, ',');
+            snprintf(buf, cap, "%.*s", (int)(e ? (size_t)(e - v) : strlen(v)), v);
+            break;
+        }
+    return buf;
 }
 
 /* ---- bench rays ------------------------------------------------------------ */
 
 static int bench_rays(int argc, char **argv)
 {
-    const char *scene_path = NULL, *rays_path = NULL, *hits_path = NULL;
+    const char *scene_path = NULL, *rays_path = NULL, *hits_path = NULL, *config = NULL;
     pk_accel_kind kind = PK_ACCEL_DEFAULT;
     int threads = 0, reps = 5, any_hit = 0, packets = 0, stats = 0;
     bench_options();
@@ -246,11 +276,13 @@ static int bench_rays(int argc, char **argv)
         case B_ANY_HIT: any_hit = 1; break;
         case B_PACKETS: packets = 1; break;
         case B_STATS: stats = 1; break;
+        case B_CONFIG: config = v; break;
         case B_HELP: cli_bench_help(stdout); return 0;
         }
     }
     if (!scene_path || !rays_path)
         return cli_usage_error("bench rays needs SCENE.obj and RAYS.rays\n%s", usage_text);
+    if (cli_check_config(config)) return 2;
     if (hits_path && cli_check_output(hits_path, 1)) return 1;
     if (threads == 0) threads = online_cpus();
 
@@ -264,7 +296,8 @@ static int bench_rays(int argc, char **argv)
     size_t n = 0;
 
     if (read_records(rays_path, sizeof(pk_ray), "ray", (void **)&rays, &n)) goto out;
-    if (!(ctx = new_context())) goto out;
+    if (!(ctx = new_context(config, &rc))) goto out;
+    rc = 1;
     if (pk_scene_load_file(ctx, scene_path, &scene) != PK_OK ||
         pk_accel_create(ctx, scene, kind, threads, &accel) != PK_OK) {
         rc = cli_fail_ctx(ctx);
@@ -316,8 +349,8 @@ static int bench_rays(int argc, char **argv)
     const char *isa = pk_accel_isa(accel);
     if (isa) printf(" isa=%s", isa);
     if (info.name && strcmp(info.name, "embree") == 0) {
-        const char *q = getenv("PAPRSEK_EMBREE_QUALITY");
-        printf(" embree_quality=%s", q && q[0] ? q : "medium");
+        char q[32];
+        printf(" embree_quality=%s", config_value(ctx, "embree.quality", q, sizeof q));
     }
     if (on_device) {
         /* the device's name without spaces, so that the line stays key=value pairs */
@@ -550,7 +583,7 @@ static size_t make_shadow(const pk_scene *scene, pk_ray *rays, size_t n, uint64_
 
 static int bench_gen_rays(int argc, char **argv)
 {
-    const char *scene_arg = NULL, *out_path = NULL, *shared = NULL, *kind_name = "primary";
+    const char *scene_arg = NULL, *out_path = NULL, *shared = NULL, *kind_name = "primary", *gen_config = NULL;
     const workload *wl = NULL;
     float from[3], at[3], fov = 0.0f;
     int has_from = 0, has_at = 0, has_fov = 0, size = 1024, threads = 0;
@@ -613,6 +646,7 @@ static int bench_gen_rays(int argc, char **argv)
             if (pk_accel_kind_parse(v, &accel_kind) != PK_OK)
                 return cli_usage_error("--accel %s: expected none, midpoint, bvh, embree or cuda", v);
             break;
+        case B_CONFIG: gen_config = v; break;
         case B_THREADS: threads = p.int_value; break;
         case B_OUTPUT: out_path = v; break;
         case B_HELP: cli_bench_help(stdout); return 0;
@@ -634,6 +668,7 @@ static int bench_gen_rays(int argc, char **argv)
     if (!scene_path) return cli_usage_error("bench gen-rays needs SCENE.obj or --workload\n%s", usage_text);
     if (!has_from || !has_at || !has_fov)
         return cli_usage_error("bench gen-rays needs --look-from, --look-at and --fov (or --workload)");
+    if (cli_check_config(gen_config)) return 2;
     if (cli_check_output(out_path, 1)) return 1;
     if (threads == 0) threads = online_cpus();
     const int diffuse = strcmp(kind_name, "primary") != 0; /* diffuse or shadow: from the primary hits */
@@ -665,7 +700,8 @@ static int bench_gen_rays(int argc, char **argv)
         goto out;
     }
 
-    if (!(ctx = new_context())) goto out;
+    if (!(ctx = new_context(gen_config, &rc))) goto out;
+    rc = 1;
     if (pk_scene_load_file(ctx, scene_path, &scene) != PK_OK ||
         pk_accel_create(ctx, scene, accel_kind, threads, &accel) != PK_OK) {
         rc = cli_fail_ctx(ctx);

@@ -97,6 +97,7 @@ typedef struct cli_render_opts {
     int fresnel;         /* -1: not given */
     int has_accel;
     pk_accel_kind accel;
+    const char *config;  /* --config, NULL when not given */
     int has_integrator;
     pk_integrator_kind integrator;
     double time;         /* --time: seconds of passes, 0 when not given */
@@ -137,10 +138,11 @@ pk_status cli_render_write(pk_context *ctx, const cli_render_opts *o, const pk_w
 /* "dir/name.png" -> "dir/name.partial.png" (malloc'ed; NULL when out of memory) */
 char *cli_partial_name(const char *out);
 /* The statistics table of --stats on standard output (sc: its textures). */
-void cli_print_stats(const char *scene, const pk_scene *sc, const pk_render_options *ro, const pk_stats *st);
+void cli_print_stats(pk_context *ctx, const char *scene, const pk_scene *sc, const pk_render_options *ro,
+                     const pk_stats *st);
 /* --stats-json: path "-" is standard output. Returns 0 or 1 after a message. */
-int cli_write_stats_json(const char *path, const char *scene, const pk_scene *sc, const pk_render_options *ro,
-                         const pk_stats *st);
+int cli_write_stats_json(pk_context *ctx, const char *path, const char *scene, const pk_scene *sc,
+                         const pk_render_options *ro, const pk_stats *st);
 
 /* ---- the progress bar (cli/progress.c) --------------------------------- */
 
@@ -190,5 +192,15 @@ void cli_print_warning(void *user, const char *message);
 int cli_check_output(const char *path, int replace_by_rename);
 /* Seconds on a monotonic clock. */
 double cli_now(void);
+/* The library's config for ctx (pk_context_set_config): the environment
+ * variables the program has always read, passed on as their keys
+ * (PAPRSEK_CPU_ISA=avx2: cpu.isa, PAPRSEK_BVH_QUALITY=fast: bvh.quality,
+ * PAPRSEK_EMBREE_QUALITY: embree.quality, PAPRSEK_EMBREE_LIBRARY:
+ * embree.library, PAPRSEK_CUDA_LIBRARY: cuda.library), then config (--config;
+ * may be NULL), whose keys win. Returns 0, or 2 after a message naming the
+ * variable or --config. */
+int cli_configure(pk_context *ctx, const char *config);
+/* cli_configure on a context of its own: for checking before any work. */
+int cli_check_config(const char *config);
 
 #endif

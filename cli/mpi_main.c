@@ -989,12 +989,12 @@ int main(int argc, char **argv)
             const char *name = o.scene ? o.scene : "cornell-box (built in)";
             pk_stats js = job_stats(reps, wall_s);
             if (o.stats) {
-                cli_print_stats(name, scene, &ro, &js);
+                cli_print_stats(ctx, name, scene, &ro, &js);
                 printf("%-28s %u of %d spp\n", "passes", passes, ro.spp);
                 print_ranks(reps, &ro, wall_s, (uint64_t)ntiles * passes);
                 fflush(stdout);
             }
-            if (o.stats_json && cli_write_stats_json(o.stats_json, name, scene, &ro, &js) != 0) rc = 1;
+            if (o.stats_json && cli_write_stats_json(ctx, o.stats_json, name, scene, &ro, &js) != 0) rc = 1;
         }
         free(reps);
     }

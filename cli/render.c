@@ -136,8 +136,8 @@ int cli_render(int argc, char **argv)
             fprintf(stderr, "wrote %s (%dx%d, %s)\n", o.out, ro.width, ro.height, took);
     }
     const char *name = o.scene ? o.scene : "cornell-box (built in)";
-    if (o.stats) cli_print_stats(name, scene, &ro, &stats);
-    if (o.stats_json && cli_write_stats_json(o.stats_json, name, scene, &ro, &stats) != 0) goto out;
+    if (o.stats) cli_print_stats(ctx, name, scene, &ro, &stats);
+    if (o.stats_json && cli_write_stats_json(ctx, o.stats_json, name, scene, &ro, &stats) != 0) goto out;
     rc = 0;
     goto out;
 fail:

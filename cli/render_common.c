@@ -22,6 +22,7 @@ enum {
     OPT_INT, /* an integer render option of the library's table */
     OPT_ACCEL,
     OPT_DEVICE,
+    OPT_CONFIG,
     OPT_INTEGRATOR,
     OPT_FRESNEL,
     OPT_LOOK_FROM,
@@ -81,6 +82,12 @@ const cli_option *cli_render_options(size_t *n)
         add((cli_option){.name = "device", .id = OPT_DEVICE, .kind = CLI_STRING, .arg = "cpu|cuda",
                          .help = "where to render: cpu (default) or cuda (an NVIDIA GPU: the path tracer, "
                                  "triangles only; the same image as the CPU's up to noise)"});
+        add((cli_option){.name = "config", .id = OPT_CONFIG, .kind = CLI_STRING, .arg = "KEY=VALUE,...",
+                         .help = "settings of the library's back ends: cpu.isa=auto|avx2, bvh.quality=high|fast, "
+                                 "embree.quality=low|medium|high, embree.library=FILE, cuda.library=FILE "
+                                 "(README, Configuration); they override the environment variables "
+                                 "PAPRSEK_CPU_ISA, PAPRSEK_BVH_QUALITY, PAPRSEK_EMBREE_QUALITY, "
+                                 "PAPRSEK_EMBREE_LIBRARY and PAPRSEK_CUDA_LIBRARY, which are passed on as these keys"});
         add((cli_option){.name = "integrator", .id = OPT_INTEGRATOR, .kind = CLI_STRING, .arg = "NAME",
                          .help = "path (default: path tracing, global illumination, one-sided area lights) or "
                                  "whitted (direct light, mirrors and glass; emitters two-sided)"});
@@ -222,6 +229,7 @@ int cli_render_parse(int argc, char **argv, cli_render_opts *o, void (*help)(FIL
                 return cli_usage_error("--device: unknown device '%s' (cpu, cuda)", v);
             }
             break;
+        case OPT_CONFIG: o->config = v; break;
         case OPT_INTEGRATOR:
             if (pk_integrator_parse(v, &o->integrator) != PK_OK)
                 return cli_usage_error("--integrator: unknown integrator '%s' (whitted, path)", v);
@@ -289,7 +297,7 @@ int cli_render_parse(int argc, char **argv, cli_render_opts *o, void (*help)(FIL
         }
     }
     if (!o->out) return cli_usage_error("render: no output file (-o OUT.png)");
-    return 0;
+    return cli_check_config(o->config);
 }
 
 /* True when path ends with ext (ASCII, any case). */
@@ -324,7 +332,20 @@ static double peak_rss_mib(void)
     return (double)ru.ru_maxrss / 1024.0;
 }
 
-void cli_print_stats(const char *scene, const pk_scene *sc, const pk_render_options *ro, const pk_stats *st)
+/* The library's effective config (pk_context_get_config). */
+typedef struct config_text {
+    char s[1024];
+} config_text;
+
+static config_text config_of(pk_context *ctx)
+{
+    config_text t;
+    pk_context_get_config(ctx, t.s, sizeof t.s);
+    return t;
+}
+
+void cli_print_stats(pk_context *ctx, const char *scene, const pk_scene *sc, const pk_render_options *ro,
+                     const pk_stats *st)
 {
     pk_scene_info si;
     pk_scene_get_info(sc, &si);
@@ -367,6 +388,7 @@ void cli_print_stats(const char *scene, const pk_scene *sc, const pk_render_opti
            FILM_BYTES_PER_PIXEL, peak_rss_mib());
     printf("%-28s %zu image%s, %.2f MiB (mipmaps included)\n", "textures", si.textures, si.textures == 1 ? "" : "s",
            (double)si.texture_bytes / (1024.0 * 1024.0));
+    printf("%-28s %s\n", "config", config_of(ctx).s);
 }
 
 /* Writes s as a JSON string literal. */
@@ -386,8 +408,8 @@ static void json_string(FILE *f, const char *s)
 }
 
 /* path "-": standard output. */
-int cli_write_stats_json(const char *path, const char *scene, const pk_scene *sc, const pk_render_options *ro,
-                         const pk_stats *st)
+int cli_write_stats_json(pk_context *ctx, const char *path, const char *scene, const pk_scene *sc,
+                         const pk_render_options *ro, const pk_stats *st)
 {
     pk_scene_info si;
     pk_scene_get_info(sc, &si);
@@ -405,7 +427,7 @@ int cli_write_stats_json(const char *path, const char *scene, const pk_scene *sc
             "  \"intersection_tests\": %llu,\n  \"nodes_visited\": %llu,\n  \"mrays_per_s\": %.3f,\n"
             "  \"integrator\": \"%s\",\n  \"seed\": %d,\n  \"rays_bounce\": %llu,\n  \"samples_per_s\": %.1f,\n"
             "  \"film_bytes_per_pixel\": %d,\n  \"peak_rss_mib\": %.1f,\n  \"textures\": %zu,\n"
-            "  \"texture_bytes\": %zu\n}\n",
+            "  \"texture_bytes\": %zu,\n  \"config\": ",
             pk_accel_kind_name(ro->accel), ro->width, ro->height, ro->spp, ro->light_samples, pk_render_options_max_depth(ro),
             ro->fresnel ? "true" : "false", st->threads, st->build_us, st->render_s, (unsigned long long)rays,
             (unsigned long long)st->rays_camera, (unsigned long long)st->rays_shadow,
@@ -415,6 +437,8 @@ int cli_write_stats_json(const char *path, const char *scene, const pk_scene *sc
             (unsigned long long)st->rays_bounce,
             st->render_s > 0 ? (double)st->pixels * ro->spp / st->render_s : 0.0, FILM_BYTES_PER_PIXEL,
             peak_rss_mib(), si.textures, si.texture_bytes);
+    json_string(f, config_of(ctx).s);
+    fputs("\n}\n", f);
     if (to_stdout ? fflush(f) != 0 || ferror(f) : fclose(f) != 0)
         return cli_failure("%s: cannot write: %s", to_stdout ? "standard output" : path, strerror(errno));
     return 0;
@@ -526,6 +550,7 @@ pk_status cli_render_settings(pk_context *ctx, const cli_render_opts *o, pk_scen
     if (o->has_accel) ro->accel = o->accel;
     if (o->has_integrator) ro->integrator = o->integrator;
     ro->collect_stats = o->stats || o->stats_json;
+    if (cli_configure(ctx, o->config) != 0) return PK_ERR_INVALID_ARGUMENT; /* (checked at parsing) */
     pk_status st = pk_render_options_check(ctx, ro);
     if (st != PK_OK) return st;
     if (o->env) {

@@ -129,3 +129,57 @@ int cli_check_output(const char *path, int replace_by_rename)
     free(dir);
     return rc;
 }
+
+/* ---- the library's config ---------------------------------------------------- */
+
+/* The library reads no environment variable; the program reads the ones it
+ * always honoured and passes them on as config keys. */
+static const struct {
+    const char *var, *key;
+    const char *only; /* the one value that counts (others were always ignored), or NULL: any */
+} config_vars[] = {
+    {"PAPRSEK_CPU_ISA", "cpu.isa", "avx2"},
+    {"PAPRSEK_BVH_QUALITY", "bvh.quality", "fast"},
+    {"PAPRSEK_EMBREE_QUALITY", "embree.quality", NULL},
+    {"PAPRSEK_EMBREE_LIBRARY", "embree.library", NULL},
+    {"PAPRSEK_CUDA_LIBRARY", "cuda.library", NULL},
+};
+
+/* The library's message without its "config: " prefix. */
+static const char *config_message(pk_context *ctx)
+{
+    const char *m = pk_context_error(ctx);
+    return strncmp(m, "config: ", 8) == 0 ? m + 8 : m;
+}
+
+int cli_configure(pk_context *ctx, const char *config)
+{
+    for (size_t i = 0; i < sizeof config_vars / sizeof config_vars[0]; i++) {
+        const char *v = getenv(config_vars[i].var);
+        if (!v || !v[0] || (config_vars[i].only && strcmp(v, config_vars[i].only) != 0)) continue;
+        if (strchr(v, ','))
+            return cli_usage_error("%s=%s: a comma cannot be passed on to the library", config_vars[i].var, v);
+        char item[1024];
+        snprintf(item, sizeof item, "%s=%s", config_vars[i].key, v);
+        if (pk_context_set_config(ctx, item) != PK_OK) {
+            const int rc = cli_usage_error("%s: %s", config_vars[i].var, config_message(ctx));
+            pk_context_clear_error(ctx);
+            return rc;
+        }
+    }
+    if (config && pk_context_set_config(ctx, config) != PK_OK) {
+        const int rc = cli_usage_error("--config: %s", config_message(ctx));
+        pk_context_clear_error(ctx);
+        return rc;
+    }
+    return 0;
+}
+
+int cli_check_config(const char *config)
+{
+    pk_context *ctx = NULL;
+    if (pk_context_create(NULL, &ctx) != PK_OK) return cli_failure("out of memory");
+    const int rc = cli_configure(ctx, config);
+    pk_context_destroy(ctx);
+    return rc;
+}

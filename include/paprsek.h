@@ -88,6 +88,33 @@ typedef pk_status (*pk_file_reader_fn)(void *user, const char *path, const void 
                                        char *why, size_t why_cap);
 PK_API void pk_context_set_file_reader(pk_context *ctx, pk_file_reader_fn fn, void *user);
 
+/* The back ends' settings, as comma-separated key=value pairs (the shape of
+ * Embree's rtcNewDevice config), e.g. "bvh.quality=fast,cpu.isa=avx2". They
+ * are read when an accelerator (or a renderer, which builds one) is created
+ * through ctx, so a change applies to the ones created afterwards. The
+ * library reads no environment variable: this is the only way in.
+ *   cpu.isa         auto (default: AVX-512 where the CPU has it, else AVX2)
+ *                   or avx2 (the AVX2 kernels of PK_ACCEL_BVH everywhere);
+ *                   both find the same hits
+ *   bvh.quality     high (default: with spatial splits) or fast (without:
+ *                   a faster build, slower traversal); the same hits
+ *   embree.quality  low, medium (default) or high: Embree's build quality
+ *   embree.library  the Embree 3 library to load (a path or a soname;
+ *                   default libembree3.so.3)
+ *   cuda.library    the CUDA driver to load (default libcuda.so.1)
+ * A library is loaded once per process: the first name that loads stays.
+ * Keys not named keep their values (a new context has the defaults); an
+ * empty value ("cpu.isa=") restores a key's default; blanks around keys and
+ * values are ignored, empty items too; values cannot contain commas. An
+ * unknown key or a bad value is PK_ERR_INVALID_ARGUMENT, latched with a
+ * message naming the key, and then nothing is changed. */
+PK_API pk_status pk_context_set_config(pk_context *ctx, const char *config);
+/* The effective configuration, every key with its value in the order above
+ * (e.g. "cpu.isa=auto,bvh.quality=high,..."): at most size bytes, NUL
+ * included, are written to buf (may be NULL when size is 0); returns the
+ * length of the whole text, as snprintf. */
+PK_API size_t pk_context_get_config(const pk_context *ctx, char *buf, size_t size);
+
 PK_API const char *pk_status_string(pk_status status);
 
 /* ---- limits (checked on every input) ------------------------------------ */
@@ -486,8 +513,8 @@ PK_API void pk_accel_destroy(pk_accel *accel);
 PK_API void pk_accel_get_info(const pk_accel *accel, pk_accel_info *info);
 /* The SIMD instruction set of the CPU kernels accel traces with, where the
  * library chose one for this CPU: "avx512" or "avx2" for PK_ACCEL_BVH
- * (AVX-512 where the CPU has it; the environment variable
- * PAPRSEK_CPU_ISA=avx2, read when the accelerator is created, forces AVX2).
+ * (AVX-512 where the CPU has it; the config key cpu.isa=avx2, read when the
+ * accelerator is created, forces AVX2: pk_context_set_config).
  * Both find the same hits. NULL for the other accelerators. */
 PK_API const char *pk_accel_isa(const pk_accel *accel);
 /* Traces n rays with up to threads threads; hits[i] answers rays[i].

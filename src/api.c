@@ -20,9 +20,15 @@
 
 int pk_accel_available(pk_accel_kind kind)
 {
-    if (kind == PK_ACCEL_EMBREE) return accel_embree_available();
+    if (kind == PK_ACCEL_EMBREE) return accel_embree_available(NULL);
     if (kind == PK_ACCEL_CUDA) return accel_cuda_built();
     return (unsigned)kind <= PK_ACCEL_BVH;
+}
+
+/* pk_accel_available for ctx: Embree is the library its config names. */
+static bool accel_available_in(const pk_context *ctx, pk_accel_kind kind)
+{
+    return kind == PK_ACCEL_EMBREE ? accel_embree_available(ctx) : pk_accel_available(kind) != 0;
 }
 
 /* Latches why kind cannot be used (Embree says which library did not load). */
@@ -502,7 +508,7 @@ pk_status pk_accel_create(pk_context *ctx, const pk_scene *scene, pk_accel_kind 
         return ctx_error(ctx, PK_ERR_LIMIT, "threads %d is out of range (%d..%d)", threads, th->min, th->max);
     if ((unsigned)kind > PK_ACCEL_CUDA)
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "unknown accelerator %d", (int)kind);
-    if (!pk_accel_available(kind)) return accel_unavailable(ctx, kind);
+    if (!accel_available_in(ctx, kind)) return accel_unavailable(ctx, kind);
     pk_accel *pa = mem_calloc(&ctx->alloc, 1, sizeof *pa);
     if (!pa) return ctx_nomem(ctx);
     pa->ctx = ctx;

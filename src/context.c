@@ -109,6 +109,7 @@ pk_status pk_context_create(const pk_allocator *alloc, pk_context **out)
     if (!ctx) return PK_ERR_NOMEM;
     memset(ctx, 0, sizeof *ctx);
     ctx->alloc = a;
+    ctx->config.embree_quality = 1; /* medium; the other keys' defaults are zero */
     *out = ctx;
     return PK_OK;
 }

@@ -36,6 +36,18 @@
 
 #define PK_ERRMSG_MAX 512
 
+/* The context's configuration (pk_context_set_config, config.c): what the
+ * back ends read when an accelerator or a device is created. The library
+ * reads no environment variable; programs pass what they read as config. */
+#define PK_CONFIG_NAME_MAX 256
+typedef struct pk_config {
+    bool cpu_avx2;        /* cpu.isa=avx2: the BVH's AVX2 kernels even where the CPU has AVX-512 */
+    bool bvh_fast;        /* bvh.quality=fast: the BVH without spatial splits */
+    int embree_quality;   /* embree.quality: 0 low, 1 medium (default), 2 high */
+    char embree_library[PK_CONFIG_NAME_MAX]; /* embree.library: "" for libembree3.so.3 */
+    char cuda_library[PK_CONFIG_NAME_MAX];   /* cuda.library: "" for libcuda.so.1 */
+} pk_config;
+
 /* Invariants:
  *  1. status == PK_OK exactly when message[0] == '\0'.
  *  2. Once set, status and message stay until pk_context_clear_error. */
@@ -47,7 +59,13 @@ struct pk_context {
     void *warn_user;
     pk_file_reader_fn read_file; /* NULL: files are read from the file system */
     void *read_file_user;
+    pk_config config;            /* zeroed: every key at its default */
 };
+
+/* The libraries loaded for Embree and CUDA: the configured name or the
+ * default soname (ctx may be NULL: the defaults). */
+PK_HIDDEN const char *config_embree_library(const pk_context *ctx);
+PK_HIDDEN const char *config_cuda_library(const pk_context *ctx);
 
 /* ---- allocation: every library allocation goes through the context's hook */
 

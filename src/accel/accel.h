@@ -104,7 +104,8 @@ typedef struct bvh_costs {
 PK_HIDDEN pk_status accel_bvh_create_costs(pk_context *ctx, const accel_input *in, const bvh_costs *costs,
                                            accel **out);
 PK_HIDDEN pk_status accel_embree_create(pk_context *ctx, const accel_input *in, accel **out);
-PK_HIDDEN bool accel_embree_available(void);
+/* Can ctx's Embree library (config embree.library; ctx NULL: the default) be loaded? */
+PK_HIDDEN bool accel_embree_available(const pk_context *ctx);
 /* The GPU accelerator (cuda.c): built in? (a driver and a device are looked
  * for only when one is created) */
 PK_HIDDEN pk_status accel_cuda_create(pk_context *ctx, const accel_input *in, accel **out);

@@ -142,11 +142,11 @@ PK_HIDDEN bool bvh_occluded_avx512(const accel *a, const ray *r, hit *h, accel_c
 PK_HIDDEN void bvh_intersect_packet_avx512(const accel *a, const ray *r, hit *h, size_t n, bool any_hit,
                                            accel_counters *c);
 #endif
-/* True when accelerators built now use the AVX-512 kernels: they are built
- * in, the CPU and the operating system support AVX-512 F, CD, BW, DQ and VL,
- * and the environment variable PAPRSEK_CPU_ISA is not "avx2" (which forces
- * the baseline, for comparisons). */
-PK_HIDDEN bool bvh_use_avx512(void);
+/* True when accelerators built now through ctx use the AVX-512 kernels:
+ * they are built in, the CPU and the operating system support AVX-512 F,
+ * CD, BW, DQ and VL, and ctx's config does not say cpu.isa=avx2 (which
+ * forces the baseline, for comparisons; ctx NULL: the default). */
+PK_HIDDEN bool bvh_use_avx512(const pk_context *ctx);
 
 /* Tests the invariants above; false with a reason in why (may be NULL). */
 PK_HIDDEN bool bvh_check(const accel *a, char *why, size_t n);

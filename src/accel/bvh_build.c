@@ -859,7 +859,7 @@ static const accel_ops bvh_ops_avx512 = {bvh_destroy, bvh_intersect_avx512, bvh_
                                          bvh_intersect_packet_avx512, NULL, NULL};
 #endif
 
-bool bvh_use_avx512(void)
+bool bvh_use_avx512(const pk_context *ctx)
 {
 #if PK_HAVE_AVX512_KERNELS
     /* __builtin_cpu_supports also asks the OS (XCR0) whether it saves the
@@ -869,9 +869,9 @@ bool bvh_use_avx512(void)
           __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq") &&
           __builtin_cpu_supports("avx512vl")))
         return false;
-    const char *isa = getenv("PAPRSEK_CPU_ISA");
-    return !(isa && strcmp(isa, "avx2") == 0);
+    return !(ctx && ctx->config.cpu_avx2);
 #else
+    (void)ctx;
     return false;
 #endif
 }
@@ -973,9 +973,8 @@ pk_status accel_bvh_create_costs(pk_context *ctx, const accel_input *in, const b
         rootc = sbox_grow(rootc, centroid2(&bx));
         any_sphere = true;
     }
-    /* PAPRSEK_BVH_QUALITY=fast: no spatial splits (no room for duplicates) */
-    const char *q = getenv("PAPRSEK_BVH_QUALITY");
-    const bool high = !(q && strcmp(q, "fast") == 0);
+    /* bvh.quality=fast: no spatial splits (no room for duplicates) */
+    const bool high = !ctx->config.bvh_fast;
     const uint32_t cap = n + (high ? (uint32_t)((double)n * SPATIAL_EXTRA) : 0);
 
     builder b = {rbox, rid, in, NULL, 1, (uint32_t)in->ntris, any_sphere, 0.0f};
@@ -1053,7 +1052,7 @@ pk_status accel_bvh_create_costs(pk_context *ctx, const accel_input *in, const b
     t->base.ops = &bvh_ops;
     t->base.isa = "avx2";
 #if PK_HAVE_AVX512_KERNELS
-    if (bvh_use_avx512()) t->base.ops = &bvh_ops_avx512, t->base.isa = "avx512";
+    if (bvh_use_avx512(ctx)) t->base.ops = &bvh_ops_avx512, t->base.isa = "avx512";
 #endif
     t->base.alloc = al;
     t->base.ntris = in->ntris;

@@ -15,19 +15,16 @@
  * does not match Embree's declarations does not compile.
  */
 #include "accel.h"
+#include "device/dynlib.h"
 
 #if defined(PK_HAVE_EMBREE) && PK_HAVE_EMBREE
 
 #include <embree3/rtcore.h>
 
-#include <dlfcn.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* The soname of Embree 3's runtime (Debian: libembree3-3). */
-#define EMBREE_LIBRARY "libembree3.so.3"
 
 /* Every Embree function this file calls. */
 #define RTC_FUNCTIONS(X)                                                                 \
@@ -39,54 +36,40 @@
     X(AttachGeometryByID)                                                                \
     X(Intersect1) X(Occluded1) X(Intersect8) X(Occluded8) X(Intersect16) X(Occluded16)
 
-/* rtc.Name points to Embree's rtcName once load_embree has succeeded. */
+/* rtc.Name points to Embree's rtcName once the library is ready (embree
+ * below): filled under the loader's lock, never changed afterwards. The
+ * library (the config's embree.library, libembree3.so.3 by default) is
+ * never closed: Embree keeps threads of its own. */
 static struct rtc_table {
 #define RTC_FIELD(name) __typeof__(&rtc##name) name;
     RTC_FUNCTIONS(RTC_FIELD)
 #undef RTC_FIELD
 } rtc;
 
-/* Invariant: after load_once has run, loaded says whether every field of rtc
- * is set; when it is false, load_error says why (for messages). The handle is
- * never closed: Embree keeps threads of its own and the table stays valid for
- * the life of the process. */
-static pthread_once_t load_once = PTHREAD_ONCE_INIT;
-static bool loaded;
-static char load_error[256];
+static dynlib embree = DYNLIB_INIT;
 
-static void load_embree(void)
+static bool init_embree(void *h, const char *name, char *why, size_t n)
 {
-    /* PAPRSEK_EMBREE_LIBRARY names another file to load (a path or a soname):
-     * an Embree 3 build of one's own, or a missing file to try the fallback. */
-    const char *name = getenv("PAPRSEK_EMBREE_LIBRARY");
-    if (!name || !name[0]) name = EMBREE_LIBRARY;
-    void *h = dlopen(name, RTLD_NOW | RTLD_LOCAL);
-    if (!h) {
-        const char *why = dlerror();
-        snprintf(load_error, sizeof load_error, "%s could not be loaded (%s)", name,
-                 why ? why : "no reason given");
-        return;
-    }
     struct rtc_table t;
     void *sym;
 #define RTC_LOAD(fn)                                                                              \
-    sym = dlsym(h, "rtc" #fn);                                                                    \
+    sym = dynlib_symbol(h, "rtc" #fn);                                                            \
     if (!sym) {                                                                                   \
-        snprintf(load_error, sizeof load_error, "%s has no rtc" #fn " (not Embree 3?)", name);    \
-        dlclose(h);                                                                               \
-        return;                                                                                   \
+        snprintf(why, n, "%s has no rtc" #fn " (not Embree 3?)", name);                          \
+        return false;                                                                             \
     }                                                                                             \
     memcpy(&t.fn, &sym, sizeof sym);
     RTC_FUNCTIONS(RTC_LOAD)
 #undef RTC_LOAD
     rtc = t;
-    loaded = true;
+    return true;
 }
 
-/* Loads Embree once per process; true when its functions are in rtc. */
-static bool embree_loaded(void)
+/* Loads the Embree library ctx's config names (ctx NULL: the default) once
+ * per process; true when its functions are in rtc, else why says why. */
+static bool embree_loaded(const pk_context *ctx, char *why, size_t n)
 {
-    return pthread_once(&load_once, load_embree) == 0 && loaded;
+    return dynlib_load(&embree, config_embree_library(ctx), init_embree, why, n);
 }
 
 enum { GEOM_TRIS = 0, GEOM_SPHERES = 1 };
@@ -120,14 +103,19 @@ typedef struct occ_context {
     hit *out;
 } occ_context;
 
-bool accel_embree_available(void) { return embree_loaded(); }
+bool accel_embree_available(const pk_context *ctx)
+{
+    char why[8];
+    return embree_loaded(ctx, why, sizeof why);
+}
 
 pk_status accel_embree_unavailable(pk_context *ctx)
 {
-    bool ok = embree_loaded();
-    return ctx_error(ctx, PK_ERR_UNSUPPORTED,
-                     "accelerator 'embree' is not available: %s (Debian: install libembree3-3)",
-                     !ok && load_error[0] ? load_error : EMBREE_LIBRARY " could not be loaded");
+    char why[400];
+    if (embree_loaded(ctx, why, sizeof why))
+        return ctx_error(ctx, PK_ERR_UNSUPPORTED, "accelerator 'embree' is not available");
+    return ctx_error(ctx, PK_ERR_UNSUPPORTED, "accelerator 'embree' is not available: %s (Debian: install libembree3-3)",
+                     why);
 }
 
 static const char *rtc_error_name(enum RTCError code)
@@ -170,16 +158,12 @@ static bool on_memory(void *user, ssize_t bytes, bool post)
     return true;
 }
 
-static pk_status parse_quality(pk_context *ctx, enum RTCBuildQuality *q)
+/* embree.quality of ctx's config: 0 low, 1 medium, 2 high */
+static enum RTCBuildQuality build_quality(const pk_context *ctx)
 {
-    const char *s = getenv("PAPRSEK_EMBREE_QUALITY");
-    if (!s || !s[0] || strcmp(s, "medium") == 0) *q = RTC_BUILD_QUALITY_MEDIUM;
-    else if (strcmp(s, "low") == 0) *q = RTC_BUILD_QUALITY_LOW;
-    else if (strcmp(s, "high") == 0) *q = RTC_BUILD_QUALITY_HIGH;
-    else
-        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT,
-                         "PAPRSEK_EMBREE_QUALITY=%s: expected low, medium or high", s);
-    return PK_OK;
+    static const enum RTCBuildQuality q[3] = {RTC_BUILD_QUALITY_LOW, RTC_BUILD_QUALITY_MEDIUM, RTC_BUILD_QUALITY_HIGH};
+    const int i = ctx->config.embree_quality;
+    return q[i >= 0 && i < 3 ? i : 1];
 }
 
 /* u, v of a sphere hit, computed as sphere_intersect does (geom.h). */
@@ -439,10 +423,9 @@ static void add_spheres(embree_accel *e, const accel_input *in, enum RTCBuildQua
 pk_status accel_embree_create(pk_context *ctx, const accel_input *in, accel **out)
 {
     *out = NULL;
-    if (!embree_loaded()) return accel_embree_unavailable(ctx);
-    enum RTCBuildQuality quality = RTC_BUILD_QUALITY_MEDIUM;
-    pk_status st = parse_quality(ctx, &quality);
-    if (st != PK_OK) return st;
+    char why[8];
+    if (!embree_loaded(ctx, why, sizeof why)) return accel_embree_unavailable(ctx);
+    const enum RTCBuildQuality quality = build_quality(ctx);
     if (in->ntris > UINT32_MAX / 3 || in->nspheres > UINT32_MAX ||
         in->ntris + in->nspheres >= PK_NO_HIT)
         return ctx_error(ctx, PK_ERR_LIMIT, "embree: %zu triangles and %zu spheres are too many",
@@ -492,7 +475,7 @@ pk_status accel_embree_create(pk_context *ctx, const accel_input *in, accel **ou
     double t1 = time_now();
     if (be.failed || !e->scene || rtc.GetDeviceError(e->device) != RTC_ERROR_NONE) {
         if (!be.failed) ctx_error(ctx, PK_ERR_UNSUPPORTED, "embree: the scene could not be built");
-        st = pk_context_status(ctx);
+        const pk_status st = pk_context_status(ctx);
         rtc.SetDeviceErrorFunction(e->device, NULL, NULL);
         emb_destroy(&e->base);
         return st != PK_OK ? st : PK_ERR_UNSUPPORTED;
@@ -511,7 +494,11 @@ pk_status accel_embree_create(pk_context *ctx, const accel_input *in, accel **ou
 
 #else /* no Embree */
 
-bool accel_embree_available(void) { return false; }
+bool accel_embree_available(const pk_context *ctx)
+{
+    (void)ctx;
+    return false;
+}
 
 pk_status accel_embree_unavailable(pk_context *ctx)
 {

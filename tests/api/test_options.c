@@ -106,6 +106,49 @@ static void check_cli(const pk_int_option *e, long long v, bool ok)
     }
 }
 
+/* pk_context_set_config: the keys, their defaults, what is refused and
+ * that a refused string changes nothing. */
+static void check_context_config(void)
+{
+    char buf[1024];
+    const char *defaults = "cpu.isa=auto,bvh.quality=high,embree.quality=medium,embree.library=libembree3.so.3,"
+                           "cuda.library=libcuda.so.1";
+    size_t len = pk_context_get_config(ctx, buf, sizeof buf);
+    CHECKF(strcmp(buf, defaults) == 0 && len == strlen(defaults), "default config: %s", buf);
+    CHECK(pk_context_get_config(ctx, NULL, 0) == len);
+    char tiny[8];
+    CHECK(pk_context_get_config(ctx, tiny, sizeof tiny) == len && strcmp(tiny, "cpu.isa") == 0);
+    CHECK(pk_context_set_config(ctx, "") == PK_OK && pk_context_set_config(ctx, " , ,") == PK_OK);
+    CHECK(pk_context_set_config(ctx, " bvh.quality = fast ,cpu.isa=avx2,embree.quality=high,"
+                                     "embree.library=/opt/e/libembree3.so.3,cuda.library=libcuda.so.1") == PK_OK);
+    pk_context_get_config(ctx, buf, sizeof buf);
+    CHECKF(strcmp(buf, "cpu.isa=avx2,bvh.quality=fast,embree.quality=high,embree.library=/opt/e/libembree3.so.3,"
+                       "cuda.library=libcuda.so.1") == 0, "config: %s", buf);
+    /* keys not named keep their values; the last of a key wins */
+    CHECK(pk_context_set_config(ctx, "cpu.isa=auto,cpu.isa=avx2") == PK_OK);
+    pk_context_get_config(ctx, buf, sizeof buf);
+    CHECKF(strstr(buf, "cpu.isa=avx2,bvh.quality=fast,") == buf, "config: %s", buf);
+    /* refused: unknown key, bad value, no '=', NULL; the message names the key */
+    const char *bad[][2] = {{"cpu.isa=avx2,bvh.qualty=fast", "bvh.qualty"}, {"bvh.quality=slow", "bvh.quality=slow"},
+                            {"embree.quality=extreme", "embree.quality"}, {"cpu.isa", "cpu.isa"},
+                            {"cpu.isa=sse2", "cpu.isa=sse2"}, {"PAPRSEK_CPU_ISA=avx2", "PAPRSEK_CPU_ISA"}};
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+        pk_context_clear_error(ctx);
+        CHECKF(pk_context_set_config(ctx, bad[i][0]) == PK_ERR_INVALID_ARGUMENT, "'%s' accepted", bad[i][0]);
+        CHECKF(strstr(pk_context_error(ctx), bad[i][1]) != NULL, "'%s': message %s", bad[i][0], pk_context_error(ctx));
+    }
+    pk_context_clear_error(ctx);
+    CHECK(pk_context_set_config(ctx, NULL) == PK_ERR_INVALID_ARGUMENT);
+    CHECK(pk_context_set_config(NULL, "cpu.isa=avx2") == PK_ERR_INVALID_ARGUMENT);
+    pk_context_clear_error(ctx);
+    pk_context_get_config(ctx, buf, sizeof buf);
+    CHECKF(strstr(buf, "cpu.isa=avx2,bvh.quality=fast,embree.quality=high,") == buf, "config changed: %s", buf);
+    /* an empty value restores the default */
+    CHECK(pk_context_set_config(ctx, "cpu.isa=,bvh.quality=,embree.quality=,embree.library=,cuda.library=") == PK_OK);
+    pk_context_get_config(ctx, buf, sizeof buf);
+    CHECKF(strcmp(buf, defaults) == 0, "config after reset: %s", buf);
+}
+
 int main(void)
 {
     REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
@@ -147,6 +190,7 @@ int main(void)
             }
         }
     }
+    check_context_config();
     remove("options_test.png");
     remove("options_test.out");
     pk_context_destroy(ctx);

@@ -408,11 +408,13 @@ static accel *build(pk_context *ctx, const accel_input *in, const char *name)
     CHECKF(a->info.primitives == valid, "%s: %zu primitives in the tree, %zu valid", name, a->info.primitives, valid);
     CHECK(strcmp(a->info.name, "bvh") == 0);
     CHECK(a->info.nodes >= 1 && a->info.bytes > 0);
-    /* the kernels this run tests: AVX-512 where the CPU has them, unless
-     * PAPRSEK_CPU_ISA=avx2 (ctest runs this file both ways: test_bvh_avx2) */
-    const char *env = getenv("PAPRSEK_CPU_ISA");
-    const bool forced = env && strcmp(env, "avx2") == 0;
-    CHECKF(a->isa && strcmp(a->isa, bvh_use_avx512() ? "avx512" : "avx2") == 0, "%s: kernels %s", name,
+    /* the kernels this run tests: AVX-512 where the CPU has them, unless the
+     * config says cpu.isa=avx2 (main passes PAPRSEK_CPU_ISA=avx2 on as that:
+     * ctest runs this file both ways, test_bvh_avx2) */
+    char cfg[512];
+    pk_context_get_config(ctx, cfg, sizeof cfg);
+    const bool forced = strstr(cfg, "cpu.isa=avx2") != NULL;
+    CHECKF(a->isa && strcmp(a->isa, bvh_use_avx512(ctx) ? "avx512" : "avx2") == 0, "%s: kernels %s", name,
            a->isa ? a->isa : "(none)");
     CHECK(!forced || strcmp(a->isa, "avx2") == 0);
     return a;
@@ -504,7 +506,7 @@ static void check_file(pk_context *ctx, const char *rel, size_t nrays)
         pk_accel_get_info(pa, &info);
         CHECK(strcmp(info.name, "bvh") == 0);
         const char *isa = pk_accel_isa(pa);
-        CHECK(isa && strcmp(isa, bvh_use_avx512() ? "avx512" : "avx2") == 0);
+        CHECK(isa && strcmp(isa, bvh_use_avx512(ctx) ? "avx512" : "avx2") == 0);
         size_t nc;
         ray *cam = camera_rays(input_bounds(&in), 32, &nc);
         pk_hit *h1 = malloc(nc * sizeof *h1), *h2 = malloc(nc * sizeof *h2);
@@ -784,9 +786,11 @@ static void check_synthetic(pk_context *ctx)
         }
         accel_input in = {sl.v, sl.ntris, NULL, 0, 2};
         accel *a = build(ctx, &in, "slivers");
-        /* PAPRSEK_BVH_QUALITY=fast builds without spatial splits */
-        const char *q = getenv("PAPRSEK_BVH_QUALITY");
-        if (!(q && strcmp(q, "fast") == 0))
+        /* bvh.quality=fast (main passes PAPRSEK_BVH_QUALITY=fast on as
+         * that) builds without spatial splits */
+        char cfg[512];
+        pk_context_get_config(ctx, cfg, sizeof cfg);
+        if (!strstr(cfg, "bvh.quality=fast"))
             CHECKF(leaf_refs(a) > a->info.primitives, "slivers: no spatial split (%zu references, %zu primitives)",
                    leaf_refs(a), a->info.primitives);
         accel_destroy(a);
@@ -913,9 +917,14 @@ int main(void)
 {
     pk_context *ctx = NULL;
     REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
+    /* the test program (not the library) reads the old switches and passes
+     * them on as config */
     const char *env = getenv("PAPRSEK_CPU_ISA");
-    printf("BVH kernels: %s%s\n", bvh_use_avx512() ? "avx512" : "avx2",
-           bvh_use_avx512() || (env && strcmp(env, "avx2") == 0)
+    const char *q = getenv("PAPRSEK_BVH_QUALITY");
+    if (env && strcmp(env, "avx2") == 0) REQUIRE(pk_context_set_config(ctx, "cpu.isa=avx2") == PK_OK);
+    if (q && strcmp(q, "fast") == 0) REQUIRE(pk_context_set_config(ctx, "bvh.quality=fast") == PK_OK);
+    printf("BVH kernels: %s%s\n", bvh_use_avx512(ctx) ? "avx512" : "avx2",
+           bvh_use_avx512(ctx) || (env && strcmp(env, "avx2") == 0)
                ? ""
                : " (this CPU or build has no AVX-512 kernels: only the AVX2 ones are tested)");
     double t0 = omp_get_wtime();
