@@ -110,20 +110,12 @@ PK_HIDDEN bool accel_embree_available(const pk_context *ctx);
  * for only when one is created) */
 PK_HIDDEN pk_status accel_cuda_create(pk_context *ctx, const accel_input *in, accel **out);
 PK_HIDDEN bool accel_cuda_built(void);
-/* The device of a CUDA accelerator (a from accel_cuda_create), for the
- * other kernels of its module (the GPU path tracer). Errors are latched in
- * the context the accelerator was created with. Device addresses are
- * uint64_t. alloc copies src (may be NULL) into a new buffer of bytes
- * (*out 0 for 0 bytes); copy moves bytes to (to_device) or from the device;
- * launch runs kernel over threads threads in blocks of block, waits for it
- * and gives its time (ms may be NULL); bvh gives the structure's arrays. */
-PK_HIDDEN pk_status cuda_device_alloc(const accel *a, const void *src, size_t bytes, uint64_t *out);
-PK_HIDDEN void cuda_device_free(const accel *a, uint64_t p);
-PK_HIDDEN pk_status cuda_device_copy(const accel *a, void *host, uint64_t dev, size_t bytes, bool to_device);
-PK_HIDDEN pk_status cuda_device_launch(const accel *a, const char *kernel, size_t threads, unsigned block,
-                                       void **params, double *ms);
-PK_HIDDEN void cuda_device_bvh(const accel *a, uint64_t *nodes, uint64_t *tris);
-PK_HIDDEN const char *cuda_device_name(const accel *a);
+/* The same with the reference kernels (gpu_trace_v0), for the tests. */
+PK_HIDDEN pk_status accel_cuda_create_reference(pk_context *ctx, const accel_input *in, accel **out);
+/* The device addresses of a CUDA accelerator's structure (bvh_gpu.h's
+ * nodes and triangle records), for other kernels that trace in the same
+ * process (the GPU path tracer): valid while a lives. */
+PK_HIDDEN void accel_cuda_bvh(const accel *a, uint64_t *nodes, uint64_t *tris);
 /* When Embree is not available: latches why (PK_ERR_UNSUPPORTED) and returns it. */
 PK_HIDDEN pk_status accel_embree_unavailable(pk_context *ctx);
 /* Invariant checkers (tests): false with a reason when the structure is broken. */

@@ -1,6 +1,10 @@
 /*
  * path_gpu.c - the path tracer's structures copied to the GPU, and the
- * render loop around its kernel (see path_gpu.h).
+ * render loop around its kernel (see path_gpu.h). The device (driver,
+ * memory, launches) is device/cuda.h's: this file opens one with the path
+ * tracer's module (cuda/path.cu, embedded as pk_cuda_path_fatbin.h) and
+ * traces on the cuda accelerator's structure, whose device addresses the
+ * accelerator gives (accel_cuda_bvh: one primary context per process).
  *
  * The copies are the CPU's structs byte for byte (nvcc lays C structs out
  * as the host compiler does; a kernel checks their sizes once), with every
@@ -10,13 +14,21 @@
  */
 #include "path_gpu.h"
 
+#include "device/cuda.h"
+
 #include <string.h>
+
+#if defined(PK_HAVE_CUDA) && PK_HAVE_CUDA
+#include "pk_cuda_path_fatbin.h" /* generated: pk_cuda_path_fatbin[], PK_CUDA_VERSION_* */
+#endif
+
+#define WHO "device 'cuda'"
 
 #define LAUNCH_TARGET_MS 50.0 /* a launch takes about this long: progress and cancelling stay prompt */
 
 struct path_gpu {
     pk_context *ctx;
-    const accel *a;         /* the CUDA accelerator (owns the device context and the BVH) */
+    cuda_device *dev;       /* the device with the path tracer's module */
     uint64_t *buf;          /* device buffers to free */
     size_t nbuf, cap_buf;
     uint64_t textures_buf;  /* device texture array (its levels are buffers too) */
@@ -40,7 +52,7 @@ static pk_status upload(path_gpu *g, const void *src, size_t n, size_t size, uin
         g->buf = nb;
         g->cap_buf = cap;
     }
-    pk_status st = cuda_device_alloc(g->a, src, n * size, out);
+    pk_status st = cuda_device_alloc(g->dev, src, n * size, NULL, out);
     if (st != PK_OK) return st;
     g->buf[g->nbuf++] = *out;
     g->bytes += n * size;
@@ -78,15 +90,15 @@ static pk_status upload_textures(path_gpu *g, const pk_scene *s, uint64_t *out)
 static pk_status check_layout(path_gpu *g)
 {
     /* sizes of the shared structs as nvcc laid them out, against the host's */
-    const uint64_t host[8] = {sizeof(pk_scene), sizeof(material), sizeof(texture), sizeof(env_light),
+    const uint64_t host[8] = {sizeof(scene_view), sizeof(material), sizeof(texture), sizeof(env_light),
                               sizeof(light_set), sizeof(path_tracer), sizeof(frame), sizeof(camera_frame)};
     uint64_t dev[8] = {0}, d = 0;
-    pk_status st = cuda_device_alloc(g->a, NULL, sizeof dev, &d);
+    pk_status st = cuda_device_alloc(g->dev, NULL, sizeof dev, NULL, &d);
     if (st != PK_OK) return st;
     void *params[] = {&d};
-    st = cuda_device_launch(g->a, "pk_path_layout", 1, 32, params, NULL);
-    if (st == PK_OK) st = cuda_device_copy(g->a, dev, d, sizeof dev, false);
-    cuda_device_free(g->a, d);
+    st = cuda_device_run(g->dev, "pk_path_layout", 1, 32, params, NULL);
+    if (st == PK_OK) st = cuda_device_copy(g->dev, dev, d, sizeof dev, false, NULL);
+    cuda_device_free(g->dev, d);
     if (st != PK_OK) return st;
     for (int i = 0; i < 8; i++)
         if (dev[i] != host[i])
@@ -107,25 +119,34 @@ pk_status path_gpu_create(pk_context *ctx, const path_tracer *pt, path_gpu **out
     if (s->nspheres)
         return ctx_error(ctx, PK_ERR_UNSUPPORTED, "device 'cuda': the GPU renders triangles only (the scene has %zu "
                          "sphere%s)", s->nspheres, s->nspheres == 1 ? "" : "s");
+#if defined(PK_HAVE_CUDA) && PK_HAVE_CUDA
+    const cuda_image image = {pk_cuda_path_fatbin, PK_CUDA_VERSION_MAJOR, PK_CUDA_VERSION_MINOR};
+#else
+    const cuda_image image = {NULL, 0, 0};
+    if (!image.data) return ctx_error(ctx, PK_ERR_UNSUPPORTED, WHO " is not available in this build");
+#endif
     path_gpu *g = mem_calloc(&ctx->alloc, 1, sizeof *g);
     if (!g) return ctx_nomem(ctx);
     g->ctx = ctx;
-    g->a = f->a;
     g->samples_per_launch = 1;
-    pk_status st = check_layout(g);
+    pk_status st = cuda_device_open(ctx, WHO, &image, &g->dev);
+    if (st != PK_OK) {
+        path_gpu_destroy(g);
+        return st;
+    }
+    st = check_layout(g);
 
-    /* the scene */
-    pk_scene ds = *s;
-    memset(&ds.alloc, 0, sizeof ds.alloc);
-    ds.name = NULL;
-    ds.mat_index = NULL;
-    ds.degenerate = NULL;
-    ds.emissive = NULL;
-    memset(&ds.env, 0, sizeof ds.env);
+    /* the frame, without the host's scene and accelerator (the device follows neither) */
+    frame df = *f;
+    df.s = NULL;
+    df.a = NULL;
+    /* the scene: the frame's view of it, with its arrays on the device */
+    scene_view *ds = &df.v;
+    ds->spheres = NULL; /* refused above */
     uint64_t p;
 #define UP(field, n)                                                          \
     if (st == PK_OK) st = upload(g, s->field, (n), sizeof *s->field, &p); \
-    ds.field = dev_ptr(p);
+    ds->field = dev_ptr(p);
     UP(positions, s->npositions)
     UP(normals, s->nnormals)
     UP(uvs, s->nuvs)
@@ -138,18 +159,13 @@ pk_status path_gpu_create(pk_context *ctx, const path_tracer *pt, path_gpu **out
         memcpy(mats, s->materials, s->nmaterials * sizeof *mats);
         for (size_t i = 0; i < s->nmaterials; i++) mats[i].name = NULL;
         st = upload(g, mats, s->nmaterials, sizeof *mats, &p);
-        ds.materials = dev_ptr(p);
+        ds->materials = dev_ptr(p);
     }
     mem_free(&ctx->alloc, mats);
     if (st == PK_OK) st = upload_textures(g, s, &p);
-    ds.textures = dev_ptr(p);
-    uint64_t d_scene = 0;
-    if (st == PK_OK) st = upload(g, &ds, 1, sizeof ds, &d_scene);
+    ds->textures = dev_ptr(p);
 
     /* the frame and its environment */
-    frame df = *f;
-    df.s = dev_ptr(d_scene);
-    df.a = NULL;
     memset(&df.lights, 0, sizeof df.lights);
     env_light *e = &df.env;
     const size_t npix = e->uniform ? 0 : (size_t)e->w * (size_t)e->h;
@@ -177,7 +193,7 @@ pk_status path_gpu_create(pk_context *ctx, const path_tracer *pt, path_gpu **out
     UPL(of_prim, s->ntris + s->nspheres)
 #undef UPL
     uint64_t nodes, tris;
-    cuda_device_bvh(f->a, &nodes, &tris);
+    accel_cuda_bvh(f->a, &nodes, &tris);
     dp.gpu_nodes = dev_ptr(nodes);
     dp.gpu_tris = dev_ptr(tris);
     if (st == PK_OK) st = upload(g, &dp, 1, sizeof dp, &g->d_pt);
@@ -192,11 +208,14 @@ pk_status path_gpu_create(pk_context *ctx, const path_tracer *pt, path_gpu **out
 void path_gpu_destroy(path_gpu *g)
 {
     if (!g) return;
-    for (size_t i = 0; i < g->nbuf; i++) cuda_device_free(g->a, g->buf[i]);
+    if (g->dev) {
+        for (size_t i = 0; i < g->nbuf; i++) cuda_device_free(g->dev, g->buf[i]);
+        cuda_device_free(g->dev, g->d_tiles);
+        cuda_device_free(g->dev, g->d_acc);
+        cuda_device_free(g->dev, g->d_rays);
+        cuda_device_close(g->dev);
+    }
     mem_free(&g->ctx->alloc, g->buf);
-    cuda_device_free(g->a, g->d_tiles);
-    cuda_device_free(g->a, g->d_acc);
-    cuda_device_free(g->a, g->d_rays);
     mem_free(&g->ctx->alloc, g);
 }
 
@@ -210,16 +229,16 @@ size_t path_gpu_bytes(const path_gpu *g)
 static pk_status ensure_tiles(path_gpu *g, size_t ntiles)
 {
     if (!g->d_rays) {
-        pk_status st = cuda_device_alloc(g->a, NULL, 3 * sizeof(uint64_t), &g->d_rays);
+        pk_status st = cuda_device_alloc(g->dev, NULL, 3 * sizeof(uint64_t), NULL, &g->d_rays);
         if (st != PK_OK) return st;
     }
     if (ntiles <= g->cap_tiles) return PK_OK;
-    cuda_device_free(g->a, g->d_tiles);
-    cuda_device_free(g->a, g->d_acc);
+    cuda_device_free(g->dev, g->d_tiles);
+    cuda_device_free(g->dev, g->d_acc);
     g->d_tiles = g->d_acc = 0;
     g->cap_tiles = 0;
-    pk_status st = cuda_device_alloc(g->a, NULL, ntiles * sizeof(gpu_tile), &g->d_tiles);
-    if (st == PK_OK) st = cuda_device_alloc(g->a, NULL, ntiles * GPU_TILE_PIXELS * 3 * sizeof(float), &g->d_acc);
+    pk_status st = cuda_device_alloc(g->dev, NULL, ntiles * sizeof(gpu_tile), NULL, &g->d_tiles);
+    if (st == PK_OK) st = cuda_device_alloc(g->dev, NULL, ntiles * GPU_TILE_PIXELS * 3 * sizeof(float), NULL, &g->d_acc);
     if (st == PK_OK) g->cap_tiles = ntiles;
     return st;
 }
@@ -233,8 +252,9 @@ pk_status path_gpu_render(path_gpu *g, const camera_frame *cf, const gpu_tile *t
     pk_status st = ensure_tiles(g, ntiles);
     if (st != PK_OK) return st;
     uint64_t zero[3] = {0, 0, 0};
-    if ((st = cuda_device_copy(g->a, (void *)(uintptr_t)tiles, g->d_tiles, ntiles * sizeof *tiles, true)) != PK_OK ||
-        (st = cuda_device_copy(g->a, zero, g->d_rays, sizeof zero, true)) != PK_OK)
+    if ((st = cuda_device_copy(g->dev, (void *)(uintptr_t)tiles, g->d_tiles, ntiles * sizeof *tiles, true, NULL)) !=
+            PK_OK ||
+        (st = cuda_device_copy(g->dev, zero, g->d_rays, sizeof zero, true, NULL)) != PK_OK)
         return st;
     unsigned nthreads = (unsigned)(ntiles * GPU_TILE_PIXELS);
     camera_frame cam = *cf;
@@ -247,7 +267,7 @@ pk_status path_gpu_render(path_gpu *g, const camera_frame *cf, const gpu_tile *t
         int accumulate = done > 0;
         void *params[] = {&g->d_pt, &cam, &g->d_tiles, &nthreads, &from, &n, &accumulate, &g->d_acc, &g->d_rays};
         double ms = 0.0;
-        if ((st = cuda_device_launch(g->a, "pk_path_render", nthreads, 128, params, &ms)) != PK_OK) return st;
+        if ((st = cuda_device_run(g->dev, "pk_path_render", nthreads, 128, params, &ms)) != PK_OK) return st;
         done += n;
         /* the next launch sized to take about LAUNCH_TARGET_MS */
         if (ms > 0.0) {
@@ -261,9 +281,10 @@ pk_status path_gpu_render(path_gpu *g, const camera_frame *cf, const gpu_tile *t
             break;
         }
     }
-    if (st == PK_OK) st = cuda_device_copy(g->a, acc, g->d_acc, ntiles * GPU_TILE_PIXELS * 3 * sizeof(float), false);
+    if (st == PK_OK)
+        st = cuda_device_copy(g->dev, acc, g->d_acc, ntiles * GPU_TILE_PIXELS * 3 * sizeof(float), false, NULL);
     uint64_t r[3];
-    if (cuda_device_copy(g->a, r, g->d_rays, sizeof r, false) == PK_OK)
+    if (cuda_device_copy(g->dev, r, g->d_rays, sizeof r, false, NULL) == PK_OK)
         for (int k = 0; k < 3; k++) rays[k] += r[k];
     return st;
 }

@@ -3,7 +3,7 @@
  * of a render (the path tracer with its light set, its frame and
  * environment, the scene with its materials and textures) copied to the
  * device with their pointers turned into device addresses, and the kernel
- * pk_path_render (src/accel/cuda/path.cu), which runs path_kernel.h, the
+ * pk_path_render (src/render/cuda/path.cu), which runs path_kernel.h, the
  * CPU's sampling code, one thread per pixel of a tile list.
  */
 #ifndef PK_PATH_GPU_H

@@ -4,8 +4,9 @@
 # memory, a kernel that fails, and rendering on the GPU. Each is exit
 # status 1, one line on stderr ("paprsek: ..." saying what is wrong),
 # nothing on stdout and no hit file. The driver is replaced by a stub
-# (cuda_stub.c, through PAPRSEK_CUDA_LIBRARY) that plays each failure, so
-# this runs on machines without a GPU.
+# (cuda_stub.c, through PAPRSEK_CUDA_LIBRARY, which the program passes on as
+# the library's config key cuda.library, or --config cuda.library=...) that
+# plays each failure, so this runs on machines without a GPU.
 # Usage: test_cuda_errors.sh PAPRSEK TEST_DATA_DIR HAVE_CUDA STUB_LIBRARY
 set -u
 bin=$1
@@ -69,15 +70,18 @@ PK_CUDA_STUB=nomem expect_failure "too little memory" "not enough device memory 
 PK_CUDA_STUB=kernelfail expect_failure "kernel failure" "the traversal kernel failed: unspecified launch failure" \
     "${rays[@]}"
 PK_CUDA_STUB=kernelfail expect_failure "kernel failure, any-hit" "the traversal kernel failed" "${rays[@]}" --any-hit
-# every kernel version goes as far as the launch; an unknown one is refused
-for v in v0 v1 v2 v3 v4 v5 v6 v7 v8 v9; do
-    PAPRSEK_CUDA_KERNEL=$v PK_CUDA_STUB=kernelfail expect_failure "kernel $v" "the traversal kernel failed" "${rays[@]}"
-done
-PAPRSEK_CUDA_TREE=4 PAPRSEK_CUDA_KERNEL=v6 PK_CUDA_STUB=kernelfail expect_failure "tree for the GPU" \
-    "the traversal kernel failed" "${rays[@]}"
-PAPRSEK_CUDA_TREE=0 expect_failure "bad tree cost" "PAPRSEK_CUDA_TREE=0 is not a node cost from 0.25 to 64$" "${rays[@]}"
-PAPRSEK_CUDA_KERNEL=v10 expect_failure "unknown kernel version" "PAPRSEK_CUDA_KERNEL=v10 is not a kernel version \\(v0 to v9\\)$" \
-    "${rays[@]}"
+# the driver named by --config instead of the environment (which the program
+# passes on as cuda.library); --config wins
+PAPRSEK_CUDA_LIBRARY="$tmp/no-such-dir/libcuda.so.1" PK_CUDA_STUB=kernelfail \
+    expect_failure "driver from --config" "the traversal kernel failed" "${rays[@]}" --config "cuda.library=$stub"
+# the kernel versions measured once are gone: their key is unknown (a usage error, 2)
+"${rays[@]}" --config cuda.kernel=v6 >"$tmp/out" 2>"$tmp/err"
+rc=$?
+if [ "$rc" != 2 ] || ! grep -q "^paprsek: --config: unknown key 'cuda.kernel'" "$tmp/err"; then
+    fail "unknown config key: exit status $rc: $(cat "$tmp/err")"
+else
+    echo "ok: unknown config key: $(cat "$tmp/err")"
+fi
 # rendering on the GPU: the same messages, and no image written
 PK_CUDA_STUB=kernelfail expect_failure "render, kernel failure" "the kernel pk_path_[a-z]+ failed: unspecified launch failure$" \
     "$bin" render "$scene" -o "$tmp/h.hits.png" --device cuda --env 1 --width 8 --height 8
@@ -89,6 +93,10 @@ PK_CUDA_STUB=nodevice expect_failure "render, no device" "no CUDA device$" \
     "$bin" render "$scene" -o "$tmp/h.hits.png" --device cuda --env 1 --width 8 --height 8
 expect_failure "render, Whitted" "the GPU renders with the path tracer only, not the Whitted integrator$" \
     "$bin" render "$scene" -o "$tmp/h.hits.png" --device cuda --integrator whitted --env 1 --width 8 --height 8
+# --accel cuda is the older spelling of --device cuda for a render
+PK_CUDA_STUB=kernelfail expect_failure "render, --accel cuda" "the kernel pk_path_[a-z]+ failed: unspecified launch failure$" \
+    "$bin" render "$scene" -o "$tmp/h.hits.png" --accel cuda --env 1 --width 8 --height 8
+[ -e "$tmp/h.hits.png" ] && fail "render: an image was written"
 
 [ "$fails" = 0 ] || { echo "$fails failure(s)"; exit 1; }
 echo "all ok"

@@ -607,7 +607,7 @@ static void check_file(pk_context *ctx, const char *rel, size_t nrays, size_t nb
     }
     free_all(ctx, &b);
     pk_context_clear_error(ctx);
-    /* trees collapsed for the GPU (PAPRSEK_CUDA_TREE): the same checks */
+    /* trees collapsed for the GPU with other node costs: the same checks */
     static const float node_costs[] = {2.0f, 4.0f, 8.0f};
     for (size_t c = 0; c < sizeof node_costs / sizeof *node_costs; c++) {
         const bvh_costs costs = {node_costs[c], 1, 16};
@@ -646,15 +646,12 @@ static void check_file(pk_context *ctx, const char *rel, size_t nrays, size_t nb
         REQUIRE(dev && host);
         pk_accel *cpu = NULL;
         REQUIRE(pk_accel_create(ctx, s, PK_ACCEL_BVH, 2, &cpu) == PK_OK);
-        /* the default kernel, then every version (PAPRSEK_CUDA_KERNEL) */
-        static const char *const versions[] = {"", "v0", "v1", "v2", "v3", "v4", "v5", "v6", "v7", "v8", "v9"};
-        const char *keep = getenv("PAPRSEK_CUDA_KERNEL");
-        for (size_t ver = 0; ver < sizeof versions / sizeof *versions; ver++) {
-            pk_accel *pv = pa;
+        /* the default kernels, then the reference ones (gpu_trace_v0) */
+        for (int ver = 0; ver < 2; ver++) {
+            accel *ref = NULL;
             if (ver > 0) {
-                setenv("PAPRSEK_CUDA_KERNEL", versions[ver], 1);
-                st = pk_accel_create(ctx, s, PK_ACCEL_CUDA, 2, &pv);
-                CHECKF(st == PK_OK, "%s: kernel %s: %s", rel, versions[ver], pk_context_error(ctx));
+                st = accel_cuda_create_reference(ctx, &in, &ref);
+                CHECKF(st == PK_OK, "%s: reference kernels: %s", rel, pk_context_error(ctx));
                 if (st != PK_OK) {
                     pk_context_clear_error(ctx);
                     continue;
@@ -662,19 +659,20 @@ static void check_file(pk_context *ctx, const char *rel, size_t nrays, size_t nb
             }
             for (int any = 0; any < 2; any++) {
                 unsigned flags = any ? PK_TRACE_ANY_HIT : 0u;
-                pk_accel_trace(pv, (const pk_ray *)rays, dev, n, 0, flags, NULL);
+                if (ver > 0)
+                    accel_trace_batch(ref, rays, (hit *)dev, n, 0, flags, NULL);
+                else
+                    pk_accel_trace(pa, (const pk_ray *)rays, dev, n, 0, flags, NULL);
                 CHECKF(pk_context_status(ctx) == PK_OK, "%s: device trace: %s", rel, pk_context_error(ctx));
                 pk_accel_trace(cpu, (const pk_ray *)rays, host, n, 0, flags, NULL);
                 size_t bad = 0;
                 for (size_t i = 0; i < n; i++)
                     bad += any ? (dev[i].prim != PK_NO_HIT) != (host[i].prim != PK_NO_HIT) : !same_hit(&dev[i], &host[i]);
-                CHECKF(bad == 0, "%s: kernel %s: %zu of %zu device %s hits differ from the CPU's", rel,
-                       ver ? versions[ver] : "(default)", bad, n, any ? "any" : "closest");
+                CHECKF(bad == 0, "%s: %s kernels: %zu of %zu device %s hits differ from the CPU's", rel,
+                       ver ? "reference" : "default", bad, n, any ? "any" : "closest");
             }
-            if (ver > 0) pk_accel_destroy(pv);
+            accel_destroy(ref);
         }
-        if (keep) setenv("PAPRSEK_CUDA_KERNEL", keep, 1);
-        else unsetenv("PAPRSEK_CUDA_KERNEL");
         pk_accel_device_info di;
         CHECK(pk_accel_get_device_info(pa, &di) == 1 && di.kernel_ms > 0.0 && di.structure_bytes > 0);
         CHECK(pk_accel_get_device_info(cpu, &di) == 0);

@@ -1,16 +1,19 @@
 /*
  * path.cu - the GPU path tracer's kernels (see src/render/path_gpu.h): the
- * CPU's sampling code (path_kernel.h) with rays traced by gpu_trace of
- * bvh_gpu.h, one thread per pixel, a few samples per launch. Included by
- * trace.cu (one module).
+ * CPU's sampling code (path_kernel.h) with rays traced by gpu_trace_box of
+ * bvh_gpu.h on the cuda accelerator's structure, one thread per pixel, a
+ * few samples per launch. Compiled by nvcc alone into a module of its own
+ * (pk_cuda_path_fatbin.h), which render/path_gpu.c loads through the device
+ * layer (device/cuda.h).
  */
+#include "accel/bvh_gpu.h"
 #include "render/path.h"
 
 /* The box test of the path tracer's traversal (bvh_gpu.h GPU_TEST_*): the
- * exact one. The loosened one of the fastest ray kernel (v6) measured
- * slower here on the H100 (220 against 250 M samples/s on
- * CornellBox-Original, 62 against 70 M on Sponza; not profiled, so why
- * is open). */
+ * exact one with fused plane distances (GPU_TEST_FMA). The loosened one of
+ * the fastest ray kernel measured slower here on the H100 (220 against 250
+ * M samples/s on CornellBox-Original, 62 against 70 M on Sponza; not
+ * profiled, so why is open). */
 #ifndef PK_PATH_BOX
 #define PK_PATH_BOX GPU_TEST_FMA
 #endif
@@ -36,7 +39,7 @@ static __device__ __forceinline__ bool path_gpu_occluded(const path_tracer *pt, 
 extern "C" __global__ void pk_path_layout(unsigned long long *out)
 {
     if (threadIdx.x != 0 || blockIdx.x != 0) return;
-    out[0] = sizeof(pk_scene);
+    out[0] = sizeof(scene_view);
     out[1] = sizeof(material);
     out[2] = sizeof(texture);
     out[3] = sizeof(env_light);
