@@ -97,6 +97,8 @@ typedef struct cli_render_opts {
     int fresnel;         /* -1: not given */
     int has_accel;
     pk_accel_kind accel;
+    int has_device;
+    pk_device_kind device;
     const char *config;  /* --config, NULL when not given */
     int has_integrator;
     pk_integrator_kind integrator;

@@ -78,10 +78,10 @@ const cli_option *cli_render_options(size_t *n)
                          .help = "the acceleration structure: bvh (default: binned SAH, wide SIMD BVH, AVX-512 where the CPU has it), midpoint "
                                  "(simple BVH, for comparison), none (every ray tests every primitive), embree "
                                  "(Embree 3, when built with it); all give the same image; cuda: render on the "
-                                 "GPU (as --device cuda)"});
+                                 "GPU (the same as --device cuda)"});
         add((cli_option){.name = "device", .id = OPT_DEVICE, .kind = CLI_STRING, .arg = "cpu|cuda",
                          .help = "where to render: cpu (default) or cuda (an NVIDIA GPU: the path tracer, "
-                                 "triangles only; the same image as the CPU's up to noise)"});
+                                 "triangles only, on the GPU's own BVH; the same image as the CPU's up to noise)"});
         add((cli_option){.name = "config", .id = OPT_CONFIG, .kind = CLI_STRING, .arg = "KEY=VALUE,...",
                          .help = "settings of the library's back ends: cpu.isa=auto|avx2, bvh.quality=high|fast, "
                                  "embree.quality=low|medium|high, embree.library=FILE, cuda.library=FILE "
@@ -207,27 +207,32 @@ int cli_render_parse(int argc, char **argv, cli_render_opts *o, void (*help)(FIL
             o->int_set[p.index] = 1;
             o->int_value[p.index] = p.int_value;
             break;
-        case OPT_ACCEL:
-            if (pk_accel_kind_parse(v, &o->accel) != PK_OK)
+        case OPT_ACCEL: {
+            pk_accel_kind k;
+            if (pk_accel_kind_parse(v, &k) != PK_OK)
                 return cli_usage_error("--accel: unknown accelerator '%s' (none, midpoint, bvh, embree)", v);
-            if (!pk_accel_available(o->accel))
+            if (!pk_accel_available(k))
                 return cli_usage_error("--accel %s: not available in this build (%s)", v,
-                                       o->accel == PK_ACCEL_CUDA ? "rebuild where nvcc is, with -DPK_WITH_CUDA=ON"
-                                                                 : "install libembree-dev and rebuild");
-            o->has_accel = 1;
-            break;
-        case OPT_DEVICE:
-            if (strcmp(v, "cuda") == 0) {
-                if (!pk_accel_available(PK_ACCEL_CUDA))
-                    return cli_usage_error("--device cuda: not available in this build (rebuild where nvcc is, "
-                                           "with -DPK_WITH_CUDA=ON)");
-                o->accel = PK_ACCEL_CUDA;
-                o->has_accel = 1;
-            } else if (strcmp(v, "cpu") == 0) {
-                if (o->has_accel && o->accel == PK_ACCEL_CUDA) o->has_accel = 0;
+                                       k == PK_ACCEL_CUDA ? "rebuild where nvcc is, with -DPK_WITH_CUDA=ON"
+                                                          : "install libembree-dev and rebuild");
+            if (k == PK_ACCEL_CUDA) { /* a render on the GPU: the device's spelling */
+                o->device = PK_DEVICE_CUDA;
+                o->has_device = 1;
+                o->has_accel = 0;
             } else {
-                return cli_usage_error("--device: unknown device '%s' (cpu, cuda)", v);
+                o->accel = k;
+                o->has_accel = 1;
+                if (o->has_device && o->device == PK_DEVICE_CUDA) o->has_device = 0;
             }
+            break;
+        }
+        case OPT_DEVICE:
+            if (pk_device_parse(v, &o->device) != PK_OK)
+                return cli_usage_error("--device: unknown device '%s' (cpu, cuda)", v);
+            if (o->device == PK_DEVICE_CUDA && !pk_accel_available(PK_ACCEL_CUDA))
+                return cli_usage_error("--device cuda: not available in this build (rebuild where nvcc is, "
+                                       "with -DPK_WITH_CUDA=ON)");
+            o->has_device = 1;
             break;
         case OPT_CONFIG: o->config = v; break;
         case OPT_INTEGRATOR:
@@ -332,6 +337,12 @@ static double peak_rss_mib(void)
     return (double)ru.ru_maxrss / 1024.0;
 }
 
+/* The accelerator a render traced with: the GPU's own with --device cuda. */
+static const char *accel_label(const pk_render_options *ro)
+{
+    return ro->device == PK_DEVICE_CUDA ? pk_accel_kind_name(PK_ACCEL_CUDA) : pk_accel_kind_name(ro->accel);
+}
+
 /* The library's effective config (pk_context_get_config). */
 typedef struct config_text {
     char s[1024];
@@ -354,11 +365,11 @@ void cli_print_stats(pk_context *ctx, const char *scene, const pk_scene *sc, con
     const int path = ro->integrator != PK_INTEGRATOR_WHITTED;
     printf("%-28s %s\n", "scene", scene);
     if (path) /* light samples and the Fresnel switch are the Whitted integrator's */
-        printf("%-28s %s, %d thread%s, %dx%d, %d spp, depth %d\n", "settings", pk_accel_kind_name(ro->accel),
+        printf("%-28s %s, %d thread%s, %dx%d, %d spp, depth %d\n", "settings", accel_label(ro),
                st->threads, st->threads == 1 ? "" : "s", ro->width, ro->height, ro->spp, pk_render_options_max_depth(ro));
     else
         printf("%-28s %s, %d thread%s, %dx%d, %d spp, %d light samples, depth %d, fresnel %s\n", "settings",
-               pk_accel_kind_name(ro->accel), st->threads, st->threads == 1 ? "" : "s", ro->width, ro->height, ro->spp,
+               accel_label(ro), st->threads, st->threads == 1 ? "" : "s", ro->width, ro->height, ro->spp,
                ro->light_samples, pk_render_options_max_depth(ro), ro->fresnel ? "on" : "off");
     printf("%-28s %.0f\n", "build [us]", st->build_us);
     printf("%-28s %.3f\n", "render [s]", st->render_s);
@@ -373,7 +384,7 @@ void cli_print_stats(pk_context *ctx, const char *scene, const pk_scene *sc, con
                (unsigned long long)rays, (unsigned long long)st->rays_camera, (unsigned long long)st->rays_shadow,
                (unsigned long long)st->rays_reflection, (unsigned long long)st->rays_refraction);
     }
-    if (ro->accel == PK_ACCEL_CUDA) { /* the GPU counts rays, not tests and nodes */
+    if (ro->device == PK_DEVICE_CUDA || ro->accel == PK_ACCEL_CUDA) { /* the GPU counts rays, not tests and nodes */
         printf("%-28s %s\n", "intersection tests", "not counted on the GPU");
         printf("%-28s %s\n", "nodes traversed", "not counted on the GPU");
     } else {
@@ -427,8 +438,8 @@ int cli_write_stats_json(pk_context *ctx, const char *path, const char *scene, c
             "  \"intersection_tests\": %llu,\n  \"nodes_visited\": %llu,\n  \"mrays_per_s\": %.3f,\n"
             "  \"integrator\": \"%s\",\n  \"seed\": %d,\n  \"rays_bounce\": %llu,\n  \"samples_per_s\": %.1f,\n"
             "  \"film_bytes_per_pixel\": %d,\n  \"peak_rss_mib\": %.1f,\n  \"textures\": %zu,\n"
-            "  \"texture_bytes\": %zu,\n  \"config\": ",
-            pk_accel_kind_name(ro->accel), ro->width, ro->height, ro->spp, ro->light_samples, pk_render_options_max_depth(ro),
+            "  \"texture_bytes\": %zu,\n  \"device\": \"%s\",\n  \"config\": ",
+            accel_label(ro), ro->width, ro->height, ro->spp, ro->light_samples, pk_render_options_max_depth(ro),
             ro->fresnel ? "true" : "false", st->threads, st->build_us, st->render_s, (unsigned long long)rays,
             (unsigned long long)st->rays_camera, (unsigned long long)st->rays_shadow,
             (unsigned long long)st->rays_reflection, (unsigned long long)st->rays_refraction,
@@ -436,7 +447,8 @@ int cli_write_stats_json(pk_context *ctx, const char *path, const char *scene, c
             st->render_s > 0 ? (double)rays / st->render_s / 1e6 : 0.0, pk_integrator_name(ro->integrator), ro->seed,
             (unsigned long long)st->rays_bounce,
             st->render_s > 0 ? (double)st->pixels * ro->spp / st->render_s : 0.0, FILM_BYTES_PER_PIXEL,
-            peak_rss_mib(), si.textures, si.texture_bytes);
+            peak_rss_mib(), si.textures, si.texture_bytes,
+            pk_device_name(ro->device == PK_DEVICE_CUDA || ro->accel == PK_ACCEL_CUDA ? PK_DEVICE_CUDA : PK_DEVICE_CPU));
     json_string(f, config_of(ctx).s);
     fputs("\n}\n", f);
     if (to_stdout ? fflush(f) != 0 || ferror(f) : fclose(f) != 0)
@@ -548,6 +560,10 @@ pk_status cli_render_settings(pk_context *ctx, const cli_render_opts *o, pk_scen
         if (o->int_set[i]) *(int *)(void *)((char *)ro + opts[i].render->offset) = o->int_value[i];
     if (o->fresnel >= 0) ro->fresnel = o->fresnel;
     if (o->has_accel) ro->accel = o->accel;
+    if (o->has_device) {
+        ro->device = o->device;
+        if (o->device == PK_DEVICE_CPU && ro->accel == PK_ACCEL_CUDA) ro->accel = PK_ACCEL_DEFAULT;
+    }
     if (o->has_integrator) ro->integrator = o->integrator;
     ro->collect_stats = o->stats || o->stats_json;
     if (cli_configure(ctx, o->config) != 0) return PK_ERR_INVALID_ARGUMENT; /* (checked at parsing) */

@@ -175,6 +175,17 @@ PK_API pk_status pk_accel_kind_parse(const char *name, pk_accel_kind *out);
  * for CUDA: compiled in, whether or not this machine has a GPU). */
 PK_API int pk_accel_available(pk_accel_kind kind);
 
+/* Where a render runs. */
+typedef enum pk_device_kind {
+    PK_DEVICE_CPU = 0,  /* the CPU's threads, with the accelerator of pk_render_options.accel */
+    PK_DEVICE_CUDA = 1  /* an NVIDIA GPU, when built with CUDA: the path tracer, triangles only, on
+                           the GPU's own structure (PK_ACCEL_CUDA, which the renderer builds) */
+} pk_device_kind;
+
+PK_API const char *pk_device_name(pk_device_kind kind);
+/* Returns PK_OK and sets *out for "cpu", "cuda". */
+PK_API pk_status pk_device_parse(const char *name, pk_device_kind *out);
+
 typedef enum pk_integrator_kind {
     PK_INTEGRATOR_DEFAULT = 0, /* the path tracer */
     PK_INTEGRATOR_WHITTED = 1, /* direct light, mirror reflection and refraction */
@@ -208,6 +219,11 @@ typedef struct pk_render_options {
     void *progress_user;
     pk_integrator_kind integrator;
     int seed;            /* the path tracer's noise pattern (0..2^31-1) */
+    /* Where to render. PK_DEVICE_CUDA traces on the GPU's own structure,
+     * whatever accel says (it reads PK_ACCEL_CUDA afterwards); accel
+     * PK_ACCEL_CUDA with PK_DEVICE_CPU means PK_DEVICE_CUDA too (as programs
+     * written before this field said it). */
+    pk_device_kind device;
 } pk_render_options;
 
 /* Arbitrary output variables: what the camera ray of each sample found,

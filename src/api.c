@@ -304,12 +304,14 @@ pk_status pk_image_write(pk_context *ctx, const pk_image *img, const char *path)
 
 /* ---- rendering ---------------------------------------------------------------- */
 
-static pk_status check_options(pk_context *ctx, const pk_render_options *o)
+/* Checks *o and resolves its device (options_resolve_device). */
+static pk_status check_options(pk_context *ctx, pk_render_options *o)
 {
     pk_status st = options_check(ctx, o);
     if (st != PK_OK) return st;
-    if (!pk_accel_available(o->accel)) return accel_unavailable(ctx, o->accel);
-    if (o->accel == PK_ACCEL_CUDA && o->integrator == PK_INTEGRATOR_WHITTED)
+    options_resolve_device(o);
+    if (!accel_available_in(ctx, o->accel)) return accel_unavailable(ctx, o->accel);
+    if (o->device == PK_DEVICE_CUDA && o->integrator == PK_INTEGRATOR_WHITTED)
         return ctx_error(ctx, PK_ERR_UNSUPPORTED, "device 'cuda': the GPU renders with the path tracer only, not "
                                                   "the Whitted integrator");
     return PK_OK;
@@ -318,7 +320,8 @@ static pk_status check_options(pk_context *ctx, const pk_render_options *o)
 pk_status pk_render_options_check(pk_context *ctx, const pk_render_options *opt)
 {
     if (!ctx || !opt) return PK_ERR_INVALID_ARGUMENT;
-    return check_options(ctx, opt);
+    pk_render_options o = *opt;
+    return check_options(ctx, &o);
 }
 
 /* The camera a render of scene uses, checked. */

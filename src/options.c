@@ -86,7 +86,38 @@ pk_status options_check(pk_context *ctx, const pk_render_options *o)
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "unknown accelerator %d", (int)o->accel);
     if ((unsigned)o->integrator > PK_INTEGRATOR_PATH)
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "unknown integrator %d", (int)o->integrator);
+    if ((unsigned)o->device > PK_DEVICE_CUDA)
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "unknown device %d", (int)o->device);
     return PK_OK;
+}
+
+void options_resolve_device(pk_render_options *o)
+{
+    if (o->device == PK_DEVICE_CUDA)
+        o->accel = PK_ACCEL_CUDA;
+    else if (o->device == PK_DEVICE_CPU && o->accel == PK_ACCEL_CUDA)
+        o->device = PK_DEVICE_CUDA;
+}
+
+/* ---- device names ------------------------------------------------------------ */
+
+static const char *const device_names[] = {"cpu", "cuda"};
+
+const char *pk_device_name(pk_device_kind kind)
+{
+    if ((unsigned)kind >= sizeof device_names / sizeof device_names[0]) return "unknown";
+    return device_names[kind];
+}
+
+pk_status pk_device_parse(const char *name, pk_device_kind *out)
+{
+    if (!name || !out) return PK_ERR_INVALID_ARGUMENT;
+    for (int k = PK_DEVICE_CPU; k <= PK_DEVICE_CUDA; k++)
+        if (strcmp(name, device_names[k]) == 0) {
+            *out = (pk_device_kind)k;
+            return PK_OK;
+        }
+    return PK_ERR_INVALID_ARGUMENT;
 }
 
 /* ---- integrator names ------------------------------------------------------ */

@@ -149,6 +149,34 @@ static void check_context_config(void)
     CHECKF(strcmp(buf, defaults) == 0, "config after reset: %s", buf);
 }
 
+/* The device field: names, and PK_ACCEL_CUDA and PK_DEVICE_CUDA checked alike. */
+static void check_device(void)
+{
+    pk_device_kind k = PK_DEVICE_CUDA;
+    CHECK(pk_device_parse("cpu", &k) == PK_OK && k == PK_DEVICE_CPU);
+    CHECK(pk_device_parse("cuda", &k) == PK_OK && k == PK_DEVICE_CUDA);
+    CHECK(pk_device_parse("gpu", &k) == PK_ERR_INVALID_ARGUMENT && pk_device_parse(NULL, &k) == PK_ERR_INVALID_ARGUMENT);
+    CHECK(strcmp(pk_device_name(PK_DEVICE_CPU), "cpu") == 0 && strcmp(pk_device_name(PK_DEVICE_CUDA), "cuda") == 0);
+    pk_render_options o;
+    pk_render_options_init(&o);
+    CHECK(o.device == PK_DEVICE_CPU);
+    o.device = (pk_device_kind)7;
+    CHECK(pk_render_options_check(ctx, &o) == PK_ERR_INVALID_ARGUMENT && strstr(pk_context_error(ctx), "device"));
+    pk_context_clear_error(ctx);
+    const int gpu = pk_accel_available(PK_ACCEL_CUDA);
+    for (int spelling = 0; spelling < 2; spelling++) {
+        pk_render_options_init(&o);
+        if (spelling) o.accel = PK_ACCEL_CUDA;
+        else o.device = PK_DEVICE_CUDA;
+        o.integrator = PK_INTEGRATOR_WHITTED;
+        CHECK(pk_render_options_check(ctx, &o) == PK_ERR_UNSUPPORTED);
+        pk_context_clear_error(ctx);
+        o.integrator = PK_INTEGRATOR_PATH;
+        CHECK(pk_render_options_check(ctx, &o) == (gpu ? PK_OK : PK_ERR_UNSUPPORTED));
+        pk_context_clear_error(ctx);
+    }
+}
+
 int main(void)
 {
     REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
@@ -191,6 +219,7 @@ int main(void)
         }
     }
     check_context_config();
+    check_device();
     remove("options_test.png");
     remove("options_test.out");
     pk_context_destroy(ctx);
