@@ -99,6 +99,17 @@ PK_HIDDEN void io_warn_once(io_reader *r, const char *kind, size_t len, const ch
  * clear). */
 PK_HIDDEN bool io_demote_error(pk_context *ctx, pk_status st, bool was_ok, char *why, size_t nwhy);
 
+/* A copy of ctx with no error latched (same allocator and warning handler),
+ * for a call whose error the reader latches again itself with where it
+ * came from: "scene.json:12: meshes[0].obj: " + the copy's message. */
+static inline pk_context io_scratch_context(const pk_context *ctx)
+{
+    pk_context c = *ctx;
+    c.status = PK_OK;
+    c.message[0] = '\0';
+    return c;
+}
+
 /* Printing width for a token in a message (long tokens are cut). */
 static inline int io_tok_len(const char *s, const char *e)
 {

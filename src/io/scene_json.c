@@ -852,7 +852,7 @@ static pk_status parse_transform(jp *p, const cJSON *it, const char *path, xform
             t = xform_translate(v);
         }
         if (f[T_SCALE]) {
-            vec3 v;
+            vec3 v = v3s(1.0f);
             path_key(fp, path, "scale");
             if (cJSON_IsNumber(f[T_SCALE])) {
                 if ((st = get_float(p, f[T_SCALE], fp, &v.x))) return st;
@@ -921,9 +921,7 @@ static pk_status parse_mesh(jp *p, const cJSON *it, const char *path)
     }
     /* Read through a scratch context so that the message can say where in the
      * JSON file the path came from. */
-    scratch = *p->ctx;
-    scratch.status = PK_OK;
-    scratch.message[0] = '\0';
+    scratch = io_scratch_context(p->ctx);
     st = file_read_all(&scratch, full, &data, &size);
     if (st) {
         jfail(p, st, f[M_OBJ], fp, "%s", scratch.message);
@@ -1152,9 +1150,7 @@ static pk_status parse_environment(jp *p, const cJSON *it)
         env->map = path_join(a, p->base_dir, f[E_MAP]->valuestring);
         if (!env->map) return ctx_nomem(p->ctx);
         /* loaded now, so that a bad map is reported at its line */
-        pk_context scratch = *p->ctx;
-        scratch.status = PK_OK;
-        scratch.message[0] = '\0';
+        pk_context scratch = io_scratch_context(p->ctx);
         st = scene_env_load(&scratch, env);
         if (st) return jfail(p, st, f[E_MAP], "environment.map", "%s", scratch.message);
     }

@@ -1480,9 +1480,7 @@ static pk_status read_relative(xp *p, const xnode *at, const char *rel, char **f
     *data = NULL;
     *full = path_join(&p->ctx->alloc, at->file->dir, rel);
     if (!*full) return ctx_nomem(p->ctx);
-    pk_context scratch = *p->ctx;
-    scratch.status = PK_OK;
-    scratch.message[0] = '\0';
+    pk_context scratch = io_scratch_context(p->ctx);
     pk_status st = file_read_all(&scratch, *full, data, size);
     if (st) return xfail(p, st, at, "%s", scratch.message);
     return PK_OK;
@@ -1894,9 +1892,7 @@ static pk_status parse_emitter(xp *p, xnode *e)
                 env->to_world[c] = col.x, env->to_world[3 + c] = col.y, env->to_world[6 + c] = col.z;
             }
             /* read now, so that a bad map is reported at its element */
-            pk_context scratch = *p->ctx;
-            scratch.status = PK_OK;
-            scratch.message[0] = '\0';
+            pk_context scratch = io_scratch_context(p->ctx);
             if ((st = scene_env_load(&scratch, env))) return xfail(p, st, e, "envmap: %s", scratch.message);
         }
         static const char *const q2[] = {"sampling_weight", "gamma", "filter_type", "cache", NULL};
