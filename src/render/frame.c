@@ -60,6 +60,7 @@ pk_status frame_init(pk_context *ctx, frame *f, const pk_scene *s, pk_accel_kind
 {
     memset(f, 0, sizeof *f);
     f->s = s;
+    f->v = scene_view_of(s);
     double t0 = time_now();
     pk_status st = frame_build_accel(ctx, s, kind, threads, &f->a);
     if (st != PK_OK) return st;

@@ -11,7 +11,8 @@
 #include "lights.h"
 
 typedef struct frame {
-    const pk_scene *s;
+    const pk_scene *s;   /* the authored scene (host code: lights, environment, warnings) */
+    scene_view v;        /* what kernels read of it */
     accel *a;
     env_light env;       /* the surroundings: environment and sun */
     light_set lights;    /* every light, the environment's and the sun's included */

@@ -11,7 +11,7 @@
 
 #include "../accel/geom.h"
 #include "../math/distrib.h"
-#include "../scene/scene.h"
+#include "../scene/scene_view.h"
 #include "env.h"
 #include "sampling.h"
 
@@ -64,7 +64,7 @@ typedef struct light_sample {
 
 /* Solid-angle pdf of light l (a triangle or sphere of s) sampling the point
  * q, of normal nq, from p, the choice of the light excluded. */
-static inline PK_HD float light_pdf_li(const pk_scene *s, const light *l, vec3 p, vec3 q, vec3 nq)
+static inline PK_HD float light_pdf_li(const scene_view *s, const light *l, vec3 p, vec3 q, vec3 nq)
 {
     vec3 d = v3_sub(q, p);
     float dist2 = v3_len2(d);
@@ -86,7 +86,7 @@ static inline PK_HD float light_pdf_li(const pk_scene *s, const light *l, vec3 p
 
 /* Samples light li of the set from lc with (u1, u2): false when it sends
  * nothing toward lc->p. ls->pdf excludes the light's choice. */
-static inline PK_HD bool light_sample_one(const light_set *set, const pk_scene *s, const env_light *e, size_t li,
+static inline PK_HD bool light_sample_one(const light_set *set, const scene_view *s, const env_light *e, size_t li,
                                           const light_ctx *lc, float u1, float u2, light_sample *ls)
 {
     const light *l = &set->lights[li];
@@ -123,7 +123,7 @@ static inline PK_HD bool light_sample_one(const light_set *set, const pk_scene *
     const material *m;
     if (l->kind == LIGHT_TRIANGLE) {
         vec3 a, b, c;
-        scene_tri_verts(s, l->index, &a, &b, &c);
+        view_tri_verts(s, l->index, &a, &b, &c);
         q = sample_triangle(a, b, c, u1, u2);
         nq = l->normal;
         m = &s->materials[s->tris[l->index].material];
@@ -175,7 +175,7 @@ static inline PK_HD bool light_sample_one(const light_set *set, const pk_scene *
 
 /* One light chosen by power with u0, then sampled with (u1, u2); ls->pdf
  * includes the choice. */
-static inline PK_HD bool light_sample_li(const light_set *set, const pk_scene *s, const env_light *e,
+static inline PK_HD bool light_sample_li(const light_set *set, const scene_view *s, const env_light *e,
                                          const light_ctx *lc, float u0, float u1, float u2, light_sample *ls)
 {
     if (set->n == 0) return false;

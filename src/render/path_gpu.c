@@ -90,7 +90,7 @@ static pk_status upload_textures(path_gpu *g, const pk_scene *s, uint64_t *out)
 static pk_status check_layout(path_gpu *g)
 {
     /* sizes of the shared structs as nvcc laid them out, against the host's */
-    const uint64_t host[8] = {sizeof(pk_scene), sizeof(material), sizeof(texture), sizeof(env_light),
+    const uint64_t host[8] = {sizeof(scene_view), sizeof(material), sizeof(texture), sizeof(env_light),
                               sizeof(light_set), sizeof(path_tracer), sizeof(frame), sizeof(camera_frame)};
     uint64_t dev[8] = {0}, d = 0;
     pk_status st = cuda_device_alloc(g->dev, NULL, sizeof dev, NULL, &d);
@@ -136,18 +136,17 @@ pk_status path_gpu_create(pk_context *ctx, const path_tracer *pt, path_gpu **out
     }
     st = check_layout(g);
 
-    /* the scene */
-    pk_scene ds = *s;
-    memset(&ds.alloc, 0, sizeof ds.alloc);
-    ds.name = NULL;
-    ds.mat_index = NULL;
-    ds.degenerate = NULL;
-    ds.emissive = NULL;
-    memset(&ds.env, 0, sizeof ds.env);
+    /* the frame, without the host's scene and accelerator (the device follows neither) */
+    frame df = *f;
+    df.s = NULL;
+    df.a = NULL;
+    /* the scene: the frame's view of it, with its arrays on the device */
+    scene_view *ds = &df.v;
+    ds->spheres = NULL; /* refused above */
     uint64_t p;
 #define UP(field, n)                                                          \
     if (st == PK_OK) st = upload(g, s->field, (n), sizeof *s->field, &p); \
-    ds.field = dev_ptr(p);
+    ds->field = dev_ptr(p);
     UP(positions, s->npositions)
     UP(normals, s->nnormals)
     UP(uvs, s->nuvs)
@@ -160,18 +159,13 @@ pk_status path_gpu_create(pk_context *ctx, const path_tracer *pt, path_gpu **out
         memcpy(mats, s->materials, s->nmaterials * sizeof *mats);
         for (size_t i = 0; i < s->nmaterials; i++) mats[i].name = NULL;
         st = upload(g, mats, s->nmaterials, sizeof *mats, &p);
-        ds.materials = dev_ptr(p);
+        ds->materials = dev_ptr(p);
     }
     mem_free(&ctx->alloc, mats);
     if (st == PK_OK) st = upload_textures(g, s, &p);
-    ds.textures = dev_ptr(p);
-    uint64_t d_scene = 0;
-    if (st == PK_OK) st = upload(g, &ds, 1, sizeof ds, &d_scene);
+    ds->textures = dev_ptr(p);
 
     /* the frame and its environment */
-    frame df = *f;
-    df.s = dev_ptr(d_scene);
-    df.a = NULL;
     memset(&df.lights, 0, sizeof df.lights);
     env_light *e = &df.env;
     const size_t npix = e->uniform ? 0 : (size_t)e->w * (size_t)e->h;

@@ -37,7 +37,7 @@
 /* Steps past holes (surface.h trace_past_holes, with the includer's tracing). */
 static inline PK_HD bool path_past_holes(const path_tracer *pt, path_thread *t, ray *r, hit *h)
 {
-    for (int k = 0; k < HOLE_STEPS && surface_is_hole(pt->f->s, r, h); k++) {
+    for (int k = 0; k < HOLE_STEPS && surface_is_hole(&pt->f->v, r, h); k++) {
         r->tmin = nextafterf(h->t, INFINITY);
         if (!PATH_TRACE(pt, t, r, h)) return false;
     }
@@ -47,7 +47,7 @@ static inline PK_HD bool path_past_holes(const path_tracer *pt, path_thread *t, 
 /* Whether a shadow ray is blocked, seeing through holes. */
 static inline PK_HD bool path_occluded(const path_tracer *pt, path_thread *t, const ray *r)
 {
-    if (!pt->f->s->has_cutout) return PATH_OCCLUDED(pt, t, r);
+    if (!pt->f->v.has_cutout) return PATH_OCCLUDED(pt, t, r);
     ray rr = *r;
     hit h;
     if (!PATH_TRACE(pt, t, &rr, &h)) return false;
@@ -134,7 +134,7 @@ static inline PK_HD void path_begin(path_state *ps, const ray *r, const hit *h, 
 static inline PK_HD bool path_step_aov(const path_tracer *pt, path_thread *t, path_state *ps, aov_sample *aov)
 {
     const frame *fr = pt->f;
-    const pk_scene *s = fr->s;
+    const scene_view *s = &fr->v;
     sampler *smp = &ps->smp;
     if (s->has_cutout && !path_past_holes(pt, t, &ps->r, &ps->h)) { /* through map_d holes, out */
         ps->L = v3_add(ps->L, v3_mul(ps->beta, leaving(pt, v3_norm(ps->r.d), ps->prev_delta, ps->prev_pdf)));

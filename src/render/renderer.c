@@ -334,7 +334,7 @@ static void film_add_aovs(pk_film *film, const tile *tl, float (*aovs)[BATCH * 3
  * the CPU, one at a time, and shaded as the path tracer's first vertex. */
 static void render_tile_aovs_cpu(const pk_renderer *r, const camera_frame *cf, const tile *tl, pk_film *film)
 {
-    const pk_scene *s = r->fr.s;
+    const scene_view *s = &r->fr.v;
     const int tw = tl->w, n = tl->w * tl->h;
     float v[FILM_AOVS][BATCH * 3];
     memset(v, 0, sizeof v);

@@ -4,7 +4,7 @@
  */
 #include "surface.h"
 
-bool trace_past_holes(const accel *a, const pk_scene *s, ray *r, hit *h, accel_counters *cp)
+bool trace_past_holes(const accel *a, const scene_view *s, ray *r, hit *h, accel_counters *cp)
 {
     for (int k = 0; k < HOLE_STEPS && surface_is_hole(s, r, h); k++) {
         r->tmin = nextafterf(h->t, INFINITY);
@@ -13,7 +13,7 @@ bool trace_past_holes(const accel *a, const pk_scene *s, ray *r, hit *h, accel_c
     return true;
 }
 
-bool occluded_past_holes(const accel *a, const pk_scene *s, const ray *r, accel_counters *cp)
+bool occluded_past_holes(const accel *a, const scene_view *s, const ray *r, accel_counters *cp)
 {
     if (!s->has_cutout) return accel_occluded(a, r, cp);
     ray rr = *r;

@@ -8,7 +8,7 @@
 
 #include "../accel/accel.h"
 #include "../accel/geom.h"
-#include "../scene/scene.h"
+#include "../scene/scene_view.h"
 
 typedef struct surface {
     vec3 p;        /* world-space hit point */
@@ -19,14 +19,14 @@ typedef struct surface {
 } surface;
 
 /* The surface that ray r hit at h (h->prim is a triangle or a sphere of s). */
-static inline PK_HD surface surface_at(const pk_scene *s, const ray *r, const hit *h)
+static inline PK_HD surface surface_at(const scene_view *s, const ray *r, const hit *h)
 {
     surface sf;
     vec3 ng, ns;
     if (h->prim < s->ntris) {
         const triangle *t = &s->tris[h->prim];
         vec3 a, b, c;
-        scene_tri_verts(s, h->prim, &a, &b, &c);
+        view_tri_verts(s, h->prim, &a, &b, &c);
         float w = 1.0f - h->u - h->v;
         sf.p = v3_add(v3_add(v3_scale(a, w), v3_scale(b, h->u)), v3_scale(c, h->v));
         ng = tri_normal(a, b, c);
@@ -71,13 +71,13 @@ typedef struct surface_uv {
     float uv_per_len;
 } surface_uv;
 #define SURFACE_MIN_COS 0.05f    /* footprints of grazing hits stop growing here */
-static inline PK_HD surface_uv surface_uv_at(const pk_scene *s, const ray *r, const hit *h)
+static inline PK_HD surface_uv surface_uv_at(const scene_view *s, const ray *r, const hit *h)
 {
     surface_uv q;
     if (h->prim < s->ntris) {
         const triangle *t = &s->tris[h->prim];
         vec3 a, b, c;
-        scene_tri_verts(s, h->prim, &a, &b, &c);
+        view_tri_verts(s, h->prim, &a, &b, &c);
         uv2 ta = {0.0f, 0.0f}, tb = {1.0f, 0.0f}, tc = {0.0f, 1.0f};
         if (t->t[0] >= 0 && t->t[1] >= 0 && t->t[2] >= 0) {
             ta = s->uvs[t->t[0]];
@@ -125,13 +125,13 @@ static inline PK_HD vec3 surface_clamp_rgb(vec3 c)
 }
 
 /* Height of a bump map at (u, v), the fine level. */
-static inline PK_HD float surface_bump_height(const pk_scene *s, const tex_ref *ref, float u, float v)
+static inline PK_HD float surface_bump_height(const scene_view *s, const tex_ref *ref, float u, float v)
 {
     tex_query q = {u, v, 0.0f};
     return tex_eval_scalar(s->textures, ref, q);
 }
 
-static inline PK_HD void surface_texture_at(const pk_scene *s, const ray *r, const hit *h, float cone_width, surface *sf, material *tm)
+static inline PK_HD void surface_texture_at(const scene_view *s, const ray *r, const hit *h, float cone_width, surface *sf, material *tm)
 {
     const material *m = sf->m;
     *tm = *m;
@@ -193,7 +193,7 @@ static inline PK_HD void surface_texture_at(const pk_scene *s, const ray *r, con
  * surface, writes the textured material into *tm and returns sf with m
  * pointing at it; bump and normal maps bend its ns. (sf by value, so that
  * callers keep theirs in registers.) */
-static inline PK_HD surface surface_texture(const pk_scene *s, const ray *r, const hit *h, float cone_width, surface sf, material *tm)
+static inline PK_HD surface surface_texture(const scene_view *s, const ray *r, const hit *h, float cone_width, surface sf, material *tm)
 {
     surface_texture_at(s, r, h, cone_width, &sf, tm);
     return sf;
@@ -202,7 +202,7 @@ static inline PK_HD surface surface_texture(const pk_scene *s, const ray *r, con
 #define HOLE_STEPS 256   /* holes passed along one ray at most; then the surface counts */
 
 /* True when the hit lies in a hole of its material's map_d (opacity < 0.5). */
-static inline PK_HD bool surface_is_hole(const pk_scene *s, const ray *r, const hit *h)
+static inline PK_HD bool surface_is_hole(const scene_view *s, const ray *r, const hit *h)
 {
     const uint32_t mi = h->prim < s->ntris ? s->tris[h->prim].material : s->spheres[h->prim - s->ntris].material;
     const material *m = &s->materials[mi];
@@ -215,10 +215,10 @@ static inline PK_HD bool surface_is_hole(const pk_scene *s, const ray *r, const 
 /* Steps past holes: while h (a hit of *r) is a hole, looks further along *r
  * (tmin just past the hole). Returns false when nothing else is hit. For
  * scenes with cut-outs (s->has_cutout); every accelerator gives the same. */
-PK_HIDDEN bool trace_past_holes(const accel *a, const pk_scene *s, ray *r, hit *h, accel_counters *cp);
+PK_HIDDEN bool trace_past_holes(const accel *a, const scene_view *s, ray *r, hit *h, accel_counters *cp);
 /* Any-hit test that sees through holes: the fast any-hit when the scene has
  * no cut-out, else closest hits stepped past holes. */
-PK_HIDDEN bool occluded_past_holes(const accel *a, const pk_scene *s, const ray *r, accel_counters *cp);
+PK_HIDDEN bool occluded_past_holes(const accel *a, const scene_view *s, const ray *r, accel_counters *cp);
 
 /* Origin for a ray leaving p on the side of normal n: a robust offset of eps
  * (the frame's, proportional to the scene's size) plus a part proportional

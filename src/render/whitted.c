@@ -65,7 +65,7 @@ static vec3 trace(const whitted *w, whitted_thread *ts, const ray *r, int depth,
 static vec3 direct_light(const whitted *w, whitted_thread *ts, const surface *sf, vec3 wo)
 {
     const frame *fr = w->f;
-    const pk_scene *s = fr->s;
+    const scene_view *s = &fr->v;
     const light_set *set = &fr->lights;
     vec3 L = v3s(0.0f);
     const light_ctx lc = {sf->p, sf->ng, offset_origin(fr->eps, sf->p, sf->ng), true};
@@ -119,10 +119,10 @@ static vec3 direct_light(const whitted *w, whitted_thread *ts, const surface *sf
 static vec3 shade_opaque(const whitted *w, whitted_thread *ts, const ray *r, const hit *h, int depth, aov_sample *aov)
 {
     const frame *fr = w->f;
-    surface sf = surface_at(fr->s, r, h);
-    const float cone = fr->s->has_textured ? ts->cone + w->spread * h->t * v3_len(r->d) : 0.0f;
+    surface sf = surface_at(&fr->v, r, h);
+    const float cone = fr->v.has_textured ? ts->cone + w->spread * h->t * v3_len(r->d) : 0.0f;
     material textured;
-    if (sf.m->textured) sf = surface_texture(fr->s, r, h, cone, sf, &textured);
+    if (sf.m->textured) sf = surface_texture(&fr->v, r, h, cone, sf, &textured);
     if (aov) aov_from_surface(&sf, r, h, aov);
     const material *m = sf.m;
     vec3 wo = v3_neg(v3_norm(r->d));
@@ -186,7 +186,7 @@ static vec3 shade_opaque(const whitted *w, whitted_thread *ts, const ray *r, con
 static vec3 whitted_shade(const whitted *w, whitted_thread *ts, const ray *r, const hit *h, int depth,
                           aov_sample *aov)
 {
-    const pk_scene *s = w->f->s;
+    const scene_view *s = &w->f->v;
     if (s->has_cutout && surface_is_hole(s, r, h)) { /* map_d holes: what lies behind */
         ray rr = *r;
         hit hh = *h;

@@ -189,9 +189,10 @@ static void test_uv(void)
     REQUIRE(s->ntris == 2 && s->nuvs == 3);
     CHECK(s->tris[0].t[0] == 0 && s->tris[0].t[1] == 1 && s->tris[0].t[2] == 2);
     CHECK(s->tris[1].t[0] == -1 && s->tris[1].t[2] == -1);
+    scene_view v = scene_view_of(s); /* what the renderer's kernels read */
     ray r = {{0.5f, 1.0f, 1.0f}, 0.0f, {0.0f, 0.0f, -1.0f}, INFINITY};
     hit h = {1.0f, 0, 0.25f, 0.25f}; /* the point (0.5, 1, 0): b weight 0.25, c weight 0.25 */
-    surface_uv q = surface_uv_at(s, &r, &h);
+    surface_uv q = surface_uv_at(&v, &r, &h);
     CHECK_NEAR(q.u, 0.5 * 0.1 + 0.25 * 0.9 + 0.25 * 0.1, 1e-6);
     CHECK_NEAR(q.v, 0.5 * 0.2 + 0.25 * 0.2 + 0.25 * 0.6, 1e-6);
     /* dp/du: 2 units of x per 0.8 of u; dp/dv: 4 of y per 0.4 of v */
@@ -200,7 +201,7 @@ static void test_uv(void)
     /* uv area 0.16 over the area 4: 0.2 uv per unit length */
     CHECK_NEAR(q.uv_per_len, 0.2, 1e-6);
     h.prim = 1; /* no vt: the barycentric coordinates */
-    q = surface_uv_at(s, &r, &h);
+    q = surface_uv_at(&v, &r, &h);
     CHECK(q.u == 0.25f && q.v == 0.25f);
     scene_destroy(s);
 
@@ -209,16 +210,17 @@ static void test_uv(void)
     sphere sp = {{0, 0, 0}, 2.0f, 0};
     REQUIRE(scene_add_sphere(ctx, s, &sp) == PK_OK);
     REQUIRE(scene_commit(ctx, s) == PK_OK);
+    v = scene_view_of(s);
     ray down = {{0, 5, 0}, 0.0f, {0, -1, 0}, INFINITY};
     hit top = {3.0f, 0, 0, 0};
-    CHECK_NEAR(surface_uv_at(s, &down, &top).v, 1.0, 1e-6);
+    CHECK_NEAR(surface_uv_at(&v, &down, &top).v, 1.0, 1e-6);
     ray side = {{5, 0, 0}, 0.0f, {-1, 0, 0}, INFINITY}; /* hits (2, 0, 0): phi 0 */
     hit eq = {3.0f, 0, 0, 0};
-    q = surface_uv_at(s, &side, &eq);
+    q = surface_uv_at(&v, &side, &eq);
     CHECK_NEAR(q.v, 0.5, 1e-6);
     CHECK_NEAR(q.u, 0.5, 1e-6);
     ray back = {{0, 0, 5}, 0.0f, {0, 0, -1}, INFINITY}; /* hits (0, 0, 2): phi pi/2 */
-    q = surface_uv_at(s, &back, &eq);
+    q = surface_uv_at(&v, &back, &eq);
     CHECK_NEAR(q.u, 0.75, 1e-6);
     CHECK_NEAR(q.dpdu.x, -4.0 * (double)PK_PI, 1e-4); /* around the axis, toward -x there */
     scene_destroy(s);
@@ -311,6 +313,7 @@ static void test_cutout(void)
     const ray shadow_solid = {{-0.03125f, 0.78125f, 3.0f}, 0.0f, {0.0f, 0.0f, -3.5f}, 1.0f};
     const pk_accel_kind kinds[] = {PK_ACCEL_NONE, PK_ACCEL_BVH, PK_ACCEL_MIDPOINT, PK_ACCEL_EMBREE};
     hit ref_through = {0}, ref_solid = {0};
+    const scene_view v = scene_view_of(s);
     for (size_t k = 0; k < sizeof kinds / sizeof kinds[0]; k++) {
         if (!pk_accel_available(kinds[k])) {
             printf("accelerator %s not available, skipped\n", pk_accel_kind_name(kinds[k]));
@@ -321,21 +324,21 @@ static void test_cutout(void)
         ray r = through;
         hit h;
         REQUIRE(accel_intersect(a, &r, &h, NULL));
-        CHECK(h.prim < 2 && surface_is_hole(s, &r, &h)); /* the sheet, in a hole */
-        CHECK(trace_past_holes(a, s, &r, &h, NULL));
+        CHECK(h.prim < 2 && surface_is_hole(&v, &r, &h)); /* the sheet, in a hole */
+        CHECK(trace_past_holes(a, &v, &r, &h, NULL));
         CHECKF(h.prim >= 2 && h.t == 4.0f, "%s: prim %u t %g", pk_accel_kind_name(kinds[k]), h.prim, (double)h.t);
         if (k == 0) ref_through = h;
         CHECK(memcmp(&h, &ref_through, sizeof h) == 0); /* the same hit as brute force */
         r = solid;
         REQUIRE(accel_intersect(a, &r, &h, NULL));
-        CHECK(!surface_is_hole(s, &r, &h));
-        CHECK(trace_past_holes(a, s, &r, &h, NULL));
+        CHECK(!surface_is_hole(&v, &r, &h));
+        CHECK(trace_past_holes(a, &v, &r, &h, NULL));
         CHECK(h.prim < 2 && h.t == 3.0f);
         if (k == 0) ref_solid = h;
         CHECK(memcmp(&h, &ref_solid, sizeof h) == 0);
         /* shadow rays: through the hole nothing blocks (the back quad is beyond the end) */
-        CHECK(!occluded_past_holes(a, s, &shadow_through, NULL));
-        CHECK(occluded_past_holes(a, s, &shadow_solid, NULL));
+        CHECK(!occluded_past_holes(a, &v, &shadow_through, NULL));
+        CHECK(occluded_past_holes(a, &v, &shadow_solid, NULL));
         CHECK(accel_occluded(a, &shadow_through, NULL)); /* without the holes it would be blocked */
         accel_destroy(a);
     }

@@ -39,7 +39,7 @@ static __device__ __forceinline__ bool path_gpu_occluded(const path_tracer *pt, 
 extern "C" __global__ void pk_path_layout(unsigned long long *out)
 {
     if (threadIdx.x != 0 || blockIdx.x != 0) return;
-    out[0] = sizeof(pk_scene);
+    out[0] = sizeof(scene_view);
     out[1] = sizeof(material);
     out[2] = sizeof(texture);
     out[3] = sizeof(env_light);
