@@ -1,20 +1,14 @@
 /* fuzz_mtl.c - the MTL parser through its (buffer, size) entry point. */
-#include "fuzz.h"
+#include "fuzz_scene.h"
 
 #include "io/readers.h"
-#include "scene/scene.h"
+
+static pk_status parse(pk_context *ctx, pk_scene *s, const char *data, size_t size)
+{
+    return mtl_parse(ctx, s, data, size, "fuzz.mtl");
+}
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    pk_context *ctx = NULL;
-    if (pk_context_create(NULL, &ctx) != PK_OK) return 0;
-    size_t warned = 0;
-    pk_context_set_warning_handler(ctx, fuzz_warning, &warned);
-    pk_scene *s = NULL;
-    if (scene_create(ctx, "fuzz.mtl", &s) == PK_OK) {
-        fuzz_check_error(ctx, mtl_parse(ctx, s, (const char *)data, size, "fuzz.mtl"));
-        scene_destroy(s);
-    }
-    pk_context_destroy(ctx);
-    return 0;
+    return fuzz_scene_run(data, size, "fuzz.mtl", parse, false);
 }
