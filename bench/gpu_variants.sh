@@ -1,16 +1,19 @@
 #!/usr/bin/env bash
-# gpu_variants.sh - the versions of the GPU traversal kernel (PAPRSEK_CUDA_KERNEL,
-# see docs/gpu.md) against each other on the standard workloads of
-# spec/ray-benchmark.md at SIZE x SIZE rays: kernel Grays/s of each version,
-# and whether its hits agree with the CPU's (--accel bvh: closest hits bit for
-# bit, any hits on hit or miss). The CPU traces each ray file once; only the
-# GPU runs are repeated. Prints a markdown table; raw lines stay in
-# bench/out/gpu_variants/.
+# gpu_variants.sh - the GPU traversal kernel on the standard workloads of
+# spec/ray-benchmark.md at SIZE x SIZE rays: kernel Grays/s, and whether its
+# hits agree with the CPU's (--accel bvh: closest hits bit for bit, any hits
+# on hit or miss). The CPU traces each ray file once; only the GPU runs are
+# repeated. Prints a markdown table; raw lines stay in bench/out/gpu_variants/.
+#
+# It used to time ten kernel versions and several GPU trees against each
+# other (PAPRSEK_CUDA_KERNEL, PAPRSEK_CUDA_TREE); after those measurements
+# (docs/gpu.md, docs/performance.md) the versions but the default and the
+# reference one left the product, and the switches with them. They are in
+# the history at commit 51a7231 (the last with them), with this script as it
+# ran them: build that commit to measure them again.
 #
 # usage: bench/gpu_variants.sh [SHARED_DIR [PAPRSEK]]   (defaults: ../shared, build/paprsek)
 # environment: SIZE (4096), REPS (3), THREADS (0 = all cores),
-#              VARIANTS (v0 v1 v3 v6 v7 v8 v9 v3/t4 v6/t4: kernel version, and /tN for a tree
-#              collapsed for the GPU with node cost N, PAPRSEK_CUDA_TREE=N; without /tN the CPU's tree),
 #              WORKLOADS (cornell-sphere bunny sponza), KINDS (primary diffuse diffuse-any)
 set -euo pipefail
 
@@ -21,7 +24,9 @@ bin=${2:-$repo/build/paprsek}
 size=${SIZE:-4096}
 reps=${REPS:-3}
 threads=${THREADS:-0}
-variants=${VARIANTS:-v0 v1 v3 v6 v7 v8 v9 v3/t4 v6/t4}
+[ -z "${VARIANTS:-}" ] || [ "${VARIANTS}" = default ] ||
+    { echo "gpu_variants.sh: the kernel versions were removed; build commit 51a7231 to time them" >&2; exit 2; }
+variants=default
 workloads=${WORKLOADS:-cornell-sphere bunny sponza}
 kinds=${KINDS:-primary diffuse diffuse-any}
 out=$here/out/gpu_variants
@@ -32,7 +37,7 @@ die() { echo "gpu_variants.sh: $*" >&2; exit 1; }
 
 . "$here/workloads.sh"
 
-echo "## GPU kernel versions: kernel Grays/s (hits agree with the CPU's: ok, or the number that differ)"
+echo "## GPU kernel: kernel Grays/s (hits agree with the CPU's: ok, or the number that differ)"
 echo
 echo "- GPU: $(nvidia-smi --query-gpu=name,driver_version,clocks.max.sm --format=csv,noheader 2>/dev/null || echo unknown)"
 echo "- ${size}x${size} rays, $reps passes (median kernel time)"
@@ -53,8 +58,7 @@ for wl in $workloads; do
         echo "$wl $kind CPU $c" >>"$out/raw.txt"
         row="| $wl $kind |"
         for v in $variants; do
-            tree=cpu; case $v in */t*) tree=${v##*/t} ;; esac
-            g=$(PAPRSEK_CUDA_KERNEL=${v%%/*} PAPRSEK_CUDA_TREE=$tree "$bin" bench rays "$scene" "$rays" --accel cuda --reps "$reps" $any --hits "$out/gpu.hits" 2>>"$out/err.log") || g=
+            g=$("$bin" bench rays "$scene" "$rays" --accel cuda --reps "$reps" $any --hits "$out/gpu.hits" 2>>"$out/err.log") || g=
             echo "$wl $kind $v $g" >>"$out/raw.txt"
             kg=$(echo "$g" | field kernel_mrays_per_s)
             if [ -z "$kg" ]; then
