@@ -2,11 +2,14 @@
  * test_scene_build.c - io/scene_build.h, the readers' graphics state: the
  * transform stack (push, pop, concatenation order), the current material,
  * and meshes added through the current transform (positions, normals by the
- * inverse transpose, texture coordinates, winding).
+ * inverse transpose, texture coordinates, winding); objects and instances,
+ * flattened by scene_commit; and a Mitsuba XML scene with a shapegroup
+ * loaded with every allocation failing in turn.
  */
 #include "test.h"
 
 #include "io/scene_build.h"
+#include "io/readers.h"
 #include "scene/scene.h"
 
 static pk_context *new_ctx(void)
@@ -173,10 +176,84 @@ static void test_objects(void)
     pk_context_destroy(ctx);
 }
 
+/* ---- allocation failures through capture and flattening ---- */
+
+typedef struct fail_alloc {
+    long calls, fail_at; /* fail the call numbered fail_at (1-based); 0 = never */
+    long live;           /* blocks currently allocated */
+} fail_alloc;
+
+/* Blocks carry a 16-byte header so that live blocks can be counted. */
+static void *fail_hook(void *user, void *ptr, size_t size)
+{
+    fail_alloc *f = user;
+    if (size == 0) {
+        if (ptr) {
+            f->live--;
+            free((char *)ptr - 16);
+        }
+        return NULL;
+    }
+    f->calls++;
+    if (f->fail_at && f->calls == f->fail_at) return NULL;
+    char *q = realloc(ptr ? (char *)ptr - 16 : NULL, size + 16);
+    if (!q) return NULL;
+    if (!ptr) f->live++;
+    return q + 16;
+}
+
+static const char *group_xml =
+    "<scene version=\"3.0.0\">\n"
+    "  <shape type=\"rectangle\"/>\n"
+    "  <shape type=\"shapegroup\" id=\"g\">\n"
+    "    <shape type=\"cube\"/>\n"
+    "    <shape type=\"disk\"><emitter type=\"area\"><rgb name=\"radiance\" value=\"1\"/></emitter></shape>\n"
+    "  </shape>\n"
+    "  <shape type=\"instance\"><ref id=\"g\"/></shape>\n"
+    "  <shape type=\"rectangle\"/>\n"
+    "  <shape type=\"instance\"><ref id=\"g\"/>\n"
+    "    <transform name=\"to_world\"><translate x=\"3\"/></transform></shape>\n"
+    "</scene>\n";
+
+/* 0: loaded and committed; else the status of the failure */
+static pk_status load_group(fail_alloc *f, size_t *ntris)
+{
+    pk_allocator a = {fail_hook, f};
+    pk_context *ctx;
+    if (pk_context_create(&a, &ctx) != PK_OK) return PK_ERR_NOMEM;
+    pk_scene *s = NULL;
+    pk_status st = scene_create(ctx, "g.xml", &s);
+    if (st == PK_OK) st = scene_xml_parse(ctx, s, group_xml, strlen(group_xml), "g.xml", PK_TEST_DATA, NULL, 0);
+    if (st == PK_OK) st = scene_commit(ctx, s);
+    if (st == PK_OK) *ntris = s->ntris;
+    if (st != PK_OK) CHECKF(pk_context_error(ctx)[0] != '\0', "status %d without a message", (int)st);
+    scene_destroy(s);
+    pk_context_destroy(ctx);
+    return st;
+}
+
+static void test_alloc_failures(void)
+{
+    fail_alloc f = {0, 0, 0};
+    size_t ntris = 0;
+    REQUIRE(load_group(&f, &ntris) == PK_OK);
+    CHECK(ntris == 2 + (12 + 64) + 2 + (12 + 64));
+    CHECK(f.live == 0);
+    long total = f.calls;
+    for (long n = 1; n <= total; n++) {
+        fail_alloc g = {0, n, 0};
+        size_t k = 0;
+        pk_status st = load_group(&g, &k);
+        CHECKF(st == PK_ERR_NOMEM, "allocation %ld of %ld failed: status %d", n, total, (int)st);
+        CHECKF(g.live == 0, "allocation %ld failed: %ld blocks leaked", n, g.live);
+    }
+}
+
 int main(void)
 {
     test_stack();
     test_add_mesh();
     test_objects();
+    test_alloc_failures();
     return test_done("test_scene_build");
 }
