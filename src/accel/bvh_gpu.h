@@ -276,7 +276,7 @@ done:
     return true;
 }
 
-/* ---- the traversal (kernels v1 to v9; docs/gpu.md) -------------------------
+/* ---- the traversal (the kernels of cuda/trace.cu; docs/gpu.md) --------------
  * The same arithmetic and the same visiting order as gpu_trace_v0, so the
  * same answers bit for bit, arranged for the GPU:
  *  - a node is read as six 16-byte loads into 24 registers (gpu_node_load)
@@ -377,35 +377,9 @@ static inline PK_HD void gpu_node_rows(const uint32_t w[24], const gpu_ray *r, g
     }
 }
 
-/* v1: gpu_node_hits_v0's planes and operations in the same order, so the
- * same distances bit for bit. fmaxf/fminf instead of gpu_max/gpu_min: the
- * second operand is never NaN here (tmin and tcull are not, nor is an
- * fmaxf/fminf of them), and then the two agree but for the sign of a zero,
- * which no comparison sees. */
-static GPU_BOX_INLINE PK_HD unsigned gpu_node_hits(const uint32_t w[24], const gpu_ray *r, float tcull,
-                                                   float tn[GPU_WIDTH])
-{
-    gpu_rows x;
-    gpu_node_rows(w, r, &x);
-    unsigned mask = 0;
-    GPU_UNROLL
-    for (int s = 0; s < GPU_WIDTH; s++) {
-        tn[s] = 0.0f;
-        if (w[16 + s] == GPU_EMPTY) continue;
-        const int h = s >> 2, b = s & 3;
-        float near = r->tmin, far = tcull;
-        GPU_UNROLL
-        for (int k = 2; k >= 0; k--) {
-            near = fmaxf((x.org[k] + gpu_byte_float(x.nw[k][h], b) * x.sc[k] - r->o[k]) * r->rd[k], near);
-            far = fminf((x.org[k] + gpu_byte_float(x.fw[k][h], b) * x.sc[k] - r->o[k]) * r->rdf[k], far);
-        }
-        tn[s] = near;
-        if (near <= far) mask |= 1u << s;
-    }
-    return mask;
-}
-
-/* v3: the same distances bit for bit with one operation less per plane:
+/* GPU_TEST_FMA (kernel v3's; the path tracer's, and the default kernels'
+ * for rays GPU_TEST_WIDE cannot take): gpu_node_hits_v0's distances bit for
+ * bit with one operation less per plane:
  * org + q * scale with q * scale exact is one fma (one rounding of the
  * same exact value). The converter makes sure q * scale never overflows
  * where it matters (gpu_quantise checks both forms). */
@@ -432,20 +406,22 @@ static GPU_BOX_INLINE PK_HD unsigned gpu_node_hits_fma(const uint32_t w[24], con
     return mask;
 }
 
-/* v4: one fma per plane, t = q * S + A with S = scale / d and
+/* The loosened box test, in two steps. Step one (kernel v4's, measured and
+ * removed; GPU_TEST_WIDE below is built on it): one fma per plane,
+ * t = fl(q * S + fl(A - E)) with S = scale / d and
  * A = (org - o) / d per node and axis, moved out by a bound E on the
  * rounding: near distances down, far ones up.
  *
- * Why it enters every box v1 enters (so every box the CPU enters). With
+ * Why it enters every box gpu_node_hits_v0 enters (so every box the CPU enters). With
  * u = 2^-24, P = org + q * scale (exact) and x = (P - o) * rd (exact):
- * v1's distance fl(fl(fl(P) - o) * rd) is within
+ * gpu_node_hits_v0's distance fl(fl(fl(P) - o) * rd) is within
  * u * (|org rd| + 3.01 * 255 |S| + 2.01 |A|) of x (three roundings, |P| <=
  * |org| + 255 scale). Here S = scale * rd is exact (a power of
  * two times rd; a subnormal S errs by at most 2^-150, covered by the
  * 2^-100 below) and A = fl(fl(org - o) * rd) is within 2.0001 u |(org-o) rd|
  * of its exact value; fl(q * S + fl(A - E)) is then within
  * u * (2.0001 |(org-o) rd| + 2.0001 |A| + 255 |S| + 2.0001 E) of x - E.
- * So it is below v1's distance when E >= u * (|org rd| + 1023 |S| + 6.03 |A|)
+ * So it is below gpu_node_hits_v0's distance when E >= u * (|org rd| + 1023 |S| + 6.03 |A|)
  * (+ a little for E's own rounding); E = 2^-20 * (|A| + 255 |S| + |org rd|)
  * + 2^-100 is twice that or more on every term. The far side is the same
  * with rdf and + E. Nothing there uses the signs of q, S or A, so it holds
@@ -453,48 +429,15 @@ static GPU_BOX_INLINE PK_HD unsigned gpu_node_hits_fma(const uint32_t w[24], con
  * the test: 1/d = +-inf (d = 0) or an overflowing S, A or |org rd| makes E
  * infinite, so every near distance of that axis is -inf or NaN and every
  * far one +inf or NaN, and a NaN plane is no limit (fmaxf, fminf); 1/d NaN
- * makes them all NaN, as in v1. (So that an axis-parallel ray is not slowed
+ * makes them all NaN, as in gpu_node_hits_v0. (So that an axis-parallel ray is not slowed
  * down by it, gpu_trace_box gives rays with a 1/d component of 2^64 or more
  * gpu_node_hits_fma instead.) The cost: boxes are looser by 2^-20 of the
  * distances involved, and of |org| / |d| (scenes far from the origin). The
- * entry distances differ from v1's by as much, so children at nearly equal
+ * entry distances differ from gpu_node_hits_v0's by as much, so children at nearly equal
  * distances may be visited in another order: the closest hit is the same
  * (smallest t, then smallest number), an any hit may be another. */
 #define GPU_LOOSE_REL 0x1p-20f
 #define GPU_LOOSE_ABS 0x1p-100f
-
-static GPU_BOX_INLINE PK_HD unsigned gpu_node_hits_slack(const uint32_t w[24], const gpu_ray *r, float tcull,
-                                                         float tn[GPU_WIDTH])
-{
-    gpu_rows x;
-    gpu_node_rows(w, r, &x);
-    float sn[3], an[3], sf[3], af[3];
-    GPU_UNROLL
-    for (int k = 0; k < 3; k++) {
-        const float d = x.org[k] - r->o[k];
-        const float a = d * r->rd[k], s = x.sc[k] * r->rd[k];
-        const float a2 = d * r->rdf[k], s2 = x.sc[k] * r->rdf[k];
-        const float g = fabsf(a) + fabsf(x.org[k] * r->rd[k]), g2 = fabsf(a2) + fabsf(x.org[k] * r->rdf[k]);
-        sn[k] = s, an[k] = a - gpu_fma(GPU_LOOSE_REL, gpu_fma(255.0f, fabsf(s), g), GPU_LOOSE_ABS);
-        sf[k] = s2, af[k] = a2 + gpu_fma(GPU_LOOSE_REL, gpu_fma(255.0f, fabsf(s2), g2), GPU_LOOSE_ABS);
-    }
-    unsigned mask = 0;
-    GPU_UNROLL
-    for (int s = 0; s < GPU_WIDTH; s++) {
-        tn[s] = 0.0f;
-        if (w[16 + s] == GPU_EMPTY) continue;
-        const int h = s >> 2, b = s & 3;
-        float near = r->tmin, far = tcull;
-        GPU_UNROLL
-        for (int k = 2; k >= 0; k--) {
-            near = fmaxf(gpu_fma(gpu_byte_float(x.nw[k][h], b), sn[k], an[k]), near);
-            far = fminf(gpu_fma(gpu_byte_float(x.fw[k][h], b), sf[k], af[k]), far);
-        }
-        tn[s] = near;
-        if (near <= far) mask |= 1u << s;
-    }
-    return mask;
-}
 
 /* Byte b (0..3, a constant) of word w as the float 2^23 + 256 * byte,
  * exactly: its bits with the byte in bits 8-15 (one byte permute). */
@@ -507,17 +450,18 @@ static inline PK_HD float gpu_byte_wide(uint32_t w, int b)
 #endif
 }
 
-/* v6: gpu_node_hits_slack without the add that turns the byte into a
+/* Step two, GPU_TEST_WIDE (kernel v6's, the default): step one without the
+ * add that turns the byte into a
  * float: with m = 2^23 + 256 q (gpu_byte_wide, a byte permute),
  * t = fma(m, S', A'') where S' = S * 2^-8 and A'' = fl(fl(A - E) - 2^15 S)
  * (one fma: 2^23 * S' is exact), since m * S' = 2^15 S + q S. Against the
- * bound of gpu_node_hits_slack this adds the rounding of A'' and of the
- * extra subtraction, u * (2 |A| + 2 E + 2^15 |S|): v1's distance is then
+ * bound of step one this adds the rounding of A'' and of the
+ * extra subtraction, u * (2 |A| + 2 E + 2^15 |S|): gpu_node_hits_v0's distance is then
  * above this one when E >= u * (|org rd| + 7.02 |A| + 33791 |S|) (+ E's own
  * rounding); E = 2^-20 * (|A| + |org rd|) + 2^-8 |S| + 2^-100 is 1.9 times
  * that or more on every term (2^-8 |S| is 1/256 of a quantisation step). A
  * subnormal S' errs by at most 2^-150, times m < 2^24: covered by 2^-100.
- * Infinite and NaN values loosen the test as in gpu_node_hits_slack, and
+ * Infinite and NaN values loosen the test as in step one, and
  * gpu_trace_box gives it the same rays (every |1/d| < 2^64). */
 static GPU_BOX_INLINE PK_HD unsigned gpu_node_hits_wide(const uint32_t w[24], const gpu_ray *r, float tcull,
                                                         float tn[GPU_WIDTH])
@@ -579,9 +523,10 @@ static inline PK_HD bool gpu_tri_intersect_rec(const gpu_ray *r, const gpu_tri *
                                gpu_sel3(c, kz) - oz, r->sx, r->sy, r->sz, r->tmin, tmax, t_out, u_out, v_out);
 }
 
-/* The traversal with box test box (a constant: GPU_TEST_EXACT, GPU_TEST_FMA,
- * GPU_TEST_LOOSE or GPU_TEST_WIDE); gpu_trace below is the one to call. */
-enum { GPU_TEST_EXACT = 1, GPU_TEST_FMA = 3, GPU_TEST_LOOSE = 4, GPU_TEST_WIDE = 6 };
+/* The traversal with box test box (a constant: GPU_TEST_FMA or
+ * GPU_TEST_WIDE, named after the kernel versions that introduced them);
+ * gpu_trace below is the one to call. */
+enum { GPU_TEST_FMA = 3, GPU_TEST_WIDE = 6 };
 /* One ray's traversal as a state that advances a step at a time: a step
  * goes down to a leaf, tests its triangles and pops the next node, so that
  * a kernel can give a lane whose ray is done a new ray between steps
@@ -592,7 +537,7 @@ typedef struct gpu_walk {
     float best_t, best_u, best_v, tcull;
     uint32_t best_prim, ref;
     int sp;
-    bool loose;             /* GPU_TEST_LOOSE or _WIDE for this ray */
+    bool loose;             /* GPU_TEST_WIDE for this ray */
 } gpu_walk;
 
 /* Starts *w on *in; false when there is nothing to trace (no hit). */
@@ -604,10 +549,10 @@ static inline PK_HD bool gpu_walk_init(gpu_walk *w, const pk_ray *in, int box)
     if (!gpu_ray_traceable(in)) return false;
     gpu_ray_init(&w->r, in);
     w->tcull = gpu_cull_limit(w->best_t);
-    /* GPU_TEST_LOOSE's per-ray terms; a ray with a huge or infinite 1/d
+    /* GPU_TEST_WIDE's per-ray terms; a ray with a huge or infinite 1/d
      * component (d = 0: axis-parallel) takes GPU_TEST_FMA instead, where
      * the bound would be infinite and the axis would limit nothing */
-    w->loose = (box == GPU_TEST_LOOSE || box == GPU_TEST_WIDE) && fabsf(w->r.rd[0]) < 0x1p64f &&
+    w->loose = box == GPU_TEST_WIDE && fabsf(w->r.rd[0]) < 0x1p64f &&
                fabsf(w->r.rd[1]) < 0x1p64f && fabsf(w->r.rd[2]) < 0x1p64f;
     return true;
 }
@@ -625,10 +570,7 @@ static inline PK_HD bool gpu_walk_step(gpu_walk *ws, gpu_stack_entry *stack, con
         uint32_t w[24];
         gpu_node_load(&nodes[ref], w);
         float tn[GPU_WIDTH];
-        const unsigned mask = ws->loose ? (box == GPU_TEST_WIDE ? gpu_node_hits_wide(w, r, tcull, tn)
-                                                                : gpu_node_hits_slack(w, r, tcull, tn))
-                              : box != GPU_TEST_EXACT ? gpu_node_hits_fma(w, r, tcull, tn)
-                                                      : gpu_node_hits(w, r, tcull, tn);
+        const unsigned mask = ws->loose ? gpu_node_hits_wide(w, r, tcull, tn) : gpu_node_hits_fma(w, r, tcull, tn);
         if (!mask) goto pop;
         /* The order of gpu_trace_v0, which pushes every hit child with an
          * insertion sort (a child goes above those nearer than it and above

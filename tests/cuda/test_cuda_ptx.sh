@@ -38,9 +38,9 @@ n_approx=$(grep -Ec '(div|sqrt|rcp)\.(approx|full)' "$tmp/build.ptx")
 n_rn=$(grep -Ec '(mul|add|sub)\.rn\.f32' "$tmp/build.ptx")
 bad=$(fma_by_function "$tmp/build.ptx" | awk '$1 ~ /^pk_trace_[a-z]+_ref$/ && $2 > 0')
 [ -z "$bad" ] || fail "fused multiply-adds in kernels without fma box tests: $bad"
-bad=$(fma_by_function "$tmp/apart.ptx" | awk '$1 !~ /(gpu_node_hits_fma|gpu_node_hits_slack|gpu_node_hits_wide)/ && $2 > 0')
+bad=$(fma_by_function "$tmp/apart.ptx" | awk '$1 !~ /(gpu_node_hits_fma|gpu_node_hits_wide)/ && $2 > 0')
 [ -z "$bad" ] || fail "fused multiply-adds outside the box tests: $bad"
-n_box=$(fma_by_function "$tmp/apart.ptx" | awk '$1 ~ /(gpu_node_hits_fma|gpu_node_hits_slack|gpu_node_hits_wide)/ && $2 > 0' | wc -l)
+n_box=$(fma_by_function "$tmp/apart.ptx" | awk '$1 ~ /(gpu_node_hits_fma|gpu_node_hits_wide)/ && $2 > 0' | wc -l)
 # the default kernels' GPU_TEST_WIDE, and GPU_TEST_FMA for the rays it leaves to it
 [ "$n_box" = 2 ] || fail "the box tests' fused multiply-adds are not where expected ($n_box functions)"
 [ "$n_approx" = 0 ] || fail "$n_approx approximate divisions or square roots in the kernels' PTX"

@@ -197,15 +197,15 @@ static ray *make_rays(rng *g, const accel_input *in, size_t n)
 }
 
 /* The box tests on every node of b against gpu_node_hits_v0 (whose boxes
- * contain the CPU's): GPU_TEST_EXACT and GPU_TEST_FMA give the same slots
- * and the same entry distances, GPU_TEST_LOOSE at least the same slots with
- * entry distances no larger. Rays from make_rays and harder ones: tiny and
+ * contain the CPU's): GPU_TEST_FMA gives the same slots and the same entry
+ * distances, GPU_TEST_WIDE at least the same slots with entry distances no
+ * larger. Rays from make_rays and harder ones: tiny and
  * huge direction components (1/d overflowing or S = scale / d doing so),
  * origins far away, and cull distances of every size. */
 static void check_box_tests(const built *b, const accel_input *in, rng *g, size_t nrays, const char *name)
 {
     ray *rays = make_rays(g, in, nrays);
-    long bad_exact = 0, bad_fma = 0, bad_loose = 0, bad_wide = 0, entered = 0, extra = 0, extra6 = 0;
+    long bad_fma = 0, bad_wide = 0, entered = 0, extra6 = 0;
     for (size_t i = 0; i < nrays; i++) {
         ray r = rays[i];
         const uint32_t kind = rng_u32(g) % 8;
@@ -221,38 +221,30 @@ static void check_box_tests(const built *b, const accel_input *in, rng *g, size_
             const gpu_node *nd = &b->g.nodes[j];
             uint32_t w[24];
             gpu_node_load(nd, w);
-            float t0[GPU_WIDTH], t1[GPU_WIDTH], t3[GPU_WIDTH], t4[GPU_WIDTH], t6[GPU_WIDTH];
-            const unsigned m0 = gpu_node_hits_v0(nd, &q, tcull, t0), m1 = gpu_node_hits(w, &q, tcull, t1);
+            float t0[GPU_WIDTH], t3[GPU_WIDTH], t6[GPU_WIDTH];
+            const unsigned m0 = gpu_node_hits_v0(nd, &q, tcull, t0);
             const unsigned m3 = gpu_node_hits_fma(w, &q, tcull, t3);
-            const unsigned m4 = gpu_node_hits_slack(w, &q, tcull, t4);
             const unsigned m6 = gpu_node_hits_wide(w, &q, tcull, t6);
             /* (gpu_trace_box uses it only for rays with every |1/d| < 2^64; here it is
              * tried on all, overflows included) */
             if (kind >= 4 && fabsf(q.rd[0]) < 0x1p64f && fabsf(q.rd[1]) < 0x1p64f && fabsf(q.rd[2]) < 0x1p64f) {
                 /* rays it is used for */
                 entered += __builtin_popcount(m0);
-                extra += __builtin_popcount(m4 & ~m0);
                 extra6 += __builtin_popcount(m6 & ~m0);
             }
-            bad_exact += m1 != m0, bad_fma += m3 != m0, bad_loose += (m4 & m0) != m0, bad_wide += (m6 & m0) != m0;
+            bad_fma += m3 != m0, bad_wide += (m6 & m0) != m0;
             for (int s = 0; s < GPU_WIDTH; s++) {
                 if (!(m0 >> s & 1u)) continue;
-                bad_exact += !(t1[s] == t0[s]);
                 bad_fma += !(t3[s] == t0[s]);
-                bad_loose += !(t4[s] <= t0[s]);
                 bad_wide += !(t6[s] <= t0[s]);
             }
         }
     }
     free(rays);
-    CHECKF(bad_exact == 0, "%s: GPU_TEST_EXACT differs from gpu_node_hits_v0 %ld times", name, bad_exact);
     CHECKF(bad_fma == 0, "%s: GPU_TEST_FMA differs from gpu_node_hits_v0 %ld times", name, bad_fma);
-    CHECKF(bad_loose == 0, "%s: GPU_TEST_LOOSE misses a box or enters it later %ld times", name, bad_loose);
     CHECKF(bad_wide == 0, "%s: GPU_TEST_WIDE misses a box or enters it later %ld times", name, bad_wide);
-    printf("%s: box tests: %ld boxes entered by ordinary rays, %ld more (%.3f%%) by GPU_TEST_LOOSE, %ld (%.3f%%) by "
-           "GPU_TEST_WIDE\n",
-           name, entered, extra, 100.0 * (double)extra / (double)(entered ? entered : 1), extra6,
-           100.0 * (double)extra6 / (double)(entered ? entered : 1));
+    printf("%s: box tests: %ld boxes entered by ordinary rays, %ld more (%.3f%%) by GPU_TEST_WIDE\n", name, entered,
+           extra6, 100.0 * (double)extra6 / (double)(entered ? entered : 1));
 }
 
 /* Every ray: closest hit bit for bit against brute force (and against the
@@ -278,18 +270,16 @@ static void check_rays(const built *b, const accel_input *in, const ray *rays, s
         const bool a0 = gpu_trace_v0(b->g.nodes, b->g.tris, (const pk_ray *)r, true, &any0, NULL);
         bad_v0 += !same_hit(&got, &got0) || !same_hit(&any, &any0) || f0 != (got.prim != PK_NO_HIT) ||
                   a0 != (any.prim != PK_NO_HIT);
-        const int exact[2] = {GPU_TEST_EXACT, GPU_TEST_FMA};
-        for (int m = 0; m < 2; m++) {
-            bool f = gpu_trace_box(b->g.nodes, b->g.tris, (const pk_ray *)r, false, &h, NULL, exact[m]);
+        {
+            bool f = gpu_trace_box(b->g.nodes, b->g.tris, (const pk_ray *)r, false, &h, NULL, GPU_TEST_FMA);
             bad_v0 += !same_hit(&h, &got0) || f != f0;
-            f = gpu_trace_box(b->g.nodes, b->g.tris, (const pk_ray *)r, true, &h, NULL, exact[m]);
+            f = gpu_trace_box(b->g.nodes, b->g.tris, (const pk_ray *)r, true, &h, NULL, GPU_TEST_FMA);
             bad_v0 += !same_hit(&h, &any0) || f != a0;
         }
         /* (the visiting order may differ: an exact tie in t may then go to
          * another triangle, as between brute force and the CPU BVH) */
-        const int loose_modes[2] = {GPU_TEST_LOOSE, GPU_TEST_WIDE};
-        for (int lm = 0; lm < 2; lm++) {
-            bool fl = gpu_trace_box(b->g.nodes, b->g.tris, (const pk_ray *)r, false, &h, NULL, loose_modes[lm]);
+        {
+            bool fl = gpu_trace_box(b->g.nodes, b->g.tris, (const pk_ray *)r, false, &h, NULL, GPU_TEST_WIDE);
             if (fl != f0) bad_loose++;
             else if (!same_hit(&h, &got0)) {
                 const vec3 *p = in->verts + 3 * (size_t)h.prim;
@@ -300,7 +290,7 @@ static void check_rays(const built *b, const accel_input *in, const ray *rays, s
                 loose_ties += tie;
                 bad_loose += !tie;
             }
-            fl = gpu_trace_box(b->g.nodes, b->g.tris, (const pk_ray *)r, true, &h, NULL, loose_modes[lm]);
+            fl = gpu_trace_box(b->g.nodes, b->g.tris, (const pk_ray *)r, true, &h, NULL, GPU_TEST_WIDE);
             if (fl != a0) bad_loose++;
             else if (fl) { /* some real hit in [tmin, tmax] */
                 const vec3 *p = in->verts + 3 * (size_t)h.prim;
@@ -349,14 +339,14 @@ static void check_rays(const built *b, const accel_input *in, const ray *rays, s
     }
     CHECKF(bad_brute == 0, "%s: %ld of %zu closest hits differ from brute force", name, bad_brute, n);
     CHECKF(bad_cpu == 0, "%s: %ld of %zu closest hits differ from the CPU BVH", name, bad_cpu, n);
-    CHECKF(bad_v0 == 0, "%s: %ld of %zu hits differ between the exact box tests and gpu_trace_v0", name, bad_v0, n);
-    CHECKF(bad_loose == 0, "%s: %ld of %zu hits of the loosened box test (GPU_TEST_LOOSE) are wrong", name, bad_loose,
+    CHECKF(bad_v0 == 0, "%s: %ld of %zu hits differ between the exact box test and gpu_trace_v0", name, bad_v0, n);
+    CHECKF(bad_loose == 0, "%s: %ld of %zu hits of the loosened box test (GPU_TEST_WIDE) are wrong", name, bad_loose,
            n);
     CHECKF(bad_any == 0, "%s: %ld of %zu any-hit answers disagree with the closest hit", name, bad_any, n);
     CHECKF(bad_anyhit == 0, "%s: %ld of %zu any-hit answers are not real hits", name, bad_anyhit, n);
     if (ties) printf("%s: %ld exact ties went to another triangle than brute force's\n", name, ties);
     if (loose_ties)
-        printf("%s: %ld exact ties went to another triangle with GPU_TEST_LOOSE than with the CPU BVH\n", name,
+        printf("%s: %ld exact ties went to another triangle with GPU_TEST_WIDE than with the CPU BVH\n", name,
                loose_ties);
     if (in->ntris > 1 && n > 0) CHECKF(nhits > 0, "%s: no ray hit anything", name);
 }
