@@ -5,28 +5,20 @@
  * allocation failures at every step, and the Cornell box's geometry.
  */
 #include "test.h"
+#include "warnings.h"
 
 #include "io/readers.h"
 #include "scene/scene.h"
 
 #define NAME "scene.json"
 
-static char warnings[16][PK_ERRMSG_MAX];
-static int nwarnings;
-
-static void on_warning(void *user, const char *message)
-{
-    (void)user;
-    if (nwarnings < 16) snprintf(warnings[nwarnings], sizeof warnings[0], "%s", message);
-    nwarnings++;
-}
+static warning_log wl;
 
 static pk_context *new_ctx(void)
 {
     pk_context *ctx = NULL;
     REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
-    pk_context_set_warning_handler(ctx, on_warning, NULL);
-    nwarnings = 0;
+    warning_log_attach(ctx, &wl);
     return ctx;
 }
 
@@ -60,7 +52,7 @@ static void test_example(void)
     REQUIRE(scene_create(ctx, "json_example.json", &s) == PK_OK);
     pk_status st = scene_json_parse(ctx, s, data, size, "json_example.json", PK_TEST_DATA);
     CHECKF(st == PK_OK, "%s", pk_context_error(ctx));
-    CHECKF(nwarnings == 0, "%s", warnings[0]);
+    CHECKF(wl.count == 0, "%s", wl.msg[0]);
 
     CHECK(s->has_camera);
     CHECK(s->camera.look_from[0] == 0.0f && s->camera.look_from[1] == 1.5f && s->camera.look_from[2] == 5.0f);
@@ -252,22 +244,22 @@ static void test_warnings(void)
                          "}",
                          &s);
     CHECKF(st == PK_OK, "%s", pk_context_error(ctx));
-    CHECK(nwarnings == 3);
-    CHECK(strcmp(warnings[0], "scene.json:1: comment: unknown key ignored") == 0);
+    CHECK(wl.count == 3);
+    CHECK(strcmp(wl.msg[0], "scene.json:1: comment: unknown key ignored") == 0);
     /* sections are read in a fixed order (camera before spheres); the
      * second sphere's colour is not reported again */
-    CHECKF(strcmp(warnings[1], "scene.json:6: camera.aperture: unknown key ignored") == 0, "%s", warnings[1]);
-    CHECKF(strcmp(warnings[2], "scene.json:3: spheres[0].colour: unknown key ignored") == 0, "%s", warnings[2]);
+    CHECKF(strcmp(wl.msg[1], "scene.json:6: camera.aperture: unknown key ignored") == 0, "%s", wl.msg[1]);
+    CHECKF(strcmp(wl.msg[2], "scene.json:3: spheres[0].colour: unknown key ignored") == 0, "%s", wl.msg[2]);
     scene_destroy(s);
 
     /* many different unknown keys: the first 32 are reported, then one line */
     char json[4096] = "{";
     for (int i = 0; i < 40; i++) snprintf(json + strlen(json), sizeof json - strlen(json), "\"k%d\": %d, ", i, i);
     strcat(json, "\"ambient\": [0, 0, 0]}");
-    nwarnings = 0;
+    warning_log_clear(&wl);
     st = parse(ctx, json, &s);
-    CHECK(st == PK_OK && nwarnings == 33);
-    CHECK(strcmp(warnings[0], "scene.json:1: k0: unknown key ignored") == 0);
+    CHECK(st == PK_OK && wl.count == 33);
+    CHECK(strcmp(wl.msg[0], "scene.json:1: k0: unknown key ignored") == 0);
     scene_destroy(s);
     pk_context_destroy(ctx);
 }
@@ -522,7 +514,7 @@ static void test_cornell(void)
     CHECKF(st == PK_OK, "%s", pk_context_error(ctx));
     char why[256];
     CHECKF(scene_check(s, why, sizeof why), "%s", why);
-    CHECK(nwarnings == 0);
+    CHECK(wl.count == 0);
 
     /* 5 walls + light + 2 boxes of 5 faces, 2 triangles each */
     CHECK(s->ntris == 32);

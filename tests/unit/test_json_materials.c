@@ -5,28 +5,20 @@
  * keys that do not belong to a type, and the exact text of each refusal.
  */
 #include "test.h"
+#include "warnings.h"
 
 #include "io/readers.h"
 #include "scene/scene.h"
 
 #define NAME "scene.json"
 
-static char warnings[16][PK_ERRMSG_MAX];
-static int nwarnings;
-
-static void on_warning(void *user, const char *message)
-{
-    (void)user;
-    if (nwarnings < 16) snprintf(warnings[nwarnings], sizeof warnings[0], "%s", message);
-    nwarnings++;
-}
+static warning_log wl;
 
 static pk_context *new_ctx(void)
 {
     pk_context *ctx = NULL;
     REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
-    pk_context_set_warning_handler(ctx, on_warning, NULL);
-    nwarnings = 0;
+    warning_log_attach(ctx, &wl);
     return ctx;
 }
 
@@ -142,7 +134,7 @@ static void test_explicit(void)
                          "  {\"center\": [3, 0, 0], \"radius\": 1, \"material\": \"gold\"}]}",
                          &s);
     CHECKF(st == PK_OK, "%s", pk_context_error(ctx));
-    CHECK(nwarnings == 0);
+    CHECK(wl.count == 0);
     REQUIRE(s->nspheres == 2);
     const material *a = &s->materials[s->spheres[0].material], *b = &s->materials[s->spheres[1].material];
     CHECK(a->type == MAT_PLASTIC && fabsf(a->alpha - 0.01f) < 1e-7f);
@@ -163,10 +155,10 @@ static void test_foreign_keys(void)
                          " \"glass\": {\"type\": \"dielectric\", \"alpha\": 0.5}}}",
                          &s);
     CHECKF(st == PK_OK, "%s", pk_context_error(ctx));
-    CHECK(nwarnings == 3);
-    CHECKF(strcmp(warnings[0], "scene.json:2: materials.gold.kd: unknown key ignored") == 0, "%s", warnings[0]);
-    CHECKF(strcmp(warnings[1], "scene.json:3: materials.gold.albedo: unknown key ignored") == 0, "%s", warnings[1]);
-    CHECKF(strcmp(warnings[2], "scene.json:4: materials.glass.alpha: unknown key ignored") == 0, "%s", warnings[2]);
+    CHECK(wl.count == 3);
+    CHECKF(strcmp(wl.msg[0], "scene.json:2: materials.gold.kd: unknown key ignored") == 0, "%s", wl.msg[0]);
+    CHECKF(strcmp(wl.msg[1], "scene.json:3: materials.gold.albedo: unknown key ignored") == 0, "%s", wl.msg[1]);
+    CHECKF(strcmp(wl.msg[2], "scene.json:4: materials.glass.alpha: unknown key ignored") == 0, "%s", wl.msg[2]);
     const material *g = &s->materials[scene_find_material(s, "glass")];
     CHECK(g->type == MAT_DIELECTRIC && g->alpha == 0.0f);
     scene_destroy(s);

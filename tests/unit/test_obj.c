@@ -9,35 +9,20 @@
 #include "io/readers.h"
 #include "scene/scene.h"
 #include "test.h"
+#include "warnings.h"
 
 #include <float.h>
 #include <stdint.h>
 
 /* ---- helpers ------------------------------------------------------------ */
 
-typedef struct warnings {
-    int count;
-    char last[PK_ERRMSG_MAX];
-    char all[8192];
-} warnings;
-
-static void on_warning(void *user, const char *msg)
-{
-    warnings *w = user;
-    w->count++;
-    snprintf(w->last, sizeof w->last, "%s", msg);
-    size_t n = strlen(w->all);
-    snprintf(w->all + n, sizeof w->all - n, "%s\n", msg);
-}
+typedef warning_log warnings;
 
 static pk_context *new_ctx(warnings *w)
 {
     pk_context *ctx;
     REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
-    if (w) {
-        memset(w, 0, sizeof *w);
-        pk_context_set_warning_handler(ctx, on_warning, w);
-    }
+    if (w) warning_log_attach(ctx, w);
     return ctx;
 }
 

@@ -9,6 +9,7 @@
  * render of a textured quad whose image mean is the texture's.
  */
 #include "test.h"
+#include "warnings.h"
 
 #include "paprsek.h"
 #include "image/image_read.h"
@@ -20,18 +21,7 @@
 
 static pk_context *ctx;
 
-typedef struct warns {
-    int count;
-    char all[4096];
-} warns;
-
-static void on_warn(void *user, const char *msg)
-{
-    warns *w = user;
-    w->count++;
-    size_t l = strlen(w->all);
-    snprintf(w->all + l, sizeof w->all - l, "%s\n", msg);
-}
+typedef warning_log warns;
 
 /* ---- lookups ------------------------------------------------------------------ */
 
@@ -174,7 +164,7 @@ static pk_scene *load(const char *obj_text, warns *w)
 {
     pk_scene *s;
     REQUIRE(scene_create(ctx, "t.obj", &s) == PK_OK);
-    pk_context_set_warning_handler(ctx, on_warn, w);
+    warning_log_attach(ctx, w);
     pk_status st = obj_parse(ctx, s, obj_text, strlen(obj_text), "t.obj", PK_TEST_DATA, NULL);
     CHECKF(st == PK_OK, "%s", pk_context_error(ctx));
     REQUIRE(scene_commit(ctx, s) == PK_OK);
@@ -184,7 +174,8 @@ static pk_scene *load(const char *obj_text, warns *w)
 
 static void test_uv(void)
 {
-    warns w = {0, ""};
+    static warns w;
+    warning_log_clear(&w);
     pk_scene *s = load("v 0 0 0\nv 2 0 0\nv 0 4 0\nvt 0.1 0.2\nvt 0.9 0.2\nvt 0.1 0.6\nf 1/1 2/2 3/3\nf 1 2 3\n", &w);
     REQUIRE(s->ntris == 2 && s->nuvs == 3);
     CHECK(s->tris[0].t[0] == 0 && s->tris[0].t[1] == 1 && s->tris[0].t[2] == 2);
@@ -228,7 +219,8 @@ static void test_uv(void)
 
 static void test_cache_and_fallback(void)
 {
-    warns w = {0, ""};
+    static warns w;
+    warning_log_clear(&w);
     const char *mtl = "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd tex_rgbw.png\nmap_d tex_rgbw.png\n"
                       "newmtl b\nmap_Kd -s 2 3 -o 0.5 0.25 -clamp on -blendu off -zz tex_rgbw.png\n"
                       "newmtl c\nKd 0.2 0.3 0.4\nmap_Kd missing.png\nmap_Ks tex_bad.png\n"
@@ -236,7 +228,7 @@ static void test_cache_and_fallback(void)
                       "newmtl e\nbump tex_normal.png\nnewmtl f\nbump -bm 0.5 tex_bump.png\n";
     pk_scene *s;
     REQUIRE(scene_create(ctx, "m", &s) == PK_OK);
-    pk_context_set_warning_handler(ctx, on_warn, &w);
+    warning_log_attach(ctx, &w);
     CHECKF(mtl_parse_dir(ctx, s, mtl, strlen(mtl), "m.mtl", PK_TEST_DATA) == PK_OK, "%s", pk_context_error(ctx));
     pk_context_set_warning_handler(ctx, NULL, NULL);
     /* one load per file and mode: tex_rgbw.png as colour (a's, b's and d's map_Kd) and as data
@@ -283,7 +275,8 @@ static void test_cache_and_fallback(void)
 static void test_cutout(void)
 {
     /* tex_holes.png is 32x32 with round holes centred at texels (7.5, 7.5) + 16k */
-    warns w = {0, ""};
+    static warns w;
+    warning_log_clear(&w);
     char mtlpath[] = "/tmp/pk_cutout_XXXXXX";
     int fd = mkstemp(mtlpath);
     REQUIRE(fd >= 0);
@@ -297,7 +290,7 @@ static void test_cutout(void)
              mtlpath);
     pk_scene *s;
     REQUIRE(scene_create(ctx, "t.obj", &s) == PK_OK);
-    pk_context_set_warning_handler(ctx, on_warn, &w);
+    warning_log_attach(ctx, &w);
     REQUIRE(obj_parse(ctx, s, obj, strlen(obj), "t.obj", "/", NULL) == PK_OK);
     pk_context_set_warning_handler(ctx, NULL, NULL);
     unlink(mtlpath);
@@ -392,10 +385,11 @@ static void test_json(void)
     char *text = NULL;
     size_t size = 0;
     REQUIRE(file_read_all(ctx, PK_TEST_DATA "/tex_json.json", &text, &size) == PK_OK);
-    warns w = {0, ""};
+    static warns w;
+    warning_log_clear(&w);
     pk_scene *s;
     REQUIRE(scene_create(ctx, "tex_json.json", &s) == PK_OK);
-    pk_context_set_warning_handler(ctx, on_warn, &w);
+    warning_log_attach(ctx, &w);
     CHECKF(scene_json_parse(ctx, s, text, size, "tex_json.json", PK_TEST_DATA) == PK_OK, "%s", pk_context_error(ctx));
     pk_context_set_warning_handler(ctx, NULL, NULL);
     mem_free(&ctx->alloc, text);

@@ -6,6 +6,7 @@
  * on), and the messages of malformed input with their line numbers.
  */
 #include "test.h"
+#include "warnings.h"
 
 #include "io/readers.h"
 #include "scene/scene.h"
@@ -18,22 +19,9 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-static char warnings[64][PK_ERRMSG_MAX];
-static int nwarnings;
+static warning_log wl;
 
-static void on_warning(void *user, const char *message)
-{
-    (void)user;
-    if (nwarnings < 64) snprintf(warnings[nwarnings], sizeof warnings[0], "%s", message);
-    nwarnings++;
-}
-
-static bool warned(const char *part)
-{
-    for (int i = 0; i < nwarnings && i < 64; i++)
-        if (strstr(warnings[i], part)) return true;
-    return false;
-}
+static bool warned(const char *part) { return warning_log_has(&wl, part); }
 
 static pk_context *ctx;
 static char tmpdir[256];
@@ -46,7 +34,7 @@ static pk_scene *load(const char *xml, bool wrap)
     if (wrap) snprintf(buf, sizeof buf, "<scene version=\"3.0.0\">\n%s\n</scene>\n", xml);
     else snprintf(buf, sizeof buf, "%s", xml);
     pk_context_clear_error(ctx);
-    nwarnings = 0;
+    warning_log_clear(&wl);
     pk_scene *s = NULL;
     pk_status st = pk_scene_load_xml_memory(ctx, buf, strlen(buf), NAME, tmpdir, &s);
     if (st != PK_OK) return NULL;
@@ -515,7 +503,7 @@ static void test_bsdfs(void)
     m = bsdf("<bsdf type=\"roughplastic\"><rgb name=\"diffuseReflectance\" value=\"0.1 0.2 0.3\"/>"
              "<float name=\"alpha\" value=\"0.05\"/><boolean name=\"nonlinear\" value=\"true\"/></bsdf>");
     CHECK(m.type == MAT_PLASTIC && near3(m.kd, v3(0.1f, 0.2f, 0.3f), 1e-6f) && fabsf(m.ni - 1.49f / 1.000277f) < 1e-5f);
-    CHECK(fabsf(m.alpha - 0.05f) < 1e-6f && nwarnings == 0);
+    CHECK(fabsf(m.alpha - 0.05f) < 1e-6f && wl.count == 0);
     m = bsdf("<bsdf type=\"plastic\"/>");
     CHECK(m.type == MAT_PLASTIC && m.alpha == 0.0f && near3(m.kd, v3s(0.5f), 0));
     m = bsdf("<bsdf type=\"mask\"><float name=\"opacity\" value=\"0.25\"/><bsdf type=\"diffuse\"/></bsdf>");
@@ -532,7 +520,7 @@ static void test_bsdfs(void)
     m = bsdf("<bsdf type=\"coating\"><float name=\"intIOR\" value=\"1.2\"/><bsdf type=\"diffuse\"><rgb name=\"reflectance\" "
              "value=\"0.3 0.4 0.5\"/></bsdf></bsdf>");
     CHECK(m.type == MAT_PLASTIC && near3(m.kd, v3(0.3f, 0.4f, 0.5f), 1e-6f) && fabsf(m.ni - 1.2f / 1.000277f) < 1e-5f);
-    CHECK(m.alpha == 0.0f && nwarnings == 0);
+    CHECK(m.alpha == 0.0f && wl.count == 0);
     m = bsdf("<bsdf type=\"roughcoating\"><float name=\"thickness\" value=\"2\"/><bsdf type=\"conductor\"/></bsdf>");
     CHECK(m.type == MAT_CONDUCTOR && warned("roughcoating\" over a non-diffuse bsdf"));
     m = bsdf("<bsdf type=\"hanrahan_krueger\"/>");
@@ -557,7 +545,7 @@ static void test_bsdfs(void)
     m = bsdf("<bsdf type=\"diffuse\"><texture name=\"reflectance\" type=\"bitmap\"><string name=\"filename\" value=\"t.pfm\"/>"
              "<float name=\"uscale\" value=\"4\"/></texture></bsdf>");
     CHECK(near3(m.kd, v3s(1.0f), 0) && m.map_kd.kind == TEX_IMAGE && m.map_kd.s[0] == 4.0f && m.map_kd.s[1] == 1.0f &&
-          nwarnings == 0);
+          wl.count == 0);
     m = bsdf("<bsdf type=\"roughplastic\"><texture name=\"diffuse_reflectance\" type=\"bitmap\"><string name=\"filename\" "
              "value=\"t.pfm\"/></texture></bsdf>");
     CHECK(m.type == MAT_PLASTIC && near3(m.kd, v3s(1.0f), 0) && m.map_kd.kind == TEX_IMAGE);
@@ -782,7 +770,7 @@ static void test_errors(void)
     load_fails(deep, false, "nested more than 64 deep");
     /* unknown top-level elements: one warning each kind */
     pk_scene *s = load_ok("<shape type=\"cube\"/>\n<gizmo/>\n<gizmo/>");
-    CHECK(s && nwarnings == 1 && warned("scene.xml:3: <gizmo> is not supported; ignored"));
+    CHECK(s && wl.count == 1 && warned("scene.xml:3: <gizmo> is not supported; ignored"));
     pk_scene_destroy(s);
     /* a scene of nothing but a camera is empty */
     load_fails("<sensor type=\"perspective\"/>", true, "");
@@ -873,7 +861,7 @@ int main(void)
     snprintf(tmpdir, sizeof tmpdir, "%s", "/tmp/pk_test_xml_XXXXXX");
     REQUIRE(mkdtemp(tmpdir));
     REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
-    pk_context_set_warning_handler(ctx, on_warning, NULL);
+    warning_log_attach(ctx, &wl);
     test_transforms();
     test_defaults_refs();
     test_include();
