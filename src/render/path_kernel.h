@@ -276,9 +276,8 @@ static inline PK_HD bool path_camera_sample_aov(const path_tracer *pt, path_thre
 {
     path_state ps;
     if (!path_start(pt, px, py, index, r, h, &ps, out)) return true;
-    if (path_step_aov(pt, t, &ps, aov))
-        while (path_step(pt, t, &ps)) {
-        }
+    while (path_step_aov(pt, t, &ps, aov)) { /* the AOV is taken at the first vertex only */
+    }
     return path_result(&ps, out);
 }
 

@@ -300,7 +300,8 @@ static bool render_tile(const pk_renderer *r, int tid, const camera_frame *cf, c
         accel_intersect_many(r->fr.a, rays, hits, (size_t)n, false, wk->cp);
         for (int i = 0; i < n; i++) {
             vec3 c;
-            aov_sample av = {{0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f}, 0.0f};
+            aov_sample av;
+            if (want_aov) av = (aov_sample){{0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f}, 0.0f};
             const int px = tl->x + i % tw, py = tl->y + i / tw;
             if (aov_mask & PK_AOV_HEATMAP) {
                 const float heat = camera_ray_heat(r, &rays[i]);

@@ -62,7 +62,8 @@ static vec3 trace(const whitted *w, whitted_thread *ts, const ray *r, int depth,
  * the choice; the offset within the chosen light's stratum is reused as its
  * first coordinate. Every emitter is two-sided here. Shadow rays go to the
  * accelerator as one batch. */
-static vec3 direct_light(const whitted *w, whitted_thread *ts, const surface *sf, vec3 wo)
+/* flatten: the lights' sampling inlined here, as it is into the path tracer's step */
+__attribute__((flatten)) static vec3 direct_light(const whitted *w, whitted_thread *ts, const surface *sf, vec3 wo)
 {
     const frame *fr = w->f;
     const scene_view *s = &fr->v;
@@ -72,9 +73,9 @@ static vec3 direct_light(const whitted *w, whitted_thread *ts, const surface *sf
     size_t n = 0;
     light_sample ls;
     /* point lights and the sun: one shadow ray each */
-    for (size_t li = 0; li < set->n; li++) {
+    for (size_t j = 0; j < w->nsingle; j++) {
+        const size_t li = w->single[j];
         const uint32_t kind = set->lights[li].kind;
-        if (kind != LIGHT_POINT && kind != LIGHT_SUN) continue;
         const float u1 = kind == LIGHT_SUN ? rng_float(&ts->rng) : 0.5f, u2 = kind == LIGHT_SUN ? rng_float(&ts->rng) : 0.5f;
         if (!light_sample_one(set, s, &fr->env, li, &lc, u1, u2, &ls)) continue;
         vec3 f = brdf_cos(sf, wo, ls.wi);
@@ -201,15 +202,18 @@ static vec3 whitted_shade(const whitted *w, whitted_thread *ts, const ray *r, co
 static pk_status ig_init(pk_context *ctx, void *self, const frame *f, const pk_render_options *opt)
 {
     whitted *w = self;
-    *w = (whitted){f, opt->light_samples, pk_render_options_max_depth(opt), opt->fresnel != 0, 0.0f, 0, NULL, NULL};
+    *w = (whitted){f, opt->light_samples, pk_render_options_max_depth(opt), opt->fresnel != 0, 0.0f, 0, NULL, NULL,
+                   0, NULL};
     const light_set *set = &f->lights;
     if (set->n == 0) return PK_OK;
     w->sampled = mem_realloc_array(&ctx->alloc, NULL, set->n, sizeof *w->sampled);
     w->cdf = mem_realloc_array(&ctx->alloc, NULL, set->n, sizeof *w->cdf);
-    if (!w->sampled || !w->cdf) return ctx_nomem(ctx);
+    w->single = mem_realloc_array(&ctx->alloc, NULL, set->n, sizeof *w->single);
+    if (!w->sampled || !w->cdf || !w->single) return ctx_nomem(ctx);
     double total = 0.0;
     for (size_t i = 0; i < set->n; i++) {
         const uint32_t kind = set->lights[i].kind;
+        if (kind == LIGHT_POINT || kind == LIGHT_SUN) w->single[w->nsingle++] = (uint32_t)i;
         if (kind == LIGHT_POINT || kind == LIGHT_SUN || kind == LIGHT_SPHERE || !(set->pmf[i] > 0.0f)) continue;
         total += (double)set->pmf[i];
         w->sampled[w->nsampled] = (uint32_t)i;
@@ -225,7 +229,8 @@ static void ig_free(const pk_allocator *al, void *self)
     whitted *w = self;
     mem_free(al, w->sampled);
     mem_free(al, w->cdf);
-    w->sampled = NULL, w->cdf = NULL;
+    mem_free(al, w->single);
+    w->sampled = NULL, w->cdf = NULL, w->single = NULL;
 }
 
 static pk_status ig_thread_init(pk_context *ctx, const void *self, void *t, bool stats)

@@ -34,6 +34,8 @@ typedef struct whitted {
     size_t nsampled;
     uint32_t *sampled;   /* their numbers in the set */
     float *cdf;          /* nsampled entries, last = 1 */
+    size_t nsingle;
+    uint32_t *single;    /* the point lights' and the sun's numbers in the set */
 } whitted;
 
 /* Per-thread scratch, allocated once per renderer. */
