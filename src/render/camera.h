@@ -52,11 +52,4 @@ static inline PK_HD ray camera_ray(const camera_frame *f, const camera_sample *c
     return r;
 }
 
-/* The ray through film position (x, y) in pixels. */
-static inline PK_HD ray camera_ray_at(const camera_frame *f, float x, float y)
-{
-    const camera_sample cs = {x, y, 0.5f, 0.5f};
-    return camera_ray(f, &cs);
-}
-
 #endif

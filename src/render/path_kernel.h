@@ -129,9 +129,10 @@ static inline PK_HD void path_begin(path_state *ps, const ray *r, const hit *h, 
 
 /* One vertex of the path: the surface at its hit (emission, light sampling),
  * then the next direction and its closest hit. False when the path has
- * ended (ps->L is then its radiance). The CPU loops over it per sample; GPU
+ * ended (ps->L is then its radiance). aov (NULL: not wanted) gets the
+ * surface of the path's first vertex. The CPU loops over it per sample; GPU
  * threads that start a new path as soon as one ends run the same steps. */
-static inline PK_HD bool path_step_aov(const path_tracer *pt, path_thread *t, path_state *ps, aov_sample *aov)
+static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_state *ps, aov_sample *aov)
 {
     const frame *fr = pt->f;
     const scene_view *s = &fr->v;
@@ -218,11 +219,6 @@ static inline PK_HD bool path_step_aov(const path_tracer *pt, path_thread *t, pa
     return true;
 }
 
-static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_state *ps)
-{
-    return path_step_aov(pt, t, ps, NULL);
-}
-
 /* ---- camera samples -------------------------------------------------------------- */
 
 /* Where sample index of pixel (px, py) lies: the sampler's film dimensions
@@ -276,7 +272,7 @@ static inline PK_HD bool path_camera_sample_aov(const path_tracer *pt, path_thre
 {
     path_state ps;
     if (!path_start(pt, px, py, index, r, h, &ps, out)) return true;
-    while (path_step_aov(pt, t, &ps, aov)) { /* the AOV is taken at the first vertex only */
+    while (path_step(pt, t, &ps, aov)) { /* the AOV is taken at the first vertex only */
     }
     return path_result(&ps, out);
 }
