@@ -17,6 +17,10 @@ install(TARGETS paprsek_shared paprsek_static EXPORT paprsekTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 install(FILES include/paprsek.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+# The denoiser's weights with their license, where the library looks for
+# them (PK_DENOISE_WEIGHTS_DIR), when the build has fetched them.
+install(DIRECTORY ${PK_WEIGHTS_DIR}/ DESTINATION ${CMAKE_INSTALL_DATADIR}/paprsek/weights OPTIONAL
+        FILES_MATCHING PATTERN "*.tza" PATTERN "LICENSE.txt" PATTERN ".download" EXCLUDE)
 
 install(EXPORT paprsekTargets NAMESPACE paprsek:: DESTINATION ${PK_CMAKE_DIR})
 configure_package_config_file(cmake/paprsekConfig.cmake.in

@@ -102,6 +102,7 @@ PK_API void pk_context_set_file_reader(pk_context *ctx, pk_file_reader_fn fn, vo
  *   embree.library  the Embree 3 library to load (a path or a soname;
  *                   default libembree3.so.3)
  *   cuda.library    the CUDA driver to load (default libcuda.so.1)
+ *   dnnl.library    oneDNN, which runs the denoiser (default libdnnl.so.2)
  * A library is loaded once per process: the first name that loads stays.
  * Keys not named keep their values (a new context has the defaults); an
  * empty value ("cpu.isa=") restores a key's default; blanks around keys and
@@ -479,6 +480,56 @@ PK_API void pk_renderer_get_stats(const pk_renderer *r, pk_stats *stats);
  * NULL. On PK_ERR_CANCELLED *out still holds the partial image. */
 PK_API pk_status pk_render(pk_context *ctx, const pk_scene *scene, const pk_render_options *opt,
                            pk_image **out, pk_stats *stats);
+
+/* ---- denoising ---------------------------------------------------------- */
+
+/* The denoiser runs Intel Open Image Denoise's trained network (a U-Net,
+ * weights under Apache-2.0) on the CPU through oneDNN (libdnnl.so.2, loaded
+ * at run time; config key dnnl.library). It takes a noisy HDR colour image
+ * and, when present, the albedo and normal AOVs of the same render
+ * (PK_AOV_ALBEDO, PK_AOV_NORMAL) and returns a clean colour image. The
+ * weights are OIDN's .tza files, which `make weights` fetches and `make
+ * install` installs; a file whose SHA-256 is not one of OIDN 2.3's is
+ * refused. */
+typedef enum pk_denoise_quality {
+    PK_DENOISE_HIGH = 0,     /* OIDN's default network */
+    PK_DENOISE_FAST = 1      /* the small network: about 2.5x faster, a little less sharp */
+} pk_denoise_quality;
+
+typedef struct pk_denoise_options {
+    /* A folder holding the weights (rt_hdr_alb_nrm.tza ...), or one .tza
+     * file; NULL: PK_DENOISE_WEIGHTS_DIR of the installed library. */
+    const char *weights;
+    pk_denoise_quality quality;
+    int threads;        /* 0: every processor */
+    float input_scale;  /* the colour is multiplied by it before the network; 0: automatic exposure */
+    int clean_aux;      /* non-zero: the albedo and normal are noise-free (many samples, or no depth of field
+                         * and motion blur): the network made for clean auxiliary images */
+    int tile_size;      /* the image is denoised in tiles of at most this side (pixels, a
+                         * multiple of 16, >= 64) that overlap; 0: 1024 */
+    int tile_overlap;   /* overlap of tiles (multiple of 16); 0: 96, half the network's reach */
+} pk_denoise_options;
+
+PK_API void pk_denoise_options_init(pk_denoise_options *opt);
+
+/* A denoiser keeps its networks and buffers between images (one thread at a
+ * time). opt NULL: the defaults; opt->weights is copied. */
+typedef struct pk_denoiser pk_denoiser;
+PK_API pk_status pk_denoiser_create(pk_context *ctx, const pk_denoise_options *opt, pk_denoiser **out);
+PK_API void pk_denoiser_destroy(pk_denoiser *d);
+/* out (same size as color) = color denoised. albedo and normal may be NULL
+ * (normal only with albedo); they must have color's size. Pixels that are
+ * not finite or negative are taken as 0 (one warning says how many). */
+PK_API pk_status pk_denoiser_run(pk_denoiser *d, const pk_image *color, const pk_image *albedo,
+                                 const pk_image *normal, pk_image *out);
+/* Seconds, bytes of network buffers and floating-point operations of the last run. */
+PK_API void pk_denoiser_last_run(const pk_denoiser *d, double *seconds, size_t *bytes, double *flops);
+/* One call: a denoiser, one run, *out a new image owned by the caller. */
+PK_API pk_status pk_denoise(pk_context *ctx, const pk_denoise_options *opt, const pk_image *color,
+                            const pk_image *albedo, const pk_image *normal, pk_image **out);
+/* Whether the weights the options name are there and oneDNN loads: PK_OK,
+ * or an error whose message says what is missing and how to get it. */
+PK_API pk_status pk_denoise_check(pk_context *ctx, const pk_denoise_options *opt);
 
 /* ---- rays against an acceleration structure (benchmarks, tools) --------- */
 

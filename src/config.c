@@ -11,6 +11,7 @@
 
 #define EMBREE_DEFAULT "libembree3.so.3"
 #define CUDA_DEFAULT "libcuda.so.1"
+#define DNNL_DEFAULT "libdnnl.so.2"
 
 static const char *const isa_names[] = {"auto", "avx2"};
 static const char *const bvh_names[] = {"high", "fast"};
@@ -24,10 +25,10 @@ static int choose(const char *v, size_t n, const char *const *names, size_t coun
     return -1;
 }
 
-typedef enum { KEY_ISA, KEY_BVH, KEY_EMBREE_QUALITY, KEY_EMBREE_LIBRARY, KEY_CUDA_LIBRARY, NKEYS } key_id;
+typedef enum { KEY_ISA, KEY_BVH, KEY_EMBREE_QUALITY, KEY_EMBREE_LIBRARY, KEY_CUDA_LIBRARY, KEY_DNNL_LIBRARY, NKEYS } key_id;
 
 static const char *const key_names[NKEYS] = {"cpu.isa", "bvh.quality", "embree.quality", "embree.library",
-                                             "cuda.library"};
+                                             "cuda.library", "dnnl.library"};
 
 /* Sets key k of c from the value v[0..n-1] (n 0: the default); false with a
  * message in ctx when the value is not one the key takes. */
@@ -49,8 +50,9 @@ static bool set_key(pk_context *ctx, pk_config *c, key_id k, const char *v, size
         c->embree_quality = i;
         return true;
     case KEY_EMBREE_LIBRARY:
-    case KEY_CUDA_LIBRARY: {
-        char *dst = k == KEY_CUDA_LIBRARY ? c->cuda_library : c->embree_library;
+    case KEY_CUDA_LIBRARY:
+    case KEY_DNNL_LIBRARY: {
+        char *dst = k == KEY_CUDA_LIBRARY ? c->cuda_library : k == KEY_DNNL_LIBRARY ? c->dnnl_library : c->embree_library;
         if (n >= PK_CONFIG_NAME_MAX) {
             ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "config: %s: a library name of %zu bytes (at most %d)",
                       key_names[k], n, PK_CONFIG_NAME_MAX - 1);
@@ -92,7 +94,7 @@ pk_status pk_context_set_config(pk_context *ctx, const char *config)
         if (k < 0)
             return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT,
                              "config: unknown key '%.*s' (cpu.isa, bvh.quality, embree.quality, embree.library, "
-                             "cuda.library)", (int)(kend - a > 64 ? 64 : kend - a), a);
+                             "cuda.library, dnnl.library)", (int)(kend - a > 64 ? 64 : kend - a), a);
         if (!eq) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "config: %s: expected %s=VALUE", key_names[k], key_names[k]);
         const char *v = eq + 1;
         while (v < b && blank(*v)) v++;
@@ -112,12 +114,18 @@ const char *config_cuda_library(const pk_context *ctx)
     return ctx && ctx->config.cuda_library[0] ? ctx->config.cuda_library : CUDA_DEFAULT;
 }
 
+const char *config_dnnl_library(const pk_context *ctx)
+{
+    return ctx && ctx->config.dnnl_library[0] ? ctx->config.dnnl_library : DNNL_DEFAULT;
+}
+
 size_t pk_context_get_config(const pk_context *ctx, char *buf, size_t size)
 {
-    static const pk_config defaults = {false, false, 1, "", ""};
+    static const pk_config defaults = {false, false, 1, "", "", ""};
     const pk_config *c = ctx ? &ctx->config : &defaults;
-    int n = snprintf(buf, size, "cpu.isa=%s,bvh.quality=%s,embree.quality=%s,embree.library=%s,cuda.library=%s",
+    int n = snprintf(buf, size, "cpu.isa=%s,bvh.quality=%s,embree.quality=%s,embree.library=%s,cuda.library=%s,"
+                     "dnnl.library=%s",
                      isa_names[c->cpu_avx2], bvh_names[c->bvh_fast], embree_names[c->embree_quality],
-                     config_embree_library(ctx), config_cuda_library(ctx));
+                     config_embree_library(ctx), config_cuda_library(ctx), config_dnnl_library(ctx));
     return n < 0 ? 0 : (size_t)n;
 }

@@ -46,6 +46,7 @@ typedef struct pk_config {
     int embree_quality;   /* embree.quality: 0 low, 1 medium (default), 2 high */
     char embree_library[PK_CONFIG_NAME_MAX]; /* embree.library: "" for libembree3.so.3 */
     char cuda_library[PK_CONFIG_NAME_MAX];   /* cuda.library: "" for libcuda.so.1 */
+    char dnnl_library[PK_CONFIG_NAME_MAX];   /* dnnl.library: "" for libdnnl.so.2 (the denoiser) */
 } pk_config;
 
 /* Invariants:
@@ -66,6 +67,7 @@ struct pk_context {
  * default soname (ctx may be NULL: the defaults). */
 PK_HIDDEN const char *config_embree_library(const pk_context *ctx);
 PK_HIDDEN const char *config_cuda_library(const pk_context *ctx);
+PK_HIDDEN const char *config_dnnl_library(const pk_context *ctx);
 
 /* ---- allocation: every library allocation goes through the context's hook */
 

@@ -112,7 +112,7 @@ static void check_context_config(void)
 {
     char buf[1024];
     const char *defaults = "cpu.isa=auto,bvh.quality=high,embree.quality=medium,embree.library=libembree3.so.3,"
-                           "cuda.library=libcuda.so.1";
+                           "cuda.library=libcuda.so.1,dnnl.library=libdnnl.so.2";
     size_t len = pk_context_get_config(ctx, buf, sizeof buf);
     CHECKF(strcmp(buf, defaults) == 0 && len == strlen(defaults), "default config: %s", buf);
     CHECK(pk_context_get_config(ctx, NULL, 0) == len);
@@ -123,7 +123,7 @@ static void check_context_config(void)
                                      "embree.library=/opt/e/libembree3.so.3,cuda.library=libcuda.so.1") == PK_OK);
     pk_context_get_config(ctx, buf, sizeof buf);
     CHECKF(strcmp(buf, "cpu.isa=avx2,bvh.quality=fast,embree.quality=high,embree.library=/opt/e/libembree3.so.3,"
-                       "cuda.library=libcuda.so.1") == 0, "config: %s", buf);
+                       "cuda.library=libcuda.so.1,dnnl.library=libdnnl.so.2") == 0, "config: %s", buf);
     /* keys not named keep their values; the last of a key wins */
     CHECK(pk_context_set_config(ctx, "cpu.isa=auto,cpu.isa=avx2") == PK_OK);
     pk_context_get_config(ctx, buf, sizeof buf);
