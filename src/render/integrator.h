@@ -4,8 +4,8 @@
  * the renderer allocates, and one camera sample at a time: where in the
  * pixel (and on the lens) the sample lies, then the radiance arriving along
  * its camera ray, whose closest hit the renderer has traced in a batch, and
- * the AOV sample of the first surface it sees. The path tracer (path.c) and
- * the Whitted integrator (whitted.c) each export one.
+ * its AOV sample (aov_sample). The path tracer (path.c) and the Whitted
+ * integrator (whitted.c) each export one.
  */
 #ifndef PK_INTEGRATOR_H
 #define PK_INTEGRATOR_H
@@ -14,9 +14,21 @@
 #include "frame.h"
 #include "surface.h"
 
-/* What a camera sample saw first, for the AOVs (zero where it saw nothing):
- * the material's diffuse reflectance, the shading normal and the distance
- * along the ray, at the first surface that is not a hole. */
+/* What a camera sample saw, for the AOVs (the renderer averages them over
+ * the samples of a pixel; zero where it saw nothing):
+ *
+ *  - depth: the distance along the camera ray to the first surface that is
+ *    not a hole (0 for a miss), whatever that surface is;
+ *  - albedo, normal: what a denoiser (Open Image Denoise) wants, at the
+ *    first NON-specular vertex of the path. The path tracer follows
+ *    perfectly specular (delta) chains through mirrors and smooth glass, the
+ *    albedo multiplied by each specular bounce's weight (path_kernel.h
+ *    path_aov_vertex says what each material gives); the normal is the
+ *    shading normal there, facing the ray that arrived, zero for a miss.
+ *    The Whitted integrator (whose mirrors and glass branch into both
+ *    reflection and refraction rather than pick one, so there is no one
+ *    chain to follow) and the CPU trace that gives a GPU render its AOVs
+ *    (renderer.c) take both at the first surface (aov_from_surface). */
 typedef struct aov_sample {
     vec3 albedo, normal;
     float depth;
@@ -49,12 +61,23 @@ typedef struct integrator_ops {
 
 PK_HIDDEN extern const integrator_ops integrator_path, integrator_whitted;
 
-/* The AOV sample of surface sf (textured already) seen along r at hit h. */
+/* The first-surface AOV sample of surface sf (textured already) seen along
+ * r at hit h: the material's diffuse reflectance Kd, the shading normal and
+ * the distance (Whitted, and the AOVs of GPU renders). */
 static inline PK_HD void aov_from_surface(const surface *sf, const ray *r, const hit *h, aov_sample *a)
 {
     a->albedo = sf->m->kd;
     a->normal = sf->ns;
     a->depth = h->t * v3_len(r->d);
+}
+
+/* A radiance as a denoiser's albedo: c divided by its largest component
+ * (zero when that is not positive and finite). Emitters and the
+ * environment give their colour this way. */
+static inline PK_HD vec3 aov_normalised(vec3 c)
+{
+    const float m = v3_max_comp(c);
+    return m > 0.0f && isfinite(m) ? v3_scale(c, 1.0f / m) : v3s(0.0f);
 }
 
 #endif

@@ -11,7 +11,9 @@
  * before including this file (pt: const path_tracer *, t: path_thread *).
  *
  * The BSDF at each vertex comes from shading.h (the material at a hit as a
- * pbsdf), the lights' sampling from lights.h.
+ * pbsdf), the lights' sampling from lights.h. The AOVs (integrator.h
+ * aov_sample) are taken along the path while it is traced, at its first
+ * non-specular vertex (path_aov_*); the GPU asks for none.
  */
 #ifndef PK_PATH_KERNEL_H
 #define PK_PATH_KERNEL_H
@@ -111,6 +113,84 @@ typedef struct path_state {
     sampler smp;
 } path_state;
 
+/* ---- AOVs for a denoiser ------------------------------------------------------ */
+
+/* The AOVs of a path in progress: out (zeroed by the caller) gets them;
+ * open while every vertex so far was specular, i.e. the first non-specular
+ * vertex (or the end of the path) is still to come. */
+typedef struct path_aov {
+    aov_sample *out;
+    bool open;
+} path_aov;
+
+/* Whether the material at a vertex scatters by delta lobes alone, so that
+ * the AOVs look through it to what it shows: a smooth mirror or smooth
+ * glass, a surface dissolved entirely, or a smooth mirror lobe or coating
+ * over a black base (the MTL mirror, illum 3 with Kd 0: the path tracer
+ * then always takes the mirror lobe). */
+static inline PK_HD bool path_aov_specular(const shading *sh)
+{
+    const pbsdf *b = &sh->b;
+    if (!(sh->opaque > 0.0f) || !pbsdf_has_nondelta(b)) return true;
+    if (b->alpha >= PBSDF_ALPHA_SMOOTH || !black(b->albedo)) return false;
+    return b->type == PBSDF_PLASTIC || (b->type == PBSDF_GLOSSY && !black(b->specular));
+}
+
+/* The albedo of a non-specular vertex, by its BSDF: the diffuse reflectance
+ * Kd (textured) of diffuse, plastic and MTL (Phong, illum 3 over a diffuse
+ * base) surfaces; a rough conductor's Fresnel reflectance at normal
+ * incidence (F0: its tint, the same from every view); a rough dielectric's
+ * transmittance (white for clear glass, the tint of what enters
+ * otherwise). A surface partly dissolved (d < 1) counts as opaque here. */
+static inline PK_HD vec3 path_aov_albedo(const surface *sf, const shading *sh)
+{
+    switch (sh->b.type) {
+    case PBSDF_CONDUCTOR: return pbsdf__fresnel_conductor(&sh->b, 1.0f);
+    case PBSDF_DIELECTRIC: return sh->b.transmittance;
+    default: return sf->m->kd;
+    }
+}
+
+/* The AOVs at a vertex of the path, reached along ray r (hit h) with
+ * throughput beta, while they are open: the depth at the first vertex;
+ * then an emitter gives its colour normalised (aov_normalised), a
+ * non-specular surface path_aov_albedo, either times beta, with its shading
+ * normal, and closes the AOVs; a specular one leaves them open for the
+ * next vertex. On a chain of specular bounces beta is the product of their
+ * weights f cos / pdf (a mirror's tint; glass picks reflection or
+ * refraction at random, each with weight 1 or its transmittance, so the
+ * mean over the samples is the Fresnel mixture), and of Russian roulette's
+ * 1 / q where it spared the path: the paths it ends give zeros, and the
+ * mean stays the same. */
+static inline PK_HD void path_aov_vertex(path_aov *pa, const surface *sf, const ray *r, const hit *h, int depth,
+                                         vec3 beta)
+{
+    aov_sample *a = pa->out;
+    if (depth == 0) a->depth = h->t * v3_len(r->d);
+    const vec3 le = emitted(sf);
+    vec3 albedo;
+    if (!black(le)) {
+        albedo = aov_normalised(le);
+    } else {
+        const shading sh = shading_at(sf);
+        if (path_aov_specular(&sh)) return;
+        albedo = path_aov_albedo(sf, &sh);
+    }
+    a->albedo = v3_mul(beta, albedo);
+    a->normal = sf->ns;
+    pa->open = false;
+}
+
+/* The AOVs of a path that leaves the scene toward d (unit) while they are
+ * open (the camera ray, or a chain of specular bounces of throughput beta):
+ * what it sees there (env_background: environment and sun) normalised,
+ * times beta; the normal stays zero. */
+static inline PK_HD void path_aov_miss(const path_tracer *pt, path_aov *pa, vec3 d, vec3 beta)
+{
+    pa->out->albedo = v3_mul(beta, aov_normalised(env_background(&pt->f->env, d)));
+    pa->open = false;
+}
+
 /* The state of a path whose camera ray r hit at h, with the sampler of its
  * pixel sample (past the pixel position). */
 static inline PK_HD void path_begin(path_state *ps, const ray *r, const hit *h, const sampler *smp)
@@ -129,15 +209,18 @@ static inline PK_HD void path_begin(path_state *ps, const ray *r, const hit *h, 
 
 /* One vertex of the path: the surface at its hit (emission, light sampling),
  * then the next direction and its closest hit. False when the path has
- * ended (ps->L is then its radiance). aov (NULL: not wanted) gets the
- * surface of the path's first vertex. The CPU loops over it per sample; GPU
- * threads that start a new path as soon as one ends run the same steps. */
-static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_state *ps, aov_sample *aov)
+ * ended (ps->L is then its radiance). aov (NULL: not wanted) follows the
+ * path to its first non-specular vertex (path_aov_vertex); it draws no
+ * random numbers and changes nothing of the path. The CPU loops over it per
+ * sample; GPU threads that start a new path as soon as one ends run the
+ * same steps. */
+static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_state *ps, path_aov *aov)
 {
     const frame *fr = pt->f;
     const scene_view *s = &fr->v;
     sampler *smp = &ps->smp;
     if (s->has_cutout && !path_past_holes(pt, t, &ps->r, &ps->h)) { /* through map_d holes, out */
+        if (aov && aov->open) path_aov_miss(pt, aov, v3_norm(ps->r.d), ps->beta);
         ps->L = v3_add(ps->L, v3_mul(ps->beta, leaving(pt, v3_norm(ps->r.d), ps->prev_delta, ps->prev_pdf)));
         return false;
     }
@@ -147,7 +230,7 @@ static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_s
         ps->cone += pt->spread * ps->h.t * v3_len(ps->r.d);
         if (sf.m->textured) sf = surface_texture(s, &ps->r, &ps->h, ps->cone, sf, &textured);
     }
-    if (aov && ps->depth == 0) aov_from_surface(&sf, &ps->r, &ps->h, aov);
+    if (aov && aov->open) path_aov_vertex(aov, &sf, &ps->r, &ps->h, ps->depth, ps->beta);
     const vec3 wo = v3_neg(v3_norm(ps->r.d));
     /* emission reached by the path */
     vec3 le = emitted(&sf);
@@ -212,6 +295,7 @@ static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_s
     ps->prev_p = sf.p;
     t->rays_bounce++;
     if (!PATH_TRACE(pt, t, &ps->r, &ps->h)) {
+        if (aov && aov->open) path_aov_miss(pt, aov, wi, ps->beta); /* (open: the vertex left was specular) */
         ps->L = v3_add(ps->L, v3_mul(ps->beta, leaving(pt, wi, ps->prev_delta, ps->prev_pdf)));
         return false;
     }
@@ -265,14 +349,19 @@ static inline PK_HD bool path_result(const path_state *ps, vec3 *out)
 }
 
 /* What sample index of pixel (px, py) sees along its camera ray r (path_start's
- * arguments); false for a lost sample. */
+ * arguments); false for a lost sample. aov (NULL: not wanted; else zeroed)
+ * gets the sample's AOVs (path_aov_vertex). */
 static inline PK_HD bool path_camera_sample_aov(const path_tracer *pt, path_thread *t, int px, int py,
                                                 uint32_t index, const ray *r, const hit *h, vec3 *out,
                                                 aov_sample *aov)
 {
     path_state ps;
-    if (!path_start(pt, px, py, index, r, h, &ps, out)) return true;
-    while (path_step(pt, t, &ps, aov)) { /* the AOV is taken at the first vertex only */
+    path_aov pa = {aov, true};
+    if (!path_start(pt, px, py, index, r, h, &ps, out)) {
+        if (aov) aov->albedo = aov_normalised(*out); /* the camera ray's miss: what it sees */
+        return true;
+    }
+    while (path_step(pt, t, &ps, aov ? &pa : NULL)) {
     }
     return path_result(&ps, out);
 }

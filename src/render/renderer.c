@@ -332,7 +332,13 @@ static void film_add_aovs(pk_film *film, const tile *tl, float (*aovs)[BATCH * 3
 }
 
 /* The AOVs of a tile the GPU rendered, from its camera rays traced again on
- * the CPU, one at a time, and shaded as the path tracer's first vertex. */
+ * the CPU, one at a time: first-surface AOVs (aov_from_surface: Kd and the
+ * shading normal of the first surface hit, zero for a miss), not the
+ * path tracer's, which look through mirrors and glass to the first
+ * non-specular vertex (path_kernel.h path_aov_vertex). Until these are
+ * taken on the device, a GPU render's albedo and normal differ from a CPU
+ * render's wherever specular surfaces, emitters or the environment are
+ * seen; its depth is the same. */
 static void render_tile_aovs_cpu(const pk_renderer *r, const camera_frame *cf, const tile *tl, pk_film *film)
 {
     const scene_view *s = &r->fr.v;
