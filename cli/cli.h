@@ -109,6 +109,9 @@ typedef struct cli_render_opts {
     const char *env;     /* --env, NULL when not given */
     const char *defines[64]; /* -D NAME=VALUE */
     size_t ndefines;
+    int denoise;         /* --denoise 1, --no-denoise 0, -1 when neither is given */
+    int denoise_fast;    /* --denoise-quality fast */
+    const char *weights; /* --weights DIR, NULL when not given */
     /* a program's own options (cli_render_add_option): the value given ("" for
      * a flag), NULL when absent */
     const char *extra[CLI_RENDER_MAX_EXTRA];
@@ -133,6 +136,34 @@ int cli_render_check(const cli_render_opts *o, pk_write_options *wo);
  * when statistics are asked for), checked; --env and the camera options
  * applied to scene (--env FILE reads the file through ctx). */
 pk_status cli_render_settings(pk_context *ctx, const cli_render_opts *o, pk_scene *scene, pk_render_options *ro);
+/* The samples per pixel of a render that names none (neither --spp nor
+ * --time nor the scene file): enough for the denoiser to give a clean
+ * image (docs/denoising.md says how it was chosen). */
+#define CLI_CLEAN_SPP 16
+/* Non-zero when the render is the default one: no --spp, no --time, no
+ * sample count in the scene. It then takes CLI_CLEAN_SPP samples and is
+ * denoised unless --no-denoise. */
+int cli_render_clean_default(const cli_render_opts *o, const pk_scene *scene);
+
+/* ---- denoising (cli/denoise.c) ------------------------------------------- */
+
+/* `paprsek denoise IN -o OUT ...`. argv[0] is "denoise". */
+int cli_denoise(int argc, char **argv);
+void cli_denoise_help(FILE *f);
+/* The folder of the weights when none is named: beside the program
+ * (weights/, where the build puts them) or ../share/paprsek/weights from
+ * it (an installed program); NULL when neither holds them (the library's
+ * own default then applies). */
+const char *cli_weights_dir(void);
+/* What the render asks of the denoiser: 1 denoise, 0 not. When it should
+ * but cannot (no weights, no oneDNN), an explicit --denoise is a failure
+ * (returns -1 after the message); the default render warns and stays raw. */
+int cli_render_wants_denoise(pk_context *ctx, const cli_render_opts *o, const pk_scene *scene,
+                             pk_denoise_options *dopt);
+/* img = img denoised with the albedo and normal of film; seconds, bytes and
+ * flops of the denoiser for --stats. */
+pk_status cli_render_denoise(pk_context *ctx, const pk_denoise_options *dopt, const pk_film *film, pk_image *img,
+                             double *seconds, size_t *bytes, double *flops);
 /* Writes OUT (through pk_image_write_ex: a temporary file renamed into place)
  * and the AOVs of --aov from film. */
 pk_status cli_render_write(pk_context *ctx, const cli_render_opts *o, const pk_write_options *wo,

@@ -14,6 +14,7 @@ static void usage(FILE *f)
           "commands:\n"
           "  render [SCENE] -o OUT     render a scene (.obj, .json or .xml; without SCENE the\n"
           "                            built-in Cornell box) to OUT (.png, .pfm or .exr)\n"
+          "  denoise IN -o OUT         denoise a rendered image (its albedo and normal too)\n"
           "  bench rays SCENE RAYS     time an accelerator on a ray file\n"
           "  bench gen-rays SCENE ...  make the standard ray files\n"
           "  bench compare A B         check that two hit files agree\n"
@@ -28,7 +29,7 @@ static void usage(FILE *f)
           f);
 }
 
-static const char *const commands[] = {"render", "bench", "help"};
+static const char *const commands[] = {"render", "denoise", "bench", "help"};
 #define NCOMMANDS (sizeof commands / sizeof commands[0])
 
 static int unknown_command(const char *cmd)
@@ -47,6 +48,7 @@ int main(int argc, char **argv)
     const char *cmd = argv[1];
     if (strcmp(cmd, "render") == 0) return cli_render(argc - 1, argv + 1);
     if (strcmp(cmd, "bench") == 0) return cli_bench(argc - 1, argv + 1);
+    if (strcmp(cmd, "denoise") == 0) return cli_denoise(argc - 1, argv + 1);
     if (strcmp(cmd, "help") == 0) {
         if (argc < 3) {
             usage(stdout);
@@ -59,6 +61,10 @@ int main(int argc, char **argv)
         }
         if (strcmp(argv[2], "bench") == 0) {
             cli_bench_help(stdout);
+            return 0;
+        }
+        if (strcmp(argv[2], "denoise") == 0) {
+            cli_denoise_help(stdout);
             return 0;
         }
         if (strcmp(argv[2], "help") == 0) {

@@ -106,12 +106,25 @@ int cli_render(int argc, char **argv)
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
 
+    pk_denoise_options dopt;
+    const int denoise = cli_render_wants_denoise(ctx, &o, scene, &dopt);
+    if (denoise < 0) goto out;
+    /* the denoiser takes the albedo and normal of the same render */
+    const unsigned aovs = o.aovs | (denoise ? PK_AOV_ALBEDO | PK_AOV_NORMAL : 0u);
+
     pk_stats stats;
     uint32_t passes = 1;
-    if (o.time > 0.0 || o.aovs)
-        st = render_passes(ctx, scene, &ro, o.time, o.aovs, &bar, &img, &film, &stats, &passes);
+    if (o.time > 0.0 || aovs)
+        st = render_passes(ctx, scene, &ro, o.time, aovs, &bar, &img, &film, &stats, &passes);
     else
         st = pk_render(ctx, scene, &ro, &img, &stats);
+    double dn_s = 0.0, dn_flops = 0.0;
+    size_t dn_bytes = 0;
+    if (st == PK_OK && denoise) {
+        snprintf(bar.note, sizeof bar.note, "denoising");
+        cli_progress_update(&bar, 999, 1000, cli_now() - t0);
+        st = cli_render_denoise(ctx, &dopt, film, img, &dn_s, &dn_bytes, &dn_flops);
+    }
     cli_progress_clear(&bar);
     if (st == PK_ERR_CANCELLED) {
         char *partial = cli_partial_name(o.out);
@@ -130,13 +143,20 @@ int cli_render(int argc, char **argv)
         char took[32];
         cli_format_duration(took, sizeof took, cli_now() - t0);
         if (o.time > 0.0)
-            fprintf(stderr, "wrote %s (%dx%d, %u passes of %d spp, %s)\n", o.out, ro.width, ro.height, passes, ro.spp,
-                    took);
+            fprintf(stderr, "wrote %s (%dx%d, %u passes of %d spp%s, %s)\n", o.out, ro.width, ro.height, passes,
+                    ro.spp, denoise ? ", denoised" : "", took);
         else
-            fprintf(stderr, "wrote %s (%dx%d, %s)\n", o.out, ro.width, ro.height, took);
+            fprintf(stderr, "wrote %s (%dx%d, %d spp%s, %s)\n", o.out, ro.width, ro.height, ro.spp,
+                    denoise ? ", denoised" : "", took);
     }
     const char *name = o.scene ? o.scene : "cornell-box (built in)";
-    if (o.stats) cli_print_stats(ctx, name, scene, &ro, &stats);
+    if (o.stats) {
+        cli_print_stats(ctx, name, scene, &ro, &stats);
+        if (denoise)
+            printf("%-28s %.3f s, %.1f MiB, %.1f GFLOP/s (%s network)\n", "denoise", dn_s,
+                   (double)dn_bytes / (1024.0 * 1024.0), dn_s > 0 ? dn_flops / dn_s * 1e-9 : 0.0,
+                   o.denoise_fast ? "fast" : "high-quality");
+    }
     if (o.stats_json && cli_write_stats_json(ctx, o.stats_json, name, scene, &ro, &stats) != 0) goto out;
     rc = 0;
     goto out;

@@ -36,6 +36,10 @@ enum {
     OPT_STATS_JSON,
     OPT_DEFINE,
     OPT_QUIET,
+    OPT_DENOISE,
+    OPT_NO_DENOISE,
+    OPT_DENOISE_QUALITY,
+    OPT_WEIGHTS,
     OPT_HELP
 };
 
@@ -121,6 +125,18 @@ const cli_option *cli_render_options(size_t *n)
         add((cli_option){.name = "define", .short_name = 'D', .id = OPT_DEFINE, .kind = CLI_STRING, .arg = "NAME=VALUE",
                          .help = "set the parameter $NAME of a Mitsuba XML scene over its <default> value "
                                  "(may be repeated, up to 64 times)"});
+        add((cli_option){.name = "denoise", .id = OPT_DENOISE, .kind = CLI_FLAG,
+                         .help = "denoise the image (Open Image Denoise's network, with the albedo and normal of "
+                                 "the same render); the default when neither --spp nor --time nor the scene "
+                                 "names a sample count"});
+        add((cli_option){.name = "no-denoise", .id = OPT_NO_DENOISE, .kind = CLI_FLAG,
+                         .help = "write the raw image, also in the default case"});
+        add((cli_option){.name = "denoise-quality", .id = OPT_DENOISE_QUALITY, .kind = CLI_STRING, .arg = "high|fast",
+                         .help = "the denoiser's network: high (default) or fast (the small one, about 2.5x "
+                                 "faster)"});
+        add((cli_option){.name = "weights", .id = OPT_WEIGHTS, .kind = CLI_STRING, .arg = "DIR",
+                         .help = "the folder of the denoiser's weights (default: beside the program, where "
+                                 "`make weights` puts them, or the installed share/paprsek/weights)"});
         add((cli_option){.name = "quiet", .short_name = 'q', .id = OPT_QUIET, .kind = CLI_FLAG,
                          .help = "no progress bar, no 'wrote' line, no warnings (errors are still printed)"});
         for (size_t i = 0; i < g_nextra; i++) add(g_extra[i]);
@@ -177,6 +193,7 @@ int cli_render_parse(int argc, char **argv, cli_render_opts *o, void (*help)(FIL
 {
     memset(o, 0, sizeof *o);
     o->fresnel = -1;
+    o->denoise = -1;
     size_t n;
     const cli_option *opts = cli_render_options(&n);
     cli_parser p;
@@ -294,6 +311,17 @@ int cli_render_parse(int argc, char **argv, cli_render_opts *o, void (*help)(FIL
             o->defines[o->ndefines++] = v;
             break;
         case OPT_QUIET: o->quiet = 1; break;
+        case OPT_DENOISE: o->denoise = 1; break;
+        case OPT_NO_DENOISE: o->denoise = 0; break;
+        case OPT_DENOISE_QUALITY:
+            if (strcmp(v, "high") == 0)
+                o->denoise_fast = 0;
+            else if (strcmp(v, "fast") == 0)
+                o->denoise_fast = 1;
+            else
+                return cli_usage_error("--denoise-quality: expected high or fast, not '%s'", v);
+            break;
+        case OPT_WEIGHTS: o->weights = v; break;
         default:
             if (opts[p.index].id >= CLI_RENDER_EXTRA && opts[p.index].id < CLI_RENDER_EXTRA + CLI_RENDER_MAX_EXTRA)
                 o->extra[opts[p.index].id - CLI_RENDER_EXTRA] = v ? v : "";
@@ -551,6 +579,15 @@ int cli_render_check(const cli_render_opts *o, pk_write_options *wo)
     return 0;
 }
 
+int cli_render_clean_default(const cli_render_opts *o, const pk_scene *scene)
+{
+    size_t n;
+    const cli_option *opts = cli_render_options(&n);
+    for (size_t i = 0; i < n; i++)
+        if (o->int_set[i] && opts[i].render && strcmp(opts[i].render->name, "spp") == 0) return 0;
+    return o->time <= 0.0 && !pk_scene_has_sample_count(scene);
+}
+
 pk_status cli_render_settings(pk_context *ctx, const cli_render_opts *o, pk_scene *scene, pk_render_options *ro)
 {
     pk_scene_get_render_options(scene, ro);
@@ -565,6 +602,7 @@ pk_status cli_render_settings(pk_context *ctx, const cli_render_opts *o, pk_scen
         if (o->device == PK_DEVICE_CPU && ro->accel == PK_ACCEL_CUDA) ro->accel = PK_ACCEL_DEFAULT;
     }
     if (o->has_integrator) ro->integrator = o->integrator;
+    if (cli_render_clean_default(o, scene)) ro->spp = CLI_CLEAN_SPP;
     ro->collect_stats = o->stats || o->stats_json;
     if (cli_configure(ctx, o->config) != 0) return PK_ERR_INVALID_ARGUMENT; /* (checked at parsing) */
     pk_status st = pk_render_options_check(ctx, ro);

@@ -349,6 +349,9 @@ PK_API void pk_scene_get_camera(const pk_scene *scene, pk_camera *cam);
 PK_API pk_status pk_scene_set_camera(pk_context *ctx, pk_scene *scene, const pk_camera *cam);
 /* The scene's own render settings (JSON "render") over the defaults. */
 PK_API void pk_scene_get_render_options(const pk_scene *scene, pk_render_options *opt);
+/* Non-zero when the scene file names its samples per pixel (a JSON
+ * "render.spp", a Mitsuba sampler's sample_count). */
+PK_API int pk_scene_has_sample_count(const pk_scene *scene);
 
 /* ---- images ------------------------------------------------------------ */
 
@@ -362,6 +365,12 @@ PK_API int pk_image_height(const pk_image *img);
 /* 3 floats per pixel; owned by img. */
 PK_API float *pk_image_pixels(pk_image *img);
 PK_API const float *pk_image_pixels_const(const pk_image *img);
+/* Reads an image file (PNG, JPEG, OpenEXR, Radiance .hdr, PFM; told by its
+ * first bytes) as linear RGB: 8-bit files are decoded from sRGB, grey is
+ * copied to the three channels, alpha dropped. layer (NULL: the image
+ * itself) reads the channels LAYER.R, LAYER.G, LAYER.B of an OpenEXR file,
+ * as --aov writes them ("albedo", "normal"). */
+PK_API pk_status pk_image_read(pk_context *ctx, const char *path, const char *layer, pk_image **out);
 /* Writes by extension (any case):
  *   .png  8-bit sRGB, through the tone curve below;
  *   .pfm  linear float RGB, the values as they are;

@@ -281,6 +281,8 @@ void pk_scene_get_render_options(const pk_scene *s, pk_render_options *opt)
     if (r->has_integrator) opt->integrator = r->opt.integrator;
 }
 
+int pk_scene_has_sample_count(const pk_scene *s) { return s && s->render.has_spp; }
+
 /* ---- images ---------------------------------------------------------------- */
 
 pk_status pk_image_create(pk_context *ctx, int width, int height, pk_image **out)

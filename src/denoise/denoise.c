@@ -327,7 +327,7 @@ pk_status denoise_raw(pk_denoiser *d, int w, int h, const float *color, const fl
     for (size_t i = 0; i < 3 * npx; i++)
         if (!(color[i] >= 0.0f) || !isfinite(color[i])) bad++;
     if (bad)
-        ctx_warn(ctx, "denoise: %zu colour values were negative or not finite; the denoiser took them as 0", bad);
+        ctx_warn(ctx, "denoise: colour values that were negative or not finite, taken as 0: %zu", bad);
     const int ic = unet_input_channels(d->net);
     if ((ic >= 6 && !albedo) || (ic >= 9 && !normal) || (ic != 3 && ic != 6 && ic != 9))
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: a network of %d input channels needs %s", d->loaded, ic,

@@ -6,6 +6,8 @@
  */
 #include "image_read.h"
 
+#include "image.h"
+
 #include <limits.h>
 #include <math.h>
 #include <setjmp.h>
@@ -256,13 +258,21 @@ static int64_t exr_on_size(exr_const_context_t e, void *user)
     return (int64_t)((exr_src *)user)->size;
 }
 
-/* Which of the file's channels go where: index into out's nc samples, -1 = skipped. */
-static int exr_pick_channels(const exr_attr_chlist_t *cl, int map[], int *nc)
+/* Which of the file's channels go where: index into out's nc samples, -1 =
+ * skipped. layer (NULL: the image's own channels) picks LAYER.R/G/B/A/Y. */
+static int exr_pick_channels(const exr_attr_chlist_t *cl, const char *layer, int map[], int *nc)
 {
     int r = -1, g = -1, b = -1, a = -1, y = -1;
+    const size_t lp = layer ? strlen(layer) : 0;
     for (int i = 0; i < cl->num_channels; i++) {
         const char *n = cl->entries[i].name.str;
         if (!n) continue;
+        if (layer) {
+            if (strncmp(n, layer, lp) != 0 || n[lp] != '.') continue;
+            n += lp + 1;
+        } else if (strchr(n, '.')) {
+            continue; /* another layer's */
+        }
         if (!strcmp(n, "R")) r = i;
         else if (!strcmp(n, "G")) g = i;
         else if (!strcmp(n, "B")) b = i;
@@ -275,7 +285,7 @@ static int exr_pick_channels(const exr_attr_chlist_t *cl, int map[], int *nc)
         *nc = 3;
     } else {
         int grey = y >= 0 ? y : r >= 0 ? r : g >= 0 ? g : b >= 0 ? b : -1;
-        if (grey < 0) { /* anything: the first channel that is not alpha */
+        if (grey < 0 && !layer) { /* anything: the first channel that is not alpha */
             for (int i = 0; i < cl->num_channels && grey < 0; i++)
                 if (i != a) grey = i;
         }
@@ -288,6 +298,12 @@ static int exr_pick_channels(const exr_attr_chlist_t *cl, int map[], int *nc)
 }
 
 pk_status image_decode_exr(pk_context *ctx, const void *data, size_t size, const char *name, image_buf *out)
+{
+    return image_decode_exr_layer(ctx, data, size, name, NULL, out);
+}
+
+pk_status image_decode_exr_layer(pk_context *ctx, const void *data, size_t size, const char *name, const char *layer,
+                                 image_buf *out)
 {
     memset(out, 0, sizeof *out);
     exr_src src = {data, size, ""};
@@ -323,8 +339,12 @@ pk_status image_decode_exr(pk_context *ctx, const void *data, size_t size, const
     const exr_attr_chlist_t *cl = NULL;
     if ((rv = exr_get_channels(e, 0, &cl)) != EXR_ERR_SUCCESS) goto exr_fail;
     int nc = 0;
-    if (!cl || cl->num_channels <= 0 || cl->num_channels > 128 || exr_pick_channels(cl, map, &nc) != 0) {
-        st = ctx_error(ctx, PK_ERR_UNSUPPORTED, "%s: OpenEXR image has no usable channel", name);
+    if (!cl || cl->num_channels <= 0 || cl->num_channels > 128 || exr_pick_channels(cl, layer, map, &nc) != 0) {
+        if (layer)
+            st = ctx_error(ctx, PK_ERR_PARSE, "%s: OpenEXR image has no layer '%s' (channels %s.R, %s.G, %s.B)", name,
+                           layer, layer, layer, layer);
+        else
+            st = ctx_error(ctx, PK_ERR_UNSUPPORTED, "%s: OpenEXR image has no usable channel", name);
         goto done;
     }
     for (int i = 0; i < cl->num_channels; i++)
@@ -676,4 +696,35 @@ pk_status image_load_rgb(pk_context *ctx, const char *path, int *w, int *h, floa
     *rgb = o;
     image_buf_free(&ctx->alloc, &img);
     return PK_OK;
+}
+
+pk_status pk_image_read(pk_context *ctx, const char *path, const char *layer, pk_image **out)
+{
+    if (!ctx || !out) return PK_ERR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!path) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "image: no file name");
+    char *data;
+    size_t size;
+    pk_status st = file_read_all(ctx, path, &data, &size);
+    if (st != PK_OK) return st;
+    image_buf img;
+    if (layer && image_sniff(data, size) != IMAGE_EXR)
+        st = ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: layer '%s' asked of an image that is not OpenEXR", path, layer);
+    else
+        st = layer ? image_decode_exr_layer(ctx, data, size, path, layer, &img) : image_decode(ctx, data, size, path, &img);
+    mem_free(&ctx->alloc, data);
+    if (st != PK_OK) return st;
+    pk_image *im;
+    if ((st = image_create(ctx, img.w, img.h, &im)) == PK_OK) {
+        const size_t np = (size_t)img.w * (size_t)img.h;
+        const int nc = img.nc, colour = nc >= 3;
+        for (size_t i = 0; i < np; i++)
+            for (int c = 0; c < 3; c++) {
+                size_t k = i * (size_t)nc + (size_t)(colour ? c : 0);
+                im->pixels[3 * i + (size_t)c] = img.pxf ? img.pxf[k] : image_srgb_to_linear[img.px8[k]];
+            }
+        *out = im;
+    }
+    image_buf_free(&ctx->alloc, &img);
+    return st;
 }

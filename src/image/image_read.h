@@ -46,6 +46,10 @@ PK_HIDDEN pk_status image_decode(pk_context *ctx, const void *data, size_t size,
 PK_HIDDEN pk_status image_decode_png(pk_context *ctx, const void *data, size_t size, const char *name, image_buf *out);
 PK_HIDDEN pk_status image_decode_jpeg(pk_context *ctx, const void *data, size_t size, const char *name, image_buf *out);
 PK_HIDDEN pk_status image_decode_exr(pk_context *ctx, const void *data, size_t size, const char *name, image_buf *out);
+/* The channels LAYER.R, LAYER.G, LAYER.B (and .A, or .Y alone) of an
+ * OpenEXR image (layer NULL: the channels without a layer prefix). */
+PK_HIDDEN pk_status image_decode_exr_layer(pk_context *ctx, const void *data, size_t size, const char *name,
+                                           const char *layer, image_buf *out);
 PK_HIDDEN pk_status image_decode_hdr(pk_context *ctx, const void *data, size_t size, const char *name, image_buf *out);
 PK_HIDDEN pk_status image_decode_pfm(pk_context *ctx, const void *data, size_t size, const char *name, image_buf *out);
 PK_HIDDEN void image_buf_free(const pk_allocator *a, image_buf *img);

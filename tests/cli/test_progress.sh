@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The progress bar: on a terminal (a pty from `script`) stderr shows a bar
 # redrawn in place ('\r', percentage, elapsed time, ETA) and then one line
-# "wrote OUT (WxH, T)"; stdout (--stats) holds none of it; a pipe or a file
+# "wrote OUT (WxH, N spp[, denoised], T)"; stdout (--stats) holds none of it; a pipe or a file
 # gets neither, and --quiet silences both.
 # usage: test_progress.sh PAPRSEK SHARED_DIR DATA_DIR
 set -u
@@ -35,7 +35,7 @@ elif [ "$bars" -lt 2 ]; then
   bad "on a terminal: $bars bar(s), wanted the first and at least the last: $tty"
 elif ! grep -qE '^\[#+\] 100%  .*, done' <<<"$tty"; then
   bad "on a terminal: no full bar at 100%: $tty"
-elif ! grep -qE "^wrote $tmp/a.png \(256x256, [0-9.:]+( s)?\)$" <<<"$tty"; then
+elif ! grep -qE "^wrote $tmp/a.png \(256x256, [0-9]+ spp(, denoised)?, [0-9.:]+( s)?\)$" <<<"$tty"; then
   bad "on a terminal: no 'wrote $tmp/a.png (256x256, ...)' line: $tty"
 else
   echo "ok   on a terminal: $bars redraws of the bar, then '$(grep '^wrote' <<<"$tty")'"

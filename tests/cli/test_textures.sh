@@ -53,7 +53,7 @@ grep -Eq '"texture_bytes": [1-9][0-9]*' "$tmp/json" && ok "--stats-json has text
 
 # the quad's albedo AOV is its texture: red, green, blue, white quarters
 "$bin" render "$data/tex_quad.obj" -o "$tmp/q.pfm" --width 8 --height 8 --look-from 0,0,2.7474774 --look-at 0,0,0 \
-  --fov 40 --aov albedo --quiet --integrator whitted
+  --fov 40 --aov albedo --quiet --integrator whitted --spp 1
 # pixel (2, 2) from the top left (file row 5: PFM rows run bottom to top) is 1/8 of a texel
 # right of and below the red texel's centre: bilinear weights 49/64 red, 7/64 green, 7/64
 # blue, 1/64 white give (0.78125, 0.125, 0.125)

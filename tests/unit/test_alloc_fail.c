@@ -2,7 +2,9 @@
  * test_alloc_fail.c - fault injection (as SQLite's test_malloc.c): an
  * allocator that fails the Nth allocation, swept over N through three runs:
  * an OBJ load and a small render, the built-in Cornell box, and a JSON scene
- * that reads meshes and a material library, rendered and written. Every failure must come back as PK_ERR_NOMEM (or the
+ * that reads meshes and a material library, rendered and written; and the
+ * denoiser (weights loaded, network planned, an image denoised) when the
+ * weights are there. Every failure must come back as PK_ERR_NOMEM (or the
  * load's own error) without a crash, and every block taken must be freed
  * (the live-block count returns to zero; ASan builds check the rest).
  */
@@ -57,7 +59,30 @@ static const char *json_text =
     "  \"lights\": [ { \"position\": [0, 3, 2], \"intensity\": 5 } ],\n"
     "  \"camera\": { \"look_from\": [0, 1, 5], \"look_at\": [0, 0.5, 0] } }\n";
 
-enum { RUN_OBJ, RUN_CORNELL, RUN_JSON };
+enum { RUN_OBJ, RUN_CORNELL, RUN_JSON, RUN_DENOISE };
+
+/* The denoiser's small network on a 20x12 image with albedo and normal. */
+static pk_status run_denoise(pk_context *ctx)
+{
+    pk_image *im[3] = {NULL, NULL, NULL}, *out = NULL;
+    pk_status st = PK_OK;
+    for (int k = 0; k < 3 && st == PK_OK; k++) {
+        st = pk_image_create(ctx, 20, 12, &im[k]);
+        if (st != PK_OK) break;
+        float *p = pk_image_pixels(im[k]);
+        for (int i = 0; i < 20 * 12 * 3; i++) p[i] = k == 2 ? (i % 3 == 2 ? 1.0f : 0.0f) : 0.1f * (float)(i % 7);
+    }
+    pk_denoise_options o;
+    pk_denoise_options_init(&o);
+    o.weights = PK_WEIGHTS_DIR;
+    o.quality = PK_DENOISE_FAST;
+    o.threads = 2;
+    if (st == PK_OK) st = pk_denoise(ctx, &o, im[0], im[1], im[2], &out);
+    if (st == PK_OK) CHECK(out != NULL);
+    for (int k = 0; k < 3; k++) pk_image_destroy(im[k]);
+    pk_image_destroy(out);
+    return st;
+}
 
 /* One run with the Nth allocation failing; returns the status of the first failing step. */
 static pk_status run(fail_alloc *f, int mode)
@@ -69,6 +94,12 @@ static pk_status run(fail_alloc *f, int mode)
     if (st != PK_OK) return st;
     pk_scene *s = NULL;
     pk_image *img = NULL;
+    if (mode == RUN_DENOISE) {
+        st = run_denoise(ctx);
+        if (st != PK_OK) CHECKF(pk_context_error(ctx)[0] != '\0', "status %d without a message", (int)st);
+        pk_context_destroy(ctx);
+        return st;
+    }
     if (mode == RUN_JSON)
         st = pk_scene_load_json_memory(ctx, json_text, strlen(json_text), "scene.json", PK_TEST_DATA, &s);
     else
@@ -120,7 +151,8 @@ static void sweep(int mode)
         }
     }
     printf("%s: %ld allocations, each failed once: %ld reported out of memory, no leaks\n",
-           mode == RUN_CORNELL ? "cornell box + bvh render"
+           mode == RUN_DENOISE ? "denoiser (weights, network, a 20x12 image)"
+           : mode == RUN_CORNELL ? "cornell box + bvh render"
            : mode == RUN_JSON  ? "json scene (meshes, MTL) + bvh render + PNG write"
                                : "obj load + midpoint render",
            total, nomem);
@@ -131,5 +163,16 @@ int main(void)
     sweep(RUN_OBJ);
     sweep(RUN_CORNELL);
     sweep(RUN_JSON);
+    char probe[512];
+    snprintf(probe, sizeof probe, "%s/rt_hdr_alb_nrm_small.tza", PK_WEIGHTS_DIR);
+    pk_context *ctx = NULL;
+    pk_context_create(NULL, &ctx);
+    if (access(probe, R_OK) != 0)
+        printf("denoiser sweep skipped: no weights at %s (make weights)\n", PK_WEIGHTS_DIR);
+    else if (pk_denoise_check(ctx, NULL) != PK_OK && strstr(pk_context_error(ctx), "oneDNN"))
+        printf("denoiser sweep skipped: %s\n", pk_context_error(ctx));
+    else
+        sweep(RUN_DENOISE);
+    pk_context_destroy(ctx);
     return test_done("test_alloc_fail");
 }
