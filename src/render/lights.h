@@ -5,6 +5,21 @@
  * shading context, with its radiance and solid-angle pdf, and that pdf for
  * a direction found otherwise (MIS). Built once per renderer; every
  * function below is PK_HD, so the GPU's path tracer runs the same code.
+ *
+ * Triangles are sampled by the solid angle they subtend
+ * (spherical_triangle.h), optionally warped toward the cosine at the
+ * receiver, or by area (LIGHT_TRI_*): the path tracer's light_sample_li and
+ * light_pdf_li use the warped solid angle, the Whitted integrator asks for
+ * area (light_sample_one_with). Solid-angle sampling spends no samples on
+ * the parts of a near light that look small from the receiver (area
+ * sampling's r^2 / cos in the estimate is what makes fireflies next to
+ * lights), and the warp follows the receiver's cosine across the light.
+ * Where the triangle subtends less than SPH_TRI_MIN_SOLID_ANGLE area
+ * sampling is as good and cheaper, and from almost on it (more than
+ * SPH_TRI_MAX_SOLID_ANGLE) more robust, so the solid-angle modes fall back
+ * to it there. In every mode the pdf that sampling returns and the one
+ * light_pdf_at (light_pdf_li) gives for the same direction are the same
+ * function of (receiver, direction), as MIS needs.
  */
 #ifndef PK_LIGHTS_H
 #define PK_LIGHTS_H
@@ -14,6 +29,7 @@
 #include "../scene/scene_view.h"
 #include "env.h"
 #include "sampling.h"
+#include "spherical_triangle.h"
 
 enum { LIGHT_TRIANGLE, LIGHT_SPHERE, LIGHT_POINT, LIGHT_ENV, LIGHT_SUN };
 
@@ -45,6 +61,13 @@ static inline PK_HD size_t light_set_pick(const light_set *ls, float u) { return
 
 #define SHADOW_SHORTEN 1e-3f  /* shadow rays toward area lights stop this fraction short of them */
 
+/* How triangle lights are sampled (light_sample_one_with, light_pdf_at). */
+enum {
+    LIGHT_TRI_SOLID_ANGLE = 0, /* uniform in the subtended solid angle */
+    LIGHT_TRI_AREA = 1,        /* uniform in area (the Whitted integrator: cheaper, its images unchanged) */
+    LIGHT_TRI_SOLID_ANGLE_COS = 2 /* the solid angle warped toward |cos| at the receiver of normal n */
+};
+
 /* Where light is gathered: the shading point p, its geometric normal n
  * (zero for a point in a medium), o where shadow rays leave (p moved off
  * the surface), and whether every emitter counts as two-sided (the Whitted
@@ -62,9 +85,10 @@ typedef struct light_sample {
     ray shadow;
 } light_sample;
 
-/* Solid-angle pdf of light l (a triangle or sphere of s) sampling the point
- * q, of normal nq, from p, the choice of the light excluded. */
-static inline PK_HD float light_pdf_li(const scene_view *s, const light *l, vec3 p, vec3 q, vec3 nq)
+/* Solid-angle pdf of light l (a triangle or sphere of s) sampled by area
+ * (a sphere seen from outside: uniform in its cone) at the point q, of
+ * normal nq, from p, the choice of the light excluded. */
+static inline PK_HD float light_pdf_area(const scene_view *s, const light *l, vec3 p, vec3 q, vec3 nq)
 {
     vec3 d = v3_sub(q, p);
     float dist2 = v3_len2(d);
@@ -84,10 +108,95 @@ static inline PK_HD float light_pdf_li(const scene_view *s, const light *l, vec3
     return dist2 / (cos_l * l->area);
 }
 
-/* Samples light li of the set from lc with (u1, u2): false when it sends
- * nothing toward lc->p. ls->pdf excludes the light's choice. */
-static inline PK_HD bool light_sample_one(const light_set *set, const scene_view *s, const env_light *e, size_t li,
-                                          const light_ctx *lc, float u1, float u2, light_sample *ls)
+/* Whether triangle light l is sampled by its solid angle from p (else by
+ * area), with the spherical triangle *st when it is: the one rule of both
+ * the sampling and the pdf. */
+static inline PK_HD bool light_tri_spherical(const scene_view *s, const light *l, vec3 p, sph_tri *st)
+{
+    vec3 a, b, c;
+    view_tri_verts(s, l->index, &a, &b, &c);
+    return sph_tri_setup(st, p, a, b, c, SPH_TRI_MIN_SOLID_ANGLE, SPH_TRI_MAX_SOLID_ANGLE);
+}
+
+/* Solid-angle pdf of light l (a triangle or sphere of s) sampling the point
+ * q, of normal nq, from p with the receiver normal n and triangle mode tri
+ * (LIGHT_TRI_*), the choice of the light excluded: what light_sample_one
+ * returns as pdf for the direction from p to q. */
+static inline PK_HD float light_pdf_at(const scene_view *s, const light *l, vec3 p, vec3 n, uint32_t tri, vec3 q,
+                                       vec3 nq)
+{
+    if (l->kind == LIGHT_TRIANGLE && tri != LIGHT_TRI_AREA) {
+        sph_tri st;
+        if (light_tri_spherical(s, l, p, &st)) {
+            if (tri != LIGHT_TRI_SOLID_ANGLE_COS) return 1.0f / st.area;
+            float u0, u1, w[4];
+            sph_tri_invert(&st, v3_norm_scaled(v3_sub(q, p)), &u0, &u1);
+            sph_tri_cos_weights(&st, n, w);
+            return bilinear_pdf(u0, u1, w) / st.area;
+        }
+    }
+    return light_pdf_area(s, l, p, q, nq);
+}
+
+/* The same for the path tracer's mode (LIGHT_TRI_SOLID_ANGLE_COS): n is
+ * the receiver's normal, what light_ctx.n was when it sampled lights. */
+static inline PK_HD float light_pdf_li(const scene_view *s, const light *l, vec3 p, vec3 n, vec3 q, vec3 nq)
+{
+    return light_pdf_at(s, l, p, n, LIGHT_TRI_SOLID_ANGLE_COS, q, nq);
+}
+
+/* Samples triangle light l (material m) by the solid angle st it subtends
+ * from lc->p: false when it sends nothing toward lc->p. */
+static inline PK_HD bool light_sample_tri_solid_angle(const scene_view *s, const light *l, const material *m,
+                                                      const light_ctx *lc, uint32_t tri, const sph_tri *st, float u1,
+                                                      float u2, light_sample *ls)
+{
+    vec3 v0, v1, v2;
+    view_tri_verts(s, l->index, &v0, &v1, &v2);
+    const vec3 p = lc->p, o = lc->o;
+    const bool front = v3_dot(l->normal, v3_sub(p, v0)) > 0.0f;
+    if (!front && !m->two_sided && !lc->two_sided) return false;
+    float x = u1, y = u2, pdf;
+    if (tri == LIGHT_TRI_SOLID_ANGLE_COS) {
+        float w[4];
+        sph_tri_cos_weights(st, lc->n, w);
+        sample_bilinear(u1, u2, w, &x, &y);
+        pdf = bilinear_pdf(x, y, w) / st->area;
+    } else {
+        pdf = 1.0f / st->area;
+    }
+    const vec3 w = sph_tri_sample(st, x, y);
+    /* where w meets the triangle (Moeller-Trumbore), kept on it */
+    const vec3 e1 = v3_sub(v1, v0), e2 = v3_sub(v2, v0), s1 = v3_cross(w, e2);
+    const float div = v3_dot(s1, e1);
+    if (!(fabsf(div) > 0.0f)) return false;
+    const vec3 sv = v3_sub(p, v0);
+    float b1 = v3_dot(sv, s1) / div, b2 = v3_dot(w, v3_cross(sv, e1)) / div;
+    b1 = b1 > 0.0f ? b1 : 0.0f, b2 = b2 > 0.0f ? b2 : 0.0f;
+    if (b1 + b2 > 1.0f) {
+        const float sum = b1 + b2;
+        b1 /= sum, b2 /= sum;
+    }
+    const vec3 q = v3_add(v3_add(v3_scale(v0, 1.0f - b1 - b2), v3_scale(v1, b1)), v3_scale(v2, b2));
+    if (!(pdf > 0.0f) || !isfinite(pdf) || !v3_finite(q)) return false;
+    const vec3 d = v3_sub(q, o);
+    const float dist2 = v3_len2(d);
+    if (!(dist2 > 0.0f)) return false;
+    ls->wi = v3_scale(d, 1.0f / sqrtf(dist2));
+    ls->le = m->ke;
+    ls->pdf = pdf;
+    ls->delta = false;
+    ls->shadow = (ray){o, 0.0f, d, 1.0f - SHADOW_SHORTEN};
+    return true;
+}
+
+/* Samples light li of the set from lc with (u1, u2), triangles as tri
+ * says (LIGHT_TRI_*): false when it sends nothing toward lc->p. ls->pdf
+ * excludes the light's choice; it is light_pdf_at(s, l, lc->p, lc->n, tri,
+ * the point sampled, its normal). */
+static inline PK_HD bool light_sample_one_with(const light_set *set, const scene_view *s, const env_light *e,
+                                               size_t li, const light_ctx *lc, uint32_t tri, float u1, float u2,
+                                               light_sample *ls)
 {
     const light *l = &set->lights[li];
     const vec3 o = lc->o, p = lc->p;
@@ -122,11 +231,15 @@ static inline PK_HD bool light_sample_one(const light_set *set, const scene_view
     }
     const material *m;
     if (l->kind == LIGHT_TRIANGLE) {
+        m = &s->materials[s->tris[l->index].material];
+        if (tri != LIGHT_TRI_AREA) {
+            sph_tri st;
+            if (light_tri_spherical(s, l, p, &st)) return light_sample_tri_solid_angle(s, l, m, lc, tri, &st, u1, u2, ls);
+        }
         vec3 a, b, c;
         view_tri_verts(s, l->index, &a, &b, &c);
         q = sample_triangle(a, b, c, u1, u2);
         nq = l->normal;
-        m = &s->materials[s->tris[l->index].material];
         vec3 toward = v3_sub(p, q);
         bool front = v3_dot(nq, toward) > 0.0f;
         if (!front && !m->two_sided && !lc->two_sided) return false;
@@ -160,7 +273,7 @@ static inline PK_HD bool light_sample_one(const light_set *set, const scene_view
         }
     }
     le = m->ke;
-    pdf = light_pdf_li(s, l, p, q, nq);
+    pdf = light_pdf_area(s, l, p, q, nq);
     if (!(pdf > 0.0f) || !isfinite(pdf)) return false;
     vec3 d = v3_sub(q, o);
     float dist2 = v3_len2(d);
@@ -173,18 +286,35 @@ static inline PK_HD bool light_sample_one(const light_set *set, const scene_view
     return true;
 }
 
-/* One light chosen by power with u0, then sampled with (u1, u2); ls->pdf
- * includes the choice. */
-static inline PK_HD bool light_sample_li(const light_set *set, const scene_view *s, const env_light *e,
-                                         const light_ctx *lc, float u0, float u1, float u2, light_sample *ls)
+/* The same with the path tracer's triangles (LIGHT_TRI_SOLID_ANGLE_COS),
+ * whose pdf is light_pdf_li. */
+static inline PK_HD bool light_sample_one(const light_set *set, const scene_view *s, const env_light *e, size_t li,
+                                          const light_ctx *lc, float u1, float u2, light_sample *ls)
+{
+    return light_sample_one_with(set, s, e, li, lc, LIGHT_TRI_SOLID_ANGLE_COS, u1, u2, ls);
+}
+
+/* One light chosen by power with u0, then sampled with (u1, u2), triangles
+ * as tri says; ls->pdf includes the choice. */
+static inline PK_HD bool light_sample_li_with(const light_set *set, const scene_view *s, const env_light *e,
+                                              const light_ctx *lc, uint32_t tri, float u0, float u1, float u2,
+                                              light_sample *ls)
 {
     if (set->n == 0) return false;
     size_t li = light_set_pick(set, u0);
     const float psel = set->pmf[li];
     if (!(psel > 0.0f)) return false;
-    if (!light_sample_one(set, s, e, li, lc, u1, u2, ls)) return false;
+    if (!light_sample_one_with(set, s, e, li, lc, tri, u1, u2, ls)) return false;
     ls->pdf = psel * ls->pdf;
     return true;
+}
+
+/* The path tracer's: triangles by solid angle warped toward the cosine at
+ * lc->n; the pdf of a direction found otherwise is pmf * light_pdf_li. */
+static inline PK_HD bool light_sample_li(const light_set *set, const scene_view *s, const env_light *e,
+                                         const light_ctx *lc, float u0, float u1, float u2, light_sample *ls)
+{
+    return light_sample_li_with(set, s, e, lc, LIGHT_TRI_SOLID_ANGLE_COS, u0, u1, u2, ls);
 }
 
 #endif

@@ -108,6 +108,7 @@ typedef struct path_state {
     bool prev_delta;   /* the last bounce was a delta one (the camera counts as one) */
     float prev_pdf;    /* its solid-angle pdf */
     vec3 prev_p;       /* the vertex it left */
+    vec3 prev_n;       /* its geometric normal (light_pdf_li: triangles are sampled toward its cosine) */
     float cone;        /* the ray cone's width where the path left the last vertex */
     int depth;
     sampler smp;
@@ -202,6 +203,7 @@ static inline PK_HD void path_begin(path_state *ps, const ray *r, const hit *h, 
     ps->prev_delta = true; /* the camera: emission is counted in full */
     ps->prev_pdf = 0.0f;
     ps->prev_p = r->o;
+    ps->prev_n = v3s(0.0f);
     ps->cone = 0.0f;
     ps->depth = 0;
     ps->smp = *smp;
@@ -241,7 +243,7 @@ static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_s
             int32_t li = pt->lights.of_prim[ps->h.prim];
             if (li >= 0) {
                 const light *l = &pt->lights.lights[li];
-                float pl = pt->lights.pmf[li] * light_pdf_li(s, l, ps->prev_p, sf.p,
+                float pl = pt->lights.pmf[li] * light_pdf_li(s, l, ps->prev_p, ps->prev_n, sf.p,
                                                               l->kind == LIGHT_TRIANGLE ? l->normal : sf.ng);
                 w = power_heuristic(ps->prev_pdf, pl);
             }
@@ -293,6 +295,7 @@ static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_s
     ps->prev_delta = delta;
     ps->prev_pdf = pdf;
     ps->prev_p = sf.p;
+    ps->prev_n = sf.ng;
     t->rays_bounce++;
     if (!PATH_TRACE(pt, t, &ps->r, &ps->h)) {
         if (aov && aov->open) path_aov_miss(pt, aov, wi, ps->beta); /* (open: the vertex left was specular) */

@@ -60,8 +60,9 @@ static vec3 trace(const whitted *w, whitted_thread *ts, const ray *r, int depth,
  * the frame's light set (emissive triangles and the environment; emissive
  * spheres are not lights here) chosen by the set's weights, stratified in
  * the choice; the offset within the chosen light's stratum is reused as its
- * first coordinate. Every emitter is two-sided here. Shadow rays go to the
- * accelerator as one batch. */
+ * first coordinate. Every emitter is two-sided here, and triangles are
+ * sampled by area (cheaper than the path tracer's solid angle; lights.h).
+ * Shadow rays go to the accelerator as one batch. */
 /* flatten: the lights' sampling inlined here, as it is into the path tracer's step */
 __attribute__((flatten)) static vec3 direct_light(const whitted *w, whitted_thread *ts, const surface *sf, vec3 wo)
 {
@@ -77,7 +78,7 @@ __attribute__((flatten)) static vec3 direct_light(const whitted *w, whitted_thre
         const size_t li = w->single[j];
         const uint32_t kind = set->lights[li].kind;
         const float u1 = kind == LIGHT_SUN ? rng_float(&ts->rng) : 0.5f, u2 = kind == LIGHT_SUN ? rng_float(&ts->rng) : 0.5f;
-        if (!light_sample_one(set, s, &fr->env, li, &lc, u1, u2, &ls)) continue;
+        if (!light_sample_one_with(set, s, &fr->env, li, &lc, LIGHT_TRI_AREA, u1, u2, &ls)) continue;
         vec3 f = brdf_cos(sf, wo, ls.wi);
         if (is_black(f)) continue;
         ts->shadow_weight[n] = v3_scale(v3_mul(f, ls.le), 1.0f / ls.pdf);
@@ -95,7 +96,8 @@ __attribute__((flatten)) static vec3 direct_light(const whitted *w, whitted_thre
             float u1 = (u - lo) / p_pick;
             u1 = u1 > 0.0f ? (u1 < 0x1.fffffep-1f ? u1 : 0x1.fffffep-1f) : 0.0f;
             const float u2 = rng_float(&ts->rng);
-            if (!(p_pick > 0.0f) || !light_sample_one(set, s, &fr->env, w->sampled[j], &lc, u1, u2, &ls)) continue;
+            if (!(p_pick > 0.0f) || !light_sample_one_with(set, s, &fr->env, w->sampled[j], &lc, LIGHT_TRI_AREA, u1, u2, &ls))
+                continue;
             vec3 f = brdf_cos(sf, wo, ls.wi);
             if (is_black(f)) continue;
             ts->shadow_weight[n] = v3_scale(v3_mul(f, ls.le), inv_n / (p_pick * ls.pdf));
