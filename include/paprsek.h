@@ -231,8 +231,10 @@ typedef struct pk_render_options {
  * averaged over the pixel like the image. A film holds those it was created
  * with (pk_film_create_aovs); renders fill them. */
 enum {
-    PK_AOV_ALBEDO = 1u,  /* the material's diffuse reflectance (0 where nothing is hit) */
-    PK_AOV_NORMAL = 2u,  /* the shading normal, world space, facing the camera */
+    PK_AOV_ALBEDO = 1u,  /* the material's diffuse reflectance; the path tracer takes it at the first
+                          * surface that is not a perfect mirror or glass, times their tint (what a
+                          * denoiser wants); emitters and the sky their colour over its largest part */
+    PK_AOV_NORMAL = 2u,  /* the shading normal, world space, facing the ray, at that same surface */
     PK_AOV_DEPTH = 4u,   /* distance from the camera to the hit (0 where nothing is hit) */
     PK_AOV_HEATMAP = 8u  /* acceleration-structure nodes visited + primitives tested by the camera ray */
 };
