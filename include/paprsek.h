@@ -442,6 +442,10 @@ PK_API pk_status pk_film_merge(pk_context *ctx, pk_film *dst, const pk_film *src
  * and one uint32_t (sample count) per pixel, rows top to bottom. */
 PK_API float *pk_film_sums(pk_film *film);
 PK_API uint32_t *pk_film_counts(pk_film *film);
+/* The raw sums of one AOV the film holds (aov: one PK_AOV_*), as pk_film_sums:
+ * 3 floats per pixel, rows top to bottom, over the samples pk_film_counts
+ * counts; NULL when the film does not hold it. */
+PK_API float *pk_film_aov_sums(pk_film *film, unsigned aov);
 /* A new image of the film's size: sum / count per pixel (0 where count is 0
  * or the mean is not finite). */
 PK_API pk_status pk_film_resolve(pk_context *ctx, const pk_film *film, pk_image **out);

@@ -474,6 +474,14 @@ int pk_film_height(const pk_film *film) { return film ? film->height : 0; }
 float *pk_film_sums(pk_film *film) { return film ? film->sums : NULL; }
 uint32_t *pk_film_counts(pk_film *film) { return film ? film->counts : NULL; }
 
+float *pk_film_aov_sums(pk_film *film, unsigned aov)
+{
+    if (!film) return NULL;
+    for (int k = 0; k < FILM_AOVS; k++)
+        if (aov == 1u << k) return film->aov[k]; /* NULL when not held */
+    return NULL;
+}
+
 void pk_film_clear(pk_film *film)
 {
     if (film) film_clear(film);
