@@ -10,16 +10,20 @@
  * and builds its own render session. Rank 0 deals tiles one at a time (two
  * outstanding per rank, so that a rank never waits for its next tile): a
  * rank that renders slowly asks less often and gets fewer tiles. Results
- * come back as the tile's sums and counts and are added into rank 0's film,
- * which is resolved and written like `paprsek render` writes it. Rank 0 also
- * renders, in a thread of its own, while its main thread deals and merges
- * (only that thread calls MPI).
+ * come back as the tile's sums and counts (and the sums of the AOVs the film
+ * holds: albedo and normal when the image is denoised, those of --aov) and
+ * are added into rank 0's film, which is resolved, denoised when `paprsek
+ * render` would denoise it, and written like `paprsek render` writes it.
+ * Rank 0 also renders, in a thread of its own, while its main thread deals
+ * and merges (only that thread calls MPI).
  *
  * Every pixel's samples depend only on the scene, the options, the pixel
  * and the pass, and each tile's sums are added once per pass into a film
  * that held the same sums as one process's film: the image is the single
  * process's image bit for bit, whatever the number of ranks and the order
- * in which tiles finish.
+ * in which tiles finish. The denoiser runs once, on rank 0, on that image
+ * and the AOVs merged the same way, and gives the same bits for any number
+ * of threads: the denoised image is `paprsek render`'s too.
  */
 #include "cli.h"
 
@@ -40,7 +44,7 @@
 enum {
     TAG_TILE = 1,   /* 0 -> rank: int32 tile index, pass */
     TAG_STOP = 2,   /* 0 -> rank: no more tiles (empty) */
-    TAG_RESULT = 3, /* rank -> 0: header + sums + counts of one tile */
+    TAG_RESULT = 3, /* rank -> 0: header + sums + counts (+ the AOVs' sums) of one tile */
     TAG_FAIL = 4    /* rank -> 0: a message: the rank could not render */
 };
 
@@ -59,6 +63,7 @@ static void on_signal(int sig)
 }
 
 static int g_rank, g_size;
+static unsigned g_aovs; /* the AOVs (PK_AOV_*) every film holds and every result carries */
 static char g_host[MPI_MAX_PROCESSOR_NAME];
 
 /* "paprsek-mpi: <fmt>" on stderr. */
@@ -349,49 +354,94 @@ static pk_status render_tile(job *j, int t, uint32_t pass, double *busy)
     return st;
 }
 
-/* The tile's sums and counts, from the scratch film into out (w*h*3 floats
- * then w*h counts), and the region cleared for the next tile. */
-static void take_tile(job *j, int t, unsigned char *out)
+/* The AOVs of g_aovs, lowest bit first: the order of their blocks in a result. */
+static int aov_list(unsigned out[4])
 {
-    const pk_region *g = &j->tiles[t];
-    float *sums = pk_film_sums(j->scratch);
-    uint32_t *counts = pk_film_counts(j->scratch);
-    const size_t row3 = 3 * (size_t)g->width * sizeof(float), row1 = (size_t)g->width * sizeof(uint32_t);
-    unsigned char *cp = out + (size_t)g->height * row3;
+    int n = 0;
+    for (unsigned a = PK_AOV_ALBEDO; a <= PK_AOV_HEATMAP; a <<= 1)
+        if (g_aovs & a) out[n++] = a;
+    return n;
+}
+
+/* 3 floats per pixel of the tile g, from a film's array (rows of width
+ * pixels) into out, row after row; those values zeroed in the film. */
+static void take_rgb(float *from, int width, const pk_region *g, unsigned char *out)
+{
+    const size_t row3 = 3 * (size_t)g->width * sizeof(float);
     for (int y = 0; y < g->height; y++) {
-        const size_t at = (size_t)(g->y + y) * (size_t)j->width + (size_t)g->x;
-        memcpy(out + (size_t)y * row3, sums + 3 * at, row3);
-        memcpy(cp + (size_t)y * row1, counts + at, row1);
-        memset(sums + 3 * at, 0, row3);
-        memset(counts + at, 0, row1);
+        const size_t at = (size_t)(g->y + y) * (size_t)width + (size_t)g->x;
+        memcpy(out + (size_t)y * row3, from + 3 * at, row3);
+        memset(from + 3 * at, 0, row3);
     }
 }
 
-/* Adds a tile taken by take_tile into film: each pixel's sums and count once,
- * as the renderer adds a tile (its region held what one process's film holds). */
-static void add_tile(pk_film *film, const pk_region *g, const unsigned char *in)
+/* The tile's sums and counts, from the scratch film into out (w*h*3 floats,
+ * w*h counts, then w*h*3 floats per AOV of g_aovs), and the region cleared
+ * for the next tile. */
+static void take_tile(job *j, int t, unsigned char *out)
 {
-    float *sums = pk_film_sums(film);
-    uint32_t *counts = pk_film_counts(film);
-    const int width = pk_film_width(film);
-    const size_t n = (size_t)g->width * (size_t)g->height;
+    const pk_region *g = &j->tiles[t];
+    uint32_t *counts = pk_film_counts(j->scratch);
+    const size_t n = (size_t)g->width * (size_t)g->height, row1 = (size_t)g->width * sizeof(uint32_t);
+    take_rgb(pk_film_sums(j->scratch), j->width, g, out);
+    unsigned char *cp = out + 3 * n * sizeof(float);
+    for (int y = 0; y < g->height; y++) {
+        const size_t at = (size_t)(g->y + y) * (size_t)j->width + (size_t)g->x;
+        memcpy(cp + (size_t)y * row1, counts + at, row1);
+        memset(counts + at, 0, row1);
+    }
+    unsigned aov[4];
+    const int na = aov_list(aov);
+    for (int k = 0; k < na; k++)
+        take_rgb(pk_film_aov_sums(j->scratch, aov[k]), j->width, g,
+                 out + n * (3 * sizeof(float) + sizeof(uint32_t)) + (size_t)k * 3 * n * sizeof(float));
+}
+
+/* dst (3 floats per pixel, rows of width pixels) += in over the tile g (3
+ * floats per pixel, row after row): one addition per value. */
+static void add_rgb(float *dst, int width, const pk_region *g, const unsigned char *in)
+{
     for (int y = 0; y < g->height; y++) {
         const size_t at = (size_t)(g->y + y) * (size_t)width + (size_t)g->x;
         for (int x = 0; x < g->width; x++) {
             const size_t q = (size_t)y * (size_t)g->width + (size_t)x;
             float v[3];
-            uint32_t c;
             memcpy(v, in + 3 * q * sizeof(float), sizeof v);
-            memcpy(&c, in + 3 * n * sizeof(float) + q * sizeof(uint32_t), sizeof c);
-            for (int k = 0; k < 3; k++) sums[3 * (at + (size_t)x) + (size_t)k] += v[k];
-            counts[at + (size_t)x] += c;
+            for (int k = 0; k < 3; k++) dst[3 * (at + (size_t)x) + (size_t)k] += v[k];
         }
     }
 }
 
+/* Adds a tile taken by take_tile into film: each pixel's sums, count and AOV
+ * sums once, as the renderer adds a tile (its region held what one process's
+ * film holds). */
+static void add_tile(pk_film *film, const pk_region *g, const unsigned char *in)
+{
+    uint32_t *counts = pk_film_counts(film);
+    const int width = pk_film_width(film);
+    const size_t n = (size_t)g->width * (size_t)g->height;
+    add_rgb(pk_film_sums(film), width, g, in);
+    for (int y = 0; y < g->height; y++) {
+        const size_t at = (size_t)(g->y + y) * (size_t)width + (size_t)g->x;
+        for (int x = 0; x < g->width; x++) {
+            uint32_t c;
+            memcpy(&c, in + 3 * n * sizeof(float) + ((size_t)y * (size_t)g->width + (size_t)x) * sizeof c, sizeof c);
+            counts[at + (size_t)x] += c;
+        }
+    }
+    unsigned aov[4];
+    const int na = aov_list(aov);
+    for (int k = 0; k < na; k++)
+        add_rgb(pk_film_aov_sums(film, aov[k]), width, g,
+                in + n * (3 * sizeof(float) + sizeof(uint32_t)) + (size_t)k * 3 * n * sizeof(float));
+}
+
+/* A result's bytes after its header: the sums and counts, and each AOV's sums. */
 static size_t tile_bytes(const pk_region *g)
 {
-    return (size_t)g->width * (size_t)g->height * (3 * sizeof(float) + sizeof(uint32_t));
+    unsigned aov[4];
+    const size_t na = (size_t)aov_list(aov);
+    return (size_t)g->width * (size_t)g->height * ((3 + 3 * na) * sizeof(float) + sizeof(uint32_t));
 }
 
 /* ---- ranks 1..N-1: render what rank 0 deals ------------------------------- */
@@ -636,7 +686,8 @@ static void mpi_help(FILE *f)
                         "other ranks (no shared file system is needed), deals tiles to the ranks as\n"
                         "they finish, and writes OUT. Each rank renders with --threads threads (by\n"
                         "default the cores mpirun lets it use: see --bind-to and --map-by in\n"
-                        "mpirun's manual). --aov is not available. Under mpirun the progress bar\n"
+                        "mpirun's manual). A denoised image (the default render, --denoise) is\n"
+                        "denoised once, by rank 0, after the merge. Under mpirun the progress bar\n"
                         "is drawn only with --progress (on standard output). Details:\n"
                         "docs/distributed.md.\n");
     fputs("\nUnder mpirun, Ctrl-C stops every rank (mpirun sends them SIGTERM and, a\n"
@@ -749,7 +800,6 @@ int main(int argc, char **argv)
     pk_write_options wo;
     if (g_rank == 0) {
         rc = cli_render_parse(argc - 1, argv + 1, &o, mpi_help);
-        if (rc == 0 && o.aovs) rc = cli_usage_error("--aov: not available in paprsek-mpi (use paprsek render)");
         if (rc == 0) rc = cli_render_check(&o, &wo);
     }
     MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD);
@@ -793,20 +843,32 @@ int main(int argc, char **argv)
     pk_render_options ro;
     /* Rank 0 loads the scene and applies the command line (which may read
      * files too, as an environment map) while its reader records; then the
-     * recorded files go to the other ranks, which do the same from them. */
-    int loaded0 = 1;
+     * recorded files go to the other ranks, which do the same from them.
+     * Rank 0 alone decides, as `paprsek render` does, whether the image is
+     * denoised (it alone needs the weights): loaded0[1] tells the others,
+     * whose films then hold the albedo and normal the denoiser takes. */
+    int loaded0[2] = {1, 0}; /* loaded; denoise: 1 yes, 0 no, -1 cannot (said) */
+    pk_denoise_options dopt;
+    pk_denoise_options_init(&dopt);
     if (g_rank == 0) {
         st = o.scene ? pk_scene_load_file_params(ctx, o.scene, o.defines, o.ndefines, &scene)
                     : pk_scene_create_cornell_box(ctx, &scene);
         if (st == PK_OK) st = cli_render_settings(ctx, &o, scene, &ro);
-        loaded0 = st == PK_OK;
+        loaded0[0] = st == PK_OK;
+        if (st == PK_OK) loaded0[1] = cli_render_wants_denoise(ctx, &o, scene, &dopt);
     }
-    MPI_Bcast(&loaded0, 1, MPI_INT, 0, MPI_COMM_WORLD);
-    if (!loaded0) { /* only rank 0 read anything: its message is the cause */
+    MPI_Bcast(loaded0, 2, MPI_INT, 0, MPI_COMM_WORLD);
+    if (!loaded0[0]) { /* only rank 0 read anything: its message is the cause */
         if (g_rank == 0) say("rank 0 on %s: %s", g_host, pk_context_error(ctx));
         rc = 1;
         goto finish;
     }
+    if (loaded0[1] < 0) { /* --denoise without weights: rank 0 said why */
+        rc = 1;
+        goto finish;
+    }
+    const int denoise = loaded0[1];
+    g_aovs = o.aovs | (denoise ? PK_AOV_ALBEDO | PK_AOV_NORMAL : 0u);
     int bcast_ok = 1;
     rep.bytes_sent += g_rank == 0 ? bcast_files(&files, &bcast_ok) : 0;
     if (g_rank == 0) {
@@ -825,8 +887,8 @@ int main(int argc, char **argv)
         ro.progress = NULL; /* the bar follows the tiles of the whole job */
         st = pk_renderer_create(ctx, scene, &ro, &r);
     }
-    if (bcast_ok && st == PK_OK) st = pk_film_create(ctx, ro.width, ro.height, &scratch);
-    if (bcast_ok && st == PK_OK && g_rank == 0) st = pk_film_create(ctx, ro.width, ro.height, &film);
+    if (bcast_ok && st == PK_OK) st = pk_film_create_aovs(ctx, ro.width, ro.height, g_aovs, &scratch);
+    if (bcast_ok && st == PK_OK && g_rank == 0) st = pk_film_create_aovs(ctx, ro.width, ro.height, g_aovs, &film);
     int ntiles = 0;
     size_t max_tile = 0;
     if (bcast_ok && st == PK_OK) {
@@ -968,8 +1030,20 @@ int main(int argc, char **argv)
     MPI_Gather(&rep, (int)sizeof rep, MPI_BYTE, reps, (int)sizeof rep, MPI_BYTE, 0, MPI_COMM_WORLD);
     if (g_rank == 0) {
         pk_image *img = NULL;
+        double dn_s = 0.0, dn_flops = 0.0;
+        size_t dn_bytes = 0;
         rc = 1;
-        if (pk_film_resolve(ctx, film, &img) == PK_OK && cli_render_write(ctx, &o, &wo, img, film) == PK_OK) {
+        st = pk_film_resolve(ctx, film, &img);
+        if (st == PK_OK && denoise) {
+            /* once, here, on the merged image: the weights come from rank
+             * 0's file system, not through the recording reader */
+            pk_context_set_file_reader(ctx, NULL, NULL);
+            snprintf(bar.note, sizeof bar.note, "denoising");
+            cli_progress_update(&bar, 999, 1000, cli_now() - t_start);
+            st = cli_render_denoise(ctx, &dopt, film, img, &dn_s, &dn_bytes, &dn_flops);
+            cli_progress_clear(&bar);
+        }
+        if (st == PK_OK && cli_render_write(ctx, &o, &wo, img, film) == PK_OK) {
             rc = 0;
         } else {
             const char *m = pk_context_error(ctx);
@@ -981,15 +1055,20 @@ int main(int argc, char **argv)
                 char took[32];
                 cli_format_duration(took, sizeof took, cli_now() - t_start);
                 if (o.time > 0.0)
-                    fprintf(bar.f, "wrote %s (%dx%d, %d ranks, %u passes of %d spp, %s)\n", o.out, ro.width,
-                            ro.height, g_size, passes, ro.spp, took);
+                    fprintf(bar.f, "wrote %s (%dx%d, %d ranks, %u passes of %d spp%s, %s)\n", o.out, ro.width,
+                            ro.height, g_size, passes, ro.spp, denoise ? ", denoised" : "", took);
                 else
-                    fprintf(bar.f, "wrote %s (%dx%d, %d ranks, %s)\n", o.out, ro.width, ro.height, g_size, took);
+                    fprintf(bar.f, "wrote %s (%dx%d, %d ranks, %d spp%s, %s)\n", o.out, ro.width, ro.height, g_size,
+                            ro.spp, denoise ? ", denoised" : "", took);
             }
             const char *name = o.scene ? o.scene : "cornell-box (built in)";
             pk_stats js = job_stats(reps, wall_s);
             if (o.stats) {
                 cli_print_stats(ctx, name, scene, &ro, &js);
+                if (denoise) /* as `paprsek render` prints it */
+                    printf("%-28s %.3f s, %.1f MiB, %.1f GFLOP/s (%s network)\n", "denoise", dn_s,
+                           (double)dn_bytes / (1024.0 * 1024.0), dn_s > 0 ? dn_flops / dn_s * 1e-9 : 0.0,
+                           o.denoise_fast ? "fast" : "high-quality");
                 printf("%-28s %u of %d spp\n", "passes", passes, ro.spp);
                 print_ranks(reps, &ro, wall_s, (uint64_t)ntiles * passes);
                 fflush(stdout);

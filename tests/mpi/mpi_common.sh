@@ -8,6 +8,10 @@ if [ -z "$mpi" ] || [ ! -x "$mpi" ] || [ -z "$mpiexec" ]; then
   echo "SKIP: paprsek-mpi is not built (MPI was not found, or -DPK_WITH_MPI=OFF: install libopenmpi-dev openmpi-bin and reconfigure)"
   exit 77
 fi
+if ! command -v "$mpiexec" >/dev/null 2>&1; then
+  echo "SKIP: mpirun ($mpiexec) is missing (install openmpi-bin)"
+  exit 77
+fi
 # Open MPI refuses to start as root without these.
 if [ "$(id -u)" = 0 ]; then export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1; fi
 # Sanitizer builds: Open MPI leaves some 3000 small allocations of its

@@ -4,7 +4,8 @@
 # scene, an OBJ+MTL+texture scene and a JSON scene with OBJ meshes, tiles of three sizes, an
 # environment map (--env FILE); the scene's files exist only in rank 0's
 # folder. --time passes of 1 spp equal one
-# render of as many samples. --stats reports every rank.
+# render of as many samples. --aov: the AOVs as EXR layers and as files beside
+# a PNG. --stats reports every rank.
 # usage: test_mpi_identical.sh PAPRSEK PAPRSEK_MPI MPIEXEC DATA_DIR
 . "$(dirname "$0")/mpi_common.sh"
 
@@ -61,6 +62,23 @@ tiles=$(awk '/^rank [0-9]+ / { for (i = 1; i <= NF; i++) if ($i == "tiles") s +=
 grep -q '^ranks  *3$' "$tmp/stats" || bad "--stats: no 'ranks 3' line"
 samples=$(awk '/^rank [0-9]+ / { for (i = 1; i <= NF; i++) if ($i == "samples,") s += $(i - 1) } END { print s + 0 }' "$tmp/stats")
 [ "$samples" = $((48 * 32 * 2)) ] || bad "--stats: the ranks' samples add up to $samples, not $((48 * 32 * 2))"
+
+# --aov: the AOVs' sums travel with the tiles; as layers of an OpenEXR file
+# and as files beside a PNG, the same bytes as paprsek render's
+(cd "$tmp/scene" && "$bin" render mpi_room.obj -o "$tmp/one.exr" "${common[@]}" --spp 3 "${cam[@]}" \
+  --aov albedo,normal,depth,heatmap) || bad "paprsek render --aov to EXR"
+run_mpi 3 mpi_room.obj -o "$tmp/many.exr" "${common[@]}" --spp 3 --tile 8 "${cam[@]}" --aov albedo,normal,depth,heatmap \
+  >"$tmp/out" 2>"$tmp/err" || { bad "3 ranks with --aov to EXR"; cat "$tmp/err"; }
+cmp -s "$tmp/one.exr" "$tmp/many.exr" || bad "3 ranks, --aov albedo,normal,depth,heatmap: the EXR differs"
+mkdir -p "$tmp/one" "$tmp/many"
+(cd "$tmp/scene" && "$bin" render mpi_room.obj -o "$tmp/one/a.png" "${common[@]}" --spp 2 "${cam[@]}" \
+  --aov albedo,depth,heatmap) || bad "paprsek render --aov to PNG"
+run_mpi 2 mpi_room.obj -o "$tmp/many/a.png" "${common[@]}" --spp 2 --tile 24 "${cam[@]}" --aov albedo,depth,heatmap \
+  >"$tmp/out" 2>"$tmp/err" || { bad "2 ranks with --aov to PNG"; cat "$tmp/err"; }
+for f in a.png a.albedo.png a.depth.png a.heatmap.png; do
+  [ -e "$tmp/one/$f" ] || bad "paprsek render --aov did not write $f"
+  cmp -s "$tmp/one/$f" "$tmp/many/$f" || bad "2 ranks, --aov albedo,depth,heatmap: $f differs"
+done
 
 # --time: passes of 1 spp; the same number of samples in one render
 if run_mpi 2 mpi_room.obj -o "$tmp/timed.pfm" "${common[@]}" --spp 1 --time 0.4 --stats "${cam[@]}" \
