@@ -115,6 +115,16 @@ static inline PK_HD bool light_tri_spherical(const scene_view *s, const light *l
 {
     vec3 a, b, c;
     view_tri_verts(s, l->index, &a, &b, &c);
+    /* Cheaply first: the solid angle, the integral of h / r^3 over the
+     * triangle (h: p's distance from its plane), is at most area h / r^3
+     * for any r below p's distance from it, such as the distance to the
+     * centroid less the centroid's farthest vertex. */
+    const vec3 cen = v3_scale(v3_add(v3_add(a, b), c), 1.0f / 3.0f);
+    const float ra = v3_len2(v3_sub(a, cen)), rb = v3_len2(v3_sub(b, cen)), rc = v3_len2(v3_sub(c, cen));
+    const float rmax = sph_sqrt(ra > rb ? (ra > rc ? ra : rc) : (rb > rc ? rb : rc));
+    const float h = fabsf(v3_dot(l->normal, v3_sub(p, a))), d = sph_sqrt(v3_len2(v3_sub(p, cen))) - rmax;
+    const float r = d > h ? d : h;
+    if (l->area * h < SPH_TRI_MIN_SOLID_ANGLE * (r * r * r)) return false;
     return sph_tri_setup(st, p, a, b, c, SPH_TRI_MIN_SOLID_ANGLE, SPH_TRI_MAX_SOLID_ANGLE);
 }
 
@@ -130,7 +140,10 @@ static inline PK_HD float light_pdf_at(const scene_view *s, const light *l, vec3
         if (light_tri_spherical(s, l, p, &st)) {
             if (tri != LIGHT_TRI_SOLID_ANGLE_COS) return 1.0f / st.area;
             float u0, u1, w[4];
-            sph_tri_invert(&st, v3_norm_scaled(v3_sub(q, p)), &u0, &u1);
+            const vec3 d = v3_sub(q, p);
+            const float id = 1.0f / sph_sqrt(v3_len2(d));
+            if (!(id > 0.0f) || !isfinite(id)) return 0.0f;
+            sph_tri_invert(&st, v3_scale(d, id), &u0, &u1);
             sph_tri_cos_weights(&st, n, w);
             return bilinear_pdf(u0, u1, w) / st.area;
         }
@@ -168,10 +181,10 @@ static inline PK_HD bool light_sample_tri_solid_angle(const scene_view *s, const
     const vec3 w = sph_tri_sample(st, x, y);
     /* where w meets the triangle (Moeller-Trumbore), kept on it */
     const vec3 e1 = v3_sub(v1, v0), e2 = v3_sub(v2, v0), s1 = v3_cross(w, e2);
-    const float div = v3_dot(s1, e1);
-    if (!(fabsf(div) > 0.0f)) return false;
+    const float idiv = 1.0f / v3_dot(s1, e1);
+    if (!isfinite(idiv)) return false;
     const vec3 sv = v3_sub(p, v0);
-    float b1 = v3_dot(sv, s1) / div, b2 = v3_dot(w, v3_cross(sv, e1)) / div;
+    float b1 = v3_dot(sv, s1) * idiv, b2 = v3_dot(w, v3_cross(sv, e1)) * idiv;
     b1 = b1 > 0.0f ? b1 : 0.0f, b2 = b2 > 0.0f ? b2 : 0.0f;
     if (b1 + b2 > 1.0f) {
         const float sum = b1 + b2;
@@ -182,7 +195,7 @@ static inline PK_HD bool light_sample_tri_solid_angle(const scene_view *s, const
     const vec3 d = v3_sub(q, o);
     const float dist2 = v3_len2(d);
     if (!(dist2 > 0.0f)) return false;
-    ls->wi = v3_scale(d, 1.0f / sqrtf(dist2));
+    ls->wi = v3_scale(d, 1.0f / sph_sqrt(dist2));
     ls->le = m->ke;
     ls->pdf = pdf;
     ls->delta = false;

@@ -13,7 +13,8 @@
  *   returned with a sample is light_pdf_at's for the same direction (the
  *   MIS weights of the path tracer use the latter); light_pdf_at integrates
  *   to 1 over the triangle's solid angle (Monte Carlo, with the variance
- *   measured), and the sampler covers the whole triangle.
+ *   measured), and the sampler covers the whole triangle. The cheap bound
+ *   that light_tri_spherical tries first decides as the exact rule does.
  * - Closed forms: the irradiance of a uniform emissive triangle and quad
  *   (Lambert's polygon formula) against the light-sampling estimator and
  *   against MIS of light and cosine sampling, within Z_MEAN standard errors
@@ -625,6 +626,30 @@ static void test_robust(void)
     printf("robustness: %ld samples, %ld refused, nothing non-finite\n", sampled, refused);
 }
 
+/* light_tri_spherical's cheap bound never turns away a triangle whose
+ * solid angle is in range: the rule is the exact one. */
+static void test_bound(void)
+{
+    rng r = rng_seed(17, 2);
+    long spherical = 0, n = 200000;
+    for (long k = 0; k < n; k++) {
+        vec3 v[3];
+        const float size = powf(10.0f, -3.0f * rng_float(&r)); /* 1e-3 .. 1, seen from about 1 */
+        const vec3 c = v3(2.0f * rng_float(&r) - 1.0f, 2.0f * rng_float(&r) - 1.0f, 2.0f * rng_float(&r) - 1.0f);
+        for (int j = 0; j < 3; j++)
+            v[j] = v3_add(c, v3_scale(v3(rng_float(&r) - 0.5f, rng_float(&r) - 0.5f, rng_float(&r) - 0.5f), size));
+        lab L;
+        lab_init(&L, v, 1, true);
+        sph_tri a, b;
+        const bool exact = sph_tri_setup(&a, v3s(0.0f), v[0], v[1], v[2], SPH_TRI_MIN_SOLID_ANGLE, SPH_TRI_MAX_SOLID_ANGLE);
+        const bool rule = light_tri_spherical(&L.v, &L.lights[0], v3s(0.0f), &b);
+        CHECKF(exact == rule, "size %g: exact %d, with the bound %d (solid angle %g)", (double)size, exact, rule,
+               solid_angle_d((d3){0, 0, 0}, d3_of(v[0]), d3_of(v[1]), d3_of(v[2])));
+        spherical += rule;
+    }
+    printf("bound: %ld of %ld random triangles sampled by solid angle, the same as without the bound\n", spherical, n);
+}
+
 int main(void)
 {
     test_solid_angle();
@@ -632,6 +657,7 @@ int main(void)
     test_bilinear();
     test_chi2();
     test_pdf_consistency();
+    test_bound();
     test_irradiance();
     test_robust();
     return test_done("test_light_sampling");
