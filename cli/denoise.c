@@ -22,7 +22,7 @@ static int has_weights(const char *dir)
 
 const char *cli_weights_dir(void)
 {
-    static char dir[PATH_MAX];
+    static char dir[PATH_MAX + 32];
     static int done;
     if (done) return dir[0] ? dir : NULL;
     done = 1;

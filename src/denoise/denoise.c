@@ -200,18 +200,26 @@ static pk_status load_network(pk_denoiser *d, const char *path)
 #define PU_X1 3.70974749e-01
 #define HDR_MAX 65504.0
 
+/* The same curve in float, for the pixels (the network's input is float). */
+static float pu_forward_f(float y)
+{
+    if (y <= (float)PU_Y0) return (float)PU_A * y;
+    if (y <= (float)PU_Y1) return (float)PU_B * powf(y, (float)PU_C) + (float)PU_D;
+    return (float)PU_E * logf(y + (float)PU_F) + (float)PU_G;
+}
+
+static float pu_inverse_f(float x)
+{
+    if (x <= (float)PU_X0) return x / (float)PU_A;
+    if (x <= (float)PU_X1) return powf((x - (float)PU_D) / (float)PU_B, (float)(1.0 / PU_C));
+    return expf((x - (float)PU_G) / (float)PU_E) - (float)PU_F;
+}
+
 static double pu_forward(double y)
 {
     if (y <= PU_Y0) return PU_A * y;
     if (y <= PU_Y1) return PU_B * pow(y, PU_C) + PU_D;
     return PU_E * log(y + PU_F) + PU_G;
-}
-
-static double pu_inverse(double x)
-{
-    if (x <= PU_X0) return x / PU_A;
-    if (x <= PU_X1) return pow((x - PU_D) / PU_B, 1.0 / PU_C);
-    return exp((x - PU_G) / PU_E) - PU_F;
 }
 
 static float sanitize(float v, float lo, float hi) { return isfinite(v) ? fminf(fmaxf(v, lo), hi) : 0.0f; }
@@ -230,18 +238,33 @@ double denoise_autoexposure(const float *rgb, int w, int h)
     const int bh = (h + 15) / 16, bw = (w + 15) / 16;
     double sum = 0.0;
     long n = 0;
-    for (int i = 0; i < bh; i++)
-        for (int j = 0; j < bw; j++) {
-            int y0 = i * h / bh, y1 = (i + 1) * h / bh, x0 = j * w / bw, x1 = (j + 1) * w / bw;
-            double l = 0.0;
-            for (int y = y0; y < y1; y++)
-                for (int x = x0; x < x1; x++) l += luminance(rgb + 3 * ((size_t)y * (size_t)w + (size_t)x));
-            l /= (double)((y1 - y0) * (x1 - x0));
-            if (l > 1e-8) {
-                sum += log2(l);
-                n++;
+    /* a row of bins per iteration, summed in order below: the same result
+     * for every thread count */
+    double row_sum[64];
+    long row_n[64];
+    for (int i0 = 0; i0 < bh; i0 += 64) {
+        const int rows = bh - i0 < 64 ? bh - i0 : 64;
+#pragma omp parallel for schedule(static)
+        for (int r = 0; r < rows; r++) {
+            const int i = i0 + r;
+            double rs = 0.0;
+            long rn = 0;
+            for (int j = 0; j < bw; j++) {
+                int y0 = i * h / bh, y1 = (i + 1) * h / bh, x0 = j * w / bw, x1 = (j + 1) * w / bw;
+                double l = 0.0;
+                for (int y = y0; y < y1; y++)
+                    for (int x = x0; x < x1; x++) l += luminance(rgb + 3 * ((size_t)y * (size_t)w + (size_t)x));
+                l /= (double)((y1 - y0) * (x1 - x0));
+                if (l > 1e-8) {
+                    rs += log2(l);
+                    rn++;
+                }
             }
+            row_sum[r] = rs;
+            row_n[r] = rn;
         }
+        for (int r = 0; r < rows; r++) sum += row_sum[r], n += row_n[r];
+    }
     return n ? 0.18 / exp2(sum / (double)n) : 1.0;
 }
 
@@ -282,7 +305,7 @@ static void prepare_tile(const tile_job *j, int x0, int y0, int tw, int th, int 
             size_t src = 3 * ((size_t)(y0 + y) * (size_t)j->w + (size_t)(x0 + x)), dst = (size_t)y * (size_t)pw + (size_t)x;
             for (int c = 0; c < 3; c++) {
                 float v = sanitize(j->color[src + c] * j->scale, 0.0f, FLT_MAX);
-                in[(size_t)c * plane + dst] = (float)(pu_forward((double)v) * (double)j->norm);
+                in[(size_t)c * plane + dst] = pu_forward_f(v) * j->norm;
                 if (j->ic >= 6) in[(size_t)(3 + c) * plane + dst] = sanitize(j->albedo[src + c], 0.0f, 1.0f);
                 if (j->ic >= 9)
                     in[(size_t)(6 + c) * plane + dst] = sanitize(j->normal[src + c], -1.0f, 1.0f) * 0.5f + 0.5f;
@@ -294,15 +317,14 @@ static void finish_tile(const tile_job *j, const float *net, int pw, int ph, int
                         const tile_span *sy, float *out, int threads)
 {
     const size_t plane = (size_t)pw * (size_t)ph;
-    const double inv = j->scale > 0.0f ? 1.0 / (double)j->scale : 0.0;
+    const float inv = j->scale > 0.0f ? 1.0f / j->scale : 0.0f, rnorm = 1.0f / j->norm;
 #pragma omp parallel for num_threads(threads) schedule(static)
     for (int y = sy->out0; y < sy->out1; y++)
         for (int x = sx->out0; x < sx->out1; x++) {
             size_t p = (size_t)(y - y0) * (size_t)pw + (size_t)(x - x0);
             for (int c = 0; c < 3; c++) {
                 float v = sanitize(net[(size_t)c * plane + p], 0.0f, FLT_MAX);
-                double r = pu_inverse((double)v / (double)j->norm) * inv;
-                out[3 * ((size_t)y * (size_t)j->w + (size_t)x) + c] = (float)fmax(r, 0.0);
+                out[3 * ((size_t)y * (size_t)j->w + (size_t)x) + c] = fmaxf(pu_inverse_f(v * rnorm) * inv, 0.0f);
             }
         }
 }
