@@ -26,6 +26,12 @@
  */
 #include "test.h"
 
+/* The spherical map is tested down to small solid angles: this file's copy
+ * of the sampling code turns to area sampling only below pbrt-v4's 3e-4 sr
+ * (the library's threshold is higher for speed, src/render/spherical_triangle.h;
+ * the renders of test_direct, test_mis and test_path run with it). */
+#define SPH_TRI_MIN_SOLID_ANGLE 3e-4f
+
 #include "chi2.h"
 #include "math/tri.h"
 #include "render/lights.h"
