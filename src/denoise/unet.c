@@ -23,7 +23,6 @@
 
 #include <math.h>
 #include <omp.h>
-#include <sys/mman.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -113,7 +112,7 @@ struct unet {
     conv_layer conv[UNET_CONVS];
     /* made for one image size */
     int h, w, threads;
-    float *buf;      /* every activation, one block (2 MiB aligned, inside block) */
+    float *buf;      /* every activation, one block (aligned, inside block) */
     void *block;
     float *cat1, *cat2, *cat3, *cat4, *t0a, *t0b, *t1a, *t1b, *t2a, *t2b, *t3a, *t3b, *t4a, *t4b;
     char impl[128];
@@ -430,8 +429,7 @@ static pk_status make_conv(unet *u, int k, int h, int w, float *src, float *dst)
     dnnl_primitive_attr_t attr = NULL;
     dnnl_post_ops_t po = NULL;
     DN(dn.primitive_attr_create(&attr), "make attributes");
-    /* one scratchpad for every layer (they run one after the other), on the
-     * same huge pages as the activations */
+    /* one scratchpad for every layer (they run one after the other) */
     if (dn.primitive_attr_set_scratchpad_mode(attr, dnnl_scratchpad_mode_user) != dnnl_success) {
         dn.primitive_attr_destroy(attr);
         return dnnl_fail(u->ctx, "set the scratchpad mode", dnnl_runtime_error);
@@ -493,17 +491,15 @@ static pk_status make_conv(unet *u, int k, int h, int w, float *src, float *dst)
     return PK_OK;
 }
 
-/* size bytes on 2 MiB pages where the kernel grants them: the block to free
- * is returned, *at the 2 MiB-aligned start inside it. */
-static void *huge_alloc(const pk_allocator *al, size_t size, void **at)
+/* size bytes, 64-byte aligned: the block to free is returned, *at the
+ * aligned start inside it. (Transparent huge pages, asked for with
+ * madvise, cut the page faults but made the time vary from 0.24 to 0.57 s
+ * at 512x512 where 4 KiB pages gave 0.27 to 0.30 s: docs/denoising.md.) */
+static void *block_alloc(const pk_allocator *al, size_t size, void **at)
 {
-    const size_t huge = (size_t)2 << 20;
-    void *block = mem_alloc(al, size + huge);
+    void *block = mem_alloc(al, size + 64);
     if (!block) return NULL;
-    *at = (void *)(((uintptr_t)block + huge - 1) & ~(uintptr_t)(huge - 1));
-#ifdef MADV_HUGEPAGE
-    if (size >= huge) madvise(*at, size / huge * huge, MADV_HUGEPAGE);
-#endif
+    *at = (void *)(((uintptr_t)block + 63) & ~(uintptr_t)63);
     return block;
 }
 
@@ -519,12 +515,10 @@ static pk_status make_plan(unet *u, int h, int w, int threads)
     omp_set_num_threads(threads);
     plan_sizes s = sizes_of(u);
     size_t total = unet_activation_bytes(u, h, w);
-    /* Hundreds of MiB touched once per image: on 2 MiB pages where the
-     * kernel grants them (transparent huge pages on request), a page fault
-     * per 2 MiB instead of per 4 KiB. Every byte is written before it is
-     * read (each layer's output, each part of a concatenation), so nothing
-     * is cleared. */
-    u->block = huge_alloc(u->al, total, (void **)&u->buf);
+    /* Hundreds of MiB touched once per image: every byte is written before
+     * it is read (each layer's output, each part of a concatenation), so
+     * nothing is cleared. */
+    u->block = block_alloc(u->al, total, (void **)&u->buf);
     if (!u->block) return ctx_nomem(u->ctx);
     const size_t p0 = (size_t)h * (size_t)w;
     float *p = u->buf;
@@ -551,7 +545,7 @@ static pk_status make_plan(unet *u, int h, int w, int threads)
         }
     }
     if (u->scratch_bytes) {
-        u->scratch_block = huge_alloc(u->al, u->scratch_bytes, (void **)&u->scratch);
+        u->scratch_block = block_alloc(u->al, u->scratch_bytes, (void **)&u->scratch);
         if (!u->scratch_block) {
             release_plan(u);
             return ctx_nomem(u->ctx);
