@@ -110,7 +110,7 @@ static const cli_option d_opts[] = {
      .help = "the albedo and normal are free of noise (many samples): the network made for clean "
              "auxiliary images"},
     {.name = "quality", .id = D_QUALITY, .kind = CLI_STRING, .arg = "high|fast",
-     .help = "the network: high (default) or fast (the small one, about 2.5x faster)"},
+     .help = "the network: high (default) or fast (the small one, about 1.6x faster)"},
     {.name = "weights", .id = D_WEIGHTS, .kind = CLI_STRING, .arg = "DIR",
      .help = "the folder of the weights (default: beside the program, or the installed "
              "share/paprsek/weights)"},

@@ -128,11 +128,13 @@ const cli_option *cli_render_options(size_t *n)
         add((cli_option){.name = "denoise", .id = OPT_DENOISE, .kind = CLI_FLAG,
                          .help = "denoise the image (Open Image Denoise's network, with the albedo and normal of "
                                  "the same render); the default when neither --spp nor --time nor the scene "
-                                 "names a sample count"});
+                                 "names a sample count, which then takes 16 samples per pixel (measured: the "
+                                 "denoised error falls 2.5x from 4 to 16 samples and slowly after; "
+                                 "docs/denoising.md)"});
         add((cli_option){.name = "no-denoise", .id = OPT_NO_DENOISE, .kind = CLI_FLAG,
                          .help = "write the raw image, also in the default case"});
         add((cli_option){.name = "denoise-quality", .id = OPT_DENOISE_QUALITY, .kind = CLI_STRING, .arg = "high|fast",
-                         .help = "the denoiser's network: high (default) or fast (the small one, about 2.5x "
+                         .help = "the denoiser's network: high (default) or fast (the small one, about 1.6x "
                                  "faster)"});
         add((cli_option){.name = "weights", .id = OPT_WEIGHTS, .kind = CLI_STRING, .arg = "DIR",
                          .help = "the folder of the denoiser's weights (default: beside the program, where "
