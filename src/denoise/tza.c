@@ -109,10 +109,12 @@ pk_status tza_parse(pk_context *ctx, const char *name, const void *data, size_t 
         if (!rd_u8(&r, &dt)) goto truncated;
         t->dtype = (char)dt;
         if (dt != 'h' && dt != 'f') {
+            /* the message first: t lives in the array tza_free releases */
+            pk_status st = ctx_error(ctx, PK_ERR_UNSUPPORTED, "%s: byte %zu: tensor %s has data type '%c' "
+                                     "(only binary16 'h' and binary32 'f' are read)", name, r.at - 1, t->name,
+                                     dt >= 32 && dt < 127 ? dt : '?');
             tza_free(&ctx->alloc, out);
-            return ctx_error(ctx, PK_ERR_UNSUPPORTED, "%s: byte %zu: tensor %s has data type '%c' "
-                             "(only binary16 'h' and binary32 'f' are read)", name, r.at - 1, t->name,
-                             dt >= 32 && dt < 127 ? dt : '?');
+            return st;
         }
         uint64_t off;
         if (!rd_u64(&r, &off)) goto truncated;

@@ -134,6 +134,12 @@ int main(int argc, char **argv)
     float scale = (float)denoise_autoexposure(color, IW, IH);
     put("img_scale", &scale, 1);
     printf("pipeline %dx%d: exposure scale %g\n", IW, IH, (double)scale);
+    for (int r = 0; r < 4; r++) free(res[r]);
+    for (int t = 0; t < 3; t++) free(out[t]);
+    free(in);
+    free(color);
+    free(alb);
+    free(nrm);
     unet_destroy(u);
     tza_free(&ctx->alloc, &a);
     free(data);
