@@ -225,6 +225,11 @@ typedef struct pk_render_options {
      * PK_ACCEL_CUDA with PK_DEVICE_CPU means PK_DEVICE_CUDA too (as programs
      * written before this field said it). */
     pk_device_kind device;
+    /* Path regularisation (the path tracer): 1 roughens near-specular
+     * surfaces (GGX roughness below 0.3 doubled, to 0.1..0.3) once a path
+     * has bounced off a rough or diffuse one, which turns caustic fireflies
+     * into a smooth, slightly wrong glow: biased, off (0) by default. */
+    int regularize;
 } pk_render_options;
 
 /* Arbitrary output variables: what the camera ray of each sample found,

@@ -23,6 +23,9 @@ static const pk_int_option table[] = {
         "default, 64 for path and 8 for whitted"),
     OPT(threads, "threads", 0, PK_MAX_THREADS, 0, "worker threads (0 = all cores)"),
     OPT(seed, "seed", 0, 2147483647, 0, "the path tracer's noise pattern (another seed, other noise)"),
+    OPT(regularize, "regularize", 0, 1, 0,
+        "1: after the first rough or diffuse bounce, roughen near-specular surfaces (fewer caustic "
+        "fireflies, a biased image); 0: off"),
 };
 #undef OPT
 

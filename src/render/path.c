@@ -18,6 +18,7 @@ pk_status path_init(pk_context *ctx, path_tracer *pt, const frame *f, const pk_r
     memset(pt, 0, sizeof *pt);
     pt->f = f;
     pt->max_depth = pk_render_options_max_depth(opt);
+    pt->regularize = opt->regularize;
     pt->seed = (uint32_t)opt->seed;
     pt->lights = f->lights;
     (void)ctx;

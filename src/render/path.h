@@ -26,6 +26,7 @@ typedef struct path_tracer {
     uint32_t seed;
     int strategy;        /* PATH_* */
     float spread;        /* ray cone spread angle per unit length: the camera's pixel angle (textures) */
+    int regularize;      /* pk_render_options.regularize */
     const void *gpu_nodes, *gpu_tris;  /* in the GPU's copy only: the device BVH (bvh_gpu.h) */
 } path_tracer;
 

@@ -106,6 +106,7 @@ typedef struct path_state {
     ray r;
     hit h;
     bool prev_delta;   /* the last bounce was a delta one (the camera counts as one) */
+    bool rough_seen;   /* some bounce so far was not a delta one (regularisation starts after it) */
     float prev_pdf;    /* its solid-angle pdf */
     vec3 prev_p;       /* the vertex it left */
     vec3 prev_n;       /* its geometric normal (light_pdf_li: triangles are sampled toward its cosine) */
@@ -201,6 +202,7 @@ static inline PK_HD void path_begin(path_state *ps, const ray *r, const hit *h, 
     ps->r = *r;
     ps->h = *h;
     ps->prev_delta = true; /* the camera: emission is counted in full */
+    ps->rough_seen = false;
     ps->prev_pdf = 0.0f;
     ps->prev_p = r->o;
     ps->prev_n = v3s(0.0f);
@@ -251,7 +253,8 @@ static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_s
         ps->L = v3_add(ps->L, v3_mul(ps->beta, v3_scale(le, w)));
     }
     if (ps->depth >= pt->max_depth) return false;
-    const shading sh = shading_at(&sf);
+    shading sh = shading_at(&sf);
+    if (pt->regularize && ps->rough_seen) shading_regularize(&sh);
     float u0, u1, u2, u3, u4, u5;
     sampler_2d(smp, &u0, &u1);
     sampler_2d(smp, &u2, &u3);
@@ -293,6 +296,7 @@ static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_s
     const bool below = v3_dot(wi, sf.ng) < 0.0f;
     ps->r = (ray){offset_origin(fr->eps, sf.p, below ? v3_neg(sf.ng) : sf.ng), 0.0f, wi, INFINITY};
     ps->prev_delta = delta;
+    ps->rough_seen = ps->rough_seen || !delta;
     ps->prev_pdf = pdf;
     ps->prev_p = sf.p;
     ps->prev_n = sf.ng;

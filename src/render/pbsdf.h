@@ -380,6 +380,14 @@ static inline PK_HD bool pbsdf__refract(vec3 w, vec3 m, float ior, vec3 *out)
 
 /* True if the BSDF has a non-delta part, i.e. light sampling and MIS can
  * reach it (eval and pdf are not identically 0). */
+/* Path regularisation (pbrt-v4's Regularize): a lobe smoother than GGX
+ * alpha 0.3 gets twice its roughness, at least 0.1 and at most 0.3. The
+ * Lambertian lobe has no roughness and is left alone. */
+static inline PK_HD void pbsdf_regularize(pbsdf *b)
+{
+    if (b->type != PBSDF_DIFFUSE && b->alpha < 0.3f) b->alpha = fminf(fmaxf(2.0f * b->alpha, 0.1f), 0.3f);
+}
+
 static inline PK_HD bool pbsdf_has_nondelta(const pbsdf *b)
 {
     switch (b->type) {

@@ -70,6 +70,15 @@ static inline PK_HD shading shading_at(const surface *sf)
     return sh;
 }
 
+/* The shading of a regularised path (pbsdf_regularize): near-specular lobes
+ * roughened, so light sampling now reaches them. */
+static inline PK_HD void shading_regularize(shading *sh)
+{
+    pbsdf_regularize(&sh->b);
+    sh->nondelta = sh->opaque > 0.0f && pbsdf_has_nondelta(&sh->b) &&
+                   (sh->b.type != PBSDF_DIFFUSE || !black(sh->b.albedo));
+}
+
 /* f * cos toward wi (world, unit) and its pdf, the dissolve included; zero
  * where the geometric normal says the light comes through the surface. */
 static inline PK_HD vec3 shading_eval(const surface *sf, const shading *sh, vec3 wo, vec3 wi, float *pdf)
