@@ -62,7 +62,7 @@ static void blocks_c(uint32_t h[8], const unsigned char *p, size_t n)
 
 /* The same rounds with the x86 SHA extensions (two rounds per
  * sha256rnds2, the message schedule by sha256msg1/msg2), where the CPU has
- * them: about 10x faster, which is most of reading the weights. The state
+ * them: 6x faster (1.1 against 6.9 ms for the default weights here). The state
  * is kept as the instructions want it, ABEF and CDGH. */
 __attribute__((target("sha,sse4.1"))) static void blocks_shani(uint32_t h[8], const unsigned char *p, size_t n)
 {
