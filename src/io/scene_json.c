@@ -387,13 +387,15 @@ static pk_status get_unit(jp *p, const cJSON *it, const char *path, float *out)
 
 /* The physically based material types (docs/materials.md). The keys of each:
  * the common ones ("type", "two_sided") and the type's parameters. */
-enum { TP_ALBEDO, TP_SPECULAR, TP_ETA, TP_K, TP_ROUGHNESS, TP_ALPHA, TP_IOR, TP_TRANSMITTANCE, TP_RADIANCE, TP_BSDF, TP_COUNT };
-static const char *const tp_keys[TP_COUNT] = {"albedo", "specular", "eta",           "k",       "roughness",
-                                              "alpha",  "ior",      "transmittance", "radiance", "bsdf"};
+enum { TP_ALBEDO, TP_SPECULAR, TP_ETA, TP_K, TP_ROUGHNESS, TP_ALPHA, TP_IOR, TP_TRANSMITTANCE, TP_RADIANCE, TP_BSDF,
+       TP_BASE_COLOR, TP_METALLIC, TP_TRANSMISSION, TP_MR_MAP, TP_COUNT };
+static const char *const tp_keys[TP_COUNT] = {"albedo",     "specular", "eta",           "k",       "roughness",
+                                              "alpha",      "ior",      "transmittance", "radiance", "bsdf",
+                                              "base_color", "metallic", "transmission",  "metallic_roughness_map"};
 typedef struct mat_type_def {
     const char *name;
     int nparams;
-    int params[5];
+    int params[6];
 } mat_type_def;
 static const mat_type_def mat_types[] = {
     {"diffuse", 1, {TP_ALBEDO}},
@@ -402,7 +404,9 @@ static const mat_type_def mat_types[] = {
     {"plastic", 3, {TP_ALBEDO, TP_IOR, TP_ROUGHNESS}},
     {"emitter", 2, {TP_RADIANCE, TP_BSDF}},
     {"two_sided", 1, {TP_BSDF}},
+    {"metallic_roughness", 6, {TP_BASE_COLOR, TP_METALLIC, TP_ROUGHNESS, TP_TRANSMISSION, TP_IOR, TP_MR_MAP}},
 };
+#define MT_METALLIC_ROUGHNESS 6 /* its index in mat_types */
 #define N_MAT_TYPES (sizeof mat_types / sizeof mat_types[0])
 
 /* The maps any material may have: "d"/"opacity" as a texture (cut-out
@@ -440,13 +444,13 @@ static pk_status read_typed_material(jp *p, const cJSON *obj, const cJSON *type_
         while (t < N_MAT_TYPES && strcmp(type_item->valuestring, mat_types[t].name) != 0) t++;
     if (!cJSON_IsString(type_item) || t == N_MAT_TYPES)
         return jfail(p, PK_ERR_PARSE, type_item, fp,
-                     "must be one of \"diffuse\", \"conductor\", \"dielectric\", \"plastic\", \"emitter\", "
-                     "\"two_sided\"");
+                     "must be one of \"diffuse\", \"conductor\", \"dielectric\", \"plastic\", "
+                     "\"metallic_roughness\", \"emitter\", \"two_sided\"");
     const mat_type_def *def = &mat_types[t];
     /* the known keys: "type", "two_sided", the type's parameters, and "name"
      * where materials are listed in an array */
-    const char *keys[12];
-    const cJSON *f[12];
+    const char *keys[16];
+    const cJSON *f[16];
     size_t nk = 0;
     keys[nk++] = "type", keys[nk++] = "two_sided", keys[nk++] = "opacity", keys[nk++] = "bump",
     keys[nk++] = "normal_map";
@@ -469,6 +473,33 @@ static pk_status read_typed_material(jp *p, const cJSON *obj, const cJSON *type_
     bool loaded;
     vec3 tex_albedo = v3s(-1.0f), tex_specular = v3s(-1.0f);
     float tex_alpha = -1.0f;
+    if (t == MT_METALLIC_ROUGHNESS) {
+        /* base colour: a colour or an (sRGB) texture; metallic and roughness:
+         * numbers, scaled by the metallic_roughness_map (data, not sRGB) */
+        for (int k = TP_METALLIC; k <= TP_TRANSMISSION; k++) {
+            if (!pv[k] || !cJSON_IsObject(pv[k])) continue;
+            path_key(fp, path, tp_keys[k]);
+            return jfail(p, PK_ERR_PARSE, pv[k], fp, "must be a number in 0..1 (textures: \"metallic_roughness_map\")");
+        }
+        if (pv[TP_ROUGHNESS] && cJSON_IsObject(pv[TP_ROUGHNESS])) {
+            path_key(fp, path, "roughness");
+            return jfail(p, PK_ERR_PARSE, pv[TP_ROUGHNESS], fp,
+                         "must be a number in 0..1 (textures: \"metallic_roughness_map\")");
+        }
+        if (pv[TP_BASE_COLOR] && cJSON_IsObject(pv[TP_BASE_COLOR])) {
+            path_key(fp, path, "base_color");
+            if ((st = get_texture(p, pv[TP_BASE_COLOR], fp, true, &m->map_kd, &loaded))) return st;
+            tex_albedo = loaded ? v3s(1.0f) : v3s(0.5f);
+            pv[TP_BASE_COLOR] = NULL;
+        }
+        if (pv[TP_MR_MAP]) {
+            path_key(fp, path, "metallic_roughness_map");
+            if (!cJSON_IsObject(pv[TP_MR_MAP]))
+                return jfail(p, PK_ERR_PARSE, pv[TP_MR_MAP], fp, "must be a texture object");
+            if ((st = get_texture(p, pv[TP_MR_MAP], fp, false, &m->map_mr, &loaded))) return st;
+            pv[TP_MR_MAP] = NULL;
+        }
+    }
     if (pv[TP_ALBEDO] && cJSON_IsObject(pv[TP_ALBEDO])) {
         path_key(fp, path, "albedo");
         if ((st = get_texture(p, pv[TP_ALBEDO], fp, true, &m->map_kd, &loaded))) return st;
@@ -495,6 +526,11 @@ static pk_status read_typed_material(jp *p, const cJSON *obj, const cJSON *type_
     float roughness = 0.0f, alpha = 0.0f, ior = 1.5f;
     vec3 albedo = v3s(0.5f), transmittance = v3s(1.0f);
     if (pv[TP_ALBEDO] && (st = get_reflectance(p, pv[TP_ALBEDO], pp[TP_ALBEDO], &albedo))) return st;
+    if (t == MT_METALLIC_ROUGHNESS) {
+        albedo = v3s(1.0f); /* glTF's defaults: base colour 1, metallic 1, roughness 1 */
+        roughness = 1.0f;
+        if (pv[TP_BASE_COLOR] && (st = get_reflectance(p, pv[TP_BASE_COLOR], pp[TP_BASE_COLOR], &albedo))) return st;
+    }
     if (pv[TP_TRANSMITTANCE] &&
         (st = get_reflectance(p, pv[TP_TRANSMITTANCE], pp[TP_TRANSMITTANCE], &transmittance)))
         return st;
@@ -510,7 +546,7 @@ static pk_status read_typed_material(jp *p, const cJSON *obj, const cJSON *type_
     if (pv[TP_IOR]) {
         if ((st = get_float(p, pv[TP_IOR], pp[TP_IOR], &ior))) return st;
         if (!(ior > 0.0f)) return jfail(p, PK_ERR_PARSE, pv[TP_IOR], pp[TP_IOR], "must be a positive number");
-        if (ior == 1.0f && alpha > 0.0f)
+        if (ior == 1.0f && alpha > 0.0f && t != MT_METALLIC_ROUGHNESS)
             return jfail(p, PK_ERR_PARSE, pv[TP_IOR], pp[TP_IOR], "must not be 1 on a rough surface (roughness > 0)");
     }
     if (tex_albedo.x >= 0.0f) albedo = tex_albedo;
@@ -574,6 +610,16 @@ static pk_status read_typed_material(jp *p, const cJSON *obj, const cJSON *type_
     case 3: /* plastic */
         material_plastic(m, albedo, ior, alpha);
         break;
+    case MT_METALLIC_ROUGHNESS: { /* glTF 2.0's material */
+        float metallic = 1.0f, transmission = 0.0f;
+        if (pv[TP_METALLIC] && (st = get_unit(p, pv[TP_METALLIC], pp[TP_METALLIC], &metallic))) return st;
+        if (pv[TP_TRANSMISSION] && (st = get_unit(p, pv[TP_TRANSMISSION], pp[TP_TRANSMISSION], &transmission)))
+            return st;
+        material_metallic_roughness(m, albedo, metallic, roughness);
+        m->transmission = transmission;
+        m->ni = ior;
+        break;
+    }
     default: { /* emitter: black diffuse, or the surface its "bsdf" describes */
         vec3 ke = v3s(1.0f);
         if (pv[TP_RADIANCE] && (st = get_color(p, pv[TP_RADIANCE], pp[TP_RADIANCE], &ke))) return st;

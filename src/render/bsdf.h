@@ -14,7 +14,7 @@ static inline bool is_dielectric(const material *m) { return m->illum == 4 || m-
 /* The material has a diffuse or glossy part that direct light can reach. */
 static inline bool has_direct_lobe(const material *m)
 {
-    return !is_black(m->kd) || (m->illum == 2 && !is_black(m->ks));
+    return !is_black(material_whitted_kd(m)) || (m->illum == 2 && !is_black(m->ks));
 }
 
 /* BRDF times cos(theta_i) for light arriving from wi, seen from wo (unit
@@ -23,7 +23,7 @@ static inline vec3 brdf_cos(const surface *sf, vec3 wo, vec3 wi)
 {
     float cos_i = v3_dot(sf->ns, wi);
     if (cos_i <= 0.0f || v3_dot(sf->ng, wi) <= 0.0f) return v3s(0.0f); /* no light through surfaces */
-    vec3 f = v3_scale(sf->m->kd, 1.0f / PK_PI);
+    vec3 f = v3_scale(material_whitted_kd(sf->m), 1.0f / PK_PI);
     if (sf->m->illum == 2 && !is_black(sf->m->ks)) {
         vec3 r = v3_reflect(v3_neg(wi), sf->ns);
         float c = v3_dot(r, wo);

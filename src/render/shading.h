@@ -46,6 +46,7 @@ static inline PK_HD shading shading_at(const surface *sf)
             if (!sf->front) n = v3_neg(n); /* the outward normal: wo.z < 0 inside */
             break;
         case MAT_PLASTIC: sh.b = pbsdf_plastic(m->kd, m->ni, m->alpha); break;
+        case MAT_METALLIC_ROUGHNESS: sh.b = pbsdf_diffuse(material_whitted_kd(m)); break; /* for now */
         default: sh.b = pbsdf_diffuse(m->kd); break;
         }
     } else if (glass) {

@@ -151,6 +151,14 @@ static inline PK_HD void surface_texture_at(const scene_view *s, const ray *r, c
         float a = fminf(fmaxf(tex_eval_scalar(s->textures, &m->map_alpha, q), 0.0f), 1.0f);
         tm->alpha = fminf(m->alpha * (m->map_alpha.squared ? a * a : a), 1.0f);
     }
+    if (m->map_mr.kind) { /* glTF: blue metallic, green roughness (a grey map: both) */
+        float c[4];
+        const int nc = tex_eval_raw(s->textures, &m->map_mr, q, c);
+        const float mt = nc >= 3 ? c[2] : c[0], rg = nc >= 3 ? c[1] : c[0];
+        tm->metallic = fminf(fmaxf(m->metallic * mt, 0.0f), 1.0f);
+        tm->roughness = fminf(fmaxf(m->roughness * rg, 0.0f), 1.0f);
+        tm->alpha = tm->roughness * tm->roughness;
+    }
     sf->m = tm;
     if (!m->map_bump.kind && !m->map_norm.kind) return;
     /* a frame on the surface, z = the shading normal as it faces the ray */

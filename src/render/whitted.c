@@ -133,7 +133,8 @@ static vec3 shade_opaque(const whitted *w, whitted_thread *ts, const ray *r, con
     if (m->illum == 0) return v3_add(L, m->kd);
     bool dielectric = is_dielectric(m);
     if (has_direct_lobe(m)) L = v3_add(L, direct_light(w, ts, &sf, wo));
-    if (!is_black(fr->s->ambient)) L = v3_add(L, v3_mul(fr->s->ambient, is_black(m->ka) ? m->kd : m->ka));
+    if (!is_black(fr->s->ambient))
+        L = v3_add(L, v3_mul(fr->s->ambient, is_black(m->ka) ? material_whitted_kd(m) : m->ka));
     vec3 dn = v3_norm(r->d);
     if (depth < w->max_depth) {
         if (is_mirror(m) && !is_black(m->ks)) {

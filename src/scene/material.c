@@ -21,6 +21,7 @@ void material_init(material *m)
     tex_ref_init(&m->map_alpha);
     tex_ref_init(&m->map_bump);
     tex_ref_init(&m->map_norm);
+    tex_ref_init(&m->map_mr);
 }
 
 float material_f0_dielectric(float ior)
@@ -89,4 +90,19 @@ void material_plastic(material *m, vec3 albedo, float ior, float alpha)
     m->kd = albedo, m->ni = ior, m->alpha = alpha;
     m->ks = v3s(material_f0_dielectric(ior));
     whitted_gloss(m, alpha);
+}
+
+void material_metallic_roughness(material *m, vec3 base_color, float metallic, float roughness)
+{
+    m->type = MAT_METALLIC_ROUGHNESS;
+    m->kd = base_color;
+    m->metallic = metallic, m->roughness = roughness, m->transmission = 0.0f;
+    m->ni = 1.5f;
+    m->alpha = roughness * roughness;
+    /* Whitted: the diffuse share of kd (material_whitted_kd), and a glossy
+     * lobe of the Fresnel reflectance at normal incidence, 0.04 for the
+     * dielectric, the base colour for the metal */
+    m->ks = v3_add(v3s((1.0f - metallic) * 0.04f), v3_scale(base_color, metallic));
+    m->illum = 2;
+    whitted_gloss(m, m->alpha);
 }

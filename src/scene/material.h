@@ -10,8 +10,10 @@
  * Kinds: MAT_MTL (an MTL material: Kd, Ks, Ns, Ni, Tf, d and the illum code,
  * set field by field by the MTL reader), diffuse, conductor (a complex
  * index or a normal-incidence reflectance), dielectric, plastic (a diffuse
- * base under a dielectric coat). Emission (ke) and two-sidedness go with
- * any kind; texture maps (texture.h) scale the constants.
+ * base under a dielectric coat), metallic-roughness (glTF 2.0's BRDF: a
+ * metal and a dielectric mixed by metalness). Emission (ke) and
+ * two-sidedness go with any kind; texture maps (texture.h) scale the
+ * constants.
  */
 #ifndef PK_MATERIAL_H
 #define PK_MATERIAL_H
@@ -21,7 +23,14 @@
 
 #include <stdbool.h>
 
-typedef enum material_type { MAT_MTL, MAT_DIFFUSE, MAT_CONDUCTOR, MAT_DIELECTRIC, MAT_PLASTIC } material_type;
+typedef enum material_type {
+    MAT_MTL,
+    MAT_DIFFUSE,
+    MAT_CONDUCTOR,
+    MAT_DIELECTRIC,
+    MAT_PLASTIC,
+    MAT_METALLIC_ROUGHNESS
+} material_type;
 
 /* Colours are linear RGB. illum follows the MTL convention: 3/5 add mirror
  * reflection weighted by ks, 4/6/7 make the surface a dielectric of index
@@ -49,19 +58,29 @@ typedef struct material {
      * reflectance ks (Schlick's Fresnel); MAT_DIELECTRIC the index ni and
      * the transmittance tf; MAT_PLASTIC the albedo kd under a coating of
      * index ni. alpha is the GGX roughness of the conductor, dielectric and
-     * plastic (0 = smooth). Their constructors also set the MTL fields to
-     * what the Whitted integrator renders of them. */
+     * plastic (0 = smooth). MAT_METALLIC_ROUGHNESS is glTF 2.0's material:
+     * base colour kd, metallic and perceptual roughness in 0..1 (GGX alpha =
+     * roughness^2 at shading), transmission in 0..1 (KHR_materials_
+     * transmission: the thin-walled transmitted share of the dielectric's
+     * base) and the dielectric's index ni (KHR_materials_ior, 1.5 by
+     * default). Their constructors also set the MTL fields to what the
+     * Whitted integrator renders of them (for metallic-roughness,
+     * material_whitted_kd gives the Whitted diffuse, since kd holds the base
+     * colour). */
     int type;
     float alpha;
     vec3 eta, k;
     bool schlick;
+    float metallic, roughness, transmission;
     /* Texture maps (docs/materials.md), kind TEX_NONE when absent. A map's
      * value multiplies its constant: map_kd kd, map_ks ks, map_ns ns,
-     * map_alpha alpha. map_d cuts holes: where its opacity is below 0.5 the
+     * map_alpha alpha; map_mr is glTF's metallic-roughness texture (data,
+     * not sRGB): its blue channel multiplies metallic, its green roughness
+     * (a grey texture multiplies both). map_d cuts holes: where its opacity is below 0.5 the
      * surface is not there for any ray (the constant d still dissolves the
      * rest). map_bump is a height field (heights times bm, in scene units);
      * map_norm a tangent-space normal map. */
-    tex_ref map_kd, map_ks, map_ns, map_d, map_alpha, map_bump, map_norm;
+    tex_ref map_kd, map_ks, map_ns, map_d, map_alpha, map_bump, map_norm, map_mr;
     bool textured;   /* derived by scene_commit: a map other than map_d is set */
     bool cutout;     /* derived by scene_commit: map_d is set */
 } material;
@@ -83,6 +102,22 @@ PK_HIDDEN void material_conductor_f0(material *m, vec3 f0, float alpha);
 PK_HIDDEN void material_dielectric(material *m, float ior, float alpha, vec3 transmittance);
 /* A diffuse base of albedo under a dielectric coat of index ior. */
 PK_HIDDEN void material_plastic(material *m, vec3 albedo, float ior, float alpha);
+
+/* glTF 2.0's metallic-roughness material: base colour (linear), metallic and
+ * perceptual roughness in 0..1; transmission 0 and ior 1.5 (set the fields
+ * transmission and ni afterwards for KHR_materials_transmission and
+ * KHR_materials_ior; material_whitted_kd reads transmission where it is
+ * used). */
+PK_HIDDEN void material_metallic_roughness(material *m, vec3 base_color, float metallic, float roughness);
+
+/* The diffuse reflectance that the MTL model and the Whitted integrator use:
+ * kd, but for metallic-roughness the base colour's diffuse share
+ * kd (1 - metallic) (1 - transmission). */
+static inline PK_HD vec3 material_whitted_kd(const material *m)
+{
+    if (m->type != MAT_METALLIC_ROUGHNESS) return m->kd;
+    return v3_scale(m->kd, (1.0f - m->metallic) * (1.0f - m->transmission));
+}
 
 /* Fresnel reflectance at normal incidence of a dielectric of index ior,
  * and of a conductor of index eta + i k (per channel). */
