@@ -1039,17 +1039,69 @@ static pk_status parse_sphere(jp *p, const cJSON *it, const char *path)
 
 static pk_status parse_light(jp *p, const cJSON *it, const char *path)
 {
-    enum { L_POSITION, L_INTENSITY, L_COLOR, L_COUNT };
-    static const char *const keys[L_COUNT] = {"position", "intensity", "color"};
+    enum { L_TYPE, L_POSITION, L_INTENSITY, L_COLOR, L_DIRECTION, L_OUTER, L_INNER, L_COUNT };
+    static const char *const keys[L_COUNT] = {"type", "position", "intensity", "color",
+                                              "direction", "outer_angle", "inner_angle"};
     const cJSON *f[L_COUNT];
     char fp[JP_PATH_MAX];
     pk_status st = object_fields(p, it, path, keys, L_COUNT, f);
     if (st) return st;
-    if (!f[L_POSITION]) return jfail(p, PK_ERR_PARSE, it, path, "missing \"position\"");
     point_light l;
+    memset(&l, 0, sizeof l);
+    int kind = 0; /* 0 point, 1 spot, 2 distant */
+    if (f[L_TYPE]) {
+        path_key(fp, path, "type");
+        const char *t = cJSON_IsString(f[L_TYPE]) ? f[L_TYPE]->valuestring : "";
+        if (strcmp(t, "point") == 0) kind = 0;
+        else if (strcmp(t, "spot") == 0) kind = 1;
+        else if (strcmp(t, "distant") == 0) kind = 2;
+        else return jfail(p, PK_ERR_PARSE, f[L_TYPE], fp, "must be \"point\", \"spot\" or \"distant\"");
+    }
+    if (kind != 2) {
+        if (!f[L_POSITION]) return jfail(p, PK_ERR_PARSE, it, path, "missing \"position\"");
+        path_key(fp, path, "position");
+        if ((st = get_vec3(p, f[L_POSITION], fp, &l.position))) return st;
+    } else if (f[L_POSITION]) {
+        return jfail(p, PK_ERR_PARSE, f[L_POSITION], path, "a distant light has no \"position\"");
+    }
+    if (kind == 0 && (f[L_DIRECTION] || f[L_OUTER] || f[L_INNER]))
+        return jfail(p, PK_ERR_PARSE, it, path, "a point light has no \"direction\" or cone angles (\"type\": \"spot\")");
+    if (kind != 0) {
+        if (!f[L_DIRECTION]) return jfail(p, PK_ERR_PARSE, it, path, "missing \"direction\"");
+        vec3 d;
+        path_key(fp, path, "direction");
+        if ((st = get_vec3(p, f[L_DIRECTION], fp, &d))) return st;
+        const float len = v3_len(d);
+        if (!(len > 0.0f) || !isfinite(len)) return jfail(p, PK_ERR_PARSE, f[L_DIRECTION], fp, "must be a non-zero vector");
+        d = v3_scale(d, 1.0f / len);
+        if (kind == 2) {
+            l.distant = true;
+            l.position = v3_neg(d); /* toward the light */
+        } else {
+            float outer = 30.0f, inner = -1.0f;
+            if (f[L_OUTER]) {
+                path_key(fp, path, "outer_angle");
+                if ((st = get_float(p, f[L_OUTER], fp, &outer))) return st;
+                if (!(outer > 0.0f && outer <= 180.0f))
+                    return jfail(p, PK_ERR_PARSE, f[L_OUTER], fp, "must be in (0, 180] degrees");
+            }
+            if (f[L_INNER]) {
+                path_key(fp, path, "inner_angle");
+                if ((st = get_float(p, f[L_INNER], fp, &inner))) return st;
+                if (!(inner >= 0.0f && inner <= outer))
+                    return jfail(p, PK_ERR_PARSE, f[L_INNER], fp, "must be in [0, outer_angle] degrees");
+            } else {
+                inner = 0.8f * outer;
+            }
+            l.spot_dir = d;
+            l.cos_outer = cosf(outer * PK_PI / 180.0f);
+            l.cos_inner = cosf(inner * PK_PI / 180.0f);
+            l.spot_falloff = SPOT_FALLOFF_SMOOTHSTEP;
+        }
+    } else if (f[L_OUTER] || f[L_INNER]) {
+        return jfail(p, PK_ERR_PARSE, it, path, "cone angles belong to a spot light");
+    }
     vec3 intensity = v3s(1.0f), color = v3s(1.0f);
-    path_key(fp, path, "position");
-    if ((st = get_vec3(p, f[L_POSITION], fp, &l.position))) return st;
     if (f[L_INTENSITY]) {
         path_key(fp, path, "intensity");
         if (cJSON_IsNumber(f[L_INTENSITY])) {

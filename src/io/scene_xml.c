@@ -1847,6 +1847,7 @@ static pk_status parse_emitter(xp *p, xnode *e)
 
     if (strcmp(type, "point") == 0 || strcmp(type, "spot") == 0) {
         point_light l;
+        memset(&l, 0, sizeof l);
         vec3 pos = v3s(0.0f), intensity = v3s(1.0f);
         bool has_pos;
         xform m;
@@ -1854,10 +1855,25 @@ static pk_status parse_emitter(xp *p, xnode *e)
         if ((st = get_vec(p, e, "position", &pos, &has_pos))) return st;
         if ((st = get_color(p, e, "intensity", &intensity))) return st;
         if (type[0] == 's') {
-            float cutoff = 20.0f, beam = 15.0f;
+            /* Mitsuba's spot shines along +z of its to_world: full within
+             * beam_width, fading linearly in the angle to nothing at
+             * cutoff_angle (degrees, half-angles; beam_width defaults to
+             * three quarters of the cutoff) */
+            float cutoff = 20.0f, beam = -1.0f;
             if ((st = get_float(p, e, "cutoff_angle", &cutoff))) return st;
             if ((st = get_float(p, e, "beam_width", &beam))) return st;
-            xwarn(p, e, "spot light rendered as a point light shining in every direction");
+            if (beam < 0.0f) beam = 0.75f * cutoff;
+            if (!(cutoff > 0.0f && cutoff <= 180.0f))
+                return xfail(p, PK_ERR_PARSE, e, "cutoff_angle must be in (0, 180] degrees");
+            if (!(beam >= 0.0f)) return xfail(p, PK_ERR_PARSE, e, "beam_width must not be negative");
+            if (beam > cutoff) beam = cutoff;
+            const vec3 axis = xform_vector(&m, v3(0.0f, 0.0f, 1.0f));
+            const float len = v3_len(axis);
+            if (!(len > 0.0f) || !isfinite(len)) return xfail(p, PK_ERR_PARSE, e, "spot light: degenerate to_world");
+            l.spot_dir = v3_scale(axis, 1.0f / len);
+            l.cos_outer = cosf(cutoff * PK_PI / 180.0f);
+            l.cos_inner = cosf(beam * PK_PI / 180.0f);
+            l.spot_falloff = SPOT_FALLOFF_ANGLE;
         }
         l.position = has_pos ? pos : xform_point(&m, v3s(0.0f));
         l.intensity = intensity;
@@ -1957,20 +1973,14 @@ static pk_status parse_emitter(xp *p, xnode *e)
         if (!has_dir && has_m) dir = xform_vector(&m, v3(0.0f, 0.0f, 1.0f));
         if ((st = get_color(p, e, "irradiance", &irr))) return st;
         if (!(v3_len2(dir) > 0.0f)) return xfail(p, PK_ERR_PARSE, e, "direction must not be zero");
-        /* a sun of 0.1 degrees with the same irradiance */
-        const float angle = 0.1f;
-        float half = 0.5f * angle * (PK_PI / 180.0f);
-        float sh = sinf(0.5f * half), solid = 4.0f * PK_PI * sh * sh; /* 2 pi (1 - cos half) */
-        if (env->has_sun) {
-            xwarn(p, e, "a second sun or directional light is not supported; ignored");
-        } else {
-            env->set = true;
-            env->has_sun = true;
-            env->sun_dir = v3_neg(v3_norm_scaled(dir));
-            env->sun_angle = angle;
-            env->sun_radiance = v3_scale(irr, 1.0f / solid);
-            xwarn(p, e, "directional light rendered as a sun of %g degrees with the same irradiance", (double)angle);
-        }
+        if (!v3_finite(irr) || !(irr.x >= 0.0f && irr.y >= 0.0f && irr.z >= 0.0f))
+            return xfail(p, PK_ERR_PARSE, e, "irradiance must be finite and not negative");
+        point_light l;
+        memset(&l, 0, sizeof l);
+        l.distant = true;
+        l.position = v3_neg(v3_norm_scaled(dir)); /* toward the light */
+        l.intensity = irr;
+        if ((st = scene_add_point_light(p->ctx, p->s, &l))) return st;
     } else if (strcmp(type, "area") == 0) {
         xwarn(p, e, "an area emitter belongs inside a shape; ignored");
         return PK_OK;

@@ -7,6 +7,21 @@
 
 static bool emits(vec3 ke) { return ke.x > 0.0f || ke.y > 0.0f || ke.z > 0.0f; }
 
+/* The radius of a sphere about the centre of the scene's bounds that holds
+ * its triangles and spheres (1 for an empty scene). */
+static double scene_radius(const pk_scene *s)
+{
+    vec3 lo = v3s(INFINITY), hi = v3s(-INFINITY);
+    for (size_t i = 0; i < s->npositions; i++) lo = v3_min(lo, s->positions[i]), hi = v3_max(hi, s->positions[i]);
+    for (size_t i = 0; i < s->nspheres; i++) {
+        const vec3 r = v3s(s->spheres[i].radius);
+        lo = v3_min(lo, v3_sub(s->spheres[i].center, r)), hi = v3_max(hi, v3_add(s->spheres[i].center, r));
+    }
+    if (!(lo.x <= hi.x)) return 1.0;
+    const double r = 0.5 * (double)v3_len(v3_sub(hi, lo));
+    return r > 0.0 && isfinite(r) ? r : 1.0;
+}
+
 pk_status light_set_build(pk_context *ctx, const pk_scene *s, const env_light *env, light_set *ls)
 {
     memset(ls, 0, sizeof *ls);
@@ -57,13 +72,23 @@ pk_status light_set_build(pk_context *ctx, const pk_scene *s, const env_light *e
         ls->of_prim[s->ntris + i] = (int32_t)k;
         k++;
     }
+    double radius = -1.0; /* of the scene's bounding sphere, for distant lights' power */
     for (size_t i = 0; i < s->nlights; i++) {
+        const point_light *pl = &s->lights[i];
         light *l = &ls->lights[k];
         l->kind = LIGHT_POINT;
         l->index = (uint32_t)i;
         l->area = 0.0f;
         l->normal = v3s(0.0f);
-        power[k] = (double)fmaxf(v3_luminance(s->lights[i].intensity), 1e-6f) * 4.0 * (double)PK_PI;
+        double flux = 4.0 * (double)PK_PI; /* per unit of intensity: the whole sphere */
+        if (pl->distant) {
+            if (radius < 0.0) radius = scene_radius(s);
+            flux = (double)PK_PI * radius * radius; /* irradiance through the scene's disc */
+        } else if (v3_len2(pl->spot_dir) > 0.0f) {
+            /* the cone, its falloff counted as half the band between the cones */
+            flux = 2.0 * (double)PK_PI * (1.0 - 0.5 * ((double)pl->cos_inner + (double)pl->cos_outer));
+        }
+        power[k] = (double)fmaxf(v3_luminance(pl->intensity), 1e-6f) * fmax(flux, 1e-9);
         k++;
     }
     if (env->active) {

@@ -203,6 +203,24 @@ static inline PK_HD bool light_sample_tri_solid_angle(const scene_view *s, const
     return true;
 }
 
+/* The fraction of a point light's intensity it sends in the unit direction
+ * w (from the light): 1 for point lights, a spot light's cone and falloff
+ * (SPOT_FALLOFF_*). */
+static inline PK_HD float spot_falloff(const point_light *pl, vec3 w)
+{
+    if (!(v3_len2(pl->spot_dir) > 0.0f)) return 1.0f;
+    const float c = v3_dot(pl->spot_dir, w);
+    if (c >= pl->cos_inner) return 1.0f;
+    if (c <= pl->cos_outer) return 0.0f;
+    const float t = (c - pl->cos_outer) / (pl->cos_inner - pl->cos_outer);
+    if (pl->spot_falloff == SPOT_FALLOFF_SQUARED) return t * t;
+    if (pl->spot_falloff == SPOT_FALLOFF_ANGLE) {
+        const float a = acosf(fminf(c, 1.0f)), ai = acosf(pl->cos_inner), ao = acosf(pl->cos_outer);
+        return ao > ai ? fminf(fmaxf((ao - a) / (ao - ai), 0.0f), 1.0f) : 1.0f;
+    }
+    return t * t * (3.0f - 2.0f * t);
+}
+
 /* Samples light li of the set from lc with (u1, u2), triangles as tri
  * says (LIGHT_TRI_*): false when it sends nothing toward lc->p. ls->pdf
  * excludes the light's choice; it is light_pdf_at(s, l, lc->p, lc->n, tri,
@@ -232,11 +250,23 @@ static inline PK_HD bool light_sample_one_with(const light_set *set, const scene
     }
     if (l->kind == LIGHT_POINT) {
         const point_light *pl = &s->lights[l->index];
-        vec3 d = v3_sub(pl->position, o);
-        float dist2 = v3_len2(d);
-        if (!(dist2 > 0.0f)) return false;
-        ls->wi = v3_scale(d, 1.0f / sqrtf(dist2));
-        ls->le = v3_scale(pl->intensity, 1.0f / dist2);
+        if (pl->distant) {
+            ls->wi = pl->position;
+            ls->le = pl->intensity;
+            ls->pdf = 1.0f;
+            ls->delta = true;
+            ls->shadow = (ray){o, 0.0f, pl->position, INFINITY};
+            return true;
+        }
+        /* the inverse square from the shading point itself, not from o
+         * (lifted off the surface by an offset that grows with the scene) */
+        const vec3 d = v3_sub(pl->position, o), dp = v3_sub(pl->position, p);
+        const float dist2 = v3_len2(dp);
+        if (!(dist2 > 0.0f) || !(v3_len2(d) > 0.0f)) return false;
+        ls->wi = v3_scale(dp, 1.0f / sqrtf(dist2));
+        const float f = spot_falloff(pl, v3_neg(ls->wi));
+        if (!(f > 0.0f)) return false;
+        ls->le = v3_scale(pl->intensity, f / dist2);
         ls->pdf = 1.0f;
         ls->delta = true;
         ls->shadow = (ray){o, 0.0f, d, 1.0f};

@@ -447,9 +447,18 @@ bool scene_check(const pk_scene *s, char *why, size_t n)
             FAIL("sphere %zu: bad center or radius", i);
         if (sp->material >= s->nmaterials) FAIL("sphere %zu: material out of range", i);
     }
-    for (size_t i = 0; i < s->nlights; i++)
-        if (!v3_finite(s->lights[i].position) || !v3_finite(s->lights[i].intensity))
+    for (size_t i = 0; i < s->nlights; i++) {
+        const point_light *l = &s->lights[i];
+        if (!v3_finite(l->position) || !v3_finite(l->intensity) || !v3_finite(l->spot_dir) ||
+            !isfinite(l->cos_inner) || !isfinite(l->cos_outer))
             FAIL("light %zu is not finite", i);
+        if (l->distant && fabsf(v3_len(l->position) - 1.0f) > 1e-3f)
+            FAIL("light %zu: a distant light's direction is not a unit vector", i);
+        if (v3_len2(l->spot_dir) > 0.0f &&
+            (fabsf(v3_len(l->spot_dir) - 1.0f) > 1e-3f || l->cos_outer > l->cos_inner || l->cos_outer < -1.0f ||
+             l->cos_inner > 1.0f || l->spot_falloff < 0 || l->spot_falloff > SPOT_FALLOFF_SQUARED))
+            FAIL("light %zu: a spot light needs a unit axis and -1 <= cos_outer <= cos_inner <= 1", i);
+    }
     for (size_t i = 0; i < s->nmeshes; i++) {
         const scene_mesh *m = &s->meshes[i];
         if (m->first_pos + m->npos > s->nmesh_positions || m->first_nrm + m->nnrm > s->nmesh_normals ||

@@ -35,9 +35,25 @@ typedef struct sphere {
     uint32_t material;
 } sphere;
 
+/* How a spot light fades between its inner and outer cones (t: where the
+ * direction's cosine lies, 0 at cos_outer, 1 at cos_inner). */
+enum {
+    SPOT_FALLOFF_SMOOTHSTEP = 0, /* pbrt-v4: smoothstep(t) */
+    SPOT_FALLOFF_ANGLE = 1,      /* Mitsuba: linear in the angle, not the cosine */
+    SPOT_FALLOFF_SQUARED = 2     /* glTF KHR_lights_punctual: t^2 */
+};
+
+/* A point light, a spot light (spot_dir non-zero) or a distant light
+ * (distant). Zero-initialise, then set what applies. */
 typedef struct point_light {
-    vec3 position;   /* world space */
-    vec3 intensity;  /* radiant intensity, linear RGB (W/sr per channel) */
+    vec3 position;   /* world space; distant: the unit direction toward the light */
+    vec3 intensity;  /* radiant intensity, linear RGB (W/sr per channel); distant: the
+                        irradiance (W/m^2) of a surface that faces the light */
+    vec3 spot_dir;   /* unit axis along which a spot light shines; zero: every direction */
+    float cos_inner; /* spot: full intensity within this cone (cosine of its half-angle) */
+    float cos_outer; /* spot: nothing outside this one (cos_outer < cos_inner) */
+    int spot_falloff;/* SPOT_FALLOFF_* */
+    bool distant;
 } point_light;
 
 /* Light from the surroundings (docs/scene-format.md, "environment"): what a
