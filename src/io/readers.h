@@ -1,10 +1,11 @@
 /*
  * readers.h - the scene file readers, one door each: OBJ (obj.c) and its MTL
  * libraries (mtl.c), the JSON scene (scene_json.c), Mitsuba XML
- * (scene_xml.c) and the PLY meshes it names (ply.c). Every reader parses a
- * (data, size) buffer, reads any further file through file_read_all, and
- * reports a bad input as "file:line: what is wrong" latched in the context;
- * none prints, exits or commits the scene.
+ * (scene_xml.c) and the PLY meshes it names (ply.c), glTF 2.0 (scene_gltf.c,
+ * gltf_data.c, gltf_material.c). Every reader parses a (data, size) buffer,
+ * reads any further file through file_read_all, and reports a bad input as
+ * "file:line: what is wrong" (glTF: "file: /json/pointer: what is wrong")
+ * latched in the context; none prints, exits or commits the scene.
  */
 #ifndef PK_READERS_H
 #define PK_READERS_H
@@ -38,6 +39,18 @@ PK_HIDDEN pk_status scene_json_parse(pk_context *ctx, pk_scene *s, const char *d
 PK_HIDDEN pk_status scene_xml_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,
                                     const char *name, const char *base_dir, const char *const *params,
                                     size_t nparams);
+
+/* Parses a glTF 2.0 asset into s: JSON (.gltf) or binary (.glb, told by
+ * its magic bytes); buffers and images are read relative to base_dir
+ * (docs/scene-format.md, "glTF 2.0"). Messages name the JSON pointer of what
+ * is wrong ("model.gltf: /accessors/3: ..."). Does not commit. */
+PK_HIDDEN pk_status scene_gltf_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,
+                                     const char *name, const char *base_dir);
+/* The same with parameters "NAME=VALUE": camera=N renders /cameras/N (the
+ * first camera in node order by default); others are warned about. */
+PK_HIDDEN pk_status scene_gltf_parse_params(pk_context *ctx, pk_scene *s, const char *data, size_t size,
+                                            const char *name, const char *base_dir, const char *const *params,
+                                            size_t nparams);
 
 /* ---- PLY meshes (Stanford polygon files): ascii, binary little and big
  * endian; vertex positions, optional normals and texture coordinates, and

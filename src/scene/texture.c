@@ -151,3 +151,44 @@ pk_status texture_load(pk_context *ctx, pk_scene *s, const char *path, bool colo
     *index = (int32_t)s->ntextures++;
     return PK_OK;
 }
+
+int32_t texture_find(const pk_scene *s, const char *key, bool colour)
+{
+    for (size_t i = 0; i < s->ntextures; i++)
+        if (s->textures[i].key[0] == (colour ? 'c' : 'd') && strcmp(s->textures[i].key + 1, key) == 0)
+            return (int32_t)i;
+    return -1;
+}
+
+pk_status texture_add_pixels(pk_context *ctx, pk_scene *s, const char *key, int w, int h, int nc, const uint8_t *px8,
+                             const float *pxf, bool colour, int32_t *index)
+{
+    *index = -1;
+    if (s->ntextures >= (size_t)INT32_MAX) return ctx_error(ctx, PK_ERR_LIMIT, "%s: too many textures", key);
+    size_t lk = strlen(key);
+    char *k = mem_alloc(&ctx->alloc, lk + 2);
+    if (!k) return ctx_nomem(ctx);
+    k[0] = colour ? 'c' : 'd';
+    memcpy(k + 1, key, lk + 1);
+    texture t;
+    pk_status st = texture_build(ctx, w, h, nc, px8, pxf, colour, &t);
+    if (st != PK_OK) {
+        mem_free(&ctx->alloc, k);
+        return st;
+    }
+    t.key = k;
+    if (t.bytes > PK_MAX_TEXTURE_BYTES - s->texture_bytes) {
+        size_t have = s->texture_bytes;
+        texture_free(&ctx->alloc, &t);
+        return ctx_error(ctx, PK_ERR_LIMIT, "%s: the scene's textures would take more than %zu bytes (%zu already)", key,
+                         (size_t)PK_MAX_TEXTURE_BYTES, have);
+    }
+    if (!mem_grow(&s->alloc, (void **)&s->textures, &s->cap_textures, s->ntextures + 1, sizeof *s->textures)) {
+        texture_free(&ctx->alloc, &t);
+        return ctx_nomem(ctx);
+    }
+    s->textures[s->ntextures] = t;
+    s->texture_bytes += t.bytes;
+    *index = (int32_t)s->ntextures++;
+    return PK_OK;
+}

@@ -79,6 +79,14 @@ PK_HIDDEN void texture_free(const pk_allocator *a, texture *t);
  * Errors (unreadable, corrupt, beyond the limits, the scene's texture
  * memory past PK_MAX_TEXTURE_BYTES) are latched in ctx with the file named. */
 PK_HIDDEN pk_status texture_load(pk_context *ctx, struct pk_scene *s, const char *path, bool colour, int32_t *index);
+/* The same for pixels decoded by the caller (an image held in a glTF
+ * buffer or data: URI): key names them (a path is the usual key, any
+ * unique string will do), and texture_find finds them again. The pixels are
+ * copied (texture_build). */
+PK_HIDDEN pk_status texture_add_pixels(pk_context *ctx, struct pk_scene *s, const char *key, int w, int h, int nc,
+                                       const uint8_t *px8, const float *pxf, bool colour, int32_t *index);
+/* The index of the texture loaded under key in that decode mode, or -1. */
+PK_HIDDEN int32_t texture_find(const struct pk_scene *s, const char *key, bool colour);
 
 
 

@@ -1,0 +1,439 @@
+/*
+ * gltf_material.c - glTF materials as the scene's metallic-roughness kind:
+ * base colour (factor and sRGB texture), the metallic-roughness texture,
+ * normal maps, emission (+KHR_materials_emissive_strength), alpha modes,
+ * double-sidedness, KHR_texture_transform, KHR_materials_transmission and
+ * KHR_materials_ior; images from files, data: URIs and buffer views, with
+ * their samplers' wrap modes. What the model cannot show is warned about
+ * (docs/scene-format.md, "glTF 2.0").
+ */
+#include "gltf.h"
+#include "io_util.h"
+#include "../image/image_read.h"
+#include "../scene/material.h"
+#include "../scene/texture.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+/* A texture reference as a glTF textureInfo describes it. */
+typedef struct tex_info {
+    bool present;
+    int64_t texture;
+    int texcoord;
+    float m[6];     /* the uv transform in glTF's uv space: u' = m0 u + m1 v + m2, v' = m3 u + m4 v + m5 */
+    bool has_transform;
+    float scale;    /* normalTexture.scale */
+} tex_info;
+
+static pk_status read_tex_info(gltf *g, const cJSON *o, const char *path, tex_info *ti)
+{
+    memset(ti, 0, sizeof *ti);
+    ti->m[0] = ti->m[4] = 1.0f;
+    ti->scale = 1.0f;
+    if (!o) return PK_OK;
+    if (!cJSON_IsObject(o)) return gltf_fail(g, PK_ERR_PARSE, "%s: must be an object", path);
+    pk_status st;
+    int64_t tc;
+    if ((st = gltf_index(g, o, path, "index", gltf_count(g, "textures"), true, &ti->texture))) return st;
+    if ((st = gltf_int(g, o, path, "texCoord", 0, INT32_MAX, 0, &tc))) return st;
+    if ((st = gltf_num(g, o, path, "scale", -1e30, 1e30, 1.0, &ti->scale))) return st;
+    const cJSON *tt = gltf_ext(o, "KHR_texture_transform");
+    if (tt) {
+        char tp[160];
+        snprintf(tp, sizeof tp, "%s/extensions/KHR_texture_transform", path);
+        if (!cJSON_IsObject(tt)) return gltf_fail(g, PK_ERR_PARSE, "%s: must be an object", tp);
+        float off[2] = {0, 0}, sc[2] = {1, 1}, rot;
+        bool found;
+        if ((st = gltf_nums(g, tt, tp, "offset", 2, off, &found))) return st;
+        if ((st = gltf_nums(g, tt, tp, "scale", 2, sc, &found))) return st;
+        if ((st = gltf_num(g, tt, tp, "rotation", -1e30, 1e30, 0.0, &rot))) return st;
+        if ((st = gltf_int(g, tt, tp, "texCoord", 0, INT32_MAX, tc, &tc))) return st;
+        /* T R S; R as the extension's sample model TextureTransformTest
+         * checks it: (u, v) -> (c u + s v, -s u + c v) */
+        const float c = cosf(rot), s = sinf(rot);
+        ti->m[0] = c * sc[0], ti->m[1] = s * sc[1], ti->m[2] = off[0];
+        ti->m[3] = -s * sc[0], ti->m[4] = c * sc[1], ti->m[5] = off[1];
+        ti->has_transform = true;
+    }
+    ti->texcoord = (int)tc;
+    ti->present = true;
+    return PK_OK;
+}
+
+static bool same_transform(const tex_info *a, const tex_info *b)
+{
+    return memcmp(a->m, b->m, sizeof a->m) == 0;
+}
+
+/* ---- images ------------------------------------------------------------------- */
+
+/* The bytes of image i (owned *buf, or borrowed from a buffer view). */
+static pk_status image_bytes(gltf *g, int64_t i, const uint8_t **data, size_t *size, void **owned)
+{
+    *owned = NULL;
+    const cJSON *o = cJSON_GetArrayItem(gltf_array(g, "images"), (int)i);
+    char path[48], up[64];
+    snprintf(path, sizeof path, "/images/%lld", (long long)i);
+    snprintf(up, sizeof up, "%s/uri", path);
+    if (!cJSON_IsObject(o)) return gltf_fail(g, PK_ERR_PARSE, "%s: must be an object", path);
+    const char *uri;
+    pk_status st;
+    int64_t view;
+    if ((st = gltf_string(g, o, path, "uri", &uri))) return st;
+    if ((st = gltf_index(g, o, path, "bufferView", gltf_count(g, "bufferViews"), false, &view))) return st;
+    if (uri && view >= 0) return gltf_fail(g, PK_ERR_PARSE, "%s: both uri and bufferView", path);
+    if (view >= 0) {
+        size_t stride;
+        return gltf_view(g, view, data, size, &stride);
+    }
+    if (!uri) return gltf_fail(g, PK_ERR_PARSE, "%s: neither uri nor bufferView", path);
+    if (strncmp(uri, "data:", 5) == 0) {
+        uint8_t *b;
+        if ((st = gltf_data_uri(g, uri, up, &b, size))) return st;
+        *data = b;
+        *owned = b;
+        return PK_OK;
+    }
+    char *b;
+    if ((st = gltf_read_uri_file(g, uri, up, &b, size))) return st;
+    *data = (const uint8_t *)b;
+    *owned = b;
+    return PK_OK;
+}
+
+/* The scene texture of image i in a decode mode (-1 with a warning when it
+ * cannot be used). */
+static pk_status image_texture(gltf *g, int64_t i, bool colour, const char *user, int32_t *tex)
+{
+    *tex = -1;
+    int32_t *slot = &g->images[colour ? 0 : 1][i];
+    if (*slot) { /* tried before: -1 unusable, else the texture + 1 */
+        *tex = *slot < 0 ? -1 : *slot - 1;
+        return PK_OK;
+    }
+    const bool was_ok = g->ctx->status == PK_OK;
+    const uint8_t *data = NULL;
+    size_t size = 0;
+    void *owned = NULL;
+    char key[PK_ERRMSG_MAX];
+    snprintf(key, sizeof key, "%s#/images/%lld", g->name, (long long)i);
+    pk_status st = image_bytes(g, i, &data, &size, &owned);
+    if (st == PK_OK) {
+        image_buf img;
+        pk_context scratch = io_scratch_context(g->ctx);
+        st = image_decode(&scratch, data, size, key, &img);
+        if (st == PK_ERR_NOMEM) st = ctx_nomem(g->ctx);
+        else if (st != PK_OK) st = gltf_fail(g, st, "/images/%lld: %s", (long long)i, scratch.message);
+        if (st == PK_OK) {
+            st = texture_add_pixels(g->ctx, g->s, key, img.w, img.h, img.nc, img.px8, img.pxf, colour, tex);
+            image_buf_free(&g->ctx->alloc, &img);
+        }
+    }
+    mem_free(&g->ctx->alloc, owned);
+    if (st != PK_OK) {
+        char why[PK_ERRMSG_MAX];
+        if (!io_demote_error(g->ctx, st, was_ok, why, sizeof why)) return st;
+        ctx_warn(g->ctx, "%s (%s drawn without it)", why, user);
+        *slot = -1; /* unusable: not tried again */
+        *tex = -1;
+        return PK_OK;
+    }
+    *slot = *tex + 1;
+    return PK_OK;
+}
+
+/* Resolves a textureInfo into a tex_ref (kind TEX_NONE when unusable). bake:
+ * the transform is baked into the primitive's uvs (identity here). */
+static pk_status make_ref(gltf *g, const tex_info *ti, bool colour, bool bake, const char *user, tex_ref *r)
+{
+    tex_ref_init(r);
+    if (!ti->present) return PK_OK;
+    const cJSON *t = cJSON_GetArrayItem(gltf_array(g, "textures"), (int)ti->texture);
+    char path[48];
+    snprintf(path, sizeof path, "/textures/%lld", (long long)ti->texture);
+    if (!cJSON_IsObject(t)) return gltf_fail(g, PK_ERR_PARSE, "%s: must be an object", path);
+    int64_t src, smp;
+    pk_status st;
+    if ((st = gltf_index(g, t, path, "source", g->nimages, false, &src))) return st;
+    if ((st = gltf_index(g, t, path, "sampler", gltf_count(g, "samplers"), false, &smp))) return st;
+    if (src < 0) {
+        gltf_warn(g, "%s: no source image this reader can decode (%s drawn without it)", path, user);
+        return PK_OK;
+    }
+    if (g->images[colour ? 0 : 1][src] < 0) return PK_OK; /* known unusable */
+    int32_t tex;
+    if ((st = image_texture(g, src, colour, user, &tex))) return st;
+    if (tex < 0) return PK_OK;
+    r->kind = TEX_IMAGE;
+    r->tex = tex;
+    if (smp >= 0) {
+        const cJSON *so = cJSON_GetArrayItem(gltf_array(g, "samplers"), (int)smp);
+        char sp[48];
+        snprintf(sp, sizeof sp, "/samplers/%lld", (long long)smp);
+        if (!cJSON_IsObject(so)) return gltf_fail(g, PK_ERR_PARSE, "%s: must be an object", sp);
+        int64_t ws, wt;
+        if ((st = gltf_int(g, so, sp, "wrapS", 0, INT32_MAX, 10497, &ws))) return st;
+        if ((st = gltf_int(g, so, sp, "wrapT", 0, INT32_MAX, 10497, &wt))) return st;
+        for (int k = 0; k < 2; k++) {
+            int64_t w = k ? wt : ws;
+            if (w != 10497 && w != 33071 && w != 33648)
+                return gltf_fail(g, PK_ERR_PARSE, "%s: %s %lld is not a glTF wrap mode", sp, k ? "wrapT" : "wrapS",
+                                 (long long)w);
+        }
+        r->clamp = ws == 33071 && wt == 33071;
+        if (ws == 33648 || wt == 33648 || ((ws == 33071) != (wt == 33071)))
+            gltf_warn_once(g, GW_WRAP,
+                           "%s: mirrored repeat, or clamping along one axis only, is drawn as %s (further ones not "
+                           "reported)",
+                           sp, r->clamp ? "clamp" : "repeat");
+    }
+    if (!bake) {
+        /* glTF's v runs down the image, the scene's up: v_scene = 1 - v_gltf */
+        r->s[0] = ti->m[0];
+        r->s[1] = ti->m[4];
+        r->o[0] = ti->m[2];
+        r->o[1] = 1.0f - ti->m[4] - ti->m[5];
+        if (ti->m[1] != 0.0f || ti->m[3] != 0.0f)
+            gltf_warn_once(g, GW_ROTATION,
+                           "%s: a KHR_texture_transform rotation differs between the material's textures: "
+                           "drawn without it (further ones not reported)",
+                           user);
+    }
+    return PK_OK;
+}
+
+/* ---- the derived textures: cut-out masks ------------------------------------------ */
+
+/* A one-channel mask (255 where alpha * factor >= cutoff) from the base
+ * colour texture tex (or the constant factor alone when tex < 0). */
+static pk_status make_mask(gltf *g, int64_t mi, int32_t tex, float factor, float cutoff, int32_t *out)
+{
+    char key[PK_ERRMSG_MAX];
+    snprintf(key, sizeof key, "%s#/materials/%lld/alpha", g->name, (long long)mi);
+    int w = 1, h = 1;
+    const texture *t = tex >= 0 ? &g->s->textures[tex] : NULL;
+    if (t) w = t->lv[0].w, h = t->lv[0].h;
+    uint8_t *px = mem_alloc(&g->ctx->alloc, (size_t)w * (size_t)h);
+    if (!px) return ctx_nomem(g->ctx);
+    for (size_t k = 0; k < (size_t)w * (size_t)h; k++) {
+        float a = 1.0f;
+        if (t && (t->nc == 2 || t->nc == 4)) {
+            size_t at = k * (size_t)t->nc + (size_t)t->nc - 1;
+            a = t->lv[0].px8 ? (float)t->lv[0].px8[at] / 255.0f : t->lv[0].pxf[at];
+        }
+        px[k] = a * factor >= cutoff ? 255 : 0;
+    }
+    pk_status st = texture_add_pixels(g->ctx, g->s, key, w, h, 1, px, NULL, false, out);
+    mem_free(&g->ctx->alloc, px);
+    return st;
+}
+
+/* The mean linear colour of a texture (its last mip level). */
+static vec3 texture_mean(const texture *t)
+{
+    float c[4] = {1, 1, 1, 1};
+    const tex_level *l = &t->lv[t->nlevels - 1];
+    tex_fetch(t, l, 0, 0, c);
+    return t->nc >= 3 ? v3(c[0], c[1], c[2]) : v3s(c[0]);
+}
+
+/* ---- materials ------------------------------------------------------------------------ */
+
+static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
+{
+    const cJSON *o = cJSON_GetArrayItem(gltf_array(g, "materials"), (int)mi);
+    char path[48], pp[96], ep[160];
+    snprintf(path, sizeof path, "/materials/%lld", (long long)mi);
+    snprintf(pp, sizeof pp, "%s/pbrMetallicRoughness", path);
+    if (!cJSON_IsObject(o)) return gltf_fail(g, PK_ERR_PARSE, "%s: must be an object", path);
+    pk_status st;
+    const cJSON *pbr = cJSON_GetObjectItemCaseSensitive(o, "pbrMetallicRoughness");
+    if (pbr && !cJSON_IsObject(pbr)) return gltf_fail(g, PK_ERR_PARSE, "%s: must be an object", pp);
+    float base[4] = {1, 1, 1, 1}, metallic = 1.0f, roughness = 1.0f, emissive[3] = {0, 0, 0};
+    bool found;
+    tex_info t_base, t_mr, t_norm, t_emit, t_occ;
+    char tp[160];
+    if (pbr) {
+        if ((st = gltf_nums(g, pbr, pp, "baseColorFactor", 4, base, &found))) return st;
+        if ((st = gltf_num(g, pbr, pp, "metallicFactor", 0.0, 1.0, 1.0, &metallic))) return st;
+        if ((st = gltf_num(g, pbr, pp, "roughnessFactor", 0.0, 1.0, 1.0, &roughness))) return st;
+        snprintf(tp, sizeof tp, "%s/baseColorTexture", pp);
+        if ((st = read_tex_info(g, cJSON_GetObjectItemCaseSensitive(pbr, "baseColorTexture"), tp, &t_base))) return st;
+        snprintf(tp, sizeof tp, "%s/metallicRoughnessTexture", pp);
+        if ((st = read_tex_info(g, cJSON_GetObjectItemCaseSensitive(pbr, "metallicRoughnessTexture"), tp, &t_mr)))
+            return st;
+    } else {
+        read_tex_info(g, NULL, pp, &t_base);
+        read_tex_info(g, NULL, pp, &t_mr);
+    }
+    for (int k = 0; k < 4; k++)
+        if (base[k] < 0.0f || base[k] > 1.0f)
+            return gltf_fail(g, PK_ERR_PARSE, "%s/baseColorFactor: %g is outside [0, 1]", pp, (double)base[k]);
+    snprintf(tp, sizeof tp, "%s/normalTexture", path);
+    if ((st = read_tex_info(g, cJSON_GetObjectItemCaseSensitive(o, "normalTexture"), tp, &t_norm))) return st;
+    snprintf(tp, sizeof tp, "%s/emissiveTexture", path);
+    if ((st = read_tex_info(g, cJSON_GetObjectItemCaseSensitive(o, "emissiveTexture"), tp, &t_emit))) return st;
+    snprintf(tp, sizeof tp, "%s/occlusionTexture", path);
+    if ((st = read_tex_info(g, cJSON_GetObjectItemCaseSensitive(o, "occlusionTexture"), tp, &t_occ))) return st;
+    if ((st = gltf_nums(g, o, path, "emissiveFactor", 3, emissive, &found))) return st;
+    for (int k = 0; k < 3; k++)
+        if (emissive[k] < 0.0f)
+            return gltf_fail(g, PK_ERR_PARSE, "%s/emissiveFactor: %g is negative", path, (double)emissive[k]);
+    const char *mode;
+    if ((st = gltf_string(g, o, path, "alphaMode", &mode))) return st;
+    int amode = 0; /* OPAQUE, MASK, BLEND */
+    if (mode) {
+        if (strcmp(mode, "OPAQUE") == 0) amode = 0;
+        else if (strcmp(mode, "MASK") == 0) amode = 1;
+        else if (strcmp(mode, "BLEND") == 0) amode = 2;
+        else return gltf_fail(g, PK_ERR_PARSE, "%s/alphaMode: '%.16s' is not OPAQUE, MASK or BLEND", path, mode);
+    }
+    float cutoff;
+    if ((st = gltf_num(g, o, path, "alphaCutoff", 0.0, 1e30, 0.5, &cutoff))) return st;
+    const cJSON *ds = cJSON_GetObjectItemCaseSensitive(o, "doubleSided");
+    if (ds && !cJSON_IsBool(ds)) return gltf_fail(g, PK_ERR_PARSE, "%s/doubleSided: must be true or false", path);
+
+    /* extensions */
+    float strength = 1.0f, transmission = 0.0f, ior = 1.5f;
+    const cJSON *ext = cJSON_GetObjectItemCaseSensitive(o, "extensions");
+    for (const cJSON *e = ext ? ext->child : NULL; e; e = e->next) {
+        snprintf(ep, sizeof ep, "%s/extensions/%.40s", path, e->string ? e->string : "");
+        if (!e->string) continue;
+        if (strcmp(e->string, "KHR_materials_emissive_strength") == 0) {
+            if ((st = gltf_num(g, e, ep, "emissiveStrength", 0.0, 1e30, 1.0, &strength))) return st;
+        } else if (strcmp(e->string, "KHR_materials_transmission") == 0) {
+            if ((st = gltf_num(g, e, ep, "transmissionFactor", 0.0, 1.0, 0.0, &transmission))) return st;
+            if (cJSON_GetObjectItemCaseSensitive(e, "transmissionTexture"))
+                gltf_warn(g, "%s: transmissionTexture is not supported (the factor is used alone)", ep);
+        } else if (strcmp(e->string, "KHR_materials_ior") == 0) {
+            if ((st = gltf_num(g, e, ep, "ior", 0.0, 1e30, 1.5, &ior))) return st;
+            if (ior == 0.0f) ior = 1.5f; /* never seen through: glTF's "0" is an infinite index; a dielectric default */
+            else if (ior < 1.0f) return gltf_fail(g, PK_ERR_PARSE, "%s: ior %g is below 1", ep, (double)ior);
+        } else if (strcmp(e->string, "KHR_materials_clearcoat") == 0 ||
+                   strcmp(e->string, "KHR_materials_sheen") == 0 || strcmp(e->string, "KHR_materials_volume") == 0 ||
+                   strcmp(e->string, "KHR_materials_specular") == 0 ||
+                   strcmp(e->string, "KHR_materials_iridescence") == 0 ||
+                   strcmp(e->string, "KHR_materials_anisotropy") == 0 ||
+                   strcmp(e->string, "KHR_materials_dispersion") == 0) {
+            gltf_warn(g, "%s: not supported; the material is drawn without it", ep);
+        } else if (strcmp(e->string, "KHR_materials_unlit") == 0) {
+            gltf_warn(g, "%s: not supported; drawn as a lit diffuse surface of the base colour", ep);
+            metallic = 0.0f;
+            roughness = 1.0f;
+        } else {
+            gltf_warn(g, "%s: unknown material extension ignored", ep);
+        }
+    }
+
+    /* which uv set, and whether one transform serves every texture (then it
+     * is baked into the primitive's uvs, rotation included) */
+    tex_info *all[4] = {&t_base, &t_mr, &t_norm, &t_emit};
+    int set = -1;
+    bool same = true;
+    const tex_info *first = NULL;
+    for (int k = 0; k < 4; k++) {
+        if (!all[k]->present) continue;
+        if (set < 0) set = all[k]->texcoord;
+        else if (all[k]->texcoord != set)
+            gltf_warn_once(g, GW_UV_SETS, "%s: textures read different uv sets; all read TEXCOORD_%d", path, set);
+        if (!first) first = all[k];
+        else if (!same_transform(first, all[k])) same = false;
+    }
+    if (set > 1) {
+        gltf_warn(g, "%s: TEXCOORD_%d is not read; the textures read TEXCOORD_0", path, set);
+        set = 0;
+    }
+    *uvset = set < 0 ? 0 : set;
+
+    uint32_t idx;
+    char mname[64];
+    const char *nm;
+    if ((st = gltf_string(g, o, path, "name", &nm))) return st;
+    if (nm) snprintf(mname, sizeof mname, "%.60s", nm);
+    else snprintf(mname, sizeof mname, "material%lld", (long long)mi);
+    if ((st = scene_add_material(g->ctx, g->s, mname, &idx))) return st;
+    material m = g->s->materials[idx];
+    material_metallic_roughness(&m, v3(base[0], base[1], base[2]), metallic, roughness);
+    m.transmission = transmission;
+    m.ni = ior;
+    m.two_sided = cJSON_IsTrue(ds);
+    m.ke = v3_scale(v3(emissive[0], emissive[1], emissive[2]), strength);
+
+    const bool bake = same && first && first->has_transform;
+    if ((st = make_ref(g, &t_base, true, bake, path, &m.map_kd))) goto fail;
+    if ((st = make_ref(g, &t_mr, false, bake, path, &m.map_mr))) goto fail;
+    if ((st = make_ref(g, &t_norm, false, bake, path, &m.map_norm))) goto fail;
+    if (m.map_norm.kind && t_norm.scale != 1.0f)
+        gltf_warn_once(g, GW_NORMAL_SCALE, "%s/normalTexture: scale %g is drawn as 1 (further ones not reported)",
+                       path, (double)t_norm.scale);
+    if (t_emit.present && v3_max_comp(m.ke) > 0.0f) {
+        tex_ref er;
+        if ((st = make_ref(g, &t_emit, true, bake, path, &er))) goto fail;
+        if (er.kind == TEX_IMAGE) {
+            m.ke = v3_mul(m.ke, texture_mean(&g->s->textures[er.tex]));
+            gltf_warn_once(g, GW_EMISSIVE_TEX,
+                           "%s/emissiveTexture: emission is uniform over a surface: the texture's mean colour "
+                           "is used (further ones not reported)",
+                           path);
+        }
+    }
+    if (amode == 1 || amode == 2) {
+        const bool tex_alpha =
+            m.map_kd.kind == TEX_IMAGE && (g->s->textures[m.map_kd.tex].nc == 2 || g->s->textures[m.map_kd.tex].nc == 4);
+        if (amode == 1 || tex_alpha) {
+            /* MASK: the cut-out alpha * factor >= cutoff; BLEND with a texture's alpha: its
+             * cut-out at one half, the constant factor dissolving the rest */
+            float factor = amode == 1 ? base[3] : 1.0f, cut = amode == 1 ? cutoff : 0.5f;
+            int32_t mask;
+            if ((st = make_mask(g, mi, tex_alpha ? m.map_kd.tex : -1, factor, cut, &mask))) goto fail;
+            tex_ref_init(&m.map_d);
+            m.map_d = m.map_kd; /* the same uv transform and wrap */
+            m.map_d.tex = mask;
+            if (amode == 2)
+                gltf_warn_once(g, GW_BLEND,
+                               "%s: alphaMode BLEND with a texture's alpha is drawn as a cut-out at alpha 0.5 "
+                               "(further ones not reported)",
+                               path);
+        }
+        if (amode == 2) m.d = base[3]; /* stochastic opacity */
+    }
+    g->s->materials[idx] = m;
+    g->mat_uv[mi].bake = bake;
+    if (bake) memcpy(g->mat_uv[mi].m, first->m, sizeof first->m);
+    *out = idx;
+    return PK_OK;
+fail:
+    g->s->materials[idx] = m;
+    return st;
+}
+
+pk_status gltf_material(gltf *g, int64_t i, uint32_t *mat, int *uvset)
+{
+    if (i < 0) {
+        *mat = 0;
+        *uvset = 0;
+        return PK_OK;
+    }
+    if (!g->materials[i]) {
+        uint32_t m;
+        int set;
+        pk_status st = make_material(g, i, &m, &set);
+        if (st) return st;
+        g->materials[i] = m + 1;
+        g->mat_uvset[i] = (uint8_t)set;
+    }
+    *mat = g->materials[i] - 1;
+    *uvset = g->mat_uvset[i];
+    return PK_OK;
+}
+
+void gltf_materials_free(gltf *g)
+{
+    mem_free(&g->ctx->alloc, g->materials);
+    mem_free(&g->ctx->alloc, g->mat_uvset);
+    mem_free(&g->ctx->alloc, g->mat_uv);
+    mem_free(&g->ctx->alloc, g->images[0]);
+    mem_free(&g->ctx->alloc, g->images[1]);
+}
