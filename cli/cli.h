@@ -106,6 +106,10 @@ typedef struct cli_render_opts {
     unsigned aovs;       /* --aov: PK_AOV_* */
     int has_from, has_at, has_up, has_fov;
     float from[3], at[3], up[3], fov;
+    int has_lens_radius, has_focus_distance;
+    float lens_radius, focus_distance;
+    int projection;      /* pk_projection + 1, 0 when neither --orthographic nor --perspective is given */
+    float ortho_width;   /* --orthographic WIDTH */
     const char *env;     /* --env, NULL when not given */
     const char *defines[64]; /* -D NAME=VALUE */
     size_t ndefines;

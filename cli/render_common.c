@@ -29,6 +29,10 @@ enum {
     OPT_LOOK_AT,
     OPT_UP,
     OPT_FOV,
+    OPT_LENS_RADIUS,
+    OPT_FOCUS_DISTANCE,
+    OPT_ORTHOGRAPHIC,
+    OPT_PERSPECTIVE,
     OPT_TIME,
     OPT_ENV,
     OPT_AOV,
@@ -117,6 +121,19 @@ const cli_option *cli_render_options(size_t *n)
                                  "layers NAME.R/G/B of an .exr OUT, else files beside OUT as NAME.AOV.EXT"});
         add((cli_option){.name = "fov", .id = OPT_FOV, .kind = CLI_STRING, .arg = "DEG",
                          .help = "vertical field of view in degrees, between 0 and 180"});
+        add((cli_option){.name = "lens-radius", .id = OPT_LENS_RADIUS, .kind = CLI_STRING, .arg = "R",
+                         .help = "a thin lens of radius R (scene units) for depth of field: only what lies at "
+                                 "--focus-distance is sharp; 0 is a pinhole (everything sharp)"});
+        add((cli_option){.name = "focus-distance", .id = OPT_FOCUS_DISTANCE, .kind = CLI_STRING, .arg = "D",
+                         .help = "the distance along the view to the plane in focus (with --lens-radius); 0 "
+                                 "(default) is the distance from --look-from to --look-at"});
+        add((cli_option){.name = "orthographic", .id = OPT_ORTHOGRAPHIC, .kind = CLI_STRING, .arg = "WIDTH",
+                         .help = "an orthographic projection: parallel rays along the view, the view WIDTH "
+                                 "scene units wide (the height follows the image's aspect); 0 is the width "
+                                 "the perspective view has at --look-at"});
+        add((cli_option){.name = "perspective", .id = OPT_PERSPECTIVE, .kind = CLI_FLAG,
+                         .help = "the perspective projection (--fov), also where the scene's camera is "
+                                 "orthographic"});
         add((cli_option){.name = "stats", .id = OPT_STATS, .kind = CLI_FLAG,
                          .help = "print the statistics table on standard output (rays, intersection tests, "
                                  "nodes, build and render time)"});
@@ -285,6 +302,33 @@ int cli_render_parse(int argc, char **argv, cli_render_opts *o, void (*help)(FIL
             o->has_fov = 1;
             break;
         }
+        case OPT_LENS_RADIUS:
+        case OPT_FOCUS_DISTANCE:
+        case OPT_ORTHOGRAPHIC: {
+            const int id = opts[p.index].id;
+            char *end;
+            const float x = strtof(v, &end);
+            if (*end || end == v || !(x >= 0.0f && isfinite(x)))
+                return cli_usage_error("--%s: '%s' must be a number of scene units, 0 or more", name, v);
+            if (id == OPT_LENS_RADIUS) {
+                o->lens_radius = x;
+                o->has_lens_radius = 1;
+            } else if (id == OPT_FOCUS_DISTANCE) {
+                o->focus_distance = x;
+                o->has_focus_distance = 1;
+            } else {
+                if (o->projection == PK_PROJECTION_PERSPECTIVE + 1)
+                    return cli_usage_error("--orthographic and --perspective exclude each other");
+                o->ortho_width = x;
+                o->projection = PK_PROJECTION_ORTHOGRAPHIC + 1;
+            }
+            break;
+        }
+        case OPT_PERSPECTIVE:
+            if (o->projection == PK_PROJECTION_ORTHOGRAPHIC + 1)
+                return cli_usage_error("--orthographic and --perspective exclude each other");
+            o->projection = PK_PROJECTION_PERSPECTIVE + 1;
+            break;
         case OPT_ENV: o->env = v; break;
         case OPT_TIME: {
             char *end;
@@ -625,13 +669,18 @@ pk_status cli_render_settings(pk_context *ctx, const cli_render_opts *o, pk_scen
         }
         if (st != PK_OK) return st;
     }
-    if (o->has_from || o->has_at || o->has_up || o->has_fov) {
+    if (o->has_from || o->has_at || o->has_up || o->has_fov || o->has_lens_radius || o->has_focus_distance ||
+        o->projection) {
         pk_camera cam;
         pk_scene_get_camera(scene, &cam);
         if (o->has_from) memcpy(cam.look_from, o->from, sizeof o->from);
         if (o->has_at) memcpy(cam.look_at, o->at, sizeof o->at);
         if (o->has_up) memcpy(cam.up, o->up, sizeof o->up);
         if (o->has_fov) cam.fov_deg = o->fov;
+        if (o->has_lens_radius) cam.lens_radius = o->lens_radius;
+        if (o->has_focus_distance) cam.focus_distance = o->focus_distance;
+        if (o->projection) cam.projection = o->projection - 1;
+        if (o->projection == PK_PROJECTION_ORTHOGRAPHIC + 1) cam.ortho_width = o->ortho_width;
         st = pk_scene_set_camera(ctx, scene, &cam);
     }
     return st;

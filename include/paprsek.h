@@ -147,17 +147,39 @@ PK_API const char *pk_status_string(pk_status status);
 
 /* ---- camera, options, statistics ----------------------------------------- */
 
-/* A pinhole camera in world space; fov_deg is the vertical field of view. */
+/* How the camera projects the scene onto the film (pk_camera.projection). */
+typedef enum pk_projection {
+    PK_PROJECTION_PERSPECTIVE = 0, /* rays from the eye (a pinhole or a thin lens) through the film */
+    PK_PROJECTION_ORTHOGRAPHIC = 1 /* parallel rays along the view direction, from the plane of the eye */
+} pk_projection;
+
+/* A camera in world space, looking from look_from toward look_at with up
+ * upward in the image. fov_deg is the vertical field of view of the
+ * perspective projection.
+ * lens_radius: 0 is a pinhole (everything sharp); above 0 a thin lens of
+ * that radius (scene units) centred on look_from, sharp only at
+ * focus_distance, the distance along the view direction to the plane in
+ * focus (0: the distance from look_from to look_at). Both projections
+ * take a lens.
+ * ortho_width: the full width of the orthographic view in scene units (its
+ * height follows the image's aspect); 0 is the width the perspective view
+ * of fov_deg has at look_at's distance. */
 typedef struct pk_camera {
     float look_from[3];
     float look_at[3];
     float up[3];
     float fov_deg;
+    float lens_radius;
+    float focus_distance;
+    int projection;      /* pk_projection */
+    float ortho_width;
 } pk_camera;
 
 /* Sets every field to its default: at the origin, looking along -z
- * (look_at 0,0,-1), up +y, fov_deg 45. Start from it, then set what you
- * need, so that fields added in later versions get their defaults. */
+ * (look_at 0,0,-1), up +y, fov_deg 45, a pinhole (lens_radius 0,
+ * focus_distance 0), the perspective projection, ortho_width 0. Start from
+ * it, then set what you need, so that fields added in later versions get
+ * their defaults. */
 PK_API void pk_camera_init(pk_camera *cam);
 
 typedef enum pk_accel_kind {
@@ -352,7 +374,8 @@ PK_API pk_status pk_scene_get_triangle(const pk_scene *scene, size_t k, float ve
 PK_API pk_status pk_scene_get_emissive_triangle(const pk_scene *scene, size_t k, size_t *triangle);
 /* The scene's camera, or one framed automatically on its bounds. */
 PK_API void pk_scene_get_camera(const pk_scene *scene, pk_camera *cam);
-/* Validates (finite, fov in (0,180), look_from != look_at, up not parallel). */
+/* Validates (finite, fov in (0,180), look_from != look_at, up not parallel,
+ * lens_radius, focus_distance and ortho_width >= 0, a known projection). */
 PK_API pk_status pk_scene_set_camera(pk_context *ctx, pk_scene *scene, const pk_camera *cam);
 /* The scene's own render settings (JSON "render") over the defaults. */
 PK_API void pk_scene_get_render_options(const pk_scene *scene, pk_render_options *opt);

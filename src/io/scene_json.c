@@ -756,8 +756,9 @@ static pk_status parse_materials(jp *p, const cJSON *it)
 
 static pk_status parse_camera(jp *p, const cJSON *it)
 {
-    enum { C_FROM, C_AT, C_UP, C_FOV, C_COUNT };
-    static const char *const keys[C_COUNT] = {"look_from", "look_at", "up", "fov"};
+    enum { C_FROM, C_AT, C_UP, C_FOV, C_LENS, C_FOCUS, C_PROJ, C_OWIDTH, C_COUNT };
+    static const char *const keys[C_COUNT] = {"look_from", "look_at",        "up",         "fov",
+                                              "lens_radius", "focus_distance", "projection", "ortho_width"};
     const cJSON *f[C_COUNT];
     pk_status st = object_fields(p, it, "camera", keys, C_COUNT, f);
     if (st) return st;
@@ -769,7 +770,25 @@ static pk_status parse_camera(jp *p, const cJSON *it)
     if ((st = get_vec3(p, f[C_AT], "camera.look_at", &at))) return st;
     if (f[C_UP] && (st = get_vec3(p, f[C_UP], "camera.up", &up))) return st;
     if (f[C_FOV] && (st = get_float(p, f[C_FOV], "camera.fov", &fov))) return st;
-    pk_camera cam = {{from.x, from.y, from.z}, {at.x, at.y, at.z}, {up.x, up.y, up.z}, fov};
+    pk_camera cam;
+    pk_camera_init(&cam);
+    const float v[3][3] = {{from.x, from.y, from.z}, {at.x, at.y, at.z}, {up.x, up.y, up.z}};
+    memcpy(cam.look_from, v[0], sizeof v[0]);
+    memcpy(cam.look_at, v[1], sizeof v[1]);
+    memcpy(cam.up, v[2], sizeof v[2]);
+    cam.fov_deg = fov;
+    if (f[C_LENS] && (st = get_float(p, f[C_LENS], "camera.lens_radius", &cam.lens_radius))) return st;
+    if (f[C_FOCUS] && (st = get_float(p, f[C_FOCUS], "camera.focus_distance", &cam.focus_distance))) return st;
+    if (f[C_OWIDTH] && (st = get_float(p, f[C_OWIDTH], "camera.ortho_width", &cam.ortho_width))) return st;
+    if (f[C_PROJ]) {
+        const char *pr = cJSON_IsString(f[C_PROJ]) ? f[C_PROJ]->valuestring : "";
+        if (strcmp(pr, "perspective") == 0)
+            cam.projection = PK_PROJECTION_PERSPECTIVE;
+        else if (strcmp(pr, "orthographic") == 0)
+            cam.projection = PK_PROJECTION_ORTHOGRAPHIC;
+        else
+            return jfail(p, PK_ERR_PARSE, f[C_PROJ], "camera.projection", "must be \"perspective\" or \"orthographic\"");
+    }
     /* the one camera rule (scene/camera.c), with the messages of this format */
     switch (camera_check(&cam)) {
     case CAMERA_OK: break;
@@ -784,6 +803,15 @@ static pk_status parse_camera(jp *p, const cJSON *it)
         if (f[C_UP]) return jfail(p, PK_ERR_PARSE, f[C_UP], "camera.up", "is parallel to the view direction");
         return jfail(p, PK_ERR_PARSE, it, "camera",
                      "the default up [0, 1, 0] is parallel to the view direction; give \"up\"");
+    case CAMERA_LENS:
+        return jfail(p, PK_ERR_PARSE, f[C_LENS], "camera.lens_radius", "must not be negative (0: a pinhole)");
+    case CAMERA_FOCUS:
+        return jfail(p, PK_ERR_PARSE, f[C_FOCUS], "camera.focus_distance",
+                     "must not be negative (0: the distance to look_at)");
+    case CAMERA_PROJECTION: /* checked above */
+    case CAMERA_ORTHO_WIDTH:
+        return jfail(p, PK_ERR_PARSE, f[C_OWIDTH] ? f[C_OWIDTH] : it, "camera.ortho_width",
+                     "must not be negative (0: the perspective view's width at look_at)");
     }
     p->s->camera = cam;
     p->s->has_camera = true;

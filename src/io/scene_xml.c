@@ -2055,34 +2055,63 @@ static pk_status parse_sensor(xp *p, xnode *sn)
     if (!type) return xfail(p, PK_ERR_PARSE, sn, "<sensor> needs a type");
     char ty[40];
     shown(ty, sizeof ty, type);
-    if (strcmp(type, "perspective") != 0) {
-        if (strcmp(type, "thinlens") == 0) {
-            xwarn(p, sn, "sensor \"thinlens\" rendered as a pinhole camera (no depth of field)");
-            prop(p, sn, "aperture_radius"), prop(p, sn, "focus_distance");
-        } else {
-            xwarn(p, sn, "sensor \"%s\" is not supported; rendered as a perspective camera", ty);
-            for (xnode *c = sn->child; c; c = c->next)
-                if (is_property_tag(c->tag) && strcmp(c->tag, "transform") != 0) c->used = true;
-        }
+    const bool thinlens = strcmp(type, "thinlens") == 0, ortho = strcmp(type, "orthographic") == 0;
+    if (strcmp(type, "perspective") != 0 && !thinlens && !ortho) {
+        xwarn(p, sn, "sensor \"%s\" is not supported; rendered as a perspective camera", ty);
+        for (xnode *c = sn->child; c; c = c->next)
+            if (is_property_tag(c->tag) && strcmp(c->tag, "transform") != 0) c->used = true;
     }
     xform m;
     bool has_m;
     if ((st = get_to_world(p, sn, &m, &has_m))) return st;
     float fov = XML_DEFAULT_FOV;
-    xnode *fn = prop(p, sn, "fov");
-    if (fn && (st = node_float(p, fn, &fov))) return st;
-    if (fn && !(fov > 0.0f && fov < 180.0f)) return xfail(p, PK_ERR_PARSE, fn, "fov must be in (0, 180) degrees");
-    if (!fn && prop(p, sn, "focal_length"))
-        xwarn(p, sn, "focal_length is not supported; using fov %g", (double)fov);
     const char *axis = "x";
-    xnode *an;
-    if ((st = get_string(p, sn, "fov_axis", &axis, &an))) return st;
-    if (strcmp(axis, "x") && strcmp(axis, "y") && strcmp(axis, "diagonal") && strcmp(axis, "smaller") &&
-        strcmp(axis, "larger"))
-        return xfail(p, PK_ERR_PARSE, an, "fov_axis must be x, y, diagonal, smaller or larger");
+    if (!ortho) { /* (the orthographic sensor's view is its to_world's scale) */
+        xnode *fn = prop(p, sn, "fov");
+        if (fn && (st = node_float(p, fn, &fov))) return st;
+        if (fn && !(fov > 0.0f && fov < 180.0f)) return xfail(p, PK_ERR_PARSE, fn, "fov must be in (0, 180) degrees");
+        if (!fn && prop(p, sn, "focal_length"))
+            xwarn(p, sn, "focal_length is not supported; using fov %g", (double)fov);
+        xnode *an;
+        if ((st = get_string(p, sn, "fov_axis", &axis, &an))) return st;
+        if (strcmp(axis, "x") && strcmp(axis, "y") && strcmp(axis, "diagonal") && strcmp(axis, "smaller") &&
+            strcmp(axis, "larger"))
+            return xfail(p, PK_ERR_PARSE, an, "fov_axis must be x, y, diagonal, smaller or larger");
+    }
     snprintf(p->fov_axis, sizeof p->fov_axis, "%s", axis);
     p->fov = fov;
     p->has_fov = true;
+    /* Mitsuba's thin lens: aperture_radius (required, scene units) and
+     * focus_distance (the distance to the plane in focus along the view;
+     * Mitsuba's default is far_clip, itself 10^4 by default) */
+    float aperture = 0.0f, focus = 0.0f, far_clip = 1e4f;
+    if (thinlens) {
+        xnode *ap = prop(p, sn, "aperture_radius");
+        if (!ap) return xfail(p, PK_ERR_PARSE, sn, "sensor \"thinlens\" needs aperture_radius");
+        if ((st = get_float(p, sn, "aperture_radius", &aperture))) return st;
+        if (!(aperture >= 0.0f && isfinite(aperture)))
+            return xfail(p, PK_ERR_PARSE, ap, "aperture_radius must be a finite number, not negative");
+        if ((st = get_float(p, sn, "far_clip", &far_clip))) return st;
+        focus = far_clip;
+        xnode *fd = prop(p, sn, "focus_distance");
+        if ((st = get_float(p, sn, "focus_distance", &focus))) return st;
+        if (!(focus > 0.0f && isfinite(focus)))
+            return xfail(p, PK_ERR_PARSE, fd ? fd : sn, "focus_distance must be a finite number above 0");
+    }
+    /* Mitsuba's orthographic sensor sees x in [-1, 1] of its frame, scaled
+     * by to_world (y follows the film's aspect): the view is twice as wide
+     * as to_world's x axis is long */
+    float ortho_width = 0.0f;
+    if (ortho) {
+        const float sx = v3_len(xform_vector(&m, v3(1.0f, 0.0f, 0.0f)));
+        const float sy = v3_len(xform_vector(&m, v3(0.0f, 1.0f, 0.0f)));
+        ortho_width = 2.0f * sx;
+        if (!(ortho_width > 0.0f) || !isfinite(ortho_width))
+            return xfail(p, PK_ERR_PARSE, sn, "the orthographic sensor's to_world gives no usable view width");
+        if (fabsf(sx - sy) > 1e-4f * sx)
+            xwarn(p, sn, "the orthographic sensor's to_world scales x and y differently; the view is %g wide and "
+                         "its height follows the image's aspect", (double)ortho_width);
+    }
 
     /* Mitsuba's camera looks along +z of its frame with +y up; its image x
      * runs along -x (so a right-handed frame has the image's right on the
@@ -2094,7 +2123,18 @@ static pk_status parse_sensor(xp *p, xnode *sn)
     if (v3_dot(v3_cross(fwd, up), right) < 0.0f)
         xwarn(p, sn, "the camera's to_world mirrors the image; rendered unmirrored");
     vec3 at = v3_add(o, fwd);
-    pk_camera cam = {{o.x, o.y, o.z}, {at.x, at.y, at.z}, {up.x, up.y, up.z}, 45.0f};
+    pk_camera cam;
+    pk_camera_init(&cam);
+    const float v[3][3] = {{o.x, o.y, o.z}, {at.x, at.y, at.z}, {up.x, up.y, up.z}};
+    memcpy(cam.look_from, v[0], sizeof v[0]);
+    memcpy(cam.look_at, v[1], sizeof v[1]);
+    memcpy(cam.up, v[2], sizeof v[2]);
+    cam.lens_radius = aperture;
+    cam.focus_distance = focus;
+    if (ortho) {
+        cam.projection = PK_PROJECTION_ORTHOGRAPHIC;
+        cam.ortho_width = ortho_width;
+    }
     switch (camera_check(&cam)) {
     case CAMERA_OK: break;
     default: return xfail(p, PK_ERR_PARSE, sn, "the sensor's to_world gives no usable camera (singular or not finite)");

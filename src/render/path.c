@@ -47,7 +47,13 @@ static pk_status ig_thread_init(pk_context *ctx, const void *self, void *ts, boo
 
 static void ig_thread_free(const pk_allocator *al, void *ts) { (void)al, (void)ts; }
 
-static void ig_set_camera(void *self, const camera_frame *cf) { ((path_tracer *)self)->spread = cf->spread; }
+static void ig_set_camera(void *self, const camera_frame *cf)
+{
+    path_tracer *pt = self;
+    pt->spread = cf->spread;
+    pt->cone0 = cf->cone0;
+    pt->lens = camera_has_lens(cf);
+}
 
 static camera_sample ig_camera_sample(const void *self, int px, int py, uint64_t index, int smp, int spp)
 {

@@ -25,7 +25,10 @@ typedef struct path_tracer {
     int max_depth;       /* bounces after the camera ray */
     uint32_t seed;
     int strategy;        /* PATH_* */
+    /* the camera's (set_camera; path_gpu_render copies them to the GPU's copy, spread to lens): */
     float spread;        /* ray cone spread angle per unit length: the camera's pixel angle (textures) */
+    float cone0;         /* the ray cone's width where camera rays start (camera_frame) */
+    int lens;            /* camera samples take the sampler's lens dimensions (camera_has_lens) */
     int regularize;      /* pk_render_options.regularize */
     const void *gpu_nodes, *gpu_tris;  /* in the GPU's copy only: the device BVH (bvh_gpu.h) */
 } path_tracer;

@@ -16,6 +16,7 @@
 
 #include "device/cuda.h"
 
+#include <stddef.h>
 #include <string.h>
 
 #if defined(PK_HAVE_CUDA) && PK_HAVE_CUDA
@@ -256,6 +257,14 @@ pk_status path_gpu_render(path_gpu *g, const camera_frame *cf, const gpu_tile *t
             PK_OK ||
         (st = cuda_device_copy(g->dev, zero, g->d_rays, sizeof zero, true, NULL)) != PK_OK)
         return st;
+    /* the camera's fields of the device's path tracer, from this render's
+     * camera (set_camera may have changed it since the copy was made) */
+    path_tracer pc;
+    pc.spread = cf->spread;
+    pc.cone0 = cf->cone0;
+    pc.lens = camera_has_lens(cf);
+    const size_t c0 = offsetof(path_tracer, spread), c1 = offsetof(path_tracer, lens) + sizeof pc.lens;
+    if ((st = cuda_device_copy(g->dev, (char *)&pc + c0, g->d_pt + c0, c1 - c0, true, NULL)) != PK_OK) return st;
     unsigned nthreads = (unsigned)(ntiles * GPU_TILE_PIXELS);
     camera_frame cam = *cf;
     const uint64_t total = (uint64_t)spp;

@@ -313,13 +313,15 @@ static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_s
 /* ---- camera samples -------------------------------------------------------------- */
 
 /* Where sample index of pixel (px, py) lies: the sampler's film dimensions
- * place it in the pixel. */
+ * place it in the pixel, its lens dimensions on the lens (when the camera
+ * has one). */
 static inline PK_HD camera_sample path_camera_place(const path_tracer *pt, int px, int py, uint32_t index)
 {
     sampler sm = sampler_start((uint32_t)px, (uint32_t)py, index, pt->seed);
     float jx, jy;
     sampler_2d(&sm, &jx, &jy); /* SAMPLER_DIM_FILM */
-    const camera_sample cs = {(float)px + jx, (float)py + jy, 0.5f, 0.5f};
+    camera_sample cs = {(float)px + jx, (float)py + jy, 0.5f, 0.5f};
+    if (pt->lens) sampler_2d(&sm, &cs.lens_u, &cs.lens_v); /* SAMPLER_DIM_LENS */
     return cs;
 }
 
@@ -341,8 +343,9 @@ static inline PK_HD bool path_start(const path_tracer *pt, int px, int py, uint3
         return false;
     }
     sampler sm = sampler_start((uint32_t)px, (uint32_t)py, index, pt->seed);
-    sm.dim = SAMPLER_DIM_PATH(false); /* past the camera's dimensions (a pinhole: the film's) */
+    sm.dim = SAMPLER_DIM_PATH(pt->lens); /* past the camera's dimensions */
     path_begin(ps, r, h, &sm);
+    ps->cone = pt->cone0;
     return true;
 }
 

@@ -345,7 +345,7 @@ static void render_tile_aovs_cpu(const pk_renderer *r, const camera_frame *cf, c
     const int tw = tl->w, n = tl->w * tl->h;
     float v[FILM_AOVS][BATCH * 3];
     memset(v, 0, sizeof v);
-    const float spread = cf->spread;
+    const float spread = cf->spread, cone0 = cf->cone0;
     for (int smp = 0; smp < r->opt.spp; smp++)
         for (int i = 0; i < n; i++) {
             ray cr = sample_camera_ray(r, cf, tl->x + i % tw, tl->y + i / tw, smp);
@@ -358,7 +358,8 @@ static void render_tile_aovs_cpu(const pk_renderer *r, const camera_frame *cf, c
             if (!got || (s->has_cutout && !trace_past_holes(r->fr.a, s, &cr, &h, NULL))) continue;
             surface sf = surface_at(s, &cr, &h);
             material textured;
-            if (sf.m->textured) sf = surface_texture(s, &cr, &h, spread * h.t * v3_len(cr.d), sf, &textured);
+            if (sf.m->textured)
+                sf = surface_texture(s, &cr, &h, cone0 + spread * h.t * v3_len(cr.d), sf, &textured);
             aov_sample av;
             aov_from_surface(&sf, &cr, &h, &av);
             a[0] += av.albedo.x, a[1] += av.albedo.y, a[2] += av.albedo.z;

@@ -55,6 +55,29 @@ static inline PK_HD vec3 sample_cosine(vec3 n, float u1, float u2)
     return v3_norm(v3_add(v3_add(v3_scale(t, r * cosf(phi)), v3_scale(b, r * sinf(phi))), v3_scale(n, z)));
 }
 
+/* A point of the unit disk, uniform in area, from (u1, u2) in [0, 1)^2 by the
+ * concentric map (Shirley and Chiu): each square ring about the centre goes
+ * onto the disk's ring of the same area fraction, so strata of the square
+ * stay compact on the disk (a low-discrepancy pattern stays one). */
+static inline PK_HD void sample_disk_concentric(float u1, float u2, float *x, float *y)
+{
+    const float a = 2.0f * u1 - 1.0f, b = 2.0f * u2 - 1.0f;
+    if (a == 0.0f && b == 0.0f) {
+        *x = *y = 0.0f;
+        return;
+    }
+    float r, phi;
+    if (fabsf(a) > fabsf(b)) {
+        r = a;
+        phi = 0.25f * PK_PI * (b / a);
+    } else {
+        r = b;
+        phi = 0.5f * PK_PI - 0.25f * PK_PI * (a / b);
+    }
+    *x = r * cosf(phi);
+    *y = r * sinf(phi);
+}
+
 /* Uniform point on triangle (a, b, c). */
 static inline PK_HD vec3 sample_triangle(vec3 a, vec3 b, vec3 c, float u1, float u2)
 {

@@ -205,8 +205,8 @@ static vec3 whitted_shade(const whitted *w, whitted_thread *ts, const ray *r, co
 static pk_status ig_init(pk_context *ctx, void *self, const frame *f, const pk_render_options *opt)
 {
     whitted *w = self;
-    *w = (whitted){f, opt->light_samples, pk_render_options_max_depth(opt), opt->fresnel != 0, 0.0f, 0, NULL, NULL,
-                   0, NULL};
+    *w = (whitted){.f = f, .light_samples = opt->light_samples, .max_depth = pk_render_options_max_depth(opt),
+                   .fresnel = opt->fresnel != 0};
     const light_set *set = &f->lights;
     if (set->n == 0) return PK_OK;
     w->sampled = mem_realloc_array(&ctx->alloc, NULL, set->n, sizeof *w->sampled);
@@ -243,21 +243,32 @@ static pk_status ig_thread_init(pk_context *ctx, const void *self, void *t, bool
 
 static void ig_thread_free(const pk_allocator *al, void *t) { whitted_thread_free(al, t); }
 
-static void ig_set_camera(void *self, const camera_frame *cf) { ((whitted *)self)->spread = cf->spread; }
+static void ig_set_camera(void *self, const camera_frame *cf)
+{
+    whitted *w = self;
+    w->spread = cf->spread;
+    w->cone0 = cf->cone0;
+    w->lens = camera_has_lens(cf);
+}
 
 /* Through the pixel centre at 1 sample per pixel, above that jittered in
- * sx x sy strata of the pixel (a PCG stream seeded by pixel and sample). */
+ * sx x sy strata of the pixel (a PCG stream seeded by pixel and sample);
+ * on the lens, when the camera has one, uniform from the same stream. */
 static camera_sample ig_camera_sample(const void *self, int px, int py, uint64_t index, int smp, int spp)
 {
-    (void)self;
+    const whitted *w = self;
     float jx = 0.5f, jy = 0.5f;
+    rng jr = rng_seed(((uint64_t)py << 32) | (uint32_t)px, index * 2 + 1);
     if (spp > 1) {
         const int sx = (int)ceilf(sqrtf((float)spp)), sy = (spp + sx - 1) / sx;
-        rng jr = rng_seed(((uint64_t)py << 32) | (uint32_t)px, index * 2 + 1);
         jx = ((float)(smp % sx) + rng_float(&jr)) / (float)sx;
         jy = ((float)(smp / sx) + rng_float(&jr)) / (float)sy;
     }
-    const camera_sample cs = {(float)px + jx, (float)py + jy, 0.5f, 0.5f};
+    camera_sample cs = {(float)px + jx, (float)py + jy, 0.5f, 0.5f};
+    if (w->lens) {
+        cs.lens_u = rng_float(&jr);
+        cs.lens_v = rng_float(&jr);
+    }
     return cs;
 }
 
@@ -272,7 +283,7 @@ static bool ig_sample(const void *self, void *t, int px, int py, uint64_t index,
     }
     ts->rng = rng_seed(((uint64_t)py << 32) | (uint32_t)px, index * 2);
     ts->ray_budget = WHITTED_RAY_BUDGET;
-    ts->cone = 0.0f;
+    ts->cone = w->cone0;
     *L = whitted_shade(w, ts, r, h, 0, aov);
     return true;
 }

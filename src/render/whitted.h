@@ -27,6 +27,8 @@ typedef struct whitted {
     int light_samples, max_depth;
     bool fresnel;
     float spread;        /* ray cone spread angle: the camera's pixel angle (textures) */
+    float cone0;         /* the ray cone's width where camera rays start (camera_frame) */
+    bool lens;           /* the camera has a lens (camera_has_lens) */
     /* The lights it samples: those of the frame's light set that are not
      * point lights or the sun (each gets a shadow ray of its own) or
      * emissive spheres (not lights for this integrator), with the set's
@@ -49,7 +51,7 @@ typedef struct whitted_thread {
     vec3 *shadow_weight;
     rng rng;
     uint32_t ray_budget; /* secondary rays left for the current camera ray */
-    float cone;          /* ray cone width at the origin of the ray being shaded (0 for camera rays) */
+    float cone;          /* ray cone width at the origin of the ray being shaded (cone0 for camera rays) */
 } whitted_thread;
 
 /* The Whitted integrator (integrator.h) is integrator_whitted; its self is a

@@ -10,7 +10,9 @@ camera_problem camera_check(const pk_camera *cam)
     vec3 from = v3(cam->look_from[0], cam->look_from[1], cam->look_from[2]);
     vec3 at = v3(cam->look_at[0], cam->look_at[1], cam->look_at[2]);
     vec3 up = v3(cam->up[0], cam->up[1], cam->up[2]);
-    if (!v3_finite(from) || !v3_finite(at) || !v3_finite(up) || !isfinite(cam->fov_deg)) return CAMERA_NOT_FINITE;
+    if (!v3_finite(from) || !v3_finite(at) || !v3_finite(up) || !isfinite(cam->fov_deg) ||
+        !isfinite(cam->lens_radius) || !isfinite(cam->focus_distance) || !isfinite(cam->ortho_width))
+        return CAMERA_NOT_FINITE;
     if (!(cam->fov_deg > 0.0f && cam->fov_deg < 180.0f)) return CAMERA_FOV;
     vec3 dir = v3_sub(at, from);
     if (!v3_finite(dir)) return CAMERA_TOO_FAR;
@@ -19,6 +21,11 @@ camera_problem camera_check(const pk_camera *cam)
     /* sine of the angle between view and up: below 1e-4 (0.006 degrees) the
      * camera frame is too ill-conditioned to trust */
     if (!(v3_len(v3_cross(v3_norm_scaled(dir), v3_norm_scaled(up))) > 1e-4f)) return CAMERA_UP_PARALLEL;
+    if (cam->lens_radius < 0.0f) return CAMERA_LENS;
+    if (cam->focus_distance < 0.0f) return CAMERA_FOCUS;
+    if (cam->projection != PK_PROJECTION_PERSPECTIVE && cam->projection != PK_PROJECTION_ORTHOGRAPHIC)
+        return CAMERA_PROJECTION;
+    if (cam->ortho_width < 0.0f) return CAMERA_ORTHO_WIDTH;
     return CAMERA_OK;
 }
 
@@ -39,6 +46,21 @@ pk_status camera_validate(pk_context *ctx, const pk_camera *cam, const char *wha
     case CAMERA_UP_PARALLEL:
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: up vector is zero or parallel to the view direction",
                          what);
+    case CAMERA_LENS:
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: lens_radius %g must not be negative (0: a pinhole)", what,
+                         (double)cam->lens_radius);
+    case CAMERA_FOCUS:
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT,
+                         "%s: focus_distance %g must not be negative (0: the distance to look_at)", what,
+                         (double)cam->focus_distance);
+    case CAMERA_PROJECTION:
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT,
+                         "%s: projection %d is not PK_PROJECTION_PERSPECTIVE (0) or PK_PROJECTION_ORTHOGRAPHIC (1)",
+                         what, cam->projection);
+    case CAMERA_ORTHO_WIDTH:
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT,
+                         "%s: ortho_width %g must not be negative (0: the perspective view's width at look_at)", what,
+                         (double)cam->ortho_width);
     }
     return PK_ERR_INVALID_ARGUMENT;
 }
@@ -46,7 +68,8 @@ pk_status camera_validate(pk_context *ctx, const pk_camera *cam, const char *wha
 void pk_camera_init(pk_camera *cam)
 {
     if (!cam) return;
-    const pk_camera k = {{0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, -1.0f}, {0.0f, 1.0f, 0.0f}, 45.0f};
+    const pk_camera k = {{0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, -1.0f}, {0.0f, 1.0f, 0.0f}, 45.0f,
+                         0.0f, 0.0f, PK_PROJECTION_PERSPECTIVE, 0.0f};
     *cam = k;
 }
 

@@ -1,6 +1,8 @@
 /*
  * camera.h - the one camera rule (finite values, fov in (0, 180), distinct
- * eye and target, an up vector that is not parallel to the view) used by the
+ * eye and target, an up vector that is not parallel to the view, a lens
+ * radius, focus distance and orthographic width that are not negative, a
+ * known projection) used by the
  * API, JSON scenes and the renderer, and the automatic framing of a scene
  * without a camera.
  */
@@ -16,7 +18,11 @@ typedef enum camera_problem {
     CAMERA_TOO_FAR,      /* look_at - look_from overflows */
     CAMERA_SAME_POINT,   /* look_from == look_at */
     CAMERA_UP_ZERO,      /* up is the zero vector */
-    CAMERA_UP_PARALLEL   /* up is parallel to the view direction */
+    CAMERA_UP_PARALLEL,  /* up is parallel to the view direction */
+    CAMERA_LENS,         /* lens_radius < 0 */
+    CAMERA_FOCUS,        /* focus_distance < 0 */
+    CAMERA_PROJECTION,   /* not a pk_projection */
+    CAMERA_ORTHO_WIDTH   /* ortho_width < 0 */
 } camera_problem;
 
 PK_HIDDEN camera_problem camera_check(const pk_camera *cam);

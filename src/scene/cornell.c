@@ -85,7 +85,8 @@ pk_status scene_build_cornell(pk_context *ctx, pk_scene *s)
 
     /* The published camera: at (278, 273, -800) mm looking along +z, focal
      * length 35 mm on a 25 mm film: fov = 2 atan(12.5 / 35) = 39.3077 deg. */
-    pk_camera cam = {{0.278f, 0.273f, -0.800f}, {0.278f, 0.273f, 0.0f}, {0.0f, 1.0f, 0.0f}, 39.3077f};
+    const pk_camera cam = {{0.278f, 0.273f, -0.800f}, {0.278f, 0.273f, 0.0f}, {0.0f, 1.0f, 0.0f}, 39.3077f,
+                           0.0f, 0.0f, PK_PROJECTION_PERSPECTIVE, 0.0f};
     s->camera = cam;
     s->has_camera = true;
     return PK_OK;
