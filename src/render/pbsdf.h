@@ -1,8 +1,8 @@
 /*
  * pbsdf.h - physically based BSDFs for the path tracer: Lambert, GGX
  * conductors, smooth and rough dielectrics (Walter et al. 2007), plastic (a
- * diffuse base under a dielectric coating) and the MTL "glossy over diffuse"
- * model. Plain static inline PK_HD C over one plain struct: no context, no
+ * diffuse base under a dielectric coating), the MTL "glossy over diffuse"
+ * model and glTF 2.0's metallic-roughness material. Plain static inline PK_HD C over one plain struct: no context, no
  * allocation, no function pointers, so that nvcc can compile the same code.
  * docs/materials.md describes the models, their parameters and conventions.
  *
@@ -14,7 +14,9 @@
  *    (non-delta part only, 0 for directions only a delta lobe reaches).
  *  - Reflection-only types (diffuse, conductor, plastic, glossy) are one-sided:
  *    they scatter only for wo.z > 0 and wi.z > 0. A two-sided material is
- *    the caller's business (flip the frame so that wo.z > 0).
+ *    the caller's business (flip the frame so that wo.z > 0). The
+ *    metallic-roughness type is a thin sheet: wo.z > 0 as for those, and wi
+ *    below (wi.z < 0) where it transmits.
  *  - Dielectrics are two-sided: wo.z < 0 means wo is inside (the side with
  *    index `ior`), and wi may lie on either side.
  *  - Transmitted light is not scaled by 1/eta^2 (the radiance compression at
@@ -36,6 +38,7 @@ typedef enum pbsdf_type {
     PBSDF_DIELECTRIC,   /* glass: ior, alpha, transmittance */
     PBSDF_PLASTIC,      /* diffuse albedo under a dielectric coating: ior, alpha */
     PBSDF_GLOSSY,       /* MTL Kd + Ks + Ns: albedo (kd) + specular (ks), alpha; no Fresnel */
+    PBSDF_METALLIC_ROUGHNESS, /* glTF 2.0: albedo (base colour), metallic, alpha, transmission, ior */
     PBSDF_TYPE_COUNT
 } pbsdf_type;
 
@@ -57,7 +60,12 @@ typedef enum pbsdf_type {
  *   transmittance [0, 1] per channel       dielectric: tint of refracted light (MTL Tf)
  *   alpha         [0, 1]                   GGX roughness (alpha = perceptual roughness^2);
  *                                          < PBSDF_ALPHA_SMOOTH: smooth (delta lobes)
- *   ior           > 0, != 1 for dielectric dielectric, plastic: inside / outside index */
+ *   ior           > 0, != 1 for dielectric dielectric, plastic: inside / outside index;
+ *                                          metallic-roughness: the dielectric's Fresnel
+ *                                          (Schlick, F0 = ((ior - 1) / (ior + 1))^2)
+ *   metallic      [0, 1]                   metallic-roughness: the metal's share
+ *   transmission  [0, 1]                   metallic-roughness: the share of the dielectric's
+ *                                          base that is transmitted rather than diffuse */
 typedef struct pbsdf {
     int type;            /* pbsdf_type */
     unsigned flags;      /* PBSDF_SCHLICK */
@@ -67,6 +75,7 @@ typedef struct pbsdf {
     vec3 transmittance;
     float alpha;
     float ior;
+    float metallic, transmission;
 } pbsdf;
 
 /* ---- constructors ------------------------------------------------------- */
@@ -81,6 +90,7 @@ static inline PK_HD pbsdf pbsdf__blank(int type)
     b.k = v3s(0.0f);
     b.alpha = 0.0f;
     b.ior = 1.5f;
+    b.metallic = b.transmission = 0.0f;
     return b;
 }
 static inline PK_HD pbsdf pbsdf_diffuse(vec3 albedo)
@@ -127,6 +137,20 @@ static inline PK_HD pbsdf pbsdf_glossy(vec3 kd, vec3 ks, float alpha)
     b.albedo = kd;
     b.specular = ks;
     b.alpha = alpha;
+    return b;
+}
+/* glTF 2.0's metallic-roughness material: base colour, metallic, GGX alpha
+ * (the glTF roughness squared), transmission (KHR_materials_transmission)
+ * and the dielectric's ior (KHR_materials_ior). */
+static inline PK_HD pbsdf pbsdf_metallic_roughness(vec3 base_color, float metallic, float alpha, float transmission,
+                                                   float ior)
+{
+    pbsdf b = pbsdf__blank(PBSDF_METALLIC_ROUGHNESS);
+    b.albedo = base_color;
+    b.metallic = metallic;
+    b.alpha = alpha;
+    b.transmission = transmission;
+    b.ior = ior;
     return b;
 }
 /* GGX roughness for an MTL Phong exponent: alpha = sqrt(2 / (Ns + 2)). */
@@ -306,6 +330,110 @@ static inline PK_HD vec3 pbsdf__plastic_diffuse_cos(const pbsdf *b, vec3 wo, vec
     return v3_scale(b->albedo, t * wi.z / PK_PI);
 }
 
+/* ---- glTF 2.0 metallic-roughness ------------------------------------------------ */
+
+/* The glTF specification's Appendix B, term by term, with x = |wo.h| for the
+ * half vector h of wo and wi (of wo and wi mirrored to wo's side for the
+ * transmitted part) and w = (1 - x)^5:
+ *   metal      = specular(alpha) (base + (1 - base) w)       conductor_fresnel
+ *   dielectric = mix(base_lobe, specular(alpha), F)          fresnel_mix,
+ *                F = f0 + (1 - f0) w, f0 = ((1 - ior) / (1 + ior))^2
+ *   base_lobe  = mix(base / pi, specular_t(alpha) base, transmission)
+ *   material   = mix(dielectric, metal, metallic)
+ * specular is the GGX lobe with the height-correlated Smith G2 (as the
+ * specification writes it and the conductor uses); specular_t is the thin
+ * sheet's transmission of KHR_materials_transmission: the same lobe about
+ * the direction straight through (no refraction, ior only in F). All terms
+ * are symmetric in wo and wi (|wo.h| = |wi.h|), so the BSDF is reciprocal.
+ * As the specification says of its fresnel_mix, the diffuse base weighted by
+ * 1 - F(|wo.h|) does not conserve energy toward grazing angles: a white
+ * dielectric reflects up to 1.05 of the light at 65 degrees from the normal
+ * and 1.4 to 1.7 (smooth) at 87 (docs/materials.md; test_bsdf measures it). */
+static inline PK_HD float pbsdf__schlick_w(float c)
+{
+    float m = 1.0f - fminf(1.0f, fmaxf(0.0f, c));
+    return m * m * m * m * m;
+}
+static inline PK_HD float pbsdf__mr_f0(const pbsdf *b)
+{
+    float r = (b->ior - 1.0f) / (b->ior + 1.0f);
+    return r * r;
+}
+static inline PK_HD vec3 pbsdf__mirror_z(vec3 w) { return v3(w.x, w.y, -w.z); }
+
+/* The probabilities of sampling the specular reflection (*ps), the diffuse
+ * base (*pd) and the transmission (*pt), in proportion to the lobes'
+ * weights at normal-to-wo incidence. */
+static inline PK_HD void pbsdf__mr_probs(const pbsdf *b, vec3 wo, float *ps, float *pd, float *pt)
+{
+    const float w = pbsdf__schlick_w(wo.z), f0 = pbsdf__mr_f0(b), m = b->metallic, t = b->transmission;
+    const float f = f0 + (1.0f - f0) * w, base = pbsdf__mean(b->albedo);
+    const float es = (1.0f - m) * f + m * (base + (1.0f - base) * w);
+    const float eb = (1.0f - m) * (1.0f - f) * base;
+    const float ed = eb * (1.0f - t), et = eb * t, sum = es + ed + et;
+    if (!(sum > 0.0f)) {
+        *ps = 1.0f, *pd = *pt = 0.0f;
+        return;
+    }
+    *pd = ed / sum, *pt = et / sum;
+    *ps = 1.0f - *pd - *pt;
+}
+
+/* The delta lobes of a smooth surface toward wo (h = the normal): the
+ * mirror's weight and the straight-through transmission's. */
+static inline PK_HD vec3 pbsdf__mr_delta_reflect(const pbsdf *b, vec3 wo)
+{
+    const float w = pbsdf__schlick_w(wo.z), f0 = pbsdf__mr_f0(b), m = b->metallic;
+    const vec3 fm = v3_add(b->albedo, v3_scale(v3_sub(v3s(1.0f), b->albedo), w));
+    return v3_add(v3s((1.0f - m) * (f0 + (1.0f - f0) * w)), v3_scale(fm, m));
+}
+static inline PK_HD vec3 pbsdf__mr_delta_transmit(const pbsdf *b, vec3 wo)
+{
+    const float w = pbsdf__schlick_w(wo.z), f0 = pbsdf__mr_f0(b);
+    return v3_scale(b->albedo, (1.0f - b->metallic) * b->transmission * (1.0f - (f0 + (1.0f - f0) * w)));
+}
+
+/* f cos of the non-delta part (wo.z > 0; wi on either side). */
+static inline PK_HD vec3 pbsdf__mr_eval(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    if (!(wo.z > 0.0f) || wi.z == 0.0f) return v3s(0.0f);
+    const float m = b->metallic, t = b->transmission, f0 = pbsdf__mr_f0(b);
+    const bool smooth = pbsdf__smooth(b);
+    vec3 h;
+    if (wi.z < 0.0f) { /* the thin sheet's transmission */
+        if (smooth || !((1.0f - m) * t > 0.0f)) return v3s(0.0f);
+        const float s = pbsdf__ggx_refl_cos(b->alpha, wo, pbsdf__mirror_z(wi), &h);
+        if (!(s > 0.0f)) return v3s(0.0f);
+        const float f = f0 + (1.0f - f0) * pbsdf__schlick_w(fabsf(v3_dot(wo, h)));
+        return v3_scale(b->albedo, (1.0f - m) * t * (1.0f - f) * s);
+    }
+    h = v3_norm(v3_add(wo, wi));
+    const float w = pbsdf__schlick_w(fabsf(v3_dot(wo, h)));
+    const float f = f0 + (1.0f - f0) * w;
+    vec3 r = v3_scale(b->albedo, (1.0f - m) * (1.0f - t) * (1.0f - f) * wi.z / PK_PI);
+    if (!smooth) {
+        const float s = pbsdf__ggx_refl_cos(b->alpha, wo, wi, &h);
+        if (s > 0.0f) {
+            const vec3 fm = v3_add(b->albedo, v3_scale(v3_sub(v3s(1.0f), b->albedo), w));
+            r = v3_add(r, v3_scale(v3_add(v3s((1.0f - m) * f), v3_scale(fm, m)), s));
+        }
+    }
+    return r;
+}
+
+/* The mixture density of the three lobes' samplers. */
+static inline PK_HD float pbsdf__mr_pdf(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    if (!(wo.z > 0.0f) || wi.z == 0.0f) return 0.0f;
+    float ps, pd, pt;
+    pbsdf__mr_probs(b, wo, &ps, &pd, &pt);
+    const bool smooth = pbsdf__smooth(b);
+    if (wi.z < 0.0f) return smooth || !(pt > 0.0f) ? 0.0f : pt * pbsdf__ggx_refl_pdf(b->alpha, wo, pbsdf__mirror_z(wi));
+    float p = pd * wi.z / PK_PI;
+    if (!smooth && ps > 0.0f) p += ps * pbsdf__ggx_refl_pdf(b->alpha, wo, wi);
+    return p;
+}
+
 /* ---- dielectric ------------------------------------------------------------ */
 
 /* Generalised half vector of a rough dielectric (Walter 2007), facing +z;
@@ -392,6 +520,7 @@ static inline PK_HD bool pbsdf_has_nondelta(const pbsdf *b)
 {
     switch (b->type) {
     case PBSDF_DIFFUSE: case PBSDF_PLASTIC: case PBSDF_GLOSSY: return true;
+    case PBSDF_METALLIC_ROUGHNESS: return !pbsdf__smooth(b) || (1.0f - b->metallic) * (1.0f - b->transmission) > 0.0f;
     default: return !pbsdf__smooth(b);
     }
 }
@@ -400,6 +529,7 @@ static inline PK_HD bool pbsdf_has_nondelta(const pbsdf *b)
 static inline PK_HD vec3 pbsdf_eval(const pbsdf *b, vec3 wo, vec3 wi)
 {
     if (b->type == PBSDF_DIELECTRIC) return pbsdf__dielectric_eval(b, wo, wi);
+    if (b->type == PBSDF_METALLIC_ROUGHNESS) return pbsdf__mr_eval(b, wo, wi);
     if (!(wo.z > 0.0f && wi.z > 0.0f)) return v3s(0.0f);
     vec3 h;
     switch (b->type) {
@@ -437,6 +567,7 @@ static inline PK_HD vec3 pbsdf_eval(const pbsdf *b, vec3 wo, vec3 wi)
 static inline PK_HD float pbsdf_pdf(const pbsdf *b, vec3 wo, vec3 wi)
 {
     if (b->type == PBSDF_DIELECTRIC) return pbsdf__dielectric_pdf(b, wo, wi);
+    if (b->type == PBSDF_METALLIC_ROUGHNESS) return pbsdf__mr_pdf(b, wo, wi);
     if (!(wo.z > 0.0f && wi.z > 0.0f)) return 0.0f;
     switch (b->type) {
     case PBSDF_DIFFUSE:
@@ -529,6 +660,45 @@ static inline PK_HD bool pbsdf_sample(const pbsdf *b, vec3 wo, const float u[3],
         /* f cos / pdf = F D G2 / (4 cos_o) / (G1(wo) D / (4 cos_o)) = F G2 / G1(wo) */
         *weight = v3_scale(pbsdf__fresnel_conductor(b, om),
                            pbsdf_ggx_g2(b->alpha, wo, w) / pbsdf_ggx_g1(b->alpha, wo));
+        return true;
+    }
+    case PBSDF_METALLIC_ROUGHNESS: {
+        float ps, pd, pt;
+        pbsdf__mr_probs(b, wo, &ps, &pd, &pt);
+        const bool smooth = pbsdf__smooth(b);
+        if (u[0] < ps || !(pd > 0.0f || pt > 0.0f)) { /* specular reflection */
+            if (smooth) {
+                *wi = pbsdf__mirror(wo);
+                *weight = v3_scale(pbsdf__mr_delta_reflect(b, wo), 1.0f / ps);
+                *pdf = ps;
+                *is_delta = true;
+                return true;
+            }
+            vec3 m = pbsdf_ggx_vndf_sample(b->alpha, wo, u[1], u[2]);
+            w = v3_sub(v3_scale(m, 2.0f * v3_dot(wo, m)), wo);
+            if (!(w.z > 0.0f)) return false;
+        } else if (u[0] < ps + pd || !(pt > 0.0f)) { /* the diffuse base */
+            float r = sqrtf(u[1]), phi = 2.0f * PK_PI * u[2];
+            w = v3(r * cosf(phi), r * sinf(phi), sqrtf(fmaxf(0.0f, 1.0f - u[1])));
+            if (!(w.z > 0.0f)) return false;
+        } else { /* transmission: the specular lobe mirrored through the sheet */
+            if (smooth) {
+                *wi = v3_neg(wo);
+                *weight = v3_scale(pbsdf__mr_delta_transmit(b, wo), 1.0f / pt);
+                *pdf = pt;
+                *is_delta = true;
+                return true;
+            }
+            vec3 m = pbsdf_ggx_vndf_sample(b->alpha, wo, u[1], u[2]);
+            w = v3_sub(v3_scale(m, 2.0f * v3_dot(wo, m)), wo);
+            if (!(w.z > 0.0f)) return false;
+            w = pbsdf__mirror_z(w);
+        }
+        float p = pbsdf__mr_pdf(b, wo, w);
+        if (!(p > 0.0f)) return false;
+        *wi = w;
+        *pdf = p;
+        *weight = v3_scale(pbsdf__mr_eval(b, wo, w), 1.0f / p);
         return true;
     }
     case PBSDF_PLASTIC:

@@ -7,9 +7,9 @@
  * weighted by Ks over the diffuse part, illum 5 a mirror with Fresnel;
  * illum 4, 6, 7 smooth dielectrics (Ni, Tf) with exact Fresnel; dissolve
  * d < 1 lets a fraction of the light pass straight through. The physically
- * based types (diffuse, conductor, dielectric, plastic) map to their pbsdf
- * directly. Directions are world space, unit, pointing away from the
- * surface.
+ * based types (diffuse, conductor, dielectric, plastic, metallic-roughness)
+ * map to their pbsdf directly. Directions are world space, unit, pointing
+ * away from the surface.
  */
 #ifndef PK_SHADING_H
 #define PK_SHADING_H
@@ -46,7 +46,12 @@ static inline PK_HD shading shading_at(const surface *sf)
             if (!sf->front) n = v3_neg(n); /* the outward normal: wo.z < 0 inside */
             break;
         case MAT_PLASTIC: sh.b = pbsdf_plastic(m->kd, m->ni, m->alpha); break;
-        case MAT_METALLIC_ROUGHNESS: sh.b = pbsdf_diffuse(material_whitted_kd(m)); break; /* for now */
+        case MAT_METALLIC_ROUGHNESS: { /* a thin sheet: the frame faces wo on either side */
+            const float r = fminf(fmaxf(m->roughness, 0.0f), 1.0f);
+            sh.b = pbsdf_metallic_roughness(surface_clamp_rgb(m->kd), fminf(fmaxf(m->metallic, 0.0f), 1.0f), r * r,
+                                            fminf(fmaxf(m->transmission, 0.0f), 1.0f), m->ni);
+            break;
+        }
         default: sh.b = pbsdf_diffuse(m->kd); break;
         }
     } else if (glass) {
@@ -86,7 +91,11 @@ static inline PK_HD vec3 shading_eval(const surface *sf, const shading *sh, vec3
 {
     *pdf = 0.0f;
     const float side = v3_dot(wi, sf->ng), shade = v3_dot(wi, sf->ns);
-    if (sh->b.type != PBSDF_DIELECTRIC && (side <= 0.0f || shade <= 0.0f)) return v3s(0.0f);
+    if (sh->b.type == PBSDF_METALLIC_ROUGHNESS) { /* reflects and transmits: both normals must agree */
+        if (!(side * shade > 0.0f)) return v3s(0.0f);
+    } else if (sh->b.type != PBSDF_DIELECTRIC && (side <= 0.0f || shade <= 0.0f)) {
+        return v3s(0.0f);
+    }
     vec3 lo = onb_to_local(sh->frame, wo), li = onb_to_local(sh->frame, wi);
     *pdf = sh->opaque * pbsdf_pdf(&sh->b, lo, li);
     return v3_scale(pbsdf_eval(&sh->b, lo, li), sh->opaque);
