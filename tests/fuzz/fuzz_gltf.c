@@ -1,0 +1,17 @@
+/* fuzz_gltf.c - the glTF 2.0 reader through its (buffer, size) entry point
+ * (JSON or GLB, told by the first bytes), then the scene commit; buffers and
+ * images are looked up in tests/data/gltf, so fuzzed assets can name real
+ * files. */
+#include "fuzz_scene.h"
+
+#include "io/readers.h"
+
+static pk_status parse(pk_context *ctx, pk_scene *s, const char *data, size_t size)
+{
+    return scene_gltf_parse(ctx, s, data, size, "fuzz.gltf", PK_TEST_DATA "/gltf");
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    return fuzz_scene_run(data, size, "fuzz.gltf", parse, true);
+}
