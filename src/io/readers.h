@@ -52,6 +52,13 @@ PK_HIDDEN pk_status scene_gltf_parse_params(pk_context *ctx, pk_scene *s, const 
                                             const char *name, const char *base_dir, const char *const *params,
                                             size_t nparams);
 
+/* Parses a pbrt-v4 scene into s (Include/Import and the files its shapes
+ * and textures name are read relative to the including file; base_dir is
+ * the folder of the first; docs/scene-format.md, "pbrt-v4"). Messages say
+ * "file:line: what". Does not commit. */
+PK_HIDDEN pk_status scene_pbrt_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size, const char *name,
+                                     const char *base_dir);
+
 /* ---- PLY meshes (Stanford polygon files): ascii, binary little and big
  * endian; vertex positions, optional normals and texture coordinates, and
  * faces as lists of vertex indices (fan-triangulated). Other elements and

@@ -1,0 +1,2682 @@
+/*
+ * scene_pbrt.c - pbrt-v4 scenes (docs/scene-format.md, "pbrt-v4"): the
+ * directive layer over the tokenizer (pbrt_tok.c) and the shared graphics
+ * state (scene_build.h). Directives are read one at a time with their
+ * positional arguments and their parameter list ("type name" value...), then
+ * carried out: transforms on the builder's stack, materials through the
+ * material constructors, shapes as meshes (or analytic spheres), lights as
+ * the scene's point lights, environment and emissive materials, objects as
+ * the scene's meshes and instances. Every message says file:line.
+ *
+ * Handedness: pbrt's camera space is left-handed (+x right, +y up, +z
+ * forward), Paprsek's camera right-handed. When the camera transform does
+ * not itself mirror, the image pbrt renders is the mirror image of what a
+ * right-handed camera with the same eye, view and up sees; the reader then
+ * mirrors the whole world across the camera's vertical plane (the matrix
+ * `mirror`, applied before every world transform), which gives pbrt's image
+ * with Paprsek's camera. Windings are kept so that each surface faces the
+ * side pbrt's normal points to.
+ */
+#include "readers.h"
+
+#include "../image/image_read.h"
+#include "../options.h"
+#include "../scene/camera.h"
+#include "../scene/spectra.h"
+#include "io_util.h"
+#include "pbrt_tok.h"
+#include "scene_build.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#define PB_MAX_INCLUDE_DEPTH 16
+#define PB_NAME_MAX 256
+
+/* ---- parameters -------------------------------------------------------------------- */
+
+typedef enum ptype {
+    PT_INT, PT_FLOAT, PT_POINT2, PT_VECTOR2, PT_POINT3, PT_VECTOR3, PT_NORMAL, PT_RGB, PT_SPECTRUM,
+    PT_BLACKBODY, PT_STRING, PT_TEXTURE, PT_BOOL
+} ptype;
+
+static const struct {
+    const char *name;
+    ptype type;
+} ptype_names[] = {{"integer", PT_INT},    {"float", PT_FLOAT},     {"point2", PT_POINT2},   {"vector2", PT_VECTOR2},
+                   {"point3", PT_POINT3},  {"point", PT_POINT3},    {"vector3", PT_VECTOR3}, {"vector", PT_VECTOR3},
+                   {"normal", PT_NORMAL},  {"normal3", PT_NORMAL},  {"rgb", PT_RGB},         {"color", PT_RGB},
+                   {"spectrum", PT_SPECTRUM}, {"blackbody", PT_BLACKBODY}, {"string", PT_STRING},
+                   {"texture", PT_TEXTURE}, {"bool", PT_BOOL}};
+
+typedef struct pparam {
+    ptype type;
+    char tname[16];
+    char name[64];
+    size_t line;
+    double *num;
+    size_t nnum, cap_num;
+    char **str;
+    size_t nstr, cap_str;
+    bool used;
+} pparam;
+
+typedef struct plist {
+    pparam *p;
+    size_t n, cap;
+} plist;
+
+/* ---- the reader's state ------------------------------------------------------------ */
+
+typedef enum tex_class { TC_IMAGE, TC_CHECKER, TC_CONST } tex_class;
+
+typedef struct named_tex {
+    char *name;
+    bool is_float;
+    tex_class cls;
+    tex_ref ref;      /* TC_IMAGE, TC_CHECKER */
+    vec3 value;       /* TC_CONST: the value; else the constant the map multiplies */
+} named_tex;
+
+typedef struct area_light {
+    vec3 L;           /* radiance (scale applied) */
+    bool two_sided;
+    float power;      /* > 0: the emitted power the shape is scaled to */
+} area_light;
+
+typedef struct mat_variant {
+    uint32_t base;
+    vec3 ke;
+    bool two_sided;
+    int32_t alpha_tex;   /* named texture index, -1 none */
+    uint32_t mat;
+} mat_variant;
+
+typedef struct gstate {
+    uint32_t material;
+    bool interface;      /* the current material is pbrt's "interface": shapes are not drawn */
+    int32_t area;        /* index into areas, -1 none */
+    bool reverse;
+} gstate;
+
+typedef struct named_xf {
+    char *name;
+    xform x;
+} named_xf;
+
+typedef struct named_obj {
+    char *name;
+    uint32_t mesh;       /* UINT32_MAX: empty */
+} named_obj;
+
+typedef struct pfile {
+    const char *name;    /* for messages */
+    const char *dir;     /* includes are relative to it */
+    char *key;           /* the resolved path, for cycles */
+    pbrt_tokenizer tok;
+} pfile;
+
+typedef struct pp {
+    pk_context *ctx;
+    pk_scene *s;
+    scene_builder b;
+    pfile *files[PB_MAX_INCLUDE_DEPTH + 1];
+    int nfiles;
+    pfile *f;            /* the current file */
+    size_t line;         /* of the directive being carried out */
+    const char *dname;   /* its name */
+    plist pl;
+
+    gstate gs[SB_MAX_DEPTH];
+    bool in_world;
+    bool active_end;     /* ActiveTransform EndTime: transforms are not applied */
+    xform mirror;        /* applied before every world transform (see the top) */
+
+    /* camera */
+    bool cam_set;
+    xform cam_from_world;
+    size_t cam_line;
+    const char *cam_file;
+    float fov, lens_radius, focal_distance, frame_aspect, screen[4];
+    bool has_screen, ortho;
+    int film_w, film_h;
+
+    named_tex *tex;
+    size_t ntex, cap_tex;
+    area_light *areas;
+    size_t nareas, cap_areas;
+    mat_variant *vars;
+    size_t nvars, cap_vars;
+    uint8_t *is_interface;  /* per scene material */
+    size_t cap_iface;
+    named_xf *coords;
+    size_t ncoords, cap_coords;
+    named_obj *objs;
+    size_t nobjs, cap_objs;
+    char *obj_name;         /* the object being defined */
+    int obj_depth;          /* the attribute depth its ObjectBegin opened */
+    pfile top;              /* the first file, for messages after it is read */
+    size_t warned_unused;
+} pp;
+
+static const pk_allocator *A(pp *p) { return &p->ctx->alloc; }
+
+static pk_status pfail(pp *p, size_t line, pk_status st, const char *fmt, ...) PK_PRINTF(4, 5);
+static pk_status pfail(pp *p, size_t line, pk_status st, const char *fmt, ...)
+{
+    char buf[PK_ERRMSG_MAX];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    return ctx_error(p->ctx, st, "%s:%zu: %s", p->f->name, line, buf);
+}
+
+static void pwarn(pp *p, size_t line, const char *fmt, ...) PK_PRINTF(3, 4);
+static void pwarn(pp *p, size_t line, const char *fmt, ...)
+{
+    if (!p->ctx->warn) return;
+    char buf[PK_ERRMSG_MAX];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    ctx_warn(p->ctx, "%s:%zu: %s", p->f->name, line, buf);
+}
+
+static gstate *GS(pp *p) { return &p->gs[p->b.depth]; }
+
+/* ---- parameter lists ------------------------------------------------------------------ */
+
+static void plist_clear(pp *p)
+{
+    for (size_t i = 0; i < p->pl.n; i++) {
+        pparam *q = &p->pl.p[i];
+        mem_free(A(p), q->num);
+        for (size_t k = 0; k < q->nstr; k++) mem_free(A(p), q->str[k]);
+        mem_free(A(p), q->str);
+    }
+    p->pl.n = 0;
+}
+
+static bool is_stringish(ptype t) { return t == PT_STRING || t == PT_TEXTURE; }
+
+static pk_status push_num(pp *p, pparam *q, double v)
+{
+    if (!mem_grow(A(p), (void **)&q->num, &q->cap_num, q->nnum + 1, sizeof *q->num)) return ctx_nomem(p->ctx);
+    q->num[q->nnum++] = v;
+    return PK_OK;
+}
+
+static pk_status push_str(pp *p, pparam *q, const pbrt_token *tk)
+{
+    if (!mem_grow(A(p), (void **)&q->str, &q->cap_str, q->nstr + 1, sizeof *q->str)) return ctx_nomem(p->ctx);
+    char *s = mem_alloc(A(p), tk->len + 1);
+    if (!s) return ctx_nomem(p->ctx);
+    pbrt_tok_string(tk, s, tk->len + 1);
+    q->str[q->nstr++] = s;
+    return PK_OK;
+}
+
+static pk_status tok_error(pp *p, const pbrt_token *tk)
+{
+    return pfail(p, tk->line, PK_ERR_PARSE, "%s", p->f->tok.why);
+}
+
+/* One value token of parameter q. */
+static pk_status param_value(pp *p, pparam *q, const pbrt_token *tk)
+{
+    if (tk->kind == PBRT_TOK_ERROR) return tok_error(p, tk);
+    if (q->type == PT_BOOL) {
+        if (pbrt_tok_is(tk, "true")) return push_num(p, q, 1.0);
+        if (pbrt_tok_is(tk, "false")) return push_num(p, q, 0.0);
+        return pfail(p, tk->line, PK_ERR_PARSE, "'bool %s' takes true or false, not '%.*s'", q->name,
+                     io_tok_len(tk->text, tk->text + tk->len), tk->text);
+    }
+    if (tk->kind == PBRT_TOK_NUMBER && !is_stringish(q->type)) {
+        if (q->type == PT_INT && !tk->integer)
+            return pfail(p, tk->line, PK_ERR_PARSE, "'integer %s' takes integers, not '%.*s'", q->name,
+                         io_tok_len(tk->text, tk->text + tk->len), tk->text);
+        if (!isfinite(tk->number))
+            return pfail(p, tk->line, PK_ERR_PARSE, "'%s %s': number '%.*s' is not finite", q->tname, q->name,
+                         io_tok_len(tk->text, tk->text + tk->len), tk->text);
+        return push_num(p, q, tk->number);
+    }
+    if (tk->kind == PBRT_TOK_STRING && (is_stringish(q->type) || q->type == PT_SPECTRUM)) return push_str(p, q, tk);
+    const char *want = is_stringish(q->type) ? "strings" : q->type == PT_SPECTRUM ? "numbers or a name" : "numbers";
+    return pfail(p, tk->line, PK_ERR_PARSE, "'%s %s' takes %s, not '%.*s'", q->tname, q->name, want,
+                 io_tok_len(tk->text, tk->text + tk->len), tk->text);
+}
+
+/* The parameter list that follows a directive's arguments: "type name"
+ * followed by one value or a bracketed list of values. */
+static pk_status read_params(pp *p)
+{
+    pbrt_tokenizer *t = &p->f->tok;
+    pk_status st;
+    plist_clear(p);
+    for (;;) {
+        pbrt_token tk = pbrt_tok_peek(t);
+        if (tk.kind != PBRT_TOK_STRING) return tk.kind == PBRT_TOK_ERROR ? tok_error(p, &tk) : PK_OK;
+        pbrt_tok_next(t);
+        char decl[160];
+        pbrt_tok_string(&tk, decl, sizeof decl);
+        char tn[32] = "", nm[96] = "", extra[8] = "";
+        int got = sscanf(decl, "%31s %95s %7s", tn, nm, extra);
+        if (got != 2)
+            return pfail(p, tk.line, PK_ERR_PARSE, "expected a parameter \"type name\", found \"%.*s\"",
+                         io_tok_len(tk.text, tk.text + tk.len), tk.text);
+        int type = -1;
+        for (size_t i = 0; i < sizeof ptype_names / sizeof ptype_names[0]; i++)
+            if (strcmp(tn, ptype_names[i].name) == 0) type = (int)ptype_names[i].type;
+        if (type < 0) return pfail(p, tk.line, PK_ERR_PARSE, "unknown parameter type '%s' (in \"%s\")", tn, decl);
+        if (strlen(nm) >= sizeof p->pl.p[0].name)
+            return pfail(p, tk.line, PK_ERR_PARSE, "parameter name '%.40s...' is too long", nm);
+        for (size_t i = 0; i < p->pl.n; i++)
+            if (strcmp(p->pl.p[i].name, nm) == 0)
+                return pfail(p, tk.line, PK_ERR_PARSE, "parameter '%s' is given twice", nm);
+        if (!mem_grow(A(p), (void **)&p->pl.p, &p->pl.cap, p->pl.n + 1, sizeof *p->pl.p)) return ctx_nomem(p->ctx);
+        pparam *q = &p->pl.p[p->pl.n++];
+        memset(q, 0, sizeof *q);
+        q->type = (ptype)type;
+        snprintf(q->tname, sizeof q->tname, "%s", tn);
+        snprintf(q->name, sizeof q->name, "%s", nm);
+        q->line = tk.line;
+        pbrt_token v = pbrt_tok_next(t);
+        if (v.kind == PBRT_TOK_LBRACK) {
+            for (;;) {
+                v = pbrt_tok_next(t);
+                if (v.kind == PBRT_TOK_RBRACK) break;
+                if (v.kind == PBRT_TOK_END)
+                    return pfail(p, q->line, PK_ERR_PARSE, "'%s %s': the list has no closing ']'", tn, nm);
+                if ((st = param_value(p, q, &v))) return st;
+            }
+        } else if (v.kind == PBRT_TOK_END) {
+            return pfail(p, q->line, PK_ERR_PARSE, "'%s %s' has no value", tn, nm);
+        } else if ((st = param_value(p, q, &v))) {
+            return st;
+        }
+        /* counts */
+        size_t n = q->nnum + q->nstr, per = 1;
+        if (q->type == PT_POINT2 || q->type == PT_VECTOR2) per = 2;
+        if (q->type == PT_POINT3 || q->type == PT_VECTOR3 || q->type == PT_NORMAL || q->type == PT_RGB) per = 3;
+        if (n == 0) return pfail(p, q->line, PK_ERR_PARSE, "'%s %s' has no value", tn, nm);
+        if (n % per)
+            return pfail(p, q->line, PK_ERR_PARSE, "'%s %s' has %zu values, not a multiple of %zu", tn, nm, n, per);
+        if (q->type == PT_SPECTRUM && q->nnum && (q->nstr || q->nnum % 2))
+            return pfail(p, q->line, PK_ERR_PARSE,
+                         "'spectrum %s' takes (wavelength, value) pairs or one name, not %zu values", nm, n);
+        if (q->type == PT_SPECTRUM && q->nstr > 1)
+            return pfail(p, q->line, PK_ERR_PARSE, "'spectrum %s' takes one name", nm);
+    }
+}
+
+static pparam *param(pp *p, const char *name)
+{
+    for (size_t i = 0; i < p->pl.n; i++)
+        if (strcmp(p->pl.p[i].name, name) == 0) {
+            p->pl.p[i].used = true;
+            return &p->pl.p[i];
+        }
+    return NULL;
+}
+
+/* A parameter of one of the types (a bit mask of 1 << ptype); a present
+ * parameter of another type is an error. */
+static pk_status param_typed(pp *p, const char *name, unsigned types, const char *want, pparam **out)
+{
+    pparam *q = param(p, name);
+    *out = NULL;
+    if (!q) return PK_OK;
+    if (!(types & (1u << q->type)))
+        return pfail(p, q->line, PK_ERR_PARSE, "parameter '%s %s' should be %s", q->tname, q->name, want);
+    *out = q;
+    return PK_OK;
+}
+
+#define TB(t) (1u << (t))
+
+static pk_status get_float(pp *p, const char *name, float *v)
+{
+    pparam *q;
+    pk_status st = param_typed(p, name, TB(PT_FLOAT) | TB(PT_INT), "a float", &q);
+    if (st || !q) return st;
+    if (q->nnum != 1) return pfail(p, q->line, PK_ERR_PARSE, "'%s %s' takes one value, not %zu", q->tname, name, q->nnum);
+    *v = (float)q->num[0];
+    if (!isfinite(*v)) return pfail(p, q->line, PK_ERR_PARSE, "'%s %s' is not a finite float", q->tname, name);
+    return PK_OK;
+}
+
+static pk_status get_int(pp *p, const char *name, int64_t lo, int64_t hi, int64_t *v)
+{
+    pparam *q;
+    pk_status st = param_typed(p, name, TB(PT_INT), "an integer", &q);
+    if (st || !q) return st;
+    if (q->nnum != 1) return pfail(p, q->line, PK_ERR_PARSE, "'integer %s' takes one value, not %zu", name, q->nnum);
+    if (q->num[0] < (double)lo || q->num[0] > (double)hi)
+        return pfail(p, q->line, PK_ERR_PARSE, "'integer %s' %.0f is outside %lld..%lld", name, q->num[0],
+                     (long long)lo, (long long)hi);
+    *v = (int64_t)q->num[0];
+    return PK_OK;
+}
+
+static pk_status get_bool(pp *p, const char *name, bool *v)
+{
+    pparam *q;
+    pk_status st = param_typed(p, name, TB(PT_BOOL), "a bool", &q);
+    if (st || !q) return st;
+    if (q->nnum != 1) return pfail(p, q->line, PK_ERR_PARSE, "'bool %s' takes one value, not %zu", name, q->nnum);
+    *v = q->num[0] != 0.0;
+    return PK_OK;
+}
+
+static pk_status get_string(pp *p, const char *name, const char **v)
+{
+    pparam *q;
+    pk_status st = param_typed(p, name, TB(PT_STRING), "a string", &q);
+    if (st || !q) return st;
+    if (q->nstr != 1) return pfail(p, q->line, PK_ERR_PARSE, "'string %s' takes one value, not %zu", name, q->nstr);
+    *v = q->str[0];
+    return PK_OK;
+}
+
+static pk_status get_vec3(pp *p, const char *name, vec3 *v)
+{
+    pparam *q;
+    pk_status st = param_typed(p, name, TB(PT_POINT3) | TB(PT_VECTOR3) | TB(PT_NORMAL) | TB(PT_RGB), "3 numbers", &q);
+    if (st || !q) return st;
+    if (q->nnum != 3) return pfail(p, q->line, PK_ERR_PARSE, "'%s %s' takes 3 values, not %zu", q->tname, name, q->nnum);
+    *v = v3((float)q->num[0], (float)q->num[1], (float)q->num[2]);
+    if (!v3_finite(*v)) return pfail(p, q->line, PK_ERR_PARSE, "'%s %s' is not finite in float", q->tname, name);
+    return PK_OK;
+}
+
+/* Warns about the parameters the directive did not use (pbrt refuses them;
+ * a scene written for a later pbrt still renders here). */
+static void warn_unused(pp *p, const char *what)
+{
+    for (size_t i = 0; i < p->pl.n; i++) {
+        pparam *q = &p->pl.p[i];
+        if (!q->used) pwarn(p, q->line, "%s: parameter '%s %s' is not supported; ignored", what, q->tname, q->name);
+    }
+}
+
+/* ---- colours and spectra ------------------------------------------------------------------ */
+
+/* Linear sRGB of a blackbody at kelvin, scaled to luminance 1 (pbrt-v4
+ * normalises its emitters' spectra to one nit before "scale"). */
+static vec3 blackbody_unit(float kelvin)
+{
+    const double h = 6.62607015e-34, c = 2.99792458e8, kb = 1.380649e-23;
+    double X = 0, Y = 0, Z = 0;
+    for (int nm = 360; nm <= 830; nm++) {
+        double l = nm * 1e-9;
+        double b = 2.0 * h * c * c / (l * l * l * l * l) / (exp(h * c / (l * kb * (double)kelvin)) - 1.0);
+        float x, y, z;
+        spectra_cie_xyz((float)nm, &x, &y, &z);
+        X += b * (double)x, Y += b * (double)y, Z += b * (double)z;
+    }
+    if (!(Y > 0.0) || !isfinite(Y)) return v3s(1.0f);
+    X /= Y, Z /= Y, Y = 1.0;
+    double r = 3.2404542 * X - 1.5371385 * Y - 0.4985314 * Z;
+    double g = -0.9692660 * X + 1.8760108 * Y + 0.0415560 * Z;
+    double bl = 0.0556434 * X - 0.2040259 * Y + 1.0572252 * Z;
+    return v3((float)fmax(r, 0.0), (float)fmax(g, 0.0), (float)fmax(bl, 0.0));
+}
+
+/* pbrt's named metal spectra "metal-XX-eta" / "metal-XX-k". */
+static bool named_metal(const char *name, bool *is_k, vec3 *v, bool *approx)
+{
+    if (strncmp(name, "metal-", 6) != 0) return false;
+    const char *el = name + 6, *dash = strrchr(el, '-');
+    if (!dash || dash == el) return false;
+    if (strcmp(dash, "-eta") == 0) *is_k = false;
+    else if (strcmp(dash, "-k") == 0) *is_k = true;
+    else return false;
+    char sym[16];
+    size_t n = (size_t)(dash - el);
+    if (n >= sizeof sym) return false;
+    memcpy(sym, el, n);
+    sym[n] = '\0';
+    vec3 eta, k;
+    *approx = false;
+    if (!spectra_named_metal(sym, &eta, &k)) {
+        if (strcmp(sym, "CuZn") && strcmp(sym, "MgO") && strcmp(sym, "TiO2")) return false;
+        spectra_named_metal("Cu", &eta, &k); /* brass and the oxides: not in the table */
+        *approx = true;
+    }
+    *v = *is_k ? k : eta;
+    return true;
+}
+
+/* pbrt's named glasses, reduced to their index at 550 nm (Schott's
+ * dispersion formulas). */
+static bool named_glass(const char *name, float *eta)
+{
+    static const struct {
+        const char *name;
+        float eta;
+    } g[] = {{"glass-BK7", 1.5185f},  {"glass-BAF10", 1.6734f}, {"glass-FK51A", 1.4875f}, {"glass-LASF9", 1.8555f},
+             {"glass-F5", 1.6076f},   {"glass-SF5", 1.6776f},   {"glass-F10", 1.6289f},   {"glass-SF10", 1.7343f},
+             {"glass-F11", 1.6235f},  {"glass-SF11", 1.7919f}};
+    for (size_t i = 0; i < sizeof g / sizeof g[0]; i++)
+        if (strcmp(g[i].name, name) == 0) {
+            *eta = g[i].eta;
+            return true;
+        }
+    return false;
+}
+
+/* A spectrum parameter as linear RGB. illuminant: the light's rule (a
+ * blackbody or a standard illuminant at luminance 1). */
+static pk_status spectrum_rgb(pp *p, pparam *q, bool illuminant, vec3 *out)
+{
+    if (q->type == PT_RGB) {
+        *out = v3((float)q->num[0], (float)q->num[1], (float)q->num[2]);
+        if (q->nnum != 3) return pfail(p, q->line, PK_ERR_PARSE, "'rgb %s' takes 3 values, not %zu", q->name, q->nnum);
+        if (!v3_finite(*out)) return pfail(p, q->line, PK_ERR_PARSE, "'rgb %s' is not finite in float", q->name);
+        return PK_OK;
+    }
+    if (q->type == PT_BLACKBODY) {
+        if (!(q->num[0] > 0.0) || q->num[0] > 1e6)
+            return pfail(p, q->line, PK_ERR_PARSE, "'blackbody %s' %g K is not a temperature", q->name, q->num[0]);
+        *out = blackbody_unit((float)q->num[0]);
+        if (!illuminant) *out = v3_scale(*out, 1.0f / fmaxf(v3_max_comp(*out), 1e-6f));
+        return PK_OK;
+    }
+    if (q->type == PT_FLOAT) {
+        if (q->nnum != 1) return pfail(p, q->line, PK_ERR_PARSE, "'float %s' takes one value", q->name);
+        *out = v3s((float)q->num[0]);
+        return PK_OK;
+    }
+    /* spectrum: pairs or a name */
+    if (q->nnum) {
+        size_t n = q->nnum / 2;
+        if (n > 4096) return pfail(p, q->line, PK_ERR_LIMIT, "'spectrum %s': more than 4096 samples", q->name);
+        float nm[4096], val[4096];
+        for (size_t i = 0; i < n; i++) {
+            nm[i] = (float)q->num[2 * i], val[i] = (float)q->num[2 * i + 1];
+            if (i && !(nm[i] > nm[i - 1]))
+                return pfail(p, q->line, PK_ERR_PARSE, "'spectrum %s': wavelengths must increase", q->name);
+        }
+        *out = spectrum_to_rgb(nm, val, (int)n);
+        if (illuminant) {
+            /* luminance 1, as pbrt normalises an emitter's spectrum */
+            float y = v3_luminance(*out);
+            if (y > 0.0f) *out = v3_scale(*out, 1.0f / y);
+        }
+        return PK_OK;
+    }
+    const char *nmn = q->str[0];
+    bool is_k, approx;
+    float eta;
+    if (named_metal(nmn, &is_k, out, &approx)) {
+        if (approx) pwarn(p, q->line, "spectrum \"%s\" is not in the table; copper's is used", nmn);
+        return PK_OK;
+    }
+    if (named_glass(nmn, &eta)) {
+        *out = v3s(eta);
+        return PK_OK;
+    }
+    if (strcmp(nmn, "stdillum-D65") == 0 || strcmp(nmn, "illum-acesD60") == 0 || strcmp(nmn, "stdillum-D50") == 0) {
+        *out = v3s(1.0f);
+        if (strcmp(nmn, "stdillum-D50") == 0) *out = blackbody_unit(5003.0f);
+        return PK_OK;
+    }
+    if (strcmp(nmn, "stdillum-A") == 0) {
+        *out = blackbody_unit(2856.0f);
+        return PK_OK;
+    }
+    *out = v3s(1.0f);
+    pwarn(p, q->line, "spectrum \"%.60s\" is not known (spectrum files are not read); using 1", nmn);
+    return PK_OK;
+}
+
+/* ---- named textures ------------------------------------------------------------------------- */
+
+static named_tex *find_tex(pp *p, const char *name)
+{
+    for (size_t i = p->ntex; i-- > 0;)
+        if (strcmp(p->tex[i].name, name) == 0) return &p->tex[i];
+    return NULL;
+}
+
+/* A colour parameter (reflectance, ...): *c the constant, *tex the map
+ * (when tex is non-NULL and the parameter names an image or checkerboard
+ * texture). found: whether the parameter was there. */
+static pk_status get_colour(pp *p, const char *name, vec3 *c, tex_ref *tex, bool *found)
+{
+    pparam *q;
+    pk_status st = param_typed(p, name,
+                               TB(PT_RGB) | TB(PT_SPECTRUM) | TB(PT_BLACKBODY) | TB(PT_TEXTURE) | TB(PT_FLOAT),
+                               "a colour (rgb, spectrum, blackbody, float or texture)", &q);
+    if (found) *found = q != NULL;
+    if (st || !q) return st;
+    if (q->type != PT_TEXTURE) return spectrum_rgb(p, q, false, c);
+    if (q->nstr != 1) return pfail(p, q->line, PK_ERR_PARSE, "'texture %s' takes one name", name);
+    named_tex *t = find_tex(p, q->str[0]);
+    if (!t) return pfail(p, q->line, PK_ERR_PARSE, "'texture %s': no texture named \"%.60s\"", name, q->str[0]);
+    if (t->cls == TC_CONST) {
+        *c = t->value;
+        return PK_OK;
+    }
+    if (!tex) {
+        pwarn(p, q->line, "a texture for '%s' is not supported; using its mean %g", name, (double)v3_luminance(t->value));
+        *c = t->value;
+        return PK_OK;
+    }
+    *tex = t->ref;
+    *c = t->value;
+    return PK_OK;
+}
+
+/* A float parameter that may be a texture (a constant one is used; an
+ * image is warned and def used) or, where spectra are allowed, a named
+ * glass. */
+static pk_status get_float_tex(pp *p, const char *name, float *v, bool *found)
+{
+    pparam *q;
+    pk_status st = param_typed(p, name, TB(PT_FLOAT) | TB(PT_TEXTURE) | TB(PT_SPECTRUM) | TB(PT_RGB),
+                               "a float or a float texture", &q);
+    if (found) *found = q != NULL;
+    if (st || !q) return st;
+    if (q->type == PT_FLOAT) {
+        if (q->nnum != 1) return pfail(p, q->line, PK_ERR_PARSE, "'float %s' takes one value, not %zu", name, q->nnum);
+        *v = (float)q->num[0];
+        return PK_OK;
+    }
+    if (q->type == PT_SPECTRUM || q->type == PT_RGB) {
+        vec3 c;
+        if ((st = spectrum_rgb(p, q, false, &c))) return st;
+        if (q->type == PT_RGB || q->nnum) pwarn(p, q->line, "'%s %s' is reduced to one value (green)", q->tname, name);
+        *v = c.y;
+        return PK_OK;
+    }
+    if (q->nstr != 1) return pfail(p, q->line, PK_ERR_PARSE, "'texture %s' takes one name", name);
+    named_tex *t = find_tex(p, q->str[0]);
+    if (!t) return pfail(p, q->line, PK_ERR_PARSE, "'texture %s': no texture named \"%.60s\"", name, q->str[0]);
+    if (t->cls == TC_CONST) {
+        *v = t->value.x;
+        return PK_OK;
+    }
+    pwarn(p, q->line, "a texture for '%s' is not supported; using %g", name, (double)*v);
+    return PK_OK;
+}
+
+/* ---- transforms ------------------------------------------------------------------------------- */
+
+/* pbrt's 16 numbers: the matrix in column-major order. */
+static pk_status read_matrix(pp *p, const double *v, size_t line, xform *out)
+{
+    xform x;
+    for (int r = 0; r < 4; r++)
+        for (int c = 0; c < 4; c++) x.m[4 * r + c] = (float)v[4 * c + r];
+    if (!xform_finite(&x)) return pfail(p, line, PK_ERR_PARSE, "the matrix is not finite");
+    if (!xform_is_affine(&x))
+        return pfail(p, line, PK_ERR_PARSE, "projective matrices are not supported (the last column must be 0 0 0 1)");
+    *out = x;
+    return PK_OK;
+}
+
+static pk_status ctm_concat(pp *p, const xform *x)
+{
+    if (p->active_end) return PK_OK;
+    xform c = xform_mul(sb_transform(&p->b), x);
+    if (!xform_finite(&c)) return pfail(p, p->line, PK_ERR_PARSE, "%s: the transform is no longer finite", p->dname);
+    sb_set_transform(&p->b, &c);
+    return PK_OK;
+}
+
+static void ctm_set(pp *p, const xform *x)
+{
+    if (!p->active_end) sb_set_transform(&p->b, x);
+}
+
+/* The transform from the current object space to Paprsek's world. */
+static xform world_xf(pp *p) { return xform_mul(&p->mirror, sb_transform(&p->b)); }
+
+/* ---- materials -------------------------------------------------------------------------------- */
+
+static pk_status set_interface(pp *p, uint32_t mat, bool v)
+{
+    if (mat >= p->cap_iface) {
+        size_t cap = p->cap_iface;
+        uint8_t *n = p->is_interface;
+        if (!mem_grow(A(p), (void **)&n, &cap, (size_t)mat + 1, 1)) return ctx_nomem(p->ctx);
+        memset(n + p->cap_iface, 0, cap - p->cap_iface);
+        p->is_interface = n, p->cap_iface = cap;
+    }
+    p->is_interface[mat] = v;
+    return PK_OK;
+}
+
+static bool mat_is_interface(pp *p, uint32_t mat) { return mat < p->cap_iface && p->is_interface[mat]; }
+
+static float rough_alpha(float r, bool remap)
+{
+    if (!(r > 0.0f)) return 0.0f;
+    float a = remap ? sqrtf(r) : r;
+    return a < 1e-3f ? 0.0f : a; /* pbrt treats these as smooth */
+}
+
+/* roughness / uroughness / vroughness and remaproughness (prefix: "" or
+ * "interface." / "conductor."). */
+static pk_status get_roughness(pp *p, const char *prefix, float *alpha)
+{
+    char n1[64], n2[64], n3[64], n4[64];
+    snprintf(n1, sizeof n1, "%sroughness", prefix);
+    snprintf(n2, sizeof n2, "%suroughness", prefix);
+    snprintf(n3, sizeof n3, "%svroughness", prefix);
+    snprintf(n4, sizeof n4, "remaproughness");
+    float r = 0.0f, u = -1.0f, v = -1.0f;
+    bool remap = true, fu, fv;
+    pk_status st;
+    if ((st = get_float_tex(p, n1, &r, NULL)) || (st = get_float_tex(p, n2, &u, &fu)) ||
+        (st = get_float_tex(p, n3, &v, &fv)) || (st = get_bool(p, n4, &remap)))
+        return st;
+    if (fu || fv) {
+        if (!fu) u = r;
+        if (!fv) v = r;
+        if (u != v)
+            pwarn(p, p->line, "anisotropic roughness %g x %g is rendered isotropic (the mean of the two alphas)",
+                  (double)u, (double)v);
+        *alpha = 0.5f * (rough_alpha(u, remap) + rough_alpha(v, remap));
+        if (*alpha < 1e-3f) *alpha = 0.0f;
+    } else {
+        *alpha = rough_alpha(r, remap);
+    }
+    if (!isfinite(*alpha) || *alpha < 0.0f) *alpha = 0.0f;
+    if (*alpha > 1.0f) *alpha = 1.0f;
+    return PK_OK;
+}
+
+static pk_status get_eta(pp *p, const char *name, float def, float *eta)
+{
+    *eta = def;
+    pk_status st = get_float_tex(p, name, eta, NULL);
+    if (st) return st;
+    if (!(*eta > 0.0f) || !isfinite(*eta)) {
+        pwarn(p, p->line, "'%s' %g is not an index of refraction; using %g", name, (double)*eta, (double)def);
+        *eta = def;
+    }
+    if (*eta == 1.0f) *eta = 1.0001f; /* an index-matched surface: next to invisible */
+    return PK_OK;
+}
+
+static pk_status make_conductor(pp *p, material *m, const char *prefix)
+{
+    char ne[64], nk[64], nr[64];
+    snprintf(ne, sizeof ne, "%seta", prefix);
+    snprintf(nk, sizeof nk, "%sk", prefix);
+    snprintf(nr, sizeof nr, "%sroughness", prefix);
+    float alpha;
+    pk_status st = get_roughness(p, prefix, &alpha);
+    if (st) return st;
+    vec3 refl;
+    bool has_refl;
+    tex_ref tr;
+    tex_ref_init(&tr);
+    if ((st = get_colour(p, "reflectance", &refl, &tr, &has_refl))) return st;
+    vec3 eta, k;
+    spectra_named_metal("Cu", &eta, &k);
+    bool fe, fk;
+    if ((st = get_colour(p, ne, &eta, NULL, &fe)) || (st = get_colour(p, nk, &k, NULL, &fk))) return st;
+    if (has_refl) {
+        if (fe || fk) pwarn(p, p->line, "conductor: both reflectance and eta/k are given; reflectance is used");
+        material_conductor_f0(m, refl, alpha);
+        m->map_ks = tr;
+    } else {
+        material_conductor(m, eta, k, alpha);
+    }
+    return PK_OK;
+}
+
+/* Fills m from a material's type and the current parameters. */
+static pk_status build_material(pp *p, const char *type, material *m, bool *interface, int depth)
+{
+    pk_status st;
+    *interface = false;
+    tex_ref tkd;
+    tex_ref_init(&tkd);
+    vec3 kd = v3s(0.5f);
+    float alpha = 0.0f, eta;
+    if (strcmp(type, "diffuse") == 0) {
+        if ((st = get_colour(p, "reflectance", &kd, &tkd, NULL))) return st;
+        material_diffuse(m, kd);
+        m->map_kd = tkd;
+    } else if (strcmp(type, "coateddiffuse") == 0) {
+        if ((st = get_colour(p, "reflectance", &kd, &tkd, NULL)) || (st = get_roughness(p, "", &alpha)) ||
+            (st = get_eta(p, "eta", 1.5f, &eta)))
+            return st;
+        float thick = 0.01f, g = 0.0f;
+        vec3 albedo = v3s(0.0f);
+        int64_t md = 10, ns = 1;
+        if ((st = get_float_tex(p, "thickness", &thick, NULL)) || (st = get_colour(p, "albedo", &albedo, NULL, NULL)) ||
+            (st = get_float_tex(p, "g", &g, NULL)) || (st = get_int(p, "maxdepth", 0, 1 << 20, &md)) ||
+            (st = get_int(p, "nsamples", 0, 1 << 20, &ns)))
+            return st;
+        if (v3_max_comp(albedo) > 0.0f)
+            pwarn(p, p->line, "coateddiffuse: a scattering layer (albedo) is not rendered; the coat is clear");
+        material_plastic(m, kd, eta, alpha);
+        m->map_kd = tkd;
+    } else if (strcmp(type, "conductor") == 0) {
+        if ((st = make_conductor(p, m, ""))) return st;
+    } else if (strcmp(type, "coatedconductor") == 0) {
+        /* the base conductor alone, roughened by the coat (docs: an approximation) */
+        float ia;
+        if ((st = get_roughness(p, "interface.", &ia)) || (st = get_eta(p, "interface.eta", 1.5f, &eta)) ||
+            (st = make_conductor(p, m, "conductor.")))
+            return st;
+        float thick = 0.01f, g = 0.0f;
+        vec3 albedo = v3s(0.0f);
+        int64_t md = 10, ns = 1;
+        if ((st = get_float_tex(p, "thickness", &thick, NULL)) || (st = get_colour(p, "albedo", &albedo, NULL, NULL)) ||
+            (st = get_float_tex(p, "g", &g, NULL)) || (st = get_int(p, "maxdepth", 0, 1 << 20, &md)) ||
+            (st = get_int(p, "nsamples", 0, 1 << 20, &ns)))
+            return st;
+        if (ia > m->alpha) m->alpha = ia;
+        pwarn(p, p->line, "coatedconductor is approximated by its conductor under the coat's roughness (no clear "
+                          "coat layer)");
+    } else if (strcmp(type, "dielectric") == 0 || strcmp(type, "thindielectric") == 0) {
+        if ((st = get_eta(p, "eta", 1.5f, &eta)) || (st = get_roughness(p, "", &alpha))) return st;
+        if (type[0] == 't')
+            pwarn(p, p->line, "thindielectric is rendered as a solid dielectric of the same index (no thin sheet)");
+        material_dielectric(m, eta, alpha, v3s(1.0f));
+    } else if (strcmp(type, "diffusetransmission") == 0) {
+        vec3 tr = v3s(0.25f);
+        float sc = 1.0f;
+        kd = v3s(0.25f);
+        if ((st = get_colour(p, "reflectance", &kd, &tkd, NULL)) || (st = get_colour(p, "transmittance", &tr, NULL, NULL)) ||
+            (st = get_float(p, "scale", &sc)))
+            return st;
+        pwarn(p, p->line, "diffusetransmission: the transmitted part is not rendered; a diffuse reflector of the "
+                          "reflectance");
+        material_diffuse(m, v3_scale(kd, sc));
+        m->map_kd = tkd;
+    } else if (strcmp(type, "mix") == 0) {
+        pparam *q;
+        if ((st = param_typed(p, "materials", TB(PT_STRING), "two material names", &q))) return st;
+        if (!q || q->nstr != 2) return pfail(p, p->line, PK_ERR_PARSE, "mix needs 'string materials' with two names");
+        float amount = 0.5f;
+        if ((st = get_float_tex(p, "amount", &amount, NULL))) return st;
+        const char *pick = amount > 0.5f ? q->str[1] : q->str[0];
+        int64_t idx = scene_find_material(p->s, pick);
+        if (idx < 0 || depth > 8)
+            return pfail(p, q->line, PK_ERR_PARSE, "mix: no material named \"%.60s\"", pick);
+        pwarn(p, p->line, "mix is rendered as its dominant material \"%.60s\" (amount %g)", pick, (double)amount);
+        char *nm = m->name;
+        *m = p->s->materials[idx];
+        m->name = nm;
+        *interface = mat_is_interface(p, (uint32_t)idx);
+    } else if (strcmp(type, "interface") == 0 || strcmp(type, "") == 0 || strcmp(type, "none") == 0) {
+        *interface = true;
+    } else if (strcmp(type, "measured") == 0 || strcmp(type, "hair") == 0 || strcmp(type, "subsurface") == 0) {
+        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        pwarn(p, p->line, "material \"%s\" is not supported; rendered as diffuse grey 0.5", type);
+        material_diffuse(m, v3s(0.5f));
+    } else {
+        return pfail(p, p->line, PK_ERR_PARSE, "unknown material type \"%.40s\"", type);
+    }
+    /* shared parameters */
+    pparam *q;
+    if ((st = param_typed(p, "normalmap", TB(PT_STRING), "a file name", &q))) return st;
+    if (q && q->nstr == 1) {
+        char *path = path_join(A(p), p->f->dir, q->str[0]);
+        if (!path) return ctx_nomem(p->ctx);
+        int32_t idx;
+        const bool was_ok = p->ctx->status == PK_OK;
+        st = texture_load(p->ctx, p->s, path, false, &idx);
+        mem_free(A(p), path);
+        if (st != PK_OK) {
+            char why[PK_ERRMSG_MAX];
+            if (!io_demote_error(p->ctx, st, was_ok, why, sizeof why)) return st;
+            pwarn(p, q->line, "normal map not used (%s)", why);
+        } else {
+            tex_ref_init(&m->map_norm);
+            m->map_norm.kind = TEX_IMAGE;
+            m->map_norm.tex = idx;
+        }
+    }
+    if (param(p, "displacement")) pwarn(p, p->line, "bump mapping by 'displacement' is not supported; ignored");
+    return PK_OK;
+}
+
+/* A material from a Material or MakeNamedMaterial directive. */
+static pk_status new_material(pp *p, const char *name, const char *type, uint32_t *out)
+{
+    uint32_t idx;
+    pk_status st = scene_add_material(p->ctx, p->s, name, &idx);
+    if (st) return st;
+    material *m = &p->s->materials[idx];
+    m->two_sided = false;
+    bool iface;
+    if ((st = build_material(p, type, m, &iface, 0))) return st;
+    if ((st = set_interface(p, idx, iface))) return st;
+    *out = idx;
+    return PK_OK;
+}
+
+/* The material a shape gets: the current one with the current area light's
+ * emission and an alpha map, made once per combination. */
+static pk_status shape_material(pp *p, vec3 ke, bool two_sided, int32_t alpha_tex, uint32_t *out)
+{
+    uint32_t base = GS(p)->material;
+    if (ke.x == 0.0f && ke.y == 0.0f && ke.z == 0.0f && alpha_tex < 0) {
+        *out = base;
+        return PK_OK;
+    }
+    for (size_t i = 0; i < p->nvars; i++) {
+        const mat_variant *v = &p->vars[i];
+        if (v->base == base && v->ke.x == ke.x && v->ke.y == ke.y && v->ke.z == ke.z && v->two_sided == two_sided &&
+            v->alpha_tex == alpha_tex) {
+            *out = v->mat;
+            return PK_OK;
+        }
+    }
+    if (!mem_grow(A(p), (void **)&p->vars, &p->cap_vars, p->nvars + 1, sizeof *p->vars)) return ctx_nomem(p->ctx);
+    char name[PB_NAME_MAX + 16];
+    snprintf(name, sizeof name, "%.*s+%zu", PB_NAME_MAX, p->s->materials[base].name ? p->s->materials[base].name : "",
+             p->nvars);
+    uint32_t idx;
+    pk_status st = scene_add_material(p->ctx, p->s, name, &idx);
+    if (st) return st;
+    material *m = &p->s->materials[idx];
+    char *nm = m->name;
+    *m = p->s->materials[base];
+    m->name = nm;
+    m->ke = ke;
+    m->two_sided = two_sided;
+    if (alpha_tex >= 0) m->map_d = p->tex[alpha_tex].ref;
+    mat_variant v = {base, ke, two_sided, alpha_tex, idx};
+    p->vars[p->nvars++] = v;
+    *out = idx;
+    return PK_OK;
+}
+
+/* ---- shapes ------------------------------------------------------------------------------------- */
+
+typedef struct mesh_in {
+    vec3 *pos;
+    vec3 *nrm;        /* NULL: none */
+    float *uv;        /* NULL: none */
+    size_t npos;
+    uint32_t *tris;   /* 3 per triangle; reordered here */
+    size_t ntris;
+} mesh_in;
+
+/* A builder call's failure, latched again with where it happened. */
+static pk_status builder_status(pp *p, pk_status st, const pk_context *tmp)
+{
+    if (st == PK_OK) return PK_OK;
+    if (st == PK_ERR_NOMEM) return ctx_nomem(p->ctx);
+    return pfail(p, p->line, st, "%s", tmp->message);
+}
+
+/* World area of the mesh (for an area light's power). */
+static double mesh_area(const xform *x, const mesh_in *m)
+{
+    double a = 0.0;
+    for (size_t t = 0; t < m->ntris; t++) {
+        vec3 p0 = xform_point(x, m->pos[m->tris[3 * t]]), p1 = xform_point(x, m->pos[m->tris[3 * t + 1]]),
+             p2 = xform_point(x, m->pos[m->tris[3 * t + 2]]);
+        a += 0.5 * (double)v3_len(v3_cross(v3_sub(p1, p0), v3_sub(p2, p0)));
+    }
+    return a;
+}
+
+/* Emission of the current area light on a shape of world area area. */
+static vec3 area_emission(pp *p, double area, bool *two_sided)
+{
+    int32_t a = GS(p)->area;
+    *two_sided = false;
+    if (a < 0) return v3s(0.0f);
+    const area_light *l = &p->areas[a];
+    *two_sided = l->two_sided;
+    vec3 L = l->L;
+    if (l->power > 0.0f) {
+        double k = (l->two_sided ? 2.0 : 1.0) * area * (double)PK_PI;
+        if (k > 0.0) L = v3_scale(L, (float)((double)l->power / k));
+    }
+    return L;
+}
+
+/* Adds a mesh in the current space with the current material and area
+ * light. Triangles face where pbrt's surface normal points: the shading
+ * normals' side when the mesh has them, else the winding's (reversed by
+ * ReverseOrientation); the winding is swapped wherever the transform to the
+ * world mirrors. alpha_tex: the cut-out texture, -1 none. */
+static pk_status add_mesh(pp *p, mesh_in *m, int32_t alpha_tex)
+{
+    if (GS(p)->interface) return PK_OK;
+    xform w = world_xf(p);
+    const bool mirrored = xform_det3(&w) < 0.0;
+    for (size_t t = 0; t < m->ntris; t++) {
+        uint32_t *tr = &m->tris[3 * t];
+        bool flip;
+        if (m->nrm) {
+            vec3 a = m->pos[tr[0]], b = m->pos[tr[1]], c = m->pos[tr[2]];
+            vec3 ng = v3_cross(v3_sub(b, a), v3_sub(c, a));
+            vec3 ns = v3_add(v3_add(m->nrm[tr[0]], m->nrm[tr[1]]), m->nrm[tr[2]]);
+            flip = v3_dot(ng, ns) < 0.0f;
+        } else {
+            flip = GS(p)->reverse;
+        }
+        if (flip != mirrored) {
+            uint32_t sw = tr[1];
+            tr[1] = tr[2], tr[2] = sw;
+        }
+    }
+    bool two = false;
+    vec3 ke = v3s(0.0f);
+    if (GS(p)->area >= 0) ke = area_emission(p, p->areas[GS(p)->area].power > 0.0f ? mesh_area(&w, m) : 0.0, &two);
+    uint32_t mat;
+    pk_status st = shape_material(p, ke, two, alpha_tex, &mat);
+    if (st) return st;
+    xform saved = *sb_transform(&p->b);
+    sb_set_transform(&p->b, &w);
+    uint32_t old = p->b.material;
+    sb_set_material(&p->b, mat);
+    sb_mesh sm = {m->pos, m->nrm, m->uv, m->npos, m->tris, m->ntris, false};
+    pk_context tmp = io_scratch_context(p->ctx);
+    p->b.ctx = &tmp;
+    st = sb_add_mesh(&p->b, &sm);
+    p->b.ctx = p->ctx;
+    sb_set_transform(&p->b, &saved);
+    sb_set_material(&p->b, old);
+    return builder_status(p, st, &tmp);
+}
+
+static void mesh_free(pp *p, mesh_in *m)
+{
+    mem_free(A(p), m->pos);
+    mem_free(A(p), m->nrm);
+    mem_free(A(p), m->uv);
+    mem_free(A(p), m->tris);
+    memset(m, 0, sizeof *m);
+}
+
+static pk_status mesh_alloc(pp *p, mesh_in *m, size_t npos, size_t ntris, bool nrm, bool uv)
+{
+    memset(m, 0, sizeof *m);
+    m->npos = npos, m->ntris = ntris;
+    m->pos = mem_calloc(A(p), npos ? npos : 1, sizeof(vec3));
+    m->tris = mem_calloc(A(p), ntris ? ntris : 1, 3 * sizeof(uint32_t));
+    if (nrm) m->nrm = mem_calloc(A(p), npos ? npos : 1, sizeof(vec3));
+    if (uv) m->uv = mem_calloc(A(p), npos ? npos : 1, 2 * sizeof(float));
+    if (!m->pos || !m->tris || (nrm && !m->nrm) || (uv && !m->uv)) {
+        mesh_free(p, m);
+        return ctx_nomem(p->ctx);
+    }
+    return PK_OK;
+}
+
+/* The shape's "alpha": 1 (opaque: -1), 0 (invisible: *skip), a float
+ * image texture (its index). */
+static pk_status shape_alpha(pp *p, int32_t *tex, bool *skip)
+{
+    pparam *q;
+    *tex = -1;
+    *skip = false;
+    pk_status st = param_typed(p, "alpha", TB(PT_FLOAT) | TB(PT_TEXTURE), "a float or a float texture", &q);
+    if (st || !q) return st;
+    if (q->type == PT_FLOAT) {
+        if (q->nnum != 1) return pfail(p, q->line, PK_ERR_PARSE, "'float alpha' takes one value");
+        if (q->num[0] <= 0.0) *skip = true;
+        else if (q->num[0] < 1.0)
+            pwarn(p, q->line, "a partly transparent alpha %g is rendered opaque (only textures cut holes)", q->num[0]);
+        return PK_OK;
+    }
+    if (q->nstr != 1) return pfail(p, q->line, PK_ERR_PARSE, "'texture alpha' takes one name");
+    named_tex *t = find_tex(p, q->str[0]);
+    if (!t) return pfail(p, q->line, PK_ERR_PARSE, "'texture alpha': no texture named \"%.60s\"", q->str[0]);
+    if (t->cls == TC_CONST) {
+        if (t->value.x <= 0.0f) *skip = true;
+        return PK_OK;
+    }
+    if (t->cls != TC_IMAGE) {
+        pwarn(p, q->line, "an alpha texture that is not an image is not supported; the shape is opaque");
+        return PK_OK;
+    }
+    *tex = (int32_t)(t - p->tex);
+    return PK_OK;
+}
+
+/* Vertex arrays of a mesh directive: P, N, uv, indices (checked). */
+static pk_status read_mesh_params(pp *p, const char *what, size_t per_face, mesh_in *m, uint32_t **faces,
+                                  size_t *nfaces)
+{
+    pparam *P, *N, *UV, *I;
+    pk_status st;
+    if ((st = param_typed(p, "P", TB(PT_POINT3), "point3", &P)) || (st = param_typed(p, "N", TB(PT_NORMAL), "normal", &N)) ||
+        (st = param_typed(p, "uv", TB(PT_POINT2) | TB(PT_FLOAT), "point2", &UV)) ||
+        (st = param_typed(p, "indices", TB(PT_INT), "integer", &I)))
+        return st;
+    if (!UV && (st = param_typed(p, "st", TB(PT_POINT2) | TB(PT_FLOAT), "point2", &UV))) return st;
+    param(p, "S"), param(p, "faceIndices");
+    if (!P) return pfail(p, p->line, PK_ERR_PARSE, "%s needs 'point3 P'", what);
+    size_t npos = P->nnum / 3;
+    if (npos > UINT32_MAX / 2) return pfail(p, P->line, PK_ERR_LIMIT, "%s: too many vertices", what);
+    if (N && N->nnum != P->nnum)
+        return pfail(p, N->line, PK_ERR_PARSE, "%s: 'normal N' has %zu normals for %zu vertices", what, N->nnum / 3, npos);
+    if (UV && UV->nnum != 2 * npos)
+        return pfail(p, UV->line, PK_ERR_PARSE, "%s: '%s %s' has %zu values for %zu vertices (2 each)", what, UV->tname,
+                     UV->name, UV->nnum, npos);
+    size_t nidx;
+    if (I) {
+        nidx = I->nnum;
+        if (nidx % per_face)
+            return pfail(p, I->line, PK_ERR_PARSE, "%s: 'integer indices' has %zu values, not a multiple of %zu", what,
+                         nidx, per_face);
+    } else {
+        if (npos != per_face)
+            return pfail(p, p->line, PK_ERR_PARSE, "%s without 'integer indices' must have exactly %zu vertices, not %zu",
+                         what, per_face, npos);
+        nidx = per_face;
+    }
+    *nfaces = nidx / per_face;
+    if ((st = mesh_alloc(p, m, npos, 0, N != NULL, UV != NULL))) return st;
+    mem_free(A(p), m->tris);
+    m->tris = NULL;
+    *faces = mem_calloc(A(p), nidx ? nidx : 1, sizeof(uint32_t));
+    if (!*faces) {
+        mesh_free(p, m);
+        return ctx_nomem(p->ctx);
+    }
+    for (size_t i = 0; i < nidx; i++) {
+        double v = I ? I->num[i] : (double)i;
+        if (v < 0.0 || v >= (double)npos) {
+            mesh_free(p, m);
+            mem_free(A(p), *faces);
+            *faces = NULL;
+            return pfail(p, I->line, PK_ERR_PARSE, "%s: index %.0f (number %zu) is out of range (%zu vertices)", what, v, i,
+                         npos);
+        }
+        (*faces)[i] = (uint32_t)v;
+    }
+    for (size_t i = 0; i < npos; i++) {
+        m->pos[i] = v3((float)P->num[3 * i], (float)P->num[3 * i + 1], (float)P->num[3 * i + 2]);
+        if (N) m->nrm[i] = v3((float)N->num[3 * i], (float)N->num[3 * i + 1], (float)N->num[3 * i + 2]);
+        if (UV) m->uv[2 * i] = (float)UV->num[2 * i], m->uv[2 * i + 1] = (float)UV->num[2 * i + 1];
+    }
+    for (size_t i = 0; i < npos; i++)
+        if (!v3_finite(m->pos[i])) {
+            mesh_free(p, m);
+            mem_free(A(p), *faces);
+            *faces = NULL;
+            return pfail(p, P->line, PK_ERR_PARSE, "%s: vertex %zu is not finite in float", what, i);
+        }
+    return PK_OK;
+}
+
+static pk_status shape_trianglemesh(pp *p, int32_t alpha)
+{
+    mesh_in m;
+    uint32_t *f;
+    size_t nf;
+    pk_status st = read_mesh_params(p, "trianglemesh", 3, &m, &f, &nf);
+    if (st) return st;
+    m.tris = f, m.ntris = nf;
+    st = add_mesh(p, &m, alpha);
+    mesh_free(p, &m);
+    return st;
+}
+
+/* Bilinear patches (p00 p10 p01 p11) as two triangles each. */
+static pk_status shape_bilinear(pp *p, int32_t alpha)
+{
+    mesh_in m;
+    uint32_t *f;
+    size_t nf;
+    pk_status st = read_mesh_params(p, "bilinearmesh", 4, &m, &f, &nf);
+    if (st) return st;
+    uint32_t *t = mem_calloc(A(p), nf ? 2 * nf : 1, 3 * sizeof(uint32_t));
+    if (!t) {
+        mem_free(A(p), f);
+        mesh_free(p, &m);
+        return ctx_nomem(p->ctx);
+    }
+    for (size_t i = 0; i < nf; i++) {
+        const uint32_t *q = &f[4 * i];
+        uint32_t a[6] = {q[0], q[1], q[3], q[0], q[3], q[2]};
+        memcpy(&t[6 * i], a, sizeof a);
+    }
+    mem_free(A(p), f);
+    mem_free(A(p), m.tris);
+    m.tris = t, m.ntris = 2 * nf;
+    st = add_mesh(p, &m, alpha);
+    mesh_free(p, &m);
+    return st;
+}
+
+/* ---- Loop subdivision ---- */
+
+typedef struct edge_rec {
+    uint32_t a, b;       /* a < b */
+    uint32_t opp[2];     /* the vertices opposite the edge in its faces */
+    int nfaces;
+    uint32_t mid;        /* the new vertex */
+} edge_rec;
+
+typedef struct edge_map {
+    edge_rec *e;
+    size_t n, slots;     /* slots a power of two; index 0 means empty (stored index + 1) */
+    uint32_t *idx;
+} edge_map;
+
+static uint64_t edge_hash(uint32_t a, uint32_t b)
+{
+    uint64_t h = ((uint64_t)a << 32) | b;
+    h ^= h >> 33;
+    h *= 0xff51afd7ed558ccdULL;
+    h ^= h >> 33;
+    return h;
+}
+
+/* The edge (a, b), added when absent; NULL when out of memory. */
+static edge_rec *edge_get(edge_map *em, uint32_t a, uint32_t b)
+{
+    if (a > b) {
+        uint32_t t = a;
+        a = b, b = t;
+    }
+    size_t mask = em->slots - 1, i = (size_t)edge_hash(a, b) & mask;
+    while (em->idx[i]) {
+        edge_rec *r = &em->e[em->idx[i] - 1];
+        if (r->a == a && r->b == b) return r;
+        i = (i + 1) & mask;
+    }
+    edge_rec *r = &em->e[em->n];
+    memset(r, 0, sizeof *r);
+    r->a = a, r->b = b;
+    em->idx[i] = (uint32_t)(++em->n);
+    return r;
+}
+
+/* One level of Loop subdivision of (pos, npos, tris, ntris) into new
+ * arrays; boundary edges and vertices follow the boundary rules (the
+ * boundary curve is a cubic B-spline of its own). */
+static pk_status loop_level(pp *p, size_t line, vec3 **pos, size_t *npos, uint32_t **tris, size_t *ntris)
+{
+    const size_t nv = *npos, nt = *ntris, ne_max = 3 * nt;
+    const vec3 *P = *pos;
+    const uint32_t *T = *tris;
+    edge_map em = {0};
+    em.slots = 16;
+    while (em.slots < 2 * ne_max + 2) em.slots *= 2;
+    em.e = mem_calloc(A(p), ne_max ? ne_max : 1, sizeof *em.e);
+    em.idx = mem_calloc(A(p), em.slots, sizeof *em.idx);
+    uint32_t *valence = mem_calloc(A(p), nv ? nv : 1, sizeof *valence);
+    vec3 *ring = mem_calloc(A(p), nv ? nv : 1, sizeof *ring);      /* sum of neighbours */
+    vec3 *bsum = mem_calloc(A(p), nv ? nv : 1, sizeof *bsum);      /* sum of boundary neighbours */
+    uint8_t *bnd = mem_calloc(A(p), nv ? nv : 1, 1);
+    vec3 *np = NULL;
+    uint32_t *ntr = NULL;
+    pk_status st = PK_OK;
+    if (!em.e || !em.idx || !valence || !ring || !bsum || !bnd) {
+        st = ctx_nomem(p->ctx);
+        goto done;
+    }
+    for (size_t t = 0; t < nt; t++)
+        for (int k = 0; k < 3; k++) {
+            uint32_t a = T[3 * t + k], b = T[3 * t + (k + 1) % 3], c = T[3 * t + (k + 2) % 3];
+            edge_rec *r = edge_get(&em, a, b);
+            if (r->nfaces == 2) {
+                st = pfail(p, line, PK_ERR_PARSE,
+                           "loopsubdiv: the edge %u-%u is shared by more than two triangles (not a manifold)", a, b);
+                goto done;
+            }
+            r->opp[r->nfaces++] = c;
+        }
+    for (size_t i = 0; i < em.n; i++) {
+        edge_rec *r = &em.e[i];
+        valence[r->a]++, valence[r->b]++;
+        ring[r->a] = v3_add(ring[r->a], P[r->b]);
+        ring[r->b] = v3_add(ring[r->b], P[r->a]);
+        if (r->nfaces == 1) {
+            bnd[r->a] = bnd[r->b] = 1;
+            bsum[r->a] = v3_add(bsum[r->a], P[r->b]);
+            bsum[r->b] = v3_add(bsum[r->b], P[r->a]);
+        }
+    }
+    size_t nnew = nv + em.n;
+    if (nnew > UINT32_MAX / 2 || 4 * nt > UINT32_MAX / 4) {
+        st = pfail(p, line, PK_ERR_LIMIT, "loopsubdiv: too many vertices");
+        goto done;
+    }
+    np = mem_calloc(A(p), nnew ? nnew : 1, sizeof *np);
+    ntr = mem_calloc(A(p), nt ? 4 * nt : 1, 3 * sizeof *ntr);
+    if (!np || !ntr) {
+        st = ctx_nomem(p->ctx);
+        goto done;
+    }
+    /* even vertices */
+    for (size_t v = 0; v < nv; v++) {
+        uint32_t n = valence[v];
+        if (n == 0) {
+            np[v] = P[v];
+        } else if (bnd[v]) {
+            np[v] = v3_add(v3_scale(P[v], 0.75f), v3_scale(bsum[v], 0.125f));
+        } else {
+            float beta = n == 3 ? 3.0f / 16.0f : 3.0f / (8.0f * (float)n);
+            np[v] = v3_add(v3_scale(P[v], 1.0f - (float)n * beta), v3_scale(ring[v], beta));
+        }
+    }
+    /* odd vertices */
+    for (size_t i = 0; i < em.n; i++) {
+        edge_rec *r = &em.e[i];
+        r->mid = (uint32_t)(nv + i);
+        vec3 e = v3_add(P[r->a], P[r->b]);
+        if (r->nfaces == 2)
+            np[r->mid] = v3_add(v3_scale(e, 0.375f), v3_scale(v3_add(P[r->opp[0]], P[r->opp[1]]), 0.125f));
+        else
+            np[r->mid] = v3_scale(e, 0.5f);
+    }
+    for (size_t t = 0; t < nt; t++) {
+        uint32_t a = T[3 * t], b = T[3 * t + 1], c = T[3 * t + 2];
+        uint32_t ab = edge_get(&em, a, b)->mid, bc = edge_get(&em, b, c)->mid, ca = edge_get(&em, c, a)->mid;
+        uint32_t q[12] = {a, ab, ca, ab, b, bc, ca, bc, c, ab, bc, ca};
+        memcpy(&ntr[12 * t], q, sizeof q);
+    }
+    mem_free(A(p), *pos);
+    mem_free(A(p), *tris);
+    *pos = np, *npos = nnew, *tris = ntr, *ntris = 4 * nt;
+    np = NULL, ntr = NULL;
+done:
+    mem_free(A(p), em.e);
+    mem_free(A(p), em.idx);
+    mem_free(A(p), valence);
+    mem_free(A(p), ring);
+    mem_free(A(p), bsum);
+    mem_free(A(p), bnd);
+    mem_free(A(p), np);
+    mem_free(A(p), ntr);
+    return st;
+}
+
+/* Moves the vertices to their limit positions (Loop's limit masks:
+ * interior 1 - n g and g = 1 / (n + 3 / (8 beta)) each neighbour; boundary
+ * 3/5 and 1/5 each boundary neighbour), and gives area-weighted normals. */
+static pk_status loop_limit(pp *p, vec3 *pos, size_t npos, const uint32_t *tris, size_t ntris, vec3 *nrm)
+{
+    uint32_t *valence = mem_calloc(A(p), npos ? npos : 1, sizeof *valence);
+    vec3 *ring = mem_calloc(A(p), npos ? npos : 1, sizeof *ring);
+    vec3 *bsum = mem_calloc(A(p), npos ? npos : 1, sizeof *bsum);
+    uint8_t *bnd = mem_calloc(A(p), npos ? npos : 1, 1);
+    edge_map em = {0};
+    em.slots = 16;
+    while (em.slots < 6 * ntris + 2) em.slots *= 2;
+    em.e = mem_calloc(A(p), ntris ? 3 * ntris : 1, sizeof *em.e);
+    em.idx = mem_calloc(A(p), em.slots, sizeof *em.idx);
+    pk_status st = PK_OK;
+    if (!valence || !ring || !bsum || !bnd || !em.e || !em.idx) {
+        st = ctx_nomem(p->ctx);
+        goto done;
+    }
+    for (size_t t = 0; t < ntris; t++)
+        for (int k = 0; k < 3; k++) {
+            edge_rec *r = edge_get(&em, tris[3 * t + k], tris[3 * t + (k + 1) % 3]);
+            r->nfaces++;
+        }
+    for (size_t i = 0; i < em.n; i++) {
+        edge_rec *r = &em.e[i];
+        valence[r->a]++, valence[r->b]++;
+        ring[r->a] = v3_add(ring[r->a], pos[r->b]);
+        ring[r->b] = v3_add(ring[r->b], pos[r->a]);
+        if (r->nfaces == 1) {
+            bnd[r->a] = bnd[r->b] = 1;
+            bsum[r->a] = v3_add(bsum[r->a], pos[r->b]);
+            bsum[r->b] = v3_add(bsum[r->b], pos[r->a]);
+        }
+    }
+    for (size_t v = 0; v < npos; v++) {
+        uint32_t n = valence[v];
+        if (n == 0) continue;
+        if (bnd[v]) {
+            pos[v] = v3_add(v3_scale(pos[v], 0.6f), v3_scale(bsum[v], 0.2f));
+        } else {
+            float beta = n == 3 ? 3.0f / 16.0f : 3.0f / (8.0f * (float)n);
+            float g = 1.0f / ((float)n + 3.0f / (8.0f * beta));
+            pos[v] = v3_add(v3_scale(pos[v], 1.0f - (float)n * g), v3_scale(ring[v], g));
+        }
+    }
+    for (size_t v = 0; v < npos; v++) nrm[v] = v3s(0.0f);
+    for (size_t t = 0; t < ntris; t++) {
+        const uint32_t *q = &tris[3 * t];
+        vec3 ng = v3_cross(v3_sub(pos[q[1]], pos[q[0]]), v3_sub(pos[q[2]], pos[q[0]]));
+        for (int k = 0; k < 3; k++) nrm[q[k]] = v3_add(nrm[q[k]], ng);
+    }
+    for (size_t v = 0; v < npos; v++) nrm[v] = v3_norm_scaled(nrm[v]);
+done:
+    mem_free(A(p), valence);
+    mem_free(A(p), ring);
+    mem_free(A(p), bsum);
+    mem_free(A(p), bnd);
+    mem_free(A(p), em.e);
+    mem_free(A(p), em.idx);
+    return st;
+}
+
+static pk_status shape_loopsubdiv(pp *p, int32_t alpha)
+{
+    int64_t levels = 3;
+    pk_status st = get_int(p, "levels", 0, 16, &levels);
+    if (st) return st;
+    mesh_in m;
+    uint32_t *f;
+    size_t nf;
+    if ((st = read_mesh_params(p, "loopsubdiv", 3, &m, &f, &nf))) return st;
+    mem_free(A(p), m.nrm), m.nrm = NULL;
+    if (m.uv) {
+        pwarn(p, p->line, "loopsubdiv: texture coordinates are not subdivided; dropped");
+        mem_free(A(p), m.uv), m.uv = NULL;
+    }
+    mem_free(A(p), m.tris);
+    m.tris = f, m.ntris = nf;
+    for (size_t t = 0; t < nf; t++)
+        if (f[3 * t] == f[3 * t + 1] || f[3 * t + 1] == f[3 * t + 2] || f[3 * t] == f[3 * t + 2]) {
+            mesh_free(p, &m);
+            return pfail(p, p->line, PK_ERR_PARSE, "loopsubdiv: triangle %zu repeats a vertex", t);
+        }
+    double grow = (double)nf;
+    for (int64_t l = 0; l < levels; l++) grow *= 4.0;
+    if (grow > (double)(1u << 26)) {
+        mesh_free(p, &m);
+        return pfail(p, p->line, PK_ERR_LIMIT, "loopsubdiv: %lld levels of %zu triangles make more than %u triangles",
+                     (long long)levels, nf, 1u << 26);
+    }
+    for (int64_t l = 0; l < levels && st == PK_OK; l++) st = loop_level(p, p->line, &m.pos, &m.npos, &m.tris, &m.ntris);
+    if (st == PK_OK) {
+        m.nrm = mem_calloc(A(p), m.npos ? m.npos : 1, sizeof(vec3));
+        if (!m.nrm) st = ctx_nomem(p->ctx);
+    }
+    if (st == PK_OK) st = loop_limit(p, m.pos, m.npos, m.tris, m.ntris, m.nrm);
+    if (st == PK_OK) {
+        /* the limit normals follow the winding; pbrt's side is the winding's */
+        if (GS(p)->reverse)
+            for (size_t v = 0; v < m.npos; v++) m.nrm[v] = v3_neg(m.nrm[v]);
+        st = add_mesh(p, &m, alpha);
+    }
+    mesh_free(p, &m);
+    return st;
+}
+
+/* A surface of revolution about z as a grid: nu steps of phi in
+ * [0, phimax], nv rows given by f(row) -> (radius, z) and the normal. */
+typedef void (*rev_fn)(const void *user, float t, float *r, float *z, float *nr, float *nz);
+
+static pk_status add_revolution(pp *p, int nu, int nv, float phimax, rev_fn fn, const void *user, int32_t alpha)
+{
+    mesh_in m;
+    size_t npos = (size_t)(nu + 1) * (size_t)(nv + 1);
+    pk_status st = mesh_alloc(p, &m, npos, (size_t)nu * (size_t)nv * 2, true, true);
+    if (st) return st;
+    for (int j = 0; j <= nv; j++) {
+        float t = (float)j / (float)nv, r, z, nr, nz;
+        fn(user, t, &r, &z, &nr, &nz);
+        for (int i = 0; i <= nu; i++) {
+            float u = (float)i / (float)nu, phi = u * phimax;
+            size_t k = (size_t)j * (size_t)(nu + 1) + (size_t)i;
+            m.pos[k] = v3(r * cosf(phi), r * sinf(phi), z);
+            m.nrm[k] = v3(nr * cosf(phi), nr * sinf(phi), nz);
+            m.uv[2 * k] = u, m.uv[2 * k + 1] = t;
+        }
+    }
+    /* a row of radius 0 (a pole, a disk's centre) is one point: the
+     * triangles that would have two corners there are left out */
+    size_t o = 0;
+    for (int j = 0; j < nv; j++) {
+        const bool lo0 = v3_len2(v3_sub(m.pos[(size_t)j * (size_t)(nu + 1)], m.pos[(size_t)j * (size_t)(nu + 1) + 1])) == 0.0f;
+        const bool hi0 = v3_len2(v3_sub(m.pos[(size_t)(j + 1) * (size_t)(nu + 1)],
+                                        m.pos[(size_t)(j + 1) * (size_t)(nu + 1) + 1])) == 0.0f;
+        for (int i = 0; i < nu; i++) {
+            uint32_t a = (uint32_t)(j * (nu + 1) + i), b = a + 1, c = a + (uint32_t)(nu + 1), d = c + 1;
+            if (!lo0) {
+                uint32_t q[3] = {a, b, d};
+                memcpy(&m.tris[o], q, sizeof q);
+                o += 3;
+            }
+            if (!hi0) {
+                uint32_t q[3] = {a, d, c};
+                memcpy(&m.tris[o], q, sizeof q);
+                o += 3;
+            }
+        }
+    }
+    m.ntris = o / 3;
+    if (GS(p)->reverse)
+        for (size_t k = 0; k < npos; k++) m.nrm[k] = v3_neg(m.nrm[k]);
+    st = add_mesh(p, &m, alpha);
+    mesh_free(p, &m);
+    return st;
+}
+
+typedef struct sph_arg {
+    float radius, zmin, zmax;
+} sph_arg;
+
+static void sph_fn(const void *user, float t, float *r, float *z, float *nr, float *nz)
+{
+    const sph_arg *a = user;
+    float th0 = acosf(fminf(fmaxf(a->zmin / a->radius, -1.0f), 1.0f));
+    float th1 = acosf(fminf(fmaxf(a->zmax / a->radius, -1.0f), 1.0f));
+    float th = th0 + (th1 - th0) * t;
+    *r = a->radius * sinf(th), *z = a->radius * cosf(th);
+    *nr = sinf(th), *nz = cosf(th);
+}
+
+typedef struct disk_arg {
+    float h, rin, rout;
+} disk_arg;
+
+static void disk_fn(const void *user, float t, float *r, float *z, float *nr, float *nz)
+{
+    const disk_arg *a = user;
+    *r = a->rout + (a->rin - a->rout) * t, *z = a->h;
+    *nr = 0.0f, *nz = 1.0f;
+}
+
+typedef struct cyl_arg {
+    float r, zmin, zmax;
+} cyl_arg;
+
+static void cyl_fn(const void *user, float t, float *r, float *z, float *nr, float *nz)
+{
+    const cyl_arg *a = user;
+    *r = a->r, *z = a->zmin + (a->zmax - a->zmin) * t;
+    *nr = 1.0f, *nz = 0.0f;
+}
+
+/* The steps around: 128 for a full turn, fewer for a part. */
+static int steps_around(float phimax) { return (int)ceilf(128.0f * phimax / (2.0f * PK_PI)) < 4 ? 4 : (int)ceilf(128.0f * phimax / (2.0f * PK_PI)); }
+
+static pk_status shape_sphere(pp *p, int32_t alpha)
+{
+    float radius = 1.0f, zmin, zmax, phimax = 360.0f;
+    pk_status st;
+    if ((st = get_float(p, "radius", &radius))) return st;
+    zmin = -radius, zmax = radius;
+    if ((st = get_float(p, "zmin", &zmin)) || (st = get_float(p, "zmax", &zmax)) || (st = get_float(p, "phimax", &phimax)))
+        return st;
+    if (!(radius > 0.0f)) return pfail(p, p->line, PK_ERR_PARSE, "sphere: radius %g must be positive", (double)radius);
+    float zlo = fmaxf(fminf(zmin, zmax), -radius), zhi = fminf(fmaxf(zmin, zmax), radius);
+    phimax = fminf(fmaxf(phimax, 0.0f), 360.0f);
+    if (!(zhi > zlo) || !(phimax > 0.0f)) return PK_OK; /* nothing left of it */
+    xform w = world_xf(p);
+    const float *x = w.m;
+    vec3 c0 = v3(x[0], x[4], x[8]), c1 = v3(x[1], x[5], x[9]), c2 = v3(x[2], x[6], x[10]);
+    float l0 = v3_len(c0), l1 = v3_len(c1), l2 = v3_len(c2);
+    bool similar = fabsf(l0 - l1) <= 1e-5f * l0 && fabsf(l0 - l2) <= 1e-5f * l0 &&
+                   fabsf(v3_dot(c0, c1)) <= 1e-5f * l0 * l1 && fabsf(v3_dot(c0, c2)) <= 1e-5f * l0 * l2 &&
+                   fabsf(v3_dot(c1, c2)) <= 1e-5f * l1 * l2;
+    bool full = zlo <= -radius && zhi >= radius && phimax >= 360.0f;
+    if (full && similar && !GS(p)->reverse && alpha < 0) {
+        if (GS(p)->interface) return PK_OK;
+        sphere sp;
+        sp.center = xform_point(&w, v3s(0.0f));
+        sp.radius = radius * l0;
+        if (!v3_finite(sp.center) || !(sp.radius > 0.0f) || !isfinite(sp.radius))
+            return pfail(p, p->line, PK_ERR_PARSE, "sphere: its place in the world is not finite");
+        bool two;
+        vec3 ke = area_emission(p, 4.0 * (double)PK_PI * (double)sp.radius * (double)sp.radius, &two);
+        if ((st = shape_material(p, ke, two, -1, &sp.material))) return st;
+        return scene_add_sphere(p->ctx, p->s, &sp);
+    }
+    /* partial, inside out, stretched or cut out: tessellated */
+    sph_arg a = {radius, zlo, zhi};
+    int nu = steps_around(phimax * PK_PI / 180.0f);
+    return add_revolution(p, nu, 64, phimax * PK_PI / 180.0f, sph_fn, &a, alpha);
+}
+
+static pk_status shape_disk(pp *p, int32_t alpha)
+{
+    float h = 0.0f, r = 1.0f, ri = 0.0f, phimax = 360.0f;
+    pk_status st;
+    if ((st = get_float(p, "height", &h)) || (st = get_float(p, "radius", &r)) ||
+        (st = get_float(p, "innerradius", &ri)) || (st = get_float(p, "phimax", &phimax)))
+        return st;
+    phimax = fminf(fmaxf(phimax, 0.0f), 360.0f);
+    if (!(r > 0.0f) || !(ri >= 0.0f) || !(ri < r) || !(phimax > 0.0f)) return PK_OK;
+    disk_arg a = {h, ri, r};
+    return add_revolution(p, steps_around(phimax * PK_PI / 180.0f), 1, phimax * PK_PI / 180.0f, disk_fn, &a, alpha);
+}
+
+static pk_status shape_cylinder(pp *p, int32_t alpha)
+{
+    float r = 1.0f, zmin = -1.0f, zmax = 1.0f, phimax = 360.0f;
+    pk_status st;
+    if ((st = get_float(p, "radius", &r)) || (st = get_float(p, "zmin", &zmin)) || (st = get_float(p, "zmax", &zmax)) ||
+        (st = get_float(p, "phimax", &phimax)))
+        return st;
+    phimax = fminf(fmaxf(phimax, 0.0f), 360.0f);
+    if (!(r > 0.0f) || zmin == zmax || !(phimax > 0.0f)) return PK_OK;
+    cyl_arg a = {r, fminf(zmin, zmax), fmaxf(zmin, zmax)};
+    return add_revolution(p, steps_around(phimax * PK_PI / 180.0f), 1, phimax * PK_PI / 180.0f, cyl_fn, &a, alpha);
+}
+
+static pk_status shape_plymesh(pp *p, int32_t alpha)
+{
+    const char *fn = NULL;
+    pk_status st = get_string(p, "filename", &fn);
+    if (st) return st;
+    if (!fn) return pfail(p, p->line, PK_ERR_PARSE, "plymesh needs 'string filename'");
+    if (param(p, "displacement"))
+        pwarn(p, p->line, "plymesh: 'displacement' is not supported; the mesh is rendered undisplaced");
+    param(p, "edgelength");
+    size_t n = strlen(fn);
+    if (n > 3 && strcmp(fn + n - 3, ".gz") == 0)
+        return pfail(p, p->line, PK_ERR_PARSE, "plymesh \"%.80s\": compressed PLY files are not read (gunzip it)", fn);
+    char *path = path_join(A(p), p->f->dir, fn);
+    if (!path) return ctx_nomem(p->ctx);
+    char *data = NULL;
+    size_t size = 0;
+    pk_context tmp = io_scratch_context(p->ctx);
+    st = file_read_all(&tmp, path, &data, &size);
+    ply_mesh pm;
+    memset(&pm, 0, sizeof pm);
+    if (st == PK_OK) st = ply_parse(&tmp, data, size, path, &pm);
+    mem_free(A(p), data);
+    mem_free(A(p), path);
+    if (st != PK_OK) {
+        ply_mesh_free(p->ctx, &pm);
+        if (st == PK_ERR_NOMEM) return ctx_nomem(p->ctx);
+        return pfail(p, p->line, st, "plymesh: %s", tmp.message);
+    }
+    mesh_in m = {pm.positions, pm.normals, pm.uvs, pm.nvertices, pm.indices, pm.ntriangles};
+    st = add_mesh(p, &m, alpha);
+    ply_mesh_free(p->ctx, &pm);
+    return st;
+}
+
+static pk_status d_shape(pp *p, const char *type)
+{
+    int32_t alpha;
+    bool skip;
+    pk_status st = shape_alpha(p, &alpha, &skip);
+    if (st) return st;
+    param(p, "emissionfilename");
+    if (skip) {
+        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        return PK_OK;
+    }
+    if (strcmp(type, "trianglemesh") == 0) st = shape_trianglemesh(p, alpha);
+    else if (strcmp(type, "plymesh") == 0) st = shape_plymesh(p, alpha);
+    else if (strcmp(type, "sphere") == 0) st = shape_sphere(p, alpha);
+    else if (strcmp(type, "disk") == 0) st = shape_disk(p, alpha);
+    else if (strcmp(type, "cylinder") == 0) st = shape_cylinder(p, alpha);
+    else if (strcmp(type, "bilinearmesh") == 0) st = shape_bilinear(p, alpha);
+    else if (strcmp(type, "loopsubdiv") == 0) st = shape_loopsubdiv(p, alpha);
+    else if (strcmp(type, "curve") == 0) {
+        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        pwarn(p, p->line, "shape \"curve\" is not supported; skipped");
+    } else {
+        return pfail(p, p->line, PK_ERR_PARSE, "unknown shape \"%.40s\"", type);
+    }
+    if (st == PK_OK) {
+        char what[64];
+        snprintf(what, sizeof what, "Shape \"%.40s\"", type);
+        warn_unused(p, what);
+    }
+    return st;
+}
+
+/* ---- lights ------------------------------------------------------------------------------------- */
+
+/* pbrt's "scale" and the spectrum of a light (illuminant rules). */
+static pk_status light_spectrum(pp *p, const char *name, vec3 *c)
+{
+    pparam *q;
+    *c = v3s(1.0f);
+    pk_status st = param_typed(p, name, TB(PT_RGB) | TB(PT_SPECTRUM) | TB(PT_BLACKBODY), "a spectrum (rgb, spectrum, blackbody)", &q);
+    if (st || !q) return st;
+    return spectrum_rgb(p, q, true, c);
+}
+
+static pk_status equal_area_env(pp *p, const char *file, size_t line, const xform *light_to_world, float scale);
+
+static pk_status d_light(pp *p, const char *type)
+{
+    pk_status st;
+    float scale = 1.0f, power = -1.0f;
+    if ((st = get_float(p, "scale", &scale))) return st;
+    if (p->b.in_object) {
+        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        pwarn(p, p->line, "a light inside an object definition is ignored (as pbrt-v4 does not allow it)");
+        return PK_OK;
+    }
+    xform w = world_xf(p);
+    if (strcmp(type, "point") == 0 || strcmp(type, "spot") == 0) {
+        vec3 I, from = v3s(0.0f), to = v3(0.0f, 0.0f, 1.0f);
+        float cone = 30.0f, delta = 5.0f;
+        if ((st = light_spectrum(p, "I", &I)) || (st = get_float(p, "power", &power)) || (st = get_vec3(p, "from", &from)))
+            return st;
+        point_light l;
+        memset(&l, 0, sizeof l);
+        l.position = xform_point(&w, from);
+        float k_e = 4.0f * PK_PI;
+        if (type[0] == 's') {
+            if ((st = get_vec3(p, "to", &to)) || (st = get_float(p, "coneangle", &cone)) ||
+                (st = get_float(p, "conedelta", &delta)))
+                return st;
+            float ce = cosf(cone * PK_PI / 180.0f), cs = cosf((cone - delta) * PK_PI / 180.0f);
+            if (!(cs > ce)) cs = fminf(ce + 1e-4f, 1.0f);
+            vec3 dir = v3_norm_scaled(xform_vector(&w, v3_sub(to, from)));
+            if (!v3_finite(dir) || v3_len2(dir) == 0.0f)
+                return pfail(p, p->line, PK_ERR_PARSE, "spot: 'from' and 'to' give no direction");
+            l.spot_dir = dir;
+            l.cos_inner = cs, l.cos_outer = ce;
+            k_e = 2.0f * PK_PI * ((1.0f - cs) + (cs - ce) * 0.5f);
+        }
+        if (power > 0.0f) scale *= power / k_e;
+        l.intensity = v3_scale(I, scale);
+        if (!v3_finite(l.position) || !v3_finite(l.intensity))
+            return pfail(p, p->line, PK_ERR_PARSE, "light: not finite in the world");
+        if ((st = scene_add_point_light(p->ctx, p->s, &l))) return st;
+    } else if (strcmp(type, "distant") == 0) {
+        vec3 L, from = v3s(0.0f), to = v3(0.0f, 0.0f, 1.0f);
+        float illum = -1.0f;
+        if ((st = light_spectrum(p, "L", &L)) || (st = get_vec3(p, "from", &from)) || (st = get_vec3(p, "to", &to)) ||
+            (st = get_float(p, "illuminance", &illum)))
+            return st;
+        if (illum > 0.0f) scale *= illum;
+        point_light l;
+        memset(&l, 0, sizeof l);
+        l.distant = true;
+        l.position = v3_norm_scaled(xform_vector(&w, v3_sub(from, to)));
+        if (!v3_finite(l.position) || v3_len2(l.position) == 0.0f)
+            return pfail(p, p->line, PK_ERR_PARSE, "distant: 'from' and 'to' give no direction");
+        l.intensity = v3_scale(L, scale);
+        if ((st = scene_add_point_light(p->ctx, p->s, &l))) return st;
+    } else if (strcmp(type, "infinite") == 0) {
+        vec3 L;
+        const char *fn = NULL;
+        bool has_L;
+        pparam *q;
+        if ((st = param_typed(p, "L", TB(PT_RGB) | TB(PT_SPECTRUM) | TB(PT_BLACKBODY), "a spectrum", &q))) return st;
+        has_L = q != NULL;
+        if ((st = light_spectrum(p, "L", &L)) || (st = get_string(p, "filename", &fn))) return st;
+        float illum = -1.0f;
+        if ((st = get_float(p, "illuminance", &illum))) return st;
+        if (illum > 0.0f) pwarn(p, p->line, "infinite: 'illuminance' is not supported; 'scale' alone is used");
+        if (param(p, "portal")) pwarn(p, p->line, "infinite: portals are not used (the light is sampled as a whole)");
+        if (has_L && fn) return pfail(p, p->line, PK_ERR_PARSE, "infinite: give either 'L' or 'filename', not both");
+        p->s->env.set = true;
+        if (fn) {
+            if ((st = equal_area_env(p, fn, p->line, &w, scale))) return st;
+        } else {
+            p->s->env.radiance = v3_add(p->s->env.radiance, v3_scale(L, scale));
+        }
+    } else if (strcmp(type, "goniometric") == 0 || strcmp(type, "projection") == 0) {
+        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        pwarn(p, p->line, "light \"%s\" is not supported; skipped", type);
+    } else {
+        return pfail(p, p->line, PK_ERR_PARSE, "unknown light \"%.40s\"", type);
+    }
+    char what[64];
+    snprintf(what, sizeof what, "LightSource \"%.40s\"", type);
+    warn_unused(p, what);
+    return PK_OK;
+}
+
+/* pbrt-v4's equal-area octahedral square: the point of the unit square
+ * whose direction (light space) is d (Clarberg's mapping). */
+static void sphere_to_square(vec3 d, float *u, float *v)
+{
+    float x = fabsf(d.x), y = fabsf(d.y), z = fabsf(d.z);
+    float r = sqrtf(fmaxf(1.0f - z, 0.0f));
+    float phi = atan2f(y, x); /* [0, pi/2] */
+    float b = r * (phi * (2.0f / PK_PI));  /* v' */
+    float a = r - b;                        /* u' */
+    if (d.z < 0.0f) {
+        float t = a;
+        a = 1.0f - b, b = 1.0f - t;
+    }
+    a = copysignf(a, d.x), b = copysignf(b, d.y);
+    *u = 0.5f * (a + 1.0f), *v = 0.5f * (b + 1.0f);
+}
+
+/* An infinite light's image: pbrt-v4 keeps it as an equal-area octahedral
+ * square, looked up through the light's transform; it is resampled here
+ * into the lat-long map of the environment, already in the world (so its
+ * rotation stays the identity). */
+static pk_status equal_area_env(pp *p, const char *file, size_t line, const xform *light_to_world, float scale)
+{
+    char *path = path_join(A(p), p->f->dir, file);
+    if (!path) return ctx_nomem(p->ctx);
+    int w = 0, h = 0;
+    float *src = NULL;
+    const bool was_ok = p->ctx->status == PK_OK;
+    pk_status st = image_load_rgb(p->ctx, path, &w, &h, &src);
+    mem_free(A(p), path);
+    if (st != PK_OK) {
+        char why[PK_ERRMSG_MAX];
+        if (!io_demote_error(p->ctx, st, was_ok, why, sizeof why)) return st;
+        pwarn(p, line, "infinite light not read (%s); a uniform environment of radiance %g is used", why, (double)scale);
+        p->s->env.radiance = v3_add(p->s->env.radiance, v3s(scale));
+        return PK_OK;
+    }
+    if (w != h) {
+        mem_free(A(p), src);
+        pwarn(p, line,
+              "infinite: \"%.80s\" is %dx%d, not the square equal-area image pbrt-v4 uses (lat-long images are not "
+              "pbrt-v4's); a uniform environment of radiance %g is used",
+              file, w, h, (double)scale);
+        p->s->env.radiance = v3_add(p->s->env.radiance, v3s(scale));
+        return PK_OK;
+    }
+    if (p->s->env.map || p->s->env.map_rgb) {
+        mem_free(A(p), src);
+        pwarn(p, line, "a second image environment is ignored (one map per scene)");
+        return PK_OK;
+    }
+    xform to_light;
+    if (!xform_invert(light_to_world, &to_light)) {
+        mem_free(A(p), src);
+        return pfail(p, line, PK_ERR_PARSE, "infinite: the light's transform is singular");
+    }
+    int ow = 2 * w, oh = w;
+    if (ow > 8192) ow = 8192, oh = 4096;
+    float *dst = mem_calloc(A(p), (size_t)ow * (size_t)oh, 3 * sizeof(float));
+    char *name = mem_strdup(A(p), file);
+    if (!dst || !name) {
+        mem_free(A(p), src);
+        mem_free(A(p), dst);
+        mem_free(A(p), name);
+        return ctx_nomem(p->ctx);
+    }
+    for (int j = 0; j < oh; j++)
+        for (int i = 0; i < ow; i++) {
+            float th = ((float)j + 0.5f) / (float)oh * PK_PI, ph = ((float)i + 0.5f) / (float)ow * 2.0f * PK_PI;
+            vec3 d = v3(sinf(th) * sinf(ph), cosf(th), -sinf(th) * cosf(ph));
+            vec3 dl = v3_norm_scaled(xform_vector(&to_light, d));
+            float u, v;
+            sphere_to_square(dl, &u, &v);
+            /* bilinear, clamped at the edges */
+            float x = u * (float)w - 0.5f, y = v * (float)h - 0.5f;
+            int x0 = (int)floorf(x), y0 = (int)floorf(y);
+            float fx = x - (float)x0, fy = y - (float)y0;
+            float *o = &dst[3 * ((size_t)j * (size_t)ow + (size_t)i)];
+            for (int c = 0; c < 3; c++) {
+                float acc = 0.0f;
+                for (int dy = 0; dy < 2; dy++)
+                    for (int dx = 0; dx < 2; dx++) {
+                        int xx = x0 + dx, yy = y0 + dy;
+                        xx = xx < 0 ? 0 : xx >= w ? w - 1 : xx;
+                        yy = yy < 0 ? 0 : yy >= h ? h - 1 : yy;
+                        float wt = (dx ? fx : 1.0f - fx) * (dy ? fy : 1.0f - fy);
+                        acc += wt * src[3 * ((size_t)yy * (size_t)w + (size_t)xx) + (size_t)c];
+                    }
+                o[c] = acc * scale;
+            }
+        }
+    mem_free(A(p), src);
+    p->s->env.map = name;
+    p->s->env.map_rgb = dst;
+    p->s->env.map_w = ow, p->s->env.map_h = oh;
+    p->s->env.map_scale = 1.0f;
+    return PK_OK;
+}
+
+static pk_status d_area_light(pp *p, const char *type)
+{
+    pk_status st;
+    if (strcmp(type, "diffuse") != 0) {
+        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        pwarn(p, p->line, "area light \"%.40s\" is not supported; the shapes do not emit", type);
+        GS(p)->area = -1;
+        return PK_OK;
+    }
+    area_light l = {v3s(1.0f), false, -1.0f};
+    float scale = 1.0f;
+    if ((st = light_spectrum(p, "L", &l.L)) || (st = get_float(p, "scale", &scale)) || (st = get_bool(p, "twosided", &l.two_sided)) ||
+        (st = get_float(p, "power", &l.power)))
+        return st;
+    if (param(p, "filename")) pwarn(p, p->line, "AreaLightSource: an emission image is not supported; 'L' is used");
+    l.L = v3_scale(l.L, scale);
+    if (!v3_finite(l.L)) return pfail(p, p->line, PK_ERR_PARSE, "AreaLightSource: the radiance is not finite");
+    if (!mem_grow(A(p), (void **)&p->areas, &p->cap_areas, p->nareas + 1, sizeof *p->areas)) return ctx_nomem(p->ctx);
+    p->areas[p->nareas] = l;
+    GS(p)->area = (int32_t)p->nareas++;
+    warn_unused(p, "AreaLightSource");
+    return PK_OK;
+}
+
+/* ---- textures ------------------------------------------------------------------------------------- */
+
+static pk_status d_texture(pp *p, const char *name, const char *kind, const char *cls)
+{
+    pk_status st;
+    bool is_float = strcmp(kind, "float") == 0;
+    if (!is_float && strcmp(kind, "spectrum") != 0 && strcmp(kind, "color") != 0)
+        return pfail(p, p->line, PK_ERR_PARSE, "Texture \"%.60s\": the type must be \"float\" or \"spectrum\", not \"%.20s\"",
+                     name, kind);
+    named_tex t;
+    memset(&t, 0, sizeof t);
+    t.is_float = is_float;
+    tex_ref_init(&t.ref);
+    t.value = v3s(1.0f);
+    t.cls = TC_CONST;
+    float us = 1.0f, vs = 1.0f, ud = 0.0f, vd = 0.0f, sc = 1.0f;
+    const char *mapping = "uv";
+    if ((st = get_float(p, "uscale", &us)) || (st = get_float(p, "vscale", &vs)) || (st = get_float(p, "udelta", &ud)) ||
+        (st = get_float(p, "vdelta", &vd)) || (st = get_string(p, "mapping", &mapping)))
+        return st;
+    if (strcmp(mapping, "uv") != 0)
+        pwarn(p, p->line, "Texture \"%.60s\": mapping \"%.20s\" is not supported; uv is used", name, mapping);
+    if (strcmp(cls, "imagemap") == 0) {
+        const char *fn = NULL, *enc = NULL, *wrap = "repeat", *filter = NULL;
+        bool invert = false;
+        if ((st = get_string(p, "filename", &fn)) || (st = get_string(p, "encoding", &enc)) ||
+            (st = get_string(p, "wrap", &wrap)) || (st = get_string(p, "filter", &filter)) ||
+            (st = get_float(p, "scale", &sc)) || (st = get_bool(p, "invert", &invert)))
+            return st;
+        param(p, "maxanisotropy");
+        if (!fn) return pfail(p, p->line, PK_ERR_PARSE, "imagemap \"%.60s\" needs 'string filename'", name);
+        bool colour = !is_float;
+        if (enc && strcmp(enc, "linear") == 0) colour = false;
+        else if (enc && strcmp(enc, "sRGB") == 0) colour = true;
+        else if (enc) pwarn(p, p->line, "imagemap: encoding \"%.20s\" is read as sRGB", enc);
+        if (invert) pwarn(p, p->line, "imagemap: 'invert' is not supported; the image is used as it is");
+        char *path = path_join(A(p), p->f->dir, fn);
+        if (!path) return ctx_nomem(p->ctx);
+        int32_t idx;
+        const bool was_ok = p->ctx->status == PK_OK;
+        st = texture_load(p->ctx, p->s, path, colour, &idx);
+        mem_free(A(p), path);
+        if (st != PK_OK) {
+            char why[PK_ERRMSG_MAX];
+            if (!io_demote_error(p->ctx, st, was_ok, why, sizeof why)) return st;
+            pwarn(p, p->line, "texture \"%.60s\" not used (%s); the constant %g stands in", name, why, (double)sc);
+            t.value = v3s(sc);
+        } else {
+            t.cls = TC_IMAGE;
+            t.ref.kind = TEX_IMAGE;
+            t.ref.tex = idx;
+            t.ref.clamp = strcmp(wrap, "clamp") == 0 || strcmp(wrap, "black") == 0;
+            if (strcmp(wrap, "black") == 0) pwarn(p, p->line, "imagemap: wrap \"black\" is rendered as \"clamp\"");
+            t.value = v3s(sc);
+        }
+    } else if (strcmp(cls, "checkerboard") == 0) {
+        int64_t dim = 2;
+        if ((st = get_int(p, "dimension", 2, 3, &dim))) return st;
+        vec3 c1 = v3s(1.0f), c2 = v3s(0.0f);
+        if (is_float) {
+            float f1 = 1.0f, f2 = 0.0f;
+            if ((st = get_float_tex(p, "tex1", &f1, NULL)) || (st = get_float_tex(p, "tex2", &f2, NULL))) return st;
+            c1 = v3s(f1), c2 = v3s(f2);
+        } else if ((st = get_colour(p, "tex1", &c1, NULL, NULL)) || (st = get_colour(p, "tex2", &c2, NULL, NULL))) {
+            return st;
+        }
+        if (dim == 3) {
+            pwarn(p, p->line, "a 3D checkerboard is not supported; its mean colour is used");
+            t.value = v3_scale(v3_add(c1, c2), 0.5f);
+        } else {
+            t.cls = TC_CHECKER;
+            t.ref.kind = TEX_CHECKER;
+            t.ref.even = c1, t.ref.odd = c2;
+            t.ref.checker_scale = 1.0f;
+        }
+    } else if (strcmp(cls, "constant") == 0) {
+        if (is_float) {
+            float v = 1.0f;
+            if ((st = get_float_tex(p, "value", &v, NULL))) return st;
+            t.value = v3s(v);
+        } else if ((st = get_colour(p, "value", &t.value, NULL, NULL))) {
+            return st;
+        }
+    } else if (strcmp(cls, "scale") == 0 || strcmp(cls, "mix") == 0 || strcmp(cls, "directionmix") == 0) {
+        /* the first texture, times the scale (mixes: the first, warned) */
+        const char *a = cls[0] == 's' ? "tex" : "tex1";
+        tex_ref r;
+        tex_ref_init(&r);
+        vec3 c = v3s(1.0f);
+        if (is_float) {
+            float v = 1.0f;
+            pparam *q = NULL;
+            if ((st = param_typed(p, a, TB(PT_TEXTURE) | TB(PT_FLOAT), "a float texture", &q))) return st;
+            if (q && q->type == PT_TEXTURE && q->nstr == 1) {
+                named_tex *src = find_tex(p, q->str[0]);
+                if (!src) return pfail(p, q->line, PK_ERR_PARSE, "no texture named \"%.60s\"", q->str[0]);
+                r = src->ref, c = src->value;
+            } else if (q) {
+                v = (float)q->num[0], c = v3s(v);
+            }
+        } else if ((st = get_colour(p, a, &c, &r, NULL))) {
+            return st;
+        }
+        if (cls[0] == 's') {
+            float s = 1.0f;
+            if ((st = get_float_tex(p, "scale", &s, NULL))) return st;
+            c = v3_scale(c, s);
+        } else {
+            for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+            pwarn(p, p->line, "Texture \"%.60s\": \"%s\" is rendered as its first texture", name, cls);
+        }
+        t.value = c;
+        if (r.kind != TEX_NONE) {
+            t.ref = r;
+            t.cls = r.kind == TEX_IMAGE ? TC_IMAGE : TC_CHECKER;
+        }
+        us = 1.0f, vs = 1.0f, ud = 0.0f, vd = 0.0f; /* the inner texture's mapping stands */
+    } else {
+        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        pwarn(p, p->line, "texture \"%.30s\" is not supported; \"%.60s\" is the constant 1", cls, name);
+    }
+    if (t.cls != TC_CONST && cls[0] != 's' && strcmp(cls, "mix") != 0 && strcmp(cls, "directionmix") != 0) {
+        t.ref.s[0] = us, t.ref.s[1] = vs, t.ref.o[0] = ud, t.ref.o[1] = vd;
+    }
+    if (!mem_grow(A(p), (void **)&p->tex, &p->cap_tex, p->ntex + 1, sizeof *p->tex)) return ctx_nomem(p->ctx);
+    t.name = mem_strdup(A(p), name);
+    if (!t.name) return ctx_nomem(p->ctx);
+    p->tex[p->ntex++] = t;
+    char what[96];
+    snprintf(what, sizeof what, "Texture \"%.30s\"", cls);
+    warn_unused(p, what);
+    return PK_OK;
+}
+
+/* ---- camera, film, sampler, integrator ------------------------------------------------------- */
+
+static pk_status set_coords(pp *p, const char *name, const xform *x);
+
+static pk_status d_camera(pp *p, const char *type)
+{
+    pk_status st;
+    if (strcmp(type, "perspective") == 0) p->ortho = false;
+    else if (strcmp(type, "orthographic") == 0) p->ortho = true;
+    else {
+        pwarn(p, p->line, "camera \"%.40s\" is not supported; rendered as a perspective camera", type);
+        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+    }
+    p->fov = 90.0f;
+    if ((st = get_float(p, "fov", &p->fov)) || (st = get_float(p, "lensradius", &p->lens_radius)) ||
+        (st = get_float(p, "focaldistance", &p->focal_distance)) || (st = get_float(p, "frameaspectratio", &p->frame_aspect)))
+        return st;
+    if (!(p->fov > 0.0f && p->fov < 180.0f))
+        return pfail(p, p->line, PK_ERR_PARSE, "camera: fov %g must be between 0 and 180 degrees", (double)p->fov);
+    pparam *q;
+    if ((st = param_typed(p, "screenwindow", TB(PT_FLOAT), "4 floats", &q))) return st;
+    if (q) {
+        if (q->nnum != 4) return pfail(p, q->line, PK_ERR_PARSE, "'float screenwindow' takes 4 values, not %zu", q->nnum);
+        for (int i = 0; i < 4; i++) p->screen[i] = (float)q->num[i];
+        if (!(p->screen[1] > p->screen[0]) || !(p->screen[3] > p->screen[2]))
+            return pfail(p, q->line, PK_ERR_PARSE, "camera: the screen window is empty");
+        p->has_screen = true;
+    }
+    static const char *const quiet[] = {"shutteropen", "shutterclose", "near", "far", "hither", "yon", NULL};
+    for (int i = 0; quiet[i]; i++) param(p, quiet[i]);
+    xform inv;
+    if (!xform_invert(sb_transform(&p->b), &inv))
+        return pfail(p, p->line, PK_ERR_PARSE, "camera: the current transform is singular (no camera can be placed)");
+    pk_status cs = set_coords(p, "camera", &inv);
+    if (cs) return cs;
+    p->cam_set = true;
+    p->cam_from_world = *sb_transform(&p->b);
+    p->cam_line = p->line;
+    p->cam_file = p->f->name;
+    warn_unused(p, "Camera");
+    return PK_OK;
+}
+
+/* The camera at WorldBegin: pbrt's camera frame, the world mirror when that
+ * frame is pbrt's usual left-handed one, and the vertical fov. */
+static pk_status finish_camera(pp *p)
+{
+    xform wfc;
+    if (!xform_invert(&p->cam_from_world, &wfc))
+        return pfail(p, p->cam_line, PK_ERR_PARSE, "camera: the camera transform is singular");
+    vec3 eye = xform_point(&wfc, v3s(0.0f));
+    vec3 fwd = v3_norm_scaled(xform_vector(&wfc, v3(0.0f, 0.0f, 1.0f)));
+    vec3 up = v3_norm_scaled(xform_vector(&wfc, v3(0.0f, 1.0f, 0.0f)));
+    vec3 right = xform_vector(&wfc, v3(1.0f, 0.0f, 0.0f));
+    vec3 n = v3_norm_scaled(v3_cross(fwd, up)); /* Paprsek's right */
+    p->mirror = xform_identity();
+    if (v3_dot(n, right) < 0.0f) {
+        /* reflection across the plane through eye with normal n */
+        float *m = p->mirror.m;
+        float nv[3] = {n.x, n.y, n.z}, e[3] = {eye.x, eye.y, eye.z};
+        float ne = n.x * eye.x + n.y * eye.y + n.z * eye.z;
+        for (int r = 0; r < 3; r++) {
+            for (int c = 0; c < 3; c++) m[4 * r + c] = (r == c ? 1.0f : 0.0f) - 2.0f * nv[r] * nv[c];
+            m[4 * r + 3] = 2.0f * ne * nv[r];
+        }
+        (void)e;
+    }
+    vec3 at = v3_add(eye, fwd);
+    pk_camera cam;
+    pk_camera_init(&cam);
+    cam.look_from[0] = eye.x, cam.look_from[1] = eye.y, cam.look_from[2] = eye.z;
+    cam.look_at[0] = at.x, cam.look_at[1] = at.y, cam.look_at[2] = at.z;
+    cam.up[0] = up.x, cam.up[1] = up.y, cam.up[2] = up.z;
+    /* the screen window: pbrt's default spans [-1, 1] on the shorter axis */
+    const float w = (float)p->film_w, h = (float)p->film_h;
+    float aspect = p->frame_aspect > 0.0f ? p->frame_aspect : w / h;
+    float sx0, sx1, sy0, sy1;
+    if (p->has_screen) sx0 = p->screen[0], sx1 = p->screen[1], sy0 = p->screen[2], sy1 = p->screen[3];
+    else if (aspect > 1.0f) sx0 = -aspect, sx1 = aspect, sy0 = -1.0f, sy1 = 1.0f;
+    else sx0 = -1.0f, sx1 = 1.0f, sy0 = -1.0f / aspect, sy1 = 1.0f / aspect;
+    if (fabsf(sx0 + sx1) > 1e-4f * (sx1 - sx0) || fabsf(sy0 + sy1) > 1e-4f * (sy1 - sy0))
+        pwarn(p, p->cam_line, "camera: an off-centre screen window is rendered centred");
+    float pix_aspect = ((sx1 - sx0) / w) / ((sy1 - sy0) / h);
+    if (fabsf(pix_aspect - 1.0f) > 1e-3f)
+        pwarn(p, p->cam_line, "camera: the screen window's shape does not match the film's (non-square pixels); the "
+                              "vertical extent is kept");
+    float half_y = 0.5f * (sy1 - sy0);
+    float t = tanf(0.5f * p->fov * PK_PI / 180.0f) * half_y;
+    cam.fov_deg = 2.0f * atanf(t) * 180.0f / PK_PI;
+    if (p->ortho) {
+        /* pbrt's orthographic screen window is in camera-space units */
+        cam.projection = PK_PROJECTION_ORTHOGRAPHIC;
+        cam.ortho_width = sx1 - sx0;
+        cam.fov_deg = 45.0f;
+    }
+    if (p->lens_radius > 0.0f) {
+        if (!(p->focal_distance > 0.0f))
+            return pfail(p, p->cam_line, PK_ERR_PARSE, "camera: 'focaldistance' %g must be positive",
+                         (double)p->focal_distance);
+        cam.lens_radius = p->lens_radius;
+        cam.focus_distance = p->focal_distance;
+    }
+    if (!(cam.fov_deg > 0.0f && cam.fov_deg < 180.0f))
+        return pfail(p, p->cam_line, PK_ERR_PARSE, "camera: the vertical field of view is out of range");
+    if (camera_check(&cam) != CAMERA_OK)
+        return pfail(p, p->cam_line, PK_ERR_PARSE, "camera: the camera transform gives no usable camera");
+    p->s->camera = cam;
+    p->s->has_camera = true;
+    return PK_OK;
+}
+
+static pk_status d_film(pp *p, const char *type)
+{
+    (void)type;
+    pk_status st;
+    const pk_int_option *ow = pk_int_option_find("width"), *oh = pk_int_option_find("height");
+    int64_t w = p->film_w, h = p->film_h;
+    if ((st = get_int(p, "xresolution", ow->min, ow->max, &w)) || (st = get_int(p, "yresolution", oh->min, oh->max, &h)))
+        return st;
+    if ((uint64_t)w * (uint64_t)h > (uint64_t)PK_MAX_IMAGE_PIXELS)
+        return pfail(p, p->line, PK_ERR_LIMIT, "Film: %lldx%lld is more than %u pixels", (long long)w, (long long)h,
+                     (unsigned)PK_MAX_IMAGE_PIXELS);
+    p->film_w = (int)w, p->film_h = (int)h;
+    pparam *q;
+    if ((st = param_typed(p, "cropwindow", TB(PT_FLOAT), "4 floats", &q))) return st;
+    if (q) pwarn(p, q->line, "Film: crop windows are not supported; the whole image is rendered");
+    if ((st = param_typed(p, "pixelbounds", TB(PT_INT), "4 integers", &q))) return st;
+    if (q) pwarn(p, q->line, "Film: pixel bounds are not supported; the whole image is rendered");
+    /* the output file is named on the command line; the rest is the film's look */
+    static const char *const quiet[] = {"filename", "diagonal", "iso", "whitebalance", "sensor", "exposuretime",
+                                        "maxcomponentvalue", "savefp16", "writefp16", NULL};
+    for (int i = 0; quiet[i]; i++) param(p, quiet[i]);
+    warn_unused(p, "Film");
+    return PK_OK;
+}
+
+static pk_status d_sampler(pp *p, const char *type)
+{
+    (void)type;
+    int64_t spp = -1;
+    const pk_int_option *o = pk_int_option_find("spp");
+    pk_status st = get_int(p, "pixelsamples", 1, INT64_C(1) << 40, &spp);
+    if (st) return st;
+    if (spp > 0) {
+        if (spp > o->max) {
+            pwarn(p, p->line, "pixelsamples %lld is more than %d; using %d", (long long)spp, o->max, o->max);
+            spp = o->max;
+        }
+        p->s->render.opt.spp = (int)spp;
+        p->s->render.has_spp = true;
+    }
+    static const char *const quiet[] = {"seed", "randomization", "jitter", "xsamples", "ysamples", "dimensions", NULL};
+    for (int i = 0; quiet[i]; i++) param(p, quiet[i]);
+    warn_unused(p, "Sampler");
+    return PK_OK;
+}
+
+static pk_status d_integrator(pp *p, const char *type)
+{
+    static const char *const pathlike[] = {"path", "volpath", "bdpt", "mlt", "sppm", "lightpath", "simplepath",
+                                           "simplevolpath", NULL};
+    bool ok = false;
+    for (int i = 0; pathlike[i]; i++) ok |= strcmp(type, pathlike[i]) == 0;
+    int64_t md = 5;
+    bool reg = false;
+    pk_status st;
+    if ((st = get_int(p, "maxdepth", 0, INT32_MAX, &md)) || (st = get_bool(p, "regularize", &reg))) return st;
+    if (!ok) {
+        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        pwarn(p, p->line, "integrator \"%.40s\" is not supported; rendered with the path tracer", type);
+    } else if (strcmp(type, "path") != 0 && strcmp(type, "volpath") != 0) {
+        pwarn(p, p->line, "integrator \"%.40s\" is rendered with the path tracer", type);
+    }
+    scene_render_settings *r = &p->s->render;
+    r->opt.integrator = PK_INTEGRATOR_PATH;
+    r->has_integrator = true;
+    r->opt.max_depth = md > PK_MAX_DEPTH ? PK_MAX_DEPTH : (int)md;
+    r->has_max_depth = true;
+    r->opt.regularize = reg ? 1 : 0;
+    r->has_regularize = true;
+    static const char *const quiet[] = {"lightsampler", "samplelights", "samplebsdf", "iterations", "photonsperiteration",
+                                        "radius", "seed", "visualizestrategies", "visualizeweights", "mutationsperpixel",
+                                        "largestepprobability", "sigma", "bootstrapsamples", "chains", NULL};
+    for (int i = 0; quiet[i]; i++) param(p, quiet[i]);
+    warn_unused(p, "Integrator");
+    return PK_OK;
+}
+
+/* ---- directives ---------------------------------------------------------------------------------- */
+
+/* Positional arguments: n numbers (an optional bracket around them). */
+static pk_status read_numbers(pp *p, double *v, int n)
+{
+    pbrt_tokenizer *t = &p->f->tok;
+    pbrt_token tk = pbrt_tok_peek(t);
+    bool br = tk.kind == PBRT_TOK_LBRACK;
+    if (br) pbrt_tok_next(t);
+    for (int i = 0; i < n; i++) {
+        tk = pbrt_tok_next(t);
+        if (tk.kind == PBRT_TOK_ERROR) return tok_error(p, &tk);
+        if (tk.kind != PBRT_TOK_NUMBER)
+            return pfail(p, tk.line, PK_ERR_PARSE, "%s takes %d numbers; found %s after %d", p->dname, n,
+                         tk.kind == PBRT_TOK_END ? "the end of the file" : "something else", i);
+        v[i] = tk.number;
+        if (!isfinite(v[i]) || fabs(v[i]) > 3.4e38)
+            return pfail(p, tk.line, PK_ERR_PARSE, "%s: number %d is not finite", p->dname, i + 1);
+    }
+    if (br) {
+        tk = pbrt_tok_next(t);
+        if (tk.kind != PBRT_TOK_RBRACK)
+            return pfail(p, tk.line, PK_ERR_PARSE, "%s takes %d numbers; the list does not end with ']' after them",
+                         p->dname, n);
+    }
+    return PK_OK;
+}
+
+/* A positional quoted string into buf. */
+static pk_status read_name(pp *p, char *buf, size_t cap)
+{
+    pbrt_token tk = pbrt_tok_next(&p->f->tok);
+    if (tk.kind == PBRT_TOK_ERROR) return tok_error(p, &tk);
+    if (tk.kind != PBRT_TOK_STRING)
+        return pfail(p, tk.line, PK_ERR_PARSE, "%s needs a quoted name here", p->dname);
+    if (pbrt_tok_string(&tk, buf, cap) >= cap)
+        return pfail(p, tk.line, PK_ERR_LIMIT, "%s: the name is longer than %zu bytes", p->dname, cap - 1);
+    return PK_OK;
+}
+
+static pk_status parse_file(pp *p, const char *data, size_t size, const char *name, const char *dir, char *key);
+
+static pk_status d_include(pp *p)
+{
+    char rel[1024];
+    pk_status st = read_name(p, rel, sizeof rel);
+    if (st) return st;
+    if (p->nfiles > PB_MAX_INCLUDE_DEPTH)
+        return pfail(p, p->line, PK_ERR_LIMIT, "%s \"%.200s\": includes nested deeper than %d", p->dname, rel,
+                     PB_MAX_INCLUDE_DEPTH);
+    char *path = path_join(A(p), p->f->dir, rel);
+    if (!path) return ctx_nomem(p->ctx);
+    for (int i = 0; i < p->nfiles; i++)
+        if (p->files[i]->key && strcmp(p->files[i]->key, path) == 0) {
+            st = pfail(p, p->line, PK_ERR_PARSE, "%s \"%.200s\": the file includes itself (a cycle)", p->dname, rel);
+            mem_free(A(p), path);
+            return st;
+        }
+    size_t n = strlen(rel);
+    if (n > 3 && strcmp(rel + n - 3, ".gz") == 0) {
+        mem_free(A(p), path);
+        return pfail(p, p->line, PK_ERR_PARSE, "%s \"%.200s\": compressed files are not read (gunzip it)", p->dname, rel);
+    }
+    char *data = NULL;
+    size_t size = 0;
+    pk_context tmp = io_scratch_context(p->ctx);
+    st = file_read_all(&tmp, path, &data, &size);
+    if (st) {
+        mem_free(A(p), path);
+        if (st == PK_ERR_NOMEM) return ctx_nomem(p->ctx);
+        return pfail(p, p->line, st, "%s: %s", p->dname, tmp.message);
+    }
+    char *dir = path_dirname(A(p), path);
+    if (!dir) {
+        mem_free(A(p), path);
+        mem_free(A(p), data);
+        return ctx_nomem(p->ctx);
+    }
+    st = parse_file(p, data, size, path, dir, path);
+    mem_free(A(p), data);
+    mem_free(A(p), dir);
+    mem_free(A(p), path);
+    return st;
+}
+
+static pk_status push_state(pp *p)
+{
+    if (!sb_push(&p->b))
+        return pfail(p, p->line, PK_ERR_LIMIT, "%s: more than %d nested attribute blocks", p->dname, SB_MAX_DEPTH - 1);
+    p->gs[p->b.depth] = p->gs[p->b.depth - 1];
+    return PK_OK;
+}
+
+static pk_status pop_state(pp *p, bool transform_only)
+{
+    gstate keep = *GS(p);
+    if (!sb_pop(&p->b)) return pfail(p, p->line, PK_ERR_PARSE, "%s without a matching begin", p->dname);
+    if (transform_only) *GS(p) = keep;
+    return PK_OK;
+}
+
+static pk_status d_world_begin(pp *p)
+{
+    if (p->in_world) return pfail(p, p->line, PK_ERR_PARSE, "WorldBegin appears twice");
+    p->in_world = true;
+    pk_status st;
+    if (!p->cam_set) {
+        p->cam_set = true;
+        p->cam_from_world = xform_identity();
+        p->cam_line = p->line;
+    }
+    if ((st = finish_camera(p))) return st;
+    xform id = xform_identity();
+    sb_set_transform(&p->b, &id);
+    p->active_end = false;
+    return set_coords(p, "world", &id);
+}
+
+static named_xf *find_coords(pp *p, const char *name)
+{
+    for (size_t i = p->ncoords; i-- > 0;)
+        if (strcmp(p->coords[i].name, name) == 0) return &p->coords[i];
+    return NULL;
+}
+
+static pk_status set_coords(pp *p, const char *name, const xform *x)
+{
+    named_xf *c = find_coords(p, name);
+    if (c) {
+        c->x = *x;
+        return PK_OK;
+    }
+    if (!mem_grow(A(p), (void **)&p->coords, &p->cap_coords, p->ncoords + 1, sizeof *p->coords)) return ctx_nomem(p->ctx);
+    char *n = mem_strdup(A(p), name);
+    if (!n) return ctx_nomem(p->ctx);
+    p->coords[p->ncoords].name = n;
+    p->coords[p->ncoords++].x = *x;
+    return PK_OK;
+}
+
+static pk_status d_object_end(pp *p)
+{
+    if (!p->b.in_object) return pfail(p, p->line, PK_ERR_PARSE, "ObjectEnd without ObjectBegin");
+    uint32_t mesh = UINT32_MAX;
+    pk_status st;
+    if (p->s->ntris == p->b.obj_tri) {
+        p->b.in_object = false; /* nothing was added: an empty object */
+    } else {
+        pk_context tmp = io_scratch_context(p->ctx);
+        p->b.ctx = &tmp;
+        st = sb_end_object(&p->b, &mesh);
+        p->b.ctx = p->ctx;
+        if ((st = builder_status(p, st, &tmp))) return st;
+    }
+    if (!mem_grow(A(p), (void **)&p->objs, &p->cap_objs, p->nobjs + 1, sizeof *p->objs)) return ctx_nomem(p->ctx);
+    p->objs[p->nobjs].name = p->obj_name;
+    p->objs[p->nobjs++].mesh = mesh;
+    p->obj_name = NULL;
+    return pop_state(p, false);
+}
+
+static pk_status d_object_instance(pp *p, const char *name)
+{
+    if (p->b.in_object) return pfail(p, p->line, PK_ERR_PARSE, "ObjectInstance inside ObjectBegin/ObjectEnd");
+    named_obj *o = NULL;
+    for (size_t i = p->nobjs; i-- > 0;)
+        if (strcmp(p->objs[i].name, name) == 0) {
+            o = &p->objs[i];
+            break;
+        }
+    if (!o) return pfail(p, p->line, PK_ERR_PARSE, "ObjectInstance: no object named \"%.80s\"", name);
+    if (o->mesh == UINT32_MAX) return PK_OK;
+    /* the object's triangles were placed by mirror x (their own transform);
+     * the instance is mirror x CTM x mirror^-1 (the mirror is its own inverse) */
+    xform c = *sb_transform(&p->b);
+    xform a = xform_mul(&p->mirror, &c);
+    xform w = xform_mul(&a, &p->mirror);
+    double det = xform_det3(&w);
+    if (!xform_finite(&w) || !(det != 0.0) || !isfinite(det) || fabs(det) < 1e-30)
+        return pfail(p, p->line, PK_ERR_PARSE, "ObjectInstance \"%.80s\": the transform is singular or not finite", name);
+    if (det < 0.0)
+        pwarn(p, p->line, "ObjectInstance \"%.80s\": a mirroring instance turns its one-sided surfaces inside out", name);
+    xform saved = c;
+    sb_set_transform(&p->b, &w);
+    pk_context tmp = io_scratch_context(p->ctx);
+    p->b.ctx = &tmp;
+    pk_status st = sb_add_instance(&p->b, o->mesh);
+    p->b.ctx = p->ctx;
+    sb_set_transform(&p->b, &saved);
+    return builder_status(p, st, &tmp);
+}
+
+/* The directives that take no parameter list read none; every other reads
+ * its list before it acts. */
+static pk_status directive(pp *p, const pbrt_token *tk)
+{
+    char dn[32];
+    if (tk->len >= sizeof dn) return pfail(p, tk->line, PK_ERR_PARSE, "unknown directive '%.40s'", tk->text);
+    memcpy(dn, tk->text, tk->len);
+    dn[tk->len] = '\0';
+    p->dname = dn;
+    p->line = tk->line;
+    pk_status st;
+    double v[16];
+    char a[PB_NAME_MAX], b2[PB_NAME_MAX], c[PB_NAME_MAX];
+
+    /* transforms */
+    if (strcmp(dn, "Identity") == 0) {
+        xform id = xform_identity();
+        ctm_set(p, &id);
+        return PK_OK;
+    }
+    if (strcmp(dn, "Translate") == 0) {
+        if ((st = read_numbers(p, v, 3))) return st;
+        xform x = xform_translate(v3((float)v[0], (float)v[1], (float)v[2]));
+        return ctm_concat(p, &x);
+    }
+    if (strcmp(dn, "Scale") == 0) {
+        if ((st = read_numbers(p, v, 3))) return st;
+        xform x = xform_scale(v3((float)v[0], (float)v[1], (float)v[2]));
+        return ctm_concat(p, &x);
+    }
+    if (strcmp(dn, "Rotate") == 0) {
+        if ((st = read_numbers(p, v, 4))) return st;
+        vec3 ax = v3((float)v[1], (float)v[2], (float)v[3]);
+        if (!(v3_len2(ax) > 0.0f) || !isfinite(v3_len2(ax)))
+            return pfail(p, p->line, PK_ERR_PARSE, "Rotate: the axis %g %g %g has no direction", v[1], v[2], v[3]);
+        xform x = xform_rotate(v3_norm_scaled(ax), (float)v[0]);
+        return ctm_concat(p, &x);
+    }
+    if (strcmp(dn, "LookAt") == 0) {
+        if ((st = read_numbers(p, v, 9))) return st;
+        vec3 eye = v3((float)v[0], (float)v[1], (float)v[2]), at = v3((float)v[3], (float)v[4], (float)v[5]),
+             up = v3((float)v[6], (float)v[7], (float)v[8]);
+        vec3 dir = v3_sub(at, eye);
+        if (!(v3_len2(dir) > 0.0f)) return pfail(p, p->line, PK_ERR_PARSE, "LookAt: the eye and the target are the same point");
+        dir = v3_norm_scaled(dir);
+        vec3 right = v3_cross(v3_norm_scaled(up), dir);
+        if (!(v3_len(right) > 1e-6f))
+            return pfail(p, p->line, PK_ERR_PARSE, "LookAt: the up vector is zero or parallel to the view direction");
+        right = v3_norm_scaled(right);
+        vec3 nup = v3_cross(dir, right);
+        /* world from camera: columns right, up, dir, eye; LookAt concatenates its inverse */
+        xform wc = xform_identity();
+        wc.m[0] = right.x, wc.m[4] = right.y, wc.m[8] = right.z;
+        wc.m[1] = nup.x, wc.m[5] = nup.y, wc.m[9] = nup.z;
+        wc.m[2] = dir.x, wc.m[6] = dir.y, wc.m[10] = dir.z;
+        wc.m[3] = eye.x, wc.m[7] = eye.y, wc.m[11] = eye.z;
+        xform cw;
+        if (!xform_invert(&wc, &cw)) return pfail(p, p->line, PK_ERR_PARSE, "LookAt: singular");
+        return ctm_concat(p, &cw);
+    }
+    if (strcmp(dn, "Transform") == 0 || strcmp(dn, "ConcatTransform") == 0) {
+        if ((st = read_numbers(p, v, 16))) return st;
+        xform x;
+        if ((st = read_matrix(p, v, p->line, &x))) return st;
+        if (dn[0] == 'T') {
+            ctm_set(p, &x);
+            return PK_OK;
+        }
+        return ctm_concat(p, &x);
+    }
+    if (strcmp(dn, "CoordinateSystem") == 0) {
+        if ((st = read_name(p, a, sizeof a))) return st;
+        return set_coords(p, a, sb_transform(&p->b));
+    }
+    if (strcmp(dn, "CoordSysTransform") == 0) {
+        if ((st = read_name(p, a, sizeof a))) return st;
+        named_xf *cx = find_coords(p, a);
+        if (!cx) {
+            pwarn(p, p->line, "CoordSysTransform: no coordinate system named \"%.80s\"; ignored", a);
+            return PK_OK;
+        }
+        ctm_set(p, &cx->x);
+        return PK_OK;
+    }
+    if (strcmp(dn, "ActiveTransform") == 0) {
+        pbrt_token w = pbrt_tok_next(&p->f->tok);
+        if (pbrt_tok_is(&w, "StartTime") || pbrt_tok_is(&w, "All")) p->active_end = false;
+        else if (pbrt_tok_is(&w, "EndTime")) {
+            p->active_end = true;
+            pwarn(p, p->line, "ActiveTransform EndTime: motion is not rendered; the start transform is used");
+        } else return pfail(p, w.line, PK_ERR_PARSE, "ActiveTransform takes StartTime, EndTime or All");
+        return PK_OK;
+    }
+    if (strcmp(dn, "TransformTimes") == 0) return read_numbers(p, v, 2);
+    if (strcmp(dn, "ReverseOrientation") == 0) {
+        GS(p)->reverse = !GS(p)->reverse;
+        return PK_OK;
+    }
+    /* blocks */
+    if (strcmp(dn, "AttributeBegin") == 0 || strcmp(dn, "TransformBegin") == 0) return push_state(p);
+    if (strcmp(dn, "AttributeEnd") == 0 || strcmp(dn, "TransformEnd") == 0) {
+        if (p->b.in_object && p->b.depth == p->obj_depth)
+            return pfail(p, p->line, PK_ERR_PARSE, "%s closes the ObjectBegin block", dn);
+        return pop_state(p, dn[0] == 'T');
+    }
+    if (strcmp(dn, "WorldBegin") == 0) return d_world_begin(p);
+    if (strcmp(dn, "WorldEnd") == 0) return PK_OK; /* pbrt-v3's; the end of the file ends the world */
+    if (strcmp(dn, "Include") == 0 || strcmp(dn, "Import") == 0) return d_include(p);
+    if (strcmp(dn, "ObjectEnd") == 0) return d_object_end(p);
+
+    /* directives with names and parameter lists */
+    if (strcmp(dn, "ObjectBegin") == 0) {
+        if ((st = read_name(p, a, sizeof a)) || (st = read_params(p))) return st;
+        if (p->b.in_object) return pfail(p, p->line, PK_ERR_PARSE, "ObjectBegin \"%.80s\" inside another object", a);
+        if ((st = push_state(p))) return st;
+        if (!sb_begin_object(&p->b)) return pfail(p, p->line, PK_ERR_PARSE, "ObjectBegin inside another object");
+        p->obj_depth = p->b.depth;
+        p->obj_name = mem_strdup(A(p), a);
+        return p->obj_name ? PK_OK : ctx_nomem(p->ctx);
+    }
+    if (strcmp(dn, "ObjectInstance") == 0) {
+        if ((st = read_name(p, a, sizeof a)) || (st = read_params(p))) return st;
+        return d_object_instance(p, a);
+    }
+    if (strcmp(dn, "NamedMaterial") == 0) {
+        if ((st = read_name(p, a, sizeof a)) || (st = read_params(p))) return st;
+        int64_t idx = scene_find_material(p->s, a);
+        if (idx < 0) return pfail(p, p->line, PK_ERR_PARSE, "NamedMaterial: no material named \"%.80s\"", a);
+        GS(p)->material = (uint32_t)idx;
+        GS(p)->interface = mat_is_interface(p, (uint32_t)idx);
+        return PK_OK;
+    }
+    if (strcmp(dn, "MediumInterface") == 0) {
+        if ((st = read_name(p, a, sizeof a))) return st;
+        pbrt_token nx = pbrt_tok_peek(&p->f->tok);
+        if (nx.kind == PBRT_TOK_STRING && !memchr(nx.text, ' ', nx.len)) {
+            if ((st = read_name(p, b2, sizeof b2))) return st;
+        }
+        if (a[0] || b2[0]) pwarn(p, p->line, "MediumInterface: participating media are not rendered yet; ignored");
+        return PK_OK;
+    }
+    if (strcmp(dn, "ColorSpace") == 0) {
+        if ((st = read_name(p, a, sizeof a))) return st;
+        if (strcmp(a, "srgb") != 0)
+            pwarn(p, p->line, "ColorSpace \"%.40s\": colours are read as linear sRGB all the same", a);
+        return PK_OK;
+    }
+    if (strcmp(dn, "Option") == 0) {
+        if ((st = read_params(p))) return st;
+        for (size_t i = 0; i < p->pl.n; i++) {
+            pparam *q = &p->pl.p[i];
+            q->used = true;
+            if (strcmp(q->name, "seed") == 0 && q->type == PT_INT && q->nnum == 1 && q->num[0] >= 0 &&
+                q->num[0] <= 2147483647.0) {
+                p->s->render.opt.seed = (int)q->num[0];
+                p->s->render.has_seed = true;
+            } else if (strcmp(q->name, "disablepixeljitter") != 0 && strcmp(q->name, "disabletexturefiltering") != 0 &&
+                       strcmp(q->name, "disablewavelengthjitter") != 0 && strcmp(q->name, "forcediffuse") != 0 &&
+                       strcmp(q->name, "pixelstats") != 0 && strcmp(q->name, "wavefront") != 0 &&
+                       strcmp(q->name, "rendercoordsys") != 0 && strcmp(q->name, "displacementedgescale") != 0 &&
+                       strcmp(q->name, "msereferenceimage") != 0 && strcmp(q->name, "msereferenceout") != 0) {
+                pwarn(p, q->line, "Option '%s' is not known; ignored", q->name);
+            }
+        }
+        return PK_OK;
+    }
+    if (strcmp(dn, "Attribute") == 0) {
+        if ((st = read_name(p, a, sizeof a)) || (st = read_params(p))) return st;
+        if (strcmp(a, "shape") && strcmp(a, "light") && strcmp(a, "material") && strcmp(a, "medium") && strcmp(a, "texture"))
+            return pfail(p, p->line, PK_ERR_PARSE, "Attribute: unknown target \"%.40s\"", a);
+        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        if (p->pl.n) pwarn(p, p->line, "Attribute \"%s\": parameter defaults are not supported; ignored", a);
+        return PK_OK;
+    }
+    if (strcmp(dn, "MakeNamedMedium") == 0) {
+        if ((st = read_name(p, a, sizeof a)) || (st = read_params(p))) return st;
+        pwarn(p, p->line, "MakeNamedMedium \"%.80s\": participating media are not rendered yet; ignored", a);
+        return PK_OK;
+    }
+    if (strcmp(dn, "Texture") == 0) {
+        if ((st = read_name(p, a, sizeof a)) || (st = read_name(p, b2, sizeof b2)) || (st = read_name(p, c, sizeof c)) ||
+            (st = read_params(p)))
+            return st;
+        return d_texture(p, a, b2, c);
+    }
+    if (strcmp(dn, "MakeNamedMaterial") == 0) {
+        if ((st = read_name(p, a, sizeof a)) || (st = read_params(p))) return st;
+        const char *type = NULL;
+        if ((st = get_string(p, "type", &type))) return st;
+        if (!type) return pfail(p, p->line, PK_ERR_PARSE, "MakeNamedMaterial \"%.80s\" needs 'string type'", a);
+        uint32_t idx;
+        if ((st = new_material(p, a, type, &idx))) return st;
+        char what[96];
+        snprintf(what, sizeof what, "material \"%.40s\"", type);
+        warn_unused(p, what);
+        return PK_OK;
+    }
+    if (strcmp(dn, "Material") == 0) {
+        if ((st = read_name(p, a, sizeof a)) || (st = read_params(p))) return st;
+        char nm[PB_NAME_MAX + 64];
+        snprintf(nm, sizeof nm, "%.200s:%zu", p->f->name, p->line);
+        uint32_t idx;
+        if ((st = new_material(p, nm, a, &idx))) return st;
+        GS(p)->material = idx;
+        GS(p)->interface = mat_is_interface(p, idx);
+        char what[96];
+        snprintf(what, sizeof what, "material \"%.40s\"", a);
+        warn_unused(p, what);
+        return PK_OK;
+    }
+    /* the rest: a type name and parameters */
+    static const char *const typed[] = {"Shape",   "LightSource", "AreaLightSource", "Camera",      "Film",
+                                        "Sampler", "Integrator",  "PixelFilter",     "Accelerator", NULL};
+    int which = -1;
+    for (int i = 0; typed[i]; i++)
+        if (strcmp(dn, typed[i]) == 0) which = i;
+    if (which < 0) return pfail(p, tk->line, PK_ERR_PARSE, "unknown directive '%s'", dn);
+    if ((st = read_name(p, a, sizeof a)) || (st = read_params(p))) return st;
+    bool world_only = which <= 2, options_only = which >= 3;
+    if (world_only && !p->in_world) return pfail(p, p->line, PK_ERR_PARSE, "%s before WorldBegin", dn);
+    if (options_only && p->in_world) return pfail(p, p->line, PK_ERR_PARSE, "%s after WorldBegin", dn);
+    switch (which) {
+    case 0: return d_shape(p, a);
+    case 1: return d_light(p, a);
+    case 2: return d_area_light(p, a);
+    case 3: return d_camera(p, a);
+    case 4: return d_film(p, a);
+    case 5: return d_sampler(p, a);
+    case 6: return d_integrator(p, a);
+    default:
+        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        return PK_OK; /* Paprsek's pixel filter is a box; its accelerator its own */
+    }
+}
+
+static pk_status parse_file(pp *p, const char *data, size_t size, const char *name, const char *dir, char *key)
+{
+    pfile f;
+    memset(&f, 0, sizeof f);
+    f.name = name, f.dir = dir, f.key = key;
+    pbrt_tok_init(&f.tok, data, size);
+    pfile *outer = p->f;
+    p->files[p->nfiles++] = &f;
+    p->f = &f;
+    pk_status st = PK_OK;
+    for (;;) {
+        pbrt_token tk = pbrt_tok_next(&f.tok);
+        if (tk.kind == PBRT_TOK_END) break;
+        if (tk.kind == PBRT_TOK_ERROR) {
+            st = tok_error(p, &tk);
+            break;
+        }
+        if (tk.kind != PBRT_TOK_WORD) {
+            st = pfail(p, tk.line, PK_ERR_PARSE, "expected a directive, found %s '%.*s'",
+                       tk.kind == PBRT_TOK_STRING ? "the string" : tk.kind == PBRT_TOK_NUMBER ? "the number" : "",
+                       io_tok_len(tk.text, tk.text + tk.len), tk.text);
+            break;
+        }
+        if ((st = directive(p, &tk))) break;
+        plist_clear(p);
+    }
+    plist_clear(p);
+    p->nfiles--;
+    p->f = outer;
+    return st;
+}
+
+pk_status scene_pbrt_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size, const char *name,
+                           const char *base_dir)
+{
+    pp *p = mem_calloc(&ctx->alloc, 1, sizeof *p);
+    if (!p) return ctx_nomem(ctx);
+    p->ctx = ctx;
+    p->s = s;
+    sb_init(&p->b, ctx, s);
+    p->gs[0].material = 0;
+    p->gs[0].area = -1;
+    p->mirror = xform_identity();
+    p->cam_from_world = xform_identity();
+    p->film_w = 1280, p->film_h = 720;
+    p->fov = 90.0f;
+    p->focal_distance = 1e6f;
+    const char *dir = base_dir ? base_dir : ".";
+    const char *base = strrchr(name, '/');
+    char *key = path_join(&ctx->alloc, dir, base ? base + 1 : name);
+    pk_status st = key ? PK_OK : ctx_nomem(ctx);
+    /* pbrt's defaults: the material "diffuse" 0.5 (material 0 is that grey),
+     * 16 samples are the sampler's own (not set), depth 5 */
+    if (st == PK_OK) {
+        s->render.opt.max_depth = 5;
+        s->render.has_max_depth = true;
+        st = parse_file(p, data, size, name, dir, key);
+    }
+    p->top.name = name, p->top.dir = dir;
+    p->f = &p->top;
+    if (st == PK_OK && !p->in_world) st = finish_camera(p); /* no WorldBegin: nothing but the camera */
+    if (st == PK_OK && p->b.in_object)
+        st = pfail(p, p->line, PK_ERR_PARSE, "ObjectBegin \"%.80s\" has no ObjectEnd", p->obj_name ? p->obj_name : "");
+    if (st == PK_OK) {
+        s->render.opt.width = p->film_w, s->render.opt.height = p->film_h;
+        s->render.has_width = s->render.has_height = true;
+        if (!s->env.set && s->nlights == 0) {
+            /* pbrt renders a scene without lights black; so does this reader */
+            bool emits = false;
+            for (size_t i = 0; i < s->nmaterials && !emits; i++) emits = v3_max_comp(s->materials[i].ke) > 0.0f;
+            if (!emits) s->env.set = true;
+        }
+    }
+    plist_clear(p);
+    mem_free(&ctx->alloc, p->pl.p);
+    for (size_t i = 0; i < p->ntex; i++) mem_free(&ctx->alloc, p->tex[i].name);
+    for (size_t i = 0; i < p->ncoords; i++) mem_free(&ctx->alloc, p->coords[i].name);
+    for (size_t i = 0; i < p->nobjs; i++) mem_free(&ctx->alloc, p->objs[i].name);
+    mem_free(&ctx->alloc, p->obj_name);
+    mem_free(&ctx->alloc, p->tex);
+    mem_free(&ctx->alloc, p->areas);
+    mem_free(&ctx->alloc, p->vars);
+    mem_free(&ctx->alloc, p->is_interface);
+    mem_free(&ctx->alloc, p->coords);
+    mem_free(&ctx->alloc, p->objs);
+    mem_free(&ctx->alloc, key);
+    mem_free(&ctx->alloc, p);
+    return st;
+}
