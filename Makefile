@@ -12,7 +12,7 @@ TEST_PKGS   = $(BUILD_PKGS) libembree-dev g++ libopenmpi-dev openmpi-bin iproute
 PREFIX     ?= /usr/local
 FUZZ_PKGS   = $(TEST_PKGS) clang libclang-rt-14-dev libomp-14-dev
 FUZZ_SECONDS ?= 60
-FUZZERS     = obj mtl json xml render image tza gltf
+FUZZERS     = obj mtl json xml render image tza gltf pbrt
 
 .PHONY: all build demo test deps deps-test install bench clean build-asan sanitize fuzz fuzz-build fuzz-seeds fuzz-merge weights npm npm-install
 
@@ -101,7 +101,7 @@ FUZZ_FLAGS = -max_len=65536 -rss_limit_mb=2048 -timeout=10 -print_final_stats=1
 FUZZ_SEEDS = tests/data $(wildcard ../shared/scenes/cornell)
 # The public scenes of ../shared/scenes (when present) seed the fuzzers too,
 # by kind: $(FUZZ_DIR)/seeds/<name> holds links to every .obj (obj, render),
-# .mtl (mtl), .json (json, render), .xml (xml, render), .gltf and .glb (gltf) and image (image: .png, .jpg,
+# .mtl (mtl), .json (json, render), .xml (xml, render), .gltf and .glb (gltf), .pbrt (pbrt) and image (image: .png, .jpg,
 # .exr, .hdr, .pfm) file there; inputs beyond -max_len are read truncated.
 SHARED_SCENES = ../shared/scenes
 
@@ -117,7 +117,7 @@ fuzz-seeds:
 	@for f in $(FUZZERS); do rm -rf $(FUZZ_DIR)/seeds/$$f; mkdir -p $(FUZZ_DIR)/seeds/$$f; done
 	@if [ -d $(SHARED_SCENES) ]; then \
 	  find $(abspath $(SHARED_SCENES)) -type f \( -name '*.obj' -o -name '*.mtl' -o -name '*.json' -o -name '*.xml' -o -name '*.png' \
-	    -o -name '*.jpg' -o -name '*.jpeg' -o -name '*.exr' -o -name '*.hdr' -o -name '*.pfm' -o -name '*.gltf' -o -name '*.glb' \) | while read -r p; do \
+	    -o -name '*.jpg' -o -name '*.jpeg' -o -name '*.exr' -o -name '*.hdr' -o -name '*.pfm' -o -name '*.gltf' -o -name '*.glb' -o -name '*.pbrt' \) | while read -r p; do \
 	    n=$$(echo "$${p#$(abspath $(SHARED_SCENES))/}" | tr '/' '_'); \
 	    case "$$p" in \
 	      *.obj) ln -sf "$$p" $(FUZZ_DIR)/seeds/obj/$$n; ln -sf "$$p" $(FUZZ_DIR)/seeds/render/$$n;; \
@@ -125,6 +125,7 @@ fuzz-seeds:
 	      *.json) ln -sf "$$p" $(FUZZ_DIR)/seeds/json/$$n; ln -sf "$$p" $(FUZZ_DIR)/seeds/render/$$n;; \
 	      *.xml) ln -sf "$$p" $(FUZZ_DIR)/seeds/xml/$$n; ln -sf "$$p" $(FUZZ_DIR)/seeds/render/$$n;; \
 	      *.gltf|*.glb) ln -sf "$$p" $(FUZZ_DIR)/seeds/gltf/$$n;; \
+	      *.pbrt) ln -sf "$$p" $(FUZZ_DIR)/seeds/pbrt/$$n;; \
 	      *) ln -sf "$$p" $(FUZZ_DIR)/seeds/image/$$n;; \
 	    esac; \
 	  done; \

@@ -34,6 +34,7 @@
 
 #define PB_MAX_INCLUDE_DEPTH 16
 #define PB_NAME_MAX 256
+#define PB_MAX_SUBDIV_TRIS (1u << 24) /* triangles one loopsubdiv shape may make */
 
 /* ---- parameters -------------------------------------------------------------------- */
 
@@ -1381,10 +1382,10 @@ static pk_status shape_loopsubdiv(pp *p, int32_t alpha)
         }
     double grow = (double)nf;
     for (int64_t l = 0; l < levels; l++) grow *= 4.0;
-    if (grow > (double)(1u << 26)) {
+    if (grow > (double)PB_MAX_SUBDIV_TRIS) {
         mesh_free(p, &m);
         return pfail(p, p->line, PK_ERR_LIMIT, "loopsubdiv: %lld levels of %zu triangles make more than %u triangles",
-                     (long long)levels, nf, 1u << 26);
+                     (long long)levels, nf, (unsigned)PB_MAX_SUBDIV_TRIS);
     }
     for (int64_t l = 0; l < levels && st == PK_OK; l++) st = loop_level(p, p->line, &m.pos, &m.npos, &m.tris, &m.ntris);
     if (st == PK_OK) {
@@ -1525,8 +1526,8 @@ static pk_status shape_sphere(pp *p, int32_t alpha)
     }
     /* partial, inside out, stretched or cut out: tessellated */
     sph_arg a = {radius, zlo, zhi};
-    int nu = steps_around(phimax * PK_PI / 180.0f);
-    return add_revolution(p, nu, 64, phimax * PK_PI / 180.0f, sph_fn, &a, alpha);
+    int nu = (steps_around(phimax * PK_PI / 180.0f) + 1) / 2;
+    return add_revolution(p, nu < 4 ? 4 : nu, 32, phimax * PK_PI / 180.0f, sph_fn, &a, alpha);
 }
 
 static pk_status shape_disk(pp *p, int32_t alpha)

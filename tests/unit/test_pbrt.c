@@ -549,7 +549,7 @@ static void test_errors(void)
     expect_error(PLAIN "Shape \"loopsubdiv\" \"point3 P\" [0 0 0 1 0 0 0 1 0 0 0 1 0 -1 0] "
                        "\"integer indices\" [0 1 2 0 1 3 0 1 4]\n",
                  "t.pbrt:4: ", "shared by more than two triangles");
-    expect_error(PLAIN "Shape \"loopsubdiv\" \"integer levels\" 13 \"point3 P\" [0 0 0 1 0 0 0 1 0 0 0 1] "
+    expect_error(PLAIN "Shape \"loopsubdiv\" \"integer levels\" 12 \"point3 P\" [0 0 0 1 0 0 0 1 0 0 0 1] "
                        "\"integer indices\" [0 1 2 0 3 1 0 2 3 1 3 2]\n",
                  "t.pbrt:4: ", "more than");
     expect_error("WorldBegin\n\nShape \"plymesh\" \"string filename\" \"no_such_mesh.ply\"\n", "t.pbrt:3: plymesh: ",
