@@ -266,6 +266,13 @@ static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_s
         if (light_sample_li(&pt->lights, s, &fr->env, &lc, u0, u1, u2, &ls)) {
             float pb;
             vec3 f = shading_eval(&sf, &sh, wo, ls.wi, &pb);
+            if (!black(f) && v3_dot(ls.wi, sf.ng) < 0.0f) {
+                /* through a transmitting surface: the shadow ray leaves from
+                 * its other side, toward the same point of the light */
+                const vec3 o2 = offset_origin(fr->eps, sf.p, v3_neg(sf.ng));
+                if (isfinite(ls.shadow.tmax)) ls.shadow.d = v3_sub(v3_add(ls.shadow.o, ls.shadow.d), o2);
+                ls.shadow.o = o2;
+            }
             if (!black(f)) {
                 t->rays_shadow++;
                 const bool blocked = path_occluded(pt, t, &ls.shadow);

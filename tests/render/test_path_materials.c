@@ -112,6 +112,14 @@ int main(void)
         "{\"type\": \"diffuse\", \"albedo\": {\"texture\": \"" PK_TEST_DATA "/tex_white.png\", \"scale\": 3}}",
         "{\"type\": \"diffuse\", \"albedo\": {\"checker\": {\"even\": [1, 1, 1], \"odd\": 1}}}",
         "{\"type\": \"diffuse\", \"albedo\": [1, 1, 1], \"two_sided\": true}",
+        /* glTF metallic-roughness: the smooth white metal is a perfect mirror;
+         * the smooth white thin sheet reflects F and transmits 1 - F; a white
+         * metallic-roughness map leaves metallic 1 and roughness 0 */
+        "{\"type\": \"metallic_roughness\", \"base_color\": [1, 1, 1], \"metallic\": 1, \"roughness\": 0}",
+        "{\"type\": \"metallic_roughness\", \"base_color\": [1, 1, 1], \"metallic\": 0, \"roughness\": 0,"
+        " \"transmission\": 1}",
+        "{\"type\": \"metallic_roughness\", \"roughness\": 0,"
+        " \"metallic_roughness_map\": {\"texture\": \"" PK_TEST_DATA "/tex_white.png\"}}",
     };
     const char *lossy[] = {
         "{\"type\": \"conductor\", \"roughness\": 0.7}",
@@ -123,6 +131,13 @@ int main(void)
         "{\"type\": \"diffuse\", \"albedo\": [0.5, 0.5, 0.5]}",
         "{\"type\": \"diffuse\", \"albedo\": {\"texture\": \"" PK_TEST_DATA "/tex_rgbw.png\"}}",
         "{\"type\": \"diffuse\", \"albedo\": {\"checker\": {\"even\": 1, \"odd\": 0.25}}}",
+        "{\"type\": \"metallic_roughness\", \"roughness\": 0.7}",
+        "{\"type\": \"metallic_roughness\", \"base_color\": [0.9, 0.6, 0.3], \"metallic\": 0.5, \"roughness\": 0.4}",
+        "{\"type\": \"metallic_roughness\", \"base_color\": [1, 1, 1], \"metallic\": 0, \"roughness\": 0.5,"
+        " \"transmission\": 1, \"ior\": 1.33}",
+        "{\"type\": \"metallic_roughness\", \"base_color\": [0.8, 0.8, 0.8], \"metallic\": 0, \"roughness\": 1}",
+        "{\"type\": \"metallic_roughness\", \"base_color\": {\"texture\": \"" PK_TEST_DATA "/tex_rgbw.png\"},"
+        " \"roughness\": 0.3, \"metallic_roughness_map\": {\"texture\": \"" PK_TEST_DATA "/tex_rgbw.png\"}}",
     };
     for (size_t i = 0; i < sizeof lossless / sizeof lossless[0]; i++) {
         check(lossless[i], 0.0f, 0.5f, true); /* a pure emitter shell: no noise at all */

@@ -81,6 +81,13 @@ static void test_defaults(void)
 
     m = one("{\"type\": \"emitter\"}");
     CHECK(m.type == MAT_DIFFUSE && near3(m.ke, 1, 1, 1, 0) && near3(m.kd, 0, 0, 0, 0));
+
+    /* glTF's defaults: base colour 1, metallic 1, roughness 1, ior 1.5 */
+    m = one("{\"type\": \"metallic_roughness\"}");
+    CHECK(m.type == MAT_METALLIC_ROUGHNESS && near3(m.kd, 1, 1, 1, 0) && m.metallic == 1.0f && m.roughness == 1.0f);
+    CHECK(m.alpha == 1.0f && m.transmission == 0.0f && m.ni == 1.5f && m.map_mr.kind == TEX_NONE);
+    /* Whitted: no diffuse, a Phong lobe of the base colour as wide as alpha 1 */
+    CHECK(near3(material_whitted_kd(&m), 0, 0, 0, 0) && near3(m.ks, 1, 1, 1, 0) && m.illum == 2 && m.ns == 0.0f);
 }
 
 static void test_explicit(void)
@@ -123,6 +130,37 @@ static void test_explicit(void)
     CHECK(m.type == MAT_CONDUCTOR && m.schlick && near3(m.ks, 1, 0.5f, 0.25f, 0) && m.two_sided);
     m = one("{\"type\": \"two_sided\", \"bsdf\": {\"type\": \"emitter\", \"radiance\": [5, 5, 5]}}");
     CHECK(near3(m.ke, 5, 5, 5, 0) && m.two_sided);
+
+    /* metallic-roughness with every parameter */
+    m = one("{\"type\": \"metallic_roughness\", \"base_color\": [0.8, 0.4, 0.2], \"metallic\": 0.25,"
+            " \"roughness\": 0.5, \"transmission\": 0.5, \"ior\": 1.33}");
+    CHECK(m.type == MAT_METALLIC_ROUGHNESS && near3(m.kd, 0.8f, 0.4f, 0.2f, 0) && m.metallic == 0.25f);
+    CHECK(m.roughness == 0.5f && m.alpha == 0.25f && m.transmission == 0.5f && m.ni == 1.33f);
+    /* Whitted: kd (1 - metallic) (1 - transmission); F0 0.04 and the base colour mixed by metallic */
+    CHECK(near3(material_whitted_kd(&m), 0.3f, 0.15f, 0.075f, 1e-6f));
+    CHECK(near3(m.ks, 0.75f * 0.04f + 0.2f, 0.75f * 0.04f + 0.1f, 0.75f * 0.04f + 0.05f, 1e-6f));
+    CHECK(m.illum == 2 && fabsf(m.ns - 30.0f) < 1e-4f);
+    m = one("{\"type\": \"metallic_roughness\", \"metallic\": 0, \"roughness\": 0}"); /* smooth: a mirror lobe */
+    CHECK(m.alpha == 0.0f && m.illum == 3 && near3(m.ks, 0.04f, 0.04f, 0.04f, 1e-7f));
+    CHECK(near3(material_whitted_kd(&m), 1, 1, 1, 0));
+    /* the maps: base colour sRGB, metallic-roughness data */
+    {
+        pk_context *ctx = new_ctx();
+        pk_scene *s;
+        pk_status st = parse(ctx,
+                             "{\"materials\": {\"m\": {\"type\": \"metallic_roughness\", \"metallic\": 0.5,"
+                             " \"base_color\": {\"texture\": \"tex_rgbw.png\"},"
+                             " \"metallic_roughness_map\": {\"texture\": \"tex_rgbw.png\", \"scale\": 2}}}}",
+                             &s);
+        CHECKF(st == PK_OK, "%s", pk_context_error(ctx));
+        const material *t = &s->materials[scene_find_material(s, "m")];
+        CHECK(t->type == MAT_METALLIC_ROUGHNESS && t->map_kd.kind == TEX_IMAGE && t->map_mr.kind == TEX_IMAGE);
+        CHECK(near3(t->kd, 1, 1, 1, 0) && t->metallic == 0.5f && t->map_mr.s[0] == 2.0f);
+        REQUIRE(s->ntextures == 2); /* the same file, once as colour and once as data */
+        CHECK(s->textures[t->map_kd.tex].srgb && !s->textures[t->map_mr.tex].srgb);
+        scene_destroy(s);
+        pk_context_destroy(ctx);
+    }
 
     /* the array form (with "name") and an inline sphere material */
     pk_context *ctx = new_ctx();
@@ -185,7 +223,8 @@ static void expect_error(int line, const char *json, const char *message)
 static void test_errors(void)
 {
     const char *types =
-        "must be one of \"diffuse\", \"conductor\", \"dielectric\", \"plastic\", \"emitter\", \"two_sided\"";
+        "must be one of \"diffuse\", \"conductor\", \"dielectric\", \"plastic\", \"metallic_roughness\", "
+        "\"emitter\", \"two_sided\"";
     char want[512];
     snprintf(want, sizeof want, "scene.json:1: materials.gold.type: %s", types);
     EXPECT_ERROR(MAT("{\"type\": \"metal\"}"), want);
@@ -264,6 +303,20 @@ static void test_errors(void)
                  "scene.json:1: materials.gold.bsdf.type: is two-sided already");
     EXPECT_ERROR(MAT("{\"type\": \"two_sided\", \"bsdf\": {\"type\": \"diffuse\"}, \"two_sided\": false}"),
                  "scene.json:1: materials.gold.two_sided: a two_sided material is two-sided by its type");
+
+    /* metallic-roughness */
+    EXPECT_ERROR(MAT("{\"type\": \"metallic_roughness\", \"metallic\": 2}"),
+                 "scene.json:1: materials.gold.metallic: must be in 0..1");
+    EXPECT_ERROR(MAT("{\"type\": \"metallic_roughness\", \"transmission\": -0.5}"),
+                 "scene.json:1: materials.gold.transmission: must be in 0..1");
+    EXPECT_ERROR(MAT("{\"type\": \"metallic_roughness\", \"roughness\": {\"texture\": \"tex_rgbw.png\"}}"),
+                 "scene.json:1: materials.gold.roughness: must be a number in 0..1 (textures: \"metallic_roughness_map\")");
+    EXPECT_ERROR(MAT("{\"type\": \"metallic_roughness\", \"metallic_roughness_map\": 1}"),
+                 "scene.json:1: materials.gold.metallic_roughness_map: must be a texture object");
+    EXPECT_ERROR(MAT("{\"type\": \"metallic_roughness\", \"base_color\": [2, 0, 0]}"),
+                 "scene.json:1: materials.gold.base_color: components must be in 0..1");
+    EXPECT_ERROR(MAT("{\"type\": \"metallic_roughness\", \"ior\": 0}"),
+                 "scene.json:1: materials.gold.ior: must be a positive number");
 
     /* the array form still needs a name */
     EXPECT_ERROR("{\"materials\": [{\"type\": \"diffuse\"}]}", "scene.json:1: materials[0]: missing \"name\"");
