@@ -60,7 +60,7 @@ static bool has_ext(const char *path, const char *ext)
     return true;
 }
 
-typedef enum { FMT_OBJ, FMT_JSON, FMT_XML } scene_format;
+typedef enum { FMT_OBJ, FMT_JSON, FMT_XML, FMT_PBRT, FMT_GLTF } scene_format;
 
 static pk_status load_memory(pk_context *ctx, scene_format fmt, const char *data, size_t size,
                              const char *name, const char *base_dir, const char *const *params, size_t nparams,
@@ -71,6 +71,8 @@ static pk_status load_memory(pk_context *ctx, scene_format fmt, const char *data
     if (st != PK_OK) return st;
     if (fmt == FMT_OBJ) st = obj_parse(ctx, s, data, size, name, base_dir, NULL);
     else if (fmt == FMT_JSON) st = scene_json_parse(ctx, s, data, size, name, base_dir);
+    else if (fmt == FMT_PBRT) st = scene_pbrt_parse(ctx, s, data, size, name, base_dir);
+    else if (fmt == FMT_GLTF) st = scene_gltf_parse_params(ctx, s, data, size, name, base_dir, params, nparams);
     else st = scene_xml_parse(ctx, s, data, size, name, base_dir, params, nparams);
     if (st == PK_OK) st = scene_commit(ctx, s);
     if (st != PK_OK) {
@@ -130,9 +132,13 @@ pk_status pk_scene_load_file_params(pk_context *ctx, const char *path, const cha
         fmt = FMT_JSON;
     else if (has_ext(path, ".xml"))
         fmt = FMT_XML;
+    else if (has_ext(path, ".pbrt"))
+        fmt = FMT_PBRT;
+    else if (has_ext(path, ".gltf") || has_ext(path, ".glb"))
+        fmt = FMT_GLTF;
     else
-        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: unknown scene format (expected .obj, .json or .xml)",
-                         path);
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT,
+                         "%s: unknown scene format (expected .obj, .json, .xml, .pbrt, .gltf or .glb)", path);
     char *data = NULL, *dir = NULL;
     size_t size = 0;
     pk_status st = file_read_all(ctx, path, &data, &size);

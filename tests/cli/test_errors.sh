@@ -53,7 +53,7 @@ if mkfifo "$tmp/fifo.obj" 2>/dev/null; then # opening it must not wait for a wri
   expect "scene is a FIFO" 1 "$tmp/fifo.obj: not a regular file" render "$tmp/fifo.obj" -o "$tmp/out.png"
 fi
 put scene.txt 'v 0 0 0\n'
-expect "unknown scene type" 1 "$tmp/scene.txt: unknown scene format (expected .obj, .json or .xml)" \
+expect "unknown scene type" 1 "$tmp/scene.txt: unknown scene format (expected .obj, .json, .xml, .pbrt, .gltf or .glb)" \
   render "$tmp/scene.txt" -o "$tmp/out.png"
 put bad.xml '<scene version="3.0.0">\n<shape type="cube">\n</scene>\n'
 expect "malformed XML" 1 "bad.xml:3: malformed XML: mismatched tag" render "$tmp/bad.xml" -o "$tmp/out.png"
