@@ -39,6 +39,7 @@ enum {
     OPT_STATS,
     OPT_STATS_JSON,
     OPT_DEFINE,
+    OPT_CAMERA,
     OPT_QUIET,
     OPT_DENOISE,
     OPT_NO_DENOISE,
@@ -142,6 +143,9 @@ const cli_option *cli_render_options(size_t *n)
         add((cli_option){.name = "define", .short_name = 'D', .id = OPT_DEFINE, .kind = CLI_STRING, .arg = "NAME=VALUE",
                          .help = "set the parameter $NAME of a Mitsuba XML scene over its <default> value "
                                  "(may be repeated, up to 64 times)"});
+        add((cli_option){.name = "camera", .id = OPT_CAMERA, .kind = CLI_STRING, .arg = "N",
+                         .help = "a glTF asset (.gltf, .glb): render its camera N (its cameras array, from "
+                                 "0); without it the first camera in node order"});
         add((cli_option){.name = "denoise", .id = OPT_DENOISE, .kind = CLI_FLAG,
                          .help = "denoise the image (Open Image Denoise's network, with the albedo and normal of "
                                  "the same render); the default when neither --spp nor --time nor the scene "
@@ -171,9 +175,9 @@ void cli_render_usage(FILE *f, const char *usage_line)
     const cli_option *opts = cli_render_options(&n);
     fputs(usage_line, f);
     fputs("\n"
-          "SCENE is a Wavefront .obj (materials from its .mtl files), a .json scene or\n"
-          "a Mitsuba .xml scene (docs/scene-format.md); without it the built-in Cornell\n"
-          "box is rendered.\n"
+          "SCENE is a Wavefront .obj (materials from its .mtl files), a .json scene,\n"
+          "a Mitsuba .xml scene or a glTF 2.0 asset (.gltf, .glb) (docs/scene-format.md);\n"
+          "without it the built-in Cornell box is rendered.\n"
           "OUT is written by extension, through a temporary file that is renamed into\n"
           "place. Its folder is checked before the scene is read: it must exist and be\n"
           "writable. The formats:\n"
@@ -356,6 +360,19 @@ int cli_render_parse(int argc, char **argv, cli_render_opts *o, void (*help)(FIL
                 return cli_usage_error("-D: more than %zu parameters", sizeof o->defines / sizeof o->defines[0]);
             o->defines[o->ndefines++] = v;
             break;
+        case OPT_CAMERA: {
+            static char param[32];
+            char *end;
+            long num = strtol(v, &end, 10);
+            if (*end || end == v || num < 0 || num > 1000000)
+                return cli_usage_error("--camera: '%s' must be a camera number (0, 1, ...)", v);
+            if (o->ndefines == sizeof o->defines / sizeof o->defines[0])
+                return cli_usage_error("-D: more than %zu parameters", sizeof o->defines / sizeof o->defines[0]);
+            snprintf(param, sizeof param, "camera=%ld", num);
+            o->defines[o->ndefines++] = param;
+            o->has_camera_pick = 1;
+            break;
+        }
         case OPT_QUIET: o->quiet = 1; break;
         case OPT_DENOISE: o->denoise = 1; break;
         case OPT_NO_DENOISE: o->denoise = 0; break;
@@ -611,6 +628,10 @@ int cli_render_check(const cli_render_opts *o, pk_write_options *wo)
     if (o->has_exposure) wo->exposure_ev = o->exposure;
     if (o->has_exposure && o->exposure != 0.0f && !png && !o->quiet)
         cli_print_warning(NULL, "--exposure applies to PNG only; the HDR image is written unscaled");
+    if (o->has_camera_pick && (!o->scene || (!ends_with_ci(o->scene, ".gltf") && !ends_with_ci(o->scene, ".glb"))))
+        return cli_usage_error("--camera: picks a camera of a glTF asset (.gltf, .glb); %s%s%s is not one",
+                               o->scene ? "'" : "", o->scene ? o->scene : "the built-in Cornell box",
+                               o->scene ? "'" : "");
     if (o->scene && same_file(o->scene, o->out))
         return cli_usage_error("render: refusing to write the image over the scene file '%s'", o->scene);
     const int json_stdout = o->stats_json && strcmp(o->stats_json, "-") == 0;
