@@ -17,7 +17,10 @@
 #include "scene/spectra.h"
 
 #include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 static warning_log warnings;
 
@@ -348,6 +351,75 @@ static void test_lights(void)
     done(ctx, s);
 }
 
+/* An equal-area image (pbrt-v4's infinite lights) turned into the world's
+ * lat-long map: a 32 x 32 image red where the light-space direction has
+ * x > 0 (the right half of the square) and green where z > 0 (the inner
+ * diamond |u| + |v| <= 1 of the square mapped to [-1, 1]^2), written as a
+ * PFM. Then the same light rotated by 90 degrees about y. */
+static void test_equal_area(void)
+{
+    const int n = 32;
+    char path[] = "/tmp/pk_test_pbrt_envXXXXXX";
+    int fd = mkstemp(path);
+    REQUIRE(fd >= 0);
+    FILE *f = fdopen(fd, "wb");
+    REQUIRE(f);
+    fprintf(f, "PF\n%d %d\n-1\n", n, n);
+    for (int y = 0; y < n; y++)
+        for (int x = 0; x < n; x++) {
+            float u = 2.0f * ((float)x + 0.5f) / (float)n - 1.0f, v = 2.0f * ((float)y + 0.5f) / (float)n - 1.0f;
+            float px[3] = {u > 0.0f ? 1.0f : 0.0f, fabsf(u) + fabsf(v) <= 1.0f ? 1.0f : 0.0f, 0.25f};
+            fwrite(px, sizeof px, 1, f);
+        }
+    fclose(f);
+    for (int rot = 0; rot < 2; rot++) {
+        char text[512];
+        snprintf(text, sizeof text,
+                 PLAIN "%sLightSource \"infinite\" \"string filename\" \"%s\" \"float scale\" 2\nShape \"sphere\"\n",
+                 rot ? "Rotate 90 0 1 0\n" : "", path);
+        pk_context *ctx;
+        pk_scene *s = load(&ctx, text);
+        if (s) {
+            const scene_environment *e = &s->env;
+            REQUIRE(e->map_rgb && e->map_w == 2 * e->map_h);
+            size_t wrong = 0, tested = 0;
+            for (int j = 0; j < e->map_h; j++)
+                for (int i = 0; i < e->map_w; i++) {
+                    float th = ((float)j + 0.5f) / (float)e->map_h * (float)M_PI;
+                    float ph = ((float)i + 0.5f) / (float)e->map_w * 2.0f * (float)M_PI;
+                    vec3 d = v3(sinf(th) * sinf(ph), cosf(th), -sinf(th) * cosf(ph));
+                    /* into light space: the rotation's inverse */
+                    vec3 l = rot ? v3(-d.z, d.y, d.x) : d;
+                    const float *px = &e->map_rgb[3 * ((size_t)j * (size_t)e->map_w + (size_t)i)];
+                    if (fabsf(l.x) > 0.15f) {
+                        tested++;
+                        wrong += (px[0] > 1.0f) != (l.x > 0.0f);
+                    }
+                    if (fabsf(l.z) > 0.15f) {
+                        tested++;
+                        wrong += (px[1] > 1.0f) != (l.z > 0.0f);
+                    }
+                    wrong += fabsf(px[2] - 0.5f) > 1e-6f;
+                }
+            CHECKF(wrong == 0 && tested > 1000, "rotation %d: %zu of %zu lookups wrong", rot, wrong, tested);
+        }
+        done(ctx, s);
+    }
+    /* a lat-long (2:1) image is refused with a warning */
+    f = fopen(path, "wb");
+    REQUIRE(f);
+    fprintf(f, "PF\n4 2\n-1\n");
+    for (int i = 0; i < 24; i++) fwrite(&(float){1.0f}, sizeof(float), 1, f);
+    fclose(f);
+    pk_context *ctx;
+    char text[512];
+    snprintf(text, sizeof text, PLAIN "LightSource \"infinite\" \"string filename\" \"%s\"\nShape \"sphere\"\n", path);
+    pk_scene *s = load(&ctx, text);
+    if (s) CHECK(!s->env.map_rgb && warning_log_has(&warnings, "not the square equal-area image"));
+    done(ctx, s);
+    remove(path);
+}
+
 /* ---- shapes ---- */
 
 /* Loop subdivision of a regular tetrahedron, one level, pushed to the limit:
@@ -575,6 +647,7 @@ int main(void)
     test_camera();
     test_materials();
     test_lights();
+    test_equal_area();
     test_loop();
     test_shapes();
     test_objects();
