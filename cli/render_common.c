@@ -176,7 +176,8 @@ void cli_render_usage(FILE *f, const char *usage_line)
     fputs(usage_line, f);
     fputs("\n"
           "SCENE is a Wavefront .obj (materials from its .mtl files), a .json scene,\n"
-          "a Mitsuba .xml scene or a glTF 2.0 asset (.gltf, .glb) (docs/scene-format.md);\n"
+          "a Mitsuba .xml scene, a pbrt-v4 .pbrt scene or a glTF 2.0 asset (.gltf,\n"
+          ".glb) (docs/scene-format.md);\n"
           "without it the built-in Cornell box is rendered.\n"
           "OUT is written by extension, through a temporary file that is renamed into\n"
           "place. Its folder is checked before the scene is read: it must exist and be\n"
