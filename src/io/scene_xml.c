@@ -3,9 +3,10 @@
  * 2.x/3.x with snake_case names) read with expat into a small tree, then
  * mapped onto a pk_scene: shapes (obj, ply, rectangle, cube, disk, sphere),
  * BSDFs onto the material types, emitters (area, point, environment),
- * the perspective sensor, film, sampler and integrator settings
- * (docs/scene-format.md, "Mitsuba XML"). Errors and warnings read
- * "file:line: what"; what is not supported is warned about and skipped.
+ * the perspective, thinlens and orthographic sensors, film, sampler and
+ * integrator settings (docs/scene-format.md, "Mitsuba XML"). Errors and
+ * warnings read "file:line: what"; what is not supported is warned about
+ * and skipped.
  *
  * expat allocates with the C library's malloc (its memory hooks take no user
  * pointer, so they cannot reach a context); everything else goes through the
