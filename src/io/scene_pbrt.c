@@ -62,6 +62,7 @@ typedef struct pparam {
     char **str;
     size_t nstr, cap_str;
     bool used;
+    bool from_attribute; /* a default of an Attribute directive */
 } pparam;
 
 typedef struct plist {
@@ -106,6 +107,16 @@ typedef struct named_xf {
     char *name;
     xform x;
 } named_xf;
+
+/* Attribute "target" parameters: defaults for the directives of that
+ * target in the attribute block (depth) where they were given. */
+typedef enum attr_target { AT_SHAPE, AT_LIGHT, AT_MATERIAL, AT_MEDIUM, AT_TEXTURE } attr_target;
+
+typedef struct attr_def {
+    attr_target target;
+    int depth;
+    pparam prm;
+} attr_def;
 
 typedef struct named_obj {
     char *name;
@@ -159,7 +170,8 @@ typedef struct pp {
     char *obj_name;         /* the object being defined */
     int obj_depth;          /* the attribute depth its ObjectBegin opened */
     pfile top;              /* the first file, for messages after it is read */
-    size_t warned_unused;
+    attr_def *defs;
+    size_t ndefs, cap_defs;
 } pp;
 
 static const pk_allocator *A(pp *p) { return &p->ctx->alloc; }
@@ -191,15 +203,59 @@ static gstate *GS(pp *p) { return &p->gs[p->b.depth]; }
 
 /* ---- parameter lists ------------------------------------------------------------------ */
 
+static void param_free(pp *p, pparam *q)
+{
+    mem_free(A(p), q->num);
+    for (size_t k = 0; k < q->nstr; k++) mem_free(A(p), q->str[k]);
+    mem_free(A(p), q->str);
+    q->num = NULL, q->str = NULL, q->nnum = q->nstr = 0;
+}
+
 static void plist_clear(pp *p)
 {
-    for (size_t i = 0; i < p->pl.n; i++) {
-        pparam *q = &p->pl.p[i];
-        mem_free(A(p), q->num);
-        for (size_t k = 0; k < q->nstr; k++) mem_free(A(p), q->str[k]);
-        mem_free(A(p), q->str);
-    }
+    for (size_t i = 0; i < p->pl.n; i++) param_free(p, &p->pl.p[i]);
     p->pl.n = 0;
+}
+
+/* A deep copy of q into out. */
+static pk_status param_copy(pp *p, const pparam *q, pparam *out)
+{
+    *out = *q;
+    out->num = NULL, out->str = NULL, out->cap_num = q->nnum, out->cap_str = q->nstr;
+    if (q->nnum && !(out->num = mem_calloc(A(p), q->nnum, sizeof *q->num))) goto nomem;
+    if (q->nnum) memcpy(out->num, q->num, q->nnum * sizeof *q->num);
+    if (q->nstr && !(out->str = mem_calloc(A(p), q->nstr, sizeof *q->str))) goto nomem;
+    for (size_t k = 0; k < q->nstr; k++)
+        if (!(out->str[k] = mem_strdup(A(p), q->str[k]))) goto nomem;
+    return PK_OK;
+nomem:
+    param_free(p, out);
+    return ctx_nomem(p->ctx);
+}
+
+/* Drops the Attribute defaults of blocks deeper than depth. */
+static void defs_pop(pp *p, int depth)
+{
+    while (p->ndefs && p->defs[p->ndefs - 1].depth > depth) param_free(p, &p->defs[--p->ndefs].prm);
+}
+
+/* Appends the Attribute defaults of target that the directive did not give
+ * (the latest one of a name holds). */
+static pk_status apply_defaults(pp *p, attr_target target)
+{
+    for (size_t i = p->ndefs; i-- > 0;) {
+        const attr_def *d = &p->defs[i];
+        if (d->target != target) continue;
+        bool given = false;
+        for (size_t k = 0; k < p->pl.n && !given; k++) given = strcmp(p->pl.p[k].name, d->prm.name) == 0;
+        if (given) continue;
+        if (!mem_grow(A(p), (void **)&p->pl.p, &p->pl.cap, p->pl.n + 1, sizeof *p->pl.p)) return ctx_nomem(p->ctx);
+        pk_status st = param_copy(p, &d->prm, &p->pl.p[p->pl.n]);
+        if (st) return st;
+        p->pl.p[p->pl.n].from_attribute = true;
+        p->pl.p[p->pl.n++].used = false;
+    }
+    return PK_OK;
 }
 
 static bool is_stringish(ptype t) { return t == PT_STRING || t == PT_TEXTURE; }
@@ -400,7 +456,8 @@ static void warn_unused(pp *p, const char *what)
 {
     for (size_t i = 0; i < p->pl.n; i++) {
         pparam *q = &p->pl.p[i];
-        if (!q->used) pwarn(p, q->line, "%s: parameter '%s %s' is not supported; ignored", what, q->tname, q->name);
+        if (!q->used && !q->from_attribute)
+            pwarn(p, q->line, "%s: parameter '%s %s' is not supported; ignored", what, q->tname, q->name);
     }
 }
 
@@ -1874,7 +1931,9 @@ static pk_status d_texture(pp *p, const char *name, const char *kind, const char
             return st;
         param(p, "maxanisotropy");
         if (!fn) return pfail(p, p->line, PK_ERR_PARSE, "imagemap \"%.60s\" needs 'string filename'", name);
-        bool colour = !is_float;
+        /* pbrt-v4's default: sRGB for PNG files, linear for the others */
+        size_t fl = strlen(fn);
+        bool colour = fl >= 4 && (strcmp(fn + fl - 4, ".png") == 0 || strcmp(fn + fl - 4, ".PNG") == 0);
         if (enc && strcmp(enc, "linear") == 0) colour = false;
         else if (enc && strcmp(enc, "sRGB") == 0) colour = true;
         else if (enc) pwarn(p, p->line, "imagemap: encoding \"%.20s\" is read as sRGB", enc);
@@ -2262,6 +2321,7 @@ static pk_status pop_state(pp *p, bool transform_only)
 {
     gstate keep = *GS(p);
     if (!sb_pop(&p->b)) return pfail(p, p->line, PK_ERR_PARSE, "%s without a matching begin", p->dname);
+    defs_pop(p, p->b.depth);
     if (transform_only) *GS(p) = keep;
     return PK_OK;
 }
@@ -2525,10 +2585,19 @@ static pk_status directive(pp *p, const pbrt_token *tk)
     }
     if (strcmp(dn, "Attribute") == 0) {
         if ((st = read_name(p, a, sizeof a)) || (st = read_params(p))) return st;
-        if (strcmp(a, "shape") && strcmp(a, "light") && strcmp(a, "material") && strcmp(a, "medium") && strcmp(a, "texture"))
-            return pfail(p, p->line, PK_ERR_PARSE, "Attribute: unknown target \"%.40s\"", a);
-        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
-        if (p->pl.n) pwarn(p, p->line, "Attribute \"%s\": parameter defaults are not supported; ignored", a);
+        static const char *const targets[] = {"shape", "light", "material", "medium", "texture"};
+        int tg = -1;
+        for (int i = 0; i < 5; i++)
+            if (strcmp(a, targets[i]) == 0) tg = i;
+        if (tg < 0) return pfail(p, p->line, PK_ERR_PARSE, "Attribute: unknown target \"%.40s\"", a);
+        for (size_t i = 0; i < p->pl.n; i++) {
+            if (!mem_grow(A(p), (void **)&p->defs, &p->cap_defs, p->ndefs + 1, sizeof *p->defs)) return ctx_nomem(p->ctx);
+            attr_def *d = &p->defs[p->ndefs];
+            d->target = (attr_target)tg;
+            d->depth = p->b.depth;
+            if ((st = param_copy(p, &p->pl.p[i], &d->prm))) return st;
+            p->ndefs++;
+        }
         return PK_OK;
     }
     if (strcmp(dn, "MakeNamedMedium") == 0) {
@@ -2538,12 +2607,12 @@ static pk_status directive(pp *p, const pbrt_token *tk)
     }
     if (strcmp(dn, "Texture") == 0) {
         if ((st = read_name(p, a, sizeof a)) || (st = read_name(p, b2, sizeof b2)) || (st = read_name(p, c, sizeof c)) ||
-            (st = read_params(p)))
+            (st = read_params(p)) || (st = apply_defaults(p, AT_TEXTURE)))
             return st;
         return d_texture(p, a, b2, c);
     }
     if (strcmp(dn, "MakeNamedMaterial") == 0) {
-        if ((st = read_name(p, a, sizeof a)) || (st = read_params(p))) return st;
+        if ((st = read_name(p, a, sizeof a)) || (st = read_params(p)) || (st = apply_defaults(p, AT_MATERIAL))) return st;
         const char *type = NULL;
         if ((st = get_string(p, "type", &type))) return st;
         if (!type) return pfail(p, p->line, PK_ERR_PARSE, "MakeNamedMaterial \"%.80s\" needs 'string type'", a);
@@ -2555,7 +2624,7 @@ static pk_status directive(pp *p, const pbrt_token *tk)
         return PK_OK;
     }
     if (strcmp(dn, "Material") == 0) {
-        if ((st = read_name(p, a, sizeof a)) || (st = read_params(p))) return st;
+        if ((st = read_name(p, a, sizeof a)) || (st = read_params(p)) || (st = apply_defaults(p, AT_MATERIAL))) return st;
         char nm[PB_NAME_MAX + 64];
         snprintf(nm, sizeof nm, "%.200s:%zu", p->f->name, p->line);
         uint32_t idx;
@@ -2575,6 +2644,7 @@ static pk_status directive(pp *p, const pbrt_token *tk)
         if (strcmp(dn, typed[i]) == 0) which = i;
     if (which < 0) return pfail(p, tk->line, PK_ERR_PARSE, "unknown directive '%s'", dn);
     if ((st = read_name(p, a, sizeof a)) || (st = read_params(p))) return st;
+    if (which <= 2 && (st = apply_defaults(p, which == 0 ? AT_SHAPE : AT_LIGHT))) return st;
     bool world_only = which <= 2, options_only = which >= 3;
     if (world_only && !p->in_world) return pfail(p, p->line, PK_ERR_PARSE, "%s before WorldBegin", dn);
     if (options_only && p->in_world) return pfail(p, p->line, PK_ERR_PARSE, "%s after WorldBegin", dn);
@@ -2666,6 +2736,8 @@ pk_status scene_pbrt_parse(pk_context *ctx, pk_scene *s, const char *data, size_
         }
     }
     plist_clear(p);
+    defs_pop(p, -1);
+    mem_free(&ctx->alloc, p->defs);
     mem_free(&ctx->alloc, p->pl.p);
     for (size_t i = 0; i < p->ntex; i++) mem_free(&ctx->alloc, p->tex[i].name);
     for (size_t i = 0; i < p->ncoords; i++) mem_free(&ctx->alloc, p->coords[i].name);

@@ -489,6 +489,18 @@ static void test_shapes(void)
         CHECK(warning_log_has(&warnings, "t.pbrt:12: shape \"curve\" is not supported"));
     }
     done(ctx, s);
+    /* Attribute defaults hold within their block; the directive's own values win */
+    s = load(&ctx, PLAIN "AttributeBegin\nAttribute \"light\" \"rgb I\" [2 2 2]\n"
+                         "Attribute \"shape\" \"float radius\" 2 \"float wobble\" 1\n"
+                         "LightSource \"point\"\nShape \"sphere\"\nShape \"sphere\" \"float radius\" 3\nAttributeEnd\n"
+                         "Shape \"sphere\"\nLightSource \"point\"\n");
+    if (s) {
+        CHECK(s->nspheres == 3 && s->spheres[0].radius == 2.0f && s->spheres[1].radius == 3.0f &&
+              s->spheres[2].radius == 1.0f);
+        CHECK(s->nlights == 2 && s->lights[0].intensity.x == 2.0f && s->lights[1].intensity.x == 1.0f);
+        CHECK(!warning_log_has(&warnings, "wobble"));
+    }
+    done(ctx, s);
     /* tessellated: partial sphere, stretched sphere, disk, cylinder: every
      * vertex on its surface, every triangle facing outward */
     s = load(&ctx, PLAIN "LightSource \"point\"\n"
