@@ -252,6 +252,13 @@ typedef struct pk_render_options {
      * has bounced off a rough or diffuse one, which turns caustic fireflies
      * into a smooth, slightly wrong glow: biased, off (0) by default. */
     int regularize;
+    /* How the path tracer picks the light it samples at each bounce: 1 by
+     * the light's importance to the shading point (its power, distance and
+     * orientation, through a tree over the lights: for scenes with many
+     * lights), 0 by power alone, -1 (the default) the tree when the scene
+     * has 8 or more lights other than the environment, the sun and distant
+     * lights. The image converges to the same answer either way. */
+    int light_tree;
 } pk_render_options;
 
 /* Arbitrary output variables: what the camera ray of each sample found,

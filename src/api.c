@@ -285,6 +285,7 @@ void pk_scene_get_render_options(const pk_scene *s, pk_render_options *opt)
     if (r->has_fresnel) opt->fresnel = r->opt.fresnel;
     if (r->has_seed) opt->seed = r->opt.seed;
     if (r->has_regularize) opt->regularize = r->opt.regularize;
+    if (r->has_light_tree) opt->light_tree = r->opt.light_tree;
     if (r->has_integrator) opt->integrator = r->opt.integrator;
 }
 

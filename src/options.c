@@ -26,6 +26,10 @@ static const pk_int_option table[] = {
     OPT(regularize, "regularize", 0, 1, 0,
         "1: after the first rough or diffuse bounce, roughen near-specular surfaces (fewer caustic "
         "fireflies, a biased image); 0: off"),
+    OPT(light_tree, "light tree", -1, 1, -1,
+        "how the path tracer chooses a light to sample: 1 by its importance to the shading point (a tree "
+        "over the lights), 0 by power alone, -1 the tree when the scene has 8 or more lights besides the "
+        "environment, the sun and distant lights"),
 };
 #undef OPT
 

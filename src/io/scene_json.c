@@ -852,10 +852,10 @@ static pk_status parse_film(jp *p, const cJSON *it)
 
 static pk_status parse_render(jp *p, const cJSON *it)
 {
-    enum { R_W, R_H, R_SPP, R_LS, R_DEPTH, R_THREADS, R_SEED, R_ACCEL, R_FRESNEL, R_INTEGRATOR, R_REGULARIZE, R_COUNT };
+    enum { R_W, R_H, R_SPP, R_LS, R_DEPTH, R_THREADS, R_SEED, R_ACCEL, R_FRESNEL, R_INTEGRATOR, R_REGULARIZE, R_LIGHT_TREE, R_COUNT };
     static const char *const keys[R_COUNT] = {"width",   "height", "spp",   "light_samples", "max_depth",
                                               "threads", "seed",   "accel", "fresnel",       "integrator",
-                                              "regularize"};
+                                              "regularize", "light_tree"};
     const cJSON *f[R_COUNT];
     pk_status st = object_fields(p, it, "render", keys, R_COUNT, f);
     if (st) return st;
@@ -870,7 +870,8 @@ static pk_status parse_render(jp *p, const cJSON *it)
                 {R_DEPTH, "render.max_depth", &r->has_max_depth},
                 {R_THREADS, "render.threads", &r->has_threads},
                 {R_SEED, "render.seed", &r->has_seed},
-                {R_REGULARIZE, "render.regularize", &r->has_regularize}};
+                {R_REGULARIZE, "render.regularize", &r->has_regularize},
+                {R_LIGHT_TREE, "render.light_tree", &r->has_light_tree}};
     for (size_t i = 0; i < sizeof ints / sizeof ints[0]; i++) {
         if (!f[ints[i].key]) continue;
         const pk_int_option *o = pk_int_option_find(keys[ints[i].key]);

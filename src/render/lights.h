@@ -29,6 +29,7 @@
 #include "../scene/scene_view.h"
 #include "env.h"
 #include "sampling.h"
+#include "light_tree.h"
 #include "spherical_triangle.h"
 
 enum { LIGHT_TRIANGLE, LIGHT_SPHERE, LIGHT_POINT, LIGHT_ENV, LIGHT_SUN };
@@ -50,7 +51,26 @@ typedef struct light_set {
     int32_t *of_prim;    /* ntris + nspheres entries: the light a primitive is, or -1 */
     int32_t env, sun;    /* the environment's and the sun's light, or -1 */
     double power;
+    /* The light tree (light_tree.h) over the lights with a place, built when
+     * there are at least two: ntree nodes, each light's path in it (trail,
+     * n entries, meaningful for those lights), the lights without a place
+     * (inf, ninf: the environment, the sun, distant lights) with their CDF
+     * among themselves, and the probability p_tree of choosing from the
+     * tree (the power of the lights in it over all). light_pick and
+     * light_pmf use it when use_tree is set; else the power CDF. */
+    light_tree_node *tree;
+    size_t ntree;
+    uint64_t *trail;
+    uint32_t *inf;
+    float *inf_cdf;
+    size_t ninf;
+    float p_tree;
+    int use_tree;
 } light_set;
+
+/* When a light set is sampled through its tree by default (the path
+ * tracer's light_tree option -1): from this many lights with a place. */
+#define LIGHT_TREE_MIN 8
 
 PK_HIDDEN pk_status light_set_build(pk_context *ctx, const pk_scene *s, const env_light *env, light_set *ls);
 PK_HIDDEN void light_set_free(const pk_allocator *al, light_set *ls);
@@ -337,16 +357,57 @@ static inline PK_HD bool light_sample_one(const light_set *set, const scene_view
     return light_sample_one_with(set, s, e, li, lc, LIGHT_TRI_SOLID_ANGLE_COS, u1, u2, ls);
 }
 
-/* One light chosen by power with u0, then sampled with (u1, u2), triangles
- * as tri says; ls->pdf includes the choice. */
+/* Whether light li has a place (is in the tree when there is one). */
+static inline PK_HD bool light_has_place(const light_set *set, const scene_view *s, size_t li)
+{
+    const light *l = &set->lights[li];
+    return l->kind == LIGHT_TRIANGLE || l->kind == LIGHT_SPHERE || (l->kind == LIGHT_POINT && !s->lights[l->index].distant);
+}
+
+/* Chooses a light for the point p of normal n with u: by power, or through
+ * the tree when the set uses it; *pmf the probability of the choice. */
+static inline PK_HD bool light_pick(const light_set *set, const scene_view *s, vec3 p, vec3 n, float u, size_t *li,
+                                    float *pmf)
+{
+    (void)s;
+    if (set->n == 0) return false;
+    if (!set->use_tree) {
+        *li = light_set_pick(set, u);
+        *pmf = set->pmf[*li];
+        return *pmf > 0.0f;
+    }
+    if (u < set->p_tree) {
+        uint32_t l;
+        float pr;
+        float ut = u / set->p_tree;
+        ut = ut < 0x1.fffffep-1f ? ut : 0x1.fffffep-1f;
+        if (!light_tree_pick(set->tree, p, n, ut, &l, &pr)) return false;
+        *li = l;
+        *pmf = set->p_tree * pr;
+        return *pmf > 0.0f;
+    }
+    if (set->ninf == 0) return false;
+    *li = set->inf[cdf_pick(set->inf_cdf, set->ninf, (u - set->p_tree) / (1.0f - set->p_tree))];
+    *pmf = set->pmf[*li];
+    return *pmf > 0.0f;
+}
+
+/* The probability light_pick gives light li at p, of normal n. */
+static inline PK_HD float light_pmf(const light_set *set, const scene_view *s, vec3 p, vec3 n, size_t li)
+{
+    if (!set->use_tree || !light_has_place(set, s, li)) return set->pmf[li];
+    return set->p_tree * light_tree_pmf(set->tree, set->trail[li], p, n);
+}
+
+/* One light chosen with u0 (light_pick), then sampled with (u1, u2),
+ * triangles as tri says; ls->pdf includes the choice. */
 static inline PK_HD bool light_sample_li_with(const light_set *set, const scene_view *s, const env_light *e,
                                               const light_ctx *lc, uint32_t tri, float u0, float u1, float u2,
                                               light_sample *ls)
 {
-    if (set->n == 0) return false;
-    size_t li = light_set_pick(set, u0);
-    const float psel = set->pmf[li];
-    if (!(psel > 0.0f)) return false;
+    size_t li;
+    float psel;
+    if (!light_pick(set, s, lc->p, lc->n, u0, &li, &psel)) return false;
     if (!light_sample_one_with(set, s, e, li, lc, tri, u1, u2, ls)) return false;
     ls->pdf = psel * ls->pdf;
     return true;

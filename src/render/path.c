@@ -21,6 +21,8 @@ pk_status path_init(pk_context *ctx, path_tracer *pt, const frame *f, const pk_r
     pt->regularize = opt->regularize;
     pt->seed = (uint32_t)opt->seed;
     pt->lights = f->lights;
+    const size_t placed = f->lights.tree ? (f->lights.ntree + 1) / 2 : 0;
+    pt->lights.use_tree = f->lights.tree && (opt->light_tree == 1 || (opt->light_tree < 0 && placed >= LIGHT_TREE_MIN));
     (void)ctx;
     return PK_OK;
 }

@@ -193,6 +193,9 @@ pk_status path_gpu_create(pk_context *ctx, const path_tracer *pt, path_gpu **out
     UPL(pmf, ls->n)
     UPL(of_prim, s->ntris + s->nspheres)
 #undef UPL
+    /* the GPU chooses lights by power: the tree stays on the host */
+    dp.lights.use_tree = 0;
+    dp.lights.tree = NULL, dp.lights.trail = NULL, dp.lights.inf = NULL, dp.lights.inf_cdf = NULL;
     uint64_t nodes, tris;
     accel_cuda_bvh(f->a, &nodes, &tris);
     dp.gpu_nodes = dev_ptr(nodes);

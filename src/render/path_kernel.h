@@ -245,7 +245,8 @@ static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_s
             int32_t li = pt->lights.of_prim[ps->h.prim];
             if (li >= 0) {
                 const light *l = &pt->lights.lights[li];
-                float pl = pt->lights.pmf[li] * light_pdf_li(s, l, ps->prev_p, ps->prev_n, sf.p,
+                float pl = light_pmf(&pt->lights, s, ps->prev_p, ps->prev_n, (size_t)li) *
+                           light_pdf_li(s, l, ps->prev_p, ps->prev_n, sf.p,
                                                               l->kind == LIGHT_TRIANGLE ? l->normal : sf.ng);
                 w = power_heuristic(ps->prev_pdf, pl);
             }

@@ -33,7 +33,7 @@ run render --output="$tmp/b.png" --width=24 --height=16 --spp=2 --light-samples=
 [ $rc -eq 0 ] || bad "--opt=value: exit $rc: $err"
 if cmp -s "$tmp/a.png" "$tmp/b.png"; then ok "--opt=value and --opt value: the same image"; else bad "--opt=value: the images differ"; fi
 # a unique beginning of a name is the option (getopt_long)
-run render -o "$tmp/c.png" --wid 24 --hei=16 --spp 2 --light 4 --max 3 --thr 2 --acc midpoint --fres off \
+run render -o "$tmp/c.png" --wid 24 --hei=16 --spp 2 --light-s 4 --max 3 --thr 2 --acc midpoint --fres off \
   --look-f 0,1,3.9 --look-a 0,1,0 --fov 40 -q
 if [ $rc -eq 0 ] && cmp -s "$tmp/a.png" "$tmp/c.png"; then ok "abbreviated names: the same image"; else bad "abbreviations: exit $rc: $err"; fi
 # the scene may come after the options

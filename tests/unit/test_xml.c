@@ -625,15 +625,17 @@ static void test_emitters(void)
     s = load_ok("<shape type=\"cube\"/><emitter type=\"directional\"><vector name=\"direction\" x=\"0\" y=\"-1\" z=\"0\"/>"
                 "<rgb name=\"irradiance\" value=\"2\"/></emitter>");
     if (s) {
-        const scene_environment *e = &s->env;
-        CHECK(e->has_sun && !e->has_sky && near3(e->sun_dir, v3(0, 1, 0), 1e-6f));
-        /* radiance times the disc's solid angle gives the irradiance back */
-        double half = 0.5 * (double)e->sun_angle * M_PI / 180.0;
-        CHECK_NEAR((double)e->sun_radiance.x * 2.0 * M_PI * (1.0 - cos(half)), 2.0, 2e-3);
+        /* a distant light: the direction toward it, its irradiance */
+        CHECK(!s->env.has_sun && s->nlights == 1 && s->lights[0].distant);
+        CHECK(near3(s->lights[0].position, v3(0, 1, 0), 1e-6f) && near3(s->lights[0].intensity, v3(2, 2, 2), 0.0f));
     }
     pk_scene_destroy(s);
     s = load_ok("<shape type=\"cube\"/>\n<emitter type=\"spot\"/>\n<emitter type=\"projector\"/>");
-    CHECK(s && s->nlights == 1 && warned("scene.xml:3: spot light") &&
+    /* Mitsuba's defaults: along +z, cutoff 20 degrees, beam width 3/4 of it, linear in the angle */
+    CHECK(s && s->nlights == 1 && near3(s->lights[0].spot_dir, v3(0, 0, 1), 1e-6f) &&
+          fabs(acos((double)s->lights[0].cos_outer) * 180.0 / M_PI - 20.0) < 1e-4 &&
+          fabs(acos((double)s->lights[0].cos_inner) * 180.0 / M_PI - 15.0) < 1e-4 &&
+          s->lights[0].spot_falloff == SPOT_FALLOFF_ANGLE && !warned("scene.xml:3") &&
           warned("scene.xml:4: emitter \"projector\" is not supported; ignored"));
     pk_scene_destroy(s);
 }
