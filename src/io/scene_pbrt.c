@@ -154,6 +154,7 @@ typedef struct pp {
     float fov, lens_radius, focal_distance, frame_aspect, screen[4];
     bool has_screen, ortho;
     int film_w, film_h;
+    float film_iso, exposure_time;  /* pbrt's sensor records radiance x time x ISO / 100 */
 
     named_tex *tex;
     size_t ntex, cap_tex;
@@ -2064,7 +2065,11 @@ static pk_status d_camera(pp *p, const char *type)
             return pfail(p, q->line, PK_ERR_PARSE, "camera: the screen window is empty");
         p->has_screen = true;
     }
-    static const char *const quiet[] = {"shutteropen", "shutterclose", "near", "far", "hither", "yon", NULL};
+    float so = 0.0f, sc = 1.0f;
+    if ((st = get_float(p, "shutteropen", &so)) || (st = get_float(p, "shutterclose", &sc))) return st;
+    if (!(sc > so)) return pfail(p, p->line, PK_ERR_PARSE, "camera: 'shutterclose' must be after 'shutteropen'");
+    p->exposure_time = sc - so;
+    static const char *const quiet[] = {"near", "far", "hither", "yon", NULL};
     for (int i = 0; quiet[i]; i++) param(p, quiet[i]);
     xform inv;
     if (!xform_invert(sb_transform(&p->b), &inv))
@@ -2164,9 +2169,18 @@ static pk_status d_film(pp *p, const char *type)
     if (q) pwarn(p, q->line, "Film: crop windows are not supported; the whole image is rendered");
     if ((st = param_typed(p, "pixelbounds", TB(PT_INT), "4 integers", &q))) return st;
     if (q) pwarn(p, q->line, "Film: pixel bounds are not supported; the whole image is rendered");
+    /* pbrt's sensor scales what it records by exposure time x ISO / 100 */
+    float iso = 100.0f;
+    const char *sensor = "cie1931";
+    if ((st = get_float(p, "iso", &iso)) || (st = get_string(p, "sensor", &sensor))) return st;
+    if (!(iso > 0.0f)) return pfail(p, p->line, PK_ERR_PARSE, "Film: 'iso' %g must be positive", (double)iso);
+    p->film_iso = iso;
+    if (strcmp(sensor, "cie1931") != 0)
+        pwarn(p, p->line, "Film: the sensor \"%.40s\" is not simulated (colours as the CIE 1931 observer sees them)",
+              sensor);
+    if (param(p, "whitebalance")) pwarn(p, p->line, "Film: white balance is not applied");
     /* the output file is named on the command line; the rest is the film's look */
-    static const char *const quiet[] = {"filename", "diagonal", "iso", "whitebalance", "sensor", "exposuretime",
-                                        "maxcomponentvalue", "savefp16", "writefp16", NULL};
+    static const char *const quiet[] = {"filename", "diagonal", "maxcomponentvalue", "savefp16", "writefp16", NULL};
     for (int i = 0; quiet[i]; i++) param(p, quiet[i]);
     warn_unused(p, "Film");
     return PK_OK;
@@ -2707,6 +2721,7 @@ pk_status scene_pbrt_parse(pk_context *ctx, pk_scene *s, const char *data, size_
     p->mirror = xform_identity();
     p->cam_from_world = xform_identity();
     p->film_w = 1280, p->film_h = 720;
+    p->film_iso = 100.0f, p->exposure_time = 1.0f;
     p->fov = 90.0f;
     p->focal_distance = 1e6f;
     const char *dir = base_dir ? base_dir : ".";
@@ -2727,6 +2742,14 @@ pk_status scene_pbrt_parse(pk_context *ctx, pk_scene *s, const char *data, size_
         st = pfail(p, p->line, PK_ERR_PARSE, "ObjectBegin \"%.80s\" has no ObjectEnd", p->obj_name ? p->obj_name : "");
     if (st == PK_OK) {
         s->render.opt.width = p->film_w, s->render.opt.height = p->film_h;
+        const float k = p->exposure_time * p->film_iso / 100.0f;
+        if (k != 1.0f) {
+            /* the image pbrt records: every emitter scaled by the sensor's ratio */
+            for (size_t i = 0; i < s->nmaterials; i++) s->materials[i].ke = v3_scale(s->materials[i].ke, k);
+            for (size_t i = 0; i < s->nlights; i++) s->lights[i].intensity = v3_scale(s->lights[i].intensity, k);
+            s->env.radiance = v3_scale(s->env.radiance, k);
+            if (s->env.map_rgb) s->env.map_scale *= k;
+        }
         s->render.has_width = s->render.has_height = true;
         if (!s->env.set && s->nlights == 0) {
             /* pbrt renders a scene without lights black; so does this reader */

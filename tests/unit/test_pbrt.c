@@ -185,6 +185,12 @@ static void test_transforms(void)
 static void test_camera(void)
 {
     pk_context *ctx;
+    /* pbrt's sensor: exposure time x ISO / 100 scales what the image records */
+    pk_scene *s0 = load(&ctx, "Camera \"perspective\" \"float shutterclose\" 0.5\nFilm \"rgb\" \"float iso\" 400\n"
+                              "WorldBegin\nLightSource \"point\" \"rgb I\" [1 2 3]\n"
+                              "AreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\nShape \"sphere\"\n");
+    if (s0) CHECK(near3(s0->lights[0].intensity, v3(2, 4, 6), 0) && near3(s0->materials[s0->spheres[0].material].ke, v3s(2), 0));
+    done(ctx, s0);
     /* landscape: fov is the vertical angle; settings */
     pk_scene *s = load(&ctx, "LookAt 0 1 5  0 1 0  0 1 0\nCamera \"perspective\" \"float fov\" 40\n"
                              "Film \"rgb\" \"integer xresolution\" 400 \"integer yresolution\" 200 \"string filename\" \"x.exr\"\n"
