@@ -173,6 +173,7 @@ typedef struct pp {
     pfile top;              /* the first file, for messages after it is read */
     attr_def *defs;
     size_t ndefs, cap_defs;
+    bool warned_interface;
 } pp;
 
 static const pk_allocator *A(pp *p) { return &p->ctx->alloc; }
@@ -973,6 +974,16 @@ static pk_status builder_status(pp *p, pk_status st, const pk_context *tmp)
     return pfail(p, p->line, st, "%s", tmp->message);
 }
 
+/* A shape with the "interface" material: not drawn (said once). */
+static pk_status interface_skip(pp *p)
+{
+    if (!p->warned_interface)
+        pwarn(p, p->line, "shapes with the \"interface\" material only bound media, which are not rendered yet: left "
+                          "out (further ones not reported)");
+    p->warned_interface = true;
+    return PK_OK;
+}
+
 /* World area of the mesh (for an area light's power). */
 static double mesh_area(const xform *x, const mesh_in *m)
 {
@@ -1008,7 +1019,7 @@ static vec3 area_emission(pp *p, double area, bool *two_sided)
  * world mirrors. alpha_tex: the cut-out texture, -1 none. */
 static pk_status add_mesh(pp *p, mesh_in *m, int32_t alpha_tex)
 {
-    if (GS(p)->interface) return PK_OK;
+    if (GS(p)->interface) return interface_skip(p);
     xform w = world_xf(p);
     const bool mirrored = xform_det3(&w) < 0.0;
     for (size_t t = 0; t < m->ntris; t++) {
@@ -1571,7 +1582,7 @@ static pk_status shape_sphere(pp *p, int32_t alpha)
                    fabsf(v3_dot(c1, c2)) <= 1e-5f * l1 * l2;
     bool full = zlo <= -radius && zhi >= radius && phimax >= 360.0f;
     if (full && similar && !GS(p)->reverse && alpha < 0) {
-        if (GS(p)->interface) return PK_OK;
+        if (GS(p)->interface) return interface_skip(p);
         sphere sp;
         sp.center = xform_point(&w, v3s(0.0f));
         sp.radius = radius * l0;
