@@ -259,6 +259,12 @@ typedef struct pk_render_options {
      * has 8 or more lights other than the environment, the sun and distant
      * lights. The image converges to the same answer either way. */
     int light_tree;
+    /* Indirect clamping (the path tracer): when > 0, the light a sample
+     * brings through at least one bounce after the first surface it sees
+     * is scaled down so that no component exceeds this value. Removes the
+     * rest of the fireflies at the price of a darker, biased image; 0 (the
+     * default) is off. */
+    float clamp_indirect;
 } pk_render_options;
 
 /* Arbitrary output variables: what the camera ray of each sample found,

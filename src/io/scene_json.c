@@ -852,10 +852,10 @@ static pk_status parse_film(jp *p, const cJSON *it)
 
 static pk_status parse_render(jp *p, const cJSON *it)
 {
-    enum { R_W, R_H, R_SPP, R_LS, R_DEPTH, R_THREADS, R_SEED, R_ACCEL, R_FRESNEL, R_INTEGRATOR, R_REGULARIZE, R_LIGHT_TREE, R_COUNT };
+    enum { R_W, R_H, R_SPP, R_LS, R_DEPTH, R_THREADS, R_SEED, R_ACCEL, R_FRESNEL, R_INTEGRATOR, R_REGULARIZE, R_LIGHT_TREE, R_CLAMP, R_COUNT };
     static const char *const keys[R_COUNT] = {"width",   "height", "spp",   "light_samples", "max_depth",
                                               "threads", "seed",   "accel", "fresnel",       "integrator",
-                                              "regularize", "light_tree"};
+                                              "regularize", "light_tree", "clamp_indirect"};
     const cJSON *f[R_COUNT];
     pk_status st = object_fields(p, it, "render", keys, R_COUNT, f);
     if (st) return st;
@@ -898,6 +898,12 @@ static pk_status parse_render(jp *p, const cJSON *it)
         if (!cJSON_IsBool(f[R_FRESNEL])) return jfail(p, PK_ERR_PARSE, f[R_FRESNEL], "render.fresnel", "must be true or false");
         r->opt.fresnel = cJSON_IsTrue(f[R_FRESNEL]) ? 1 : 0;
         r->has_fresnel = true;
+    }
+    if (f[R_CLAMP]) {
+        if ((st = get_float(p, f[R_CLAMP], "render.clamp_indirect", &r->opt.clamp_indirect))) return st;
+        if (!(r->opt.clamp_indirect >= 0.0f))
+            return jfail(p, PK_ERR_PARSE, f[R_CLAMP], "render.clamp_indirect", "must be 0 (off) or more");
+        r->has_clamp_indirect = true;
     }
     return parse_size(p, f[R_W], f[R_H], it, "render");
 }

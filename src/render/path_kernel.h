@@ -218,6 +218,18 @@ static inline PK_HD void path_begin(path_state *ps, const ray *r, const hit *h, 
  * random numbers and changes nothing of the path. The CPU loops over it per
  * sample; GPU threads that start a new path as soon as one ends run the
  * same steps. */
+/* Adds the contribution c to the path's radiance; indirect (light that has
+ * bounced at least once after the first surface the camera sees) is
+ * clamped when the tracer asks for it (pk_render_options.clamp_indirect). */
+static inline PK_HD void path_add(const path_tracer *pt, path_state *ps, vec3 c, bool indirect)
+{
+    if (indirect && pt->clamp_indirect > 0.0f) {
+        const float m = v3_max_comp(c);
+        if (m > pt->clamp_indirect) c = v3_scale(c, pt->clamp_indirect / m);
+    }
+    ps->L = v3_add(ps->L, c);
+}
+
 static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_state *ps, path_aov *aov)
 {
     const frame *fr = pt->f;
@@ -225,7 +237,8 @@ static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_s
     sampler *smp = &ps->smp;
     if (s->has_cutout && !path_past_holes(pt, t, &ps->r, &ps->h)) { /* through map_d holes, out */
         if (aov && aov->open) path_aov_miss(pt, aov, v3_norm(ps->r.d), ps->beta);
-        ps->L = v3_add(ps->L, v3_mul(ps->beta, leaving(pt, v3_norm(ps->r.d), ps->prev_delta, ps->prev_pdf)));
+        /* the ray came from vertex depth - 1 */
+        path_add(pt, ps, v3_mul(ps->beta, leaving(pt, v3_norm(ps->r.d), ps->prev_delta, ps->prev_pdf)), ps->depth >= 2);
         return false;
     }
     surface sf = surface_at(s, &ps->r, &ps->h);
@@ -251,7 +264,7 @@ static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_s
                 w = power_heuristic(ps->prev_pdf, pl);
             }
         }
-        ps->L = v3_add(ps->L, v3_mul(ps->beta, v3_scale(le, w)));
+        path_add(pt, ps, v3_mul(ps->beta, v3_scale(le, w)), ps->depth >= 2);
     }
     if (ps->depth >= pt->max_depth) return false;
     shading sh = shading_at(&sf);
@@ -279,7 +292,7 @@ static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_s
                 const bool blocked = path_occluded(pt, t, &ls.shadow);
                 if (!blocked) {
                     float w = ls.delta || pt->strategy == PATH_LIGHTS_ONLY ? 1.0f : power_heuristic(ls.pdf, pb);
-                    ps->L = v3_add(ps->L, v3_mul(ps->beta, v3_scale(v3_mul(f, ls.le), w / ls.pdf)));
+                    path_add(pt, ps, v3_mul(ps->beta, v3_scale(v3_mul(f, ls.le), w / ls.pdf)), ps->depth >= 1);
                 }
             }
         }
@@ -311,7 +324,7 @@ static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_s
     t->rays_bounce++;
     if (!PATH_TRACE(pt, t, &ps->r, &ps->h)) {
         if (aov && aov->open) path_aov_miss(pt, aov, wi, ps->beta); /* (open: the vertex left was specular) */
-        ps->L = v3_add(ps->L, v3_mul(ps->beta, leaving(pt, wi, ps->prev_delta, ps->prev_pdf)));
+        path_add(pt, ps, v3_mul(ps->beta, leaving(pt, wi, ps->prev_delta, ps->prev_pdf)), ps->depth >= 1);
         return false;
     }
     ps->depth++;

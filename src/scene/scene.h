@@ -106,7 +106,7 @@ typedef struct scene_instance {
 typedef struct scene_render_settings {
     pk_render_options opt;
     bool has_width, has_height, has_spp, has_light_samples, has_max_depth, has_threads,
-        has_accel, has_fresnel, has_seed, has_integrator, has_regularize, has_light_tree;
+        has_accel, has_fresnel, has_seed, has_integrator, has_regularize, has_light_tree, has_clamp_indirect;
 } scene_render_settings;
 
 /* Invariants (scene_check tests them after commit):

@@ -148,7 +148,8 @@ static void lab_init(lab *L, const vec3 *verts, int ntri, bool two_sided)
     L->v.positions = L->pos, L->v.npositions = (size_t)(3 * ntri);
     L->v.tris = L->tris, L->v.ntris = (size_t)ntri;
     L->v.materials = &L->mat, L->v.nmaterials = 1;
-    L->set = (light_set){(size_t)ntri, L->lights, L->cdf, L->pmf, L->of_prim, -1, -1, total};
+    L->set = (light_set){.n = (size_t)ntri, .lights = L->lights, .cdf = L->cdf, .pmf = L->pmf, .of_prim = L->of_prim,
+                         .env = -1, .sun = -1, .power = total};
 }
 
 static light_ctx ctx_at(vec3 p, vec3 n) { return (light_ctx){p, n, p, false}; }
