@@ -388,14 +388,15 @@ static pk_status get_unit(jp *p, const cJSON *it, const char *path, float *out)
 /* The physically based material types (docs/materials.md). The keys of each:
  * the common ones ("type", "two_sided") and the type's parameters. */
 enum { TP_ALBEDO, TP_SPECULAR, TP_ETA, TP_K, TP_ROUGHNESS, TP_ALPHA, TP_IOR, TP_TRANSMITTANCE, TP_RADIANCE, TP_BSDF,
-       TP_BASE_COLOR, TP_METALLIC, TP_TRANSMISSION, TP_MR_MAP, TP_COUNT };
+       TP_BASE_COLOR, TP_METALLIC, TP_TRANSMISSION, TP_MR_MAP, TP_CLEARCOAT, TP_CLEARCOAT_ROUGHNESS, TP_COUNT };
 static const char *const tp_keys[TP_COUNT] = {"albedo",     "specular", "eta",           "k",       "roughness",
                                               "alpha",      "ior",      "transmittance", "radiance", "bsdf",
-                                              "base_color", "metallic", "transmission",  "metallic_roughness_map"};
+                                              "base_color", "metallic", "transmission",  "metallic_roughness_map",
+                                              "clearcoat",  "clearcoat_roughness"};
 typedef struct mat_type_def {
     const char *name;
     int nparams;
-    int params[6];
+    int params[8];
 } mat_type_def;
 static const mat_type_def mat_types[] = {
     {"diffuse", 1, {TP_ALBEDO}},
@@ -404,7 +405,8 @@ static const mat_type_def mat_types[] = {
     {"plastic", 3, {TP_ALBEDO, TP_IOR, TP_ROUGHNESS}},
     {"emitter", 2, {TP_RADIANCE, TP_BSDF}},
     {"two_sided", 1, {TP_BSDF}},
-    {"metallic_roughness", 6, {TP_BASE_COLOR, TP_METALLIC, TP_ROUGHNESS, TP_TRANSMISSION, TP_IOR, TP_MR_MAP}},
+    {"metallic_roughness", 8,
+     {TP_BASE_COLOR, TP_METALLIC, TP_ROUGHNESS, TP_TRANSMISSION, TP_IOR, TP_MR_MAP, TP_CLEARCOAT, TP_CLEARCOAT_ROUGHNESS}},
 };
 #define MT_METALLIC_ROUGHNESS 6 /* its index in mat_types */
 #define N_MAT_TYPES (sizeof mat_types / sizeof mat_types[0])
@@ -476,8 +478,8 @@ static pk_status read_typed_material(jp *p, const cJSON *obj, const cJSON *type_
     if (t == MT_METALLIC_ROUGHNESS) {
         /* base colour: a colour or an (sRGB) texture; metallic and roughness:
          * numbers, scaled by the metallic_roughness_map (data, not sRGB) */
-        for (int k = TP_METALLIC; k <= TP_TRANSMISSION; k++) {
-            if (!pv[k] || !cJSON_IsObject(pv[k])) continue;
+        for (int k = TP_METALLIC; k <= TP_CLEARCOAT_ROUGHNESS; k++) {
+            if (k == TP_MR_MAP || !pv[k] || !cJSON_IsObject(pv[k])) continue;
             path_key(fp, path, tp_keys[k]);
             return jfail(p, PK_ERR_PARSE, pv[k], fp, "must be a number in 0..1 (textures: \"metallic_roughness_map\")");
         }
@@ -615,9 +617,16 @@ static pk_status read_typed_material(jp *p, const cJSON *obj, const cJSON *type_
         if (pv[TP_METALLIC] && (st = get_unit(p, pv[TP_METALLIC], pp[TP_METALLIC], &metallic))) return st;
         if (pv[TP_TRANSMISSION] && (st = get_unit(p, pv[TP_TRANSMISSION], pp[TP_TRANSMISSION], &transmission)))
             return st;
+        float clearcoat = 0.0f, clearcoat_roughness = 0.0f;
+        if (pv[TP_CLEARCOAT] && (st = get_unit(p, pv[TP_CLEARCOAT], pp[TP_CLEARCOAT], &clearcoat))) return st;
+        if (pv[TP_CLEARCOAT_ROUGHNESS] &&
+            (st = get_unit(p, pv[TP_CLEARCOAT_ROUGHNESS], pp[TP_CLEARCOAT_ROUGHNESS], &clearcoat_roughness)))
+            return st;
         material_metallic_roughness(m, albedo, metallic, roughness);
         m->transmission = transmission;
         m->ni = ior;
+        m->clearcoat = clearcoat;
+        m->clearcoat_roughness = clearcoat_roughness;
         break;
     }
     default: { /* emitter: black diffuse, or the surface its "bsdf" describes */

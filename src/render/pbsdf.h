@@ -65,7 +65,9 @@ typedef enum pbsdf_type {
  *                                          (Schlick, F0 = ((ior - 1) / (ior + 1))^2)
  *   metallic      [0, 1]                   metallic-roughness: the metal's share
  *   transmission  [0, 1]                   metallic-roughness: the share of the dielectric's
- *                                          base that is transmitted rather than diffuse */
+ *                                          base that is transmitted rather than diffuse
+ *   coat          [0, 1]                   metallic-roughness: the clearcoat's weight
+ *   coat_alpha    [0, 1]                   metallic-roughness: the clearcoat's GGX alpha */
 typedef struct pbsdf {
     int type;            /* pbsdf_type */
     unsigned flags;      /* PBSDF_SCHLICK */
@@ -76,6 +78,7 @@ typedef struct pbsdf {
     float alpha;
     float ior;
     float metallic, transmission;
+    float coat, coat_alpha;
 } pbsdf;
 
 /* ---- constructors ------------------------------------------------------- */
@@ -91,6 +94,7 @@ static inline PK_HD pbsdf pbsdf__blank(int type)
     b.alpha = 0.0f;
     b.ior = 1.5f;
     b.metallic = b.transmission = 0.0f;
+    b.coat = b.coat_alpha = 0.0f;
     return b;
 }
 static inline PK_HD pbsdf pbsdf_diffuse(vec3 albedo)
@@ -151,6 +155,15 @@ static inline PK_HD pbsdf pbsdf_metallic_roughness(vec3 base_color, float metall
     b.alpha = alpha;
     b.transmission = transmission;
     b.ior = ior;
+    return b;
+}
+/* KHR_materials_clearcoat over a metallic-roughness BSDF: a clear layer of
+ * ior 1.5 and GGX alpha coat_alpha (the clearcoat roughness squared) with
+ * weight coat. */
+static inline PK_HD pbsdf pbsdf_with_clearcoat(pbsdf b, float coat, float coat_alpha)
+{
+    b.coat = coat;
+    b.coat_alpha = coat_alpha;
     return b;
 }
 /* GGX roughness for an MTL Phong exponent: alpha = sqrt(2 / (Ns + 2)). */
@@ -345,6 +358,11 @@ static inline PK_HD vec3 pbsdf__plastic_diffuse_cos(const pbsdf *b, vec3 wo, vec
  * sheet's transmission of KHR_materials_transmission: the same lobe about
  * the direction straight through (no refraction, ior only in F). All terms
  * are symmetric in wo and wi (|wo.h| = |wi.h|), so the BSDF is reciprocal.
+ * KHR_materials_clearcoat lays a clear coat over all of it:
+ *   coated     = mix(material, specular(coat_alpha), coat Fc),
+ *                Fc = 0.04 + 0.96 (1 - wo.z)^5
+ * with Fc of the view alone, as the extension defines it (so a coated
+ * surface is not reciprocal).
  * As the specification says of its fresnel_mix, the diffuse base weighted by
  * 1 - F(|wo.h|) does not conserve energy toward grazing angles: a white
  * dielectric reflects up to 1.05 of the light at 65 degrees from the normal
@@ -361,26 +379,34 @@ static inline PK_HD float pbsdf__mr_f0(const pbsdf *b)
 }
 static inline PK_HD vec3 pbsdf__mirror_z(vec3 w) { return v3(w.x, w.y, -w.z); }
 
-/* The probabilities of sampling the specular reflection (*ps), the diffuse
- * base (*pd) and the transmission (*pt), in proportion to the lobes'
- * weights at normal-to-wo incidence. */
-static inline PK_HD void pbsdf__mr_probs(const pbsdf *b, vec3 wo, float *ps, float *pd, float *pt)
+/* The clearcoat's weight toward wo: coat Fc(wo.z). */
+static inline PK_HD float pbsdf__mr_coat(const pbsdf *b, vec3 wo)
+{
+    return b->coat > 0.0f ? b->coat * (0.04f + 0.96f * pbsdf__schlick_w(wo.z)) : 0.0f;
+}
+static inline PK_HD bool pbsdf__coat_smooth(const pbsdf *b) { return b->coat_alpha < PBSDF_ALPHA_SMOOTH; }
+
+/* The probabilities of sampling the specular reflection (p[0]), the diffuse
+ * base (p[1]), the transmission (p[2]) and the clearcoat (p[3]), in
+ * proportion to the lobes' weights at normal-to-wo incidence. */
+static inline PK_HD void pbsdf__mr_probs(const pbsdf *b, vec3 wo, float p[4])
 {
     const float w = pbsdf__schlick_w(wo.z), f0 = pbsdf__mr_f0(b), m = b->metallic, t = b->transmission;
-    const float f = f0 + (1.0f - f0) * w, base = pbsdf__mean(b->albedo);
-    const float es = (1.0f - m) * f + m * (base + (1.0f - base) * w);
-    const float eb = (1.0f - m) * (1.0f - f) * base;
-    const float ed = eb * (1.0f - t), et = eb * t, sum = es + ed + et;
+    const float f = f0 + (1.0f - f0) * w, base = pbsdf__mean(b->albedo), cw = pbsdf__mr_coat(b, wo);
+    const float es = ((1.0f - m) * f + m * (base + (1.0f - base) * w)) * (1.0f - cw);
+    const float eb = (1.0f - m) * (1.0f - f) * base * (1.0f - cw);
+    const float ed = eb * (1.0f - t), et = eb * t, sum = es + ed + et + cw;
     if (!(sum > 0.0f)) {
-        *ps = 1.0f, *pd = *pt = 0.0f;
+        p[0] = 1.0f, p[1] = p[2] = p[3] = 0.0f;
         return;
     }
-    *pd = ed / sum, *pt = et / sum;
-    *ps = 1.0f - *pd - *pt;
+    p[1] = ed / sum, p[2] = et / sum, p[3] = cw / sum;
+    p[0] = 1.0f - p[1] - p[2] - p[3];
 }
 
 /* The delta lobes of a smooth surface toward wo (h = the normal): the
- * mirror's weight and the straight-through transmission's. */
+ * mirror's weight and the straight-through transmission's (under the
+ * clearcoat, which takes its share, pbsdf__mr_coat). */
 static inline PK_HD vec3 pbsdf__mr_delta_reflect(const pbsdf *b, vec3 wo)
 {
     const float w = pbsdf__schlick_w(wo.z), f0 = pbsdf__mr_f0(b), m = b->metallic;
@@ -393,8 +419,9 @@ static inline PK_HD vec3 pbsdf__mr_delta_transmit(const pbsdf *b, vec3 wo)
     return v3_scale(b->albedo, (1.0f - b->metallic) * b->transmission * (1.0f - (f0 + (1.0f - f0) * w)));
 }
 
-/* f cos of the non-delta part (wo.z > 0; wi on either side). */
-static inline PK_HD vec3 pbsdf__mr_eval(const pbsdf *b, vec3 wo, vec3 wi)
+/* f cos of the non-delta part (wo.z > 0; wi on either side), without the
+ * clearcoat. */
+static inline PK_HD vec3 pbsdf__mr_eval_base(const pbsdf *b, vec3 wo, vec3 wi)
 {
     if (!(wo.z > 0.0f) || wi.z == 0.0f) return v3s(0.0f);
     const float m = b->metallic, t = b->transmission, f0 = pbsdf__mr_f0(b);
@@ -421,16 +448,33 @@ static inline PK_HD vec3 pbsdf__mr_eval(const pbsdf *b, vec3 wo, vec3 wi)
     return r;
 }
 
-/* The mixture density of the three lobes' samplers. */
+/* f cos of the non-delta part, the clearcoat included. */
+static inline PK_HD vec3 pbsdf__mr_eval(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    vec3 r = pbsdf__mr_eval_base(b, wo, wi);
+    if (!(b->coat > 0.0f)) return r;
+    const float cw = pbsdf__mr_coat(b, wo);
+    r = v3_scale(r, 1.0f - cw);
+    if (wi.z > 0.0f && wo.z > 0.0f && !pbsdf__coat_smooth(b)) {
+        vec3 h;
+        const float s = pbsdf__ggx_refl_cos(b->coat_alpha, wo, wi, &h);
+        if (s > 0.0f) r = v3_add(r, v3s(cw * s));
+    }
+    return r;
+}
+
+/* The mixture density of the lobes' samplers. */
 static inline PK_HD float pbsdf__mr_pdf(const pbsdf *b, vec3 wo, vec3 wi)
 {
     if (!(wo.z > 0.0f) || wi.z == 0.0f) return 0.0f;
-    float ps, pd, pt;
-    pbsdf__mr_probs(b, wo, &ps, &pd, &pt);
+    float pr[4];
+    pbsdf__mr_probs(b, wo, pr);
     const bool smooth = pbsdf__smooth(b);
-    if (wi.z < 0.0f) return smooth || !(pt > 0.0f) ? 0.0f : pt * pbsdf__ggx_refl_pdf(b->alpha, wo, pbsdf__mirror_z(wi));
-    float p = pd * wi.z / PK_PI;
-    if (!smooth && ps > 0.0f) p += ps * pbsdf__ggx_refl_pdf(b->alpha, wo, wi);
+    if (wi.z < 0.0f)
+        return smooth || !(pr[2] > 0.0f) ? 0.0f : pr[2] * pbsdf__ggx_refl_pdf(b->alpha, wo, pbsdf__mirror_z(wi));
+    float p = pr[1] * wi.z / PK_PI;
+    if (!smooth && pr[0] > 0.0f) p += pr[0] * pbsdf__ggx_refl_pdf(b->alpha, wo, wi);
+    if (!pbsdf__coat_smooth(b) && pr[3] > 0.0f) p += pr[3] * pbsdf__ggx_refl_pdf(b->coat_alpha, wo, wi);
     return p;
 }
 
@@ -514,13 +558,16 @@ static inline PK_HD bool pbsdf__refract(vec3 w, vec3 m, float ior, vec3 *out)
 static inline PK_HD void pbsdf_regularize(pbsdf *b)
 {
     if (b->type != PBSDF_DIFFUSE && b->alpha < 0.3f) b->alpha = fminf(fmaxf(2.0f * b->alpha, 0.1f), 0.3f);
+    if (b->coat > 0.0f && b->coat_alpha < 0.3f) b->coat_alpha = fminf(fmaxf(2.0f * b->coat_alpha, 0.1f), 0.3f);
 }
 
 static inline PK_HD bool pbsdf_has_nondelta(const pbsdf *b)
 {
     switch (b->type) {
     case PBSDF_DIFFUSE: case PBSDF_PLASTIC: case PBSDF_GLOSSY: return true;
-    case PBSDF_METALLIC_ROUGHNESS: return !pbsdf__smooth(b) || (1.0f - b->metallic) * (1.0f - b->transmission) > 0.0f;
+    case PBSDF_METALLIC_ROUGHNESS:
+        return !pbsdf__smooth(b) || (1.0f - b->metallic) * (1.0f - b->transmission) > 0.0f ||
+               (b->coat > 0.0f && !pbsdf__coat_smooth(b));
     default: return !pbsdf__smooth(b);
     }
 }
@@ -663,29 +710,40 @@ static inline PK_HD bool pbsdf_sample(const pbsdf *b, vec3 wo, const float u[3],
         return true;
     }
     case PBSDF_METALLIC_ROUGHNESS: {
-        float ps, pd, pt;
-        pbsdf__mr_probs(b, wo, &ps, &pd, &pt);
+        float pr[4];
+        pbsdf__mr_probs(b, wo, pr);
+        *weight = v3s(0.0f);
         const bool smooth = pbsdf__smooth(b);
-        if (u[0] < ps || !(pd > 0.0f || pt > 0.0f)) { /* specular reflection */
-            if (smooth) {
+        int lobe = 0;
+        float c = pr[0];
+        while (lobe < 3 && !(u[0] < c)) c += pr[++lobe];
+        while (!(pr[lobe] > 0.0f)) lobe = (lobe + 1) & 3; /* float rounding: a lobe that has weight */
+        const float under = 1.0f - pbsdf__mr_coat(b, wo);
+        if (lobe == 0 || lobe == 3) { /* specular reflection, or the clearcoat's */
+            const bool coat = lobe == 3;
+            if (coat ? pbsdf__coat_smooth(b) : smooth) {
                 *wi = pbsdf__mirror(wo);
-                *weight = v3_scale(pbsdf__mr_delta_reflect(b, wo), 1.0f / ps);
-                *pdf = ps;
+                vec3 f = coat ? v3s(pbsdf__mr_coat(b, wo)) : pbsdf__mr_delta_reflect(b, wo);
+                if (!coat && b->coat > 0.0f) f = v3_scale(f, under);
+                *weight = v3_scale(f, 1.0f / pr[lobe]);
+                *pdf = pr[lobe];
                 *is_delta = true;
                 return true;
             }
-            vec3 m = pbsdf_ggx_vndf_sample(b->alpha, wo, u[1], u[2]);
+            vec3 m = pbsdf_ggx_vndf_sample(coat ? b->coat_alpha : b->alpha, wo, u[1], u[2]);
             w = v3_sub(v3_scale(m, 2.0f * v3_dot(wo, m)), wo);
             if (!(w.z > 0.0f)) return false;
-        } else if (u[0] < ps + pd || !(pt > 0.0f)) { /* the diffuse base */
+        } else if (lobe == 1) { /* the diffuse base */
             float r = sqrtf(u[1]), phi = 2.0f * PK_PI * u[2];
             w = v3(r * cosf(phi), r * sinf(phi), sqrtf(fmaxf(0.0f, 1.0f - u[1])));
             if (!(w.z > 0.0f)) return false;
         } else { /* transmission: the specular lobe mirrored through the sheet */
             if (smooth) {
                 *wi = v3_neg(wo);
-                *weight = v3_scale(pbsdf__mr_delta_transmit(b, wo), 1.0f / pt);
-                *pdf = pt;
+                vec3 f = pbsdf__mr_delta_transmit(b, wo);
+                if (b->coat > 0.0f) f = v3_scale(f, under);
+                *weight = v3_scale(f, 1.0f / pr[2]);
+                *pdf = pr[2];
                 *is_delta = true;
                 return true;
             }

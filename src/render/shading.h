@@ -50,6 +50,10 @@ static inline PK_HD shading shading_at(const surface *sf)
             const float r = fminf(fmaxf(m->roughness, 0.0f), 1.0f);
             sh.b = pbsdf_metallic_roughness(surface_clamp_rgb(m->kd), fminf(fmaxf(m->metallic, 0.0f), 1.0f), r * r,
                                             fminf(fmaxf(m->transmission, 0.0f), 1.0f), m->ni);
+            if (m->clearcoat > 0.0f) {
+                const float cr = fminf(fmaxf(m->clearcoat_roughness, 0.0f), 1.0f);
+                sh.b = pbsdf_with_clearcoat(sh.b, fminf(m->clearcoat, 1.0f), cr * cr);
+            }
             break;
         }
         default: sh.b = pbsdf_diffuse(m->kd); break;

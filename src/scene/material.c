@@ -97,6 +97,7 @@ void material_metallic_roughness(material *m, vec3 base_color, float metallic, f
     m->type = MAT_METALLIC_ROUGHNESS;
     m->kd = base_color;
     m->metallic = metallic, m->roughness = roughness, m->transmission = 0.0f;
+    m->clearcoat = m->clearcoat_roughness = 0.0f;
     m->ni = 1.5f;
     m->alpha = roughness * roughness;
     /* Whitted: the diffuse share of kd (material_whitted_kd), and a glossy

@@ -63,7 +63,9 @@ typedef struct material {
      * roughness^2 at shading), transmission in 0..1 (KHR_materials_
      * transmission: the thin-walled transmitted share of the dielectric's
      * base) and the dielectric's index ni (KHR_materials_ior, 1.5 by
-     * default). Their constructors also set the MTL fields to what the
+     * default), clearcoat and clearcoat_roughness in 0..1 (KHR_materials_
+     * clearcoat: a clear layer of ior 1.5 over it all; 0 = none). Their
+     * constructors also set the MTL fields to what the
      * Whitted integrator renders of them (for metallic-roughness,
      * material_whitted_kd gives the Whitted diffuse, since kd holds the base
      * colour). */
@@ -71,7 +73,7 @@ typedef struct material {
     float alpha;
     vec3 eta, k;
     bool schlick;
-    float metallic, roughness, transmission;
+    float metallic, roughness, transmission, clearcoat, clearcoat_roughness;
     /* Texture maps (docs/materials.md), kind TEX_NONE when absent. A map's
      * value multiplies its constant: map_kd kd, map_ks ks, map_ns ns,
      * map_alpha alpha; map_mr is glTF's metallic-roughness texture (data,
@@ -104,10 +106,11 @@ PK_HIDDEN void material_dielectric(material *m, float ior, float alpha, vec3 tra
 PK_HIDDEN void material_plastic(material *m, vec3 albedo, float ior, float alpha);
 
 /* glTF 2.0's metallic-roughness material: base colour (linear), metallic and
- * perceptual roughness in 0..1; transmission 0 and ior 1.5 (set the fields
- * transmission and ni afterwards for KHR_materials_transmission and
- * KHR_materials_ior; material_whitted_kd reads transmission where it is
- * used). */
+ * perceptual roughness in 0..1; transmission 0, ior 1.5 and no clearcoat
+ * (set the fields transmission, ni, clearcoat and clearcoat_roughness
+ * afterwards for KHR_materials_transmission, _ior and _clearcoat;
+ * material_whitted_kd reads transmission where it is used; the Whitted
+ * approximation has no clearcoat). */
 PK_HIDDEN void material_metallic_roughness(material *m, vec3 base_color, float metallic, float roughness);
 
 /* The diffuse reflectance that the MTL model and the Whitted integrator use:

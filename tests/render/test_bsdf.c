@@ -273,6 +273,10 @@ static furnace white_furnace(const pbsdf *b, vec3 wo, uint64_t seed)
 
 static void test_reciprocity(const bcase *bc, uint64_t seed)
 {
+    /* KHR_materials_clearcoat weights its layer by the view's Fresnel alone:
+     * not reciprocal by its definition (test_metallic_roughness checks it
+     * against that definition instead) */
+    if (bc->b.type == PBSDF_METALLIC_ROUGHNESS && bc->b.coat > 0.0f) return;
     prng g = prng_make(seed);
     int bad = 0;
     double worst = 0.0;
@@ -320,7 +324,8 @@ static double ref_vis(double a, double nl, double nv)
     double a2 = a * a;
     return 1.0 / (2.0 * (nv * sqrt(a2 + (1.0 - a2) * nl * nl) + nl * sqrt(a2 + (1.0 - a2) * nv * nv)));
 }
-static void ref_mr(vec3 base, double metal, double a, double trans, double ior, vec3 wo, vec3 wi, double out[3])
+static void ref_mr(vec3 base, double metal, double a, double trans, double ior, double coat, double coat_a, vec3 wo,
+                   vec3 wi, double out[3])
 {
     const double c[3] = {base.x, base.y, base.z};
     const double f0 = ((1.0 - ior) / (1.0 + ior)) * ((1.0 - ior) / (1.0 + ior));
@@ -341,6 +346,9 @@ static void ref_mr(vec3 base, double metal, double a, double trans, double ior, 
             metal_brdf = (c[k] + (1.0 - c[k]) * w) * spec;
         }
         out[k] = ((1.0 - metal) * dielectric + metal * metal_brdf) * l[2];
+        /* KHR_materials_clearcoat: mix(material, coat_brdf, coat Fc(N.V)) */
+        const double fc = coat * (0.04 + 0.96 * pow(1.0 - v[2], 5.0));
+        out[k] = (1.0 - fc) * out[k] + (below ? 0.0 : fc * ref_d(coat_a, h[2]) * ref_vis(coat_a, l[2], v[2]) * l[2]);
     }
 }
 
@@ -367,13 +375,15 @@ static void test_metallic_roughness(void)
 {
     prng g = prng_make(21);
     /* eval against the specification's formulas */
-    const struct { vec3 base; float m, a, t, ior; } p[] = {
-        {{1.0f, 1.0f, 1.0f}, 0.0f, 0.3f, 0.0f, 1.5f},  {{0.9f, 0.5f, 0.2f}, 1.0f, 0.5f, 0.0f, 1.5f},
-        {{0.9f, 0.5f, 0.2f}, 0.4f, 0.1f, 0.0f, 1.5f},  {{0.8f, 0.9f, 1.0f}, 0.0f, 0.6f, 1.0f, 1.5f},
-        {{0.7f, 0.8f, 0.3f}, 0.3f, 0.25f, 0.6f, 1.33f}, {{0.2f, 0.4f, 0.6f}, 0.7f, 1.0f, 0.2f, 2.4f},
+    const struct { vec3 base; float m, a, t, ior, coat, coat_a; } p[] = {
+        {{1.0f, 1.0f, 1.0f}, 0.0f, 0.3f, 0.0f, 1.5f, 0.0f, 0.0f},  {{0.9f, 0.5f, 0.2f}, 1.0f, 0.5f, 0.0f, 1.5f, 0.0f, 0.0f},
+        {{0.9f, 0.5f, 0.2f}, 0.4f, 0.1f, 0.0f, 1.5f, 0.0f, 0.0f},  {{0.8f, 0.9f, 1.0f}, 0.0f, 0.6f, 1.0f, 1.5f, 0.0f, 0.0f},
+        {{0.7f, 0.8f, 0.3f}, 0.3f, 0.25f, 0.6f, 1.33f, 0.0f, 0.0f}, {{0.2f, 0.4f, 0.6f}, 0.7f, 1.0f, 0.2f, 2.4f, 0.0f, 0.0f},
+        {{0.9f, 0.2f, 0.1f}, 0.5f, 0.4f, 0.3f, 1.5f, 0.8f, 0.05f}, {{0.5f, 0.5f, 0.5f}, 1.0f, 0.7f, 0.0f, 1.5f, 1.0f, 0.3f},
     };
     for (size_t k = 0; k < sizeof p / sizeof p[0]; k++) {
-        pbsdf b = pbsdf_metallic_roughness(p[k].base, p[k].m, p[k].a, p[k].t, p[k].ior);
+        pbsdf b = pbsdf_with_clearcoat(pbsdf_metallic_roughness(p[k].base, p[k].m, p[k].a, p[k].t, p[k].ior), p[k].coat,
+                                       p[k].coat_a);
         int bad = 0;
         double worst = 0.0;
         for (int i = 0; i < 20000; i++) {
@@ -384,7 +394,7 @@ static void test_metallic_roughness(void)
             }
             if (i & 1) d[1].z = -d[1].z; /* transmission */
             double want[3];
-            ref_mr(p[k].base, p[k].m, p[k].a, p[k].t, p[k].ior, d[0], d[1], want);
+            ref_mr(p[k].base, p[k].m, p[k].a, p[k].t, p[k].ior, p[k].coat, p[k].coat_a, d[0], d[1], want);
             vec3 got = pbsdf_eval(&b, d[0], d[1]);
             const float gv[3] = {got.x, got.y, got.z};
             for (int c = 0; c < 3; c++) {
@@ -472,7 +482,7 @@ static void test_metallic_roughness(void)
 
 /* ---- driver ------------------------------------------------------------------ */
 
-#define MAX_CASES 64
+#define MAX_CASES 80
 static bcase cases[MAX_CASES];
 static int n_cases;
 
@@ -517,7 +527,17 @@ static void build_cases(void)
         add_case("mr m.5 coloured", a, pbsdf_metallic_roughness(v3(0.9f, 0.5f, 0.2f), 0.5f, a, 0.0f, 1.5f), false);
         add_case("mr transmission t1", a, pbsdf_metallic_roughness(v3(0.8f, 0.9f, 1.0f), 0.0f, a, 1.0f, 1.5f), false);
         add_case("mr m.3 t.6 ior1.33", a, pbsdf_metallic_roughness(v3(0.7f, 0.8f, 0.3f), 0.3f, a, 0.6f, 1.33f), false);
+        /* KHR_materials_clearcoat: a rough coat over a smooth base, the coat as rough as the base */
+        add_case("mr coat .8 over smooth", a,
+                 pbsdf_with_clearcoat(pbsdf_metallic_roughness(v3(0.9f, 0.2f, 0.1f), 0.5f, 0.0f, 0.3f, 1.5f), 0.8f, a),
+                 false);
+        add_case("mr coat 1 over m1", a,
+                 pbsdf_with_clearcoat(pbsdf_metallic_roughness(v3(1.0f, 1.0f, 1.0f), 1.0f, a, 0.0f, 1.5f), 1.0f, a),
+                 false);
     }
+    add_case("mr smooth coat over rough", 0.0f,
+             pbsdf_with_clearcoat(pbsdf_metallic_roughness(v3(0.2f, 0.6f, 0.9f), 0.0f, 0.3f, 0.0f, 1.5f), 1.0f, 0.0f),
+             false);
     /* MTL-style glossy with kd + ks = 1 in one channel, from an Ns */
     add_case("glossy mtl Ns=100", -1.0f, pbsdf_glossy_mtl(v3(0.7f, 0.2f, 0.1f), v3(0.3f, 0.3f, 0.3f), 100.0f), false);
 }

@@ -2,8 +2,9 @@
  * test_metallic_roughness.c - glTF 2.0's metallic-roughness material in the
  * renderers, from a JSON scene: light sampling, material sampling and both
  * weighted by MIS must give the same image (block means within confidence
- * intervals, block_stats.h), with the metal, the dielectric, a mixture and
- * the thin sheet's transmission (KHR_materials_transmission) in view, lit
+ * intervals, block_stats.h), with the metal, a clearcoated dielectric, a
+ * mixture and the thin sheet's transmission (KHR_materials_transmission) in
+ * view, lit
  * through the sheet as well as in front of it; the Whitted integrator
  * renders the scene (with a point light); nothing is NaN. The light behind
  * the sheet is reached by light sampling too: its shadow rays leave from
@@ -86,7 +87,7 @@ int main(void)
         "   \"roughness\": 0.45, \"transmission\": 1},"
         " \"metal\": {\"type\": \"metallic_roughness\", \"base_color\": [0.95, 0.64, 0.54], \"roughness\": 0.35},"
         " \"plastic\": {\"type\": \"metallic_roughness\", \"base_color\": [0.2, 0.5, 0.8], \"metallic\": 0,"
-        "   \"roughness\": 0.5},"
+        "   \"roughness\": 0.5, \"clearcoat\": 1, \"clearcoat_roughness\": 0.2},"
         " \"mixed\": {\"type\": \"metallic_roughness\", \"base_color\": [0.8, 0.8, 0.3], \"metallic\": 0.4,"
         "   \"roughness\": 0.6, \"transmission\": 0.5, \"ior\": 1.4},"
         " \"big\": {\"type\": \"emitter\", \"radiance\": [1.5, 1.5, 1.5]},"

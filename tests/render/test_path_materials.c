@@ -136,6 +136,8 @@ int main(void)
         "{\"type\": \"metallic_roughness\", \"base_color\": [1, 1, 1], \"metallic\": 0, \"roughness\": 0.5,"
         " \"transmission\": 1, \"ior\": 1.33}",
         "{\"type\": \"metallic_roughness\", \"base_color\": [0.8, 0.8, 0.8], \"metallic\": 0, \"roughness\": 1}",
+        "{\"type\": \"metallic_roughness\", \"base_color\": [1, 1, 1], \"roughness\": 0.3, \"clearcoat\": 1,"
+        " \"clearcoat_roughness\": 0.1}",
         "{\"type\": \"metallic_roughness\", \"base_color\": {\"texture\": \"" PK_TEST_DATA "/tex_rgbw.png\"},"
         " \"roughness\": 0.3, \"metallic_roughness_map\": {\"texture\": \"" PK_TEST_DATA "/tex_rgbw.png\"}}",
     };

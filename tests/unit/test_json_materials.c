@@ -86,6 +86,7 @@ static void test_defaults(void)
     m = one("{\"type\": \"metallic_roughness\"}");
     CHECK(m.type == MAT_METALLIC_ROUGHNESS && near3(m.kd, 1, 1, 1, 0) && m.metallic == 1.0f && m.roughness == 1.0f);
     CHECK(m.alpha == 1.0f && m.transmission == 0.0f && m.ni == 1.5f && m.map_mr.kind == TEX_NONE);
+    CHECK(m.clearcoat == 0.0f && m.clearcoat_roughness == 0.0f);
     /* Whitted: no diffuse, a Phong lobe of the base colour as wide as alpha 1 */
     CHECK(near3(material_whitted_kd(&m), 0, 0, 0, 0) && near3(m.ks, 1, 1, 1, 0) && m.illum == 2 && m.ns == 0.0f);
 }
@@ -140,6 +141,8 @@ static void test_explicit(void)
     CHECK(near3(material_whitted_kd(&m), 0.3f, 0.15f, 0.075f, 1e-6f));
     CHECK(near3(m.ks, 0.75f * 0.04f + 0.2f, 0.75f * 0.04f + 0.1f, 0.75f * 0.04f + 0.05f, 1e-6f));
     CHECK(m.illum == 2 && fabsf(m.ns - 30.0f) < 1e-4f);
+    m = one("{\"type\": \"metallic_roughness\", \"clearcoat\": 0.75, \"clearcoat_roughness\": 0.25}");
+    CHECK(m.type == MAT_METALLIC_ROUGHNESS && m.clearcoat == 0.75f && m.clearcoat_roughness == 0.25f);
     m = one("{\"type\": \"metallic_roughness\", \"metallic\": 0, \"roughness\": 0}"); /* smooth: a mirror lobe */
     CHECK(m.alpha == 0.0f && m.illum == 3 && near3(m.ks, 0.04f, 0.04f, 0.04f, 1e-7f));
     CHECK(near3(material_whitted_kd(&m), 1, 1, 1, 0));
@@ -311,6 +314,10 @@ static void test_errors(void)
                  "scene.json:1: materials.gold.transmission: must be in 0..1");
     EXPECT_ERROR(MAT("{\"type\": \"metallic_roughness\", \"roughness\": {\"texture\": \"tex_rgbw.png\"}}"),
                  "scene.json:1: materials.gold.roughness: must be a number in 0..1 (textures: \"metallic_roughness_map\")");
+    EXPECT_ERROR(MAT("{\"type\": \"metallic_roughness\", \"clearcoat_roughness\": 1.5}"),
+                 "scene.json:1: materials.gold.clearcoat_roughness: must be in 0..1");
+    EXPECT_ERROR(MAT("{\"type\": \"metallic_roughness\", \"clearcoat\": {\"texture\": \"tex_rgbw.png\"}}"),
+                 "scene.json:1: materials.gold.clearcoat: must be a number in 0..1 (textures: \"metallic_roughness_map\")");
     EXPECT_ERROR(MAT("{\"type\": \"metallic_roughness\", \"metallic_roughness_map\": 1}"),
                  "scene.json:1: materials.gold.metallic_roughness_map: must be a texture object");
     EXPECT_ERROR(MAT("{\"type\": \"metallic_roughness\", \"base_color\": [2, 0, 0]}"),
