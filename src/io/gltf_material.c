@@ -144,6 +144,38 @@ static pk_status image_texture(gltf *g, int64_t i, bool colour, const char *user
     return PK_OK;
 }
 
+/* The texture tex of image src doubled along s and/or t with its mirror
+ * image (glTF's mirrored repeat as a plain repeat of half the frequency);
+ * -1 with a warning when that would be too large. */
+static pk_status mirror_texture(gltf *g, int64_t src, bool colour, bool ms, bool mt, int32_t tex, int32_t *out)
+{
+    char key[PK_ERRMSG_MAX];
+    snprintf(key, sizeof key, "%s#/images/%lld/mirror%s%s", g->name, (long long)src, ms ? "S" : "", mt ? "T" : "");
+    *out = texture_find(g->s, key, colour);
+    if (*out >= 0) return PK_OK;
+    const texture *t = &g->s->textures[tex];
+    const tex_level *l = &t->lv[0];
+    const size_t w = (size_t)l->w, h = (size_t)l->h, nc = (size_t)t->nc;
+    const size_t W = ms ? 2 * w : w, H = mt ? 2 * h : h;
+    if (W > PK_MAX_TEXTURE_SIDE || H > PK_MAX_TEXTURE_SIDE || W * H > PK_MAX_TEXTURE_PIXELS) {
+        gltf_warn(g, "/images/%lld: too large to mirror; drawn with repeat", (long long)src);
+        return PK_OK;
+    }
+    const size_t es = l->px8 ? 1 : sizeof(float);
+    uint8_t *px = mem_alloc(&g->ctx->alloc, W * H * nc * es);
+    if (!px) return ctx_nomem(g->ctx);
+    const uint8_t *from = l->px8 ? l->px8 : (const uint8_t *)l->pxf;
+    for (size_t y = 0; y < H; y++)
+        for (size_t x = 0; x < W; x++) {
+            size_t sx = x < w ? x : 2 * w - 1 - x, sy = y < h ? y : 2 * h - 1 - y;
+            memcpy(px + (y * W + x) * nc * es, from + (sy * w + sx) * nc * es, nc * es);
+        }
+    pk_status st = texture_add_pixels(g->ctx, g->s, key, (int)W, (int)H, t->nc, l->px8 ? px : NULL,
+                                      l->px8 ? NULL : (const float *)(const void *)px, colour, out);
+    mem_free(&g->ctx->alloc, px);
+    return st;
+}
+
 /* Resolves a textureInfo into a tex_ref (kind TEX_NONE when unusable). bake:
  * the transform is baked into the primitive's uvs (identity here). */
 static pk_status make_ref(gltf *g, const tex_info *ti, bool colour, bool bake, const char *user, tex_ref *r)
@@ -168,6 +200,7 @@ static pk_status make_ref(gltf *g, const tex_info *ti, bool colour, bool bake, c
     if (tex < 0) return PK_OK;
     r->kind = TEX_IMAGE;
     r->tex = tex;
+    bool ms = false, mt = false;
     if (smp >= 0) {
         const cJSON *so = cJSON_GetArrayItem(gltf_array(g, "samplers"), (int)smp);
         char sp[48];
@@ -183,11 +216,13 @@ static pk_status make_ref(gltf *g, const tex_info *ti, bool colour, bool bake, c
                                  (long long)w);
         }
         r->clamp = ws == 33071 && wt == 33071;
-        if (ws == 33648 || wt == 33648 || ((ws == 33071) != (wt == 33071)))
+        ms = ws == 33648;
+        mt = wt == 33648;
+        if ((ws == 33071) != (wt == 33071))
             gltf_warn_once(g, GW_WRAP,
-                           "%s: mirrored repeat, or clamping along one axis only, is drawn as %s (further ones not "
+                           "%s: clamping along one axis only is drawn as repeat along both (further ones not "
                            "reported)",
-                           sp, r->clamp ? "clamp" : "repeat");
+                           sp);
     }
     if (!bake) {
         /* glTF's v runs down the image, the scene's up: v_scene = 1 - v_gltf */
@@ -200,6 +235,16 @@ static pk_status make_ref(gltf *g, const tex_info *ti, bool colour, bool bake, c
                            "%s: a KHR_texture_transform rotation differs between the material's textures: "
                            "drawn without it (further ones not reported)",
                            user);
+    }
+    if (ms || mt) {
+        /* mirrored repeat: the image and its mirror image side by side, repeated */
+        int32_t mtex;
+        if ((st = mirror_texture(g, src, colour, ms, mt, tex, &mtex))) return st;
+        if (mtex >= 0) {
+            r->tex = mtex;
+            if (ms) r->s[0] *= 0.5f, r->o[0] *= 0.5f;
+            if (mt) r->s[1] *= 0.5f, r->o[1] = 0.5f * r->o[1] + 0.5f;
+        }
     }
     return PK_OK;
 }

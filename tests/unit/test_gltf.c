@@ -539,6 +539,56 @@ static void test_materials(void)
     scene_destroy(s);
 }
 
+/* Mirrored repeat (an image doubled with its mirror image) and the second uv set. */
+static void test_mirror_and_uv1(void)
+{
+    bytes b = {0};
+    float pu[21] = {0, 0, 0, 1, 0, 0, 0, 1, 0, /* TEXCOORD_0 */ 0, 0, 0, 0, 0, 0, /* TEXCOORD_1 */ 0.25f, 0, 1, 0, 1, 1};
+    put(&b, pu, sizeof pu);
+    char *uri = b64(b.d, b.n), j[4096];
+    snprintf(j, sizeof j,
+             "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":84,\"uri\":\"%s\"}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":24},"
+             "{\"buffer\":0,\"byteOffset\":60,\"byteLength\":24}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+             "{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"},"
+             "{\"bufferView\":2,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"}],"
+             "\"images\":[{\"uri\":\"../tex_rgbw.png\"}],\"textures\":[{\"source\":0,\"sampler\":0}],"
+             "\"samplers\":[{\"wrapS\":33648,\"wrapT\":33648}],"
+             "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0,\"texCoord\":1}}}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1,\"TEXCOORD_1\":2},"
+             "\"material\":0}]}],\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}]}",
+             uri);
+    free(uri);
+    pk_context *ctx;
+    REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
+    warning_log_attach(ctx, &wlog);
+    pk_scene *s;
+    REQUIRE(scene_create(ctx, "t.gltf", &s) == PK_OK);
+    /* base_dir: tests/data/gltf, so that ../tex_rgbw.png is found */
+    CHECKF(scene_gltf_parse(ctx, s, j, strlen(j), "t.gltf", PK_TEST_DATA "/gltf") == PK_OK, "%s", pk_context_error(ctx));
+    CHECK(wlog.count == 0);
+    REQUIRE(s->ntris == 1);
+    /* TEXCOORD_1 read: (0.25, 0) -> the scene's (0.25, 1) */
+    CHECK_NEAR(s->uvs[s->tris[0].t[0]].u, 0.25, 0);
+    CHECK_NEAR(s->uvs[s->tris[0].t[0]].v, 1.0, 0);
+    const material *m = &s->materials[s->tris[0].material];
+    REQUIRE(m->map_kd.kind == TEX_IMAGE && s->ntextures == 2 && m->map_kd.tex == 1);
+    const texture *src = &s->textures[0], *mir = &s->textures[1];
+    REQUIRE(src->lv[0].w == 2 && mir->lv[0].w == 4 && mir->lv[0].h == 4 && src->nc == mir->nc && src->lv[0].px8);
+    /* texel (x, y) of the doubled image is the source's mirrored texel */
+    const int nc = src->nc;
+    for (int y = 0; y < 4; y++)
+        for (int x = 0; x < 4; x++) {
+            int sx = x < 2 ? x : 3 - x, sy = y < 2 ? y : 3 - y;
+            CHECK(memcmp(mir->lv[0].px8 + (y * 4 + x) * nc, src->lv[0].px8 + (sy * 2 + sx) * nc, (size_t)nc) == 0);
+        }
+    /* half the frequency; v shifted so that glTF's v = 0 (the top) stays the image's top */
+    CHECK(m->map_kd.s[0] == 0.5f && m->map_kd.s[1] == 0.5f && m->map_kd.o[0] == 0.0f && m->map_kd.o[1] == 0.5f);
+    scene_destroy(s);
+    pk_context_destroy(ctx);
+}
+
 /* ---- GLB ------------------------------------------------------------------------------------ */
 
 static size_t glb(uint8_t *out, const char *json, const bytes *bin, uint32_t lie_total, uint32_t lie_json)
@@ -743,6 +793,7 @@ int main(void)
     test_cameras();
     test_lights();
     test_materials();
+    test_mirror_and_uv1();
     test_glb();
     test_errors();
     return test_done("test_gltf");
