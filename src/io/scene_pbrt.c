@@ -170,6 +170,7 @@ typedef struct pp {
     size_t nobjs, cap_objs;
     char *obj_name;         /* the object being defined */
     int obj_depth;          /* the attribute depth its ObjectBegin opened */
+    size_t obj_line;        /* and its line */
     pfile top;              /* the first file, for messages after it is read */
     attr_def *defs;
     size_t ndefs, cap_defs;
@@ -1587,7 +1588,7 @@ static pk_status shape_sphere(pp *p, int32_t alpha)
         sp.center = xform_point(&w, v3s(0.0f));
         sp.radius = radius * l0;
         if (!v3_finite(sp.center) || !(sp.radius > 0.0f) || !isfinite(sp.radius))
-            return pfail(p, p->line, PK_ERR_PARSE, "sphere: its place in the world is not finite");
+            return pfail(p, p->line, PK_ERR_PARSE, "sphere: its centre or radius in the world is not a usable number (not finite, or the radius too small)");
         bool two;
         vec3 ke = area_emission(p, 4.0 * (double)PK_PI * (double)sp.radius * (double)sp.radius, &two);
         if ((st = shape_material(p, ke, two, -1, &sp.material))) return st;
@@ -2559,6 +2560,7 @@ static pk_status directive(pp *p, const pbrt_token *tk)
         if ((st = push_state(p))) return st;
         if (!sb_begin_object(&p->b)) return pfail(p, p->line, PK_ERR_PARSE, "ObjectBegin inside another object");
         p->obj_depth = p->b.depth;
+        p->obj_line = p->line;
         p->obj_name = mem_strdup(A(p), a);
         return p->obj_name ? PK_OK : ctx_nomem(p->ctx);
     }
@@ -2750,7 +2752,7 @@ pk_status scene_pbrt_parse(pk_context *ctx, pk_scene *s, const char *data, size_
     p->f = &p->top;
     if (st == PK_OK && !p->in_world) st = finish_camera(p); /* no WorldBegin: nothing but the camera */
     if (st == PK_OK && p->b.in_object)
-        st = pfail(p, p->line, PK_ERR_PARSE, "ObjectBegin \"%.80s\" has no ObjectEnd", p->obj_name ? p->obj_name : "");
+        st = pfail(p, p->obj_line, PK_ERR_PARSE, "ObjectBegin \"%.80s\" has no ObjectEnd", p->obj_name ? p->obj_name : "");
     if (st == PK_OK) {
         s->render.opt.width = p->film_w, s->render.opt.height = p->film_h;
         const float k = p->exposure_time * p->film_iso / 100.0f;

@@ -631,7 +631,7 @@ static void test_errors(void)
     expect_error("WorldBegin\nNamedMaterial \"nope\"\n", "t.pbrt:2: ", "no material named \"nope\"");
     expect_error("WorldBegin\nObjectInstance \"nope\"\n", "t.pbrt:2: ", "no object named \"nope\"");
     expect_error("WorldBegin\nObjectBegin \"a\"\nObjectBegin \"b\"\n", "t.pbrt:3: ", "inside another object");
-    expect_error("WorldBegin\nObjectBegin \"a\"\n", "t.pbrt:2: ", "has no ObjectEnd");
+    expect_error("WorldBegin\nObjectBegin \"a\"\nShape \"sphere\"\n", "t.pbrt:2: ", "has no ObjectEnd");
     expect_error("WorldBegin\nShape \"sphere\" \"float radius\" 1 \"float radius\" 2\n", "t.pbrt:2: ", "given twice");
     expect_error("WorldBegin\n\"stray\"\n", "t.pbrt:2: ", "expected a directive");
     expect_error("WorldBegin\nInclude \"no_such.pbrt\"\n", "t.pbrt:2: Include: ", "no_such.pbrt");
