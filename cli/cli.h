@@ -180,9 +180,19 @@ char *cli_partial_name(const char *out);
 /* The statistics table of --stats on standard output (sc: its textures). */
 void cli_print_stats(pk_context *ctx, const char *scene, const pk_scene *sc, const pk_render_options *ro,
                      const pk_stats *st);
-/* --stats-json: path "-" is standard output. Returns 0 or 1 after a message. */
+/* What the denoiser of a render took (pk_denoiser_last_run). */
+typedef struct cli_denoise_stats {
+    int done;        /* the image was denoised */
+    int fast;        /* with the small network */
+    double seconds, flops;
+    size_t bytes;
+} cli_denoise_stats;
+/* The denoise row of --stats (nothing when dn->done is 0). */
+void cli_print_denoise_stats(const cli_denoise_stats *dn);
+/* --stats-json: path "-" is standard output; dn NULL or not done: the image
+ * was not denoised. Returns 0 or 1 after a message. */
 int cli_write_stats_json(pk_context *ctx, const char *path, const char *scene, const pk_scene *sc,
-                         const pk_render_options *ro, const pk_stats *st);
+                         const pk_render_options *ro, const pk_stats *st, const cli_denoise_stats *dn);
 
 /* ---- the progress bar (cli/progress.c) --------------------------------- */
 

@@ -1030,8 +1030,7 @@ int main(int argc, char **argv)
     MPI_Gather(&rep, (int)sizeof rep, MPI_BYTE, reps, (int)sizeof rep, MPI_BYTE, 0, MPI_COMM_WORLD);
     if (g_rank == 0) {
         pk_image *img = NULL;
-        double dn_s = 0.0, dn_flops = 0.0;
-        size_t dn_bytes = 0;
+        cli_denoise_stats dn = {0, o.denoise_fast, 0.0, 0.0, 0};
         rc = 1;
         st = pk_film_resolve(ctx, film, &img);
         if (st == PK_OK && denoise) {
@@ -1040,7 +1039,8 @@ int main(int argc, char **argv)
             pk_context_set_file_reader(ctx, NULL, NULL);
             snprintf(bar.note, sizeof bar.note, "denoising");
             cli_progress_update(&bar, 999, 1000, cli_now() - t_start);
-            st = cli_render_denoise(ctx, &dopt, film, img, &dn_s, &dn_bytes, &dn_flops);
+            st = cli_render_denoise(ctx, &dopt, film, img, &dn.seconds, &dn.bytes, &dn.flops);
+            dn.done = st == PK_OK;
             cli_progress_clear(&bar);
         }
         if (st == PK_OK && cli_render_write(ctx, &o, &wo, img, film) == PK_OK) {
@@ -1065,15 +1065,12 @@ int main(int argc, char **argv)
             pk_stats js = job_stats(reps, wall_s);
             if (o.stats) {
                 cli_print_stats(ctx, name, scene, &ro, &js);
-                if (denoise) /* as `paprsek render` prints it */
-                    printf("%-28s %.3f s, %.1f MiB, %.1f GFLOP/s (%s network)\n", "denoise", dn_s,
-                           (double)dn_bytes / (1024.0 * 1024.0), dn_s > 0 ? dn_flops / dn_s * 1e-9 : 0.0,
-                           o.denoise_fast ? "fast" : "high-quality");
+                cli_print_denoise_stats(&dn); /* as `paprsek render` prints it */
                 printf("%-28s %u of %d spp\n", "passes", passes, ro.spp);
                 print_ranks(reps, &ro, wall_s, (uint64_t)ntiles * passes);
                 fflush(stdout);
             }
-            if (o.stats_json && cli_write_stats_json(ctx, o.stats_json, name, scene, &ro, &js) != 0) rc = 1;
+            if (o.stats_json && cli_write_stats_json(ctx, o.stats_json, name, scene, &ro, &js, &dn) != 0) rc = 1;
         }
         free(reps);
     }

@@ -118,12 +118,12 @@ int cli_render(int argc, char **argv)
         st = render_passes(ctx, scene, &ro, o.time, aovs, &bar, &img, &film, &stats, &passes);
     else
         st = pk_render(ctx, scene, &ro, &img, &stats);
-    double dn_s = 0.0, dn_flops = 0.0;
-    size_t dn_bytes = 0;
+    cli_denoise_stats dn = {0, o.denoise_fast, 0.0, 0.0, 0};
     if (st == PK_OK && denoise) {
         snprintf(bar.note, sizeof bar.note, "denoising");
         cli_progress_update(&bar, 999, 1000, cli_now() - t0);
-        st = cli_render_denoise(ctx, &dopt, film, img, &dn_s, &dn_bytes, &dn_flops);
+        st = cli_render_denoise(ctx, &dopt, film, img, &dn.seconds, &dn.bytes, &dn.flops);
+        dn.done = st == PK_OK;
     }
     cli_progress_clear(&bar);
     if (st == PK_ERR_CANCELLED) {
@@ -152,12 +152,9 @@ int cli_render(int argc, char **argv)
     const char *name = o.scene ? o.scene : "cornell-box (built in)";
     if (o.stats) {
         cli_print_stats(ctx, name, scene, &ro, &stats);
-        if (denoise)
-            printf("%-28s %.3f s, %.1f MiB, %.1f GFLOP/s (%s network)\n", "denoise", dn_s,
-                   (double)dn_bytes / (1024.0 * 1024.0), dn_s > 0 ? dn_flops / dn_s * 1e-9 : 0.0,
-                   o.denoise_fast ? "fast" : "high-quality");
+        cli_print_denoise_stats(&dn);
     }
-    if (o.stats_json && cli_write_stats_json(ctx, o.stats_json, name, scene, &ro, &stats) != 0) goto out;
+    if (o.stats_json && cli_write_stats_json(ctx, o.stats_json, name, scene, &ro, &stats, &dn) != 0) goto out;
     rc = 0;
     goto out;
 fail:

@@ -525,8 +525,16 @@ static void json_string(FILE *f, const char *s)
 }
 
 /* path "-": standard output. */
+void cli_print_denoise_stats(const cli_denoise_stats *dn)
+{
+    if (!dn || !dn->done) return;
+    printf("%-28s %.3f s, %.1f MiB, %.1f GFLOP/s (%s network)\n", "denoise", dn->seconds,
+           (double)dn->bytes / (1024.0 * 1024.0), dn->seconds > 0 ? dn->flops / dn->seconds * 1e-9 : 0.0,
+           dn->fast ? "fast" : "high-quality");
+}
+
 int cli_write_stats_json(pk_context *ctx, const char *path, const char *scene, const pk_scene *sc,
-                         const pk_render_options *ro, const pk_stats *st)
+                         const pk_render_options *ro, const pk_stats *st, const cli_denoise_stats *dn)
 {
     pk_scene_info si;
     pk_scene_get_info(sc, &si);
@@ -556,6 +564,13 @@ int cli_write_stats_json(pk_context *ctx, const char *path, const char *scene, c
             peak_rss_mib(), si.textures, si.texture_bytes,
             pk_device_name(ro->device == PK_DEVICE_CUDA || ro->accel == PK_ACCEL_CUDA ? PK_DEVICE_CUDA : PK_DEVICE_CPU));
     json_string(f, config_of(ctx).s);
+    if (dn && dn->done)
+        fprintf(f,
+                ",\n  \"denoise\": {\"network\": \"%s\", \"seconds\": %.6f, \"bytes\": %zu, "
+                "\"gflop_per_s\": %.2f}",
+                dn->fast ? "fast" : "high", dn->seconds, dn->bytes, dn->seconds > 0 ? dn->flops / dn->seconds * 1e-9 : 0.0);
+    else
+        fputs(",\n  \"denoise\": null", f);
     fputs("\n}\n", f);
     if (to_stdout ? fflush(f) != 0 || ferror(f) : fclose(f) != 0)
         return cli_failure("%s: cannot write: %s", to_stdout ? "standard output" : path, strerror(errno));

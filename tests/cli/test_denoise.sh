@@ -29,8 +29,13 @@ rc=$?
 "$bin" render -o "$tmp/nod.pfm" "${sz[@]}" --no-denoise --quiet
 cmp -s "$tmp/raw16.pfm" "$tmp/nod.pfm" && ok "--no-denoise gives the raw 16-spp image" || bad "--no-denoise differs from --spp 16"
 ! cmp -s "$tmp/raw16.pfm" "$tmp/def.pfm" && ok "the denoised image differs from the raw one" || bad "default image is raw"
-"$bin" render -o "$tmp/raw4.pfm" "${sz[@]}" --spp 4 --stats >"$tmp/stats" 2>/dev/null
+"$bin" render -o "$tmp/raw4.pfm" "${sz[@]}" --spp 4 --stats --stats-json "$tmp/raw.json" >"$tmp/stats" 2>/dev/null
 ! grep -q "^denoise" "$tmp/stats" && ok "an explicit --spp stays raw" || bad "--spp 4 was denoised"
+/usr/bin/python3 -c 'import json, sys; sys.exit(json.load(open(sys.argv[1]))["denoise"] is not None)' "$tmp/raw.json" &&
+  ok "--stats-json: denoise null when raw" || bad "--stats-json of a raw render: $(cat "$tmp/raw.json")"
+"$bin" render -o "$tmp/dn.pfm" "${sz[@]}" --spp 2 --denoise --denoise-quality fast --stats-json "$tmp/dn.json" 2>/dev/null &&
+  /usr/bin/python3 -c 'import json, sys; d = json.load(open(sys.argv[1]))["denoise"]; sys.exit(not (d["network"] == "fast" and d["seconds"] > 0 and d["bytes"] > 0 and d["gflop_per_s"] > 0))' "$tmp/dn.json" &&
+  ok "--stats-json: the denoiser's network, time, memory and GFLOP/s" || bad "--stats-json of a denoised render: $(cat "$tmp/dn.json")"
 
 # 2. render --denoise = denoise of the same render's EXR
 "$bin" render -o "$tmp/r.exr" "${sz[@]}" --spp 4 --aov albedo,normal --quiet
