@@ -81,6 +81,20 @@ static inline PK_HD camera_frame camera_setup(const pk_camera *cam, int width, i
     return f;
 }
 
+/* Whether camera_ray is camera_ray_pinhole for f (no lens, perspective). */
+static inline PK_HD bool camera_is_pinhole(const camera_frame *f) { return !f->ortho && !camera_has_lens(f); }
+
+/* The pinhole's ray of camera sample cs: from the eye through the point
+ * (sx, sy) of the image plane at distance 1. */
+static inline PK_HD ray camera_ray_pinhole(const camera_frame *f, const camera_sample *cs)
+{
+    float sx = (2.0f * cs->film_x / (float)f->width - 1.0f) * f->half_w;
+    float sy = (1.0f - 2.0f * cs->film_y / (float)f->height) * f->half_h;
+    vec3 d = v3_norm(v3_add(v3_add(v3_scale(f->u, sx), v3_scale(f->v, sy)), v3_neg(f->w)));
+    ray r = {f->origin, 0.0f, d, INFINITY};
+    return r;
+}
+
 /* The ray of camera sample cs. Perspective: from the eye through the point
  * (sx, sy) of the image plane at distance 1; orthographic: from the point
  * (sx, sy) of the plane of the eye along the view direction. With a lens the
@@ -89,19 +103,16 @@ static inline PK_HD camera_frame camera_setup(const pk_camera *cam, int width, i
  * ray meets the plane in focus, so that points there stay sharp. */
 static inline PK_HD ray camera_ray(const camera_frame *f, const camera_sample *cs)
 {
+    if (camera_is_pinhole(f)) return camera_ray_pinhole(f, cs);
     float sx = (2.0f * cs->film_x / (float)f->width - 1.0f) * f->half_w;
     float sy = (1.0f - 2.0f * cs->film_y / (float)f->height) * f->half_h;
-    if (!f->ortho && !camera_has_lens(f)) { /* the pinhole */
-        vec3 d = v3_norm(v3_add(v3_add(v3_scale(f->u, sx), v3_scale(f->v, sy)), v3_neg(f->w)));
-        ray r = {f->origin, 0.0f, d, INFINITY};
-        return r;
-    }
+    const vec3 film = v3_add(v3_scale(f->u, sx), v3_scale(f->v, sy));
     vec3 o = f->origin, d;
     if (f->ortho) {
-        o = v3_add(o, v3_add(v3_scale(f->u, sx), v3_scale(f->v, sy)));
+        o = v3_add(o, film);
         d = v3_neg(f->w);
     } else {
-        d = v3_add(v3_add(v3_scale(f->u, sx), v3_scale(f->v, sy)), v3_neg(f->w));
+        d = v3_add(film, v3_neg(f->w));
     }
     if (camera_has_lens(f)) {
         float lx, ly;

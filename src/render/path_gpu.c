@@ -270,6 +270,7 @@ pk_status path_gpu_render(path_gpu *g, const camera_frame *cf, const gpu_tile *t
     if ((st = cuda_device_copy(g->dev, (char *)&pc + c0, g->d_pt + c0, c1 - c0, true, NULL)) != PK_OK) return st;
     unsigned nthreads = (unsigned)(ntiles * GPU_TILE_PIXELS);
     camera_frame cam = *cf;
+    const char *kernel = camera_is_pinhole(cf) ? "pk_path_render" : "pk_path_render_camera";
     const uint64_t total = (uint64_t)spp;
     uint64_t done = 0;
     while (done < total) {
@@ -279,7 +280,7 @@ pk_status path_gpu_render(path_gpu *g, const camera_frame *cf, const gpu_tile *t
         int accumulate = done > 0;
         void *params[] = {&g->d_pt, &cam, &g->d_tiles, &nthreads, &from, &n, &accumulate, &g->d_acc, &g->d_rays};
         double ms = 0.0;
-        if ((st = cuda_device_run(g->dev, "pk_path_render", nthreads, 128, params, &ms)) != PK_OK) return st;
+        if ((st = cuda_device_run(g->dev, kernel, nthreads, 128, params, &ms)) != PK_OK) return st;
         done += n;
         /* the next launch sized to take about LAUNCH_TARGET_MS */
         if (ms > 0.0) {

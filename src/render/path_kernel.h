@@ -346,13 +346,6 @@ static inline PK_HD camera_sample path_camera_place(const path_tracer *pt, int p
     return cs;
 }
 
-/* The camera ray of sample index of pixel (px, py). */
-static inline PK_HD ray path_camera_ray(const path_tracer *pt, const camera_frame *cf, int px, int py, uint32_t index)
-{
-    const camera_sample cs = path_camera_place(pt, px, py, index);
-    return camera_ray(cf, &cs);
-}
-
 /* Starts sample index of pixel (px, py) along its camera ray r, whose
  * closest hit is *h (NULL: it left the scene). True with *ps ready for
  * path_step; false when the ray sees the surroundings, *bg. */

@@ -56,11 +56,16 @@ extern "C" __global__ void pk_path_layout(unsigned long long *out)
  * one path_step at a time, measured slower on the H100: 195 against 208 M
  * samples/s on CornellBox-Original; docs/gpu.md.) At most 80 registers a
  * thread (6 blocks of 128 a multiprocessor): 259 M samples/s against 212 M
- * with the compiler's 168 registers and fewer threads. */
-extern "C" __global__ void __launch_bounds__(128, 6)
-    pk_path_render(const path_tracer *__restrict__ pt, camera_frame cf, const gpu_tile *__restrict__ tiles,
-                   unsigned nthreads, unsigned first, unsigned n, int accumulate, float *__restrict__ acc,
-                   unsigned long long *rays)
+ * with the compiler's 168 registers and fewer threads.
+ * Two kernels: pk_path_render for the pinhole camera, pk_path_render_camera
+ * for a lens or the orthographic projection (camera_ray): with those in
+ * the one kernel, the compiler spilled more registers (164 bytes stored
+ * against 76), also for pinholes. */
+template <bool pinhole>
+static __device__ __forceinline__ void path_render(const path_tracer *__restrict__ pt, const camera_frame &cf,
+                                                   const gpu_tile *__restrict__ tiles, unsigned nthreads,
+                                                   unsigned first, unsigned n, int accumulate,
+                                                   float *__restrict__ acc, unsigned long long *rays)
 {
     const unsigned i = blockIdx.x * blockDim.x + threadIdx.x;
     if (i >= nthreads) return; /* (nthreads is a multiple of 256: whole warps) */
@@ -74,7 +79,8 @@ extern "C" __global__ void __launch_bounds__(128, 6)
         const int px = tl.x + k % tl.w, py = tl.y + k / tl.w;
         for (unsigned s = 0; s < n; s++) {
             const uint32_t index = first + s;
-            const ray r = path_camera_ray(pt, &cf, px, py, index);
+            const camera_sample cs = path_camera_place(pt, px, py, index);
+            const ray r = pinhole ? camera_ray_pinhole(&cf, &cs) : camera_ray(&cf, &cs);
             hit h;
             const bool got = path_gpu_trace(pt, &r, &h, false);
             t.rays_camera++;
@@ -97,4 +103,20 @@ extern "C" __global__ void __launch_bounds__(128, 6)
         atomicAdd(&rays[1], c1);
         atomicAdd(&rays[2], c2);
     }
+}
+
+extern "C" __global__ void __launch_bounds__(128, 6)
+    pk_path_render(const path_tracer *__restrict__ pt, camera_frame cf, const gpu_tile *__restrict__ tiles,
+                   unsigned nthreads, unsigned first, unsigned n, int accumulate, float *__restrict__ acc,
+                   unsigned long long *rays)
+{
+    path_render<true>(pt, cf, tiles, nthreads, first, n, accumulate, acc, rays);
+}
+
+extern "C" __global__ void __launch_bounds__(128, 6)
+    pk_path_render_camera(const path_tracer *__restrict__ pt, camera_frame cf, const gpu_tile *__restrict__ tiles,
+                          unsigned nthreads, unsigned first, unsigned n, int accumulate, float *__restrict__ acc,
+                          unsigned long long *rays)
+{
+    path_render<false>(pt, cf, tiles, nthreads, first, n, accumulate, acc, rays);
 }
