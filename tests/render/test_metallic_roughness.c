@@ -15,6 +15,8 @@
 #include "paprsek.h"
 #include "render/path.h"
 #include "render/render.h"
+#include "render/shading.h"
+#include "scene/scene.h"
 
 #include "block_stats.h"
 
@@ -74,9 +76,41 @@ static void render_whitted(const pk_scene *s)
     pk_image_destroy(img);
 }
 
+/* The maps at a hit: base colour from map_kd, metallic from map_mr's blue
+ * channel and roughness from its green one, each times its constant. */
+static void test_maps(void)
+{
+    const char *json =
+        "{\"materials\": {\"m\": {\"type\": \"metallic_roughness\", \"metallic\": 0.5, \"roughness\": 0.8,"
+        " \"base_color\": {\"checker\": {\"even\": [0.2, 0.4, 0.6], \"odd\": [0.2, 0.4, 0.6]}},"
+        " \"metallic_roughness_map\": {\"checker\": {\"even\": [0.9, 0.25, 0.75], \"odd\": [0.9, 0.25, 0.75]}}}},"
+        " \"spheres\": [{\"center\": [0, 0, 0], \"radius\": 1, \"material\": \"m\"}]}";
+    pk_scene *s = NULL;
+    pk_status st = pk_scene_load_json_memory(ctx, json, strlen(json), "maps.json", ".", &s);
+    CHECKF(st == PK_OK, "%s", pk_context_error(ctx));
+    REQUIRE(st == PK_OK);
+    REQUIRE(s->nmaterials >= 1 && s->has_textured);
+    const scene_view v = scene_view_of(s);
+    const ray r = {{0.0f, 5.0f, 0.0f}, 0.0f, {0.0f, -1.0f, 0.0f}, INFINITY};
+    const hit h = {4.0f, 0, 0.0f, 0.0f};
+    material tm;
+    surface sf = surface_at(&v, &r, &h);
+    CHECK(sf.m->textured && sf.m->map_mr.kind == TEX_CHECKER);
+    sf = surface_texture(&v, &r, &h, 0.0f, sf, &tm);
+    CHECKF(fabsf(tm.kd.x - 0.2f) < 1e-6f && fabsf(tm.kd.y - 0.4f) < 1e-6f && fabsf(tm.kd.z - 0.6f) < 1e-6f,
+           "base colour %g %g %g", (double)tm.kd.x, (double)tm.kd.y, (double)tm.kd.z);
+    CHECKF(fabsf(tm.metallic - 0.375f) < 1e-6f && fabsf(tm.roughness - 0.2f) < 1e-6f,
+           "metallic %g, roughness %g", (double)tm.metallic, (double)tm.roughness);
+    const shading sh = shading_at(&sf);
+    CHECK(sh.b.type == PBSDF_METALLIC_ROUGHNESS && fabsf(sh.b.metallic - 0.375f) < 1e-6f);
+    CHECK(fabsf(sh.b.alpha - 0.04f) < 1e-6f && sh.b.transmission == 0.0f && sh.b.ior == 1.5f);
+    pk_scene_destroy(s);
+}
+
 int main(void)
 {
     REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
+    test_maps();
     /* A huge sphere of a rough thin sheet is a wall at z = -3 in front of the
      * camera; a small bright light sits behind it (inside the sphere), a
      * large dim one in front. In front of the wall: a metal ball, a
