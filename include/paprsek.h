@@ -337,8 +337,10 @@ PK_API pk_status pk_scene_load_json_memory(pk_context *ctx, const char *data, si
                                            const char *name, const char *base_dir,
                                            pk_scene **out);
 /* As pk_scene_load_file; params (nparams strings "NAME=VALUE") set the
- * parameters ($NAME) of a Mitsuba XML scene over its <default> values.
- * Other formats have no parameters and ignore them. */
+ * parameters ($NAME) of a Mitsuba XML scene over its <default> values; a
+ * glTF asset takes camera=N (render /cameras/N instead of the first camera
+ * in node order; others are warned about). Other formats have no
+ * parameters and ignore them. */
 PK_API pk_status pk_scene_load_file_params(pk_context *ctx, const char *path, const char *const *params,
                                            size_t nparams, pk_scene **out);
 /* Mitsuba XML scene from memory; files it names (meshes, includes) are
