@@ -25,6 +25,7 @@
 #include <expat.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #define XML_MAX_NODES (1u << 20)      /* elements in a scene and its includes */
@@ -108,6 +109,9 @@ typedef struct xp {
     /* where the colour property being read may put a texture (the diffuse
      * reflectances); NULL: textures stand in as constants */
     tex_ref *want_tex;
+    /* the scene's version: 0 for Mitsuba 0.x, 3 for Mitsuba 2/3 (spectra
+     * are reduced to RGB by that version's rules) */
+    int version_major;
     scene_builder sb;     /* every shape's triangles go in through it */
 } xp;
 
@@ -620,11 +624,34 @@ static float srgb_to_linear(float c)
     return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
 }
 
-/* <spectrum value="..."/>: one number (grey), three numbers (RGB, as
- * Mitsuba 0.x's RGB mode reads them) or wavelength:value pairs. */
+/* <spectrum value="..."/>: one number, three numbers (RGB, as Mitsuba
+ * 0.x's RGB mode reads them) or wavelength:value pairs; reduced to RGB as
+ * the scene's Mitsuba version does it (spectra.h): Mitsuba 0.x by
+ * spectra_mitsuba06_rgb for every property, a single number grey;
+ * Mitsuba 3 by spectra_mitsuba3_rgb, D65-weighted and clamped to [0, 1]
+ * for reflectances, unweighted and unbounded for an emitter's radiance
+ * (and unbounded for a conductor's eta and k), a single number grey except
+ * for an emitter, where it is that number times the sRGB of the
+ * equal-energy white. <spectrum type="blackbody"> (Mitsuba 3) holds a
+ * <float name="temperature">. */
 static pk_status node_spectrum(xp *p, const xnode *n, vec3 *out)
 {
     pk_status st;
+    const bool mts3 = p->version_major >= 2;
+    const bool emitter = n->parent && strcmp(n->parent->tag, "emitter") == 0;
+    const char *pname = attr_st(p, n, "name", &st);
+    if (st) return st;
+    const bool unbounded = pname && (strcmp(pname, "eta") == 0 || strcmp(pname, "k") == 0);
+    const char *ty = attr_st(p, n, "type", &st);
+    if (st) return st;
+    if (ty && strcmp(ty, "blackbody") == 0) {
+        float kelvin = 0.0f;
+        if ((st = get_float(p, (xnode *)n, "temperature", &kelvin))) return st;
+        if (!(kelvin > 0.0f) || !isfinite(kelvin))
+            return xfail(p, PK_ERR_PARSE, n, "<spectrum type=\"blackbody\"> needs a positive temperature");
+        *out = spectra_mitsuba3_blackbody(kelvin);
+        return PK_OK;
+    }
     const char *v = attr_st(p, n, "value", &st);
     if (st) return st;
     if (!v) {
@@ -641,7 +668,7 @@ static pk_status node_spectrum(xp *p, const xnode *n, vec3 *out)
         float f[3];
         int k;
         if ((st = numbers(p, n, "spectrum", v, f, 3, &k))) return st;
-        if (k == 1) *out = v3s(f[0]);
+        if (k == 1) *out = mts3 && emitter ? spectra_mitsuba3_uniform_emitter(f[0]) : v3s(f[0]);
         else if (k == 3) *out = v3(f[0], f[1], f[2]);
         else return xfail(p, PK_ERR_PARSE, n, "<spectrum> needs 1 or 3 numbers or wavelength:value pairs");
         return PK_OK;
@@ -664,7 +691,8 @@ static pk_status node_spectrum(xp *p, const xnode *n, vec3 *out)
         c = q;
     }
     if (k == 0) goto bad;
-    *out = spectrum_to_rgb(nm, val, k);
+    if (k < 2) return xfail(p, PK_ERR_PARSE, n, "<spectrum> needs at least two wavelength:value pairs");
+    *out = mts3 ? spectra_mitsuba3_rgb(nm, val, k, emitter, !emitter && !unbounded) : spectra_mitsuba06_rgb(nm, val, k);
     return PK_OK;
 bad:;
     char sv[48];
@@ -680,7 +708,8 @@ static int hexval(char c)
     return -1;
 }
 
-/* <blackbody temperature="5000K" scale=/>: blackbody_rgb (spectra.h) times scale. */
+/* <blackbody temperature="5000K" scale=/> (Mitsuba 0.x): spectra_mitsuba06_blackbody
+ * times scale, in every version (Mitsuba 3 has no such element). */
 static pk_status node_blackbody(xp *p, const xnode *n, vec3 *out)
 {
     pk_status st;
@@ -699,7 +728,7 @@ static pk_status node_blackbody(xp *p, const xnode *n, vec3 *out)
         int k;
         if ((st = numbers(p, n, "scale", sc, &scale, 1, &k))) return st;
     }
-    *out = v3_scale(blackbody_rgb(kelvin), scale);
+    *out = v3_scale(spectra_mitsuba06_blackbody(kelvin), scale);
     if (!v3_finite(*out)) return xfail(p, PK_ERR_PARSE, n, "<blackbody> radiance is not finite");
     return PK_OK;
 }
@@ -2377,6 +2406,7 @@ pk_status scene_xml_parse(pk_context *ctx, pk_scene *s, const char *data, size_t
         for (int i = 0; i < root->nattrs; i++)
             if (strcmp(root->attrs[i].name, "version") == 0) version = root->attrs[i].value;
         if (!version) xwarn(p, root, "<scene> has no version; read as Mitsuba 3");
+        p->version_major = version ? atoi(version) : 3;
         st = parse_scene(p, root, 0);
     }
     if (st == PK_OK) st = finish_camera(p);

@@ -65,6 +65,197 @@ vec3 blackbody_rgb(float kelvin)
     return spectrum_to_rgb(nm, val, N);
 }
 
+/* ---- Mitsuba's reductions of spectra to RGB ----------------------------------------------- */
+
+#include "cie1931.inc"
+
+/* Rec. 709 / sRGB primaries from XYZ, with the coefficients both Mitsuba
+ * 0.6 and Mitsuba 3 use. */
+static vec3 xyz_to_linear_srgb(double X, double Y, double Z)
+{
+    return v3((float)(3.240479 * X - 1.537150 * Y - 0.498535 * Z),
+              (float)(-0.969256 * X + 1.875991 * Y + 0.041556 * Z),
+              (float)(0.055648 * X - 0.204043 * Y + 1.057311 * Z));
+}
+
+/* The tabulated matching functions at nm, linear between the nanometres,
+ * zero outside 360..830 nm. */
+static void cie_1nm(double nm, double xyz[3])
+{
+    xyz[0] = xyz[1] = xyz[2] = 0.0;
+    if (!(nm >= 360.0 && nm <= 830.0)) return;
+    double t = nm - 360.0;
+    int i = (int)t;
+    if (i > 469) i = 469;
+    double f = t - i;
+    for (int c = 0; c < 3; c++) xyz[c] = (1.0 - f) * (double)cie1931_xyz[i][c] + f * (double)cie1931_xyz[i + 1][c];
+}
+
+void spectra_cie1931(float nm, float xyz[3])
+{
+    double d[3];
+    cie_1nm(nm, d);
+    for (int c = 0; c < 3; c++) xyz[c] = (float)d[c];
+}
+
+/* The samples (nm, val) with Mitsuba 0.6's zero extension: a zero sample
+ * one mean spacing beyond each end whose value is not zero. */
+typedef struct zext {
+    const float *nm, *val;
+    int n;
+    double lo, hi; /* the added ends (or the first/last wavelength) */
+    bool add_lo, add_hi;
+} zext;
+
+static double zext_eval(const zext *z, double l)
+{
+    const int n = z->n;
+    if (l < z->lo || l > z->hi) return 0.0;
+    if (l < (double)z->nm[0]) return z->add_lo ? (double)z->val[0] * (l - z->lo) / ((double)z->nm[0] - z->lo) : 0.0;
+    if (l > (double)z->nm[n - 1]) return z->add_hi ? (double)z->val[n - 1] * (z->hi - l) / (z->hi - (double)z->nm[n - 1]) : 0.0;
+    int a = 0, b = n - 1; /* nm[a] <= l <= nm[b] */
+    while (b - a > 1) {
+        int m = (a + b) / 2;
+        if ((double)z->nm[m] <= l) a = m;
+        else b = m;
+    }
+    if (b == a) return (double)z->val[a];
+    double t = (l - (double)z->nm[a]) / ((double)z->nm[b] - (double)z->nm[a]);
+    return (1.0 - t) * (double)z->val[a] + t * (double)z->val[b];
+}
+
+/* The integral over [a, b] of the product of the spectrum and the matching
+ * functions, both linear there: Simpson's rule, exact for the quadratic. */
+static void simpson_piece(const zext *z, double a, double b, double acc[3])
+{
+    if (!(b > a)) return;
+    double m = 0.5 * (a + b), ca[3], cm[3], cb[3];
+    cie_1nm(a, ca), cie_1nm(m, cm), cie_1nm(b, cb);
+    double sa = zext_eval(z, a), sm = zext_eval(z, m), sb = zext_eval(z, b);
+    for (int c = 0; c < 3; c++) acc[c] += (b - a) / 6.0 * (sa * ca[c] + 4.0 * sm * cm[c] + sb * cb[c]);
+}
+
+vec3 spectra_mitsuba06_rgb(const float *nm, const float *val, int n)
+{
+    if (n < 2) return v3s(0.0f);
+    zext z = {nm, val, n, (double)nm[0], (double)nm[n - 1], false, false};
+    double spacing = ((double)nm[n - 1] - (double)nm[0]) / (n - 1);
+    if (val[0] != 0.0f) z.lo = (double)nm[0] - spacing, z.add_lo = true;
+    if (val[n - 1] != 0.0f) z.hi = (double)nm[n - 1] + spacing, z.add_hi = true;
+    /* breakpoints: every nanometre of the table, every sample and the added ends */
+    double acc[3] = {0, 0, 0};
+    int j = 0; /* next sample wavelength to place */
+    for (int i = 360; i < 830; i++) {
+        double a = i, b = i + 1.0, prev = a;
+        double extra[2] = {z.lo, z.hi};
+        /* the samples and the added ends inside (a, b), in order */
+        while (j < n && (double)nm[j] <= a) j++;
+        int e = 0;
+        for (;;) {
+            double next = b;
+            if (j < n && (double)nm[j] < b) next = (double)nm[j];
+            for (int k = 0; k < 2; k++)
+                if (extra[k] > prev && extra[k] < next) next = extra[k];
+            simpson_piece(&z, prev, next, acc);
+            if (next >= b) break;
+            if (j < n && next == (double)nm[j]) j++;
+            prev = next;
+            if (++e > 4 + n) break; /* cannot happen: a guard */
+        }
+    }
+    double ysum = 0.0;
+    for (int i = 0; i < 470; i++) ysum += 0.5 * ((double)cie1931_xyz[i][1] + (double)cie1931_xyz[i + 1][1]);
+    vec3 c = xyz_to_linear_srgb(acc[0] / ysum, acc[1] / ysum, acc[2] / ysum);
+    return v3(fmaxf(c.x, 0.0f), fmaxf(c.y, 0.0f), fmaxf(c.z, 0.0f));
+}
+
+/* Planck's law in W m^-2 sr^-1 nm^-1, with the constants Mitsuba uses. */
+static double planck_nm(double nm, double kelvin)
+{
+    const double c = 299792458.0, k = 1.3806488e-23, h = 6.62606957e-34;
+    double l = nm * 1e-9;
+    return 2.0 * h * c * c / (l * l * l * l * l) / (expm1(h * c / (l * k * kelvin)) * 1e9);
+}
+
+vec3 spectra_mitsuba06_blackbody(float kelvin)
+{
+    /* Planck's law against the tabulated functions (linear within each
+     * nanometre): composite Simpson's rule on quarter nanometres, far
+     * below float precision for this smooth integrand */
+    double acc[3] = {0, 0, 0};
+    const int sub = 4;
+    for (int i = 360; i < 830; i++)
+        for (int s = 0; s < sub; s++) {
+            double a = i + (double)s / sub, b = a + 1.0 / sub, m = 0.5 * (a + b), ca[3], cm[3], cb[3];
+            cie_1nm(a, ca), cie_1nm(m, cm), cie_1nm(b, cb);
+            double pa = planck_nm(a, kelvin), pm = planck_nm(m, kelvin), pb = planck_nm(b, kelvin);
+            for (int c = 0; c < 3; c++) acc[c] += (b - a) / 6.0 * (pa * ca[c] + 4.0 * pm * cm[c] + pb * cb[c]);
+        }
+    double ysum = 0.0;
+    for (int i = 0; i < 470; i++) ysum += 0.5 * ((double)cie1931_xyz[i][1] + (double)cie1931_xyz[i + 1][1]);
+    vec3 c = xyz_to_linear_srgb(acc[0] / ysum, acc[1] / ysum, acc[2] / ysum);
+    return v3(fmaxf(c.x, 0.0f), fmaxf(c.y, 0.0f), fmaxf(c.z, 0.0f));
+}
+
+/* Mitsuba 3's tables: the matching functions and D65 every 5 nm over
+ * 360..830 nm, linear between, zero outside. */
+static void mts3_tables(double w, double xyz[3], double *d65)
+{
+    xyz[0] = xyz[1] = xyz[2] = *d65 = 0.0;
+    if (!(w >= 360.0 && w <= 830.0)) return;
+    double t = (w - 360.0) * (94.0 / 470.0);
+    int i = (int)t;
+    if (i > 93) i = 93;
+    double f = t - i;
+    for (int c = 0; c < 3; c++) xyz[c] = (1.0 - f) * (double)cie1931_xyz[5 * i][c] + f * (double)cie1931_xyz[5 * i + 5][c];
+    /* D65 scaled as Mitsuba 3 scales it (to about 1 near 560 nm) */
+    *d65 = ((1.0 - f) * (double)cie_d65[i] + f * (double)cie_d65[i + 1]) * (1.0 / 98.99741751876255);
+}
+
+/* Mitsuba 3's sum: 1000 equally spaced wavelengths from 360 to 830 nm
+ * (both included), each weighted 470/1000 nm, over 106.7502594. */
+static vec3 mts3_reduce(const float *nm, const float *val, int n, double kelvin, bool emitter, bool bounded)
+{
+    double X = 0, Y = 0, Z = 0;
+    const int steps = 1000;
+    for (int i = 0; i < steps; i++) {
+        double w = 360.0 + (double)i / (steps - 1) * 470.0, v;
+        if (kelvin > 0.0) v = planck_nm(w, kelvin);
+        else {
+            if (n < 2 || w < (double)nm[0] || w > (double)nm[n - 1]) continue;
+            int a = 0, b = n - 1;
+            while (b - a > 1) {
+                int m = (a + b) / 2;
+                if ((double)nm[m] <= w) a = m;
+                else b = m;
+            }
+            double w0 = (double)nm[a], w1 = (double)nm[a + 1];
+            v = ((w - w1) * (double)val[a] + (w0 - w) * (double)val[a + 1]) / (w0 - w1);
+        }
+        double c[3], d65;
+        mts3_tables(w, c, &d65);
+        double wt = v * (emitter ? 1.0 : d65);
+        X += c[0] * wt, Y += c[1] * wt, Z += c[2] * wt;
+    }
+    double k = 470.0 / 106.7502593994140625 / steps;
+    vec3 c = xyz_to_linear_srgb(X * k, Y * k, Z * k);
+    c = v3(fmaxf(c.x, 0.0f), fmaxf(c.y, 0.0f), fmaxf(c.z, 0.0f));
+    if (bounded) c = v3(fminf(c.x, 1.0f), fminf(c.y, 1.0f), fminf(c.z, 1.0f));
+    return c;
+}
+
+vec3 spectra_mitsuba3_rgb(const float *nm, const float *val, int n, bool emitter, bool bounded)
+{
+    return mts3_reduce(nm, val, n, 0.0, emitter, bounded);
+}
+
+vec3 spectra_mitsuba3_blackbody(float kelvin) { return mts3_reduce(NULL, NULL, 0, kelvin, true, false); }
+
+vec3 spectra_mitsuba3_uniform_emitter(float value)
+{
+    return v3_scale(xyz_to_linear_srgb(1.0, 1.0, 1.0), value);
+}
+
 typedef struct metal {
     const char *name;
     float eta[3], k[3];

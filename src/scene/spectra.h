@@ -30,6 +30,45 @@ PK_HIDDEN vec3 spectrum_to_rgb(const float *nm, const float *val, int n);
  * RGB as spectrum_to_rgb does (Mitsuba's <blackbody> units). */
 PK_HIDDEN vec3 blackbody_rgb(float kelvin);
 
+/* The CIE 1931 2-degree colour matching functions as tabulated by the CIE
+ * (every nanometre, 360..830 nm), linear between the nanometres and zero
+ * outside: xyz[0..2] = x, y, z at nm. */
+PK_HIDDEN void spectra_cie1931(float nm, float xyz[3]);
+
+/* Mitsuba 0.5/0.6's reduction of a sampled spectrum to linear sRGB in its
+ * RGB mode (reflectances and emitters alike): the n >= 2 samples (nm
+ * strictly ascending), linear between them, zero beyond a zero sample added
+ * one mean spacing past each end whose value is not zero; XYZ = the
+ * integrals over 360..830 nm of the spectrum times the tabulated matching
+ * functions, divided by the integral of y; then the Rec. 709 matrix;
+ * negative channels clamped to 0. No white normalisation: a flat spectrum
+ * of 1 is XYZ (1, 1, 1), the equal-energy white, pinkish in sRGB.
+ * Black for n < 2. */
+PK_HIDDEN vec3 spectra_mitsuba06_rgb(const float *nm, const float *val, int n);
+
+/* Mitsuba 0.5/0.6's <blackbody temperature=kelvin>: Planck's law in
+ * W m^-2 sr^-1 nm^-1 reduced as spectra_mitsuba06_rgb reduces a spectrum. */
+PK_HIDDEN vec3 spectra_mitsuba06_blackbody(float kelvin);
+
+/* Mitsuba 3's reduction in its RGB variants: the spectrum (linear between
+ * the n >= 2 samples, zero outside them) summed at 1000 equally spaced
+ * wavelengths over 360..830 nm against the matching functions tabulated
+ * every 5 nm, weighted by D65 (scaled to about 1 at 560 nm) unless emitter,
+ * times 470 / 1000 / 106.7502594; then the Rec. 709 matrix; negative
+ * channels clamped to 0, and channels above 1 clamped to 1 when bounded
+ * (reflectances; emitters and unbounded properties such as a conductor's
+ * eta and k are not). */
+PK_HIDDEN vec3 spectra_mitsuba3_rgb(const float *nm, const float *val, int n, bool emitter, bool bounded);
+
+/* A blackbody emitter at kelvin reduced as spectra_mitsuba3_rgb reduces an
+ * emitter's spectrum (what Mitsuba 3's spectral variants show of it; its RGB
+ * variants refuse blackbodies). */
+PK_HIDDEN vec3 spectra_mitsuba3_blackbody(float kelvin);
+
+/* Mitsuba 3's RGB of a uniform emitter spectrum of value: value times the
+ * sRGB of XYZ (1, 1, 1). */
+PK_HIDDEN vec3 spectra_mitsuba3_uniform_emitter(float value);
+
 /* The complex index of refraction (eta, k) of a named metal at the red,
  * green and blue primaries: "Cu", "Au", "Ag", "Al", "Cr" (the names of
  * Mitsuba's table). False, nothing written, for another name. */
