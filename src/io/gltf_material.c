@@ -341,7 +341,7 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
     if (ds && !cJSON_IsBool(ds)) return gltf_fail(g, PK_ERR_PARSE, "%s/doubleSided: must be true or false", path);
 
     /* extensions */
-    float strength = 1.0f, transmission = 0.0f, ior = 1.5f;
+    float strength = 1.0f, transmission = 0.0f, ior = 1.5f, coat = 0.0f, coat_rough = 0.0f;
     const cJSON *ext = cJSON_GetObjectItemCaseSensitive(o, "extensions");
     for (const cJSON *e = ext ? ext->child : NULL; e; e = e->next) {
         snprintf(ep, sizeof ep, "%s/extensions/%.40s", path, e->string ? e->string : "");
@@ -356,8 +356,14 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
             if ((st = gltf_num(g, e, ep, "ior", 0.0, 1e30, 1.5, &ior))) return st;
             if (ior == 0.0f) ior = 1.5f; /* never seen through: glTF's "0" is an infinite index; a dielectric default */
             else if (ior < 1.0f) return gltf_fail(g, PK_ERR_PARSE, "%s: ior %g is below 1", ep, (double)ior);
-        } else if (strcmp(e->string, "KHR_materials_clearcoat") == 0 ||
-                   strcmp(e->string, "KHR_materials_sheen") == 0 || strcmp(e->string, "KHR_materials_volume") == 0 ||
+        } else if (strcmp(e->string, "KHR_materials_clearcoat") == 0) {
+            if ((st = gltf_num(g, e, ep, "clearcoatFactor", 0.0, 1.0, 0.0, &coat))) return st;
+            if ((st = gltf_num(g, e, ep, "clearcoatRoughnessFactor", 0.0, 1.0, 0.0, &coat_rough))) return st;
+            if (cJSON_GetObjectItemCaseSensitive(e, "clearcoatTexture") ||
+                cJSON_GetObjectItemCaseSensitive(e, "clearcoatRoughnessTexture") ||
+                cJSON_GetObjectItemCaseSensitive(e, "clearcoatNormalTexture"))
+                gltf_warn(g, "%s: the clearcoat's textures are not supported (its factors are used alone)", ep);
+        } else if (strcmp(e->string, "KHR_materials_sheen") == 0 || strcmp(e->string, "KHR_materials_volume") == 0 ||
                    strcmp(e->string, "KHR_materials_specular") == 0 ||
                    strcmp(e->string, "KHR_materials_iridescence") == 0 ||
                    strcmp(e->string, "KHR_materials_anisotropy") == 0 ||
@@ -403,6 +409,8 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
     material_metallic_roughness(&m, v3(base[0], base[1], base[2]), metallic, roughness);
     m.transmission = transmission;
     m.ni = ior;
+    m.clearcoat = coat;
+    m.clearcoat_roughness = coat_rough;
     m.two_sided = cJSON_IsTrue(ds);
     m.ke = v3_scale(v3(emissive[0], emissive[1], emissive[2]), strength);
 

@@ -156,7 +156,8 @@ static bool ext_supported(const char *e)
     static const char *const known[] = {"KHR_mesh_quantization",        "KHR_texture_transform",
                                         "KHR_lights_punctual",          "KHR_materials_emissive_strength",
                                         "KHR_materials_transmission",   "KHR_materials_ior",
-                                        "KHR_materials_unlit",          NULL};
+                                        "KHR_materials_unlit",          "KHR_materials_clearcoat",
+                                        NULL};
     for (int i = 0; known[i]; i++)
         if (strcmp(e, known[i]) == 0) return true;
     return false;
