@@ -805,7 +805,7 @@ static pk_status parse_camera(jp *p, const cJSON *it)
     case CAMERA_FOV:
         return jfail(p, PK_ERR_PARSE, f[C_FOV] ? f[C_FOV] : it, "camera.fov",
                      "must be between 0 and 180 degrees (exclusive)");
-    case CAMERA_TOO_FAR:
+    case CAMERA_TOO_FAR: return jfail(p, PK_ERR_PARSE, f[C_AT], "camera.look_at", "is too far from look_from");
     case CAMERA_SAME_POINT: return jfail(p, PK_ERR_PARSE, f[C_AT], "camera.look_at", "must differ from look_from");
     case CAMERA_UP_ZERO: return jfail(p, PK_ERR_PARSE, f[C_UP], "camera.up", "must not be zero");
     case CAMERA_UP_PARALLEL:

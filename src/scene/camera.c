@@ -26,6 +26,14 @@ camera_problem camera_check(const pk_camera *cam)
     if (cam->projection != PK_PROJECTION_PERSPECTIVE && cam->projection != PK_PROJECTION_ORTHOGRAPHIC)
         return CAMERA_PROJECTION;
     if (cam->ortho_width < 0.0f) return CAMERA_ORTHO_WIDTH;
+    /* the distance to look_at stands for a focus distance or a width of 0:
+     * it must be finite (render/camera.h camera_distance) */
+    const bool by_distance = (cam->lens_radius > 0.0f && cam->focus_distance == 0.0f) ||
+                             (cam->projection == PK_PROJECTION_ORTHOGRAPHIC && cam->ortho_width == 0.0f);
+    if (by_distance) {
+        const float m = fmaxf(fabsf(dir.x), fmaxf(fabsf(dir.y), fabsf(dir.z)));
+        if (!isfinite(m * v3_len(v3_scale(dir, 1.0f / m)))) return CAMERA_TOO_FAR;
+    }
     return CAMERA_OK;
 }
 

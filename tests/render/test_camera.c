@@ -459,6 +459,20 @@ static void test_api(void)
     CHECK(pk_scene_set_camera(ctx, s, &c) == PK_OK);
     pk_scene_get_camera(s, &now);
     CHECK(memcmp(&now, &c, sizeof now) == 0);
+    /* a focus distance or width of 0 stands for the distance to look_at,
+     * which must then be finite */
+    c = good;
+    for (int k = 0; k < 3; k++) c.look_from[k] = -1.5e38f, c.look_at[k] = 1.5e38f; /* finite, 5.2e38 apart */
+    c.lens_radius = 1.0f;
+    pk_context_clear_error(ctx);
+    CHECK(pk_scene_set_camera(ctx, s, &c) == PK_ERR_INVALID_ARGUMENT);
+    CHECKF(strstr(pk_context_error(ctx), "too far apart"), "got '%s'", pk_context_error(ctx));
+    c.focus_distance = 10.0f;
+    CHECK(pk_scene_set_camera(ctx, s, &c) == PK_OK);
+    c.lens_radius = 0.0f, c.projection = PK_PROJECTION_ORTHOGRAPHIC;
+    CHECK(pk_scene_set_camera(ctx, s, &c) == PK_ERR_INVALID_ARGUMENT);
+    c.ortho_width = 5.0f;
+    CHECK(pk_scene_set_camera(ctx, s, &c) == PK_OK);
     pk_scene_destroy(s);
 }
 
@@ -502,6 +516,14 @@ static void test_json(void)
     check_json_error(", \"projection\": 1", "must be \"perspective\" or \"orthographic\"");
     check_json_error(", \"lens_radius\": \"big\"", "camera.lens_radius");
     check_json_error(", \"lens_radius\": 0.1, \"lens_radius\": 0.2", "duplicate key");
+    const char *far = "{\"camera\": {\"look_from\": [-1.5e38, -1.5e38, -1.5e38], \"look_at\": [1.5e38, 1.5e38, 1.5e38],"
+                      " \"lens_radius\": 1}}";
+    pk_scene *f = NULL;
+    pk_context_clear_error(ctx);
+    CHECK(pk_scene_load_json_memory(ctx, far, strlen(far), "far.json", ".", &f) == PK_ERR_PARSE);
+    CHECKF(strstr(pk_context_error(ctx), "camera.look_at: is too far from look_from"), "got '%s'",
+           pk_context_error(ctx));
+    pk_scene_destroy(f);
 }
 
 static pk_scene *xml_scene(const char *sensor, pk_status want)
