@@ -9,6 +9,7 @@
  * messages of bad input, each with file:line.
  */
 #include "test.h"
+#include "test_rng.h"
 #include "warnings.h"
 
 #include "io/pbrt_tok.h"
@@ -325,6 +326,54 @@ static void test_materials(void)
               near3(b->map_kd.even, v3(1, 0, 0), 0) && near3(b->map_kd.odd, v3(0, 0, 1), 0));
     }
     done(ctx, s);
+}
+
+/* The closed form coated_albedo rests on, against a random walk through
+ * the layer it describes (a smooth coat of index 1.5 over a Lambertian base
+ * of albedo rho, nothing in between): of the light that enters, the part
+ * that leaves again is rho (1 - Fi) / (1 - rho Fi) with Fi = 1 - (1 - Fe) /
+ * eta^2 (Fe: the coat's diffuse reflectance from outside). The walk uses
+ * the Fresnel equations from inside (with total internal reflection) and
+ * knows nothing of Fe or Fi. */
+static double fresnel_t(double c, double eta) /* light in a medium of index eta going out (relative 1/eta) */
+{
+    double s2 = eta * eta * (1.0 - c * c);
+    if (s2 >= 1.0) return 1.0;
+    double ct = sqrt(1.0 - s2), e = 1.0 / eta;
+    double rs = (c - e * ct) / (c + e * ct), rp = (e * c - ct) / (e * c + ct);
+    return 0.5 * (rs * rs + rp * rp);
+}
+
+static void test_layer_walk(void)
+{
+    const double eta = 1.5;
+    double fe = 0.0;
+    for (int i = 0; i < 20000; i++) {
+        double mu = (i + 0.5) / 20000.0, ct = sqrt(1.0 - (1.0 - mu * mu) / (eta * eta));
+        double rs = (mu - eta * ct) / (mu + eta * ct), rp = (eta * mu - ct) / (eta * mu + ct);
+        fe += (rs * rs + rp * rp) * mu / 20000.0;
+    }
+    const double fi = 1.0 - (1.0 - fe) / (eta * eta);
+    rng r = {12345};
+    const double rhos[3] = {0.2, 0.5, 0.9};
+    for (int k = 0; k < 3; k++) {
+        const int n = 400000;
+        int out = 0;
+        for (int i = 0; i < n; i++) {
+            for (int bounce = 0; bounce < 1000; bounce++) {
+                if ((double)rng_f(&r) >= rhos[k]) break;          /* absorbed by the base */
+                double mu = sqrt((double)rng_f(&r) + 1e-12); /* cosine-distributed, up */
+                if ((double)rng_f(&r) >= fresnel_t(mu, eta)) {     /* through the coat */
+                    out++;
+                    break;
+                }
+            }
+        }
+        double p = (double)out / n, se = sqrt(p * (1.0 - p) / n);
+        double want = rhos[k] * (1.0 - fi) / (1.0 - rhos[k] * fi);
+        CHECKF(fabs(p - want) < 4.0 * se, "rho %g: the walk gives %.5f +- %.5f, the closed form %.5f", rhos[k], p, se,
+               want);
+    }
 }
 
 /* ---- lights ---- */
@@ -682,6 +731,7 @@ int main(void)
     test_transforms();
     test_camera();
     test_materials();
+    test_layer_walk();
     test_lights();
     test_equal_area();
     test_loop();
