@@ -90,6 +90,9 @@ int cli_render(int argc, char **argv)
     cli_progress_init(&bar, stderr, o.quiet);
     if (!o.quiet) pk_context_set_warning_handler(ctx, print_warning, &bar);
     rc = 1;
+    /* the back ends' settings before the scene: scene.instances decides what loading keeps */
+    if ((rc = cli_configure(ctx, o.config)) != 0) goto out;
+    rc = 1;
     pk_status st = o.scene ? pk_scene_load_file_params(ctx, o.scene, o.defines, o.ndefines, &scene)
                            : pk_scene_create_cornell_box(ctx, &scene);
     if (st != PK_OK) goto fail;

@@ -47,6 +47,7 @@ typedef struct pk_config {
     char embree_library[PK_CONFIG_NAME_MAX]; /* embree.library: "" for libembree3.so.3 */
     char cuda_library[PK_CONFIG_NAME_MAX];   /* cuda.library: "" for libcuda.so.1 */
     char dnnl_library[PK_CONFIG_NAME_MAX];   /* dnnl.library: "" for libdnnl.so.2 (the denoiser) */
+    int instances;        /* scene.instances: 0 auto, 1 flatten every instance, 2 keep them (scene_commit) */
 } pk_config;
 
 /* Invariants:

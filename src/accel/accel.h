@@ -9,12 +9,29 @@
 #ifndef PK_ACCEL_H
 #define PK_ACCEL_H
 
+#include "../math/xform.h"
 #include "geom.h"
 
 typedef struct accel_sphere {
     vec3 center;
     float radius;
 } accel_sphere;
+
+/* An object-space mesh that instances place: 3*ntris vertices. */
+typedef struct accel_mesh {
+    const vec3 *verts;
+    size_t ntris;
+} accel_mesh;
+
+/* A mesh placed by to_world (finite, affine, invertible); its triangle k is
+ * primitive prim0 + k. prim0 ascends with the instance, past the triangles
+ * and spheres (prim0 >= ntris + nspheres), and every instance's numbers stay
+ * below PK_NO_HIT. */
+typedef struct accel_instance {
+    xform to_world;
+    uint32_t mesh;
+    uint32_t prim0;
+} accel_instance;
 
 /* Borrowed by the builder for the duration of accel_create only. */
 typedef struct accel_input {
@@ -24,6 +41,19 @@ typedef struct accel_input {
     size_t nspheres;
     int threads;                 /* build threads, >= 1 */
 } accel_input;
+
+/* Instances (instances.c, Embree's instance geometry): a two-level
+ * structure, one bottom level per mesh and a top level over the instances'
+ * world boxes. A ray meets a mesh in its object space: the origin and
+ * direction go through the instance's inverse transform and the direction
+ * is not renormalised, so t is the world ray's parameter and hits compare
+ * across instances. Borrowed like accel_input. */
+typedef struct accel_instances {
+    const accel_mesh *meshes;
+    size_t nmeshes;
+    const accel_instance *instances;
+    size_t ninstances;
+} accel_instances;
 
 /* Counters are per thread; NULL means "do not count" and must cost nothing. */
 typedef struct accel_counters {
@@ -65,6 +95,10 @@ struct accel {
 
 /* Builds kind over in. Errors (NOMEM, UNSUPPORTED) are latched in ctx. */
 PK_HIDDEN pk_status accel_create(pk_context *ctx, pk_accel_kind kind, const accel_input *in, accel **out);
+/* The same with instances placed too (ti NULL or without instances:
+ * accel_create). The GPU accelerator refuses instances. */
+PK_HIDDEN pk_status accel_create_instanced(pk_context *ctx, pk_accel_kind kind, const accel_input *in,
+                                           const accel_instances *ti, accel **out);
 /* Inline, so that an accelerator built on another (cuda.c on the BVH)
  * needs nothing of registry.c. NULL is ignored. */
 static inline void accel_destroy(accel *a)
@@ -104,6 +138,20 @@ typedef struct bvh_costs {
 PK_HIDDEN pk_status accel_bvh_create_costs(pk_context *ctx, const accel_input *in, const bvh_costs *costs,
                                            accel **out);
 PK_HIDDEN pk_status accel_embree_create(pk_context *ctx, const accel_input *in, accel **out);
+/* The two-level structure of kind (none, midpoint, bvh) for an input with
+ * instances: kind over the world's triangles and spheres, kind over each
+ * mesh, a binary SAH tree over the instances (kind none: every instance is
+ * tested, the brute-force reference). instances.c. */
+PK_HIDDEN pk_status accel_instances_create(pk_context *ctx, pk_accel_kind kind, const accel_input *in,
+                                           const accel_instances *ti, accel **out);
+/* Embree with its instance geometry: one Embree scene per mesh (embree.c). */
+PK_HIDDEN pk_status accel_embree_create_instanced(pk_context *ctx, const accel_input *in, const accel_instances *ti,
+                                                  accel **out);
+/* Invariants of a two-level structure (tests): its top level holds every
+ * instance once, boxes contain their children and their instances' placed
+ * meshes; the bottom levels pass their own checker (bvh_check for bvh).
+ * False with a reason when broken, or when a is not two-level. */
+PK_HIDDEN bool accel_instances_check(const accel *a, char *why, size_t n);
 /* Can ctx's Embree library (config embree.library; ctx NULL: the default) be loaded? */
 PK_HIDDEN bool accel_embree_available(const pk_context *ctx);
 /* The GPU accelerator (cuda.c): built in? (a driver and a device are looked

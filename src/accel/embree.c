@@ -33,7 +33,7 @@
     X(NewScene) X(ReleaseScene) X(SetSceneFlags) X(SetSceneBuildQuality) X(CommitScene)  \
     X(NewGeometry) X(ReleaseGeometry) X(SetNewGeometryBuffer) X(SetGeometryBuildQuality) \
     X(SetGeometryUserData) X(SetGeometryOccludedFilterFunction) X(CommitGeometry)        \
-    X(AttachGeometryByID)                                                                \
+    X(AttachGeometryByID) X(SetGeometryInstancedScene) X(SetGeometryTransform)         \
     X(Intersect1) X(Occluded1) X(Intersect8) X(Occluded8) X(Intersect16) X(Occluded16)
 
 /* rtc.Name points to Embree's rtcName once the library is ready (embree
@@ -72,7 +72,7 @@ static bool embree_loaded(const pk_context *ctx, char *why, size_t n)
     return dynlib_load(&embree, config_embree_library(ctx), init_embree, why, n);
 }
 
-enum { GEOM_TRIS = 0, GEOM_SPHERES = 1 };
+enum { GEOM_TRIS = 0, GEOM_SPHERES = 1, GEOM_FIRST_INSTANCE = 2 };
 
 /* Invariants:
  *  1. scene is committed and never changed after accel_embree_create;
@@ -85,6 +85,10 @@ typedef struct embree_accel {
     RTCDevice device;
     RTCScene scene;
     accel_sphere *spheres;
+    RTCScene *mesh_scenes;    /* per mesh of an instanced input: its triangles as geometry 0 (NULL: none) */
+    size_t nmesh_scenes;
+    uint32_t *inst_prim0;     /* instance i (geometry GEOM_FIRST_INSTANCE + i): its triangle 0's number */
+    size_t ninst;
     int64_t device_bytes;     /* bytes Embree holds (memory monitor, atomic) */
     unsigned packet_width;    /* 8 or 16: the widest native packet */
     bool has_filter;          /* occlusion filters work: any-hit reports t */
@@ -177,12 +181,17 @@ static void sphere_uv(const embree_accel *e, uint32_t k, vec3 o, vec3 d, float t
     *v = theta * (1.0f / PK_PI);
 }
 
-/* Fills *h from Embree's answer for a ray from o along d. */
-static void set_hit(const embree_accel *e, vec3 o, vec3 d, float t, unsigned geom, unsigned prim,
+/* Fills *h from Embree's answer for a ray from o along d (inst: the
+ * instance geometry the hit is in, or RTC_INVALID_GEOMETRY_ID). */
+static void set_hit(const embree_accel *e, vec3 o, vec3 d, float t, unsigned inst, unsigned geom, unsigned prim,
                     float u, float v, hit *h)
 {
     h->t = t;
-    if (geom == GEOM_TRIS) {
+    if (inst != RTC_INVALID_GEOMETRY_ID) {
+        h->prim = e->inst_prim0[inst - GEOM_FIRST_INSTANCE] + prim;
+        h->u = u;
+        h->v = v;
+    } else if (geom == GEOM_TRIS) {
         h->prim = prim;
         h->u = u;
         h->v = v;
@@ -223,7 +232,7 @@ static void occ_filter(const struct RTCFilterFunctionNArguments *args)
         if (args->valid[i] != -1) continue;
         vec3 o = v3(rf[0 * n + i], rf[1 * n + i], rf[2 * n + i]);
         vec3 d = v3(rf[4 * n + i], rf[5 * n + i], rf[6 * n + i]);
-        set_hit(e, o, d, rf[8 * n + i], hu[6 * n + i], hu[5 * n + i], hf[3 * n + i], hf[4 * n + i],
+        set_hit(e, o, d, rf[8 * n + i], hu[7 * n + i], hu[6 * n + i], hu[5 * n + i], hf[3 * n + i], hf[4 * n + i],
                 &oc->out[ru[10 * n + i]]);
     }
 }
@@ -244,7 +253,7 @@ static bool emb_intersect(const accel *a, const ray *r, hit *h, accel_counters *
         hit_clear(h);
         return false;
     }
-    set_hit(e, r->o, r->d, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, h);
+    set_hit(e, r->o, r->d, rh.ray.tfar, rh.hit.instID[0], rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, h);
     return true;
 }
 
@@ -348,7 +357,7 @@ static void emb_packets(const accel *a, const ray *r, hit *h, size_t n, bool any
                 const ray *ri = &r[base + i];
                 if (u[F_GEOM * w + i] == RTC_INVALID_GEOMETRY_ID) hit_clear(&out[i]);
                 else
-                    set_hit(e, ri->o, ri->d, f[F_TFAR * w + i], u[F_GEOM * w + i],
+                    set_hit(e, ri->o, ri->d, f[F_TFAR * w + i], u[F_INST * w + i], u[F_GEOM * w + i],
                             u[F_PRIM * w + i], f[F_U * w + i], f[F_V * w + i], &out[i]);
             }
         }
@@ -361,6 +370,10 @@ static void emb_destroy(accel *a)
     if (!e) return;
     pk_allocator al = e->alloc;
     if (e->scene) rtc.ReleaseScene(e->scene);
+    for (size_t m = 0; e->mesh_scenes && m < e->nmesh_scenes; m++)
+        if (e->mesh_scenes[m]) rtc.ReleaseScene(e->mesh_scenes[m]);
+    mem_free(&al, e->mesh_scenes);
+    mem_free(&al, e->inst_prim0);
     if (e->device) rtc.ReleaseDevice(e->device);
     mem_free(&al, e->spheres);
     mem_free(&al, e);
@@ -373,8 +386,8 @@ static const accel_ops embree_ops = {
     .intersect_packet = emb_packets,
 };
 
-/* Adds the triangles as geometry GEOM_TRIS: vertices 3k..3k+2 are triangle k. */
-static void add_triangles(embree_accel *e, const accel_input *in, enum RTCBuildQuality q)
+/* Adds the triangles as geometry GEOM_TRIS of scene: vertices 3k..3k+2 are triangle k. */
+static void add_triangles(embree_accel *e, RTCScene scene, const accel_input *in, enum RTCBuildQuality q)
 {
     RTCGeometry g = rtc.NewGeometry(e->device, RTC_GEOMETRY_TYPE_TRIANGLE);
     if (!g) return;
@@ -393,7 +406,7 @@ static void add_triangles(embree_accel *e, const accel_input *in, enum RTCBuildQ
         rtc.SetGeometryUserData(g, e);
         if (e->has_filter) rtc.SetGeometryOccludedFilterFunction(g, occ_filter);
         rtc.CommitGeometry(g);
-        rtc.AttachGeometryByID(e->scene, g, GEOM_TRIS);
+        rtc.AttachGeometryByID(scene, g, GEOM_TRIS);
     }
     rtc.ReleaseGeometry(g);
 }
@@ -420,7 +433,43 @@ static void add_spheres(embree_accel *e, const accel_input *in, enum RTCBuildQua
     rtc.ReleaseGeometry(g);
 }
 
+/* The meshes as scenes of their own and the instances as instance
+ * geometries GEOM_FIRST_INSTANCE + i of e->scene. */
+static void add_instances(embree_accel *e, const accel_input *in, const accel_instances *ti, enum RTCBuildQuality q)
+{
+    for (size_t m = 0; m < ti->nmeshes; m++) {
+        if (!ti->meshes[m].ntris) continue;
+        RTCScene ms = rtc.NewScene(e->device);
+        if (!ms) return;
+        e->mesh_scenes[m] = ms;
+        rtc.SetSceneBuildQuality(ms, q);
+        accel_input mi = {ti->meshes[m].verts, ti->meshes[m].ntris, NULL, 0, in->threads};
+        add_triangles(e, ms, &mi, q);
+        rtc.CommitScene(ms);
+    }
+    for (size_t i = 0; i < ti->ninstances; i++) {
+        const accel_instance *ii = &ti->instances[i];
+        e->inst_prim0[i] = ii->prim0;
+        if (!e->mesh_scenes[ii->mesh]) continue;
+        RTCGeometry g = rtc.NewGeometry(e->device, RTC_GEOMETRY_TYPE_INSTANCE);
+        if (!g) return;
+        rtc.SetGeometryInstancedScene(g, e->mesh_scenes[ii->mesh]);
+        float m34[12];
+        for (int k = 0; k < 12; k++) m34[k] = ii->to_world.m[k];
+        rtc.SetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, m34);
+        rtc.CommitGeometry(g);
+        rtc.AttachGeometryByID(e->scene, g, (unsigned)(GEOM_FIRST_INSTANCE + i));
+        rtc.ReleaseGeometry(g);
+    }
+}
+
 pk_status accel_embree_create(pk_context *ctx, const accel_input *in, accel **out)
+{
+    return accel_embree_create_instanced(ctx, in, NULL, out);
+}
+
+pk_status accel_embree_create_instanced(pk_context *ctx, const accel_input *in, const accel_instances *ti,
+                                        accel **out)
 {
     *out = NULL;
     char why[8];
@@ -446,6 +495,20 @@ pk_status accel_embree_create(pk_context *ctx, const accel_input *in, accel **ou
         }
         memcpy(e->spheres, in->spheres, in->nspheres * sizeof *e->spheres);
     }
+    if (ti && ti->ninstances) {
+        if (ti->ninstances >= UINT32_MAX - GEOM_FIRST_INSTANCE) {
+            emb_destroy(&e->base);
+            return ctx_error(ctx, PK_ERR_LIMIT, "embree: %zu instances are too many", ti->ninstances);
+        }
+        e->mesh_scenes = mem_calloc(&e->alloc, ti->nmeshes ? ti->nmeshes : 1, sizeof *e->mesh_scenes);
+        e->inst_prim0 = mem_calloc(&e->alloc, ti->ninstances, sizeof *e->inst_prim0);
+        e->nmesh_scenes = ti->nmeshes;
+        e->ninst = ti->ninstances;
+        if (!e->mesh_scenes || !e->inst_prim0) {
+            emb_destroy(&e->base);
+            return ctx_nomem(ctx);
+        }
+    }
 
     /* start_threads: the worker threads start here, outside build_ms */
     char config[64];
@@ -468,8 +531,9 @@ pk_status accel_embree_create(pk_context *ctx, const accel_input *in, accel **ou
     if (e->scene) {
         rtc.SetSceneFlags(e->scene, RTC_SCENE_FLAG_NONE);
         rtc.SetSceneBuildQuality(e->scene, quality);
-        if (in->ntris) add_triangles(e, in, quality);
+        if (in->ntris) add_triangles(e, e->scene, in, quality);
         if (in->nspheres) add_spheres(e, in, quality);
+        if (e->ninst) add_instances(e, in, ti, quality);
         if (!be.failed) rtc.CommitScene(e->scene);
     }
     double t1 = time_now();
@@ -486,6 +550,7 @@ pk_status accel_embree_create(pk_context *ctx, const accel_input *in, accel **ou
     e->base.info.name = "embree";
     e->base.info.build_ms = (t1 - t0) * 1e3;
     e->base.info.primitives = in->ntris + in->nspheres;
+    for (size_t i = 0; i < e->ninst; i++) e->base.info.primitives += ti->meshes[ti->instances[i].mesh].ntris;
     int64_t bytes = __atomic_load_n(&e->device_bytes, __ATOMIC_RELAXED);
     e->base.info.bytes = bytes > 0 ? (size_t)bytes : 0;
     *out = &e->base;
@@ -509,6 +574,14 @@ pk_status accel_embree_unavailable(pk_context *ctx)
 pk_status accel_embree_create(pk_context *ctx, const accel_input *in, accel **out)
 {
     (void)in;
+    *out = NULL;
+    return accel_embree_unavailable(ctx);
+}
+
+pk_status accel_embree_create_instanced(pk_context *ctx, const accel_input *in, const accel_instances *ti,
+                                        accel **out)
+{
+    (void)in, (void)ti;
     *out = NULL;
     return accel_embree_unavailable(ctx);
 }

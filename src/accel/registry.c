@@ -6,11 +6,25 @@
 
 pk_status accel_create(pk_context *ctx, pk_accel_kind kind, const accel_input *in, accel **out)
 {
+    return accel_create_instanced(ctx, kind, in, NULL, out);
+}
+
+pk_status accel_create_instanced(pk_context *ctx, pk_accel_kind kind, const accel_input *in, const accel_instances *ti,
+                                 accel **out)
+{
     *out = NULL;
     if (in->ntris + in->nspheres >= (size_t)UINT32_MAX)
         return ctx_error(ctx, PK_ERR_LIMIT, "too many primitives (%zu)", in->ntris + in->nspheres);
     double t0 = time_now();
     pk_status st;
+    if (ti && ti->ninstances) {
+        if (kind == PK_ACCEL_CUDA)
+            return ctx_error(ctx, PK_ERR_UNSUPPORTED,
+                             "accelerator 'cuda' traces flattened triangles only: the scene keeps %zu instances "
+                             "(config scene.instances=flatten flattens them)", ti->ninstances);
+        if (kind == PK_ACCEL_EMBREE) st = accel_embree_create_instanced(ctx, in, ti, out);
+        else st = accel_instances_create(ctx, kind, in, ti, out);
+    } else
     switch (kind) {
     case PK_ACCEL_NONE: st = accel_none_create(ctx, in, out); break;
     case PK_ACCEL_MIDPOINT: st = accel_midpoint_create(ctx, in, out); break;

@@ -28,7 +28,35 @@ pk_status frame_build_accel(pk_context *ctx, const pk_scene *s, pk_accel_kind ki
         }
     }
     accel_input in = {verts, s->ntris, sph, s->nspheres, threads > 0 ? threads : omp_get_max_threads()};
-    pk_status st = accel_create(ctx, kind, &in, out);
+    accel_instances ti = {NULL, 0, NULL, 0};
+    pk_status st = PK_OK;
+    accel_mesh *meshes = NULL;
+    accel_instance *inst = NULL;
+    if (s->nkept) { /* the kept instances: their meshes' object-space triangles */
+        meshes = mem_calloc(&ctx->alloc, s->nmeshes, sizeof *meshes);
+        inst = mem_realloc_array(&ctx->alloc, NULL, s->nkept, sizeof *inst);
+        if (!meshes || !inst) st = ctx_nomem(ctx);
+        for (size_t i = 0; i < s->nkept && st == PK_OK; i++) {
+            const uint32_t mi = s->kept[i].mesh;
+            inst[i] = (accel_instance){s->kept[i].to_world, mi, s->kept[i].prim0};
+            if (meshes[mi].verts || !s->meshes[mi].ntris) continue;
+            const scene_mesh *m = &s->meshes[mi];
+            vec3 *mv = mem_realloc_array(&ctx->alloc, NULL, m->ntris, 3 * sizeof *mv);
+            if (!mv) {
+                st = ctx_nomem(ctx);
+                break;
+            }
+            for (size_t k = 0; k < m->ntris; k++)
+                for (int j = 0; j < 3; j++) mv[3 * k + j] = s->mesh_positions[m->first_pos + s->mesh_tris[m->first_tri + k].v[j]];
+            meshes[mi].verts = mv;
+            meshes[mi].ntris = m->ntris;
+        }
+        ti = (accel_instances){meshes, s->nmeshes, inst, s->nkept};
+    }
+    if (st == PK_OK) st = accel_create_instanced(ctx, kind, &in, &ti, out);
+    for (size_t m = 0; meshes && m < s->nmeshes; m++) mem_free(&ctx->alloc, (void *)meshes[m].verts);
+    mem_free(&ctx->alloc, meshes);
+    mem_free(&ctx->alloc, inst);
     mem_free(&ctx->alloc, verts);
     mem_free(&ctx->alloc, sph);
     return st;

@@ -120,6 +120,9 @@ pk_status path_gpu_create(pk_context *ctx, const path_tracer *pt, path_gpu **out
     if (s->nspheres)
         return ctx_error(ctx, PK_ERR_UNSUPPORTED, "device 'cuda': the GPU renders triangles only (the scene has %zu "
                          "sphere%s)", s->nspheres, s->nspheres == 1 ? "" : "s");
+    if (s->nkept)
+        return ctx_error(ctx, PK_ERR_UNSUPPORTED, "device 'cuda': the GPU renders flattened triangles only (the scene "
+                         "keeps %zu instances)", s->nkept);
 #if defined(PK_HAVE_CUDA) && PK_HAVE_CUDA
     const cuda_image image = {pk_cuda_path_fatbin, PK_CUDA_VERSION_MAJOR, PK_CUDA_VERSION_MINOR};
 #else

@@ -130,6 +130,11 @@ pk_status renderer_create(pk_context *ctx, const pk_scene *s, const pk_render_op
                           pk_renderer **out)
 {
     *out = NULL;
+    if (s->nkept && (opt->accel == PK_ACCEL_CUDA || opt->device == PK_DEVICE_CUDA))
+        return ctx_error(ctx, PK_ERR_UNSUPPORTED,
+                         "device 'cuda': the GPU renders flattened triangles only (the scene keeps %zu instances; "
+                         "render on the CPU, or flatten them with the config scene.instances=flatten)",
+                         s->nkept);
     pk_renderer *r = mem_calloc(&ctx->alloc, 1, sizeof *r);
     if (!r) return ctx_nomem(ctx);
     r->ctx = ctx;

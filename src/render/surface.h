@@ -18,29 +18,37 @@ typedef struct surface {
     const material *m;
 } surface;
 
-/* The surface that ray r hit at h (h->prim is a triangle or a sphere of s). */
+/* Whether hit number prim is a triangle (of the world arrays or of a kept
+ * instance) rather than a sphere. */
+static inline PK_HD bool surface_is_tri(const scene_view *s, uint32_t prim)
+{
+    return prim < s->ntris || (size_t)prim - s->ntris >= s->nspheres;
+}
+
+/* The surface that ray r hit at h (h->prim is a triangle, a sphere or a
+ * kept instance's triangle of s: view_tri_get gives every triangle in
+ * world space, so this is the one place a hit becomes a surface). */
 static inline PK_HD surface surface_at(const scene_view *s, const ray *r, const hit *h)
 {
     surface sf;
     vec3 ng, ns;
-    if (h->prim < s->ntris) {
-        const triangle *t = &s->tris[h->prim];
-        vec3 a, b, c;
-        view_tri_verts(s, h->prim, &a, &b, &c);
+    if (surface_is_tri(s, h->prim)) {
+        view_tri t;
+        view_tri_get(s, h->prim, &t);
+        const vec3 a = t.p[0], b = t.p[1], c = t.p[2];
         float w = 1.0f - h->u - h->v;
         sf.p = v3_add(v3_add(v3_scale(a, w), v3_scale(b, h->u)), v3_scale(c, h->v));
         ng = tri_normal(a, b, c);
         ns = ng;
-        if (t->n[0] >= 0 && t->n[1] >= 0 && t->n[2] >= 0) {
-            vec3 n = v3_add(v3_add(v3_scale(s->normals[t->n[0]], w), v3_scale(s->normals[t->n[1]], h->u)),
-                            v3_scale(s->normals[t->n[2]], h->v));
+        if (t.has_n) {
+            vec3 n = v3_add(v3_add(v3_scale(t.n[0], w), v3_scale(t.n[1], h->u)), v3_scale(t.n[2], h->v));
             if (v3_len2(n) > 0.0f) {
                 n = v3_norm(n);
                 /* vertex normals pointing against the face are taken as flipped faces */
                 ns = v3_dot(n, ng) >= 0.0f ? n : v3_neg(n);
             }
         }
-        sf.m = &s->materials[t->material];
+        sf.m = &s->materials[t.material];
     } else {
         const sphere *sp = &s->spheres[h->prim - s->ntris];
         vec3 p = v3_add(r->o, v3_scale(r->d, h->t));
@@ -74,15 +82,15 @@ typedef struct surface_uv {
 static inline PK_HD surface_uv surface_uv_at(const scene_view *s, const ray *r, const hit *h)
 {
     surface_uv q;
-    if (h->prim < s->ntris) {
-        const triangle *t = &s->tris[h->prim];
-        vec3 a, b, c;
-        view_tri_verts(s, h->prim, &a, &b, &c);
+    if (surface_is_tri(s, h->prim)) {
+        view_tri t;
+        view_tri_get(s, h->prim, &t);
+        const vec3 a = t.p[0], b = t.p[1], c = t.p[2];
         uv2 ta = {0.0f, 0.0f}, tb = {1.0f, 0.0f}, tc = {0.0f, 1.0f};
-        if (t->t[0] >= 0 && t->t[1] >= 0 && t->t[2] >= 0) {
-            ta = s->uvs[t->t[0]];
-            tb = s->uvs[t->t[1]];
-            tc = s->uvs[t->t[2]];
+        if (t.has_t) {
+            ta = t.t[0];
+            tb = t.t[1];
+            tc = t.t[2];
         }
         const float w = 1.0f - h->u - h->v;
         q.u = ta.u * w + tb.u * h->u + tc.u * h->v;
@@ -212,8 +220,7 @@ static inline PK_HD surface surface_texture(const scene_view *s, const ray *r, c
 /* True when the hit lies in a hole of its material's map_d (opacity < 0.5). */
 static inline PK_HD bool surface_is_hole(const scene_view *s, const ray *r, const hit *h)
 {
-    const uint32_t mi = h->prim < s->ntris ? s->tris[h->prim].material : s->spheres[h->prim - s->ntris].material;
-    const material *m = &s->materials[mi];
+    const material *m = &s->materials[view_prim_material(s, h->prim)];
     if (!m->cutout) return false;
     const surface_uv uv = surface_uv_at(s, r, h);
     tex_query q = {uv.u, uv.v, 0.0f};

@@ -51,6 +51,7 @@ pk_status scene_create(pk_context *ctx, const char *name, pk_scene **out)
     if (!s) return ctx_nomem(ctx);
     s->alloc = ctx->alloc;
     s->bounds = aabb_empty();
+    s->kept_bounds = aabb_empty();
     pk_render_options_init(&s->render.opt);
     scene_env_init(&s->env);
     s->name = mem_strdup(&s->alloc, name ? name : "scene");
@@ -87,6 +88,7 @@ void scene_destroy(pk_scene *s)
     mem_free(a, s->mesh_tris);
     mem_free(a, s->meshes);
     mem_free(a, s->instances);
+    mem_free(a, s->kept);
     scene_env_clear(a, &s->env);
     mem_free(a, s->name);
     pk_allocator copy = *a;
@@ -304,28 +306,149 @@ static pk_status place_instance(pk_context *ctx, pk_scene *s, const scene_instan
     return PK_OK;
 }
 
-/* Instances [nflattened, ninstances) into the triangle list, each at its place. */
+static bool box_empty(aabb b) { return !(b.lo.x <= b.hi.x); }
+
+static bool material_emits(const material *m) { return m->ke.x > 0.0f || m->ke.y > 0.0f || m->ke.z > 0.0f; }
+
+/* Whether instance in would place an emitting triangle. */
+static bool instance_emits(const pk_scene *s, const scene_instance *in)
+{
+    if (in->material != SCENE_MESH_MATERIAL) return material_emits(&s->materials[in->material]);
+    const scene_mesh *m = &s->meshes[in->mesh];
+    for (size_t k = 0; k < m->ntris; k++)
+        if (material_emits(&s->materials[s->mesh_tris[m->first_tri + k].material])) return true;
+    return false;
+}
+
+/* keep[i - first] for instances [first, n): which stay instances (scene.h's
+ * rule, ctx's config scene.instances). */
+static pk_status choose_kept(pk_context *ctx, const pk_scene *s, size_t first, size_t n, uint8_t *keep)
+{
+    const int mode = ctx->config.instances; /* 0 auto, 1 flatten, 2 keep */
+    memset(keep, 0, n - first);
+    if (mode == 1) return PK_OK;
+    uint32_t *placed = NULL;
+    if (mode == 0) {
+        placed = mem_calloc(&s->alloc, s->nmeshes ? s->nmeshes : 1, sizeof *placed);
+        if (!placed) return ctx_nomem(ctx);
+        for (size_t i = 0; i < s->ninstances; i++)
+            if (placed[s->instances[i].mesh] < 2) placed[s->instances[i].mesh]++;
+    }
+    size_t tris = 0, emitting = 0;
+    for (size_t i = first; i < n; i++) {
+        const scene_instance *in = &s->instances[i];
+        if (placed && placed[in->mesh] < 2) continue;
+        if (instance_emits(s, in)) {
+            emitting++;
+            continue;
+        }
+        keep[i - first] = 1;
+        tris += s->meshes[in->mesh].ntris;
+    }
+    mem_free(&s->alloc, placed);
+    if (mode == 0 && tris < SCENE_KEEP_MIN_TRIS) {
+        memset(keep, 0, n - first);
+        return PK_OK;
+    }
+    if (emitting)
+        ctx_warn(ctx, "%s: %zu emitting instance%s flattened (lights are world triangles): their triangles take "
+                      "memory as if written out", s->name, emitting, emitting == 1 ? "" : "s");
+    return PK_OK;
+}
+
+/* The kept instances' hit numbers and world bounds: every vertex of a
+ * triangle that is not degenerate in the mesh's space, placed as
+ * flattening would place it, so that the bounds (and the ray offsets and
+ * framing derived from them) are a flattened scene's. */
+static pk_status number_kept(pk_context *ctx, pk_scene *s)
+{
+    s->nkept_tris = 0;
+    s->kept_bounds = aabb_empty();
+    if (!s->nkept) return PK_OK;
+    uint64_t next = (uint64_t)s->ntris + s->nspheres;
+    for (size_t i = 0; i < s->nkept; i++) {
+        s->kept[i].prim0 = (uint32_t)next;
+        next += s->meshes[s->kept[i].mesh].ntris;
+        if (next >= PK_NO_HIT)
+            return ctx_error(ctx, PK_ERR_LIMIT, "%s: the instances place %llu triangles; at most %u can be numbered",
+                             s->name, (unsigned long long)next, (unsigned)PK_NO_HIT - 1u);
+    }
+    s->nkept_tris = (size_t)(next - s->ntris - s->nspheres);
+    uint8_t *used = mem_calloc(&s->alloc, s->nmesh_positions ? s->nmesh_positions : 1, 1);
+    if (!used) return ctx_nomem(ctx);
+    for (size_t mi = 0; mi < s->nmeshes; mi++) {
+        const scene_mesh *m = &s->meshes[mi];
+        for (size_t k = 0; k < m->ntris; k++) {
+            const triangle *t = &s->mesh_tris[m->first_tri + k];
+            const vec3 *p = s->mesh_positions + m->first_pos;
+            if (tri_is_degenerate(p[t->v[0]], p[t->v[1]], p[t->v[2]])) continue;
+            for (int j = 0; j < 3; j++) used[m->first_pos + t->v[j]] = 1;
+        }
+    }
+    aabb b = aabb_empty();
+    for (size_t i = 0; i < s->nkept; i++) {
+        const scene_mesh *m = &s->meshes[s->kept[i].mesh];
+        for (size_t v = 0; v < m->npos; v++)
+            if (used[m->first_pos + v]) b = aabb_grow(b, xform_point(&s->kept[i].to_world, s->mesh_positions[m->first_pos + v]));
+    }
+    mem_free(&s->alloc, used);
+    s->kept_bounds = b;
+    return PK_OK;
+}
+
+/* Instances [nflattened, ninstances) into the triangle list, each at its
+ * place, or into the kept list. */
 static pk_status flatten_instances(pk_context *ctx, pk_scene *s)
 {
     size_t first = s->nflattened, n = s->ninstances;
-    if (first == n) return PK_OK;
+    if (first == n) return number_kept(ctx, s);
+    uint8_t *keep = mem_alloc(&s->alloc, n - first);
+    if (!keep) return ctx_nomem(ctx);
+    pk_status kst = choose_kept(ctx, s, first, n, keep);
+    for (size_t i = first; i < n && kst == PK_OK; i++) {
+        if (!keep[i - first]) continue;
+        const scene_instance *in = &s->instances[i];
+        scene_kept k;
+        memset(&k, 0, sizeof k);
+        k.to_world = in->to_world;
+        k.mesh = in->mesh;
+        k.material = in->material;
+        if (s->meshes[in->mesh].nnrm && !xform_normal_matrix(&in->to_world, k.nrm))
+            kst = ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: an instance's transform is singular", s->name);
+        else if (!mem_grow(&s->alloc, (void **)&s->kept, &s->cap_kept, s->nkept + 1, sizeof *s->kept))
+            kst = ctx_nomem(ctx);
+        else
+            s->kept[s->nkept++] = k;
+    }
+    if (kst != PK_OK) {
+        mem_free(&s->alloc, keep);
+        return kst;
+    }
     size_t extra = 0;
     for (size_t i = first; i < n; i++) {
+        if (keep[i - first]) continue;
         extra += s->meshes[s->instances[i].mesh].ntris;
         if (extra > SCENE_MAX_PRIMS) break;
     }
-    if (extra > SCENE_MAX_PRIMS || s->ntris + extra > SCENE_MAX_PRIMS)
+    if (extra > SCENE_MAX_PRIMS || s->ntris + extra > SCENE_MAX_PRIMS) {
+        mem_free(&s->alloc, keep);
         return ctx_error(ctx, PK_ERR_LIMIT, "%s: more than %zu triangles in one scene", s->name,
                          (size_t)SCENE_MAX_PRIMS);
+    }
     size_t total = s->ntris + extra;
     triangle *out = mem_realloc_array(&s->alloc, NULL, total ? total : 1, sizeof *out);
-    if (!out) return ctx_nomem(ctx);
+    if (!out) {
+        mem_free(&s->alloc, keep);
+        return ctx_nomem(ctx);
+    }
     size_t o = 0, i = first;
     pk_status st = PK_OK;
     for (size_t k = 0; k <= s->ntris && st == PK_OK; k++) {
-        for (; i < n && s->instances[i].at <= k && st == PK_OK; i++) st = place_instance(ctx, s, &s->instances[i], out, &o);
+        for (; i < n && s->instances[i].at <= k && st == PK_OK; i++)
+            if (!keep[i - first]) st = place_instance(ctx, s, &s->instances[i], out, &o);
         if (k < s->ntris) out[o++] = s->tris[k];
     }
+    mem_free(&s->alloc, keep);
     if (st) {
         mem_free(&s->alloc, out);
         return st;
@@ -334,10 +457,8 @@ static pk_status flatten_instances(pk_context *ctx, pk_scene *s)
     s->tris = out;
     s->ntris = s->cap_tris = total;
     s->nflattened = n;
-    return PK_OK;
+    return number_kept(ctx, s);
 }
-
-static bool material_emits(const material *m) { return m->ke.x > 0.0f || m->ke.y > 0.0f || m->ke.z > 0.0f; }
 
 pk_status scene_commit(pk_context *ctx, pk_scene *s)
 {
@@ -385,6 +506,8 @@ pk_status scene_commit(pk_context *ctx, pk_scene *s)
         s->bounds = aabb_grow(s->bounds, v3_sub(sp->center, v3s(sp->radius)));
         s->bounds = aabb_grow(s->bounds, v3_add(sp->center, v3s(sp->radius)));
     }
+    if (s->nkept_tris && !box_empty(s->kept_bounds))
+        s->bounds = aabb_grow(aabb_grow(s->bounds, s->kept_bounds.lo), s->kept_bounds.hi);
     if (nemit) {
         s->emissive = mem_realloc_array(&s->alloc, NULL, nemit, sizeof *s->emissive);
         if (!s->emissive) return ctx_nomem(ctx);
@@ -395,7 +518,7 @@ pk_status scene_commit(pk_context *ctx, pk_scene *s)
     if (s->ndegenerate)
         ctx_warn(ctx, "%s: %zu degenerate triangle%s (zero area) dropped", s->name, s->ndegenerate,
                  s->ndegenerate == 1 ? "" : "s");
-    if (s->ntris == s->ndegenerate && s->nspheres == 0)
+    if (s->ntris == s->ndegenerate && s->nspheres == 0 && box_empty(s->kept_bounds))
         return ctx_error(ctx, PK_ERR_EMPTY_SCENE, "%s: no renderable geometry (%zu triangles, %zu degenerate, no spheres)",
                          s->name, s->ntris, s->ndegenerate);
     if (!v3_finite(s->bounds.lo) || !v3_finite(s->bounds.hi))
@@ -478,6 +601,15 @@ bool scene_check(const pk_scene *s, char *why, size_t n)
             (s->instances[i].material != SCENE_MESH_MATERIAL && s->instances[i].material >= s->nmaterials))
             FAIL("instance %zu: mesh or material out of range", i);
     if (s->committed && s->nflattened != s->ninstances) FAIL("instances not flattened");
+    uint64_t next = (uint64_t)s->ntris + s->nspheres;
+    for (size_t i = 0; i < s->nkept; i++) {
+        const scene_kept *k = &s->kept[i];
+        if (k->mesh >= s->nmeshes || (k->material != SCENE_MESH_MATERIAL && k->material >= s->nmaterials))
+            FAIL("kept instance %zu: mesh or material out of range", i);
+        if (s->committed && (k->prim0 != next || next + s->meshes[k->mesh].ntris >= PK_NO_HIT))
+            FAIL("kept instance %zu: hit numbers out of order", i);
+        next += s->meshes[k->mesh].ntris;
+    }
     return true;
 #undef FAIL
 }

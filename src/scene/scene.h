@@ -102,6 +102,23 @@ typedef struct scene_instance {
     size_t at;
 } scene_instance;
 
+/* An instance that scene_commit kept (not flattened), as renderers and
+ * accelerators see it: its triangle k has hit number prim0 + k, after every
+ * triangle and sphere of the world arrays (instances in their file order,
+ * so numbers ascend with the instance). Built by scene_commit. */
+typedef struct scene_kept {
+    xform to_world;      /* object to world */
+    float nrm[9];        /* normals to world: xform_normal_matrix(to_world), as flattening uses */
+    uint32_t mesh;
+    uint32_t material;   /* SCENE_MESH_MATERIAL or the material of all its triangles */
+    uint32_t prim0;      /* hit number of its triangle 0 */
+} scene_kept;
+
+/* scene_commit's rule (config scene.instances=auto): instances stay
+ * instances when flattening them would add at least this many triangles;
+ * below it every instance is flattened, as it always was. */
+#define SCENE_KEEP_MIN_TRIS ((size_t)1 << 22)
+
 /* Render settings a scene file may carry; a field is set when its has_ flag is. */
 typedef struct scene_render_settings {
     pk_render_options opt;
@@ -124,7 +141,12 @@ typedef struct scene_render_settings {
  *  8. every mesh's ranges lie in the mesh_* arrays and its triangles' indices
  *     within its own ranges; every instance names a mesh < nmeshes and a
  *     material < nmaterials (or SCENE_MESH_MATERIAL); after commit every
- *     instance is in the triangle list (nflattened == ninstances). */
+ *     instance is either in the triangle list or kept (nflattened ==
+ *     ninstances);
+ *  9. kept[i].prim0 = ntris + nspheres + the triangles of kept[0..i-1]'s
+ *     meshes, and the last of them fits below PK_NO_HIT; no kept instance
+ *     emits light (emitting instances are always flattened: lights are
+ *     world triangles). */
 struct pk_scene {
     pk_allocator alloc;
     char *name;             /* file name for messages and statistics */
@@ -162,7 +184,8 @@ struct pk_scene {
 
     /* Object-space meshes and their instances (scene_capture_mesh,
      * scene_add_instance). scene_commit flattens instances [nflattened,
-     * ninstances) into the world arrays above: renderers see triangles only. */
+     * ninstances) into the world arrays above or keeps them (kept: see
+     * SCENE_KEEP_MIN_TRIS and the config key scene.instances). */
     vec3 *mesh_positions; size_t nmesh_positions, cap_mesh_positions;
     vec3 *mesh_normals;   size_t nmesh_normals, cap_mesh_normals;
     uv2 *mesh_uvs;        size_t nmesh_uvs, cap_mesh_uvs;
@@ -170,6 +193,9 @@ struct pk_scene {
     scene_mesh *meshes;   size_t nmeshes, cap_meshes;
     scene_instance *instances; size_t ninstances, cap_instances;
     size_t nflattened;
+    scene_kept *kept;     size_t nkept, cap_kept;
+    size_t nkept_tris;    /* triangles the kept instances place (hit numbers past ntris + nspheres) */
+    aabb kept_bounds;     /* of the kept instances' triangles, in world space (in bounds too) */
 };
 
 /* An empty scene with the default material 0 ("default", grey 0.5 diffuse). */
@@ -217,8 +243,11 @@ PK_HIDDEN pk_status scene_add_instance(pk_context *ctx, pk_scene *s, uint32_t me
                                        uint32_t mat);
 
 /* Flattens the instances not yet flattened (positions by to_world, normals
- * by its inverse transpose, renormalised), then validates and derives
- * (degenerate flags, emissive list, bounds).
+ * by its inverse transpose, renormalised) or keeps them as instances
+ * (ctx's config scene.instances: auto keeps instances that do not emit,
+ * of meshes placed at least twice, when they would flatten to
+ * SCENE_KEEP_MIN_TRIS triangles or more; flatten; keep), then validates
+ * and derives (degenerate flags, emissive list, bounds).
  * PK_ERR_EMPTY_SCENE when nothing can be hit. Warns about degenerate triangles. */
 PK_HIDDEN pk_status scene_commit(pk_context *ctx, pk_scene *s);
 /* Tests the invariants above; returns false and fills why (if non-NULL). */

@@ -22,6 +22,15 @@ typedef struct scene_view {
     size_t npositions, nnormals, nuvs, ntris, nspheres, nmaterials, nlights, ntextures;
     bool has_cutout;          /* a material has map_d */
     bool has_textured;        /* a material has a map other than map_d */
+    /* Kept instances (scene_kept): hit numbers from ntris + nspheres on
+     * are their triangles, in object space in the mesh arrays. The GPU
+     * renders scenes without them only (nkept 0). */
+    const scene_kept *kept;
+    size_t nkept;
+    const scene_mesh *meshes;
+    const vec3 *mesh_positions, *mesh_normals;
+    const uv2 *mesh_uvs;
+    const triangle *mesh_tris;
 } scene_view;
 
 /* The view of committed scene s (its arrays, not copies). */
@@ -33,7 +42,77 @@ static inline scene_view scene_view_of(const pk_scene *s)
     v.npositions = s->npositions, v.nnormals = s->nnormals, v.nuvs = s->nuvs, v.ntris = s->ntris;
     v.nspheres = s->nspheres, v.nmaterials = s->nmaterials, v.nlights = s->nlights, v.ntextures = s->ntextures;
     v.has_cutout = s->has_cutout, v.has_textured = s->has_textured;
+    v.kept = s->kept, v.nkept = s->nkept, v.meshes = s->meshes;
+    v.mesh_positions = s->mesh_positions, v.mesh_normals = s->mesh_normals, v.mesh_uvs = s->mesh_uvs;
+    v.mesh_tris = s->mesh_tris;
     return v;
+}
+
+/* A triangle as shading sees it, in world space: hit number prim (< ntris,
+ * or a kept instance's from ntris + nspheres on). */
+typedef struct view_tri {
+    vec3 p[3];          /* vertices */
+    vec3 n[3];          /* vertex normals when has_n (possibly zero: then unusable) */
+    uv2 t[3];           /* texture coordinates when has_t */
+    bool has_n, has_t;
+    uint32_t material;
+} view_tri;
+
+/* The kept instance holding hit number prim (>= ntris + nspheres). */
+static inline PK_HD size_t view_kept_of(const scene_view *s, uint32_t prim)
+{
+    size_t lo = 0, hi = s->nkept; /* the last one with prim0 <= prim */
+    while (hi - lo > 1) {
+        const size_t mid = lo + (hi - lo) / 2;
+        if (s->kept[mid].prim0 <= prim) lo = mid;
+        else hi = mid;
+    }
+    return lo;
+}
+
+/* The world triangle of hit number prim. A kept instance's is placed as
+ * scene_commit would have flattened it (positions by to_world, normals by
+ * its normal matrix, renormalised), so that a hit on it gives the numbers
+ * the flattened triangle would. */
+static inline PK_HD void view_tri_get(const scene_view *s, uint32_t prim, view_tri *out)
+{
+    if (prim < s->ntris) {
+        const triangle *t = &s->tris[prim];
+        out->has_n = t->n[0] >= 0 && t->n[1] >= 0 && t->n[2] >= 0;
+        out->has_t = t->t[0] >= 0 && t->t[1] >= 0 && t->t[2] >= 0;
+        for (int j = 0; j < 3; j++) {
+            out->p[j] = s->positions[t->v[j]];
+            if (out->has_n) out->n[j] = s->normals[t->n[j]];
+            if (out->has_t) out->t[j] = s->uvs[t->t[j]];
+        }
+        out->material = t->material;
+        return;
+    }
+    const scene_kept *k = &s->kept[view_kept_of(s, prim)];
+    const scene_mesh *m = &s->meshes[k->mesh];
+    const triangle *t = &s->mesh_tris[m->first_tri + (prim - k->prim0)];
+    out->has_n = t->n[0] >= 0 && t->n[1] >= 0 && t->n[2] >= 0;
+    out->has_t = t->t[0] >= 0 && t->t[1] >= 0 && t->t[2] >= 0;
+    for (int j = 0; j < 3; j++) {
+        out->p[j] = xform_point(&k->to_world, s->mesh_positions[m->first_pos + t->v[j]]);
+        if (out->has_n) {
+            vec3 n = v3_norm_scaled(xform_apply3(k->nrm, s->mesh_normals[m->first_nrm + (size_t)t->n[j]]));
+            out->n[j] = v3_finite(n) ? n : v3s(0.0f);
+        }
+        if (out->has_t) out->t[j] = s->mesh_uvs[m->first_uv + (size_t)t->t[j]];
+    }
+    out->material = k->material != SCENE_MESH_MATERIAL ? k->material : t->material;
+}
+
+/* The material of hit number prim (a triangle of either kind or a sphere). */
+static inline PK_HD uint32_t view_prim_material(const scene_view *s, uint32_t prim)
+{
+    if (prim < s->ntris) return s->tris[prim].material;
+    if (prim - s->ntris < s->nspheres) return s->spheres[prim - s->ntris].material;
+    const scene_kept *k = &s->kept[view_kept_of(s, prim)];
+    if (k->material != SCENE_MESH_MATERIAL) return k->material;
+    const scene_mesh *m = &s->meshes[k->mesh];
+    return s->mesh_tris[m->first_tri + (prim - k->prim0)].material;
 }
 
 /* Geometry of triangle k. */
