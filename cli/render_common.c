@@ -94,8 +94,9 @@ const cli_option *cli_render_options(size_t *n)
                                  "triangles only, on the GPU's own BVH; the same image as the CPU's up to noise)"});
         add((cli_option){.name = "config", .id = OPT_CONFIG, .kind = CLI_STRING, .arg = "KEY=VALUE,...",
                          .help = "settings of the library's back ends: cpu.isa=auto|avx2, bvh.quality=high|fast, "
-                                 "embree.quality=low|medium|high, embree.library=FILE, cuda.library=FILE "
-                                 "(README, Configuration); they override the environment variables "
+                                 "embree.quality=low|medium|high, embree.library=FILE, cuda.library=FILE, "
+                                 "scene.instances=auto|flatten|keep (README, Configuration); they override the "
+                                 "environment variables "
                                  "PAPRSEK_CPU_ISA, PAPRSEK_BVH_QUALITY, PAPRSEK_EMBREE_QUALITY, "
                                  "PAPRSEK_EMBREE_LIBRARY and PAPRSEK_CUDA_LIBRARY, which are passed on as these keys"});
         add((cli_option){.name = "integrator", .id = OPT_INTEGRATOR, .kind = CLI_STRING, .arg = "NAME",

@@ -466,18 +466,18 @@ static void warn_unused(pp *p, const char *what)
 
 /* ---- colours and spectra ------------------------------------------------------------------ */
 
-/* Linear sRGB of a blackbody at kelvin, scaled to luminance 1 (pbrt-v4
- * normalises its emitters' spectra to one nit before "scale"). */
-static vec3 blackbody_unit(float kelvin)
+/* Linear sRGB of the emission spectrum e(nm) (called at every nanometre of
+ * 360..830), scaled to luminance 1: pbrt-v4 normalises its emitters'
+ * spectra to one nit before "scale", and renders them spectrally (no white
+ * balance: an equal-energy spectrum is not grey in sRGB). */
+static vec3 emitter_unit(double (*e)(const void *, double), const void *user)
 {
-    const double h = 6.62607015e-34, c = 2.99792458e8, kb = 1.380649e-23;
     double X = 0, Y = 0, Z = 0;
     for (int nm = 360; nm <= 830; nm++) {
-        double l = nm * 1e-9;
-        double b = 2.0 * h * c * c / (l * l * l * l * l) / (exp(h * c / (l * kb * (double)kelvin)) - 1.0);
-        float x, y, z;
-        spectra_cie_xyz((float)nm, &x, &y, &z);
-        X += b * (double)x, Y += b * (double)y, Z += b * (double)z;
+        double b = e(user, (double)nm);
+        float xyz[3];
+        spectra_cie1931((float)nm, xyz);
+        X += b * (double)xyz[0], Y += b * (double)xyz[1], Z += b * (double)xyz[2];
     }
     if (!(Y > 0.0) || !isfinite(Y)) return v3s(1.0f);
     X /= Y, Z /= Y, Y = 1.0;
@@ -485,6 +485,36 @@ static vec3 blackbody_unit(float kelvin)
     double g = -0.9692660 * X + 1.8760108 * Y + 0.0415560 * Z;
     double bl = 0.0556434 * X - 0.2040259 * Y + 1.0572252 * Z;
     return v3((float)fmax(r, 0.0), (float)fmax(g, 0.0), (float)fmax(bl, 0.0));
+}
+
+static double planck(const void *user, double nm)
+{
+    const double h = 6.62607015e-34, c = 2.99792458e8, kb = 1.380649e-23, l = nm * 1e-9;
+    return 2.0 * h * c * c / (l * l * l * l * l) / (exp(h * c / (l * kb * *(const double *)user)) - 1.0);
+}
+
+/* A blackbody at kelvin, at luminance 1. */
+static vec3 blackbody_unit(float kelvin)
+{
+    double k = (double)kelvin;
+    return emitter_unit(planck, &k);
+}
+
+typedef struct sampled {
+    const float *nm, *val;
+    size_t n;
+} sampled;
+
+/* pbrt's piecewise-linear spectrum: linear between the samples, 0 outside. */
+static double sampled_at(const void *user, double nm)
+{
+    const sampled *s = user;
+    if (nm < (double)s->nm[0] || nm > (double)s->nm[s->n - 1]) return 0.0;
+    size_t i = 0;
+    while (i + 1 < s->n && (double)s->nm[i + 1] < nm) i++;
+    if (i + 1 == s->n) return (double)s->val[i];
+    double t = (nm - (double)s->nm[i]) / ((double)s->nm[i + 1] - (double)s->nm[i]);
+    return (double)s->val[i] + t * ((double)s->val[i + 1] - (double)s->val[i]);
 }
 
 /* pbrt's named metal spectra "metal-XX-eta" / "metal-XX-k". */
@@ -562,11 +592,11 @@ static pk_status spectrum_rgb(pp *p, pparam *q, bool illuminant, vec3 *out)
             if (i && !(nm[i] > nm[i - 1]))
                 return pfail(p, q->line, PK_ERR_PARSE, "'spectrum %s': wavelengths must increase", q->name);
         }
-        *out = spectrum_to_rgb(nm, val, (int)n);
         if (illuminant) {
-            /* luminance 1, as pbrt normalises an emitter's spectrum */
-            float y = v3_luminance(*out);
-            if (y > 0.0f) *out = v3_scale(*out, 1.0f / y);
+            sampled sp = {nm, val, n};
+            *out = emitter_unit(sampled_at, &sp);
+        } else {
+            *out = spectrum_to_rgb(nm, val, (int)n); /* a reflectance: a flat one is grey */
         }
         return PK_OK;
     }

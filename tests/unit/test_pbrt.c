@@ -405,6 +405,19 @@ static void test_lights(void)
         CHECK(s->env.set && near3(s->env.radiance, v3(0.5f, 0.25f, 1.0f), 0));
     }
     done(ctx, s);
+    /* emission spectra at luminance 1 without white balance: an equal-energy
+     * spectrum is pinkish in sRGB (its white point is E, not D65), and a
+     * spectrum at 600 nm alone is red */
+    s = load(&ctx, PLAIN "LightSource \"point\" \"spectrum I\" [300 1 900 1]\n"
+                         "LightSource \"point\" \"spectrum I\" [590 0 600 1 610 0]\nShape \"sphere\"\n");
+    if (s) {
+        vec3 e = s->lights[0].intensity, r = s->lights[1].intensity;
+        CHECK_NEAR(v3_luminance(e), 1.0, 0.01);
+        /* XYZ (1, 1, 1) in linear sRGB */
+        CHECK(fabsf(e.x - 1.2048f) < 0.01f && fabsf(e.y - 0.9483f) < 0.01f && fabsf(e.z - 0.9088f) < 0.01f);
+        CHECK(r.x > 3.0f * r.y && r.z < 0.05f * r.x);
+    }
+    done(ctx, s);
     /* area lights: emission on the shapes of the block, one- or two-sided, power over the area */
     s = load(&ctx, PLAIN "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [1 2 3] \"float scale\" 2\n"
                          "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\nAttributeEnd\n"
