@@ -689,6 +689,7 @@ pk_status scene_gltf_parse_params(pk_context *ctx, pk_scene *s, const char *data
     if (size >= 4 && memcmp(data, "glTF", 4) == 0) {
         if ((st = gltf_glb_split(g, (const uint8_t *)data, size, &json, &jsize))) goto out;
     }
+    if (jsize >= 3 && memcmp(json, "\xEF\xBB\xBF", 3) == 0) json += 3, jsize -= 3; /* a byte-order mark */
     if (jsize > PK_MAX_JSON_BYTES) {
         st = gltf_fail(g, PK_ERR_LIMIT, "the JSON part holds more than %zu bytes", (size_t)PK_MAX_JSON_BYTES);
         goto out;

@@ -768,6 +768,8 @@ static void test_errors(void)
     expect_error("{\"asset\":{\"version\":\"1.0\"}}", "t.gltf: /asset/version: '1.0' is not glTF 2.x");
     expect_error("{}", "t.gltf: /asset: required, and must be an object");
     expect_error("[1]", "t.gltf: the top level must be a JSON object");
+    /* a byte-order mark is read past: the asset is valid, and empty */
+    CHECK(load("\xEF\xBB\xBF{\"asset\":{\"version\":\"2.0\"}}", NULL) == PK_ERR_EMPTY_SCENE);
     expect_error("{\"asset\":", "t.gltf: JSON syntax error near byte 8");
     /* accessor kinds */
     j = doc(&b, views, "{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"}", prim, "", "");
