@@ -35,7 +35,7 @@ for j in range(1, T - 1):
 assert len(idx) == 3 * 1280
 side = math.sqrt(n) * 2.5
 with open(out, "w") as f:
-    f.write(f'LookAt 0 {side * 0.35:.3f} {-side * 0.62:.3f}  0 0 0  0 1 0\n')
+    f.write(f'LookAt 0 6 {-side / 2 - 4:.3f}  0 0 {-side / 2 + 40:.3f}  0 1 0\n')
     f.write('Camera "perspective" "float fov" 45\n')
     f.write('Film "rgb" "integer xresolution" 320 "integer yresolution" 180 "string filename" "instances.png"\n')
     f.write('Sampler "independent" "integer pixelsamples" 4\n')
