@@ -980,8 +980,8 @@ static pk_status parse_transform(jp *p, const cJSON *it, const char *path, xform
 
 static pk_status parse_mesh(jp *p, const cJSON *it, const char *path)
 {
-    enum { M_OBJ, M_TRANSFORM, M_COUNT };
-    static const char *const keys[M_COUNT] = {"obj", "transform"};
+    enum { M_OBJ, M_TRANSFORM, M_INSTANCES, M_COUNT };
+    static const char *const keys[M_COUNT] = {"obj", "transform", "instances"};
     const cJSON *f[M_COUNT];
     char fp[JP_PATH_MAX];
     xform xf;
@@ -996,6 +996,11 @@ static pk_status parse_mesh(jp *p, const cJSON *it, const char *path)
         path_key(tp, path, "transform");
         if ((st = parse_transform(p, f[M_TRANSFORM], tp, &xf))) return st;
     }
+    char ip[JP_PATH_MAX];
+    path_key(ip, path, "instances");
+    if (f[M_INSTANCES] && (st = get_array(p, f[M_INSTANCES], ip))) return st;
+    pk_scene *s = p->s;
+    const size_t pos0 = s->npositions, nrm0 = s->nnormals, uv0 = s->nuvs, tri0 = s->ntris;
 
     const pk_allocator *a = &p->ctx->alloc;
     pk_context scratch;
@@ -1020,6 +1025,21 @@ static pk_status parse_mesh(jp *p, const cJSON *it, const char *path)
         goto out;
     }
     st = obj_parse(p->ctx, p->s, data, size, full, dir, f[M_TRANSFORM] ? &xf : NULL);
+    if (st == PK_OK && f[M_INSTANCES]) {
+        /* one mesh, placed by each transform of "instances" (after "transform") */
+        uint32_t mesh;
+        if ((st = scene_capture_mesh(p->ctx, s, pos0, nrm0, uv0, tri0, &mesh))) goto out;
+        int i = 0;
+        for (const cJSON *e = f[M_INSTANCES]->child; e && st == PK_OK; e = e->next, i++) {
+            char ep[JP_PATH_MAX];
+            xform x;
+            snprintf(ep, sizeof ep, "%.*s[%d]", JP_PATH_MAX - 16, ip, i);
+            if ((st = parse_transform(p, e, ep, &x))) break;
+            scratch = io_scratch_context(p->ctx);
+            if ((st = scene_add_instance(&scratch, s, mesh, &x, SCENE_MESH_MATERIAL)))
+                jfail(p, st, e, ep, "%s", scratch.message);
+        }
+    }
 out:
     mem_free(a, data);
     mem_free(a, dir);

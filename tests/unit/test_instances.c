@@ -543,6 +543,63 @@ static void check_many(void)
     scene_destroy(s);
 }
 
+/* ---- JSON: a mesh's "instances" ---- */
+
+static const char *json_files[][2] = {
+    {"mem/tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n"},
+    {"mem/ok.json", "{\"meshes\": [{\"obj\": \"tri.obj\", \"transform\": {\"scale\": 2},\n"
+                    "  \"instances\": [{\"translate\": [4, 0, 0]}, [1,0,0,0, 0,1,0,0, 0,0,-1,3, 0,0,0,1]]},\n"
+                    " {\"obj\": \"tri.obj\"}]}"},
+    {"mem/singular.json", "{\"meshes\": [{\"obj\": \"tri.obj\",\n  \"instances\": [{\"translate\": [4, 0, 0]},\n"
+                          "  {\"scale\": [1, 0, 1]}]}]}"},
+    {"mem/notarray.json", "{\"meshes\": [{\"obj\": \"tri.obj\", \"instances\": {}}]}"},
+};
+
+static pk_status serve(void *user, const char *path, const void **data, size_t *size, char *why, size_t cap)
+{
+    (void)user;
+    for (size_t i = 0; i < sizeof json_files / sizeof *json_files; i++)
+        if (strcmp(path, json_files[i][0]) == 0) {
+            *data = json_files[i][1];
+            *size = strlen(json_files[i][1]);
+            return PK_OK;
+        }
+    snprintf(why, cap, "no such file");
+    return PK_ERR_IO;
+}
+
+static void check_json(void)
+{
+    pk_context *c = NULL;
+    REQUIRE(pk_context_create(NULL, &c) == PK_OK);
+    pk_context_set_file_reader(c, serve, NULL);
+    REQUIRE(pk_context_set_config(c, "scene.instances=keep") == PK_OK);
+    pk_scene *s = NULL;
+    CHECKF(pk_scene_load_file(c, "mem/ok.json", &s) == PK_OK, "ok.json: %s", pk_context_error(c));
+    if (s) {
+        /* two instances of the first mesh (scaled by 2 once, then placed twice), the second in the world */
+        CHECK(s->nmeshes == 1 && s->nkept == 2 && s->ntris == 2 && s->nkept_tris == 4);
+        CHECK(s->mesh_positions[3].x == 2.0f && s->mesh_positions[3].y == 2.0f); /* "transform" shapes the mesh */
+        CHECK(s->kept[0].to_world.m[0] == 1.0f && s->kept[0].to_world.m[3] == 4.0f);
+        CHECK(s->kept[1].to_world.m[10] == -1.0f && s->kept[1].to_world.m[11] == 3.0f);
+        CHECK(s->bounds.lo.z == 0.0f && s->bounds.hi.z == 3.0f && s->bounds.hi.x == 6.0f);
+        pk_scene_destroy(s);
+    }
+    REQUIRE(pk_context_set_config(c, "scene.instances=flatten") == PK_OK);
+    s = NULL;
+    CHECK(pk_scene_load_file(c, "mem/ok.json", &s) == PK_OK && s && s->nkept == 0 && s->ntris == 6);
+    pk_scene_destroy(s);
+    s = NULL;
+    CHECK(pk_scene_load_file(c, "mem/singular.json", &s) == PK_ERR_PARSE && s == NULL);
+    CHECKF(strstr(pk_context_error(c), "singular.json:3: meshes[0].instances[1]") != NULL, "message: %s",
+           pk_context_error(c));
+    pk_context_clear_error(c);
+    CHECK(pk_scene_load_file(c, "mem/notarray.json", &s) == PK_ERR_PARSE && s == NULL);
+    CHECKF(strstr(pk_context_error(c), "meshes[0].instances") != NULL && strstr(pk_context_error(c), "array") != NULL,
+           "message: %s", pk_context_error(c));
+    pk_context_destroy(c);
+}
+
 int main(void)
 {
     REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
@@ -552,6 +609,7 @@ int main(void)
     check_exact(PK_ACCEL_NONE, "none");
     check_embree();
     check_rule();
+    check_json();
     check_images();
     check_many();
     pk_context_destroy(ctx);
