@@ -600,6 +600,73 @@ static void check_json(void)
     pk_context_destroy(c);
 }
 
+/* ---- every allocation failing in turn ---- */
+
+typedef struct fail_alloc {
+    long calls, fail_at, live, failed;
+} fail_alloc;
+
+static void *fail_hook(void *user, void *ptr, size_t size)
+{
+    fail_alloc *f = user;
+    if (size == 0) {
+        if (ptr) {
+            f->live--;
+            free((char *)ptr - 16);
+        }
+        return NULL;
+    }
+    f->calls++;
+    if (f->fail_at && f->calls == f->fail_at) {
+        f->failed++;
+        return NULL;
+    }
+    char *q = realloc(ptr ? (char *)ptr - 16 : NULL, size + 16);
+    if (!q) return NULL;
+    if (!ptr) f->live++;
+    return q + 16;
+}
+
+/* Loading a JSON scene that keeps instances, and rendering it through the
+ * two-level BVH and brute force, with allocation N failing, for every N:
+ * PK_ERR_NOMEM back and nothing left allocated. */
+static void check_alloc_fail(void)
+{
+    long n = 0;
+    for (long at = 1; at < 100000; at++) {
+        fail_alloc f = {0, at, 0, 0};
+        pk_allocator al = {fail_hook, &f};
+        pk_context *c = NULL;
+        if (pk_context_create(&al, &c) != PK_OK) {
+            CHECK(f.live == 0);
+            continue;
+        }
+        pk_context_set_file_reader(c, serve, NULL);
+        pk_status st = pk_context_set_config(c, "scene.instances=keep");
+        pk_scene *s = NULL;
+        if (st == PK_OK) st = pk_scene_load_file(c, "mem/ok.json", &s);
+        for (int k = 0; k < 2 && st == PK_OK; k++) {
+            pk_render_options ro;
+            pk_render_options_init(&ro);
+            ro.width = 8, ro.height = 8, ro.spp = 1, ro.threads = 1, ro.accel = k ? PK_ACCEL_NONE : PK_ACCEL_BVH;
+            pk_image *img = NULL;
+            st = pk_render(c, s, &ro, &img, NULL);
+            pk_image_destroy(img);
+        }
+        pk_scene_destroy(s);
+        pk_context_destroy(c);
+        CHECKF(f.live == 0, "allocation %ld failing: %ld blocks left", at, f.live);
+        CHECKF(st == PK_OK || st == PK_ERR_NOMEM || f.failed, "allocation %ld failing: status %d", at, (int)st);
+        if (!f.failed) {
+            CHECKF(st == PK_OK, "no allocation failed, status %d", (int)st);
+            n = at;
+            break;
+        }
+    }
+    CHECKF(n > 20, "the sweep ended after %ld allocations", n);
+    printf("allocation failures: %ld points swept\n", n);
+}
+
 int main(void)
 {
     REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
@@ -610,6 +677,7 @@ int main(void)
     check_embree();
     check_rule();
     check_json();
+    check_alloc_fail();
     check_images();
     check_many();
     pk_context_destroy(ctx);
