@@ -1064,8 +1064,11 @@ static pk_status get_ior(xp *p, xnode *plugin, const char *name, float *out)
 static float clamp01(float x) { return x > 0.0f ? (x < 1.0f ? x : 1.0f) : 0.0f; }
 static vec3 clamp01v(vec3 c) { return v3(clamp01(c.x), clamp01(c.y), clamp01(c.z)); }
 
-/* roughness of the rough* plugins: alpha, or alpha_u/alpha_v (averaged). */
-static pk_status get_alpha(xp *p, xnode *b, float def, float *alpha)
+/* roughness of the rough* plugins: alpha, or alpha_u/alpha_v (averaged),
+ * and the microfacet distribution (*beckmann: Mitsuba's default "beckmann",
+ * and "phong" by Mitsuba's own equivalence of the two for one alpha; false
+ * for "ggx"). */
+static pk_status get_alpha(xp *p, xnode *b, float def, float *alpha, bool *beckmann)
 {
     pk_status st;
     float a = def, au = -1.0f, av = -1.0f;
@@ -1079,8 +1082,19 @@ static pk_status get_alpha(xp *p, xnode *b, float def, float *alpha)
         a = 0.5f * (au + av);
     }
     const char *dist = NULL;
-    if ((st = get_string(p, b, "distribution", &dist, NULL))) return st;
-    /* beckmann and phong are rendered as GGX of the same alpha (docs) */
+    xnode *dist_at = NULL;
+    if ((st = get_string(p, b, "distribution", &dist, &dist_at))) return st;
+    *beckmann = true;
+    if (dist && strcmp(dist, "ggx") == 0) *beckmann = false;
+    else if (dist && strcmp(dist, "phong") == 0) {
+        if (first_time(p, "phong distribution"))
+            xwarn(p, dist_at, "the phong distribution is rendered as Beckmann of the same alpha (Mitsuba's "
+                              "exponent 2 / alpha^2 - 2 matches them)");
+    } else if (dist && strcmp(dist, "beckmann") != 0) {
+        char sd[40];
+        shown(sd, sizeof sd, dist);
+        xwarn(p, dist_at, "microfacet distribution \"%s\" is unknown; using beckmann", sd);
+    }
     *alpha = clamp01(a);
     return PK_OK;
 }
@@ -1096,6 +1110,77 @@ static xnode *nested_bsdf(xp *p, xnode *b)
             return c;
         }
     return NULL;
+}
+
+static pk_status bsdf_resolve(xp *p, xnode *b, material *m);
+
+/* Mitsuba's bump map (bumpmap, Mitsuba 0.x's bump): the nested bsdf with its
+ * shading normal bent by a height texture, displaced along the normal in
+ * scene units, as the material's map_bump with bm the product of the scale
+ * textures wrapped around the bitmap and the bumpmap's own "scale" (Mitsuba
+ * 3). A height that is not a bitmap leaves the nested bsdf alone (warning). */
+static pk_status bump_material(xp *p, xnode *b, xnode *inner, const char *ty, material *m)
+{
+    pk_status st;
+    float scale = 1.0f;
+    if ((st = get_float(p, b, "scale", &scale))) return st;
+    if (!inner) {
+        xwarn(p, b, "bsdf \"%s\" without a nested bsdf; using a grey diffuse material", ty);
+        material_diffuse(m, v3s(0.5f));
+        return PK_OK;
+    }
+    if ((st = bsdf_resolve(p, inner, m))) return st;
+    /* the height: the first texture child (or a reference to one), through scale textures */
+    xnode *t = NULL;
+    for (xnode *c = b->child; c && !t; c = c->next) {
+        if (c == inner) continue;
+        if (strcmp(c->tag, "texture") == 0) t = c;
+        else if (strcmp(c->tag, "ref") == 0) {
+            const char *id = attr_st(p, c, "id", &st);
+            if (st) return st;
+            xnode *r = id ? id_find(p, id) : NULL;
+            if (r && strcmp(r->tag, "texture") == 0) t = r, c->used = true;
+        }
+    }
+    for (int depth = 0; t && depth <= XML_MAX_BSDF_DEPTH; depth++) {
+        t->used = true;
+        const char *tt = attr_st(p, t, "type", &st);
+        if (st) return st;
+        if (!tt || strcmp(tt, "scale") != 0) break;
+        float f = 1.0f;
+        if ((st = get_float(p, t, "scale", &f))) return st;
+        scale *= f;
+        xnode *next = NULL;
+        for (xnode *c = t->child; c && !next; c = c->next) {
+            if (strcmp(c->tag, "texture") == 0) next = c;
+            else if (strcmp(c->tag, "ref") == 0) {
+                const char *id = attr_st(p, c, "id", &st);
+                if (st) return st;
+                xnode *r = id ? id_find(p, id) : NULL;
+                if (r && strcmp(r->tag, "texture") == 0) next = r;
+            }
+        }
+        t = next;
+    }
+    const char *tt = t ? attr_st(p, t, "type", &st) : NULL;
+    if (st) return st;
+    if (!t || !tt || strcmp(tt, "bitmap") != 0) {
+        xwarn(p, b, "bsdf \"%s\": only a bitmap height (scaled or not) bends the normal; using its nested bsdf alone",
+              ty);
+        return PK_OK;
+    }
+    tex_ref r;
+    tex_ref_init(&r);
+    tex_ref *want = p->want_tex;
+    p->want_tex = &r;
+    vec3 v;
+    st = texture_value(p, t, "the bump map", v3s(0.0f), &v, 0);
+    p->want_tex = want;
+    if (st) return st;
+    if (r.kind == TEX_NONE) return PK_OK; /* the image could not be read: warned */
+    r.bm = scale;
+    m->map_bump = r;
+    return PK_OK;
 }
 
 /* Converts the bsdf (or <ref> to one) n into *m. */
@@ -1170,7 +1255,8 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
         /* a dielectric coat over a diffuse base is Paprsek's plastic */
         xnode *inner = nested_bsdf(p, b);
         float in = 1.5046f, ext = 1.000277f, alpha = 0.0f;
-        if (type[0] == 'r' && (st = get_alpha(p, b, 0.1f, &alpha))) return st;
+        bool bk = false;
+        if (type[0] == 'r' && (st = get_alpha(p, b, 0.1f, &alpha, &bk))) return st;
         if ((st = get_ior(p, b, "int_ior", &in))) return st;
         if ((st = get_ior(p, b, "ext_ior", &ext))) return st;
         if (inner && (st = bsdf_resolve(p, inner, m))) return st;
@@ -1181,6 +1267,7 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
             material_init(m);
             m->d = d;
             material_plastic(m, kd, ior, alpha);
+            m->beckmann = bk;
             static const char *const q[] = {"distribution", NULL};
             warn_unused(p, b, type[0] == 'r' ? "bsdf \"roughcoating\"" : "bsdf \"coating\"", q);
             return PK_OK;
@@ -1195,8 +1282,12 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
         xwarn(p, b, "bsdf \"%s\" over a non-diffuse bsdf is not supported; using its nested bsdf alone", ty);
         return PK_OK;
     }
-    if (strcmp(type, "bumpmap") == 0 || strcmp(type, "bump") == 0 || strcmp(type, "normalmap") == 0 ||
-        strcmp(type, "blendbsdf") == 0 ||
+    if (strcmp(type, "bumpmap") == 0 || strcmp(type, "bump") == 0) {
+        xnode *inner = nested_bsdf(p, b);
+        if ((st = bump_material(p, b, inner, ty, m))) return st;
+        return PK_OK;
+    }
+    if (strcmp(type, "normalmap") == 0 || strcmp(type, "blendbsdf") == 0 ||
         strcmp(type, "mixturebsdf") == 0 || strcmp(type, "polarizer") == 0 || strcmp(type, "measured") == 0) {
         xnode *inner = nested_bsdf(p, b);
         for (xnode *c = b->child; c; c = c->next) c->used = true;
@@ -1210,6 +1301,7 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
     }
 
     float alpha = 0.0f;
+    bool bk = false;
     if (strcmp(type, "diffuse") == 0 || strcmp(type, "roughdiffuse") == 0) {
         vec3 r = v3s(0.5f);
         if ((st = get_color_tex(p, b, "reflectance", &r, &m->map_kd))) return st;
@@ -1222,7 +1314,7 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
         material_diffuse(m, clamp01v(r));
     } else if (strcmp(type, "conductor") == 0 || strcmp(type, "roughconductor") == 0) {
         bool rough = type[0] == 'r';
-        if (rough && (st = get_alpha(p, b, 0.1f, &alpha))) return st;
+        if (rough && (st = get_alpha(p, b, 0.1f, &alpha, &bk))) return st;
         vec3 eta = v3(0.200438f, 0.924033f, 1.10221f), k = v3(3.91295f, 2.45285f, 2.14219f); /* Cu */
         vec3 spec = v3s(1.0f);
         float ext = 1.000277f;
@@ -1254,11 +1346,12 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
         } else {
             material_conductor(m, eta, k, alpha);
         }
+        m->beckmann = bk;
     } else if (strcmp(type, "dielectric") == 0 || strcmp(type, "roughdielectric") == 0 ||
                strcmp(type, "thindielectric") == 0) {
         float in = 1.5046f, ext = 1.000277f;
         vec3 tr = v3s(1.0f), refl = v3s(1.0f);
-        if (type[0] == 'r' && (st = get_alpha(p, b, 0.1f, &alpha))) return st;
+        if (type[0] == 'r' && (st = get_alpha(p, b, 0.1f, &alpha, &bk))) return st;
         if ((st = get_ior(p, b, "int_ior", &in))) return st;
         if ((st = get_ior(p, b, "ext_ior", &ext))) return st;
         if ((st = get_color(p, b, "specular_transmittance", &tr))) return st;
@@ -1274,10 +1367,11 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
         }
         if (ior == 1.0f && alpha > 0.0f) alpha = 0.0f;
         material_dielectric(m, ior, alpha, clamp01v(tr));
+        m->beckmann = bk;
     } else if (strcmp(type, "plastic") == 0 || strcmp(type, "roughplastic") == 0) {
         float in = 1.49f, ext = 1.000277f;
         vec3 kd = v3s(0.5f), spec = v3s(1.0f);
-        if (type[0] == 'r' && (st = get_alpha(p, b, 0.1f, &alpha))) return st;
+        if (type[0] == 'r' && (st = get_alpha(p, b, 0.1f, &alpha, &bk))) return st;
         if ((st = get_ior(p, b, "int_ior", &in))) return st;
         if ((st = get_ior(p, b, "ext_ior", &ext))) return st;
         if ((st = get_color_tex(p, b, "diffuse_reflectance", &kd, &m->map_kd))) return st;
@@ -1287,6 +1381,7 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
         float ior = in / ext;
         if (!(ior > 0.0f) || ior == 1.0f) ior = 1.49f;
         material_plastic(m, clamp01v(kd), ior, alpha);
+        m->beckmann = bk;
     } else if (strcmp(type, "principled") == 0 || strcmp(type, "principledthin") == 0) {
         /* Disney's model by its main parameters: a metal (Schlick, F0 =
          * base_color) when metallic > 0.5, else a plastic of base_color */

@@ -1,6 +1,6 @@
 /*
  * pbsdf.h - physically based BSDFs for the path tracer: Lambert, GGX
- * conductors, smooth and rough dielectrics (Walter et al. 2007), plastic (a
+ * (or Beckmann) conductors, smooth and rough dielectrics (Walter et al. 2007), plastic (a
  * diffuse base under a dielectric coating), the MTL "glossy over diffuse"
  * model and glTF 2.0's metallic-roughness material. Plain static inline PK_HD C over one plain struct: no context, no
  * allocation, no function pointers, so that nvcc can compile the same code.
@@ -44,6 +44,9 @@ typedef enum pbsdf_type {
 
 /* flags */
 #define PBSDF_SCHLICK 1u /* conductor: Schlick's Fresnel with F0 = specular, not eta/k */
+/* conductor, dielectric, plastic: the Beckmann distribution of slopes
+ * instead of GGX (the same alpha: the RMS slope times sqrt 2) */
+#define PBSDF_BECKMANN 2u
 
 /* Below this roughness a microfacet lobe is treated as perfectly smooth (a
  * delta lobe): the GGX density would exceed float range long before 0. */
@@ -293,6 +296,73 @@ static inline PK_HD vec3 pbsdf_ggx_vndf_sample(float alpha, vec3 w, float u1, fl
     return v3_norm(v3(alpha * nh.x, alpha * nh.y, fmaxf(1e-7f, nh.z)));
 }
 
+/* ---- Beckmann, isotropic, local frame ------------------------------------- */
+
+/* D(m) = exp(-tan^2 / alpha^2) / (pi alpha^2 cos^4) for m.z > 0. */
+static inline PK_HD float pbsdf_beckmann_d(float alpha, vec3 m)
+{
+    if (m.z <= 0.0f) return 0.0f;
+    float c2 = m.z * m.z, a2 = alpha * alpha;
+    float t2 = fmaxf(0.0f, 1.0f - c2) / c2, e = t2 / a2;
+    /* 0 where exp would fall below 1e-35 (and products of it to denormals,
+     * which some builds flush to 0 in one expression and not another) */
+    if (e > 80.0f) return 0.0f;
+    return expf(-e) / (PK_PI * a2 * c2 * c2);
+}
+
+/* Smith's Lambda(w) for Beckmann, exact: with a = 1 / (alpha tan theta),
+ * Lambda = (exp(-a^2) / (a sqrt(pi)) - erfc(a)) / 2. */
+static inline PK_HD float pbsdf_beckmann_lambda(float alpha, vec3 w)
+{
+    float z2 = w.z * w.z;
+    if (z2 <= 0.0f) return INFINITY;
+    float s2 = w.x * w.x + w.y * w.y;
+    if (s2 <= 0.0f) return 0.0f;
+    float a = sqrtf(z2 / s2) / alpha;
+    if (a > 9.0f) return 0.0f; /* below 1e-37 */
+    return 0.5f * (expf(-a * a) / (a * 1.7724538509f) - erfcf(a));
+}
+
+/* Samples m from D(m) cos theta_m (the whole distribution, not only the
+ * normals visible from wo: a back-facing m is the caller's to reject). */
+static inline PK_HD vec3 pbsdf_beckmann_sample(float alpha, float u1, float u2)
+{
+    float t2 = -alpha * alpha * logf(fmaxf(1.0f - u1, 1e-30f));
+    float c = 1.0f / sqrtf(1.0f + t2), sn = sqrtf(fmaxf(0.0f, 1.0f - c * c)), phi = 2.0f * PK_PI * u2;
+    return v3(sn * cosf(phi), sn * sinf(phi), c);
+}
+
+/* ---- the distribution of a conductor, dielectric or plastic --------------- */
+
+static inline PK_HD bool pbsdf__bk(const pbsdf *b) { return (b->flags & PBSDF_BECKMANN) != 0u; }
+static inline PK_HD float pbsdf_mf_d(const pbsdf *b, vec3 m)
+{
+    return pbsdf__bk(b) ? pbsdf_beckmann_d(b->alpha, m) : pbsdf_ggx_d(b->alpha, m);
+}
+static inline PK_HD float pbsdf_mf_lambda(const pbsdf *b, vec3 w)
+{
+    return pbsdf__bk(b) ? pbsdf_beckmann_lambda(b->alpha, w) : pbsdf_ggx_lambda(b->alpha, w);
+}
+/* Height-correlated Smith masking-shadowing, as for GGX. */
+static inline PK_HD float pbsdf_mf_g2(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    return 1.0f / (1.0f + pbsdf_mf_lambda(b, wo) + pbsdf_mf_lambda(b, wi));
+}
+/* A microfacet normal for wo: GGX's visible normals, Beckmann's whole
+ * distribution. */
+static inline PK_HD vec3 pbsdf_mf_sample(const pbsdf *b, vec3 wo, float u1, float u2)
+{
+    return pbsdf__bk(b) ? pbsdf_beckmann_sample(b->alpha, u1, u2) : pbsdf_ggx_vndf_sample(b->alpha, wo, u1, u2);
+}
+/* Solid-angle density of pbsdf_mf_sample returning m (m.z > 0) for wo
+ * (either hemisphere); 0 where m faces away from wo. */
+static inline PK_HD float pbsdf_mf_pdf(const pbsdf *b, vec3 wo, vec3 m)
+{
+    if (!pbsdf__bk(b)) return pbsdf_ggx_vndf_pdf(b->alpha, wo, m);
+    if (v3_dot(wo, m) * wo.z <= 0.0f) return 0.0f;
+    return pbsdf_beckmann_d(b->alpha, m) * m.z;
+}
+
 /* ---- lobes (local frame, wo.z > 0 and wi.z > 0 checked by the caller) -- */
 
 static inline PK_HD bool pbsdf__smooth(const pbsdf *b) { return b->alpha < PBSDF_ALPHA_SMOOTH; }
@@ -317,6 +387,27 @@ static inline PK_HD float pbsdf__ggx_refl_pdf(float alpha, vec3 wo, vec3 wi)
     float oh = v3_dot(wo, h);
     if (oh <= 0.0f) return 0.0f;
     return pbsdf_ggx_vndf_pdf(alpha, wo, h) / (4.0f * oh);
+}
+
+/* The same for the BSDF's own distribution (GGX or Beckmann). */
+static inline PK_HD float pbsdf__mf_refl_cos(const pbsdf *b, vec3 wo, vec3 wi, vec3 *h_out)
+{
+    if (!pbsdf__bk(b)) return pbsdf__ggx_refl_cos(b->alpha, wo, wi, h_out);
+    vec3 h = v3_add(wo, wi);
+    if (v3_len2(h) <= 0.0f) return 0.0f;
+    h = v3_norm(h);
+    *h_out = h;
+    return pbsdf_mf_d(b, h) * pbsdf_mf_g2(b, wo, wi) / (4.0f * wo.z);
+}
+static inline PK_HD float pbsdf__mf_refl_pdf(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    if (!pbsdf__bk(b)) return pbsdf__ggx_refl_pdf(b->alpha, wo, wi);
+    vec3 h = v3_add(wo, wi);
+    if (v3_len2(h) <= 0.0f) return 0.0f;
+    h = v3_norm(h);
+    float oh = v3_dot(wo, h);
+    if (oh <= 0.0f) return 0.0f;
+    return pbsdf_mf_pdf(b, wo, h) / (4.0f * oh);
 }
 
 /* Probability of choosing the specular lobe over the diffuse one, from
@@ -492,8 +583,9 @@ static inline PK_HD bool pbsdf__dielectric_half(const pbsdf *b, vec3 wo, vec3 wi
     if (wo.z == 0.0f || wi.z == 0.0f || v3_len2(h) <= 0.0f) return false;
     h = v3_norm(h);
     if (h.z < 0.0f) h = v3_neg(h);
-    /* microfacets seen from behind by either direction do not count */
-    if (v3_dot(h, wi) * wi.z < 0.0f || v3_dot(h, wo) * wo.z < 0.0f) return false;
+    /* microfacets seen from behind by either direction do not count, nor
+     * those that wo sees edge-on (no projected area: the pdf is 0 there) */
+    if (v3_dot(h, wi) * wi.z < 0.0f || v3_dot(h, wo) * wo.z <= 0.0f) return false;
     *m = h;
     *etap = e;
     return true;
@@ -504,9 +596,8 @@ static inline PK_HD vec3 pbsdf__dielectric_eval(const pbsdf *b, vec3 wo, vec3 wi
     vec3 m;
     float e;
     if (pbsdf__smooth(b) || !pbsdf__dielectric_half(b, wo, wi, &m, &e)) return v3s(0.0f);
-    float a = b->alpha;
     float f = pbsdf_fresnel_dielectric(v3_dot(wo, m), b->ior);
-    float dg = pbsdf_ggx_d(a, m) * pbsdf_ggx_g2(a, wo, wi);
+    float dg = pbsdf_mf_d(b, m) * pbsdf_mf_g2(b, wo, wi);
     if (wo.z * wi.z > 0.0f) return v3s(dg * f / (4.0f * fabsf(wo.z)));
     float im = v3_dot(wi, m), om = v3_dot(wo, m);
     float den = im + om / e;
@@ -521,10 +612,9 @@ static inline PK_HD float pbsdf__dielectric_pdf(const pbsdf *b, vec3 wo, vec3 wi
     vec3 m;
     float e;
     if (pbsdf__smooth(b) || !pbsdf__dielectric_half(b, wo, wi, &m, &e)) return 0.0f;
-    float a = b->alpha;
     float om = v3_dot(wo, m);
     float r = pbsdf_fresnel_dielectric(om, b->ior);
-    float pm = pbsdf_ggx_vndf_pdf(a, wo, m);
+    float pm = pbsdf_mf_pdf(b, wo, m);
     if (wo.z * wi.z > 0.0f) return pm / (4.0f * fabsf(om)) * r;
     float im = v3_dot(wi, m);
     float den = im + om / e;
@@ -584,14 +674,14 @@ static inline PK_HD vec3 pbsdf_eval(const pbsdf *b, vec3 wo, vec3 wi)
         return v3_scale(b->albedo, wi.z / PK_PI);
     case PBSDF_CONDUCTOR: {
         if (pbsdf__smooth(b)) return v3s(0.0f);
-        float s = pbsdf__ggx_refl_cos(b->alpha, wo, wi, &h);
+        float s = pbsdf__mf_refl_cos(b, wo, wi, &h);
         if (s <= 0.0f) return v3s(0.0f);
         return v3_scale(pbsdf__fresnel_conductor(b, v3_dot(wo, h)), s);
     }
     case PBSDF_PLASTIC: {
         vec3 r = pbsdf__plastic_diffuse_cos(b, wo, wi);
         if (!pbsdf__smooth(b)) {
-            float s = pbsdf__ggx_refl_cos(b->alpha, wo, wi, &h);
+            float s = pbsdf__mf_refl_cos(b, wo, wi, &h);
             if (s > 0.0f) r = v3_add(r, v3s(s * pbsdf_fresnel_dielectric(v3_dot(wo, h), b->ior)));
         }
         return r;
@@ -620,12 +710,12 @@ static inline PK_HD float pbsdf_pdf(const pbsdf *b, vec3 wo, vec3 wi)
     case PBSDF_DIFFUSE:
         return wi.z / PK_PI;
     case PBSDF_CONDUCTOR:
-        return pbsdf__smooth(b) ? 0.0f : pbsdf__ggx_refl_pdf(b->alpha, wo, wi);
+        return pbsdf__smooth(b) ? 0.0f : pbsdf__mf_refl_pdf(b, wo, wi);
     case PBSDF_PLASTIC:
     case PBSDF_GLOSSY: {
         float ps = pbsdf__spec_prob(b, wo);
         float p = (1.0f - ps) * wi.z / PK_PI;
-        if (!pbsdf__smooth(b)) p += ps * pbsdf__ggx_refl_pdf(b->alpha, wo, wi);
+        if (!pbsdf__smooth(b)) p += ps * pbsdf__mf_refl_pdf(b, wo, wi);
         return p;
     }
     default:
@@ -661,7 +751,8 @@ static inline PK_HD bool pbsdf_sample(const pbsdf *b, vec3 wo, const float u[3],
             *pdf = 1.0f - r;
             return true;
         }
-        vec3 m = pbsdf_ggx_vndf_sample(b->alpha, wo, u[1], u[2]);
+        vec3 m = pbsdf_mf_sample(b, wo, u[1], u[2]);
+        if (!(v3_dot(wo, m) * wo.z > 0.0f)) return false; /* a facet turned away (Beckmann) */
         float r = pbsdf_fresnel_dielectric(v3_dot(wo, m), b->ior);
         vec3 w;
         if (u[0] < r) {
@@ -697,13 +788,17 @@ static inline PK_HD bool pbsdf_sample(const pbsdf *b, vec3 wo, const float u[3],
             *is_delta = true;
             return true;
         }
-        vec3 m = pbsdf_ggx_vndf_sample(b->alpha, wo, u[1], u[2]);
+        vec3 m = pbsdf_mf_sample(b, wo, u[1], u[2]);
         float om = v3_dot(wo, m);
         w = v3_sub(v3_scale(m, 2.0f * om), wo);
         if (!(w.z > 0.0f) || !(om > 0.0f)) return false;
         *wi = w;
-        *pdf = pbsdf__ggx_refl_pdf(b->alpha, wo, w);
+        *pdf = pbsdf__mf_refl_pdf(b, wo, w);
         if (!(*pdf > 0.0f)) return false;
+        if (pbsdf__bk(b)) { /* f cos / pdf = F D G2 / (4 cos_o) / (D cos_m / (4 o.m)) */
+            *weight = v3_scale(pbsdf__fresnel_conductor(b, om), pbsdf_mf_g2(b, wo, w) * om / (wo.z * m.z));
+            return true;
+        }
         /* f cos / pdf = F D G2 / (4 cos_o) / (G1(wo) D / (4 cos_o)) = F G2 / G1(wo) */
         *weight = v3_scale(pbsdf__fresnel_conductor(b, om),
                            pbsdf_ggx_g2(b->alpha, wo, w) / pbsdf_ggx_g1(b->alpha, wo));
@@ -771,7 +866,8 @@ static inline PK_HD bool pbsdf_sample(const pbsdf *b, vec3 wo, const float u[3],
                 *is_delta = true;
                 return true;
             }
-            vec3 m = pbsdf_ggx_vndf_sample(b->alpha, wo, u[1], u[2]);
+            vec3 m = pbsdf_mf_sample(b, wo, u[1], u[2]);
+            if (!(v3_dot(wo, m) > 0.0f)) return false; /* a facet turned away (Beckmann) */
             w = v3_sub(v3_scale(m, 2.0f * v3_dot(wo, m)), wo);
         } else {
             float r = sqrtf(u[1]), phi = 2.0f * PK_PI * u[2];

@@ -58,6 +58,8 @@ static inline PK_HD shading shading_at(const surface *sf)
         }
         default: sh.b = pbsdf_diffuse(m->kd); break;
         }
+        if (m->beckmann && (m->type == MAT_CONDUCTOR || m->type == MAT_DIELECTRIC || m->type == MAT_PLASTIC))
+            sh.b.flags |= PBSDF_BECKMANN;
     } else if (glass) {
         /* Tf: the hue of what enters, normalised to the brightest channel
          * (exporters write grey Tf of any strength for clear glass) */

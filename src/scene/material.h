@@ -73,6 +73,9 @@ typedef struct material {
     float alpha;
     vec3 eta, k;
     bool schlick;
+    /* conductor, dielectric, plastic: alpha is the roughness of the Beckmann
+     * distribution instead of GGX (Mitsuba's default microfacet model) */
+    bool beckmann;
     float metallic, roughness, transmission, clearcoat, clearcoat_roughness;
     /* Texture maps (docs/materials.md), kind TEX_NONE when absent. A map's
      * value multiplies its constant: map_kd kd, map_ks ks, map_ns ns,

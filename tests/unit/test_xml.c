@@ -510,8 +510,22 @@ static void test_bsdfs(void)
     CHECK(m.eta.x < 0.2f && m.k.x > 3.9f && m.k.z < 1.7f); /* gold: red reflects most */
     m = bsdf("<bsdf type=\"roughconductor\"><float name=\"alpha\" value=\"0.3\"/><string name=\"distribution\" "
              "value=\"beckmann\"/><rgb name=\"eta\" value=\"1.5 1 0.5\"/><rgb name=\"k\" value=\"9 6 4\"/></bsdf>");
-    CHECK(m.type == MAT_CONDUCTOR && !m.schlick && fabsf(m.alpha - 0.3f) < 1e-6f);
+    CHECK(m.type == MAT_CONDUCTOR && !m.schlick && fabsf(m.alpha - 0.3f) < 1e-6f && m.beckmann);
     CHECK(near3(m.eta, v3(1.5f / 1.000277f, 1.0f / 1.000277f, 0.5f / 1.000277f), 1e-5f));
+    /* the distribution: beckmann by default (as in Mitsuba), ggx when named,
+     * phong as beckmann (warned), for the conductor, dielectric and plastic */
+    m = bsdf("<bsdf type=\"roughconductor\"/>");
+    CHECK(m.beckmann && wl.count == 0);
+    m = bsdf("<bsdf type=\"roughconductor\"><string name=\"distribution\" value=\"ggx\"/></bsdf>");
+    CHECK(!m.beckmann);
+    m = bsdf("<bsdf type=\"roughdielectric\"/>");
+    CHECK(m.type == MAT_DIELECTRIC && m.beckmann);
+    m = bsdf("<bsdf type=\"roughdielectric\"><string name=\"distribution\" value=\"ggx\"/></bsdf>");
+    CHECK(m.type == MAT_DIELECTRIC && !m.beckmann);
+    m = bsdf("<bsdf type=\"roughplastic\"><string name=\"distribution\" value=\"phong\"/></bsdf>");
+    CHECK(m.type == MAT_PLASTIC && m.beckmann && warned("scene.xml:3: the phong distribution is rendered as Beckmann"));
+    m = bsdf("<bsdf type=\"roughplastic\"><string name=\"distribution\" value=\"as\"/></bsdf>");
+    CHECK(m.beckmann && warned("microfacet distribution \"as\" is unknown; using beckmann"));
     m = bsdf("<bsdf type=\"roughconductor\"><string name=\"material\" value=\"none\"/><rgb name=\"specular_reflectance\" value=\"0.5\"/></bsdf>");
     CHECK(m.type == MAT_CONDUCTOR && m.schlick && near3(m.ks, v3s(0.5f), 1e-6f) && fabsf(m.alpha - 0.1f) < 1e-6f);
     /* a specular_reflectance scales the Fresnel term: Schlick with the scaled F0 */
@@ -538,7 +552,10 @@ static void test_bsdfs(void)
     CHECK(m.type == MAT_DIFFUSE && fabsf(m.d - 0.25f) < 1e-6f);
     m = bsdf("<bsdf type=\"bumpmap\"><texture type=\"bitmap\"><string name=\"filename\" value=\"b.png\"/></texture>"
              "<bsdf type=\"plastic\"/></bsdf>");
-    CHECK(m.type == MAT_PLASTIC && warned("scene.xml:3: bsdf \"bumpmap\" is not supported; using its nested bsdf alone"));
+    CHECK(m.type == MAT_PLASTIC && m.map_bump.kind == TEX_NONE && warned("texture not used ("));
+    m = bsdf("<bsdf type=\"bumpmap\"><texture type=\"checkerboard\"/><bsdf type=\"plastic\"/></bsdf>");
+    CHECK(m.type == MAT_PLASTIC && m.map_bump.kind == TEX_NONE &&
+          warned("scene.xml:3: bsdf \"bumpmap\": only a bitmap height (scaled or not) bends the normal"));
     m = bsdf("<bsdf type=\"principled\"><rgb name=\"base_color\" value=\"0.9 0.6 0.2\"/><float name=\"metallic\" value=\"1\"/>"
              "<float name=\"roughness\" value=\"0.2\"/><float name=\"sheen\" value=\"0.3\"/></bsdf>");
     CHECK(m.type == MAT_CONDUCTOR && m.schlick && near3(m.ks, v3(0.9f, 0.6f, 0.2f), 1e-6f) && fabsf(m.alpha - 0.04f) < 1e-6f);
@@ -574,6 +591,15 @@ static void test_bsdfs(void)
              "<float name=\"uscale\" value=\"4\"/></texture></bsdf>");
     CHECK(near3(m.kd, v3s(1.0f), 0) && m.map_kd.kind == TEX_IMAGE && m.map_kd.s[0] == 4.0f && m.map_kd.s[1] == 1.0f &&
           wl.count == 0);
+    /* bump maps: Mitsuba 0.x's bump with a scaled bitmap, Mitsuba 3's bumpmap with its scale */
+    m = bsdf("<bsdf type=\"bump\"><texture type=\"scale\"><float name=\"scale\" value=\"0.5\"/><texture type=\"scale\">"
+             "<float name=\"scale\" value=\"4\"/><texture type=\"bitmap\"><string name=\"filename\" value=\"t.pfm\"/>"
+             "<float name=\"uscale\" value=\"3\"/></texture></texture></texture><bsdf type=\"roughconductor\"/></bsdf>");
+    CHECK(m.type == MAT_CONDUCTOR && m.beckmann && m.map_bump.kind == TEX_IMAGE && m.map_bump.bm == 2.0f &&
+          m.map_bump.s[0] == 3.0f && wl.count == 0);
+    m = bsdf("<bsdf type=\"bumpmap\"><float name=\"scale\" value=\"0.25\"/><texture type=\"bitmap\">"
+             "<string name=\"filename\" value=\"t.pfm\"/></texture><bsdf type=\"diffuse\"/></bsdf>");
+    CHECK(m.type == MAT_DIFFUSE && m.map_bump.kind == TEX_IMAGE && m.map_bump.bm == 0.25f && wl.count == 0);
     m = bsdf("<bsdf type=\"roughplastic\"><texture name=\"diffuse_reflectance\" type=\"bitmap\"><string name=\"filename\" "
              "value=\"t.pfm\"/></texture></bsdf>");
     CHECK(m.type == MAT_PLASTIC && near3(m.kd, v3s(1.0f), 0) && m.map_kd.kind == TEX_IMAGE);
