@@ -129,6 +129,11 @@ PK_API const char *pk_status_string(pk_status status);
 #define PK_DEFAULT_DEPTH_WHITTED 8
 #define PK_MAX_THREADS 1024
 #define PK_MAX_POLYGON_VERTICES 4096
+/* Instances (pbrt ObjectInstance, Mitsuba instance, glTF nodes, JSON mesh
+ * instances) in one scene: each takes about 200 bytes once placed, so the
+ * bound keeps an instance bomb (a short file whose nested objects multiply)
+ * below about 3 GiB; past it the scene is refused. */
+#define PK_MAX_INSTANCES ((size_t)1 << 24)
 #define PK_MAX_FILE_BYTES ((size_t)1 << 31) /* 2 GiB */
 /* A JSON scene holds settings, materials, spheres and lights, not meshes; its
  * parsed tree takes tens of bytes per byte of text, hence a smaller bound. */

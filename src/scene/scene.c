@@ -268,7 +268,7 @@ pk_status scene_add_instance(pk_context *ctx, pk_scene *s, uint32_t mesh, const 
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: an instance's transform is not finite, affine and invertible",
                          s->name);
     scene_instance in = {mesh, mat, *to_world, s->ntris};
-    APPEND(ctx, s, instances, ninstances, cap_instances, in, SCENE_MAX_PRIMS, "instances");
+    APPEND(ctx, s, instances, ninstances, cap_instances, in, PK_MAX_INSTANCES, "instances");
 }
 
 /* Appends instance in's vertices to the world arrays and its triangles to
