@@ -2041,13 +2041,15 @@ static pk_status parse_emitter(xp *p, xnode *e)
         env->set = true;
         return PK_OK;
     } else if (strcmp(type, "sun") == 0 || strcmp(type, "sky") == 0 || strcmp(type, "sunsky") == 0) {
-        float turbidity = 3.0f, sun_scale = 1.0f, sky_scale = 1.0f, radius_scale = 1.0f, scale = 1.0f;
-        vec3 dir = v3(0.0f, 1.0f, 0.0f);
+        float turbidity = 3.0f, sun_scale, sky_scale, radius_scale = 1.0f, scale = 1.0f;
+        vec3 dir = v3(0.0f, 1.0f, 0.0f), albedo = v3s(0.2f);
         bool has_dir;
         if ((st = get_float(p, e, "turbidity", &turbidity))) return st;
+        if ((st = get_float(p, e, "scale", &scale))) return st;
+        sun_scale = sky_scale = scale; /* sunsky: scale is the default of both */
         if ((st = get_float(p, e, "sun_scale", &sun_scale))) return st;
         if ((st = get_float(p, e, "sky_scale", &sky_scale))) return st;
-        if ((st = get_float(p, e, "scale", &scale))) return st;
+        if ((st = get_color(p, e, "albedo", &albedo))) return st;
         if ((st = get_float(p, e, "sun_radius_scale", &radius_scale))) return st;
         if ((st = get_vec(p, e, "sun_direction", &dir, &has_dir))) return st;
         if (!has_dir) {
@@ -2058,9 +2060,9 @@ static pk_status parse_emitter(xp *p, xnode *e)
         }
         if (!(v3_len2(dir) > 0.0f)) return xfail(p, PK_ERR_PARSE, e, "sun_direction must not be zero");
         dir = v3_norm_scaled(dir);
-        if (!(turbidity >= 2.0f && turbidity <= 10.0f)) {
-            xwarn(p, e, "turbidity %g is outside 2..10; clamped", (double)turbidity);
-            turbidity = turbidity < 2.0f ? 2.0f : 10.0f;
+        if (!(turbidity >= 1.0f && turbidity <= 10.0f)) {
+            xwarn(p, e, "turbidity %g is outside 1..10; clamped", (double)turbidity);
+            turbidity = turbidity < 1.0f ? 1.0f : 10.0f;
         }
         bool sun = type[2] == 'n', sky = strcmp(type, "sky") == 0 || strcmp(type, "sunsky") == 0;
         if (strcmp(type, "sun") == 0) sun_scale = scale;
@@ -2075,17 +2077,17 @@ static pk_status parse_emitter(xp *p, xnode *e)
             env->sun_radiance = v3_scale(sun_radiance(dir, turbidity), sun_scale / (rs * rs));
         }
         if (sky) {
+            /* the Hosek-Wilkie sky as Mitsuba 0.6 evaluates it (env.h) */
             env->has_sky = true;
+            env->sky_hosek = true;
             env->sky_turbidity = turbidity;
-            /* Paprsek's sky is in W m^-2 sr^-1 over the visible range (luminance
-             * / 683), Mitsuba's per nanometre: the integral of the CIE y
-             * function, 106.857 nm, converts, so that the image is as bright as
-             * Mitsuba renders it */
-            env->sky_scale = sky_scale / 106.857f;
+            env->sky_albedo = clamp01v(albedo);
+            env->sky_scale = sky_scale;
         }
-        if (first_time(p, "sunsky-model"))
-            xwarn(p, e, "%s: Mitsuba's sun and sky models are approximated by Paprsek's (docs/scene-format.md)", ty);
-        static const char *const q2[] = {"sampling_weight", "resolution", "albedo", "stretch", "extend", NULL};
+        if (sun && first_time(p, "sun-model"))
+            xwarn(p, e, "%s: Mitsuba's sun is approximated by its radiance at three wavelengths (docs/scene-format.md)",
+                  ty);
+        static const char *const q2[] = {"sampling_weight", "resolution", "stretch", "extend", NULL};
         warn_unused(p, e, kind, q2);
         return PK_OK;
     } else if (strcmp(type, "directional") == 0 || strcmp(type, "distant") == 0) {

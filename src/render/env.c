@@ -55,6 +55,60 @@ vec3 sky_preetham(vec3 d, vec3 sun, float T)
     return v3(fmaxf(c.x, 0.0f), fmaxf(c.y, 0.0f), fmaxf(c.z, 0.0f));
 }
 
+/* ---- the Hosek-Wilkie sky (RGB) ---------------------------------------------- */
+
+#include "hosek_rgb.inc"
+
+/* The quintic Bezier of the six control points c[0], c[stride], ... at x. */
+static double hosek_bezier(const double *c, int stride, double x)
+{
+    const double y = 1.0 - x;
+    return y * y * y * y * y * c[0] + 5.0 * y * y * y * y * x * c[stride] + 10.0 * y * y * y * x * x * c[2 * stride] +
+           10.0 * y * y * x * x * x * c[3 * stride] + 5.0 * y * x * x * x * x * c[4 * stride] +
+           x * x * x * x * x * c[5 * stride];
+}
+
+void sky_hosek_init(sky_hosek *h, vec3 sun, float turbidity, vec3 albedo)
+{
+    memset(h, 0, sizeof *h);
+    h->sun = sun;
+    double T = fmin(fmax((double)turbidity, 1.0), 10.0);
+    int ti = (int)T;
+    double tr = T - ti;
+    if (ti == 10) ti = 9, tr = 1.0; /* the last table row, fully */
+    const double elev = asin(fmin(fmax((double)sun.y, 0.0), 1.0));
+    const double x = cbrt(elev / 1.57079632679489661923); /* (elevation / (pi / 2))^(1/3) */
+    const float al[3] = {albedo.x, albedo.y, albedo.z};
+    for (int c = 0; c < 3; c++) {
+        const double a = fmin(fmax((double)al[c], 0.0), 1.0);
+        /* weights of (albedo 0|1) x (turbidity ti|ti + 1), rows 0-based */
+        const double w[2][2] = {{(1.0 - a) * (1.0 - tr), (1.0 - a) * tr}, {a * (1.0 - tr), a * tr}};
+        for (int ia = 0; ia < 2; ia++)
+            for (int it = 0; it < 2; it++) {
+                if (w[ia][it] == 0.0) continue;
+                const int row = ti - 1 + it;
+                const double *m = hosek_rgb[c] + 540 * ia + 54 * row;
+                for (int i = 0; i < 9; i++) h->cfg[c][i] += w[ia][it] * hosek_bezier(m + i, 9, x);
+                h->rad[c] += w[ia][it] * hosek_bezier(hosek_rgb_rad[c] + 60 * ia + 6 * row, 1, x);
+            }
+    }
+}
+
+vec3 sky_hosek_eval(const sky_hosek *h, vec3 d)
+{
+    if (!(d.y > 0.0f)) return v3s(0.0f);
+    const double ct = (double)d.y, cg = fmin(fmax((double)v3_dot(d, h->sun), -1.0), 1.0), g = acos(cg);
+    float out[3];
+    for (int c = 0; c < 3; c++) {
+        const double *k = h->cfg[c]; /* A B C D E F G I H */
+        const double mie = (1.0 + cg * cg) / pow(1.0 + k[8] * k[8] - 2.0 * k[8] * cg, 1.5);
+        const double f = (1.0 + k[0] * exp(k[1] / (ct + 0.01))) *
+                         (k[2] + k[3] * exp(k[4] * g) + k[5] * cg * cg + k[6] * mie + k[7] * sqrt(ct));
+        out[c] = (float)fmax(f * h->rad[c] / 106.856980, 0.0);
+    }
+    return v3(out[0], out[1], out[2]);
+}
+
 /* ---- building ---------------------------------------------------------------- */
 
 void env_free(const pk_allocator *al, env_light *e)
@@ -143,6 +197,8 @@ pk_status env_build(pk_context *ctx, const scene_environment *env, const float *
         if (!e->rgb) return ctx_nomem(ctx);
         e->bytes = n * 3 * sizeof(float);
         const float scale = clean(env->map_scale);
+        sky_hosek hk;
+        if (sky && env->sky_hosek) sky_hosek_init(&hk, sun, env->sky_turbidity, env->sky_albedo);
         for (int j = 0; j < e->h; j++)
             for (int i = 0; i < e->w; i++) {
                 const size_t k = (size_t)j * (size_t)e->w + (size_t)i;
@@ -152,7 +208,8 @@ pk_status env_build(pk_context *ctx, const scene_environment *env, const float *
                                      clean(map_rgb[3 * k + 2]) * scale));
                 if (sky) {
                     vec3 d = latlong_dir(e, ((float)i + 0.5f) / (float)e->w, ((float)j + 0.5f) / (float)e->h);
-                    c = v3_add(c, v3_scale(sky_preetham(d, sun, env->sky_turbidity), env->sky_scale));
+                    const vec3 sk = env->sky_hosek ? sky_hosek_eval(&hk, d) : sky_preetham(d, sun, env->sky_turbidity);
+                    c = v3_add(c, v3_scale(sk, env->sky_scale));
                 }
                 e->rgb[3 * k] = clean(c.x), e->rgb[3 * k + 1] = clean(c.y), e->rgb[3 * k + 2] = clean(c.z);
             }

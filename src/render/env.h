@@ -190,4 +190,17 @@ static inline PK_HD vec3 env_background(const env_light *e, vec3 d)
  * horizon. */
 PK_HIDDEN vec3 sky_preetham(vec3 d, vec3 sun, float turbidity);
 
+/* The Hosek-Wilkie (2012) sky in RGB, as Mitsuba 0.6's sky emitter
+ * evaluates it: the model's nine parameters and radiance scale per channel,
+ * cooked for the sun (unit, +y up; a sun below the horizon is taken at it),
+ * turbidity (1 .. 10) and ground albedo per channel (0 .. 1). */
+typedef struct sky_hosek {
+    double cfg[3][9], rad[3];
+    vec3 sun;
+} sky_hosek;
+PK_HIDDEN void sky_hosek_init(sky_hosek *h, vec3 sun, float turbidity, vec3 albedo);
+/* Its radiance toward d (unit, world), divided by 106.856980 (the sum of
+ * the CIE y table) as Mitsuba does; zero below the horizon. */
+PK_HIDDEN vec3 sky_hosek_eval(const sky_hosek *h, vec3 d);
+
 #endif

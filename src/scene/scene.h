@@ -77,6 +77,8 @@ typedef struct scene_environment {
     bool has_sky;         /* an analytic daylight sky for the sun's direction */
     float sky_turbidity;  /* 2 .. 10 (3) */
     float sky_scale;      /* multiplies the sky (1) */
+    bool sky_hosek;       /* the sky is Hosek-Wilkie's (Mitsuba scenes), not Preetham's */
+    vec3 sky_albedo;      /* Hosek-Wilkie: the ground albedo per channel (0.2) */
 } scene_environment;
 
 /* An object-space mesh: ranges of the scene's mesh_* arrays. Its triangles'

@@ -253,6 +253,71 @@ static void test_sky(void)
         }
 }
 
+/* The Hosek-Wilkie sky: the cooked parameters are the table's control points
+ * at the ends of the elevation curve (sun on the horizon, sun at the zenith),
+ * linear in turbidity and albedo between table rows; the radiance is the
+ * model's formula; a clear sky is blue overhead and brightest near the sun. */
+#include "render/hosek_rgb.inc"
+
+static void test_hosek(void)
+{
+    sky_hosek h;
+    for (int c = 0; c < 3; c++) {
+        /* sun at the zenith: the last control point; turbidity 1, albedo 0 */
+        sky_hosek_init(&h, v3(0, 1, 0), 1.0f, v3s(0.0f));
+        for (int i = 0; i < 9; i++) CHECK(fabs(h.cfg[c][i] - hosek_rgb[c][45 + i]) <= 1e-12 * fabs(hosek_rgb[c][45 + i]));
+        CHECK(fabs(h.rad[c] - hosek_rgb_rad[c][5]) <= 1e-12 * hosek_rgb_rad[c][5]);
+        /* sun on the horizon: the first; turbidity 10, albedo 1 */
+        sky_hosek_init(&h, v3(1, 0, 0), 10.0f, v3s(1.0f));
+        for (int i = 0; i < 9; i++)
+            CHECK(fabs(h.cfg[c][i] - hosek_rgb[c][540 + 54 * 9 + i]) <= 1e-12 * fabs(hosek_rgb[c][540 + 54 * 9 + i]));
+        CHECK(fabs(h.rad[c] - hosek_rgb_rad[c][60 + 6 * 9]) <= 1e-12 * hosek_rgb_rad[c][60 + 6 * 9]);
+    }
+    /* between rows: bilinear in turbidity and albedo */
+    const vec3 sun = v3_norm(v3(0.0f, 0.5f, -1.0f));
+    sky_hosek m, c00, c01, c10, c11;
+    sky_hosek_init(&m, sun, 2.5f, v3(0.5f, 0.25f, 0.0f));
+    sky_hosek_init(&c00, sun, 2.0f, v3s(0.0f));
+    sky_hosek_init(&c01, sun, 3.0f, v3s(0.0f));
+    sky_hosek_init(&c10, sun, 2.0f, v3s(1.0f));
+    sky_hosek_init(&c11, sun, 3.0f, v3s(1.0f));
+    const double al[3] = {0.5, 0.25, 0.0};
+    for (int c = 0; c < 3; c++) {
+        for (int i = 0; i < 9; i++) {
+            double want = (1.0 - al[c]) * 0.5 * (c00.cfg[c][i] + c01.cfg[c][i]) + al[c] * 0.5 * (c10.cfg[c][i] + c11.cfg[c][i]);
+            CHECK(fabs(m.cfg[c][i] - want) <= 1e-9 * fmax(1.0, fabs(want)));
+        }
+        double wr = (1.0 - al[c]) * 0.5 * (c00.rad[c] + c01.rad[c]) + al[c] * 0.5 * (c10.rad[c] + c11.rad[c]);
+        CHECK(fabs(m.rad[c] - wr) <= 1e-9 * wr);
+    }
+    /* the formula where it is short: looking at a sun at the zenith (theta = gamma = 0),
+     * (1 + A exp(B / 1.01)) (C + D + F + 2 G / (1 - H)^3 + I) times the radiance, over 106.856980 */
+    sky_hosek_init(&h, v3(0, 1, 0), 3.0f, v3s(0.2f));
+    vec3 z = sky_hosek_eval(&h, v3(0, 1, 0));
+    const float zc[3] = {z.x, z.y, z.z};
+    for (int c = 0; c < 3; c++) {
+        const double *k = h.cfg[c];
+        double want = (1.0 + k[0] * exp(k[1] / 1.01)) * (k[2] + k[3] + k[5] + 2.0 * k[6] / pow(1.0 - k[8], 3.0) + k[7]) *
+                      h.rad[c] / 106.856980;
+        CHECKF(fabs((double)zc[c] - want) <= 1e-5 * want, "hosek zenith[%d] %g, formula %g", c, (double)zc[c], want);
+    }
+    /* a clear sky: blue overhead, brightest around the sun, black below the horizon */
+    sky_hosek_init(&h, sun, 3.0f, v3s(0.2f));
+    vec3 zen = sky_hosek_eval(&h, v3(0, 1, 0));
+    vec3 near = sky_hosek_eval(&h, v3_norm(v3(0.0f, 0.6f, -1.0f)));
+    vec3 away = sky_hosek_eval(&h, v3_norm(v3(0.0f, 0.5f, 1.0f)));
+    CHECK(v3_finite(zen) && zen.z > zen.x && v3_luminance(near) > v3_luminance(away));
+    CHECK(v3_luminance(sky_hosek_eval(&h, v3(0, -1, 0))) == 0.0f);
+    for (float t = 1.0f; t <= 10.0f; t += 0.5f)
+        for (int k = 0; k < 64; k++) {
+            float a = 2.0f * PK_PI * (float)k / 64.0f;
+            vec3 dir = v3_norm(v3(cosf(a), 0.02f + (float)(k % 8) * 0.1f, sinf(a)));
+            sky_hosek_init(&h, v3_norm(v3(0.3f, 0.05f + 0.1f * (float)(k % 9), -1.0f)), t, v3s((float)(k % 5) * 0.25f));
+            vec3 c = sky_hosek_eval(&h, dir);
+            CHECK(v3_finite(c) && c.x >= 0.0f && c.y >= 0.0f && c.z >= 0.0f);
+        }
+}
+
 /* ---- renders ---------------------------------------------------------------- */
 
 #define RSIZE 16
@@ -436,6 +501,7 @@ int main(void)
     test_map_sampling(70.0f);
     test_uniform_and_sun();
     test_sky();
+    test_hosek();
     test_renders(dir);
     test_default(dir);
     char cmd[600];

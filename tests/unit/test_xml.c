@@ -671,7 +671,9 @@ static void test_emitters(void)
                 "<float name=\"sunRadiusScale\" value=\"2\"/></emitter>");
     if (s) {
         const scene_environment *e = &s->env;
-        CHECK(e->set && e->has_sun && e->has_sky && e->sky_turbidity == 4.0f && fabsf(e->sky_scale - 6.0f / 106.857f) < 1e-6f);
+        CHECK(e->set && e->has_sun && e->has_sky && e->sky_turbidity == 4.0f && e->sky_scale == 6.0f);
+        /* the Hosek-Wilkie sky with Mitsuba's default ground albedo */
+        CHECK(e->sky_hosek && near3(e->sky_albedo, v3s(0.2f), 0));
         CHECK(near3(e->sun_dir, v3(0, 0.70710678f, 0.70710678f), 1e-6f));
         CHECK(fabsf(e->sun_angle - 2.0f * 0.5358f) < 1e-5f);
         /* the sun through the air: reddened, in Mitsuba's units (about 1e4) */
