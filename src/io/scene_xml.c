@@ -1934,27 +1934,6 @@ static pk_status parse_shape(xp *p, xnode *sh)
 
 /* ---- emitters ------------------------------------------------------------------------------------- */
 
-/* Radiance of the sun's disc, linear RGB in Mitsuba's units (W m^-2 sr^-1
- * nm^-1): the sun's spectral radiance above the atmosphere at the three
- * primaries, attenuated by Rayleigh and aerosol scattering along the air
- * mass of its elevation (Preetham et al. 1999 for the optical depths,
- * Kasten and Young 1989 for the air mass). */
-static vec3 sun_radiance(vec3 to_sun, float turbidity)
-{
-    const float lambda[3] = {0.61f, 0.55f, 0.465f};     /* micrometres */
-    const float outside[3] = {24170.0f, 25500.0f, 30500.0f};
-    float cos_z = fmaxf(to_sun.y, 0.0f);
-    float zen = acosf(fminf(cos_z, 1.0f)) * (180.0f / PK_PI);
-    float mass = 1.0f / (cos_z + 0.50572f * powf(fmaxf(96.07995f - zen, 1e-3f), -1.6364f));
-    float beta = 0.04608f * turbidity - 0.04586f;
-    float r[3];
-    for (int c = 0; c < 3; c++) {
-        float tau = 0.008735f * powf(lambda[c], -4.08f) + beta * powf(lambda[c], -1.3f);
-        r[c] = outside[c] * expf(-mass * tau);
-    }
-    return v3(r[0], r[1], r[2]);
-}
-
 static pk_status parse_emitter(xp *p, xnode *e)
 {
     pk_status st;
@@ -2074,7 +2053,8 @@ static pk_status parse_emitter(xp *p, xnode *e)
             float rs = radius_scale > 0.0f ? fminf(radius_scale, 90.0f / 0.5358f) : 1.0f;
             env->has_sun = true;
             env->sun_angle = 0.5358f * rs;
-            env->sun_radiance = v3_scale(sun_radiance(dir, turbidity), sun_scale / (rs * rs));
+            env->sun_radiance =
+                v3_scale(spectra_mitsuba06_sun(acosf(fminf(fmaxf(dir.y, 0.0f), 1.0f)), turbidity), sun_scale / (rs * rs));
         }
         if (sky) {
             /* the Hosek-Wilkie sky as Mitsuba 0.6 evaluates it (env.h) */
@@ -2084,9 +2064,6 @@ static pk_status parse_emitter(xp *p, xnode *e)
             env->sky_albedo = clamp01v(albedo);
             env->sky_scale = sky_scale;
         }
-        if (sun && first_time(p, "sun-model"))
-            xwarn(p, e, "%s: Mitsuba's sun is approximated by its radiance at three wavelengths (docs/scene-format.md)",
-                  ty);
         static const char *const q2[] = {"sampling_weight", "resolution", "stretch", "extend", NULL};
         warn_unused(p, e, kind, q2);
         return PK_OK;

@@ -69,6 +69,15 @@ PK_HIDDEN vec3 spectra_mitsuba3_blackbody(float kelvin);
  * sRGB of XYZ (1, 1, 1). */
 PK_HIDDEN vec3 spectra_mitsuba3_uniform_emitter(float value);
 
+/* Mitsuba 0.6's sun: the extraterrestrial solar spectrum attenuated along
+ * the air mass of the sun's zenith angle (radians) by Rayleigh and aerosol
+ * scattering (turbidity), ozone, mixed gases and water vapour (Preetham et
+ * al. 1999, after Iqbal 1983), sampled every 5 nm over 350..800 nm into
+ * nm[91], val[91] (W m^-2 sr^-1 nm^-1); _sun reduces it to RGB as
+ * spectra_mitsuba06_rgb does. */
+PK_HIDDEN void spectra_mitsuba06_sun_spectrum(float zenith, float turbidity, float nm[91], float val[91]);
+PK_HIDDEN vec3 spectra_mitsuba06_sun(float zenith, float turbidity);
+
 /* The complex index of refraction (eta, k) of a named metal at the red,
  * green and blue primaries: "Cu", "Au", "Ag", "Al", "Cr" (the names of
  * Mitsuba's table). False, nothing written, for another name. */

@@ -269,6 +269,25 @@ static void test_mitsuba(void)
     check_rgb(spectra_mitsuba06_blackbody(3000.0f), want, 1e-4);
     ref06(NULL, NULL, 0, 6500.0, want);
     check_rgb(spectra_mitsuba06_blackbody(6500.0f), want, 1e-4);
+    /* Mitsuba 0.6's sun: at 550 nm, sun at the zenith, turbidity 3, the
+     * attenuation by hand (air mass 1/(1 + 0.15 * 93.885^-1.253), solar
+     * 25503.8, ozone 0.085 cm^-1 over 0.35 cm, no gas or water absorption) */
+    float snm[91], sval[91];
+    spectra_mitsuba06_sun_spectrum(0.0f, 3.0f, snm, sval);
+    {
+        double m = 1.0 / (1.0 + 0.15 * pow(93.885, -1.253)), beta = 0.04608365822050 * 3.0 - 0.04586025928522;
+        double want_sun = 25503.8 * exp(-m * 0.008735 * pow(0.55, -4.08)) * exp(-m * beta * pow(0.55, -1.3)) *
+                      exp(-m * 0.085 * 0.35);
+        CHECK(snm[40] == 550.0f);
+        CHECK_NEAR(sval[40], want_sun, 1e-4 * want_sun);
+        CHECK(sval[0] == 0.0f && sval[90] == 0.0f); /* beyond the solar table */
+    }
+    vec3 noon = spectra_mitsuba06_sun(0.0f, 3.0f), low = spectra_mitsuba06_sun(1.4f, 3.0f);
+    vec3 again = spectra_mitsuba06_rgb(snm, sval, 91);
+    CHECK(noon.x == again.x && noon.y == again.y && noon.z == again.z);
+    CHECK(noon.y > 1.0e4f && noon.y < 3.0e4f);            /* Mitsuba's units */
+    CHECK(low.x / low.z > noon.x / noon.z && low.y < noon.y); /* a low sun is redder and dimmer */
+    CHECK(v3_luminance(spectra_mitsuba06_sun(0.0f, 8.0f)) < v3_luminance(noon)); /* and so is a hazy one */
     /* a uniform emitter in Mitsuba 3: the sRGB of XYZ (1, 1, 1) */
     vec3 u = spectra_mitsuba3_uniform_emitter(2.0f);
     CHECK_NEAR(u.x, 2.0 * (3.240479 - 1.537150 - 0.498535), 1e-5);
