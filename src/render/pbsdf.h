@@ -45,7 +45,7 @@ typedef enum pbsdf_type {
 /* flags */
 #define PBSDF_SCHLICK 1u /* conductor: Schlick's Fresnel with F0 = specular, not eta/k */
 /* conductor, dielectric, plastic: the Beckmann distribution of slopes
- * instead of GGX (the same alpha: the RMS slope times sqrt 2) */
+ * instead of GGX (the same alpha: the RMS slope of the microfacets) */
 #define PBSDF_BECKMANN 2u
 
 /* Below this roughness a microfacet lobe is treated as perfectly smooth (a
