@@ -505,6 +505,7 @@ static pk_status place_light(gltf *g, int64_t li, const xform *x)
         pl.spot_dir = dir;
         pl.cos_inner = cosf(inner);
         pl.cos_outer = cosf(outer);
+        pl.spot_falloff = SPOT_FALLOFF_SQUARED;
     } else if (strcmp(type, "point") != 0) {
         return gltf_fail(g, PK_ERR_PARSE, "%s/type: '%.16s' is not point, spot or directional", path, type);
     }

@@ -469,6 +469,7 @@ static void test_lights(void)
         CHECK(vnear(sp->position, v3(0, 4, 0), 1e-6f) && vnear(sp->spot_dir, v3(0, -1, 0), 1e-6f));
         CHECK_NEAR(sp->cos_inner, cos(0.25), 1e-6);
         CHECK_NEAR(sp->cos_outer, cos(0.5), 1e-6);
+        CHECK(sp->spot_falloff == SPOT_FALLOFF_SQUARED); /* the specification's recommended falloff */
         CHECK(vnear(sp->intensity, v3s(2.0f), 1e-6f));
         /* directional: lux / 683 = W/m^2, position = the direction toward the light (+y) */
         CHECK(d->distant && vnear(d->position, v3(0, 1, 0), 1e-6f) && vnear(d->intensity, v3s(0.01f), 1e-7f));
