@@ -139,14 +139,14 @@ static void test_far(void)
     CHECKF(strcmp(pk_context_error(ctx), "huge.obj: the scene is too large to frame automatically; give it a camera") ==
                0, "%s", pk_context_error(ctx));
     pk_context_clear_error(ctx);
-    pk_camera far = {{0.0f, 1e30f, 1e30f}, {0.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, 40.0f};
+    pk_camera far = {{0.0f, 1e30f, 1e30f}, {0.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, 40.0f, 0.0f, 0.0f, PK_PROJECTION_PERSPECTIVE, 0.0f};
     CHECKF(pk_scene_set_camera(ctx, s, &far) == PK_OK, "%s", pk_context_error(ctx));
-    pk_camera apart = {{0.0f, 0.0f, 3e38f}, {0.0f, 0.0f, -3e38f}, {0.0f, 1.0f, 0.0f}, 40.0f};
+    pk_camera apart = {{0.0f, 0.0f, 3e38f}, {0.0f, 0.0f, -3e38f}, {0.0f, 1.0f, 0.0f}, 40.0f, 0.0f, 0.0f, PK_PROJECTION_PERSPECTIVE, 0.0f};
     CHECK(pk_scene_set_camera(ctx, s, &apart) == PK_ERR_INVALID_ARGUMENT);
     CHECKF(strcmp(pk_context_error(ctx), "camera: look_from and look_at are too far apart") == 0, "%s",
            pk_context_error(ctx));
     pk_context_clear_error(ctx);
-    pk_camera tiny = {{0.0f, 0.0f, 1e-30f}, {0.0f, 0.0f, 0.0f}, {0.0f, 1e-30f, 0.0f}, 40.0f};
+    pk_camera tiny = {{0.0f, 0.0f, 1e-30f}, {0.0f, 0.0f, 0.0f}, {0.0f, 1e-30f, 0.0f}, 40.0f, 0.0f, 0.0f, PK_PROJECTION_PERSPECTIVE, 0.0f};
     CHECKF(pk_scene_set_camera(ctx, s, &tiny) == PK_OK, "%s", pk_context_error(ctx));
     CHECK(pk_render(ctx, s, &o, &img, NULL) == PK_OK);
     pk_image_destroy(img);

@@ -341,7 +341,7 @@ static pk_scene *quad_scene(const char *dir, float rho)
     write_text(path, "mtllib quad.mtl\nusemtl q\nv -2 -2 0\nv 2 -2 0\nv 2 2 0\nv -2 2 0\nf 1 2 3 4\n");
     pk_scene *s = NULL;
     REQUIRE(pk_scene_load_file(ctx, path, &s) == PK_OK);
-    pk_camera cam = {{0.0f, 0.0f, 3.0f}, {0.0f, 0.0f, 0.0f}, {0, 1, 0}, 40.0f};
+    pk_camera cam = {{0.0f, 0.0f, 3.0f}, {0.0f, 0.0f, 0.0f}, {0, 1, 0}, 40.0f, 0.0f, 0.0f, PK_PROJECTION_PERSPECTIVE, 0.0f};
     REQUIRE(pk_scene_set_camera(ctx, s, &cam) == PK_OK);
     return s;
 }

@@ -77,7 +77,7 @@ static pk_scene *furnace_box(const char *dir, float r, float e)
     write_file(path, text);
     pk_scene *s = NULL;
     REQUIRE(pk_scene_load_file(ctx, path, &s) == PK_OK);
-    pk_camera cam = {{0.1f, 0.2f, 0.3f}, {0.5f, -0.3f, -1.0f}, {0, 1, 0}, 70.0f};
+    pk_camera cam = {{0.1f, 0.2f, 0.3f}, {0.5f, -0.3f, -1.0f}, {0, 1, 0}, 70.0f, 0.0f, 0.0f, PK_PROJECTION_PERSPECTIVE, 0.0f};
     REQUIRE(pk_scene_set_camera(ctx, s, &cam) == PK_OK);
     return s;
 }

@@ -347,7 +347,7 @@ static void test_render_quad(void)
 {
     pk_scene *s;
     REQUIRE(pk_scene_load_file(ctx, PK_TEST_DATA "/tex_quad.obj", &s) == PK_OK);
-    pk_camera cam = {{0, 0, 0}, {0, 0, 0}, {0, 1, 0}, 40.0f};
+    pk_camera cam = {{0, 0, 0}, {0, 0, 0}, {0, 1, 0}, 40.0f, 0.0f, 0.0f, PK_PROJECTION_PERSPECTIVE, 0.0f};
     cam.look_from[2] = 1.0f / tanf(20.0f * PK_PI / 180.0f);
     REQUIRE(pk_scene_set_camera(ctx, s, &cam) == PK_OK);
     for (int integ = 0; integ < 1; integ++) {
