@@ -691,8 +691,23 @@ pk_status cli_render_settings(pk_context *ctx, const cli_render_opts *o, pk_scen
     pk_scene_get_render_options(scene, ro);
     size_t nopts;
     const cli_option *opts = cli_render_options(&nopts);
+    const int scene_w = ro->width, scene_h = ro->height;
+    int set_w = 0, set_h = 0;
     for (size_t i = 0; i < nopts; i++)
-        if (o->int_set[i]) *(int *)(void *)((char *)ro + opts[i].render->offset) = o->int_value[i];
+        if (o->int_set[i]) {
+            *(int *)(void *)((char *)ro + opts[i].render->offset) = o->int_value[i];
+            set_w |= strcmp(opts[i].render->name, "width") == 0;
+            set_h |= strcmp(opts[i].render->name, "height") == 0;
+        }
+    /* one side given for a scene that has its own size: the other follows
+     * the scene's aspect ratio */
+    if (set_w != set_h && pk_scene_has_image_size(scene) && scene_w > 0 && scene_h > 0) {
+        const double other = set_w ? (double)ro->width * scene_h / scene_w : (double)ro->height * scene_w / scene_h;
+        int v = (int)(other + 0.5);
+        v = v < 1 ? 1 : v > PK_MAX_IMAGE_SIDE ? PK_MAX_IMAGE_SIDE : v;
+        if (set_w) ro->height = v;
+        else ro->width = v;
+    }
     if (o->fresnel >= 0) ro->fresnel = o->fresnel;
     if (o->has_clamp_indirect) ro->clamp_indirect = o->clamp_indirect;
     if (o->has_accel) ro->accel = o->accel;

@@ -402,6 +402,10 @@ PK_API void pk_scene_get_render_options(const pk_scene *scene, pk_render_options
 /* Non-zero when the scene file names its samples per pixel (a JSON
  * "render.spp", a Mitsuba sampler's sample_count). */
 PK_API int pk_scene_has_sample_count(const pk_scene *scene);
+/* Non-zero when the scene file gives the image's width and height (a JSON
+ * "render"/"film" size, a Mitsuba film, a pbrt Film, a glTF camera's aspect
+ * ratio). */
+PK_API int pk_scene_has_image_size(const pk_scene *scene);
 
 /* ---- images ------------------------------------------------------------ */
 

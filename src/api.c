@@ -292,6 +292,8 @@ void pk_scene_get_render_options(const pk_scene *s, pk_render_options *opt)
 
 int pk_scene_has_sample_count(const pk_scene *s) { return s && s->render.has_spp; }
 
+int pk_scene_has_image_size(const pk_scene *s) { return s && s->render.has_width && s->render.has_height; }
+
 /* ---- images ---------------------------------------------------------------- */
 
 pk_status pk_image_create(pk_context *ctx, int width, int height, pk_image **out)

@@ -154,6 +154,18 @@ while read -r name min max def; do
   done
   [ $fail -eq 0 ] && ok "--$name: $min and $max accepted, $((min - 1)) and $((max + 1)) refused"
 done <<<"$table"
+# ---- one side given: the other follows the scene file's aspect ratio
+printf '{"render": {"width": 200, "height": 100, "spp": 1}, "meshes": [{"obj": "tri.obj"}]}' >"$tmp/wide.json"
+size_of() { sed -n 's/^settings [^,]*, [0-9]* threads\{0,1\}, \([0-9]*x[0-9]*\),.*/\1/p' "$tmp/stdout"; }
+run render -o "$tmp/w.png" --width 50 --quiet --stats "$tmp/wide.json"
+[ $rc -eq 0 ] && [ "$(size_of)" = 50x25 ] && ok "--width alone keeps the scene's 2:1" || bad "--width 50 of a 200x100 scene: $(size_of), $err"
+run render -o "$tmp/w.png" --height 20 --quiet --stats "$tmp/wide.json"
+[ $rc -eq 0 ] && [ "$(size_of)" = 40x20 ] && ok "--height alone keeps the scene's 2:1" || bad "--height 20 of a 200x100 scene: $(size_of), $err"
+run render -o "$tmp/w.png" --width 30 --height 30 --quiet --stats "$tmp/wide.json"
+[ $rc -eq 0 ] && [ "$(size_of)" = 30x30 ] && ok "both sides given: as given" || bad "--width 30 --height 30: $(size_of), $err"
+run render -o "$tmp/w.png" --width 30 --quiet --stats "$tmp/tri.obj"
+[ $rc -eq 0 ] && [ "$(size_of)" = 30x512 ] && ok "a scene without a size: the default height" || bad "--width 30 of an OBJ: $(size_of), $err"
+
 run render -o "$tmp/t.png" --width 8 --height 8 --threads 0 --stats
 threads=$(sed -n 's/^settings .*, \([0-9]*\) threads\{0,1\},.*/\1/p' "$tmp/stdout")
 [ $rc -eq 0 ] && [ "${threads:-0}" -ge 1 ] && ok "--threads 0: all cores ($threads)" || bad "--threads 0: exit $rc, $err"
