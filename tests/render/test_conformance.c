@@ -79,9 +79,10 @@ static int compare_blocks(const char *what, const pk_image *a1, const pk_image *
                 for (int y = by; y < by + BLOCK; y++)
                     for (int x = bx; x < bx + BLOCK; x++) {
                         const int i = 3 * (y * SIZE + x) + c;
-                        ma += pa1[i] + pa2[i], mb += pb1[i] + pb2[i];
-                        va += (pa1[i] - pa2[i]) * (pa1[i] - pa2[i]) / 2.0;
-                        vb += (pb1[i] - pb2[i]) * (pb1[i] - pb2[i]) / 2.0;
+                        const double xa = pa1[i], ya = pa2[i], xb = pb1[i], yb = pb2[i];
+                        ma += xa + ya, mb += xb + yb;
+                        va += (xa - ya) * (xa - ya) / 2.0;
+                        vb += (xb - yb) * (xb - yb) / 2.0;
                     }
                 const double n = BLOCK * BLOCK;
                 ma /= 2 * n, mb /= 2 * n;
@@ -163,7 +164,8 @@ int main(void)
     if (!gbits) CHECK(compare_blocks("glTF", m1, m2, g1, g2) == 0);
     /* and the two material models differ where they should: a little, at grazing angles */
     double so = 0.0, sm = 0.0;
-    for (int i = 0; i < 3 * SIZE * SIZE; i++) so += pk_image_pixels_const(o1)[i], sm += pk_image_pixels_const(m1)[i];
+    for (int i = 0; i < 3 * SIZE * SIZE; i++)
+        so += (double)pk_image_pixels_const(o1)[i], sm += (double)pk_image_pixels_const(m1)[i];
     printf("  metallic-roughness (metallic 0, roughness 1) against Lambert: image mean %+.2f %%\n", 100.0 * (sm / so - 1.0));
     pk_scene_destroy(mr);
     pk_image *imgs[] = {o1, o2, j1, x1, p1, p2, g1, g2, m1, m2};
