@@ -35,9 +35,11 @@ static void warning_log_fn(void *user, const char *message)
     if (w->echo) fprintf(stderr, "  warning: %s\n", message);
 }
 
+/* Empties w and turns echo off (set it after warning_log_attach). */
 static inline void warning_log_clear(warning_log *w)
 {
     w->count = 0;
+    w->echo = false;
     w->last[0] = w->all[0] = '\0';
     for (int i = 0; i < WARNING_LOG_KEEP; i++) w->msg[i][0] = '\0';
 }
