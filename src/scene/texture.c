@@ -106,50 +106,15 @@ pk_status texture_build(pk_context *ctx, int w, int h, int nc, const uint8_t *px
 
 pk_status texture_load(pk_context *ctx, pk_scene *s, const char *path, bool colour, int32_t *index)
 {
-    *index = -1;
-    size_t lp = strlen(path);
-    char *key = mem_alloc(&ctx->alloc, lp + 2);
-    if (!key) return ctx_nomem(ctx);
-    key[0] = colour ? 'c' : 'd';
-    memcpy(key + 1, path, lp + 1);
-    for (size_t i = 0; i < s->ntextures; i++)
-        if (strcmp(s->textures[i].key, key) == 0) {
-            mem_free(&ctx->alloc, key);
-            *index = (int32_t)i;
-            return PK_OK;
-        }
-    if (s->ntextures >= (size_t)INT32_MAX) {
-        mem_free(&ctx->alloc, key);
-        return ctx_error(ctx, PK_ERR_LIMIT, "%s: too many textures", path);
-    }
+    *index = texture_find(s, path, colour);
+    if (*index >= 0) return PK_OK;
+    if (s->ntextures >= (size_t)INT32_MAX) return ctx_error(ctx, PK_ERR_LIMIT, "%s: too many textures", path);
     image_buf img;
     pk_status st = image_read_file(ctx, path, &img);
-    if (st != PK_OK) {
-        mem_free(&ctx->alloc, key);
-        return st;
-    }
-    texture t;
-    st = texture_build(ctx, img.w, img.h, img.nc, img.px8, img.pxf, colour, &t);
+    if (st != PK_OK) return st;
+    st = texture_add_pixels(ctx, s, path, img.w, img.h, img.nc, img.px8, img.pxf, colour, index);
     image_buf_free(&ctx->alloc, &img);
-    if (st != PK_OK) {
-        mem_free(&ctx->alloc, key);
-        return st;
-    }
-    t.key = key;
-    if (t.bytes > PK_MAX_TEXTURE_BYTES - s->texture_bytes) {
-        size_t have = s->texture_bytes;
-        texture_free(&ctx->alloc, &t);
-        return ctx_error(ctx, PK_ERR_LIMIT, "%s: the scene's textures would take more than %zu bytes (%zu already)", path,
-                         (size_t)PK_MAX_TEXTURE_BYTES, have);
-    }
-    if (!mem_grow(&s->alloc, (void **)&s->textures, &s->cap_textures, s->ntextures + 1, sizeof *s->textures)) {
-        texture_free(&ctx->alloc, &t);
-        return ctx_nomem(ctx);
-    }
-    s->textures[s->ntextures] = t;
-    s->texture_bytes += t.bytes;
-    *index = (int32_t)s->ntextures++;
-    return PK_OK;
+    return st;
 }
 
 int32_t texture_find(const pk_scene *s, const char *key, bool colour)
