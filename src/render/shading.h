@@ -46,6 +46,7 @@ static inline PK_HD shading shading_at(const surface *sf)
             if (!sf->front) n = v3_neg(n); /* the outward normal: wo.z < 0 inside */
             break;
         case MAT_PLASTIC: sh.b = pbsdf_plastic(m->kd, m->ni, m->alpha); break;
+        case MAT_INTERFACE: sh.b = pbsdf_dielectric(1.0f, 0.0f, v3s(1.0f)); break; /* straight through */
         case MAT_METALLIC_ROUGHNESS: { /* a thin sheet: the frame faces wo on either side */
             const float r = fminf(fmaxf(m->roughness, 0.0f), 1.0f);
             sh.b = pbsdf_metallic_roughness(surface_clamp_rgb(m->kd), fminf(fmaxf(m->metallic, 0.0f), 1.0f), r * r,

@@ -14,6 +14,7 @@ void material_init(material *m)
     m->ni = 1.0f;
     m->d = 1.0f;
     m->illum = 2;
+    m->medium_in = m->medium_out = -2; /* MEDIUM_INHERIT */
     tex_ref_init(&m->map_kd);
     tex_ref_init(&m->map_ks);
     tex_ref_init(&m->map_ns);
@@ -81,6 +82,14 @@ void material_dielectric(material *m, float ior, float alpha, vec3 transmittance
     m->type = MAT_DIELECTRIC;
     m->ni = ior, m->alpha = alpha, m->tf = transmittance;
     m->kd = v3s(0.0f), m->ks = v3s(material_f0_dielectric(ior));
+    m->illum = 7;
+}
+
+void material_interface(material *m)
+{
+    m->type = MAT_INTERFACE;
+    m->ni = 1.0f, m->alpha = 0.0f, m->tf = v3s(1.0f);
+    m->kd = v3s(0.0f), m->ks = v3s(0.0f);
     m->illum = 7;
 }
 

@@ -29,7 +29,8 @@ typedef enum material_type {
     MAT_CONDUCTOR,
     MAT_DIELECTRIC,
     MAT_PLASTIC,
-    MAT_METALLIC_ROUGHNESS
+    MAT_METALLIC_ROUGHNESS,
+    MAT_INTERFACE   /* no surface: the boundary of a medium, which rays pass straight through */
 } material_type;
 
 /* Colours are linear RGB. illum follows the MTL convention: 3/5 add mirror
@@ -86,6 +87,11 @@ typedef struct material {
      * rest). map_bump is a height field (heights times bm, in scene units);
      * map_norm a tangent-space normal map. */
     tex_ref map_kd, map_ks, map_ns, map_d, map_alpha, map_bump, map_norm, map_mr;
+    /* The media on either side (medium.h): medium_out on the side the
+     * geometric normal points to, medium_in on the other; an index into the
+     * scene's media, MEDIUM_NONE (vacuum) or MEDIUM_INHERIT (the surface
+     * does not change the ray's medium; material_init's default). */
+    int32_t medium_in, medium_out;
     bool textured;   /* derived by scene_commit: a map other than map_d is set */
     bool cutout;     /* derived by scene_commit: map_d is set */
 } material;
@@ -105,6 +111,11 @@ PK_HIDDEN void material_conductor(material *m, vec3 eta, vec3 k, float alpha);
 PK_HIDDEN void material_conductor_f0(material *m, vec3 f0, float alpha);
 /* Glass of relative index ior; transmittance tints the light that enters. */
 PK_HIDDEN void material_dielectric(material *m, float ior, float alpha, vec3 transmittance);
+/* An index-matched boundary between media (Mitsuba's null BSDF, pbrt's
+ * interface material): invisible to rays, it only says which media lie on
+ * either side. The Whitted integrator and the path tracer see it as glass of
+ * index 1 (rays pass through unchanged). */
+PK_HIDDEN void material_interface(material *m);
 /* A diffuse base of albedo under a dielectric coat of index ior. */
 PK_HIDDEN void material_plastic(material *m, vec3 albedo, float ior, float alpha);
 

@@ -52,6 +52,7 @@ pk_status scene_create(pk_context *ctx, const char *name, pk_scene **out)
     s->alloc = ctx->alloc;
     s->bounds = aabb_empty();
     s->kept_bounds = aabb_empty();
+    s->camera_medium = MEDIUM_NONE;
     pk_render_options_init(&s->render.opt);
     scene_env_init(&s->env);
     s->name = mem_strdup(&s->alloc, name ? name : "scene");
@@ -89,6 +90,8 @@ void scene_destroy(pk_scene *s)
     mem_free(a, s->meshes);
     mem_free(a, s->instances);
     mem_free(a, s->kept);
+    for (size_t i = 0; i < s->nmedia; i++) medium_free(a, &s->media[i]);
+    mem_free(a, s->media);
     scene_env_clear(a, &s->env);
     mem_free(a, s->name);
     pk_allocator copy = *a;
@@ -468,6 +471,8 @@ pk_status scene_commit(pk_context *ctx, pk_scene *s)
     if (!scene_check(s, why, sizeof why))
         return ctx_error(ctx, PK_ERR_PARSE, "%s: invalid scene: %s", s->name, why);
     pk_status est = scene_env_load(ctx, &s->env);
+    if (est != PK_OK) return est;
+    est = scene_media_prepare(ctx, s);
     if (est != PK_OK) return est;
     mem_free(&s->alloc, s->degenerate);
     mem_free(&s->alloc, s->emissive);

@@ -14,6 +14,7 @@
 #include "../math/xform.h"
 #include "../paprsek_internal.h"
 #include "material.h"
+#include "medium.h"
 #include "texture.h"
 
 /* Triangle k is the k-th triangle the file produced (fan order). */
@@ -168,6 +169,11 @@ struct pk_scene {
     texture *textures; size_t ntextures, cap_textures;
     size_t texture_bytes;
 
+    /* Participating media (medium.h), numbered as materials name them. */
+    medium *media; size_t nmedia, cap_media;
+    int32_t camera_medium;  /* the medium the camera sits in: MEDIUM_NONE (default) or a medium */
+    size_t medium_bytes;    /* the media's grids and majorants (derived by scene_commit) */
+
     vec3 ambient;           /* ambient light; zero unless the scene asks */
     scene_environment env;  /* the surroundings; nothing unless the scene asks */
     bool has_camera;
@@ -219,6 +225,30 @@ PK_HIDDEN pk_status scene_add_material(pk_context *ctx, pk_scene *s, const char 
  * (a hash index), so that files with many materials and usemtl statements
  * do not take quadratic time. */
 PK_HIDDEN int64_t scene_find_material(const pk_scene *s, const char *name);
+/* Adds medium *m (medium.h; its name, if any, is looked up by
+ * scene_find_medium) and takes what it owns (name, grids): on failure they
+ * are freed. *index receives its number. Its values are checked by
+ * scene_commit (messages name the medium). */
+PK_HIDDEN pk_status scene_add_medium(pk_context *ctx, pk_scene *s, medium *m, uint32_t *index);
+/* The material that is material mat with the media med_in (interior) and
+ * med_out (exterior) on its sides: mat itself when it has them already,
+ * else a copy made once per (mat, med_in, med_out) and named
+ * "NAME@in,out" (so that finding mat's own name still finds mat). For
+ * readers whose shapes name their media apart from their materials. */
+PK_HIDDEN pk_status scene_material_with_media(pk_context *ctx, pk_scene *s, uint32_t mat, int32_t med_in,
+                                              int32_t med_out, uint32_t *out);
+/* Number of the newest medium named name; -1 when absent. */
+PK_HIDDEN int64_t scene_find_medium(const pk_scene *s, const char *name);
+/* Frees what a medium owns (its name, grids and majorants). */
+PK_HIDDEN void medium_free(const pk_allocator *a, medium *m);
+/* Checks every medium (values, grids, placement, the voxel limit) and the
+ * media that materials and the camera name, and derives each medium's
+ * world_to_grid, bounds, majorant grid and sigma_max, and medium_bytes
+ * (scene_commit calls it). */
+PK_HIDDEN pk_status scene_media_prepare(pk_context *ctx, pk_scene *s);
+/* Whether the scene has participating media to render: a medium some
+ * material or the camera refers to. */
+PK_HIDDEN bool scene_has_media(const pk_scene *s);
 /* The empty environment (nothing set, identity rotation, scales 1, sun 0.53 degrees). */
 PK_HIDDEN void scene_env_init(scene_environment *env);
 /* Sets env's map rotation to deg degrees about +y (counter-clockwise seen from above). */

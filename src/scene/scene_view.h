@@ -31,6 +31,11 @@ typedef struct scene_view {
     const vec3 *mesh_positions, *mesh_normals;
     const uv2 *mesh_uvs;
     const triangle *mesh_tris;
+    /* Participating media (medium.h): the volumetric path tracer's (the GPU
+     * renders scenes without them). */
+    const medium *media;
+    size_t nmedia;
+    int32_t camera_medium;
 } scene_view;
 
 /* The view of committed scene s (its arrays, not copies). */
@@ -45,6 +50,7 @@ static inline scene_view scene_view_of(const pk_scene *s)
     v.kept = s->kept, v.nkept = s->nkept, v.meshes = s->meshes;
     v.mesh_positions = s->mesh_positions, v.mesh_normals = s->mesh_normals, v.mesh_uvs = s->mesh_uvs;
     v.mesh_tris = s->mesh_tris;
+    v.media = s->media, v.nmedia = s->nmedia, v.camera_medium = s->camera_medium;
     return v;
 }
 
