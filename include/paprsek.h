@@ -217,7 +217,8 @@ PK_API pk_status pk_device_parse(const char *name, pk_device_kind *out);
 typedef enum pk_integrator_kind {
     PK_INTEGRATOR_DEFAULT = 0, /* the path tracer */
     PK_INTEGRATOR_WHITTED = 1, /* direct light, mirror reflection and refraction */
-    PK_INTEGRATOR_PATH = 2     /* path tracing: global illumination, multiple importance sampling */
+    PK_INTEGRATOR_PATH = 2,    /* path tracing: global illumination, multiple importance sampling */
+    PK_INTEGRATOR_VOLPATH = 3  /* path tracing through participating media (the default for scenes with media) */
 } pk_integrator_kind;
 
 PK_API const char *pk_integrator_name(pk_integrator_kind kind);

@@ -91,7 +91,7 @@ pk_status options_check(pk_context *ctx, const pk_render_options *o)
                          PK_MAX_IMAGE_PIXELS);
     if ((unsigned)o->accel > PK_ACCEL_CUDA)
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "unknown accelerator %d", (int)o->accel);
-    if ((unsigned)o->integrator > PK_INTEGRATOR_PATH)
+    if ((unsigned)o->integrator > PK_INTEGRATOR_VOLPATH)
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "unknown integrator %d", (int)o->integrator);
     if ((unsigned)o->device > PK_DEVICE_CUDA)
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "unknown device %d", (int)o->device);
@@ -129,7 +129,7 @@ pk_status pk_device_parse(const char *name, pk_device_kind *out)
 
 /* ---- integrator names ------------------------------------------------------ */
 
-static const char *const integrator_names[] = {"path", "whitted", "path"};
+static const char *const integrator_names[] = {"path", "whitted", "path", "volpath"};
 
 const char *pk_integrator_name(pk_integrator_kind kind)
 {
@@ -142,6 +142,7 @@ pk_status pk_integrator_parse(const char *name, pk_integrator_kind *out)
     if (!name || !out) return PK_ERR_INVALID_ARGUMENT;
     if (strcmp(name, "whitted") == 0) *out = PK_INTEGRATOR_WHITTED;
     else if (strcmp(name, "path") == 0) *out = PK_INTEGRATOR_PATH;
+    else if (strcmp(name, "volpath") == 0) *out = PK_INTEGRATOR_VOLPATH;
     else if (strcmp(name, "default") == 0) *out = PK_INTEGRATOR_DEFAULT;
     else return PK_ERR_INVALID_ARGUMENT;
     return PK_OK;
