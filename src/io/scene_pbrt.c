@@ -23,6 +23,7 @@
 #include "../options.h"
 #include "../scene/camera.h"
 #include "../scene/spectra.h"
+#include "grid_io.h"
 #include "io_util.h"
 #include "pbrt_tok.h"
 #include "scene_build.h"
@@ -98,9 +99,13 @@ typedef struct mat_variant {
 
 typedef struct gstate {
     uint32_t material;
-    bool interface;      /* the current material is pbrt's "interface": shapes are not drawn */
+    bool interface;      /* the current material is pbrt's "interface": only bounds media */
     int32_t area;        /* index into areas, -1 none */
     bool reverse;
+    /* MediumInterface: the inside and outside media's names (indices into
+     * pp.mnames, -1 for "": vacuum); equal ones are no transition, and the
+     * shapes keep the ray's medium */
+    int32_t mi_in, mi_out;
 } gstate;
 
 typedef struct named_xf {
@@ -174,7 +179,15 @@ typedef struct pp {
     pfile top;              /* the first file, for messages after it is read */
     attr_def *defs;
     size_t ndefs, cap_defs;
-    bool warned_interface;
+    /* media: the names MediumInterface used, the camera's medium (the
+     * outside medium current at Camera) and where it was named, and the
+     * first medium this file added (their grids are mirrored at the end) */
+    char **mnames;
+    size_t nmnames, cap_mnames;
+    int32_t cam_mi;
+    size_t cam_mi_line;
+    char cam_mi_file[256];
+    size_t media_start;
 } pp;
 
 static const pk_allocator *A(pp *p) { return &p->ctx->alloc; }
@@ -950,6 +963,7 @@ static pk_status build_material(pp *p, const char *type, material *m, bool *inte
         m->name = nm;
         *interface = mat_is_interface(p, (uint32_t)idx);
     } else if (strcmp(type, "interface") == 0 || strcmp(type, "") == 0 || strcmp(type, "none") == 0) {
+        material_interface(m);
         *interface = true;
     } else if (strcmp(type, "measured") == 0 || strcmp(type, "hair") == 0 || strcmp(type, "subsurface") == 0) {
         for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
@@ -1053,14 +1067,61 @@ static pk_status builder_status(pp *p, pk_status st, const pk_context *tmp)
     return pfail(p, p->line, st, "%s", tmp->message);
 }
 
-/* A shape with the "interface" material: not drawn (said once). */
-static pk_status interface_skip(pp *p)
+/* ---- where media are ------------------------------------------------------------------------ */
+
+/* The number of a name MediumInterface used (*idx; -1 for "", vacuum). */
+static pk_status medium_name_index(pp *p, const char *name, int32_t *idx)
 {
-    if (!p->warned_interface)
-        pwarn(p, p->line, "shapes with the \"interface\" material only bound media, which are not rendered yet: left "
-                          "out (further ones not reported)");
-    p->warned_interface = true;
+    *idx = -1;
+    if (!name[0]) return PK_OK;
+    for (size_t i = 0; i < p->nmnames; i++)
+        if (strcmp(p->mnames[i], name) == 0) {
+            *idx = (int32_t)i;
+            return PK_OK;
+        }
+    if (p->nmnames >= INT32_MAX) return pfail(p, p->line, PK_ERR_LIMIT, "too many medium names");
+    if (!mem_grow(A(p), (void **)&p->mnames, &p->cap_mnames, p->nmnames + 1, sizeof *p->mnames)) return ctx_nomem(p->ctx);
+    char *c = mem_strdup(A(p), name);
+    if (!c) return ctx_nomem(p->ctx);
+    p->mnames[p->nmnames] = c;
+    *idx = (int32_t)p->nmnames++;
     return PK_OK;
+}
+
+/* The scene's medium of name number idx (MEDIUM_NONE for -1); what: the
+ * directive, for the message at line. */
+static pk_status medium_resolve(pp *p, int32_t idx, size_t line, const char *what, int32_t *out)
+{
+    *out = MEDIUM_NONE;
+    if (idx < 0) return PK_OK;
+    int64_t m = scene_find_medium(p->s, p->mnames[idx]);
+    if (m < 0)
+        return pfail(p, line, PK_ERR_PARSE,
+                     "%s: MediumInterface names no medium \"%.80s\" (MakeNamedMedium must define it before the "
+                     "shapes and the camera that use it)",
+                     what, p->mnames[idx]);
+    *out = (int32_t)m;
+    return PK_OK;
+}
+
+/* Whether the current MediumInterface changes the medium (pbrt's rule: a
+ * shape whose inside and outside are the same keeps the ray's medium). */
+static bool medium_transition(pp *p) { return GS(p)->mi_in != GS(p)->mi_out; }
+
+/* *mat with the current MediumInterface on its sides (pbrt's outside is the
+ * side the surface normal points to: Paprsek's exterior); unchanged (media
+ * inherited) when the interface is no transition. */
+static pk_status shape_media(pp *p, uint32_t *mat)
+{
+    if (!medium_transition(p)) return PK_OK;
+    int32_t in, out;
+    pk_status st;
+    char what[64];
+    snprintf(what, sizeof what, "%.40s", p->dname ? p->dname : "Shape");
+    if ((st = medium_resolve(p, GS(p)->mi_in, p->line, what, &in)) ||
+        (st = medium_resolve(p, GS(p)->mi_out, p->line, what, &out)))
+        return st;
+    return scene_material_with_media(p->ctx, p->s, *mat, in, out, mat);
 }
 
 /* World area of the mesh (for an area light's power). */
@@ -1098,7 +1159,8 @@ static vec3 area_emission(pp *p, double area, bool *two_sided)
  * world mirrors. alpha_tex: the cut-out texture, -1 none. */
 static pk_status add_mesh(pp *p, mesh_in *m, int32_t alpha_tex)
 {
-    if (GS(p)->interface) return interface_skip(p);
+    /* an interface that bounds no media changes nothing: left out */
+    if (GS(p)->interface && !medium_transition(p)) return PK_OK;
     xform w = world_xf(p);
     const bool mirrored = xform_det3(&w) < 0.0;
     for (size_t t = 0; t < m->ntris; t++) {
@@ -1119,9 +1181,12 @@ static pk_status add_mesh(pp *p, mesh_in *m, int32_t alpha_tex)
     }
     bool two = false;
     vec3 ke = v3s(0.0f);
-    if (GS(p)->area >= 0) ke = area_emission(p, p->areas[GS(p)->area].power > 0.0f ? mesh_area(&w, m) : 0.0, &two);
+    /* interfaces do not emit (as in pbrt) */
+    if (GS(p)->area >= 0 && !GS(p)->interface)
+        ke = area_emission(p, p->areas[GS(p)->area].power > 0.0f ? mesh_area(&w, m) : 0.0, &two);
     uint32_t mat;
     pk_status st = shape_material(p, ke, two, alpha_tex, &mat);
+    if (st == PK_OK) st = shape_media(p, &mat);
     if (st) return st;
     xform saved = *sb_transform(&p->b);
     sb_set_transform(&p->b, &w);
@@ -1661,15 +1726,16 @@ static pk_status shape_sphere(pp *p, int32_t alpha)
                    fabsf(v3_dot(c1, c2)) <= 1e-5f * l1 * l2;
     bool full = zlo <= -radius && zhi >= radius && phimax >= 360.0f;
     if (full && similar && !GS(p)->reverse && alpha < 0) {
-        if (GS(p)->interface) return interface_skip(p);
+        if (GS(p)->interface && !medium_transition(p)) return PK_OK;
         sphere sp;
         sp.center = xform_point(&w, v3s(0.0f));
         sp.radius = radius * l0;
         if (!v3_finite(sp.center) || !(sp.radius > 0.0f) || !isfinite(sp.radius))
             return pfail(p, p->line, PK_ERR_PARSE, "sphere: its centre or radius in the world is not a usable number (not finite, or the radius too small)");
-        bool two;
-        vec3 ke = area_emission(p, 4.0 * (double)PK_PI * (double)sp.radius * (double)sp.radius, &two);
-        if ((st = shape_material(p, ke, two, -1, &sp.material))) return st;
+        bool two = false;
+        vec3 ke = v3s(0.0f);
+        if (!GS(p)->interface) ke = area_emission(p, 4.0 * (double)PK_PI * (double)sp.radius * (double)sp.radius, &two);
+        if ((st = shape_material(p, ke, two, -1, &sp.material)) || (st = shape_media(p, &sp.material))) return st;
         return scene_add_sphere(p->ctx, p->s, &sp);
     }
     /* partial, inside out, stretched or cut out: tessellated */
@@ -2166,6 +2232,10 @@ static pk_status d_camera(pp *p, const char *type)
         return pfail(p, p->line, PK_ERR_PARSE, "camera: the current transform is singular (no camera can be placed)");
     pk_status cs = set_coords(p, "camera", &inv);
     if (cs) return cs;
+    /* pbrt: the camera sits in the outside medium current here */
+    p->cam_mi = GS(p)->mi_out;
+    p->cam_mi_line = p->line;
+    snprintf(p->cam_mi_file, sizeof p->cam_mi_file, "%s", p->f->name);
     p->cam_set = true;
     p->cam_from_world = *sb_transform(&p->b);
     p->cam_line = p->line;
@@ -2310,11 +2380,14 @@ static pk_status d_integrator(pp *p, const char *type)
     if (!ok) {
         for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
         pwarn(p, p->line, "integrator \"%.40s\" is not supported; rendered with the path tracer", type);
+    } else if (strcmp(type, "simplevolpath") == 0) {
+        pwarn(p, p->line, "integrator \"simplevolpath\" is rendered with the volumetric path tracer (volpath)");
     } else if (strcmp(type, "path") != 0 && strcmp(type, "volpath") != 0) {
         pwarn(p, p->line, "integrator \"%.40s\" is rendered with the path tracer", type);
     }
     scene_render_settings *r = &p->s->render;
-    r->opt.integrator = PK_INTEGRATOR_PATH;
+    r->opt.integrator = strcmp(type, "volpath") == 0 || strcmp(type, "simplevolpath") == 0 ? PK_INTEGRATOR_VOLPATH
+                                                                                          : PK_INTEGRATOR_PATH;
     r->has_integrator = true;
     r->opt.max_depth = md > PK_MAX_DEPTH ? PK_MAX_DEPTH : (int)md;
     r->has_max_depth = true;
@@ -2325,6 +2398,348 @@ static pk_status d_integrator(pp *p, const char *type)
                                         "largestepprobability", "sigma", "bootstrapsamples", "chains", NULL};
     for (int i = 0; quiet[i]; i++) param(p, quiet[i]);
     warn_unused(p, "Integrator");
+    return PK_OK;
+}
+
+/* ---- participating media: MakeNamedMedium ----------------------------------------------------- */
+
+/* pbrt-v4's "preset" media: the measured reduced scattering and absorption
+ * coefficients (per mm; red, green, blue) of Jensen, Marschner, Levoy and
+ * Hanrahan, "A Practical Model for Subsurface Light Transport" (2001). */
+static const struct {
+    const char *name;
+    float ss[3], sa[3];
+} medium_presets[] = {
+    {"Apple", {2.29f, 2.39f, 1.97f}, {0.0030f, 0.0034f, 0.046f}},
+    {"Chicken1", {0.15f, 0.21f, 0.38f}, {0.015f, 0.077f, 0.19f}},
+    {"Chicken2", {0.19f, 0.25f, 0.32f}, {0.018f, 0.088f, 0.20f}},
+    {"Cream", {7.38f, 5.47f, 3.15f}, {0.0002f, 0.0028f, 0.0163f}},
+    {"Ketchup", {0.18f, 0.07f, 0.03f}, {0.061f, 0.97f, 1.45f}},
+    {"Marble", {2.19f, 2.62f, 3.00f}, {0.0021f, 0.0041f, 0.0071f}},
+    {"Potato", {0.68f, 0.70f, 0.55f}, {0.0024f, 0.0090f, 0.12f}},
+    {"Skimmilk", {0.70f, 1.22f, 1.90f}, {0.0014f, 0.0025f, 0.0142f}},
+    {"Skin1", {0.74f, 0.88f, 1.01f}, {0.032f, 0.17f, 0.48f}},
+    {"Skin2", {1.09f, 1.59f, 1.79f}, {0.013f, 0.070f, 0.145f}},
+    {"Spectralon", {11.6f, 20.4f, 14.9f}, {0.0f, 0.0f, 0.0f}},
+    {"Wholemilk", {2.55f, 3.21f, 3.77f}, {0.0011f, 0.0024f, 0.014f}},
+};
+
+/* A medium's spectrum parameter (sigma_a, sigma_s; Le with illuminant) as
+ * RGB, >= 0; *v keeps its default when the parameter is absent. */
+static pk_status medium_spectrum(pp *p, const char *what, const char *name, bool illuminant, vec3 *v)
+{
+    pparam *q;
+    pk_status st = param_typed(p, name, TB(PT_RGB) | TB(PT_SPECTRUM) | TB(PT_BLACKBODY) | TB(PT_FLOAT),
+                               "a spectrum (rgb, spectrum, blackbody or float)", &q);
+    if (st || !q) return st;
+    if (q->type == PT_RGB && q->nnum != 3)
+        return pfail(p, q->line, PK_ERR_PARSE, "%s: 'rgb %s' takes 3 values, not %zu", what, name, q->nnum);
+    if ((st = spectrum_rgb(p, q, illuminant, v))) return st;
+    if (q->type == PT_SPECTRUM) *v = v3_max(*v, v3s(0.0f)); /* a spectrum's RGB may dip below 0 */
+    if (!v3_finite(*v) || v->x < 0.0f || v->y < 0.0f || v->z < 0.0f)
+        return pfail(p, q->line, PK_ERR_PARSE, "%s: '%s %s' (%g, %g, %g) must be finite and >= 0", what, q->tname, name,
+                     (double)v->x, (double)v->y, (double)v->z);
+    return PK_OK;
+}
+
+/* A medium's float parameter, which must lie in [lo, hi]. */
+static pk_status medium_float(pp *p, const char *what, const char *name, float lo, float hi, float *v)
+{
+    pparam *q = NULL;
+    for (size_t i = 0; i < p->pl.n && !q; i++)
+        if (strcmp(p->pl.p[i].name, name) == 0) q = &p->pl.p[i];
+    pk_status st = get_float(p, name, v);
+    if (st) return st;
+    if (q && !(*v >= lo && *v <= hi))
+        return pfail(p, q->line, PK_ERR_PARSE, "%s: '%s %s' %g must lie in %g..%g", what, q->tname, name, (double)*v,
+                     (double)lo, (double)hi);
+    return PK_OK;
+}
+
+/* sigma_t and the albedo of absorption sa and scattering ss times scale. */
+static void medium_coeffs(medium *m, vec3 sa, vec3 ss, float scale)
+{
+    const vec3 t = v3_add(sa, ss);
+    m->sigma_t = v3_scale(t, scale);
+    m->albedo = v3(t.x > 0.0f ? fminf(ss.x / t.x, 1.0f) : 0.0f, t.y > 0.0f ? fminf(ss.y / t.y, 1.0f) : 0.0f,
+                   t.z > 0.0f ? fminf(ss.z / t.z, 1.0f) : 0.0f);
+}
+
+/* The grid's size: nx, ny, nz (pbrt's defaults 1), within the voxel limit. */
+static pk_status medium_dims(pp *p, const char *what, int n[3], size_t *count)
+{
+    static const char *const names[3] = {"nx", "ny", "nz"};
+    double total = 1.0;
+    for (int a = 0; a < 3; a++) {
+        int64_t v = 1;
+        pk_status st = get_int(p, names[a], 1, (int64_t)MEDIUM_MAX_VOXELS, &v);
+        if (st) return st;
+        n[a] = (int)v;
+        total *= (double)v;
+    }
+    if (total > (double)MEDIUM_MAX_VOXELS)
+        return pfail(p, p->line, PK_ERR_LIMIT, "%s: a grid of %dx%dx%d voxels is over the limit of %zu", what, n[0], n[1],
+                     n[2], (size_t)MEDIUM_MAX_VOXELS);
+    *count = (size_t)n[0] * (size_t)n[1] * (size_t)n[2];
+    return PK_OK;
+}
+
+/* The grid of array parameter q (ch values a voxel), count voxels of size
+ * n, each value finite and >= 0; allocated as the scene's. */
+static pk_status medium_grid_param(pp *p, const char *what, const pparam *q, int ch, const int n[3], size_t count,
+                                   medium_grid *g)
+{
+    const size_t want = count * (size_t)ch;
+    if (q->nnum != want)
+        return pfail(p, q->line, PK_ERR_PARSE,
+                     "%s: '%s %s' has %zu values; nx x ny x nz = %d x %d x %d needs %zu (%d a voxel)", what, q->tname,
+                     q->name, q->nnum, n[0], n[1], n[2], want, ch);
+    float *d = mem_calloc(&p->s->alloc, want, sizeof *d);
+    if (!d) return ctx_nomem(p->ctx);
+    for (size_t i = 0; i < want; i++) {
+        d[i] = (float)q->num[i];
+        if (!isfinite(d[i]) || d[i] < 0.0f) {
+            mem_free(&p->s->alloc, d);
+            return pfail(p, q->line, PK_ERR_PARSE, "%s: '%s %s' value %zu is %g (values must be finite and >= 0)", what,
+                         q->tname, q->name, i, q->num[i]);
+        }
+    }
+    g->nx = n[0], g->ny = n[1], g->nz = n[2], g->channels = ch, g->data = d;
+    return PK_OK;
+}
+
+/* The box p0..p1 of a grid medium as the map from the unit cube. */
+static pk_status medium_box(pp *p, const char *what, xform *box)
+{
+    vec3 p0 = v3s(0.0f), p1 = v3s(1.0f);
+    pk_status st;
+    if ((st = get_vec3(p, "p0", &p0)) || (st = get_vec3(p, "p1", &p1))) return st;
+    const vec3 lo = v3_min(p0, p1), ext = v3_sub(v3_max(p0, p1), lo);
+    if (!(ext.x > 0.0f && ext.y > 0.0f && ext.z > 0.0f) || !v3_finite(ext))
+        return pfail(p, p->line, PK_ERR_PARSE, "%s: the box p0 (%g, %g, %g) .. p1 (%g, %g, %g) has no volume", what,
+                     (double)p0.x, (double)p0.y, (double)p0.z, (double)p1.x, (double)p1.y, (double)p1.z);
+    const xform t = xform_translate(lo), s = xform_scale(ext);
+    *box = xform_mul(&t, &s);
+    return PK_OK;
+}
+
+/* pbrt-v4's "uniformgrid": a density grid (float, or rgb: 3 channels) times
+ * sigma_a + sigma_s, emission Le times Lescale (one value, or a grid). */
+static pk_status medium_uniformgrid(pp *p, const char *what, medium *m)
+{
+    int n[3];
+    size_t count;
+    pk_status st;
+    pparam *dq, *lq;
+    if ((st = medium_dims(p, what, n, &count))) return st;
+    if ((st = param_typed(p, "density", TB(PT_FLOAT) | TB(PT_RGB), "floats (or rgb triples)", &dq))) return st;
+    if (!dq) return pfail(p, p->line, PK_ERR_PARSE, "%s: uniformgrid needs 'float density' (nx x ny x nz values)", what);
+    if (param(p, "temperature"))
+        return pfail(p, param(p, "temperature")->line, PK_ERR_UNSUPPORTED,
+                     "%s: 'temperature' grids (blackbody emission) are not supported; give 'Le' and 'Lescale'", what);
+    if ((st = medium_grid_param(p, what, dq, dq->type == PT_RGB ? 3 : 1, n, count, &m->density))) return st;
+    vec3 le = v3s(0.0f);
+    if ((st = medium_spectrum(p, what, "Le", true, &le))) return st;
+    if ((st = param_typed(p, "Lescale", TB(PT_FLOAT), "floats", &lq))) return st;
+    float lsc = 1.0f;
+    if (lq && lq->nnum == 1) {
+        if ((st = medium_float(p, what, "Lescale", 0.0f, 3.4e38f, &lsc))) return st;
+    } else if (lq && v3_max_comp(le) > 0.0f) {
+        if ((st = medium_grid_param(p, what, lq, 1, n, count, &m->emission_grid))) return st;
+    }
+    m->le = v3_scale(le, lsc);
+    m->kind = MEDIUM_GRID;
+    return PK_OK;
+}
+
+/* pbrt-v4's "rgbgrid": grids of sigma_a and sigma_s (RGB; an absent one is
+ * 1) and of Le; Paprsek's model takes the extinction sigma_a + sigma_s as
+ * a 3-channel density under sigma_t = scale, the albedo sigma_s /
+ * (sigma_a + sigma_s) as an albedo grid and Le as the emission grid. */
+static pk_status medium_rgbgrid(pp *p, const char *what, medium *m, float scale)
+{
+    int n[3];
+    size_t count;
+    pk_status st;
+    pparam *qa, *qs, *ql;
+    if ((st = medium_dims(p, what, n, &count))) return st;
+    if ((st = param_typed(p, "sigma_a", TB(PT_RGB), "rgb values", &qa)) ||
+        (st = param_typed(p, "sigma_s", TB(PT_RGB), "rgb values", &qs)) ||
+        (st = param_typed(p, "Le", TB(PT_RGB), "rgb values", &ql)))
+        return st;
+    if (!qa && !qs)
+        return pfail(p, p->line, PK_ERR_PARSE, "%s: rgbgrid needs 'rgb sigma_a' and/or 'rgb sigma_s' (nx x ny x nz rgb values)",
+                     what);
+    if (ql && !qa) return pfail(p, ql->line, PK_ERR_PARSE, "%s: rgbgrid: 'rgb Le' needs 'rgb sigma_a' as well", what);
+    medium_grid ga = {0}, gs = {0};
+    if ((qa && (st = medium_grid_param(p, what, qa, 3, n, count, &ga))) ||
+        (qs && (st = medium_grid_param(p, what, qs, 3, n, count, &gs))) ||
+        (ql && (st = medium_grid_param(p, what, ql, 3, n, count, &m->emission_grid)))) {
+        mem_free(&p->s->alloc, ga.data);
+        mem_free(&p->s->alloc, gs.data);
+        return st;
+    }
+    float *dens = mem_calloc(&p->s->alloc, count * 3, sizeof *dens);
+    float *alb = mem_calloc(&p->s->alloc, count * 3, sizeof *alb);
+    if (!dens || !alb) {
+        mem_free(&p->s->alloc, dens);
+        mem_free(&p->s->alloc, alb);
+        mem_free(&p->s->alloc, ga.data);
+        mem_free(&p->s->alloc, gs.data);
+        return ctx_nomem(p->ctx);
+    }
+    for (size_t i = 0; i < count * 3; i++) {
+        const float a = ga.data ? ga.data[i] : 1.0f, s = gs.data ? gs.data[i] : 1.0f, t = a + s;
+        dens[i] = t;
+        alb[i] = t > 0.0f ? fminf(s / t, 1.0f) : 0.0f;
+    }
+    mem_free(&p->s->alloc, ga.data);
+    mem_free(&p->s->alloc, gs.data);
+    m->density = (medium_grid){n[0], n[1], n[2], 3, dens};
+    m->albedo_grid = (medium_grid){n[0], n[1], n[2], 3, alb};
+    m->sigma_t = v3s(scale);
+    m->albedo = v3s(1.0f);
+    float lsc = 1.0f;
+    if ((st = medium_float(p, what, "Lescale", 0.0f, 3.4e38f, &lsc))) return st;
+    m->le = m->emission_grid.data ? v3s(lsc) : v3s(0.0f);
+    m->kind = MEDIUM_GRID;
+    return PK_OK;
+}
+
+/* pbrt-v4's "nanovdb": the density grid (or 'gridname') of a NanoVDB file,
+ * placed in its box of the file's space (*box); sigma_a, sigma_s and scale
+ * as for the other media. Temperature grids are not read. */
+static pk_status medium_nanovdb(pp *p, const char *what, medium *m, xform *box)
+{
+    const char *fn = NULL, *gname = "density";
+    pk_status st;
+    if ((st = get_string(p, "filename", &fn)) || (st = get_string(p, "gridname", &gname))) return st;
+    if (!fn) return pfail(p, p->line, PK_ERR_PARSE, "%s: nanovdb needs 'string filename'", what);
+    static const char *const temp[] = {"temperaturename", "temperaturecutoff", "temperatureoffset", "temperaturescale",
+                                       "Lescale", NULL};
+    for (int i = 0; temp[i]; i++)
+        if (param(p, temp[i]))
+            pwarn(p, param(p, temp[i])->line,
+                  "%s: temperature grids are not read; the medium does not emit ('%s' ignored)", what, temp[i]);
+    char *path = path_join(A(p), p->f->dir, fn);
+    if (!path) return ctx_nomem(p->ctx);
+    aabb b;
+    pk_context tmp = io_scratch_context(p->ctx);
+    st = grid_read_nanovdb(&tmp, &p->s->alloc, path, gname, &m->density, &b);
+    mem_free(A(p), path);
+    if (st != PK_OK) {
+        if (st == PK_ERR_NOMEM) return ctx_nomem(p->ctx);
+        return pfail(p, p->line, st, "%s: %s", what, tmp.message);
+    }
+    const vec3 ext = v3_sub(b.hi, b.lo);
+    if (!(ext.x > 0.0f && ext.y > 0.0f && ext.z > 0.0f) || !v3_finite(ext) || !v3_finite(b.lo))
+        return pfail(p, p->line, PK_ERR_PARSE, "%s: the grid of \"%.80s\" spans no volume", what, fn);
+    const xform t = xform_translate(b.lo), s = xform_scale(ext);
+    *box = xform_mul(&t, &s);
+    m->kind = MEDIUM_GRID;
+    return PK_OK;
+}
+
+static pk_status d_medium(pp *p, const char *name)
+{
+    char what[PB_NAME_MAX + 32];
+    snprintf(what, sizeof what, "MakeNamedMedium \"%.80s\"", name);
+    if (scene_find_medium(p->s, name) >= 0)
+        return pfail(p, p->line, PK_ERR_PARSE, "%s: a medium of that name is defined already", what);
+    const char *type = NULL;
+    pk_status st = get_string(p, "type", &type);
+    if (st) return st;
+    if (!type) return pfail(p, p->line, PK_ERR_PARSE, "%s needs 'string type'", what);
+    const bool homogeneous = strcmp(type, "homogeneous") == 0, uniform = strcmp(type, "uniformgrid") == 0,
+               rgb = strcmp(type, "rgbgrid") == 0, vdb = strcmp(type, "nanovdb") == 0, cloud = strcmp(type, "cloud") == 0;
+    if (!homogeneous && !uniform && !rgb && !vdb && !cloud)
+        return pfail(p, p->line, PK_ERR_PARSE,
+                     "%s: unknown medium type \"%.40s\" (homogeneous, uniformgrid, rgbgrid, nanovdb and cloud are known)",
+                     what, type);
+    if (cloud)
+        return pfail(p, p->line, PK_ERR_UNSUPPORTED,
+                     "%s: the procedural \"cloud\" medium is not supported; bake it into a uniformgrid or a nanovdb file",
+                     what);
+    medium m;
+    medium_init(&m);
+    vec3 sa = v3s(1.0f), ss = v3s(1.0f);
+    float scale = 1.0f, g = 0.0f;
+    if ((st = medium_float(p, what, "scale", 0.0f, 3.4e38f, &scale)) ||
+        (st = medium_float(p, what, "g", -0.9999f, 0.9999f, &g)))
+        return st;
+    m.g = g;
+    const char *preset = NULL;
+    if (homogeneous && (st = get_string(p, "preset", &preset))) return st;
+    if (preset) {
+        size_t k = 0, np = sizeof medium_presets / sizeof medium_presets[0];
+        while (k < np && strcmp(medium_presets[k].name, preset) != 0) k++;
+        if (k == np)
+            return pfail(p, param(p, "preset")->line, PK_ERR_UNSUPPORTED,
+                         "%s: preset \"%.60s\" is not known (Paprsek knows the measured media of Jensen et al. 2001: "
+                         "Apple, Chicken1, Chicken2, Cream, Ketchup, Marble, Potato, Skimmilk, Skin1, Skin2, Spectralon, "
+                         "Wholemilk)",
+                         what, preset);
+        sa = v3(medium_presets[k].sa[0], medium_presets[k].sa[1], medium_presets[k].sa[2]);
+        ss = v3(medium_presets[k].ss[0], medium_presets[k].ss[1], medium_presets[k].ss[2]);
+    } else if (!rgb) {
+        if ((st = medium_spectrum(p, what, "sigma_a", false, &sa)) || (st = medium_spectrum(p, what, "sigma_s", false, &ss)))
+            return st;
+    }
+    medium_coeffs(&m, sa, ss, scale);
+    xform box = xform_identity();
+    if (homogeneous) {
+        vec3 le = v3s(0.0f);
+        float lsc = 1.0f;
+        if ((st = medium_spectrum(p, what, "Le", true, &le)) || (st = medium_float(p, what, "Lescale", 0.0f, 3.4e38f, &lsc)))
+            return st;
+        m.le = v3_scale(le, lsc);
+    } else if (uniform || rgb) {
+        st = medium_box(p, what, &box);
+        if (st == PK_OK) st = uniform ? medium_uniformgrid(p, what, &m) : medium_rgbgrid(p, what, &m, scale);
+    } else {
+        st = medium_nanovdb(p, what, &m, &box);
+    }
+    if (st == PK_OK && m.kind == MEDIUM_GRID) {
+        /* placed by the current transform (pbrt's medium space); the
+         * world's mirror is applied at the end (finish_media) */
+        m.grid_to_world = xform_mul(sb_transform(&p->b), &box);
+        if (!xform_finite(&m.grid_to_world))
+            st = pfail(p, p->line, PK_ERR_PARSE, "%s: the grid's placement is not finite", what);
+    }
+    if (st == PK_OK && !(m.name = mem_strdup(&p->s->alloc, name))) st = ctx_nomem(p->ctx);
+    if (st != PK_OK) {
+        medium_free(&p->s->alloc, &m);
+        return st;
+    }
+    uint32_t idx;
+    if ((st = scene_add_medium(p->ctx, p->s, &m, &idx))) return st;
+    char w2[64];
+    snprintf(w2, sizeof w2, "medium \"%.40s\"", type);
+    warn_unused(p, w2);
+    return PK_OK;
+}
+
+/* At the end of the file: the camera's medium, and every grid medium this
+ * file made placed in Paprsek's world (through the mirror of the top). */
+static pk_status finish_media(pp *p)
+{
+    if (p->cam_mi >= 0) {
+        int64_t m = scene_find_medium(p->s, p->mnames[p->cam_mi]);
+        if (m < 0) {
+            pfile f = p->top;
+            f.name = p->cam_mi_file;
+            p->f = &f;
+            pk_status st = pfail(p, p->cam_mi_line, PK_ERR_PARSE,
+                                 "Camera: the camera's medium \"%.80s\" (the outside medium of the MediumInterface "
+                                 "before Camera) is not defined by any MakeNamedMedium",
+                                 p->mnames[p->cam_mi]);
+            p->f = &p->top;
+            return st;
+        }
+        p->s->camera_medium = (int32_t)m;
+    }
+    for (size_t i = p->media_start; i < p->s->nmedia; i++)
+        p->s->media[i].grid_to_world = xform_mul(&p->mirror, &p->s->media[i].grid_to_world);
     return PK_OK;
 }
 
@@ -2657,10 +3072,14 @@ static pk_status directive(pp *p, const pbrt_token *tk)
     if (strcmp(dn, "MediumInterface") == 0) {
         if ((st = read_name(p, a, sizeof a))) return st;
         pbrt_token nx = pbrt_tok_peek(&p->f->tok);
-        if (nx.kind == PBRT_TOK_STRING && !memchr(nx.text, ' ', nx.len)) {
+        if (nx.kind == PBRT_TOK_STRING) { /* the outside; one name names both sides */
             if ((st = read_name(p, b2, sizeof b2))) return st;
+        } else {
+            memcpy(b2, a, sizeof b2);
         }
-        if (a[0] || b2[0]) pwarn(p, p->line, "MediumInterface: participating media are not rendered yet; ignored");
+        int32_t in, out;
+        if ((st = medium_name_index(p, a, &in)) || (st = medium_name_index(p, b2, &out))) return st;
+        GS(p)->mi_in = in, GS(p)->mi_out = out;
         return PK_OK;
     }
     if (strcmp(dn, "ColorSpace") == 0) {
@@ -2706,9 +3125,8 @@ static pk_status directive(pp *p, const pbrt_token *tk)
         return PK_OK;
     }
     if (strcmp(dn, "MakeNamedMedium") == 0) {
-        if ((st = read_name(p, a, sizeof a)) || (st = read_params(p))) return st;
-        pwarn(p, p->line, "MakeNamedMedium \"%.80s\": participating media are not rendered yet; ignored", a);
-        return PK_OK;
+        if ((st = read_name(p, a, sizeof a)) || (st = read_params(p)) || (st = apply_defaults(p, AT_MEDIUM))) return st;
+        return d_medium(p, a);
     }
     if (strcmp(dn, "Texture") == 0) {
         if ((st = read_name(p, a, sizeof a)) || (st = read_name(p, b2, sizeof b2)) || (st = read_name(p, c, sizeof c)) ||
@@ -2809,6 +3227,9 @@ pk_status scene_pbrt_parse(pk_context *ctx, pk_scene *s, const char *data, size_
     sb_init(&p->b, ctx, s);
     p->gs[0].material = 0;
     p->gs[0].area = -1;
+    p->gs[0].mi_in = p->gs[0].mi_out = -1;
+    p->cam_mi = -1;
+    p->media_start = s->nmedia;
     p->mirror = xform_identity();
     p->cam_from_world = xform_identity();
     p->film_w = 1280, p->film_h = 720;
@@ -2831,6 +3252,7 @@ pk_status scene_pbrt_parse(pk_context *ctx, pk_scene *s, const char *data, size_
     if (st == PK_OK && !p->in_world) st = finish_camera(p); /* no WorldBegin: nothing but the camera */
     if (st == PK_OK && p->b.in_object)
         st = pfail(p, p->obj_line, PK_ERR_PARSE, "ObjectBegin \"%.80s\" has no ObjectEnd", p->obj_name ? p->obj_name : "");
+    if (st == PK_OK) st = finish_media(p);
     if (st == PK_OK) {
         s->render.opt.width = p->film_w, s->render.opt.height = p->film_h;
         const float k = p->exposure_time * p->film_iso / 100.0f;
@@ -2856,6 +3278,8 @@ pk_status scene_pbrt_parse(pk_context *ctx, pk_scene *s, const char *data, size_
     for (size_t i = 0; i < p->ntex; i++) mem_free(&ctx->alloc, p->tex[i].name);
     for (size_t i = 0; i < p->ncoords; i++) mem_free(&ctx->alloc, p->coords[i].name);
     for (size_t i = 0; i < p->nobjs; i++) mem_free(&ctx->alloc, p->objs[i].name);
+    for (size_t i = 0; i < p->nmnames; i++) mem_free(&ctx->alloc, p->mnames[i]);
+    mem_free(&ctx->alloc, p->mnames);
     mem_free(&ctx->alloc, p->obj_name);
     mem_free(&ctx->alloc, p->tex);
     mem_free(&ctx->alloc, p->areas);

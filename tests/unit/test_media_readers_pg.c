@@ -1,0 +1,344 @@
+/*
+ * test_media_readers_pg.c - participating media in the pbrt-v4 reader
+ * (io/scene_pbrt.c: MakeNamedMedium, MediumInterface, the camera's medium,
+ * the interface material, the volpath integrator) and the glTF reader
+ * (io/gltf_material.c: KHR_materials_volume): the media each file makes,
+ * their grids and where they are placed, the media on the sides of each
+ * surface, and the messages of bad input, each with file:line; and the
+ * pbrt-v4 version of the fog scene against the JSON one.
+ */
+#include "test.h"
+#include "warnings.h"
+
+#include "io/readers.h"
+#include "scene/scene.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+static warning_log warnings;
+
+/* A camera that does not mirror (pbrt's camera x flipped), so that world
+ * positions are the file's. */
+#define PLAIN "Scale -1 1 1\nCamera \"perspective\"\nWorldBegin\n"
+#define TRI "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"
+
+static pk_scene *pbrt_at(pk_context **ctx, const char *text, bool commit)
+{
+    REQUIRE(pk_context_create(NULL, ctx) == PK_OK);
+    warning_log_clear(&warnings);
+    warning_log_attach(*ctx, &warnings);
+    pk_scene *s = NULL;
+    REQUIRE(scene_create(*ctx, "t.pbrt", &s) == PK_OK);
+    pk_status st = scene_pbrt_parse(*ctx, s, text, strlen(text), "t.pbrt", PK_TEST_DATA "/media");
+    if (st == PK_OK && commit) st = scene_commit(*ctx, s);
+    if (st != PK_OK) {
+        scene_destroy(s);
+        return NULL;
+    }
+    return s;
+}
+
+static pk_scene *pbrt(pk_context **ctx, const char *text)
+{
+    pk_scene *s = pbrt_at(ctx, text, true);
+    CHECKF(s != NULL, "load failed: %s", pk_context_error(*ctx));
+    return s;
+}
+
+static void done(pk_context *ctx, pk_scene *s)
+{
+    if (s) scene_destroy(s);
+    pk_context_destroy(ctx);
+}
+
+/* text must fail with a message that begins with prefix and holds part. */
+static void pbrt_error(const char *text, const char *prefix, const char *part)
+{
+    pk_context *ctx;
+    pk_scene *s = pbrt_at(&ctx, text, true);
+    CHECKF(s == NULL, "loaded, expected \"%s\"", part);
+    const char *m = pk_context_error(ctx);
+    CHECKF(strncmp(m, prefix, strlen(prefix)) == 0 && strstr(m, part), "message \"%s\": expected %s...%s", m, prefix,
+           part);
+    done(ctx, s);
+}
+
+static bool near3(vec3 a, vec3 b, float tol)
+{
+    return fabsf(a.x - b.x) <= tol && fabsf(a.y - b.y) <= tol && fabsf(a.z - b.z) <= tol;
+}
+
+static const medium *find(const pk_scene *s, const char *name)
+{
+    int64_t i = scene_find_medium(s, name);
+    CHECKF(i >= 0, "no medium \"%s\"", name);
+    return i >= 0 ? &s->media[i] : NULL;
+}
+
+static const material *tri_mat(const pk_scene *s, size_t k) { return &s->materials[s->tris[k].material]; }
+
+/* The geometric normal of triangle k (its winding). */
+static vec3 geo_normal(const pk_scene *s, size_t k)
+{
+    const triangle *t = &s->tris[k];
+    vec3 a = s->positions[t->v[0]], b = s->positions[t->v[1]], c = s->positions[t->v[2]];
+    return v3_norm(v3_cross(v3_sub(b, a), v3_sub(c, a)));
+}
+
+/* ---- pbrt-v4 ------------------------------------------------------------------------------- */
+
+static void test_pbrt_homogeneous(void)
+{
+    pk_context *ctx;
+    /* the camera sits in the outside medium of the MediumInterface before
+     * Camera; sigma_t = (sigma_a + sigma_s) scale, albedo = sigma_s / that */
+    pk_scene *s = pbrt(&ctx, "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n"
+                             "  \"rgb sigma_a\" [0.1 0.2 0.3] \"rgb sigma_s\" [0.3 0.2 0.1] \"float scale\" 2\n"
+                             "  \"float g\" 0.4 \"rgb Le\" [1 2 3] \"float Lescale\" 0.5\n"
+                             "MakeNamedMedium \"plain\" \"string type\" \"homogeneous\"\n"
+                             "MakeNamedMedium \"skin\" \"string type\" \"homogeneous\" \"string preset\" \"Skin1\"\n"
+                             "  \"float scale\" 10\n"
+                             "MediumInterface \"\" \"fog\"\n"
+                             "Scale -1 1 1\nCamera \"perspective\"\n"
+                             "Integrator \"volpath\" \"integer maxdepth\" 7\n"
+                             "WorldBegin\nLightSource \"point\"\n" TRI);
+    if (s) {
+        REQUIRE(s->nmedia == 3);
+        const medium *f = find(s, "fog");
+        CHECK(f->kind == MEDIUM_HOMOGENEOUS);
+        CHECK(near3(f->sigma_t, v3(0.8f, 0.8f, 0.8f), 1e-6f));
+        CHECK(near3(f->albedo, v3(0.75f, 0.5f, 0.25f), 1e-6f));
+        CHECK(near3(f->le, v3(0.5f, 1.0f, 1.5f), 1e-6f));
+        CHECK_NEAR(f->g, 0.4, 1e-7);
+        /* pbrt's defaults: sigma_a = sigma_s = 1, no emission, isotropic */
+        const medium *pl = find(s, "plain");
+        CHECK(near3(pl->sigma_t, v3s(2.0f), 0) && near3(pl->albedo, v3s(0.5f), 0) && near3(pl->le, v3s(0.0f), 0) &&
+              pl->g == 0.0f);
+        /* Jensen et al. 2001's skin 1: sigma_s' (0.74, 0.88, 1.01), sigma_a (0.032, 0.17, 0.48) per mm */
+        const medium *sk = find(s, "skin");
+        CHECK(near3(sk->sigma_t, v3(7.72f, 10.5f, 14.9f), 1e-4f));
+        CHECK(near3(sk->albedo, v3(0.74f / 0.772f, 0.88f / 1.05f, 1.01f / 1.49f), 1e-5f));
+        CHECK(s->camera_medium == scene_find_medium(s, "fog"));
+        CHECK(s->render.has_integrator && s->render.opt.integrator == PK_INTEGRATOR_VOLPATH);
+        CHECK(s->render.opt.max_depth == 7);
+        /* the MediumInterface stays current into the world, as in pbrt: the
+         * shape bounds vacuum inside and fog outside */
+        CHECK(tri_mat(s, 0)->medium_in == MEDIUM_NONE && tri_mat(s, 0)->medium_out == f - s->media);
+        CHECK(scene_has_media(s));
+    }
+    done(ctx, s);
+    /* a MediumInterface after Camera leaves the camera in vacuum */
+    s = pbrt(&ctx, "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n"
+                   "Camera \"perspective\"\nMediumInterface \"fog\" \"fog\"\nWorldBegin\n"
+                   "LightSource \"point\"\n" TRI);
+    if (s) CHECK(s->camera_medium == MEDIUM_NONE);
+    done(ctx, s);
+}
+
+static void test_pbrt_sides(void)
+{
+    pk_context *ctx;
+    /* a triangle in z = 0 wound counter-clockwise seen from +z: pbrt's normal
+     * (the outside) is +z */
+    pk_scene *s = pbrt(&ctx, PLAIN
+                       "MakeNamedMedium \"in\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [1 1 1]\n"
+                       "MakeNamedMedium \"out\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [2 2 2]\n"
+                       "LightSource \"point\"\n"
+                       "AttributeBegin\n"
+                       "  MediumInterface \"in\" \"out\"\n"
+                       "  Material \"interface\"\n" TRI
+                       "  Material \"dielectric\"\n" TRI
+                       "  ReverseOrientation\n" TRI
+                       "  MediumInterface \"in\"\n" TRI
+                       "  MediumInterface \"in\" \"\"\n"
+                       "  AreaLightSource \"diffuse\" \"rgb L\" [4 4 4]\n" TRI
+                       "AttributeEnd\n" TRI
+                       "AttributeBegin\n"
+                       "  MediumInterface \"in\" \"out\"\n"
+                       "  Material \"diffuse\"\n"
+                       "  Shape \"sphere\" \"float radius\" 2\n"
+                       "  MediumInterface \"out\"\n"
+                       "  Material \"interface\"\n"
+                       "  Shape \"sphere\" \"float radius\" 3\n" /* no transition: left out */
+                       "AttributeEnd\n");
+    if (s) {
+        const int32_t in = (int32_t)scene_find_medium(s, "in"), out = (int32_t)scene_find_medium(s, "out");
+        REQUIRE(s->ntris == 6 && s->nspheres == 1);
+        /* the interface: index-matched, inside and outside as named, and the
+         * winding's normal points outside */
+        CHECK(tri_mat(s, 0)->type == MAT_INTERFACE);
+        CHECK(tri_mat(s, 0)->medium_in == in && tri_mat(s, 0)->medium_out == out);
+        CHECK(near3(geo_normal(s, 0), v3(0, 0, 1), 1e-6f));
+        CHECK(tri_mat(s, 1)->type == MAT_DIELECTRIC && tri_mat(s, 1)->medium_in == in &&
+              tri_mat(s, 1)->medium_out == out);
+        /* ReverseOrientation turns pbrt's normal, and with it the sides */
+        CHECK(near3(geo_normal(s, 2), v3(0, 0, -1), 1e-6f) && tri_mat(s, 2)->medium_out == out);
+        /* one name: no transition, the ray keeps its medium */
+        CHECK(tri_mat(s, 3)->medium_in == MEDIUM_INHERIT && tri_mat(s, 3)->medium_out == MEDIUM_INHERIT);
+        /* "" is vacuum; an area light keeps its emission and gets the media */
+        CHECK(tri_mat(s, 4)->medium_in == in && tri_mat(s, 4)->medium_out == MEDIUM_NONE);
+        CHECK(near3(tri_mat(s, 4)->ke, v3s(4.0f), 0));
+        /* AttributeEnd restores the interface */
+        CHECK(tri_mat(s, 5)->medium_in == MEDIUM_INHERIT && tri_mat(s, 5)->medium_out == MEDIUM_INHERIT);
+        const material *sm = &s->materials[s->spheres[0].material];
+        CHECK(sm->type == MAT_DIFFUSE && sm->medium_in == in && sm->medium_out == out && s->spheres[0].radius == 2.0f);
+        /* the materials themselves are untouched: a copy carries the media */
+        CHECK(s->materials[0].medium_in == MEDIUM_INHERIT);
+    }
+    done(ctx, s);
+}
+
+/* The world point of grid point q of medium m. */
+static vec3 grid_point(const medium *m, vec3 q) { return xform_point(&m->grid_to_world, q); }
+
+static void test_pbrt_grids(void)
+{
+    pk_context *ctx;
+    /* uniformgrid: 2 x 2 x 1 voxels in the box (1,2,3)..(3,3,5), translated
+     * by (10, 0, 0) */
+    pk_scene *s = pbrt(&ctx, PLAIN
+                       "AttributeBegin\nTranslate 10 0 0\n"
+                       "MakeNamedMedium \"smoke\" \"string type\" \"uniformgrid\"\n"
+                       "  \"integer nx\" 2 \"integer ny\" 2 \"integer nz\" 1\n"
+                       "  \"float density\" [0 1 2 3] \"point3 p0\" [1 2 3] \"point3 p1\" [3 3 5]\n"
+                       "  \"rgb sigma_a\" [1 1 1] \"rgb sigma_s\" [3 3 3] \"float scale\" 0.5\n"
+                       "  \"rgb Le\" [1 0.5 0.25] \"float Lescale\" [1 2 3 4]\n"
+                       "AttributeEnd\n"
+                       "MakeNamedMedium \"tint\" \"string type\" \"rgbgrid\"\n"
+                       "  \"integer nx\" 2\n"
+                       "  \"rgb sigma_a\" [1 2 3  0 0 0] \"rgb sigma_s\" [1 2 1  4 0 2] \"float scale\" 3\n"
+                       "  \"rgb Le\" [1 1 1  2 2 2] \"float Lescale\" 5\n"
+                       "MakeNamedMedium \"half\" \"string type\" \"rgbgrid\" \"rgb sigma_s\" [0.5 0.5 0.5]\n"
+                       "LightSource \"point\"\n" TRI);
+    if (s) {
+        const medium *m = find(s, "smoke");
+        REQUIRE(m->kind == MEDIUM_GRID && m->density.data);
+        CHECK(m->density.nx == 2 && m->density.ny == 2 && m->density.nz == 1 && m->density.channels == 1);
+        for (int i = 0; i < 4; i++) CHECK(m->density.data[i] == (float)i);
+        CHECK(near3(m->sigma_t, v3s(2.0f), 0) && near3(m->albedo, v3s(0.75f), 0));
+        CHECK(near3(m->le, v3(1.0f, 0.5f, 0.25f), 0));
+        REQUIRE(m->emission_grid.data && m->emission_grid.channels == 1);
+        CHECK(m->emission_grid.data[3] == 4.0f);
+        /* the box: the unit cube's corners go to p0 and p1, moved by the CTM */
+        CHECK(near3(grid_point(m, v3s(0.0f)), v3(11, 2, 3), 1e-5f));
+        CHECK(near3(grid_point(m, v3s(1.0f)), v3(13, 3, 5), 1e-5f));
+        /* voxel (1, 0, 0)'s centre holds its value: cell-centred, as pbrt's SampledGrid */
+        medium_point mp = medium_at(m, v3(12.5f, 2.25f, 4.0f));
+        CHECK(near3(v3_add(mp.sigma_a, mp.sigma_s), v3s(2.0f), 1e-5f));
+        CHECK(near3(mp.sigma_s, v3s(1.5f), 1e-5f));
+        mp = medium_at(m, v3(11.5f, 2.75f, 4.0f)); /* voxel (0, 1, 0): density 2 */
+        CHECK(near3(v3_add(mp.sigma_a, mp.sigma_s), v3s(4.0f), 1e-5f));
+        CHECK(near3(mp.le, v3(3.0f, 1.5f, 0.75f), 1e-5f));
+        /* outside the box: nothing */
+        mp = medium_at(m, v3(1.0f, 2.5f, 4.0f));
+        CHECK(near3(mp.sigma_s, v3s(0.0f), 0));
+
+        /* rgbgrid: density = sigma_a + sigma_s per channel, under sigma_t = scale;
+         * the albedo grid sigma_s / (sigma_a + sigma_s) */
+        const medium *t = find(s, "tint");
+        REQUIRE(t->kind == MEDIUM_GRID && t->density.channels == 3 && t->albedo_grid.data);
+        const float dens[6] = {2, 4, 4, 4, 0, 2}, alb[6] = {0.5f, 0.5f, 0.25f, 1, 0, 1};
+        for (int i = 0; i < 6; i++) {
+            CHECK_NEAR(t->density.data[i], dens[i], 1e-6);
+            CHECK_NEAR(t->albedo_grid.data[i], alb[i], 1e-6);
+        }
+        CHECK(near3(t->sigma_t, v3s(3.0f), 0) && near3(t->albedo, v3s(1.0f), 0) && near3(t->le, v3s(5.0f), 0));
+        REQUIRE(t->emission_grid.data && t->emission_grid.channels == 3);
+        CHECK(t->emission_grid.data[3] == 2.0f);
+        /* at voxel 0's centre: sigma_a (1 2 3) x 3, sigma_s (1 2 1) x 3, Le 5 */
+        medium_point tp = medium_at(t, v3(0.25f, 0.5f, 0.5f));
+        CHECK(near3(tp.sigma_a, v3(3, 6, 9), 1e-5f) && near3(tp.sigma_s, v3(3, 6, 3), 1e-5f));
+        CHECK(near3(tp.le, v3s(5.0f), 1e-6f));
+        /* an absent grid is 1 everywhere */
+        const medium *h = find(s, "half");
+        REQUIRE(h->kind == MEDIUM_GRID && h->density.nx == 1);
+        CHECK(near3(v3(h->density.data[0], h->density.data[1], h->density.data[2]), v3s(1.5f), 1e-6f));
+        CHECK_NEAR(h->albedo_grid.data[0], 1.0 / 3.0, 1e-6);
+        CHECK(near3(h->le, v3s(0.0f), 0));
+    }
+    done(ctx, s);
+
+    /* pbrt's usual left-handed camera mirrors the world: the grid is mirrored
+     * with the shapes (a vertex at the box's corner lands on its corner) */
+    s = pbrt(&ctx, "LookAt 0 0 -5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\nLightSource \"point\"\n"
+                   "Translate 0.5 0.25 0\n"
+                   "MakeNamedMedium \"g\" \"string type\" \"uniformgrid\" \"float density\" [1]\n"
+                   "  \"point3 p0\" [1 2 3] \"point3 p1\" [2 4 4]\n"
+                   "Shape \"trianglemesh\" \"point3 P\" [1 2 3 2 4 4 2 2 3]\n");
+    if (s) {
+        const medium *m = find(s, "g");
+        const vec3 c0 = grid_point(m, v3s(0.0f)), c1 = grid_point(m, v3s(1.0f));
+        CHECK(near3(c0, s->positions[s->tris[0].v[0]], 1e-5f) || near3(c0, s->positions[s->tris[0].v[1]], 1e-5f) ||
+              near3(c0, s->positions[s->tris[0].v[2]], 1e-5f));
+        CHECK(near3(c1, s->positions[s->tris[0].v[0]], 1e-5f) || near3(c1, s->positions[s->tris[0].v[1]], 1e-5f) ||
+              near3(c1, s->positions[s->tris[0].v[2]], 1e-5f));
+        CHECK(fabsf(c0.x + 1.5f) < 1e-5f); /* mirrored across x = 0 */
+        CHECK(xform_det3(&m->grid_to_world) < 0.0); /* the mirror is part of the placement */
+    }
+    done(ctx, s);
+}
+
+static void test_pbrt_errors(void)
+{
+    const char *hom = "MakeNamedMedium \"m\" \"string type\" \"homogeneous\"\n";
+    pbrt_error("WorldBegin\n\nMakeNamedMedium \"m\" \"string type\" \"fog\"\n", "t.pbrt:3: ",
+               "unknown medium type \"fog\"");
+    pbrt_error("WorldBegin\nMakeNamedMedium \"m\"\n", "t.pbrt:2: ", "needs 'string type'");
+    char text[1024];
+    snprintf(text, sizeof text, "%s%s", hom, hom);
+    pbrt_error(text, "t.pbrt:2: ", "defined already");
+    pbrt_error(PLAIN "MediumInterface \"nope\" \"\"\n\n" TRI, "t.pbrt:6: Shape: ", "no medium \"nope\"");
+    pbrt_error("MediumInterface \"\" \"nope\"\nCamera \"perspective\"\nWorldBegin\n", "t.pbrt:2: ",
+               "the camera's medium \"nope\"");
+    pbrt_error("MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [1 -1 1]\n", "t.pbrt:1: ",
+               "must be finite and >= 0");
+    pbrt_error("MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"float g\" 1\n", "t.pbrt:1: ",
+               "'float g' 1 must lie in");
+    pbrt_error("MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"float scale\" -2\n", "t.pbrt:1: ",
+               "'float scale' -2 must lie in");
+    pbrt_error("MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"string preset\" \"Mud\"\n", "t.pbrt:1: ",
+               "preset \"Mud\" is not known");
+    pbrt_error("MakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"integer nx\" 2\n"
+               "  \"float density\" [1 2 3]\n",
+               "t.pbrt:2: ", "'float density' has 3 values; nx x ny x nz = 2 x 1 x 1 needs 2");
+    pbrt_error("MakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"float density\" [-1]\n", "t.pbrt:1: ",
+               "value 0 is -1 (values must be finite and >= 0)");
+    pbrt_error("MakeNamedMedium \"m\" \"string type\" \"uniformgrid\"\n", "t.pbrt:1: ", "needs 'float density'");
+    pbrt_error("MakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"integer nx\" 0 \"float density\" [1]\n",
+               "t.pbrt:1: ", "'integer nx' 0 is outside");
+    pbrt_error("MakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"integer nx\" 100000 \"integer ny\" 100000\n"
+               "  \"float density\" [1]\n",
+               "t.pbrt:1: ", "over the limit");
+    pbrt_error("MakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"float density\" [1]\n"
+               "  \"point3 p0\" [0 0 0] \"point3 p1\" [1 0 1]\n",
+               "t.pbrt:1: ", "has no volume");
+    pbrt_error("MakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"float density\" [1]\n"
+               "  \"float temperature\" [1000]\n",
+               "t.pbrt:2: ", "'temperature' grids");
+    pbrt_error("MakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"integer nx\" 2 \"float density\" [1 1]\n"
+               "  \"rgb Le\" [1 1 1] \"float Lescale\" [1 2 3]\n",
+               "t.pbrt:2: ", "'float Lescale' has 3 values");
+    pbrt_error("MakeNamedMedium \"m\" \"string type\" \"rgbgrid\"\n", "t.pbrt:1: ", "needs 'rgb sigma_a' and/or");
+    pbrt_error("MakeNamedMedium \"m\" \"string type\" \"rgbgrid\" \"rgb sigma_s\" [1 1 1]\n\"rgb Le\" [1 1 1]\n",
+               "t.pbrt:2: ", "'rgb Le' needs 'rgb sigma_a'");
+    pbrt_error("MakeNamedMedium \"m\" \"string type\" \"rgbgrid\" \"integer nz\" 2 \"rgb sigma_a\" [1 1 1]\n",
+               "t.pbrt:1: ", "'rgb sigma_a' has 3 values; nx x ny x nz = 1 x 1 x 2 needs 6 (3 a voxel)");
+    pbrt_error("MakeNamedMedium \"m\" \"string type\" \"cloud\"\n", "t.pbrt:1: ", "\"cloud\" medium is not supported");
+    /* a grid file that cannot be read: the grid reader's message, after where */
+    pbrt_error("\nMakeNamedMedium \"m\" \"string type\" \"nanovdb\" \"string filename\" \"no_such.nvdb\"\n",
+               "t.pbrt:2: MakeNamedMedium \"m\": ", "no_such.nvdb");
+    pbrt_error("MakeNamedMedium \"m\" \"string type\" \"nanovdb\"\n", "t.pbrt:1: ", "needs 'string filename'");
+}
+
+int main(void)
+{
+    test_pbrt_homogeneous();
+    test_pbrt_sides();
+    test_pbrt_grids();
+    test_pbrt_errors();
+    return test_done("test_media_readers_pg");
+}
