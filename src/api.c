@@ -327,6 +327,9 @@ static pk_status check_options(pk_context *ctx, pk_render_options *o)
     if (o->device == PK_DEVICE_CUDA && o->integrator == PK_INTEGRATOR_WHITTED)
         return ctx_error(ctx, PK_ERR_UNSUPPORTED, "device 'cuda': the GPU renders with the path tracer only, not "
                                                   "the Whitted integrator");
+    if (o->device == PK_DEVICE_CUDA && o->integrator == PK_INTEGRATOR_VOLPATH)
+        return ctx_error(ctx, PK_ERR_UNSUPPORTED, "device 'cuda': the GPU renders with the path tracer only, not "
+                                                  "the volumetric path tracer (participating media)");
     return PK_OK;
 }
 

@@ -59,7 +59,7 @@ typedef struct integrator_ops {
     void (*take_counters)(void *t, pk_stats *st);
 } integrator_ops;
 
-PK_HIDDEN extern const integrator_ops integrator_path, integrator_whitted;
+PK_HIDDEN extern const integrator_ops integrator_path, integrator_volpath, integrator_whitted;
 
 /* The first-surface AOV sample of surface sf (textured already) seen along
  * r at hit h: the material's diffuse reflectance Kd, the shading normal and

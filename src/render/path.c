@@ -1,8 +1,10 @@
 /*
- * path.c - the path tracer (see path.h and docs/integrators.md).
+ * path.c - the path tracer and the volumetric path tracer (see path.h,
+ * docs/integrators.md and docs/media.md).
  *
- * The sampling itself is in path_kernel.h, shared with the GPU; here rays
- * are traced by the frame's accelerator.
+ * The sampling itself is in path_kernel.h, shared with the GPU, and
+ * volpath_kernel.h; here rays are traced by the frame's accelerator. The
+ * two integrators share everything but the camera sample.
  */
 #include "path.h"
 
@@ -11,7 +13,7 @@
 /* the CPU's tracing: the frame's accelerator, counting into the thread's counters */
 #define PATH_TRACE(pt, t, r, h) ((pt)->f->a->ops->intersect((pt)->f->a, (r), (h), (t)->cp))
 #define PATH_OCCLUDED(pt, t, r) ((pt)->f->a->ops->occluded((pt)->f->a, (r), NULL, (t)->cp))
-#include "path_kernel.h"
+#include "volpath_kernel.h"
 
 pk_status path_init(pk_context *ctx, path_tracer *pt, const frame *f, const pk_render_options *opt)
 {
@@ -70,6 +72,12 @@ __attribute__((flatten)) static bool ig_sample(const void *self, void *ts, int p
     return path_camera_sample_aov(self, ts, px, py, (uint32_t)index, r, h, L, aov);
 }
 
+__attribute__((flatten)) static bool ig_vol_sample(const void *self, void *ts, int px, int py, uint64_t index,
+                                                   const ray *r, const hit *h, vec3 *L, aov_sample *aov)
+{
+    return vol_camera_sample_aov(self, ts, px, py, (uint32_t)index, r, h, L, aov);
+}
+
 static void ig_take_counters(void *ts, pk_stats *st)
 {
     path_thread *t = ts;
@@ -87,4 +95,9 @@ _Static_assert(sizeof(path_thread) % 64 == 0, "path_thread: whole cache lines");
 const integrator_ops integrator_path = {
     "path", sizeof(path_tracer), sizeof(path_thread), ig_init, ig_free, ig_thread_init, ig_thread_free,
     ig_set_camera, ig_camera_sample, ig_sample, ig_take_counters,
+};
+
+const integrator_ops integrator_volpath = {
+    "volpath", sizeof(path_tracer), sizeof(path_thread), ig_init, ig_free, ig_thread_init, ig_thread_free,
+    ig_set_camera, ig_camera_sample, ig_vol_sample, ig_take_counters,
 };

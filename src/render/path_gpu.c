@@ -123,6 +123,9 @@ pk_status path_gpu_create(pk_context *ctx, const path_tracer *pt, path_gpu **out
     if (s->nkept)
         return ctx_error(ctx, PK_ERR_UNSUPPORTED, "device 'cuda': the GPU renders flattened triangles only (the scene "
                          "keeps %zu instances)", s->nkept);
+    if (scene_has_media(s))
+        return ctx_error(ctx, PK_ERR_UNSUPPORTED, "device 'cuda': the GPU does not render participating media (the "
+                         "scene has %zu medi%s); render it on the CPU", s->nmedia, s->nmedia == 1 ? "um" : "a");
 #if defined(PK_HAVE_CUDA) && PK_HAVE_CUDA
     const cuda_image image = {pk_cuda_path_fatbin, PK_CUDA_VERSION_MAJOR, PK_CUDA_VERSION_MINOR};
 #else

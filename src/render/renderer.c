@@ -146,8 +146,16 @@ pk_status renderer_create(pk_context *ctx, const pk_scene *s, const pk_render_op
         mem_free(&ctx->alloc, r);
         return st;
     }
-    const bool path = opt->integrator != PK_INTEGRATOR_WHITTED;
-    r->ig = path ? &integrator_path : &integrator_whitted;
+    const bool media = scene_has_media(s);
+    if (opt->integrator == PK_INTEGRATOR_VOLPATH || (opt->integrator == PK_INTEGRATOR_DEFAULT && media))
+        r->ig = &integrator_volpath;
+    else if (opt->integrator == PK_INTEGRATOR_WHITTED)
+        r->ig = &integrator_whitted;
+    else
+        r->ig = &integrator_path;
+    if (media && r->ig != &integrator_volpath)
+        ctx_warn(ctx, "%s: the %s integrator ignores participating media (volpath renders them)", s->name,
+                 r->ig->name);
     r->self = mem_calloc(&ctx->alloc, 1, r->ig->self_size);
     r->its = calloc_lines(&ctx->alloc, (size_t)r->nt, r->ig->thread_size);
     r->ws = calloc_lines(&ctx->alloc, (size_t)r->nt, sizeof *r->ws);
@@ -169,6 +177,7 @@ pk_status renderer_create(pk_context *ctx, const pk_scene *s, const pk_render_op
         }
         r->nits++;
     }
+    const bool path = r->ig != &integrator_whitted;
     if (path && opt->accel == PK_ACCEL_CUDA && (st = path_gpu_create(ctx, r->self, &r->gpu)) != PK_OK) {
         renderer_destroy(r);
         return st;
@@ -208,7 +217,7 @@ const pk_camera *renderer_camera(const pk_renderer *r) { return &r->cam; }
 void renderer_stats(const pk_renderer *r, pk_stats *stats) { *stats = r->total; }
 void renderer_set_path_strategy(pk_renderer *r, int strategy)
 {
-    if (r->ig == &integrator_path) ((path_tracer *)r->self)->strategy = strategy;
+    if (r->ig == &integrator_path || r->ig == &integrator_volpath) ((path_tracer *)r->self)->strategy = strategy;
 }
 void renderer_set_pass(pk_renderer *r, uint32_t pass) { r->pass = pass; }
 

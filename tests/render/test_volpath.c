@@ -1,0 +1,434 @@
+/*
+ * test_volpath.c - the volumetric path tracer (render/volpath_kernel.h)
+ * against closed forms, each tolerance Z standard errors of the estimate,
+ * the standard error measured from the image itself (its pixels are
+ * independent estimates, each the mean of SPP samples):
+ *
+ *  - absorption through a slab, homogeneous (chromatic, spectral MIS) and
+ *    a grid whose density varies along the ray: exp(-optical depth), the
+ *    camera's rays by delta tracking;
+ *  - the same behind a glass boundary: (1-F)^2 e^-tau / (1 - F^2 e^-2tau);
+ *  - shadow rays through a grid slab (ratio tracking) onto a diffuse floor:
+ *    rho / pi E e^-tau;
+ *  - an emissive, absorbing slab: le (1 - e^-tau);
+ *  - single scattering in a slab lit by a distant light: its integral;
+ *  - white furnaces: non-absorbing media (any g) inside an index-matched
+ *    sphere and inside a glass sphere, and a constant grid, under a uniform
+ *    environment, read the environment's radiance;
+ *  - the same medium as homogeneous and as a constant grid: one image.
+ *
+ * Scenes are built in memory through the scene builders.
+ */
+#include "test.h"
+
+#include "paprsek.h"
+#include "scene/scene.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#define Z 5.0
+#define PI_D 3.14159265358979323846
+
+static pk_context *ctx;
+
+/* ---- building scenes ---------------------------------------------------------- */
+
+static uint32_t add_mat(pk_scene *s, const char *name)
+{
+    uint32_t i;
+    REQUIRE(scene_add_material(ctx, s, name, &i) == PK_OK);
+    return i;
+}
+
+static void add_tri(pk_scene *s, vec3 a, vec3 b, vec3 c, uint32_t mat)
+{
+    const uint32_t v0 = (uint32_t)s->npositions;
+    REQUIRE(scene_add_position(ctx, s, a) == PK_OK);
+    REQUIRE(scene_add_position(ctx, s, b) == PK_OK);
+    REQUIRE(scene_add_position(ctx, s, c) == PK_OK);
+    triangle t = {{v0, v0 + 1, v0 + 2}, {-1, -1, -1}, {-1, -1, -1}, mat};
+    REQUIRE(scene_add_triangle(ctx, s, &t) == PK_OK);
+}
+
+/* A quad a b c d, counter-clockwise seen from the side its normal points to. */
+static void add_quad(pk_scene *s, vec3 a, vec3 b, vec3 c, vec3 d, uint32_t mat)
+{
+    add_tri(s, a, b, c, mat);
+    add_tri(s, a, c, d, mat);
+}
+
+/* A box, its normals outward. */
+static void add_box(pk_scene *s, vec3 lo, vec3 hi, uint32_t mat)
+{
+    const vec3 p[8] = {v3(lo.x, lo.y, lo.z), v3(hi.x, lo.y, lo.z), v3(hi.x, hi.y, lo.z), v3(lo.x, hi.y, lo.z),
+                       v3(lo.x, lo.y, hi.z), v3(hi.x, lo.y, hi.z), v3(hi.x, hi.y, hi.z), v3(lo.x, hi.y, hi.z)};
+    add_quad(s, p[0], p[3], p[2], p[1], mat); /* -z */
+    add_quad(s, p[4], p[5], p[6], p[7], mat); /* +z */
+    add_quad(s, p[0], p[1], p[5], p[4], mat); /* -y */
+    add_quad(s, p[3], p[7], p[6], p[2], mat); /* +y */
+    add_quad(s, p[0], p[4], p[7], p[3], mat); /* -x */
+    add_quad(s, p[1], p[2], p[6], p[5], mat); /* +x */
+}
+
+static pk_scene *new_scene(const char *name)
+{
+    pk_scene *s = NULL;
+    REQUIRE(scene_create(ctx, name, &s) == PK_OK);
+    s->env.set = true; /* black surroundings unless a test says otherwise */
+    return s;
+}
+
+static uint32_t add_homogeneous(pk_scene *s, vec3 sigma_t, vec3 albedo, float g, vec3 le)
+{
+    medium m;
+    medium_init(&m);
+    m.sigma_t = sigma_t, m.albedo = albedo, m.g = g, m.le = le;
+    uint32_t i;
+    REQUIRE(scene_add_medium(ctx, s, &m, &i) == PK_OK);
+    return i;
+}
+
+/* A grid medium over box [lo, hi]: nz values along z (constant in x and y,
+ * 2 voxels there), times sigma_t. */
+static uint32_t add_zgrid(pk_scene *s, vec3 lo, vec3 hi, const float *vals, int nz, vec3 sigma_t, vec3 albedo,
+                          float g)
+{
+    medium m;
+    medium_init(&m);
+    m.kind = MEDIUM_GRID;
+    m.sigma_t = sigma_t, m.albedo = albedo, m.g = g;
+    m.density = (medium_grid){2, 2, nz, 1, NULL};
+    m.density.data = mem_realloc_array(&s->alloc, NULL, (size_t)4 * (size_t)nz, sizeof(float));
+    REQUIRE(m.density.data);
+    for (int k = 0; k < nz; k++)
+        for (int j = 0; j < 4; j++) m.density.data[k * 4 + j] = vals[k];
+    const xform sc = xform_scale(v3_sub(hi, lo)), tr = xform_translate(lo);
+    m.grid_to_world = xform_mul(&tr, &sc);
+    uint32_t i;
+    REQUIRE(scene_add_medium(ctx, s, &m, &i) == PK_OK);
+    return i;
+}
+
+/* An interface material bounding medium med (inside), vacuum outside. */
+static uint32_t interface_of(pk_scene *s, uint32_t med)
+{
+    const uint32_t m = add_mat(s, "boundary");
+    material_interface(&s->materials[m]);
+    s->materials[m].medium_in = (int32_t)med;
+    s->materials[m].medium_out = MEDIUM_NONE;
+    return m;
+}
+
+static uint32_t emitter(pk_scene *s, vec3 le)
+{
+    const uint32_t m = add_mat(s, "lamp");
+    material_diffuse(&s->materials[m], v3s(0.0f));
+    s->materials[m].ke = le;
+    return m;
+}
+
+/* An orthographic camera at height h above the origin looking down -z,
+ * the view w wide. */
+static void ortho_down(pk_scene *s, float h, float w)
+{
+    pk_camera_init(&s->camera);
+    s->camera.look_from[2] = h;
+    s->camera.look_at[2] = h - 1.0f;
+    s->camera.up[0] = 0.0f, s->camera.up[1] = 1.0f, s->camera.up[2] = 0.0f;
+    s->camera.projection = PK_PROJECTION_ORTHOGRAPHIC;
+    s->camera.ortho_width = w;
+    s->has_camera = true;
+}
+
+/* ---- rendering and comparing -------------------------------------------------- */
+
+typedef struct est {
+    double mean[3], se[3];
+} est;
+
+static est render(pk_scene *s, int size, int spp, int max_depth, int strategy_unused)
+{
+    (void)strategy_unused;
+    REQUIRE(scene_commit(ctx, s) == PK_OK);
+    pk_render_options o;
+    pk_render_options_init(&o);
+    o.width = o.height = size;
+    o.spp = spp;
+    o.threads = 2;
+    o.max_depth = max_depth;
+    pk_image *img = NULL;
+    const pk_status st = pk_render(ctx, s, &o, &img, NULL);
+    CHECKF(st == PK_OK, "%s: %s", s->name, pk_context_error(ctx));
+    REQUIRE(st == PK_OK);
+    const float *px = pk_image_pixels_const(img);
+    const size_t n = (size_t)size * (size_t)size;
+    est e;
+    for (int c = 0; c < 3; c++) {
+        double m = 0.0, m2 = 0.0;
+        for (size_t i = 0; i < n; i++) m += (double)px[3 * i + c], m2 += (double)px[3 * i + c] * (double)px[3 * i + c];
+        m /= (double)n, m2 /= (double)n;
+        e.mean[c] = m;
+        e.se[c] = sqrt(fmax(m2 - m * m, 0.0) / (double)(n - 1));
+    }
+    pk_image_destroy(img);
+    return e;
+}
+
+static void expect(const char *what, est e, const double want[3])
+{
+    for (int c = 0; c < 3; c++) {
+        const double tol = Z * e.se[c] + 1e-4 * want[c] + 1e-6;
+        CHECKF(fabs(e.mean[c] - want[c]) <= tol, "%s: channel %d: %.6f, want %.6f +- %.2g (se %.2g)", what, c, e.mean[c],
+               want[c], tol, e.se[c]);
+    }
+    printf("  %s: (%.5f %.5f %.5f), want (%.5f %.5f %.5f), se (%.1e %.1e %.1e)\n", what, e.mean[0], e.mean[1],
+           e.mean[2], want[0], want[1], want[2], e.se[0], e.se[1], e.se[2]);
+}
+
+/* ---- absorption --------------------------------------------------------------- */
+
+/* Camera above a slab z in [0, d] of boundary material bmat, an emitter of
+ * radiance 1 below it facing up. */
+static void slab_scene(pk_scene *s, float d, uint32_t bmat)
+{
+    add_box(s, v3(-10.0f, -10.0f, 0.0f), v3(10.0f, 10.0f, d), bmat);
+    const uint32_t lamp = emitter(s, v3s(1.0f));
+    add_quad(s, v3(-20.0f, -20.0f, -1.0f), v3(20.0f, -20.0f, -1.0f), v3(20.0f, 20.0f, -1.0f), v3(-20.0f, 20.0f, -1.0f),
+             lamp);
+    ortho_down(s, 3.0f, 2.0f);
+}
+
+static void check_absorption(void)
+{
+    const vec3 sig = v3(0.4f, 1.1f, 2.3f);
+    const float d = 0.8f;
+    { /* homogeneous, chromatic: each channel's exp(-sigma d) through spectral MIS */
+        pk_scene *s = new_scene("slab homogeneous");
+        const uint32_t med = add_homogeneous(s, sig, v3s(0.0f), 0.0f, v3s(0.0f));
+        slab_scene(s, d, interface_of(s, med));
+        const double want[3] = {exp(-sig.x * d), exp(-sig.y * d), exp(-sig.z * d)};
+        expect("absorbing slab, homogeneous chromatic", render(s, 32, 64, 16, 0), want);
+        scene_destroy(s);
+    }
+    { /* a grid whose density rises along the ray (and a half-scattering albedo: scattered light is lost below) */
+        pk_scene *s = new_scene("slab grid");
+        const float vals[6] = {0.1f, 0.5f, 2.0f, 0.3f, 1.5f, 0.8f};
+        const uint32_t med = add_zgrid(s, v3(-10.0f, -10.0f, 0.0f), v3(10.0f, 10.0f, d), vals, 6, sig, v3s(0.0f), 0.0f);
+        slab_scene(s, d, interface_of(s, med));
+        /* optical depth of the trilinear density along z: piecewise linear
+         * between cell centres, held in the outer half cells */
+        double integral = 0.0;
+        const int steps = 600000;
+        for (int i = 0; i < steps; i++) {
+            const double z = (i + 0.5) / steps; /* unit cube */
+            double x = z * 6 - 0.5;
+            if (x < 0) x = 0;
+            if (x > 5) x = 5;
+            const int k = (int)x < 5 ? (int)x : 4;
+            const double f = x - k;
+            integral += ((double)vals[k] + f * (double)(vals[k + 1] - vals[k])) / steps;
+        }
+        const double want[3] = {exp(-(double)(sig.x * d) * integral), exp(-(double)(sig.y * d) * integral), exp(-(double)(sig.z * d) * integral)};
+        expect("absorbing slab, grid along the ray (delta tracking)", render(s, 32, 64, 16, 0), want);
+        scene_destroy(s);
+    }
+    { /* glass boundary: (1-F)^2 e^-tau / (1 - F^2 e^-2tau), black above */
+        pk_scene *s = new_scene("slab glass");
+        const uint32_t med = add_homogeneous(s, sig, v3s(0.0f), 0.0f, v3s(0.0f));
+        const uint32_t glass = add_mat(s, "glass");
+        material_dielectric(&s->materials[glass], 1.5f, 0.0f, v3s(1.0f));
+        s->materials[glass].medium_in = (int32_t)med, s->materials[glass].medium_out = MEDIUM_NONE;
+        slab_scene(s, d, glass);
+        const double F = 0.04;
+        double want[3];
+        const float sg[3] = {sig.x, sig.y, sig.z};
+        for (int c = 0; c < 3; c++) {
+            const double T = exp(-sg[c] * d);
+            want[c] = (1 - F) * (1 - F) * T / (1 - F * F * T * T);
+        }
+        expect("absorbing slab behind glass", render(s, 32, 128, 64, 0), want);
+        scene_destroy(s);
+    }
+}
+
+/* Shadow rays through a grid slab z in [1, 2] onto a diffuse floor at z = 0
+ * lit straight down by a distant light; the camera sits under the slab. */
+static void check_shadow_transmittance(void)
+{
+    pk_scene *s = new_scene("shadow grid");
+    const float vals[5] = {0.2f, 1.7f, 0.4f, 0.9f, 0.05f};
+    const vec3 sig = v3(0.5f, 1.0f, 1.5f);
+    const uint32_t med = add_zgrid(s, v3(-50.0f, -50.0f, 1.0f), v3(50.0f, 50.0f, 2.0f), vals, 5, sig, v3s(0.0f), 0.0f);
+    add_box(s, v3(-50.0f, -50.0f, 1.0f), v3(50.0f, 50.0f, 2.0f), interface_of(s, med));
+    const uint32_t floor_m = add_mat(s, "floor");
+    material_diffuse(&s->materials[floor_m], v3s(0.5f));
+    add_quad(s, v3(-60.0f, -60.0f, 0.0f), v3(60.0f, -60.0f, 0.0f), v3(60.0f, 60.0f, 0.0f), v3(-60.0f, 60.0f, 0.0f),
+             floor_m);
+    point_light l;
+    memset(&l, 0, sizeof l);
+    l.position = v3(0.0f, 0.0f, 1.0f), l.intensity = v3s(2.0f), l.distant = true;
+    REQUIRE(scene_add_point_light(ctx, s, &l) == PK_OK);
+    ortho_down(s, 0.5f, 2.0f);
+    double integral = 0.0;
+    const int steps = 500000;
+    for (int i = 0; i < steps; i++) {
+        double x = (i + 0.5) / steps * 5 - 0.5;
+        if (x < 0) x = 0;
+        if (x > 4) x = 4;
+        const int k = (int)x < 4 ? (int)x : 3;
+        integral += ((double)vals[k] + (x - k) * (double)(vals[k + 1] - vals[k])) / steps;
+    }
+    const float sg[3] = {sig.x, sig.y, sig.z};
+    double want[3];
+    for (int c = 0; c < 3; c++) want[c] = 0.5 / PI_D * 2.0 * exp(-(double)sg[c] * integral);
+    expect("floor under a grid slab (ratio tracking)", render(s, 32, 64, 1, 0), want);
+    scene_destroy(s);
+}
+
+/* ---- emission ----------------------------------------------------------------- */
+
+static void check_emission(void)
+{
+    pk_scene *s = new_scene("glowing slab");
+    const float sa = 1.3f, d = 0.7f;
+    const vec3 le = v3(1.0f, 0.5f, 0.25f);
+    const uint32_t med = add_homogeneous(s, v3s(sa), v3s(0.0f), 0.0f, le);
+    add_box(s, v3(-10.0f, -10.0f, 0.0f), v3(10.0f, 10.0f, d), interface_of(s, med));
+    /* something to hit far below, black, so that the scene is not empty of lights' meaning */
+    ortho_down(s, 3.0f, 2.0f);
+    const double k = 1.0 - exp(-sa * d);
+    const double want[3] = {(double)le.x * k, (double)le.y * k, (double)le.z * k};
+    expect("emissive absorbing slab", render(s, 32, 64, 16, 0), want);
+    scene_destroy(s);
+}
+
+/* ---- single scattering ---------------------------------------------------------- */
+
+static double hg(double g, double c) /* c = dot(wo, wi) */
+{
+    const double den = 1 + g * g + 2 * g * c;
+    return (1 - g * g) / (4 * PI_D * den * sqrt(den));
+}
+
+static void check_single_scattering(void)
+{
+    const float st = 0.6f, d = 0.5f, g = 0.4f;
+    const vec3 albedo = v3(0.9f, 0.6f, 0.3f);
+    pk_scene *s = new_scene("single scattering");
+    const uint32_t med = add_homogeneous(s, v3s(st), albedo, g, v3s(0.0f));
+    add_box(s, v3(-100.0f, -100.0f, 0.0f), v3(100.0f, 100.0f, d), interface_of(s, med));
+    const vec3 wl = v3_norm(v3(0.6f, 0.0f, 0.8f)); /* toward the light */
+    point_light l;
+    memset(&l, 0, sizeof l);
+    l.position = wl, l.intensity = v3s(3.0f), l.distant = true;
+    REQUIRE(scene_add_point_light(ctx, s, &l) == PK_OK);
+    ortho_down(s, 3.0f, 2.0f);
+    const double c = wl.z, k = 1.0 + 1.0 / c;
+    const double ss = 3.0 * hg(g, c) * (1.0 - exp(-(double)(st * d) * k)) / ((double)st * k); /* times sigma_s / sigma_t = albedo */
+    const double want[3] = {(double)(albedo.x * st) * ss, (double)(albedo.y * st) * ss, (double)(albedo.z * st) * ss};
+    expect("single scattering in a slab", render(s, 32, 256, 1, 0), want);
+    scene_destroy(s);
+}
+
+/* ---- white furnaces --------------------------------------------------------------- */
+
+static pk_scene *furnace(const char *name, bool glass, bool grid, float g)
+{
+    pk_scene *s = new_scene(name);
+    s->env.radiance = v3s(1.0f);
+    uint32_t med;
+    if (grid) {
+        const float vals[3] = {1.5f, 1.5f, 1.5f};
+        med = add_zgrid(s, v3s(-1.0f), v3s(1.0f), vals, 3, v3s(1.0f), v3s(1.0f), g);
+    } else {
+        med = add_homogeneous(s, v3s(1.5f), v3s(1.0f), g, v3s(0.0f));
+    }
+    uint32_t mat;
+    if (glass) {
+        mat = add_mat(s, "glass");
+        material_dielectric(&s->materials[mat], 1.33f, 0.0f, v3s(1.0f));
+        s->materials[mat].medium_in = (int32_t)med, s->materials[mat].medium_out = MEDIUM_NONE;
+    } else {
+        mat = interface_of(s, med);
+    }
+    if (grid) {
+        add_box(s, v3s(-1.0f), v3s(1.0f), mat);
+    } else {
+        sphere sp = {v3s(0.0f), 1.0f, mat};
+        REQUIRE(scene_add_sphere(ctx, s, &sp) == PK_OK);
+    }
+    pk_camera_init(&s->camera);
+    s->camera.look_from[2] = 4.0f;
+    s->camera.fov_deg = 35.0f;
+    s->has_camera = true;
+    return s;
+}
+
+static void check_furnaces(void)
+{
+    const double one[3] = {1.0, 1.0, 1.0};
+    const float gs[3] = {0.0f, 0.7f, -0.4f};
+    for (int i = 0; i < 3; i++) {
+        char name[64];
+        snprintf(name, sizeof name, "furnace, index-matched sphere, g %.1f", (double)gs[i]);
+        pk_scene *s = furnace(name, false, false, gs[i]);
+        expect(name, render(s, 24, 32, 64, 0), one);
+        scene_destroy(s);
+    }
+    pk_scene *s = furnace("furnace, glass sphere, g 0.5", true, false, 0.5f);
+    expect("furnace, glass sphere, g 0.5", render(s, 24, 32, 64, 0), one);
+    scene_destroy(s);
+    s = furnace("furnace, constant grid box, g 0.3", false, true, 0.3f);
+    expect("furnace, constant grid box, g 0.3", render(s, 24, 32, 64, 0), one);
+    scene_destroy(s);
+}
+
+/* ---- homogeneous and constant grid: one image ------------------------------------- */
+
+static void check_grid_equals_homogeneous(void)
+{
+    est e[2];
+    for (int k = 0; k < 2; k++) {
+        pk_scene *s = new_scene(k ? "grid box" : "homogeneous box");
+        const vec3 sig = v3(1.5f, 1.0f, 0.5f), al = v3(0.8f, 0.7f, 0.9f);
+        uint32_t med;
+        if (k) {
+            const float vals[4] = {1.0f, 1.0f, 1.0f, 1.0f};
+            med = add_zgrid(s, v3s(-1.0f), v3s(1.0f), vals, 4, sig, al, 0.2f);
+        } else {
+            med = add_homogeneous(s, sig, al, 0.2f, v3s(0.0f));
+        }
+        add_box(s, v3s(-1.0f), v3s(1.0f), interface_of(s, med));
+        const uint32_t lamp = emitter(s, v3s(4.0f));
+        add_quad(s, v3(-0.5f, -0.5f, 1.5f), v3(-0.5f, 0.5f, 1.5f), v3(0.5f, 0.5f, 1.5f), v3(0.5f, -0.5f, 1.5f), lamp);
+        pk_camera_init(&s->camera);
+        s->camera.look_from[0] = 3.0f, s->camera.look_from[2] = 3.0f;
+        s->camera.look_at[2] = 0.0f;
+        s->camera.fov_deg = 40.0f;
+        s->has_camera = true;
+        e[k] = render(s, 32, 64, 64, 0);
+        scene_destroy(s);
+    }
+    for (int c = 0; c < 3; c++) {
+        const double se = sqrt(e[0].se[c] * e[0].se[c] + e[1].se[c] * e[1].se[c]);
+        CHECKF(fabs(e[0].mean[c] - e[1].mean[c]) <= Z * se + 1e-6, "homogeneous %.5f vs constant grid %.5f (se %.2g)",
+               e[0].mean[c], e[1].mean[c], se);
+    }
+    printf("  homogeneous vs constant grid: (%.5f %.5f %.5f) vs (%.5f %.5f %.5f)\n", e[0].mean[0], e[0].mean[1],
+           e[0].mean[2], e[1].mean[0], e[1].mean[1], e[1].mean[2]);
+}
+
+int main(void)
+{
+    REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
+    check_absorption();
+    check_shadow_transmittance();
+    check_emission();
+    check_single_scattering();
+    check_furnaces();
+    check_grid_equals_homogeneous();
+    pk_context_destroy(ctx);
+    return test_done("volpath");
+}
