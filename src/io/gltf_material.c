@@ -286,6 +286,50 @@ static vec3 texture_mean(const texture *t)
 
 /* ---- materials ------------------------------------------------------------------------ */
 
+/* KHR_materials_volume on a transmissive material (thickness > 0): the mesh
+ * bounds a volume. Its boundary refracts: a material that only transmits
+ * (transmission 1, not metallic, no clearcoat, no base colour or
+ * metallic-roughness texture) becomes a dielectric of its index and
+ * roughness whose transmittance is the base colour (applied as light
+ * enters); any other stays glTF's thin-walled material (warned). The inside
+ * absorbs: sigma_a = -ln(attenuationColor) / attenuationDistance, a medium
+ * bounded by vacuum outside (a glTF scene has no other media); an infinite
+ * distance absorbs nothing and makes no medium. */
+static pk_status make_volume(gltf *g, const char *path, material *m, float transmission, float thickness,
+                             float dist, const float col[3], bool textured)
+{
+    (void)thickness;
+    if (transmission >= 1.0f && m->metallic == 0.0f && m->clearcoat == 0.0f && !textured) {
+        const float r = m->roughness;
+        material_dielectric(m, m->ni, r * r, m->kd);
+    } else {
+        gltf_warn(g,
+                  "%s: KHR_materials_volume: the boundary of a volume that is not purely transmissive (transmission "
+                  "< 1, metallic, clearcoat or textured) does not refract: it is drawn as a thin sheet around the "
+                  "absorbing inside",
+                  path);
+    }
+    if (!isfinite(dist)) return PK_OK;
+    medium md;
+    medium_init(&md);
+    float sa[3];
+    for (int k = 0; k < 3; k++) sa[k] = -logf(fmaxf(col[k], 1e-30f)) / dist;
+    md.sigma_t = v3(sa[0], sa[1], sa[2]);
+    md.albedo = v3s(0.0f);
+    if (!v3_finite(md.sigma_t))
+        return gltf_fail(g, PK_ERR_PARSE, "%s: KHR_materials_volume: the absorption -ln(attenuationColor) / "
+                                          "attenuationDistance is not finite", path);
+    char name[96];
+    snprintf(name, sizeof name, "%.60s/volume", m->name ? m->name : path);
+    if (!(md.name = mem_strdup(&g->s->alloc, name))) return ctx_nomem(g->ctx);
+    uint32_t idx;
+    pk_status st = scene_add_medium(g->ctx, g->s, &md, &idx);
+    if (st) return st;
+    m->medium_in = (int32_t)idx;
+    m->medium_out = MEDIUM_NONE;
+    return PK_OK;
+}
+
 static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
 {
     const cJSON *o = cJSON_GetArrayItem(gltf_array(g, "materials"), (int)mi);
@@ -342,6 +386,7 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
 
     /* extensions */
     float strength = 1.0f, transmission = 0.0f, ior = 1.5f, coat = 0.0f, coat_rough = 0.0f;
+    float thickness = 0.0f, att_dist = INFINITY, att_col[3] = {1, 1, 1};
     const cJSON *ext = cJSON_GetObjectItemCaseSensitive(o, "extensions");
     for (const cJSON *e = ext ? ext->child : NULL; e; e = e->next) {
         snprintf(ep, sizeof ep, "%s/extensions/%.40s", path, e->string ? e->string : "");
@@ -363,7 +408,23 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
                 cJSON_GetObjectItemCaseSensitive(e, "clearcoatRoughnessTexture") ||
                 cJSON_GetObjectItemCaseSensitive(e, "clearcoatNormalTexture"))
                 gltf_warn(g, "%s: the clearcoat's textures are not supported (its factors are used alone)", ep);
-        } else if (strcmp(e->string, "KHR_materials_sheen") == 0 || strcmp(e->string, "KHR_materials_volume") == 0 ||
+        } else if (strcmp(e->string, "KHR_materials_volume") == 0) {
+            /* the mesh is a closed volume (thickness > 0) whose inside absorbs */
+            if ((st = gltf_num(g, e, ep, "thicknessFactor", 0.0, 1e30, 0.0, &thickness))) return st;
+            const cJSON *ad = cJSON_GetObjectItemCaseSensitive(e, "attenuationDistance");
+            if (ad) {
+                if ((st = gltf_num(g, e, ep, "attenuationDistance", 0.0, 3.4e38, 1.0, &att_dist))) return st;
+                if (!(att_dist > 0.0f))
+                    return gltf_fail(g, PK_ERR_PARSE, "%s/attenuationDistance: %g must be greater than 0", ep,
+                                     (double)att_dist);
+            }
+            if ((st = gltf_nums(g, e, ep, "attenuationColor", 3, att_col, &found))) return st;
+            for (int k = 0; k < 3; k++)
+                if (!(att_col[k] >= 0.0f && att_col[k] <= 1.0f))
+                    return gltf_fail(g, PK_ERR_PARSE, "%s/attenuationColor: %g is outside [0, 1]", ep, (double)att_col[k]);
+            if (cJSON_GetObjectItemCaseSensitive(e, "thicknessTexture"))
+                gltf_warn(g, "%s: thicknessTexture is not used (only whether the thickness is 0 matters here)", ep);
+        } else if (strcmp(e->string, "KHR_materials_sheen") == 0 ||
                    strcmp(e->string, "KHR_materials_specular") == 0 ||
                    strcmp(e->string, "KHR_materials_iridescence") == 0 ||
                    strcmp(e->string, "KHR_materials_anisotropy") == 0 ||
@@ -452,6 +513,9 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
         }
         if (amode == 2) m.d = base[3]; /* stochastic opacity */
     }
+    if (transmission > 0.0f && thickness > 0.0f && (st = make_volume(g, path, &m, transmission, thickness, att_dist,
+                                                                      att_col, t_base.present || t_mr.present)))
+        goto fail;
     g->s->materials[idx] = m;
     g->mat_uv[mi].bake = bake;
     if (bake) memcpy(g->mat_uv[mi].m, first->m, sizeof first->m);

@@ -334,11 +334,154 @@ static void test_pbrt_errors(void)
     pbrt_error("MakeNamedMedium \"m\" \"string type\" \"nanovdb\"\n", "t.pbrt:1: ", "needs 'string filename'");
 }
 
+
+/* ---- glTF ---------------------------------------------------------------------------------- */
+
+/* A tetrahedron (outward windings) as a data: URI: 4 positions then 12
+ * indices (uint16). */
+static char *tetra_uri(void)
+{
+    static const float pos[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    static const uint16_t idx[12] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+    uint8_t raw[72];
+    memcpy(raw, pos, 48);
+    memcpy(raw + 48, idx, 24);
+    static const char al[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    char *o = malloc(256), *q = o;
+    q += sprintf(q, "data:application/octet-stream;base64,");
+    for (size_t i = 0; i < sizeof raw; i += 3) {
+        uint32_t w = (uint32_t)raw[i] << 16 | (uint32_t)raw[i + 1] << 8 | raw[i + 2];
+        for (int k = 3; k >= 0; k--) *q++ = al[w >> (6 * k) & 63];
+    }
+    *q = '\0';
+    return o;
+}
+
+/* A glTF document of one tetrahedron per material (materials: the JSON
+ * array's body). */
+static char *gltf_doc(const char *materials, int nmat)
+{
+    char *uri = tetra_uri(), prims[1024] = "";
+    for (int i = 0; i < nmat; i++)
+        snprintf(prims + strlen(prims), sizeof prims - strlen(prims),
+                 "%s{\"attributes\":{\"POSITION\":0},\"indices\":1,\"material\":%d}", i ? "," : "", i);
+    size_t n = strlen(uri) + strlen(materials) + strlen(prims) + 1024;
+    char *j = malloc(n);
+    snprintf(j, n,
+             "{\"asset\":{\"version\":\"2.0\"},"
+             "\"extensionsUsed\":[\"KHR_materials_volume\",\"KHR_materials_transmission\",\"KHR_materials_ior\"],"
+             "\"buffers\":[{\"byteLength\":72,\"uri\":\"%s\"}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":48},"
+             "{\"buffer\":0,\"byteOffset\":48,\"byteLength\":24}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+             "\"min\":[0,0,0],\"max\":[1,1,1]},{\"bufferView\":1,\"componentType\":5123,\"count\":12,\"type\":\"SCALAR\"}],"
+             "\"materials\":[%s],\"meshes\":[{\"primitives\":[%s]}],"
+             "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0}",
+             uri, materials, prims);
+    free(uri);
+    return j;
+}
+
+static pk_scene *gltf_at(pk_context **ctx, const char *materials, int nmat)
+{
+    REQUIRE(pk_context_create(NULL, ctx) == PK_OK);
+    warning_log_clear(&warnings);
+    warning_log_attach(*ctx, &warnings);
+    pk_scene *s = NULL;
+    REQUIRE(scene_create(*ctx, "t.gltf", &s) == PK_OK);
+    char *j = gltf_doc(materials, nmat);
+    pk_status st = scene_gltf_parse(*ctx, s, j, strlen(j), "t.gltf", ".");
+    free(j);
+    if (st == PK_OK) st = scene_commit(*ctx, s);
+    if (st != PK_OK) {
+        scene_destroy(s);
+        return NULL;
+    }
+    return s;
+}
+
+#define VOL(t, d, c) "\"KHR_materials_volume\":{\"thicknessFactor\":" t d c "}"
+
+static void test_gltf_volume(void)
+{
+    pk_context *ctx;
+    pk_scene *s = gltf_at(
+        &ctx,
+        /* 0: clear glass with an absorbing inside */
+        "{\"name\":\"glass\",\"pbrMetallicRoughness\":{\"metallicFactor\":0,\"roughnessFactor\":0.2,"
+        "\"baseColorFactor\":[1,0.9,0.8,1]},\"extensions\":{\"KHR_materials_transmission\":{\"transmissionFactor\":1},"
+        "\"KHR_materials_ior\":{\"ior\":1.4}," VOL("1", ",\"attenuationDistance\":2", ",\"attenuationColor\":[0.5,0.25,1]") "}},"
+        /* 1: half transmissive: the thin sheet stays, the inside absorbs */
+        "{\"pbrMetallicRoughness\":{\"metallicFactor\":0},\"extensions\":{\"KHR_materials_transmission\":"
+        "{\"transmissionFactor\":0.5}," VOL("0.5", ",\"attenuationDistance\":1", ",\"attenuationColor\":[0.5,0.5,0.5]") "}},"
+        /* 2: thin-walled (thickness 0): no volume */
+        "{\"pbrMetallicRoughness\":{\"metallicFactor\":0},\"extensions\":{\"KHR_materials_transmission\":"
+        "{\"transmissionFactor\":1}," VOL("0", ",\"attenuationDistance\":1", "") "}},"
+        /* 3: a volume that absorbs nothing (infinite distance): refracts, no medium */
+        "{\"pbrMetallicRoughness\":{\"metallicFactor\":0},\"extensions\":{\"KHR_materials_transmission\":"
+        "{\"transmissionFactor\":1}," VOL("1", "", ",\"attenuationColor\":[0.5,0.5,0.5]") "}},"
+        /* 4: no transmission: the volume has nothing to say */
+        "{\"extensions\":{" VOL("1", ",\"attenuationDistance\":1", "") "}}",
+        5);
+    CHECKF(s != NULL, "load failed: %s", pk_context_error(ctx));
+    if (s) {
+        REQUIRE(s->ntris == 20 && s->nmedia == 2);
+        const material *m0 = tri_mat(s, 0);
+        CHECK(m0->type == MAT_DIELECTRIC && fabsf(m0->ni - 1.4f) < 1e-6f && fabsf(m0->alpha - 0.04f) < 1e-6f);
+        CHECK(near3(m0->tf, v3(1.0f, 0.9f, 0.8f), 1e-6f));
+        REQUIRE(m0->medium_in >= 0);
+        CHECK(m0->medium_out == MEDIUM_NONE);
+        const medium *v = &s->media[m0->medium_in];
+        /* sigma_a = -ln(colour) / distance: the colour is what is left after the distance */
+        CHECK(v->kind == MEDIUM_HOMOGENEOUS && near3(v->sigma_t, v3(logf(2.0f) / 2, logf(4.0f) / 2, 0.0f), 1e-6f));
+        CHECK(near3(v->albedo, v3s(0.0f), 0) && near3(v->le, v3s(0.0f), 0));
+        CHECK(fabsf(expf(-v->sigma_t.y * 2.0f) - 0.25f) < 1e-6f);
+        /* the medium is inside: every triangle's normal points away from the centroid */
+        const vec3 c = v3s(0.25f);
+        for (size_t k = 0; k < 4; k++) {
+            const triangle *t = &s->tris[k];
+            vec3 tc = v3_scale(v3_add(v3_add(s->positions[t->v[0]], s->positions[t->v[1]]), s->positions[t->v[2]]),
+                               1.0f / 3.0f);
+            CHECK(v3_dot(geo_normal(s, k), v3_sub(tc, c)) > 0.0f);
+        }
+        const material *m1 = tri_mat(s, 4);
+        CHECK(m1->type == MAT_METALLIC_ROUGHNESS && m1->transmission == 0.5f);
+        REQUIRE(m1->medium_in >= 0);
+        CHECK(near3(s->media[m1->medium_in].sigma_t, v3s(logf(2.0f)), 1e-6f) && m1->medium_out == MEDIUM_NONE);
+        CHECK(warning_log_has(&warnings, "does not refract"));
+        const material *m2 = tri_mat(s, 8);
+        CHECK(m2->type == MAT_METALLIC_ROUGHNESS && m2->medium_in == MEDIUM_INHERIT && m2->medium_out == MEDIUM_INHERIT);
+        const material *m3 = tri_mat(s, 12);
+        CHECK(m3->type == MAT_DIELECTRIC && fabsf(m3->ni - 1.5f) < 1e-6f && m3->medium_in == MEDIUM_INHERIT);
+        const material *m4 = tri_mat(s, 16);
+        CHECK(m4->type == MAT_METALLIC_ROUGHNESS && m4->medium_in == MEDIUM_INHERIT);
+    }
+    done(ctx, s);
+    /* hostile values */
+    static const struct {
+        const char *mat, *part;
+    } bad[] = {
+        {"{\"extensions\":{" VOL("1", ",\"attenuationDistance\":0", "") "}}",
+         "t.gltf: /materials/0/extensions/KHR_materials_volume/attenuationDistance: 0 must be greater than 0"},
+        {"{\"extensions\":{" VOL("1", ",\"attenuationDistance\":-1", "") "}}", "attenuationDistance"},
+        {"{\"extensions\":{" VOL("1", "", ",\"attenuationColor\":[1,1.5,1]") "}}",
+         "KHR_materials_volume/attenuationColor: 1.5 is outside [0, 1]"},
+        {"{\"extensions\":{" VOL("1", "", ",\"attenuationColor\":[1,1]") "}}", "attenuationColor"},
+        {"{\"extensions\":{" VOL("-1", "", "") "}}", "thicknessFactor"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        s = gltf_at(&ctx, bad[i].mat, 1);
+        CHECKF(s == NULL && strstr(pk_context_error(ctx), bad[i].part), "case %zu: \"%s\"", i, pk_context_error(ctx));
+        done(ctx, s);
+    }
+}
+
 int main(void)
 {
     test_pbrt_homogeneous();
     test_pbrt_sides();
     test_pbrt_grids();
     test_pbrt_errors();
+    test_gltf_volume();
     return test_done("test_media_readers_pg");
 }
