@@ -275,6 +275,311 @@ static void check_vol_trailing(pk_context *ctx)
     pk_context_set_warning_handler(ctx, NULL, NULL);
 }
 
+/* ---- NanoVDB ------------------------------------------------------------------ */
+
+/* A float grid written by hand in NanoVDB's layout (version 32.3.3): a root
+ * with an upper node at the origin's block and a constant tile over the
+ * block at x = -4096; the upper node's first lower node has a leaf at the
+ * origin and a tile of 7.5 at x = 8..15; every other table entry is a tile
+ * of another value. The root's box is x -2..9, y -1..3, z 0..2, so that
+ * the dense grid meets all of them and the background (y = -1). */
+enum {
+    NVT_GRID = 672, NVT_TREE = 64, NVT_ROOT = 64, NVT_TILE = 32,
+    NVT_UPPER = 8256 + 32768 * 8, NVT_LOWER = 1088 + 4096 * 8, NVT_LEAF = 96 + 512 * 4,
+    NVT_ROOT_AT = NVT_GRID + NVT_TREE, NVT_UPPER_AT = NVT_ROOT_AT + NVT_ROOT + 2 * NVT_TILE,
+    NVT_LOWER_AT = NVT_UPPER_AT + NVT_UPPER, NVT_LEAF_AT = NVT_LOWER_AT + NVT_LOWER,
+    NVT_SIZE = NVT_LEAF_AT + NVT_LEAF,
+};
+static const uint32_t nvt_version = 32u << 21 | 3u << 10 | 3u;
+static const int nvt_lo[3] = {-2, -1, 0}, nvt_hi[3] = {9, 3, 2};
+
+static void set_u32(unsigned char *p, uint32_t v)
+{
+    for (int i = 0; i < 4; i++) p[i] = (unsigned char)(v >> (8 * i));
+}
+static void set_u64(unsigned char *p, uint64_t v)
+{
+    for (int i = 0; i < 8; i++) p[i] = (unsigned char)(v >> (8 * i));
+}
+static void set_f32(unsigned char *p, float v)
+{
+    uint32_t u;
+    memcpy(&u, &v, 4);
+    set_u32(p, u);
+}
+static void set_f64(unsigned char *p, double v)
+{
+    uint64_t u;
+    memcpy(&u, &v, 8);
+    set_u64(p, u);
+}
+
+static float nvt_leaf_value(int x, int y, int z) { return 1.0f + (float)x + 10.0f * (float)y + 100.0f * (float)z; }
+
+/* What a lookup returns at index (x, y, z) inside the root's box. */
+static float nvt_expected(int x, int y, int z)
+{
+    if (y < 0) return 0.5f;            /* no root tile: the background */
+    if (x < 0) return 3.0f;            /* the constant root tile */
+    if (x < 8) return nvt_leaf_value(x, y, z);
+    return 7.5f;                       /* the lower node's tile */
+}
+
+static uint64_t nvt_key(int32_t x, int32_t y, int32_t z)
+{
+    return (uint64_t)((uint32_t)z >> 12) | (uint64_t)((uint32_t)y >> 12) << 21 | (uint64_t)((uint32_t)x >> 12) << 42;
+}
+
+/* The grid's bytes (NVT_SIZE of them), named name, of value type type. */
+static unsigned char *nvt_grid(const char *name, uint32_t type, const char *magic)
+{
+    unsigned char *g = calloc(1, NVT_SIZE);
+    REQUIRE(g);
+    memcpy(g, magic, 8);
+    set_u32(g + 16, nvt_version);
+    set_u32(g + 28, 1);              /* grid count */
+    set_u64(g + 32, NVT_SIZE);
+    snprintf((char *)g + 40, 256, "%s", name);
+    const double scale[3] = {0.5, 0.25, 2.0}, shift[3] = {1.0, 2.0, 3.0};
+    for (int a = 0; a < 3; a++) {
+        set_f32(g + 296 + 16 * a, (float)scale[a]);          /* matF diagonal */
+        set_f32(g + 296 + 36 + 16 * a, (float)(1.0 / scale[a]));
+        set_f32(g + 296 + 72 + 4 * a, (float)shift[a]);
+        set_f64(g + 296 + 88 + 32 * a, scale[a]);            /* matD diagonal */
+        set_f64(g + 296 + 160 + 32 * a, 1.0 / scale[a]);
+        set_f64(g + 296 + 232 + 8 * a, shift[a]);
+        set_f64(g + 608 + 8 * a, scale[a]);                  /* voxel size */
+    }
+    set_u32(g + 632, 2);             /* fog volume */
+    set_u32(g + 636, type);
+    unsigned char *tree = g + NVT_GRID;
+    set_u64(tree + 0, NVT_LEAF_AT - NVT_GRID);
+    set_u64(tree + 8, NVT_LOWER_AT - NVT_GRID);
+    set_u64(tree + 16, NVT_UPPER_AT - NVT_GRID);
+    set_u64(tree + 24, NVT_ROOT_AT - NVT_GRID);
+    set_u32(tree + 32, 1), set_u32(tree + 36, 1), set_u32(tree + 40, 1);
+    unsigned char *root = g + NVT_ROOT_AT;
+    for (int a = 0; a < 3; a++) set_u32(root + 4 * a, (uint32_t)nvt_lo[a]), set_u32(root + 12 + 4 * a, (uint32_t)nvt_hi[a]);
+    set_u32(root + 24, 2);           /* tiles */
+    set_f32(root + 28, 0.5f);        /* background */
+    unsigned char *tile = root + NVT_ROOT;
+    set_u64(tile, nvt_key(0, 0, 0));
+    set_u64(tile + 8, NVT_UPPER_AT - NVT_ROOT_AT);
+    set_u32(tile + 16, 1);
+    tile += NVT_TILE;
+    set_u64(tile, nvt_key(-4096, 0, 0));
+    set_u32(tile + 16, 1);
+    set_f32(tile + 20, 3.0f);
+    unsigned char *upper = g + NVT_UPPER_AT;
+    for (int n = 0; n < 32768; n++) set_f32(upper + 8256 + 8 * n, 0.0f);
+    upper[4128] = 1; /* child mask, slot 0 */
+    upper[32] = 1;   /* value mask */
+    set_u64(upper + 8256, NVT_LOWER_AT - NVT_UPPER_AT);
+    unsigned char *lower = g + NVT_LOWER_AT;
+    for (int n = 0; n < 4096; n++) set_f32(lower + 1088 + 8 * n, 0.25f);
+    lower[544] = 1;
+    set_u64(lower + 1088, NVT_LEAF_AT - NVT_LOWER_AT);
+    set_f32(lower + 1088 + 8 * (1 << 8), 7.5f); /* slot (1, 0, 0): x 8..15 */
+    unsigned char *leaf = g + NVT_LEAF_AT;
+    for (int x = 0; x < 8; x++)
+        for (int y = 0; y < 8; y++)
+            for (int z = 0; z < 8; z++) set_f32(leaf + 96 + 4 * (x << 6 | y << 3 | z), nvt_leaf_value(x, y, z));
+    memset(leaf + 16, 0xff, 64);
+    return g;
+}
+
+typedef struct nvt_entry {
+    const char *name;
+    uint32_t type;
+    const unsigned char *data;
+    size_t size;
+} nvt_entry;
+
+/* A one-segment file of the given grids. */
+static bytes nvt_file(const nvt_entry *e, int n, uint16_t codec)
+{
+    bytes b = {0};
+    put(&b, "NanoVDB0", 8);
+    put_u32(&b, nvt_version);
+    const unsigned char c[4] = {(unsigned char)n, 0, (unsigned char)codec, (unsigned char)(codec >> 8)};
+    put(&b, c, 4);
+    for (int i = 0; i < n; i++) {
+        unsigned char m[176] = {0};
+        set_u64(m, e[i].size);
+        set_u64(m + 8, e[i].size);
+        set_u32(m + 32, e[i].type);
+        set_u32(m + 136, (uint32_t)strlen(e[i].name) + 1);
+        set_u32(m + 172, nvt_version);
+        put(&b, m, sizeof m);
+        put(&b, e[i].name, strlen(e[i].name) + 1);
+    }
+    for (int i = 0; i < n; i++) put(&b, e[i].data, e[i].size);
+    return b;
+}
+
+static void nvt_check_dense(const medium_grid *g, const aabb *box)
+{
+    const int nx = nvt_hi[0] - nvt_lo[0] + 1, ny = nvt_hi[1] - nvt_lo[1] + 1, nz = nvt_hi[2] - nvt_lo[2] + 1;
+    CHECKF(g->nx == nx && g->ny == ny && g->nz == nz && g->channels == 1, "%d x %d x %d x %d", g->nx, g->ny, g->nz,
+           g->channels);
+    int bad = 0;
+    for (int z = 0; z < nz; z++)
+        for (int y = 0; y < ny; y++)
+            for (int x = 0; x < nx; x++) {
+                const float v = g->data[((size_t)z * ny + y) * nx + x];
+                const float want = nvt_expected(x + nvt_lo[0], y + nvt_lo[1], z + nvt_lo[2]);
+                if (v != want && bad++ < 5)
+                    fprintf(stderr, "index (%d, %d, %d): %g, want %g\n", x + nvt_lo[0], y + nvt_lo[1], z + nvt_lo[2],
+                            (double)v, (double)want);
+            }
+    CHECKF(bad == 0, "%d values differ", bad);
+    /* index box -2.5..9.5, -1.5..3.5, -0.5..2.5 through scale (0.5, 0.25, 2) and shift (1, 2, 3) */
+    CHECK(box->lo.x == -0.25f && box->lo.y == 1.625f && box->lo.z == 2.0f);
+    CHECK(box->hi.x == 5.75f && box->hi.y == 2.875f && box->hi.z == 8.0f);
+}
+
+static pk_status nvt_read(pk_context *ctx, const char *name, const bytes *b, const char *grid, medium_grid *g,
+                          aabb *box, const char **path)
+{
+    *path = tmp_path(name);
+    write_file(*path, b->p, b->n);
+    return grid_read_nanovdb(ctx, &counting, *path, grid, g, box);
+}
+
+static void check_nanovdb_good(pk_context *ctx)
+{
+    unsigned char *density = nvt_grid("density", 1, "NanoVDB0");
+    unsigned char *temp = nvt_grid("temperature", 2, "NanoVDB0");
+    const nvt_entry one = {"density", 1, density, NVT_SIZE};
+    bytes b = nvt_file(&one, 1, 0);
+    medium_grid g;
+    aabb box;
+    const char *path;
+    REQUIRE(nvt_read(ctx, "one.nvdb", &b, NULL, &g, &box, &path) == PK_OK);
+    nvt_check_dense(&g, &box);
+    mem_free(&counting, g.data);
+    REQUIRE(nvt_read(ctx, "one.nvdb", &b, "density", &g, &box, &path) == PK_OK);
+    nvt_check_dense(&g, &box);
+    mem_free(&counting, g.data);
+    free(b.p);
+
+    /* the first float grid, by default, after a grid of doubles */
+    const nvt_entry two[2] = {{"temperature", 2, temp, NVT_SIZE}, {"density", 1, density, NVT_SIZE}};
+    b = nvt_file(two, 2, 0);
+    REQUIRE(nvt_read(ctx, "two.nvdb", &b, "", &g, &box, &path) == PK_OK);
+    nvt_check_dense(&g, &box);
+    mem_free(&counting, g.data);
+    pk_status st = nvt_read(ctx, "two.nvdb", &b, "temperature", &g, &box, &path);
+    expect_refused(ctx, path, st, &g, PK_ERR_UNSUPPORTED, "grid 'temperature': values of type double");
+    st = nvt_read(ctx, "two.nvdb", &b, "smoke", &g, &box, &path);
+    expect_refused(ctx, path, st, &g, PK_ERR_PARSE, "no grid named 'smoke' (the file has 'temperature', 'density')");
+    free(b.p);
+    b = nvt_file(two, 1, 0);
+    st = nvt_read(ctx, "nofloat.nvdb", &b, NULL, &g, &box, &path);
+    expect_refused(ctx, path, st, &g, PK_ERR_UNSUPPORTED, "no float grid (the file has 'temperature')");
+    free(b.p);
+
+    /* a grid as it lies in memory, no segment header */
+    memcpy(density, "NanoVDB1", 8);
+    b = (bytes){density, NVT_SIZE, NVT_SIZE};
+    REQUIRE(nvt_read(ctx, "raw.nvdb", &b, "density", &g, &box, &path) == PK_OK);
+    nvt_check_dense(&g, &box);
+    mem_free(&counting, g.data);
+    memcpy(density, "NanoVDB0", 8);
+    REQUIRE(nvt_read(ctx, "raw0.nvdb", &b, NULL, &g, &box, &path) == PK_OK);
+    nvt_check_dense(&g, &box);
+    mem_free(&counting, g.data);
+    CHECK(live_blocks == 0);
+    free(density);
+    free(temp);
+}
+
+/* The one-grid file with the grid's bytes changed by edit, refused. */
+static void nvt_refused(pk_context *ctx, const char *name, void (*edit)(unsigned char *g), uint16_t codec,
+                        pk_status want, const char *part)
+{
+    unsigned char *grid = nvt_grid("density", 1, "NanoVDB0");
+    if (edit) edit(grid);
+    const nvt_entry one = {"density", 1, grid, NVT_SIZE};
+    bytes b = nvt_file(&one, 1, codec);
+    medium_grid g;
+    aabb box;
+    const char *path;
+    pk_status st = nvt_read(ctx, name, &b, NULL, &g, &box, &path);
+    expect_refused(ctx, path, st, &g, want, part);
+    free(b.p);
+    free(grid);
+}
+
+static void edit_leaf_nan(unsigned char *g) { set_f32(g + NVT_LEAF_AT + 96 + 4 * (3 << 6 | 2 << 3 | 1), NAN); }
+static void edit_bg_inf(unsigned char *g) { set_f32(g + NVT_ROOT_AT + 28, INFINITY); }
+static void edit_upper_out(unsigned char *g) { set_u64(g + NVT_ROOT_AT + NVT_ROOT + 8, NVT_SIZE); }
+static void edit_upper_back(unsigned char *g) { set_u64(g + NVT_ROOT_AT + NVT_ROOT + 8, (uint64_t)-(int64_t)NVT_ROOT_AT); }
+static void edit_upper_huge(unsigned char *g) { set_u64(g + NVT_ROOT_AT + NVT_ROOT + 8, (uint64_t)INT64_MIN); }
+static void edit_lower_out(unsigned char *g) { set_u64(g + NVT_UPPER_AT + 8256, (uint64_t)INT64_MAX); }
+static void edit_leaf_out(unsigned char *g) { set_u64(g + NVT_LOWER_AT + 1088, NVT_LEAF_AT - NVT_LOWER_AT + 1); }
+static void edit_root_out(unsigned char *g) { set_u64(g + NVT_GRID + 24, NVT_SIZE); }
+static void edit_tiles(unsigned char *g) { set_u32(g + NVT_ROOT_AT + 24, 1u << 30); }
+static void edit_same_key(unsigned char *g) { set_u64(g + NVT_ROOT_AT + NVT_ROOT + NVT_TILE, nvt_key(0, 0, 0)); }
+static void edit_huge(unsigned char *g) { set_u32(g + NVT_ROOT_AT + 12, 600), set_u32(g + NVT_ROOT_AT + 16, 600), set_u32(g + NVT_ROOT_AT + 20, 600); }
+static void edit_widest(unsigned char *g) { set_u32(g + NVT_ROOT_AT, (uint32_t)INT32_MIN), set_u32(g + NVT_ROOT_AT + 12, INT32_MAX); }
+static void edit_empty(unsigned char *g) { set_u32(g + NVT_ROOT_AT + 4, 5), set_u32(g + NVT_ROOT_AT + 16, 4); }
+static void edit_rotate(unsigned char *g) { set_f64(g + 296 + 88 + 8, 0.1); }
+static void edit_flip(unsigned char *g) { set_f64(g + 296 + 88, -0.5); }
+static void edit_version(unsigned char *g) { set_u32(g + 16, 31u << 21); }
+static void edit_type(unsigned char *g) { set_u32(g + 636, 15); }
+static void edit_magic(unsigned char *g) { g[3] = 'X'; }
+static void edit_size(unsigned char *g) { set_u64(g + 32, NVT_SIZE + 1); }
+
+static void check_nanovdb_hostile(pk_context *ctx)
+{
+    nvt_refused(ctx, "nan.nvdb", edit_leaf_nan, 0, PK_ERR_PARSE, "grid 'density': the value at voxel (3, 2, 1) is NaN");
+    nvt_refused(ctx, "inf.nvdb", edit_bg_inf, 0, PK_ERR_PARSE, "voxel (-2, -1, 0) is infinite");
+    nvt_refused(ctx, "upper.nvdb", edit_upper_out, 0, PK_ERR_PARSE, "an upper node lies outside the grid");
+    nvt_refused(ctx, "upperback.nvdb", edit_upper_back, 0, PK_ERR_PARSE, "an upper node lies outside the grid");
+    nvt_refused(ctx, "upperhuge.nvdb", edit_upper_huge, 0, PK_ERR_PARSE, "an upper node lies outside the grid");
+    nvt_refused(ctx, "lower.nvdb", edit_lower_out, 0, PK_ERR_PARSE, "a lower node lies outside the grid");
+    nvt_refused(ctx, "leaf.nvdb", edit_leaf_out, 0, PK_ERR_PARSE, "a leaf lies outside the grid");
+    nvt_refused(ctx, "root.nvdb", edit_root_out, 0, PK_ERR_PARSE, "the root lies outside the grid");
+    nvt_refused(ctx, "tiles.nvdb", edit_tiles, 0, PK_ERR_PARSE, "the root's table runs past the grid");
+    nvt_refused(ctx, "key.nvdb", edit_same_key, 0, PK_ERR_PARSE, "two root tiles have the same key");
+    nvt_refused(ctx, "huge.nvdb", edit_huge, 0, PK_ERR_LIMIT, "beyond the limit");
+    nvt_refused(ctx, "widest.nvdb", edit_widest, 0, PK_ERR_LIMIT, "beyond the limit");
+    nvt_refused(ctx, "empty.nvdb", edit_empty, 0, PK_ERR_PARSE, "no active voxels");
+    nvt_refused(ctx, "rotate.nvdb", edit_rotate, 0, PK_ERR_UNSUPPORTED, "rotates or shears");
+    nvt_refused(ctx, "flip.nvdb", edit_flip, 0, PK_ERR_UNSUPPORTED, "positive factors");
+    nvt_refused(ctx, "version.nvdb", edit_version, 0, PK_ERR_UNSUPPORTED, "NanoVDB version 31.0.0 (only version 32.x");
+    nvt_refused(ctx, "fp16.nvdb", edit_type, 0, PK_ERR_UNSUPPORTED, "values of type fp16");
+    nvt_refused(ctx, "gridmagic.nvdb", edit_magic, 0, PK_ERR_PARSE, "bad grid magic");
+    nvt_refused(ctx, "gridsize.nvdb", edit_size, 0, PK_ERR_PARSE, "size does not match");
+    nvt_refused(ctx, "zip.nvdb", NULL, 1, PK_ERR_UNSUPPORTED, "compressed with Zip (only uncompressed files are read)");
+    nvt_refused(ctx, "blosc.nvdb", NULL, 2, PK_ERR_UNSUPPORTED, "compressed with Blosc");
+
+    /* the file's own header: magic, version, truncated anywhere */
+    unsigned char *grid = nvt_grid("density", 1, "NanoVDB0");
+    const nvt_entry one = {"density", 1, grid, NVT_SIZE};
+    bytes b = nvt_file(&one, 1, 0);
+    medium_grid g;
+    aabb box;
+    const char *path;
+    b.p[2] = 'N';
+    pk_status st = nvt_read(ctx, "magic.nvdb", &b, NULL, &g, &box, &path);
+    expect_refused(ctx, path, st, &g, PK_ERR_PARSE, "not a NanoVDB file");
+    b.p[2] = 'n';
+    set_u32(b.p + 8, 33u << 21 | 1u << 10);
+    st = nvt_read(ctx, "version.nvdb", &b, NULL, &g, &box, &path);
+    expect_refused(ctx, path, st, &g, PK_ERR_UNSUPPORTED, "a segment of NanoVDB version 33.1.0");
+    set_u32(b.p + 8, nvt_version);
+    for (size_t cut = 0; cut < b.n; cut = cut < 300 ? cut + 1 : cut * 3 / 2) {
+        bytes t = b;
+        t.n = cut;
+        st = nvt_read(ctx, "cut.nvdb", &t, NULL, &g, &box, &path);
+        expect_refused(ctx, path, st, &g, PK_ERR_PARSE, cut < 8 ? "not a NanoVDB file" : "truncated");
+    }
+    free(b.p);
+    free(grid);
+}
+
 /* ---- the rest --------------------------------------------------------------- */
 
 static void cleanup(void)
@@ -294,6 +599,8 @@ int main(void)
     check_vol_good(ctx, 3);
     check_vol_hostile(ctx);
     check_vol_trailing(ctx);
+    check_nanovdb_good(ctx);
+    check_nanovdb_hostile(ctx);
     pk_context_destroy(ctx);
     cleanup();
     return test_done("test_grid_io");
