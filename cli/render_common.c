@@ -100,8 +100,10 @@ const cli_option *cli_render_options(size_t *n)
                                  "PAPRSEK_CPU_ISA, PAPRSEK_BVH_QUALITY, PAPRSEK_EMBREE_QUALITY, "
                                  "PAPRSEK_EMBREE_LIBRARY and PAPRSEK_CUDA_LIBRARY, which are passed on as these keys"});
         add((cli_option){.name = "integrator", .id = OPT_INTEGRATOR, .kind = CLI_STRING, .arg = "NAME",
-                         .help = "path (default: path tracing, global illumination, one-sided area lights) or "
-                                 "whitted (direct light, mirrors and glass; emitters two-sided)"});
+                         .help = "path (path tracing, global illumination, one-sided area lights; the default), "
+                                 "volpath (path tracing through participating media: fog, smoke, subsurface; the "
+                                 "default for scenes with media) or whitted (direct light, mirrors and glass; "
+                                 "emitters two-sided)"});
         add((cli_option){.name = "fresnel", .id = OPT_FRESNEL, .kind = CLI_STRING, .arg = "on|off",
                          .help = "on: exact dielectric Fresnel (default); off: fixed Ks/Tf weights"});
         add((cli_option){.name = "clamp-indirect", .id = OPT_CLAMP_INDIRECT, .kind = CLI_STRING, .arg = "X",
@@ -284,7 +286,7 @@ int cli_render_parse(int argc, char **argv, cli_render_opts *o, void (*help)(FIL
         case OPT_CONFIG: o->config = v; break;
         case OPT_INTEGRATOR:
             if (pk_integrator_parse(v, &o->integrator) != PK_OK)
-                return cli_usage_error("--integrator: unknown integrator '%s' (whitted, path)", v);
+                return cli_usage_error("--integrator: unknown integrator '%s' (path, volpath, whitted)", v);
             o->has_integrator = 1;
             break;
         case OPT_CLAMP_INDIRECT: {
@@ -445,6 +447,13 @@ static double peak_rss_mib(void)
 }
 
 /* The accelerator a render traced with: the GPU's own with --device cuda. */
+/* The integrator that renders: the default is volpath for scenes with media. */
+static const char *integrator_label(const pk_render_options *ro, const pk_scene_info *si)
+{
+    if (ro->integrator == PK_INTEGRATOR_DEFAULT) return si->has_media ? "volpath" : "path";
+    return pk_integrator_name(ro->integrator);
+}
+
 static const char *accel_label(const pk_render_options *ro)
 {
     return ro->device == PK_DEVICE_CUDA ? pk_accel_kind_name(PK_ACCEL_CUDA) : pk_accel_kind_name(ro->accel);
@@ -481,7 +490,7 @@ void cli_print_stats(pk_context *ctx, const char *scene, const pk_scene *sc, con
     printf("%-28s %.0f\n", "build [us]", st->build_us);
     printf("%-28s %.3f\n", "render [s]", st->render_s);
     if (path) {
-        printf("%-28s path tracing, seed %d\n", "integrator", ro->seed);
+        printf("%-28s %s, seed %d\n", "integrator", integrator_label(ro, &si), ro->seed);
         printf("%-28s %llu (camera %llu, bounce %llu, shadow %llu)\n", "rays", (unsigned long long)rays,
                (unsigned long long)st->rays_camera, (unsigned long long)st->rays_bounce,
                (unsigned long long)st->rays_shadow);
@@ -506,6 +515,9 @@ void cli_print_stats(pk_context *ctx, const char *scene, const pk_scene *sc, con
            FILM_BYTES_PER_PIXEL, peak_rss_mib());
     printf("%-28s %zu image%s, %.2f MiB (mipmaps included)\n", "textures", si.textures, si.textures == 1 ? "" : "s",
            (double)si.texture_bytes / (1024.0 * 1024.0));
+    if (si.media)
+        printf("%-28s %zu, %.2f MiB (grids and majorants)\n", "media", si.media,
+               (double)si.medium_bytes / (1024.0 * 1024.0));
     printf("%-28s %s\n", "config", config_of(ctx).s);
 }
 
@@ -553,16 +565,17 @@ int cli_write_stats_json(pk_context *ctx, const char *path, const char *scene, c
             "  \"intersection_tests\": %llu,\n  \"nodes_visited\": %llu,\n  \"mrays_per_s\": %.3f,\n"
             "  \"integrator\": \"%s\",\n  \"seed\": %d,\n  \"rays_bounce\": %llu,\n  \"samples_per_s\": %.1f,\n"
             "  \"film_bytes_per_pixel\": %d,\n  \"peak_rss_mib\": %.1f,\n  \"textures\": %zu,\n"
-            "  \"texture_bytes\": %zu,\n  \"device\": \"%s\",\n  \"config\": ",
+            "  \"texture_bytes\": %zu,\n  \"media\": %zu,\n  \"medium_bytes\": %zu,\n  \"device\": \"%s\",\n"
+            "  \"config\": ",
             accel_label(ro), ro->width, ro->height, ro->spp, ro->light_samples, pk_render_options_max_depth(ro),
             ro->fresnel ? "true" : "false", st->threads, st->build_us, st->render_s, (unsigned long long)rays,
             (unsigned long long)st->rays_camera, (unsigned long long)st->rays_shadow,
             (unsigned long long)st->rays_reflection, (unsigned long long)st->rays_refraction,
             (unsigned long long)st->intersection_tests, (unsigned long long)st->nodes_visited,
-            st->render_s > 0 ? (double)rays / st->render_s / 1e6 : 0.0, pk_integrator_name(ro->integrator), ro->seed,
+            st->render_s > 0 ? (double)rays / st->render_s / 1e6 : 0.0, integrator_label(ro, &si), ro->seed,
             (unsigned long long)st->rays_bounce,
             st->render_s > 0 ? (double)st->pixels * ro->spp / st->render_s : 0.0, FILM_BYTES_PER_PIXEL,
-            peak_rss_mib(), si.textures, si.texture_bytes,
+            peak_rss_mib(), si.textures, si.texture_bytes, si.media, si.medium_bytes,
             pk_device_name(ro->device == PK_DEVICE_CUDA || ro->accel == PK_ACCEL_CUDA ? PK_DEVICE_CUDA : PK_DEVICE_CPU));
     json_string(f, config_of(ctx).s);
     if (dn && dn->done)

@@ -384,6 +384,9 @@ typedef struct pk_scene_info {
     int has_camera;              /* 0: the camera is framed on the bounds */
     size_t textures;             /* images loaded for texture maps (one per file and decode mode) */
     size_t texture_bytes;        /* their texels, mipmaps included */
+    size_t media;                /* participating media (docs/media.md) */
+    size_t medium_bytes;         /* their voxel grids and majorant grids */
+    int has_media;               /* 1: the camera or a surface bounds a medium (the default integrator is volpath) */
 } pk_scene_info;
 
 PK_API void pk_scene_get_info(const pk_scene *scene, pk_scene_info *info);

@@ -193,6 +193,9 @@ void pk_scene_get_info(const pk_scene *s, pk_scene_info *info)
     info->has_camera = s->has_camera;
     info->textures = s->ntextures;
     info->texture_bytes = s->texture_bytes;
+    info->media = s->nmedia;
+    info->medium_bytes = s->medium_bytes;
+    info->has_media = scene_has_media(s);
 }
 
 pk_status pk_scene_get_emissive_triangle(const pk_scene *s, size_t k, size_t *tri)
