@@ -476,6 +476,144 @@ static void test_gltf_volume(void)
     }
 }
 
+
+/* ---- the fog scene: pbrt-v4 against JSON ---------------------------------------------------- */
+
+typedef pk_status (*parse_fn)(pk_context *, pk_scene *, const char *, size_t, const char *, const char *);
+
+static pk_status parse_pbrt(pk_context *c, pk_scene *s, const char *d, size_t n, const char *name, const char *dir)
+{
+    return scene_pbrt_parse(c, s, d, n, name, dir);
+}
+
+/* tests/data/media/file, parsed and committed. */
+static pk_scene *load_file(pk_context **ctx, const char *file, parse_fn parse)
+{
+    REQUIRE(pk_context_create(NULL, ctx) == PK_OK);
+    warning_log_clear(&warnings);
+    warning_log_attach(*ctx, &warnings);
+    char path[512];
+    snprintf(path, sizeof path, "%s/media/%s", PK_TEST_DATA, file);
+    char *data = NULL;
+    size_t size = 0;
+    REQUIRE(file_read_all(*ctx, path, &data, &size) == PK_OK);
+    pk_scene *s = NULL;
+    REQUIRE(scene_create(*ctx, file, &s) == PK_OK);
+    pk_status st = parse(*ctx, s, data, size, file, PK_TEST_DATA "/media");
+    free(data);
+    if (st == PK_OK) st = scene_commit(*ctx, s);
+    CHECKF(st == PK_OK, "%s: %s", file, pk_context_error(*ctx));
+    if (st != PK_OK) {
+        scene_destroy(s);
+        return NULL;
+    }
+    return s;
+}
+
+static bool close3(vec3 a, vec3 b) { return near3(a, b, 1e-5f * fmaxf(1.0f, fmaxf(v3_max_comp(a), v3_max_comp(b)))); }
+
+/* The name of medium index i of s, "(vacuum)" or "(inherit)". */
+static const char *med_name(const pk_scene *s, int32_t i)
+{
+    if (i == MEDIUM_NONE) return "(vacuum)";
+    if (i == MEDIUM_INHERIT) return "(inherit)";
+    return i >= 0 && (size_t)i < s->nmedia && s->media[i].name ? s->media[i].name : "(bad)";
+}
+
+/* Whether materials a (of scene sa) and b (of sb) describe the same surface. */
+static bool same_material(const pk_scene *sa, const material *a, const pk_scene *sb, const material *b)
+{
+    if (a->type != b->type || !close3(a->ke, b->ke) || strcmp(med_name(sa, a->medium_in), med_name(sb, b->medium_in)) ||
+        strcmp(med_name(sa, a->medium_out), med_name(sb, b->medium_out)))
+        return false;
+    if (a->type == MAT_DIFFUSE) return close3(a->kd, b->kd);
+    if (a->type == MAT_DIELECTRIC) return fabsf(a->ni - b->ni) < 1e-6f && a->alpha == b->alpha && close3(a->tf, b->tf);
+    return true;
+}
+
+/* The triangle of s with the corners of triangle t of r (in any rotation,
+ * the same winding), or -1. */
+static int64_t match_tri(const pk_scene *s, const pk_scene *r, const triangle *t)
+{
+    for (size_t k = 0; k < s->ntris; k++)
+        for (int rot = 0; rot < 3; rot++) {
+            bool same = true;
+            for (int c = 0; c < 3 && same; c++)
+                same = near3(s->positions[s->tris[k].v[(c + rot) % 3]], r->positions[t->v[c]], 1e-6f);
+            if (same) return (int64_t)k;
+        }
+    return -1;
+}
+
+static void test_fog_scene(void)
+{
+    pk_context *cj, *cp;
+    pk_scene *p = load_file(&cp, "fog.pbrt", parse_pbrt);
+    if (p) { /* the scene on its own: the media of fog.json's numbers */
+        REQUIRE(p->nmedia == 3);
+        const medium *fog = find(p, "fog"), *milk = find(p, "milk"), *smoke = find(p, "smoke");
+        CHECK(close3(fog->sigma_t, v3s(0.1f)) && close3(fog->albedo, v3s(0.8f)) && fabsf(fog->g - 0.3f) < 1e-7f);
+        CHECK(close3(milk->sigma_t, v3(12, 14, 16)) && close3(milk->albedo, v3(0.999f, 0.998f, 0.995f)));
+        CHECK(smoke->kind == MEDIUM_GRID && close3(smoke->sigma_t, v3s(2.0f)) && close3(smoke->albedo, v3s(0.9f)));
+        CHECK(p->camera_medium == fog - p->media);
+        CHECK(p->ntris == 2 * (3 + 1 + 1 + 1 + 6) && p->nspheres == 1);
+        const material *sm = &p->materials[p->spheres[0].material];
+        CHECK(sm->type == MAT_DIELECTRIC && sm->medium_in == milk - p->media && sm->medium_out == fog - p->media);
+    }
+    char path[512];
+    snprintf(path, sizeof path, "%s/media/fog.json", PK_TEST_DATA);
+    pk_scene *j = NULL;
+    cj = NULL;
+    if (access(path, R_OK) == 0) j = load_file(&cj, "fog.json", scene_json_parse);
+    else fprintf(stderr, "note: %s is not there: fog.pbrt is not compared with it\n", path);
+    if (j && p) {
+        /* the same media */
+        REQUIRE(j->nmedia == p->nmedia);
+        for (size_t i = 0; i < j->nmedia; i++) {
+            const medium *a = &j->media[i], *b = find(p, a->name);
+            if (!b) continue;
+            CHECKF(a->kind == b->kind && close3(a->sigma_t, b->sigma_t) && close3(a->albedo, b->albedo) &&
+                       close3(a->le, b->le) && fabsf(a->g - b->g) < 1e-6f,
+                   "medium %s differs", a->name);
+            if (a->kind != MEDIUM_GRID || b->kind != MEDIUM_GRID) continue;
+            const medium_grid *ga = &a->density, *gb = &b->density;
+            REQUIRE(ga->nx == gb->nx && ga->ny == gb->ny && ga->nz == gb->nz && ga->channels == gb->channels);
+            CHECK(memcmp(ga->data, gb->data, (size_t)ga->nx * ga->ny * ga->nz * ga->channels * sizeof(float)) == 0);
+            CHECK(!a->albedo_grid.data && !b->albedo_grid.data && !a->emission_grid.data && !b->emission_grid.data);
+            for (int c = 0; c < 8; c++) {
+                const vec3 q = v3((float)(c & 1), (float)(c >> 1 & 1), (float)(c >> 2 & 1));
+                CHECKF(close3(grid_point(a, q), grid_point(b, q)), "medium %s: grid corner %d placed elsewhere", a->name, c);
+            }
+        }
+        CHECK(j->camera_medium >= 0 && strcmp(med_name(j, j->camera_medium), med_name(p, p->camera_medium)) == 0);
+        /* the same surfaces, facing the same way, with the same materials and media */
+        REQUIRE(j->ntris == p->ntris && j->nspheres == p->nspheres);
+        for (size_t k = 0; k < j->ntris; k++) {
+            int64_t m = match_tri(p, j, &j->tris[k]);
+            CHECKF(m >= 0, "triangle %zu of fog.json is not in fog.pbrt (or faces the other way)", k);
+            if (m < 0) continue;
+            CHECKF(same_material(j, tri_mat(j, k), p, tri_mat(p, (size_t)m)), "triangle %zu: materials differ", k);
+        }
+        for (size_t k = 0; k < j->nspheres; k++) {
+            const sphere *a = &j->spheres[k], *b = &p->spheres[k];
+            CHECK(close3(a->center, b->center) && fabsf(a->radius - b->radius) < 1e-6f);
+            CHECK(same_material(j, &j->materials[a->material], p, &p->materials[b->material]));
+        }
+        /* the same camera and settings */
+        for (int c = 0; c < 3; c++) CHECK(fabsf(j->camera.look_from[c] - p->camera.look_from[c]) < 1e-5f);
+        vec3 dj = v3_norm(v3_sub(v3(j->camera.look_at[0], j->camera.look_at[1], j->camera.look_at[2]),
+                                 v3(j->camera.look_from[0], j->camera.look_from[1], j->camera.look_from[2])));
+        vec3 dp = v3_norm(v3_sub(v3(p->camera.look_at[0], p->camera.look_at[1], p->camera.look_at[2]),
+                                 v3(p->camera.look_from[0], p->camera.look_from[1], p->camera.look_from[2])));
+        CHECK(near3(dj, dp, 1e-6f) && fabsf(j->camera.fov_deg - p->camera.fov_deg) < 1e-4f);
+        CHECK(j->render.opt.integrator == PK_INTEGRATOR_VOLPATH && p->render.opt.integrator == PK_INTEGRATOR_VOLPATH);
+        CHECK(j->render.opt.max_depth == p->render.opt.max_depth && j->render.opt.spp == p->render.opt.spp);
+        CHECK(j->render.opt.width == p->render.opt.width && j->render.opt.height == p->render.opt.height);
+    }
+    if (cj) done(cj, j);
+    done(cp, p);
+}
+
 int main(void)
 {
     test_pbrt_homogeneous();
@@ -483,5 +621,6 @@ int main(void)
     test_pbrt_grids();
     test_pbrt_errors();
     test_gltf_volume();
+    test_fog_scene();
     return test_done("test_media_readers_pg");
 }
