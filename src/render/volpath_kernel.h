@@ -73,10 +73,13 @@ static inline PK_HD int32_t vol_cross(const material *m, bool front, int32_t cur
 /* Delta tracking along ray r (any length of d) in medium m from r->tmin to
  * tmax: adds the medium's emission to the path at every tentative
  * collision, and returns VOL_ABSORB (the path ends), VOL_SCATTER (a real
- * scattering at *t_out, beta and r_u updated, *albedo_out the albedo
- * there) or VOL_PASS (no collision before tmax). */
+ * scattering at *t_out, beta and r_u updated) or VOL_PASS (no collision
+ * before tmax). The first real collision of a path whose AOVs are open
+ * (aov non-NULL) gives them the medium's albedo there, times the
+ * MIS-weighted throughput that reached it, and closes them (no normal; the
+ * depth of a camera ray's collision). */
 static inline PK_HD int vol_track(const path_tracer *pt, vol_state *vs, const medium *m, const ray *r, float tmax,
-                                  float *t_out, vec3 *albedo_out)
+                                  float *t_out, path_aov *aov)
 {
     path_state *ps = &vs->ps;
     const float dlen = v3_len(r->d);
@@ -97,15 +100,20 @@ static inline PK_HD int vol_track(const path_tracer *pt, vol_state *vs, const me
                 path_add(pt, ps, v3_scale(v3_mul(ps->beta, v3_mul(mp.sigma_a, mp.le)), vol_mis(vs) / sig),
                          ps->depth >= 1);
             const float pa = vol_comp(mp.sigma_a, h) / sig, pscat = vol_comp(mp.sigma_s, h) / sig;
+            if (ue < pa + pscat && aov && aov->open) {
+                const vec3 st = v3_add(mp.sigma_a, mp.sigma_s);
+                const vec3 al = v3(st.x > 0.0f ? mp.sigma_s.x / st.x : 0.0f, st.y > 0.0f ? mp.sigma_s.y / st.y : 0.0f,
+                                   st.z > 0.0f ? mp.sigma_s.z / st.z : 0.0f);
+                if (ps->depth == 0) aov->out->depth = t * dlen;
+                aov->out->albedo = v3_scale(v3_mul(ps->beta, al), vol_mis(vs));
+                aov->open = false;
+            }
             if (ue < pa) return VOL_ABSORB;
             if (ue < pa + pscat) {
                 const vec3 w = v3_scale(mp.sigma_s, 1.0f / vol_comp(mp.sigma_s, h));
                 ps->beta = v3_mul(ps->beta, w);
                 vs->r_u = v3_mul(vs->r_u, w);
                 *t_out = t;
-                const vec3 st = v3_add(mp.sigma_a, mp.sigma_s);
-                *albedo_out = v3(st.x > 0.0f ? mp.sigma_s.x / st.x : 0.0f, st.y > 0.0f ? mp.sigma_s.y / st.y : 0.0f,
-                                 st.z > 0.0f ? mp.sigma_s.z / st.z : 0.0f);
                 return VOL_SCATTER;
             }
             /* a null collision: on, weighted by sigma_n over the hero's */
@@ -227,8 +235,7 @@ static inline PK_HD void vol_trace(const path_tracer *pt, path_thread *t, vol_st
 
 /* A scattering in the medium at parameter ts of the ray: NEE, then the
  * phase function's direction. False when the path ends. */
-static inline PK_HD bool vol_scatter(const path_tracer *pt, path_thread *t, vol_state *vs, float ts, vec3 albedo,
-                                     path_aov *aov)
+static inline PK_HD bool vol_scatter(const path_tracer *pt, path_thread *t, vol_state *vs, float ts)
 {
     path_state *ps = &vs->ps;
     const frame *fr = pt->f;
@@ -236,11 +243,6 @@ static inline PK_HD bool vol_scatter(const path_tracer *pt, path_thread *t, vol_
     const medium *m = &s->media[vs->medium];
     const vec3 p = v3_add(ps->r.o, v3_scale(ps->r.d, ts));
     const vec3 wo = v3_neg(v3_norm(ps->r.d));
-    if (aov && aov->open) { /* a scattering medium: its albedo, no normal */
-        if (ps->depth == 0) aov->out->depth = ts * v3_len(ps->r.d);
-        aov->out->albedo = v3_mul(ps->beta, albedo);
-        aov->open = false;
-    }
     if (ps->depth >= pt->max_depth) return false;
     float u0, u1, u2, u3, u4, u5;
     sampler_2d(&ps->smp, &u0, &u1);
@@ -281,15 +283,13 @@ static inline PK_HD bool vol_step(const path_tracer *pt, path_thread *t, vol_sta
     const scene_view *s = &fr->v;
     if (vs->medium >= 0) {
         float ts;
-        vec3 albedo;
-        const int ev = vol_track(pt, vs, &s->media[vs->medium], &ps->r, vs->has_hit ? ps->h.t : INFINITY, &ts,
-                                 &albedo);
+        const int ev = vol_track(pt, vs, &s->media[vs->medium], &ps->r, vs->has_hit ? ps->h.t : INFINITY, &ts, aov);
         if (ev == VOL_ABSORB) return false;
-        if (ev == VOL_SCATTER) return vol_scatter(pt, t, vs, ts, albedo, aov);
+        if (ev == VOL_SCATTER) return vol_scatter(pt, t, vs, ts);
     }
     if (!vs->has_hit) { /* out of the scene */
         const vec3 d = v3_norm(ps->r.d);
-        if (aov && aov->open) path_aov_miss(pt, aov, d, ps->beta);
+        if (aov && aov->open) path_aov_miss(pt, aov, d, v3_scale(ps->beta, vol_mis(vs)));
         path_add(pt, ps, v3_scale(v3_mul(ps->beta, leaving(pt, d, ps->prev_delta, ps->prev_pdf)), vol_mis(vs)),
                  ps->depth >= 1);
         return false;
@@ -311,7 +311,7 @@ static inline PK_HD bool vol_step(const path_tracer *pt, path_thread *t, vol_sta
         ps->cone += pt->spread * ps->h.t * v3_len(ps->r.d);
         if (sf.m->textured) sf = surface_texture(s, &ps->r, &ps->h, ps->cone, sf, &textured);
     }
-    if (aov && aov->open) path_aov_vertex(aov, &sf, &ps->r, &ps->h, ps->depth, ps->beta);
+    if (aov && aov->open) path_aov_vertex(aov, &sf, &ps->r, &ps->h, ps->depth, v3_scale(ps->beta, vol_mis(vs)));
     const vec3 wo = v3_neg(v3_norm(ps->r.d));
     const vec3 le = emitted(&sf);
     if (!black(le)) {
