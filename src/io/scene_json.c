@@ -6,6 +6,7 @@
  * so a line is found by a scan of the text that numbers values in the same
  * pre-order as the parsed tree.
  */
+#include "grid_io.h"
 #include "io_util.h"
 #include "readers.h"
 #include "../math/xform.h"
@@ -360,12 +361,293 @@ static pk_status get_texture(jp *p, const cJSON *it, const char *path, bool colo
     return st;
 }
 
+/* ---- media ------------------------------------------------------------------- */
+
+/* A medium by name ("name"), or null (vacuum): *out is its number or
+ * MEDIUM_NONE. */
+static pk_status get_medium_ref(jp *p, const cJSON *it, const char *path, int32_t *out)
+{
+    if (cJSON_IsNull(it)) {
+        *out = MEDIUM_NONE;
+        return PK_OK;
+    }
+    if (!cJSON_IsString(it) || !it->valuestring[0])
+        return jfail(p, PK_ERR_PARSE, it, path, "must be the name of a medium of \"media\", or null (vacuum)");
+    const int64_t idx = scene_find_medium(p->s, it->valuestring);
+    if (idx < 0) {
+        char shown[64];
+        sanitize(shown, sizeof shown, it->valuestring);
+        return jfail(p, PK_ERR_PARSE, it, path, "unknown medium \"%s\"", shown);
+    }
+    *out = (int32_t)idx;
+    return PK_OK;
+}
+
+/* A medium coefficient: a number or three numbers, finite and >= 0. */
+static pk_status get_coeff(jp *p, const cJSON *it, const char *path, vec3 *out)
+{
+    pk_status st;
+    if (cJSON_IsNumber(it)) {
+        float f = 0.0f;
+        if ((st = get_float(p, it, path, &f))) return st;
+        *out = v3s(f);
+    } else if (cJSON_IsArray(it)) {
+        if ((st = get_vec3(p, it, path, out))) return st;
+    } else {
+        return jfail(p, PK_ERR_PARSE, it, path, "must be a number or an array of 3 numbers");
+    }
+    if (out->x < 0.0f || out->y < 0.0f || out->z < 0.0f) return jfail(p, PK_ERR_PARSE, it, path, "must not be negative");
+    return PK_OK;
+}
+
+/* An inline grid {"size": [nx, ny, nz], "channels": 1 | 3, "data": [...]}
+ * (x fastest, channels innermost), allocated with the scene's allocator. */
+static pk_status get_inline_grid(jp *p, const cJSON *it, const char *path, bool nonneg, medium_grid *g)
+{
+    enum { G_SIZE, G_CHANNELS, G_DATA, G_COUNT };
+    static const char *const keys[G_COUNT] = {"size", "channels", "data"};
+    const cJSON *f[G_COUNT];
+    char fp[JP_PATH_MAX];
+    pk_status st = object_fields(p, it, path, keys, G_COUNT, f);
+    if (st) return st;
+    if (!f[G_SIZE]) return jfail(p, PK_ERR_PARSE, it, path, "missing \"size\" ([nx, ny, nz])");
+    if (!f[G_DATA]) return jfail(p, PK_ERR_PARSE, it, path, "missing \"data\"");
+    path_key(fp, path, "size");
+    if (!cJSON_IsArray(f[G_SIZE]) || cJSON_GetArraySize(f[G_SIZE]) != 3)
+        return jfail(p, PK_ERR_PARSE, f[G_SIZE], fp, "must be an array of 3 integers");
+    int n[3], channels = 1, i = 0;
+    for (const cJSON *e = f[G_SIZE]->child; e; e = e->next, i++)
+        if ((st = get_int(p, e, fp, 1, 1 << 30, &n[i]))) return st;
+    if (f[G_CHANNELS]) {
+        path_key(fp, path, "channels");
+        if ((st = get_int(p, f[G_CHANNELS], fp, 1, 3, &channels))) return st;
+        if (channels == 2) return jfail(p, PK_ERR_PARSE, f[G_CHANNELS], fp, "must be 1 or 3");
+    }
+    const size_t voxels = (size_t)n[0] * (size_t)n[1] * (size_t)n[2];
+    if (voxels > MEDIUM_MAX_VOXELS)
+        return jfail(p, PK_ERR_LIMIT, f[G_SIZE], path, "%dx%dx%d voxels is over the limit of %zu", n[0], n[1], n[2],
+                     (size_t)MEDIUM_MAX_VOXELS);
+    path_key(fp, path, "data");
+    const cJSON *data = f[G_DATA];
+    if (!cJSON_IsArray(data)) return jfail(p, PK_ERR_PARSE, data, fp, "must be an array of numbers");
+    const size_t want = voxels * (size_t)channels, have = (size_t)cJSON_GetArraySize(data);
+    if (have != want)
+        return jfail(p, PK_ERR_PARSE, data, fp, "holds %zu numbers; a %dx%dx%d grid of %d channel%s needs %zu", have,
+                     n[0], n[1], n[2], channels, channels == 1 ? "" : "s", want);
+    float *v = mem_alloc(&p->s->alloc, want * sizeof *v);
+    if (!v) return ctx_nomem(p->ctx);
+    size_t k = 0;
+    for (const cJSON *e = data->child; e; e = e->next, k++) {
+        if (!cJSON_IsNumber(e) || !isfinite((float)e->valuedouble) || (nonneg && e->valuedouble < 0.0)) {
+            mem_free(&p->s->alloc, v);
+            return jfail(p, PK_ERR_PARSE, e, fp, "value %zu must be a finite number%s", k, nonneg ? ", not negative" : "");
+        }
+        v[k] = (float)e->valuedouble;
+    }
+    g->nx = n[0], g->ny = n[1], g->nz = n[2];
+    g->channels = channels;
+    g->data = v;
+    return PK_OK;
+}
+
+/* A grid from a file (by its extension: .vol; others refused), relative to
+ * the scene's folder; *box is the box the file says it spans. */
+static pk_status get_grid_file(jp *p, const cJSON *it, const char *path, medium_grid *g, aabb *box)
+{
+    if (!cJSON_IsString(it) || !it->valuestring[0])
+        return jfail(p, PK_ERR_PARSE, it, path, "must be a non-empty string (a path)");
+    const char *fn = it->valuestring, *dot = strrchr(fn, '.');
+    if (!dot || strcmp(dot, ".vol") != 0)
+        return jfail(p, PK_ERR_UNSUPPORTED, it, path, "grid files are Mitsuba .vol files (the name must end in .vol)");
+    const pk_allocator *a = &p->ctx->alloc;
+    char *full = path_join(a, p->base_dir, fn);
+    if (!full) return ctx_nomem(p->ctx);
+    pk_context scratch = io_scratch_context(p->ctx);
+    pk_status st = grid_read_vol(&scratch, &p->s->alloc, full, g, box);
+    mem_free(a, full);
+    if (st) return jfail(p, st, it, path, "%s", scratch.message);
+    return PK_OK;
+}
+
+enum { MD_NAME, MD_TYPE, MD_SIGMA_A, MD_SIGMA_S, MD_SIGMA_T, MD_ALBEDO, MD_SCALE, MD_G, MD_EMISSION, MD_FILE,
+       MD_DENSITY, MD_ALBEDO_FILE, MD_ALBEDO_GRID, MD_EMISSION_FILE, MD_EMISSION_GRID, MD_BOUNDS, MD_TRANSFORM,
+       MD_COUNT };
+static const char *const medium_keys[MD_COUNT] = {
+    "name",  "type", "sigma_a",     "sigma_s",     "sigma_t",       "albedo",        "scale",  "g",        "emission",
+    "file",  "density", "albedo_file", "albedo_grid", "emission_file", "emission_grid", "bounds", "transform"};
+
+static pk_status parse_transform(jp *p, const cJSON *it, const char *path, xform *m);
+
+/* One element of "media", filled into *m (the caller adds it). */
+static pk_status read_medium(jp *p, const cJSON *it, const char *path, medium *m)
+{
+    const cJSON *f[MD_COUNT];
+    char fp[MD_COUNT][JP_PATH_MAX];
+    pk_status st = object_fields(p, it, path, medium_keys, MD_COUNT, f);
+    if (st) return st;
+    for (int i = 0; i < MD_COUNT; i++) path_key(fp[i], path, medium_keys[i]);
+    if (!f[MD_NAME]) return jfail(p, PK_ERR_PARSE, it, path, "missing \"name\"");
+    if (!cJSON_IsString(f[MD_NAME]) || !f[MD_NAME]->valuestring[0])
+        return jfail(p, PK_ERR_PARSE, f[MD_NAME], fp[MD_NAME], "must be a non-empty string");
+    if (!f[MD_TYPE]) return jfail(p, PK_ERR_PARSE, it, path, "missing \"type\" (\"homogeneous\" or \"grid\")");
+    const char *ty = cJSON_IsString(f[MD_TYPE]) ? f[MD_TYPE]->valuestring : "";
+    const bool grid = strcmp(ty, "grid") == 0;
+    if (!grid && strcmp(ty, "homogeneous") != 0)
+        return jfail(p, PK_ERR_PARSE, f[MD_TYPE], fp[MD_TYPE], "must be \"homogeneous\" or \"grid\"");
+    if (!grid)
+        for (int k = MD_FILE; k <= MD_TRANSFORM; k++)
+            if (f[k]) return jfail(p, PK_ERR_PARSE, f[k], fp[k], "belongs to a grid medium (\"type\": \"grid\")");
+    medium_init(m);
+    m->kind = grid ? MEDIUM_GRID : MEDIUM_HOMOGENEOUS;
+    /* the coefficients: sigma_a and/or sigma_s, or sigma_t and/or albedo
+     * (default: sigma_t 1, albedo 1) */
+    vec3 sa = v3s(0.0f), ss = v3s(0.0f), stv = v3s(1.0f), al = v3s(1.0f);
+    const bool as = f[MD_SIGMA_A] || f[MD_SIGMA_S], ta = f[MD_SIGMA_T] || f[MD_ALBEDO];
+    if (as && ta) {
+        const int k = f[MD_SIGMA_T] ? MD_SIGMA_T : MD_ALBEDO;
+        return jfail(p, PK_ERR_PARSE, f[k], fp[k], "give \"sigma_a\" and \"sigma_s\" or \"sigma_t\" and \"albedo\", not both");
+    }
+    if (f[MD_SIGMA_A] && (st = get_coeff(p, f[MD_SIGMA_A], fp[MD_SIGMA_A], &sa))) return st;
+    if (f[MD_SIGMA_S] && (st = get_coeff(p, f[MD_SIGMA_S], fp[MD_SIGMA_S], &ss))) return st;
+    if (f[MD_SIGMA_T] && (st = get_coeff(p, f[MD_SIGMA_T], fp[MD_SIGMA_T], &stv))) return st;
+    if (f[MD_ALBEDO]) {
+        if ((st = get_coeff(p, f[MD_ALBEDO], fp[MD_ALBEDO], &al))) return st;
+        if (al.x > 1.0f || al.y > 1.0f || al.z > 1.0f)
+            return jfail(p, PK_ERR_PARSE, f[MD_ALBEDO], fp[MD_ALBEDO], "must lie in 0..1");
+    }
+    if (as) {
+        stv = v3_add(sa, ss);
+        const float t[3] = {stv.x, stv.y, stv.z}, s[3] = {ss.x, ss.y, ss.z};
+        float a[3];
+        for (int c = 0; c < 3; c++) a[c] = t[c] > 0.0f ? fminf(s[c] / t[c], 1.0f) : 1.0f;
+        al = v3(a[0], a[1], a[2]);
+    }
+    float scale = 1.0f;
+    if (f[MD_SCALE]) {
+        if ((st = get_float(p, f[MD_SCALE], fp[MD_SCALE], &scale))) return st;
+        if (scale < 0.0f) return jfail(p, PK_ERR_PARSE, f[MD_SCALE], fp[MD_SCALE], "must not be negative");
+    }
+    m->sigma_t = v3_scale(stv, scale);
+    if (!v3_finite(m->sigma_t)) return jfail(p, PK_ERR_PARSE, it, path, "the extinction times \"scale\" is not finite");
+    m->albedo = al;
+    if (f[MD_G]) {
+        if ((st = get_float(p, f[MD_G], fp[MD_G], &m->g))) return st;
+        if (!(m->g > -1.0f && m->g < 1.0f))
+            return jfail(p, PK_ERR_PARSE, f[MD_G], fp[MD_G], "must lie strictly between -1 and 1");
+    }
+    if (f[MD_EMISSION] && (st = get_coeff(p, f[MD_EMISSION], fp[MD_EMISSION], &m->le))) return st;
+    if (!grid) return PK_OK;
+
+    /* the grids, each given inline or as a file */
+    if (!f[MD_FILE] == !f[MD_DENSITY])
+        return jfail(p, PK_ERR_PARSE, it, path, "a grid medium needs \"file\" (a .vol file) or \"density\", one of them");
+    aabb box = {v3s(0.0f), v3s(1.0f)};
+    bool file_box = false;
+    if (f[MD_FILE]) {
+        if ((st = get_grid_file(p, f[MD_FILE], fp[MD_FILE], &m->density, &box))) return st;
+        file_box = true;
+    } else if ((st = get_inline_grid(p, f[MD_DENSITY], fp[MD_DENSITY], true, &m->density))) {
+        return st;
+    }
+    struct {
+        int file, inline_, what;
+        medium_grid *g;
+        bool nonneg;
+    } extra[2] = {{MD_ALBEDO_FILE, MD_ALBEDO_GRID, 0, &m->albedo_grid, true},
+                  {MD_EMISSION_FILE, MD_EMISSION_GRID, 1, &m->emission_grid, true}};
+    for (int e = 0; e < 2; e++) {
+        if (f[extra[e].file] && f[extra[e].inline_])
+            return jfail(p, PK_ERR_PARSE, f[extra[e].inline_], fp[extra[e].inline_], "give \"%s\" or \"%s\", not both",
+                         medium_keys[extra[e].file], medium_keys[extra[e].inline_]);
+        if (f[extra[e].file]) {
+            aabb b2;
+            if ((st = get_grid_file(p, f[extra[e].file], fp[extra[e].file], extra[e].g, &b2))) return st;
+            if (file_box && memcmp(&b2, &box, sizeof box) != 0)
+                return jfail(p, PK_ERR_PARSE, f[extra[e].file], fp[extra[e].file],
+                             "the file's box differs from the density file's (the grids of a medium share one box)");
+        } else if (f[extra[e].inline_] &&
+                   (st = get_inline_grid(p, f[extra[e].inline_], fp[extra[e].inline_], extra[e].nonneg, extra[e].g))) {
+            return st;
+        }
+    }
+    if (m->emission_grid.data && !f[MD_EMISSION]) m->le = v3s(1.0f); /* the grid is the radiance */
+    /* placement: the grid's unit cube onto "bounds" (or the file's box),
+     * then "transform" */
+    if (f[MD_BOUNDS]) {
+        static const char *const bk[2] = {"min", "max"};
+        const cJSON *b[2];
+        char bp[JP_PATH_MAX];
+        if ((st = object_fields(p, f[MD_BOUNDS], fp[MD_BOUNDS], bk, 2, b))) return st;
+        if (!b[0] || !b[1]) return jfail(p, PK_ERR_PARSE, f[MD_BOUNDS], fp[MD_BOUNDS], "needs \"min\" and \"max\"");
+        path_key(bp, fp[MD_BOUNDS], "min");
+        if ((st = get_vec3(p, b[0], bp, &box.lo))) return st;
+        path_key(bp, fp[MD_BOUNDS], "max");
+        if ((st = get_vec3(p, b[1], bp, &box.hi))) return st;
+        if (!(box.hi.x > box.lo.x && box.hi.y > box.lo.y && box.hi.z > box.lo.z))
+            return jfail(p, PK_ERR_PARSE, b[1], bp, "must exceed \"min\" on every axis");
+    }
+    const xform t = xform_translate(box.lo), sc = xform_scale(v3_sub(box.hi, box.lo));
+    m->grid_to_world = xform_mul(&t, &sc);
+    if (f[MD_TRANSFORM]) {
+        xform x;
+        if ((st = parse_transform(p, f[MD_TRANSFORM], fp[MD_TRANSFORM], &x))) return st;
+        m->grid_to_world = xform_mul(&x, &m->grid_to_world);
+    }
+    if (!xform_finite(&m->grid_to_world) || !(xform_det3(&m->grid_to_world) != 0.0))
+        return jfail(p, PK_ERR_PARSE, it, path, "the grid's placement is singular or not finite");
+    return PK_OK;
+}
+
+static pk_status parse_medium(jp *p, const cJSON *it, const char *path)
+{
+    medium m;
+    medium_init(&m);
+    pk_status st = read_medium(p, it, path, &m);
+    if (st) {
+        medium_free(&p->s->alloc, &m);
+        return st;
+    }
+    const char *name = cJSON_GetObjectItemCaseSensitive(it, "name")->valuestring;
+    if (scene_find_medium(p->s, name) >= 0) {
+        medium_free(&p->s->alloc, &m);
+        char shown[64];
+        sanitize(shown, sizeof shown, name);
+        return jfail(p, PK_ERR_PARSE, cJSON_GetObjectItemCaseSensitive(it, "name"), path,
+                     "a medium named \"%s\" is defined already", shown);
+    }
+    m.name = mem_strdup(&p->s->alloc, name);
+    if (!m.name) {
+        medium_free(&p->s->alloc, &m);
+        return ctx_nomem(p->ctx);
+    }
+    uint32_t idx;
+    return scene_add_medium(p->ctx, p->s, &m, &idx);
+}
+
+/* A material's "interior" and "exterior" (absent: the surface keeps the
+ * ray's medium). */
+static pk_status read_medium_sides(jp *p, const cJSON *obj, const char *path, material *m)
+{
+    static const char *const sides[2] = {"interior", "exterior"};
+    int32_t *dst[2] = {&m->medium_in, &m->medium_out};
+    char fp[JP_PATH_MAX];
+    for (int i = 0; i < 2; i++) {
+        const cJSON *it = cJSON_IsObject(obj) ? cJSON_GetObjectItemCaseSensitive(obj, sides[i]) : NULL;
+        if (!it) continue;
+        path_key(fp, path, sides[i]);
+        pk_status st = get_medium_ref(p, it, fp, dst[i]);
+        if (st) return st;
+    }
+    return PK_OK;
+}
+
 /* ---- materials ------------------------------------------------------------ */
 
 enum { MF_NAME, MF_KD, MF_KS, MF_KE, MF_TF, MF_KA, MF_NS, MF_NI, MF_D, MF_ILLUM, MF_TWO_SIDED, MF_BUMP, MF_NORMAL,
-       MF_COUNT };
-static const char *const material_keys[MF_COUNT] = {"name", "kd", "ks", "ke", "tf", "ka", "ns", "ni", "d",
-                                                    "illum", "two_sided", "bump", "normal_map"};
+       MF_INTERIOR, MF_EXTERIOR, MF_COUNT };
+static const char *const material_keys[MF_COUNT] = {"name",  "kd",        "ks",   "ke",         "tf",
+                                                    "ka",    "ns",        "ni",   "d",          "illum",
+                                                    "two_sided", "bump",  "normal_map", "interior", "exterior"};
 
 /* A reflectance: three finite numbers in 0..1. */
 static pk_status get_reflectance(jp *p, const cJSON *it, const char *path, vec3 *out)
@@ -407,8 +689,10 @@ static const mat_type_def mat_types[] = {
     {"two_sided", 1, {TP_BSDF}},
     {"metallic_roughness", 8,
      {TP_BASE_COLOR, TP_METALLIC, TP_ROUGHNESS, TP_TRANSMISSION, TP_IOR, TP_MR_MAP, TP_CLEARCOAT, TP_CLEARCOAT_ROUGHNESS}},
+    {"interface", 0, {0}},
 };
 #define MT_METALLIC_ROUGHNESS 6 /* its index in mat_types */
+#define MT_INTERFACE 7
 #define N_MAT_TYPES (sizeof mat_types / sizeof mat_types[0])
 
 /* The maps any material may have: "d"/"opacity" as a texture (cut-out
@@ -435,6 +719,20 @@ static pk_status read_surface_maps(jp *p, const cJSON *opacity, const cJSON *bum
     return PK_OK;
 }
 
+/* A nested material ("bsdf") may not name media: they belong to the outer one. */
+static pk_status nested_sides(jp *p, const cJSON *obj, const char *path)
+{
+    static const char *const sides[2] = {"interior", "exterior"};
+    for (int i = 0; i < 2; i++) {
+        const cJSON *it = cJSON_IsObject(obj) ? cJSON_GetObjectItemCaseSensitive(obj, sides[i]) : NULL;
+        if (!it) continue;
+        char fp[JP_PATH_MAX];
+        path_key(fp, path, sides[i]);
+        return jfail(p, PK_ERR_PARSE, it, fp, "media belong to the outer material, not to its \"bsdf\"");
+    }
+    return PK_OK;
+}
+
 /* Reads a material object with a "type" (type_item) into *m. */
 static pk_status read_typed_material(jp *p, const cJSON *obj, const cJSON *type_item, const char *path,
                                      bool with_name, material *m, const cJSON **name_item)
@@ -447,16 +745,17 @@ static pk_status read_typed_material(jp *p, const cJSON *obj, const cJSON *type_
     if (!cJSON_IsString(type_item) || t == N_MAT_TYPES)
         return jfail(p, PK_ERR_PARSE, type_item, fp,
                      "must be one of \"diffuse\", \"conductor\", \"dielectric\", \"plastic\", "
-                     "\"metallic_roughness\", \"emitter\", \"two_sided\"");
+                     "\"metallic_roughness\", \"emitter\", \"two_sided\", \"interface\"");
     const mat_type_def *def = &mat_types[t];
     /* the known keys: "type", "two_sided", the type's parameters, and "name"
      * where materials are listed in an array */
-    const char *keys[16];
-    const cJSON *f[16];
+    const char *keys[18];
+    const cJSON *f[18];
     size_t nk = 0;
     keys[nk++] = "type", keys[nk++] = "two_sided", keys[nk++] = "opacity", keys[nk++] = "bump",
     keys[nk++] = "normal_map";
     for (int i = 0; i < def->nparams; i++) keys[nk++] = tp_keys[def->params[i]];
+    keys[nk++] = "interior", keys[nk++] = "exterior"; /* (read by read_material) */
     if (with_name) keys[nk++] = "name";
     pk_status st = object_fields(p, obj, path, keys, nk, f);
     if (st) return st;
@@ -466,6 +765,15 @@ static pk_status read_typed_material(jp *p, const cJSON *obj, const cJSON *type_
     if (name_item) *name_item = with_name ? f[nk - 1] : NULL;
 
     material_init(m);
+    if (t == MT_INTERFACE) { /* no surface: the boundary of media */
+        for (int k = 1; k <= 4; k++)
+            if (f[k]) {
+                path_key(fp, path, keys[k]);
+                return jfail(p, PK_ERR_PARSE, f[k], fp, "an interface has no surface to shade");
+            }
+        material_interface(m);
+        return PK_OK;
+    }
     if (f[2] && !cJSON_IsObject(f[2])) {
         path_key(fp, path, "opacity");
         return jfail(p, PK_ERR_PARSE, f[2], fp, "must be a texture object (cut-out holes where it is below 0.5)");
@@ -564,6 +872,7 @@ static pk_status read_typed_material(jp *p, const cJSON *obj, const cJSON *type_
         path_key(bp, pp[TP_BSDF], "type");
         if (cJSON_IsString(bt) && (strcmp(bt->valuestring, "dielectric") == 0 || strcmp(bt->valuestring, "two_sided") == 0))
             return jfail(p, PK_ERR_PARSE, bt, bp, "is two-sided already");
+        if ((st = nested_sides(p, in, pp[TP_BSDF]))) return st;
         if ((st = read_typed_material(p, in, bt, pp[TP_BSDF], false, m, NULL))) return st;
         m->two_sided = true;
         if (two_sided) {
@@ -643,6 +952,7 @@ static pk_status read_typed_material(jp *p, const cJSON *obj, const cJSON *type_
                 path_key(bp, pp[TP_BSDF], "type");
                 return jfail(p, PK_ERR_PARSE, bt, bp, "an emitter's bsdf cannot be another emitter");
             }
+            if ((st = nested_sides(p, pv[TP_BSDF], pp[TP_BSDF]))) return st;
             if ((st = read_typed_material(p, pv[TP_BSDF], bt, pp[TP_BSDF], false, m, NULL))) return st;
         } else {
             material_diffuse(m, v3s(0.0f));
@@ -664,7 +974,10 @@ static pk_status read_material(jp *p, const cJSON *obj, const char *path, bool w
                                const cJSON **name_item)
 {
     const cJSON *type_item = cJSON_IsObject(obj) ? cJSON_GetObjectItemCaseSensitive(obj, "type") : NULL;
-    if (type_item) return read_typed_material(p, obj, type_item, path, with_name, m, name_item);
+    if (type_item) {
+        pk_status st = read_typed_material(p, obj, type_item, path, with_name, m, name_item);
+        return st ? st : read_medium_sides(p, obj, path, m);
+    }
     const cJSON *f[MF_COUNT];
     pk_status st = object_fields(p, obj, path, with_name ? material_keys : material_keys + 1,
                                  with_name ? MF_COUNT : MF_COUNT - 1, with_name ? f : f + 1);
@@ -714,7 +1027,7 @@ static pk_status read_material(jp *p, const cJSON *obj, const char *path, bool w
         if (!cJSON_IsBool(f[MF_TWO_SIDED])) return jfail(p, PK_ERR_PARSE, f[MF_TWO_SIDED], fp, "must be true or false");
         m->two_sided = cJSON_IsTrue(f[MF_TWO_SIDED]);
     }
-    return PK_OK;
+    return read_medium_sides(p, obj, path, m);
 }
 
 static pk_status add_material(jp *p, const material *m, const char *name, uint32_t *index)
@@ -765,9 +1078,9 @@ static pk_status parse_materials(jp *p, const cJSON *it)
 
 static pk_status parse_camera(jp *p, const cJSON *it)
 {
-    enum { C_FROM, C_AT, C_UP, C_FOV, C_LENS, C_FOCUS, C_PROJ, C_OWIDTH, C_COUNT };
-    static const char *const keys[C_COUNT] = {"look_from", "look_at",        "up",         "fov",
-                                              "lens_radius", "focus_distance", "projection", "ortho_width"};
+    enum { C_FROM, C_AT, C_UP, C_FOV, C_LENS, C_FOCUS, C_PROJ, C_OWIDTH, C_MEDIUM, C_COUNT };
+    static const char *const keys[C_COUNT] = {"look_from",   "look_at",        "up",         "fov",        "lens_radius",
+                                              "focus_distance", "projection", "ortho_width", "medium"};
     const cJSON *f[C_COUNT];
     pk_status st = object_fields(p, it, "camera", keys, C_COUNT, f);
     if (st) return st;
@@ -821,6 +1134,14 @@ static pk_status parse_camera(jp *p, const cJSON *it)
     case CAMERA_ORTHO_WIDTH:
         return jfail(p, PK_ERR_PARSE, f[C_OWIDTH] ? f[C_OWIDTH] : it, "camera.ortho_width",
                      "must not be negative (0: the perspective view's width at look_at)");
+    }
+    if (f[C_MEDIUM]) {
+        int32_t med;
+        if ((st = get_medium_ref(p, f[C_MEDIUM], "camera.medium", &med))) return st;
+        const cJSON *top = cJSON_GetObjectItemCaseSensitive(p->root, "medium");
+        if (top && med != p->s->camera_medium)
+            return jfail(p, PK_ERR_PARSE, f[C_MEDIUM], "camera.medium", "differs from the scene's \"medium\"; give one of them");
+        p->s->camera_medium = med;
     }
     p->s->camera = cam;
     p->s->has_camera = true;
@@ -899,7 +1220,8 @@ static pk_status parse_render(jp *p, const cJSON *it)
     if (f[R_INTEGRATOR]) {
         pk_integrator_kind kind;
         if (!cJSON_IsString(f[R_INTEGRATOR]) || pk_integrator_parse(f[R_INTEGRATOR]->valuestring, &kind) != PK_OK)
-            return jfail(p, PK_ERR_PARSE, f[R_INTEGRATOR], "render.integrator", "must be \"path\" or \"whitted\"");
+            return jfail(p, PK_ERR_PARSE, f[R_INTEGRATOR], "render.integrator",
+                         "must be \"path\", \"volpath\", \"whitted\" or \"default\"");
         r->opt.integrator = kind;
         r->has_integrator = true;
     }
@@ -1350,9 +1672,10 @@ static pk_status syntax_error(jp *p, const char *end)
 pk_status scene_json_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size, const char *name,
                            const char *base_dir)
 {
-    enum { K_MATERIALS, K_CAMERA, K_FILM, K_RENDER, K_AMBIENT, K_MESHES, K_SPHERES, K_LIGHTS, K_ENV, K_COUNT };
-    static const char *const keys[K_COUNT] = {"materials", "camera", "film",    "render",     "ambient",
-                                              "meshes",    "spheres", "lights", "environment"};
+    enum { K_MATERIALS, K_CAMERA, K_FILM, K_RENDER, K_AMBIENT, K_MESHES, K_SPHERES, K_LIGHTS, K_ENV, K_MEDIA,
+           K_MEDIUM, K_COUNT };
+    static const char *const keys[K_COUNT] = {"materials", "camera",  "film",   "render",      "ambient", "meshes",
+                                              "spheres",   "lights",  "environment", "media",  "medium"};
     if (!ctx || !s) return PK_ERR_INVALID_ARGUMENT;
     if (!data && size) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "scene_json_parse: no data");
     if (size > PK_MAX_JSON_BYTES)
@@ -1389,7 +1712,14 @@ pk_status scene_json_parse(pk_context *ctx, pk_scene *s, const char *data, size_
     const cJSON *f[K_COUNT];
     if ((st = object_fields(p, root, "", keys, K_COUNT, f))) goto out;
 
-    /* Materials first: meshes (usemtl) and spheres refer to them by name. */
+    /* Media first (materials and the camera name them), then materials:
+     * meshes (usemtl) and spheres refer to them by name. */
+    if (f[K_MEDIA] && (st = each_element(p, f[K_MEDIA], "media", parse_medium))) goto out;
+    if (f[K_MEDIUM]) {
+        int32_t med;
+        if ((st = get_medium_ref(p, f[K_MEDIUM], "medium", &med))) goto out;
+        s->camera_medium = med;
+    }
     if (f[K_MATERIALS] && (st = parse_materials(p, f[K_MATERIALS]))) goto out;
     if (f[K_CAMERA] && (st = parse_camera(p, f[K_CAMERA]))) goto out;
     if (f[K_FILM] && (st = parse_film(p, f[K_FILM]))) goto out;

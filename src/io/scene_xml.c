@@ -12,6 +12,7 @@
  * pointer, so they cannot reach a context); everything else goes through the
  * context's allocator.
  */
+#include "grid_io.h"
 #include "io_util.h"
 #include "readers.h"
 #include "scene_build.h"
@@ -65,6 +66,7 @@ typedef struct xnode {
     unsigned long line;
     int64_t mat;         /* material made of this bsdf, -1 before */
     int64_t mesh;        /* mesh made of this shapegroup, -1 before */
+    int64_t medium;      /* scene medium made of this medium, -1 before */
     bool used;           /* a property that a plugin read */
     bool busy;           /* a bsdf being converted (reference cycles) */
 } xnode;
@@ -257,6 +259,7 @@ static void XMLCALL on_start(void *user, const XML_Char *name, const XML_Char **
     n->line = line;
     n->mat = -1;
     n->mesh = -1;
+    n->medium = -1;
     n->parent = b->cur;
     if (b->cur) {
         if (b->cur->last) b->cur->last->next = n;
@@ -641,7 +644,12 @@ static pk_status node_spectrum(xp *p, const xnode *n, vec3 *out)
     const bool emitter = n->parent && strcmp(n->parent->tag, "emitter") == 0;
     const char *pname = attr_st(p, n, "name", &st);
     if (st) return st;
-    const bool unbounded = pname && (strcmp(pname, "eta") == 0 || strcmp(pname, "k") == 0);
+    bool unbounded = pname && (strcmp(pname, "eta") == 0 || strcmp(pname, "k") == 0);
+    /* a medium's coefficients are unbounded, its albedo a reflectance */
+    const xnode *owner = n->parent;
+    const char *oname = owner && strcmp(owner->tag, "volume") == 0 ? attr_st(p, owner, "name", &st) : pname;
+    if (owner && (strcmp(owner->tag, "medium") == 0 || strcmp(owner->tag, "volume") == 0))
+        unbounded = !oname || strcmp(oname, "albedo") != 0;
     const char *ty = attr_st(p, n, "type", &st);
     if (st) return st;
     if (ty && strcmp(ty, "blackbody") == 0) {
@@ -1399,7 +1407,7 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
         if (metallic > 0.5f) material_conductor_f0(m, clamp01v(base), alpha);
         else material_plastic(m, clamp01v(base), eta > 1.0f ? eta : 1.5f, alpha);
     } else if (strcmp(type, "null") == 0) {
-        material_dielectric(m, 1.0f, 0.0f, v3s(1.0f)); /* index 1: light passes straight through */
+        material_interface(m); /* no surface: light passes straight through; it may bound media */
     } else {
         for (xnode *c = b->child; c; c = c->next) c->used = true;
         xwarn(p, b, "bsdf \"%s\" is not supported; using a grey diffuse material", ty);
@@ -1704,6 +1712,339 @@ out:
     return st;
 }
 
+/* ---- media ------------------------------------------------------------------------------------- */
+
+/* The asymmetry g of a medium's phase function: its <phase> child (or a
+ * <ref> to one): isotropic (0) or hg (g, default 0.8 as in Mitsuba); others
+ * are warned about and read as isotropic. No phase: isotropic. */
+static pk_status medium_phase(xp *p, xnode *med, float *g)
+{
+    pk_status st;
+    xnode *ph = NULL;
+    for (xnode *c = med->child; c && !ph; c = c->next) {
+        if (strcmp(c->tag, "phase") == 0) {
+            ph = c;
+        } else if (strcmp(c->tag, "ref") == 0) {
+            const char *id = attr_st(p, c, "id", &st);
+            if (st) return st;
+            xnode *t = id ? id_find(p, id) : NULL;
+            if (t && strcmp(t->tag, "phase") == 0) ph = t;
+        } else {
+            continue;
+        }
+        c->used = true;
+    }
+    *g = 0.0f;
+    if (!ph) return PK_OK;
+    const char *type = attr_st(p, ph, "type", &st);
+    if (st) return st;
+    if (!type) return xfail(p, PK_ERR_PARSE, ph, "<phase> needs a type");
+    char ty[40];
+    shown(ty, sizeof ty, type);
+    if (strcmp(type, "hg") == 0) {
+        *g = 0.8f;
+        xnode *gn = prop(p, ph, "g");
+        if ((st = get_float(p, ph, "g", g))) return st;
+        if (!(*g > -1.0f && *g < 1.0f))
+            return xfail(p, PK_ERR_PARSE, gn ? gn : ph, "phase \"hg\": g = %g must lie strictly between -1 and 1",
+                         (double)*g);
+    } else if (strcmp(type, "isotropic") != 0) {
+        for (xnode *c = ph->child; c; c = c->next) c->used = true;
+        xwarn(p, ph, "phase function \"%s\" is not supported (isotropic and hg are); isotropic used", ty);
+        return PK_OK;
+    }
+    char kind[64];
+    snprintf(kind, sizeof kind, "phase \"%s\"", ty);
+    warn_unused(p, ph, kind, NULL);
+    return PK_OK;
+}
+
+/* A medium parameter: a constant (a float or a colour), a constvolume or a
+ * gridvolume (read, and placed: to_grid maps the grid's unit cube into
+ * the medium's space). */
+typedef struct xvol {
+    bool present, grid;
+    vec3 value;
+    medium_grid g;   /* a gridvolume's voxels (the scene's allocator) */
+    xform to_world;  /* a gridvolume's unit cube into the medium's space */
+    xnode *at;
+} xvol;
+
+static pk_status medium_volume_read(xp *p, xnode *med, const char *name, vec3 def, xvol *v)
+{
+    pk_status st;
+    *v = (xvol){.value = def, .to_world = xform_identity()};
+    xnode *c = prop(p, med, name);
+    if (!c) return PK_OK;
+    v->present = true;
+    v->at = c;
+    if (strcmp(c->tag, "volume") != 0) {
+        if (strcmp(c->tag, "texture") == 0 || strcmp(c->tag, "ref") == 0)
+            return xfail(p, PK_ERR_UNSUPPORTED, c, "%s: a texture or reference here is not supported (a value or a "
+                                                   "<volume> is)", name);
+        if ((st = node_color(p, c, &v->value))) return st;
+        if (!v3_finite(v->value)) return xfail(p, PK_ERR_PARSE, c, "%s is not finite", name);
+        return PK_OK;
+    }
+    const char *type = attr_st(p, c, "type", &st);
+    if (st) return st;
+    char ty[40];
+    shown(ty, sizeof ty, type ? type : "");
+    if (type && strcmp(type, "constvolume") == 0) {
+        xnode *val = prop(p, c, "value");
+        if (val && (st = node_color(p, val, &v->value))) return st;
+        if (!v3_finite(v->value)) return xfail(p, PK_ERR_PARSE, c, "%s is not finite", name);
+        warn_unused(p, c, "volume \"constvolume\"", NULL);
+        return PK_OK;
+    }
+    if (!type || strcmp(type, "gridvolume") != 0)
+        return xfail(p, PK_ERR_UNSUPPORTED, c, "volume \"%s\" is not supported (constvolume and gridvolume are)", ty);
+    const char *fn = NULL;
+    xnode *fat;
+    if ((st = get_string(p, c, "filename", &fn, &fat))) return st;
+    if (!fn) return xfail(p, PK_ERR_PARSE, c, "volume \"gridvolume\" needs a filename");
+    char *full = path_join(&p->ctx->alloc, fat->file->dir, fn);
+    if (!full) return ctx_nomem(p->ctx);
+    pk_context scratch = io_scratch_context(p->ctx);
+    aabb box;
+    st = grid_read_vol(&scratch, &p->s->alloc, full, &v->g, &box);
+    mem_free(&p->ctx->alloc, full);
+    if (st) return xfail(p, st, fat, "%s", scratch.message);
+    v->grid = true;
+    /* the grid's box: Mitsuba 0.x, the file's (or min and max); Mitsuba 3,
+     * the unit cube unless use_grid_bbox */
+    bool use_box = p->version_major < 2;
+    if ((st = get_bool(p, c, "use_grid_bbox", &use_box))) return st;
+    if (p->version_major < 2) {
+        bool has_lo, has_hi;
+        vec3 lo = box.lo, hi = box.hi;
+        if ((st = get_vec(p, c, "min", &lo, &has_lo)) || (st = get_vec(p, c, "max", &hi, &has_hi))) return st;
+        if (has_lo && has_hi) box.lo = lo, box.hi = hi;
+        if (!(box.hi.x > box.lo.x && box.hi.y > box.lo.y && box.hi.z > box.lo.z))
+            return xfail(p, PK_ERR_PARSE, c, "the grid's box is empty or inverted");
+    }
+    if (!use_box) box = (aabb){v3s(0.0f), v3s(1.0f)};
+    xform tw;
+    if ((st = get_to_world(p, c, &tw, NULL))) return st;
+    const xform t = xform_translate(box.lo), sc = xform_scale(v3_sub(box.hi, box.lo)), ts = xform_mul(&t, &sc);
+    v->to_world = xform_mul(&tw, &ts);
+    static const char *const quiet[] = {"filter_type", "wrap_mode", "raw", "accel", "send_data", "max_value", NULL};
+    warn_unused(p, c, "volume \"gridvolume\"", quiet);
+    return PK_OK;
+}
+
+/* medium_volume_read, leaving nothing allocated on failure. */
+static pk_status medium_volume(xp *p, xnode *med, const char *name, vec3 def, xvol *v)
+{
+    pk_status st = medium_volume_read(p, med, name, def, v);
+    if (st) {
+        mem_free(&p->s->alloc, v->g.data);
+        v->g.data = NULL;
+        v->grid = false;
+    }
+    return st;
+}
+
+static bool xform_near(const xform *a, const xform *b)
+{
+    for (int i = 0; i < 12; i++)
+        if (fabsf(a->m[i] - b->m[i]) > 1e-5f * (1.0f + fabsf(a->m[i]))) return false;
+    return true;
+}
+
+/* Checks a homogeneous medium's constants and a grid medium's scales. */
+static pk_status medium_values(xp *p, const xnode *mn, vec3 sigma_t, vec3 albedo)
+{
+    if (!(sigma_t.x >= 0.0f && sigma_t.y >= 0.0f && sigma_t.z >= 0.0f) || !v3_finite(sigma_t))
+        return xfail(p, PK_ERR_PARSE, mn, "medium: the extinction (%g, %g, %g) must be finite and not negative",
+                     (double)sigma_t.x, (double)sigma_t.y, (double)sigma_t.z);
+    if (!(albedo.x >= 0.0f && albedo.y >= 0.0f && albedo.z >= 0.0f && albedo.x <= 1.0f && albedo.y <= 1.0f &&
+          albedo.z <= 1.0f))
+        return xfail(p, PK_ERR_PARSE, mn, "medium: the albedo (%g, %g, %g) must lie in 0..1", (double)albedo.x,
+                     (double)albedo.y, (double)albedo.z);
+    return PK_OK;
+}
+
+/* Fills *m (medium_init'ed; grids allocated with the scene's allocator)
+ * from the <medium> element mn. */
+static pk_status medium_convert(xp *p, xnode *mn, medium *m)
+{
+    pk_status st;
+    const char *type = attr_st(p, mn, "type", &st);
+    if (st) return st;
+    if (!type) return xfail(p, PK_ERR_PARSE, mn, "<medium> needs a type");
+    char ty[40];
+    shown(ty, sizeof ty, type);
+    const bool homog = strcmp(type, "homogeneous") == 0, het = strcmp(type, "heterogeneous") == 0;
+    if (!homog && !het)
+        return xfail(p, PK_ERR_UNSUPPORTED, mn, "medium \"%s\" is not supported (homogeneous and heterogeneous are)", ty);
+    const bool v0 = p->version_major < 2;
+    medium_init(m);
+    float scale = 1.0f;
+    if ((st = get_float(p, mn, "scale", &scale))) return st;
+    xnode *dm = prop(p, mn, "density_multiplier");
+    if (dm) { /* Mitsuba 0.4's name of scale */
+        float f = 1.0f;
+        if ((st = node_float(p, dm, &f))) return st;
+        scale *= f;
+        xwarn(p, dm, "densityMultiplier is the old name of scale; read as scale");
+    }
+    if (!(scale >= 0.0f)) return xfail(p, PK_ERR_PARSE, mn, "medium: scale must not be negative");
+    if ((st = medium_phase(p, mn, &m->g))) return st;
+    if (prop(p, mn, "material"))
+        return xfail(p, PK_ERR_UNSUPPORTED, mn, "medium presets (\"material\") are not supported; give sigma_a and "
+                                                "sigma_s, or sigma_t and albedo");
+    static const char *const quiet[] = {"sample_emitters", "method", "step_size", "strategy", "has_spectral_extinction",
+                                        "medium_sampling_weight", "channel", "monochromatic", "sampling_density",
+                                        NULL};
+    char kind[64];
+    snprintf(kind, sizeof kind, "medium \"%s\"", ty);
+    if (homog) {
+        xnode *na = prop(p, mn, "sigma_a"), *ns = prop(p, mn, "sigma_s");
+        xnode *nt = prop(p, mn, "sigma_t"), *nl = prop(p, mn, "albedo");
+        if ((na || ns) && (nt || nl))
+            return xfail(p, PK_ERR_PARSE, nt ? nt : nl, "medium: give sigma_a and sigma_s, or sigma_t and albedo, not "
+                                                        "both");
+        vec3 sa, ss;
+        if (na || ns) {
+            sa = ss = v3s(0.0f);
+            if ((st = get_color(p, mn, "sigma_a", &sa)) || (st = get_color(p, mn, "sigma_s", &ss))) return st;
+            if (v0 && !(na && ns))
+                xwarn(p, mn, "medium: %s missing; Mitsuba 0.6 takes it from its default preset, which is not "
+                             "supported: 0 used", na ? "sigmaS" : "sigmaA");
+        } else {
+            vec3 sig = v3s(1.0f);
+            if ((st = get_color(p, mn, "sigma_t", &sig))) return st;
+            xvol al;
+            if ((st = medium_volume(p, mn, "albedo", v3s(0.75f), &al))) return st;
+            if (al.grid) {
+                double sum[3] = {0, 0, 0};
+                const size_t nv = (size_t)al.g.nx * (size_t)al.g.ny * (size_t)al.g.nz;
+                for (size_t i = 0; i < nv; i++)
+                    for (int c = 0; c < 3; c++) sum[c] += (double)al.g.data[i * (size_t)al.g.channels + (al.g.channels == 3 ? c : 0)];
+                al.value = v3((float)(sum[0] / (double)nv), (float)(sum[1] / (double)nv), (float)(sum[2] / (double)nv));
+                mem_free(&p->s->alloc, al.g.data);
+                xwarn(p, al.at, "a homogeneous medium's albedo grid is not supported; its mean (%g, %g, %g) used",
+                      (double)al.value.x, (double)al.value.y, (double)al.value.z);
+            }
+            if (v0 && (!nt || !nl))
+                xwarn(p, mn, "medium: %s missing; Mitsuba 0.6 takes it from its default preset, which is not "
+                             "supported: %s used", nt ? "albedo" : "sigmaT", nt ? "0.75" : "1");
+            if ((st = medium_values(p, mn, sig, al.value))) return st;
+            ss = v3_mul(sig, al.value);
+            sa = v3_max(v3_sub(sig, ss), v3s(0.0f));
+        }
+        if (!(sa.x >= 0.0f && sa.y >= 0.0f && sa.z >= 0.0f && ss.x >= 0.0f && ss.y >= 0.0f && ss.z >= 0.0f))
+            return xfail(p, PK_ERR_PARSE, na ? na : ns, "medium: sigma_a and sigma_s must not be negative");
+        if (v0 && prop(p, mn, "g")) { /* Mitsuba 0.6: g scales sigma_s to the reduced (1 - g) sigma_s */
+            vec3 gv = v3s(0.0f);
+            if ((st = get_color(p, mn, "g", &gv))) return st;
+            const float g = (gv.x + gv.y + gv.z) / 3.0f;
+            if (!(g > -1.0f && g < 1.0f)) return xfail(p, PK_ERR_PARSE, mn, "medium: g must lie in (-1, 1)");
+            ss = v3_scale(ss, 1.0f - g);
+        }
+        m->kind = MEDIUM_HOMOGENEOUS;
+        const vec3 t = v3_add(sa, ss);
+        const float tt[3] = {t.x, t.y, t.z}, s3[3] = {ss.x, ss.y, ss.z};
+        float a[3];
+        for (int c = 0; c < 3; c++) a[c] = tt[c] > 0.0f ? fminf(s3[c] / tt[c], 1.0f) : 1.0f;
+        m->sigma_t = v3_scale(t, scale);
+        m->albedo = v3(a[0], a[1], a[2]);
+        if ((st = medium_values(p, mn, m->sigma_t, m->albedo))) return st;
+        warn_unused(p, mn, kind, quiet);
+        return PK_OK;
+    }
+    /* heterogeneous: Mitsuba 3's sigma_t and albedo (each a value or a
+     * volume), Mitsuba 0.6's density and albedo volumes */
+    if (prop(p, mn, "sigma_a") || prop(p, mn, "sigma_s"))
+        return xfail(p, PK_ERR_PARSE, mn, "a heterogeneous medium takes sigma_t (or density) and albedo, not sigma_a "
+                                          "and sigma_s");
+    xform mw;
+    if ((st = get_to_world(p, mn, &mw, NULL))) return st;
+    xvol sig, al;
+    const char *sname = prop(p, mn, "density") ? "density" : "sigma_t";
+    if ((st = medium_volume(p, mn, sname, v3s(1.0f), &sig))) return st;
+    if ((st = medium_volume(p, mn, "albedo", v3s(0.75f), &al))) {
+        mem_free(&p->s->alloc, sig.g.data);
+        return st;
+    }
+    /* the grids go to *m at once, so that the caller frees them on failure */
+    m->density = sig.g, m->albedo_grid = al.g;
+    if (v0 && !sig.present) return xfail(p, PK_ERR_PARSE, mn, "a heterogeneous medium needs a density volume");
+    m->albedo = al.grid ? v3s(1.0f) : al.value;
+    m->sigma_t = v3_scale(sig.grid ? v3s(1.0f) : sig.value, scale);
+    if ((st = medium_values(p, mn, m->sigma_t, m->albedo))) return st;
+    if (!sig.grid && !al.grid) { /* constants everywhere: a homogeneous medium */
+        m->kind = MEDIUM_HOMOGENEOUS;
+        warn_unused(p, mn, kind, quiet);
+        return PK_OK;
+    }
+    m->kind = MEDIUM_GRID;
+    if (sig.grid && al.grid && !xform_near(&sig.to_world, &al.to_world))
+        return xfail(p, PK_ERR_UNSUPPORTED, al.at, "the albedo grid must span the same box as the %s grid", sname);
+    if (!sig.grid) { /* a constant extinction over the albedo grid's box */
+        m->density.data = mem_alloc(&p->s->alloc, sizeof(float));
+        if (!m->density.data) return ctx_nomem(p->ctx);
+        m->density.data[0] = 1.0f;
+        m->density.nx = m->density.ny = m->density.nz = m->density.channels = 1;
+        xwarn(p, al.at, "a constant %s with an albedo grid: the medium fills the albedo grid's box only", sname);
+    }
+    const xform *gw = sig.grid ? &sig.to_world : &al.to_world;
+    m->grid_to_world = xform_mul(&mw, gw);
+    if (!xform_finite(&m->grid_to_world) || !(xform_det3(&m->grid_to_world) != 0.0))
+        return xfail(p, PK_ERR_PARSE, mn, "the grid's placement (to_world) is singular or not finite");
+    warn_unused(p, mn, kind, quiet);
+    return PK_OK;
+}
+
+/* The scene medium of element n (a <medium> or a <ref> to one), made once
+ * per element. */
+static pk_status medium_of(xp *p, xnode *n, int32_t *index)
+{
+    pk_status st;
+    xnode *target = n;
+    if (strcmp(n->tag, "ref") == 0) {
+        const char *id = attr_st(p, n, "id", &st);
+        if (st) return st;
+        if (!id) return xfail(p, PK_ERR_PARSE, n, "<ref> needs an id");
+        target = id_find(p, id);
+        if (!target || strcmp(target->tag, "medium") != 0) {
+            char sid[48];
+            shown(sid, sizeof sid, id);
+            return xfail(p, PK_ERR_PARSE, n, "no medium has the id \"%s\"%s", sid, target ? "" : " (defined before here)");
+        }
+    }
+    n->used = true;
+    if (target->medium >= 0) {
+        *index = (int32_t)target->medium;
+        return PK_OK;
+    }
+    const char *nid = attr_st(p, target, "id", &st);
+    if (st) return st;
+    if (target == n && nid && n->parent && strcmp(n->parent->tag, "scene") != 0 && (st = id_add(p, nid, n)))
+        return st; /* (a medium inside a shape or sensor; the scene's are added as they come) */
+    medium m;
+    medium_init(&m);
+    if ((st = medium_convert(p, target, &m))) {
+        medium_free(&p->s->alloc, &m);
+        return st;
+    }
+    const char *id = attr_st(p, target, "id", &st);
+    char name[96];
+    if (id) shown(name, sizeof name, id);
+    else snprintf(name, sizeof name, "medium@%s:%lu", target->file->shown, target->line);
+    m.name = mem_strdup(&p->s->alloc, name);
+    if (!m.name) {
+        medium_free(&p->s->alloc, &m);
+        return ctx_nomem(p->ctx);
+    }
+    uint32_t idx;
+    if ((st = scene_add_medium(p->ctx, p->s, &m, &idx))) return st;
+    target->medium = (int64_t)idx;
+    *index = (int32_t)idx;
+    return PK_OK;
+}
+
 /* ---- shapes --------------------------------------------------------------------------------- */
 
 static pk_status parse_emitter_area(xp *p, xnode *e, vec3 *radiance)
@@ -1810,9 +2151,29 @@ static pk_status parse_shape(xp *p, xnode *sh)
     bool flip = false;
     if ((st = get_bool(p, sh, "flip_normals", &flip))) return st;
 
-    /* its bsdf (a nested one or a reference) and its area emitter */
-    xnode *bsdf = NULL, *emitter = NULL;
+    /* its bsdf (a nested one or a reference), its area emitter and the
+     * media inside and outside it */
+    xnode *bsdf = NULL, *emitter = NULL, *sides[2] = {NULL, NULL}; /* interior, exterior */
     for (xnode *c = sh->child; c; c = c->next) {
+        const char *cname = NULL;
+        if (strcmp(c->tag, "ref") == 0 || strcmp(c->tag, "medium") == 0) {
+            cname = attr_st(p, c, "name", &st);
+            if (st) return st;
+        }
+        const bool medium_ref = cname && strcmp(c->tag, "ref") == 0 &&
+                                (strcmp(cname, "interior") == 0 || strcmp(cname, "exterior") == 0);
+        if (strcmp(c->tag, "medium") == 0 || medium_ref) {
+            c->used = true;
+            const int side = cname && strcmp(cname, "interior") == 0 ? 0 : cname && strcmp(cname, "exterior") == 0 ? 1 : -1;
+            if (side < 0) {
+                xwarn(p, c, "a shape's medium needs name=\"interior\" or name=\"exterior\"; ignored");
+            } else if (sides[side]) {
+                xwarn(p, c, "a shape takes one %s medium; this one is ignored", cname);
+            } else {
+                sides[side] = c;
+            }
+            continue;
+        }
         if (strcmp(c->tag, "bsdf") == 0 || strcmp(c->tag, "ref") == 0) {
             if (strcmp(c->tag, "ref") == 0) {
                 const char *rid = attr_st(p, c, "id", &st);
@@ -1838,16 +2199,33 @@ static pk_status parse_shape(xp *p, xnode *sh)
                 continue;
             }
             emitter = c;
-        } else if (strcmp(c->tag, "medium") == 0 || strcmp(c->tag, "subsurface") == 0) {
+        } else if (strcmp(c->tag, "subsurface") == 0) {
             c->used = true;
-            if (first_time(p, "medium"))
-                xwarn(p, c, "participating media and subsurface scattering are not supported; ignored");
+            if (first_time(p, "subsurface"))
+                xwarn(p, c, "subsurface integrators are not supported (media inside a dielectric are); ignored");
+        }
+    }
+    int32_t med[2] = {MEDIUM_INHERIT, MEDIUM_INHERIT};
+    if (sides[0] || sides[1]) { /* a medium transition: a side left out is vacuum */
+        for (int i = 0; i < 2; i++) {
+            med[i] = MEDIUM_NONE;
+            if (sides[i] && (st = medium_of(p, sides[i], &med[i]))) return st;
         }
     }
     uint32_t mat = 0;
     bool has_bsdf = bsdf != NULL;
     if (bsdf && (st = material_of(p, bsdf, &mat))) return st;
-    if (!bsdf) { /* Mitsuba's default: diffuse, reflectance 0.5 */
+    if (!bsdf && (sides[0] || sides[1]) && p->version_major < 2) {
+        /* Mitsuba 0.x: a medium transition without a bsdf is index-matched */
+        int64_t d = scene_find_material(p->s, "mitsuba-index-matched");
+        if (d < 0) {
+            uint32_t idx;
+            if ((st = scene_add_material(p->ctx, p->s, "mitsuba-index-matched", &idx))) return st;
+            material_interface(&p->s->materials[idx]);
+            d = idx;
+        }
+        mat = (uint32_t)d;
+    } else if (!bsdf) { /* Mitsuba's default: diffuse, reflectance 0.5 */
         int64_t d = scene_find_material(p->s, "mitsuba-default-diffuse");
         if (d < 0) {
             uint32_t idx;
@@ -1857,6 +2235,8 @@ static pk_status parse_shape(xp *p, xnode *sh)
         }
         mat = (uint32_t)d;
     }
+    if ((sides[0] || sides[1]) && (st = scene_material_with_media(p->ctx, p->s, mat, med[0], med[1], &mat)))
+        return st;
     if (emitter) {
         const char *et = attr_st(p, emitter, "type", &st);
         if (st) return st;
@@ -2254,6 +2634,16 @@ static pk_status parse_sensor(xp *p, xnode *sn)
         } else if (strcmp(c->tag, "sampler") == 0) {
             c->used = true;
             if ((st = parse_sampler(p, c))) return st;
+        } else if (strcmp(c->tag, "medium") == 0 || strcmp(c->tag, "ref") == 0) { /* the camera's medium */
+            if (strcmp(c->tag, "ref") == 0) {
+                const char *rid = attr_st(p, c, "id", &st);
+                if (st) return st;
+                const xnode *t = rid ? id_find(p, rid) : NULL;
+                if (t && strcmp(t->tag, "medium") != 0) continue;
+            }
+            int32_t med;
+            if ((st = medium_of(p, c, &med))) return st;
+            p->s->camera_medium = med;
         }
     }
     static const char *const quiet[] = {"near_clip", "far_clip", "focus_distance", "shutter_open", "shutter_close",
@@ -2304,8 +2694,12 @@ static pk_status parse_integrator(xp *p, xnode *in, int depth)
     bool path = false;
     for (int i = 0; pathlike[i]; i++)
         if (strcmp(type, pathlike[i]) == 0) path = true;
+    static const char *const vol[] = {"volpath", "volpathmis", "volpath_simple", "prbvolpath", NULL};
+    bool volumetric = false;
+    for (int i = 0; vol[i]; i++)
+        if (strcmp(type, vol[i]) == 0) volumetric = true;
     scene_render_settings *r = &p->s->render;
-    r->opt.integrator = PK_INTEGRATOR_PATH;
+    r->opt.integrator = volumetric ? PK_INTEGRATOR_VOLPATH : PK_INTEGRATOR_PATH;
     r->has_integrator = true;
     int64_t md = -1;
     bool found = false;
@@ -2416,8 +2810,16 @@ static pk_status parse_scene(xp *p, xnode *root, int include_depth)
             if ((st = parse_sensor(p, c))) return st;
         } else if (strcmp(t, "integrator") == 0) {
             if ((st = parse_integrator(p, c, 0))) return st;
-        } else if (strcmp(t, "medium") == 0 || strcmp(t, "phase") == 0) {
-            if (first_time(p, "medium")) xwarn(p, c, "participating media are not supported; ignored");
+        } else if (strcmp(t, "medium") == 0) { /* made now, so that a bad one is reported where it is */
+            const char *id = attr_st(p, c, "id", &st);
+            if (st) return st;
+            if (id && (st = id_add(p, id, c))) return st;
+            int32_t med;
+            if ((st = medium_of(p, c, &med))) return st;
+        } else if (strcmp(t, "phase") == 0) {
+            const char *id = attr_st(p, c, "id", &st);
+            if (st) return st;
+            if (id && (st = id_add(p, id, c))) return st;
         } else if (strcmp(t, "ref") == 0 || strcmp(t, "null") == 0) {
             continue;
         } else {

@@ -227,7 +227,7 @@ static void test_errors(void)
 {
     const char *types =
         "must be one of \"diffuse\", \"conductor\", \"dielectric\", \"plastic\", \"metallic_roughness\", "
-        "\"emitter\", \"two_sided\"";
+        "\"emitter\", \"two_sided\", \"interface\"";
     char want[512];
     snprintf(want, sizeof want, "scene.json:1: materials.gold.type: %s", types);
     EXPECT_ERROR(MAT("{\"type\": \"metal\"}"), want);
