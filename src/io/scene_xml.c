@@ -1824,6 +1824,19 @@ static pk_status medium_volume_read(xp *p, xnode *med, const char *name, vec3 de
             return xfail(p, PK_ERR_PARSE, c, "the grid's box is empty or inverted");
     }
     if (!use_box) box = (aabb){v3s(0.0f), v3s(1.0f)};
+    if (p->version_major < 2) {
+        /* Mitsuba 0.x puts the voxels' values at the box's grid points
+         * (voxel i at lo + i (hi - lo) / (n - 1)); Paprsek's voxels are cell
+         * centred: the cells grow the box by half a cell on each side */
+        const int nn[3] = {v->g.nx, v->g.ny, v->g.nz};
+        float lo[3] = {box.lo.x, box.lo.y, box.lo.z}, hi[3] = {box.hi.x, box.hi.y, box.hi.z};
+        for (int a = 0; a < 3; a++) {
+            if (nn[a] < 2) continue;
+            const float half = 0.5f * (hi[a] - lo[a]) / (float)(nn[a] - 1);
+            lo[a] -= half, hi[a] += half;
+        }
+        box = (aabb){v3(lo[0], lo[1], lo[2]), v3(hi[0], hi[1], hi[2])};
+    }
     xform tw;
     if ((st = get_to_world(p, c, &tw, NULL))) return st;
     const xform t = xform_translate(box.lo), sc = xform_scale(v3_sub(box.hi, box.lo)), ts = xform_mul(&t, &sc);

@@ -442,8 +442,14 @@ static void test_xml_heterogeneous(void)
     m = find_medium(s, "smoke");
     REQUIRE(m);
     CHECK(near3(m->sigma_t, 3, 3, 3, 0) && near3(m->albedo, 0.9f, 0.9f, 0.9f, 1e-6f));
-    CHECK(near3(xform_point(&m->grid_to_world, v3(0, 0, 0)), -1, 0, -1, 0));
-    CHECK(near3(xform_point(&m->grid_to_world, v3(1, 1, 1)), 1, 4, 5, 0));
+    /* vertex-centred voxels: the x axis (2 voxels) grows by half its spacing
+     * of 2 on each side; y and z (1 voxel) keep the file's box */
+    CHECK(near3(xform_point(&m->grid_to_world, v3(0, 0, 0)), -2, 0, -1, 0));
+    CHECK(near3(xform_point(&m->grid_to_world, v3(1, 1, 1)), 2, 4, 5, 0));
+    /* the voxels' values at the file's box corners, as Mitsuba 0.6 reads them */
+    medium_point c0 = medium_at(m, v3(-1, 1.5f, 2)), c1 = medium_at(m, v3(1, 1.5f, 2));
+    CHECK_NEAR(c0.sigma_a.x + c0.sigma_s.x, 3.0f * 1.0f, 1e-5);
+    CHECK_NEAR(c1.sigma_a.x + c1.sigma_s.x, 3.0f * 3.0f, 1e-5);
     pk_scene_destroy(s);
 }
 
