@@ -173,6 +173,12 @@ static inline PK_HD vec3 vol_transmittance(const medium *m, const ray *r, float 
 static inline PK_HD vec3 vol_shadow(const path_tracer *pt, path_thread *t, const ray *sh, int32_t med, sampler *smp)
 {
     const scene_view *s = &pt->f->v;
+    if (!s->has_interfaces && (med < 0 || s->media[med].kind == MEDIUM_HOMOGENEOUS)) {
+        /* nothing to pass through but holes, and a transmittance in closed
+         * form: an occlusion test will do */
+        if (path_occluded(pt, t, sh)) return v3s(0.0f);
+        return med < 0 ? v3s(1.0f) : vol_transmittance(&s->media[med], sh, sh->tmax, smp);
+    }
     ray r = *sh;
     vec3 T = v3s(1.0f);
     for (int k = 0; k < VOL_MAX_CROSSINGS; k++) {

@@ -480,7 +480,7 @@ pk_status scene_commit(pk_context *ctx, pk_scene *s)
     s->emissive = NULL;
     s->ndegenerate = s->nemissive = 0;
     s->bounds = aabb_empty();
-    s->has_cutout = s->has_textured = false;
+    s->has_cutout = s->has_textured = s->has_interfaces = false;
     for (size_t i = 0; i < s->nmaterials; i++) {
         material *m = &s->materials[i];
         m->cutout = m->map_d.kind != TEX_NONE;
@@ -488,6 +488,7 @@ pk_status scene_commit(pk_context *ctx, pk_scene *s)
                       m->map_alpha.kind != TEX_NONE || m->map_bump.kind != TEX_NONE || m->map_norm.kind != TEX_NONE ||
                       m->map_mr.kind != TEX_NONE;
         s->has_cutout |= m->cutout;
+        s->has_interfaces |= m->type == MAT_INTERFACE;
         s->has_textured |= m->textured;
     }
     if (s->ntris) {

@@ -36,6 +36,7 @@ typedef struct scene_view {
     const medium *media;
     size_t nmedia;
     int32_t camera_medium;
+    bool has_interfaces;      /* a material is MAT_INTERFACE (rays pass through some surfaces) */
 } scene_view;
 
 /* The view of committed scene s (its arrays, not copies). */
@@ -51,6 +52,7 @@ static inline scene_view scene_view_of(const pk_scene *s)
     v.mesh_positions = s->mesh_positions, v.mesh_normals = s->mesh_normals, v.mesh_uvs = s->mesh_uvs;
     v.mesh_tris = s->mesh_tris;
     v.media = s->media, v.nmedia = s->nmedia, v.camera_medium = s->camera_medium;
+    v.has_interfaces = s->has_interfaces;
     return v;
 }
 

@@ -287,6 +287,37 @@ static void check_shadow_transmittance(void)
     scene_destroy(s);
 }
 
+/* A global absorbing fog (the camera's medium, no boundaries) over a
+ * diffuse floor lit by a point light: rho/pi I cos / r^2 e^-sigma r,
+ * times e^-sigma for the camera ray's way down (the occlusion test and the
+ * closed-form transmittance of shadow rays in homogeneous media). */
+static void check_global_fog(void)
+{
+    pk_scene *s = new_scene("global fog");
+    const float sa = 0.3f;
+    s->camera_medium = (int32_t)add_homogeneous(s, v3s(sa), v3s(0.0f), 0.0f, v3s(0.0f));
+    const uint32_t floor_m = add_mat(s, "floor");
+    material_diffuse(&s->materials[floor_m], v3s(0.5f));
+    add_quad(s, v3(-60.0f, -60.0f, 0.0f), v3(60.0f, -60.0f, 0.0f), v3(60.0f, 60.0f, 0.0f), v3(-60.0f, 60.0f, 0.0f),
+             floor_m);
+    point_light l;
+    memset(&l, 0, sizeof l);
+    l.position = v3(0.0f, 0.0f, 2.0f), l.intensity = v3s(5.0f);
+    REQUIRE(scene_add_point_light(ctx, s, &l) == PK_OK);
+    ortho_down(s, 1.0f, 0.5f);
+    double sum = 0.0;
+    const int n = 400;
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++) {
+            const double x = -0.25 + (i + 0.5) * 0.5 / n, y = -0.25 + (j + 0.5) * 0.5 / n;
+            const double r = sqrt(x * x + y * y + 4.0);
+            sum += 0.5 / PI_D * 5.0 * (2.0 / r) / (r * r) * exp(-(double)sa * r) * exp(-(double)sa);
+        }
+    const double m = sum / ((double)n * n), want[3] = {m, m, m};
+    expect("global fog over a lit floor", render(s, 32, 16, 1, 0), want);
+    scene_destroy(s);
+}
+
 /* ---- emission ----------------------------------------------------------------- */
 
 static void check_emission(void)
@@ -546,6 +577,7 @@ int main(void)
     REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
     check_absorption();
     check_shadow_transmittance();
+    check_global_fog();
     check_emission();
     check_single_scattering();
     check_furnaces();
