@@ -2523,6 +2523,87 @@ static pk_status medium_box(pp *p, const char *what, xform *box)
     return PK_OK;
 }
 
+/* The RGB radiance of pbrt's blackbody emitter at kelvin (its spectrum
+ * scaled to 1 at its peak, not to a luminance), as pbrt's sensor records
+ * it: the colour of luminance 1 times the spectrum's luminance. */
+static vec3 blackbody_peak_rgb(double kelvin)
+{
+    const double peak = planck(&kelvin, 2.8977721e-3 / kelvin * 1e9);
+    double y = 0.0;
+    for (int nm = 360; nm <= 830; nm++) {
+        float xyz[3];
+        spectra_cie1931((float)nm, xyz);
+        y += planck(&kelvin, (double)nm) / peak * (double)xyz[1];
+    }
+    return v3_scale(blackbody_unit((float)kelvin), (float)y);
+}
+
+#define BB_TABLE 2048
+#define BB_TMIN 100.0
+#define BB_TMAX 1e5
+
+/* uniformgrid's "temperature": emission from a blackbody at each voxel's
+ * temperature (temperature - temperatureoffset) x temperaturescale, none
+ * at 100 K or below, times Lescale (one value: lsc, or the emission grid
+ * already read). pbrt interpolates the temperature between voxels and then
+ * takes the blackbody's colour; here each voxel's colour is interpolated. */
+static pk_status medium_temperature(pp *p, const char *what, medium *m, const pparam *tq, const int n[3], size_t count,
+                                    float lsc)
+{
+    float off = 0.0f, sc = 1.0f;
+    pk_status st;
+    if (param(p, "temperatureoffset")) st = get_float(p, "temperatureoffset", &off);
+    else st = get_float(p, "temperaturecutoff", &off);
+    if (st || (st = get_float(p, "temperaturescale", &sc))) return st;
+    medium_grid tg = {0};
+    if ((st = medium_grid_param(p, what, tq, 1, n, count, &tg))) return st;
+    float *e = mem_calloc(&p->s->alloc, count * 3, sizeof *e);
+    vec3 *table = mem_calloc(A(p), BB_TABLE, sizeof *table);
+    if (!e || !table) {
+        mem_free(&p->s->alloc, tg.data);
+        mem_free(&p->s->alloc, e);
+        mem_free(A(p), table);
+        return ctx_nomem(p->ctx);
+    }
+    /* the colours on a geometric scale of temperatures, interpolated */
+    const double step = log(BB_TMAX / BB_TMIN) / (BB_TABLE - 1);
+    for (int i = 0; i < BB_TABLE; i++) table[i] = blackbody_peak_rgb(BB_TMIN * exp(step * i));
+    for (size_t v = 0; v < count; v++) {
+        const double t = ((double)tg.data[v] - (double)off) * (double)sc;
+        vec3 c = v3s(0.0f);
+        if (t > BB_TMAX) {
+            c = blackbody_peak_rgb(t);
+        } else if (t > BB_TMIN) {
+            const double x = log(t / BB_TMIN) / step;
+            int i = (int)x;
+            if (i > BB_TABLE - 2) i = BB_TABLE - 2;
+            /* geometric between neighbours (the colours grow about
+             * exponentially with the temperature), linear where one is 0 */
+            const double f = x - i;
+            const float a[3] = {table[i].x, table[i].y, table[i].z}, b[3] = {table[i + 1].x, table[i + 1].y, table[i + 1].z};
+            float o[3];
+            for (int k = 0; k < 3; k++)
+                o[k] = a[k] > 0.0f && b[k] > 0.0f ? (float)exp((1.0 - f) * log((double)a[k]) + f * log((double)b[k]))
+                                                  : (float)((1.0 - f) * (double)a[k] + f * (double)b[k]);
+            c = v3(o[0], o[1], o[2]);
+        }
+        const float k = m->emission_grid.data ? m->emission_grid.data[v] : lsc;
+        e[3 * v] = c.x * k, e[3 * v + 1] = c.y * k, e[3 * v + 2] = c.z * k;
+        if (!isfinite(e[3 * v]) || !isfinite(e[3 * v + 1]) || !isfinite(e[3 * v + 2])) {
+            mem_free(&p->s->alloc, tg.data);
+            mem_free(&p->s->alloc, e);
+            mem_free(A(p), table);
+            return pfail(p, tq->line, PK_ERR_PARSE, "%s: the emission of voxel %zu (%g K) is not finite", what, v, t);
+        }
+    }
+    mem_free(&p->s->alloc, tg.data);
+    mem_free(A(p), table);
+    mem_free(&p->s->alloc, m->emission_grid.data);
+    m->emission_grid = (medium_grid){n[0], n[1], n[2], 3, e};
+    m->le = v3s(1.0f);
+    return PK_OK;
+}
+
 /* pbrt-v4's "uniformgrid": a density grid (float, or rgb: 3 channels) times
  * sigma_a + sigma_s, emission Le times Lescale (one value, or a grid). */
 static pk_status medium_uniformgrid(pp *p, const char *what, medium *m)
@@ -2530,25 +2611,26 @@ static pk_status medium_uniformgrid(pp *p, const char *what, medium *m)
     int n[3];
     size_t count;
     pk_status st;
-    pparam *dq, *lq;
+    pparam *dq, *lq, *tq;
     if ((st = medium_dims(p, what, n, &count))) return st;
     if ((st = param_typed(p, "density", TB(PT_FLOAT) | TB(PT_RGB), "floats (or rgb triples)", &dq))) return st;
     if (!dq) return pfail(p, p->line, PK_ERR_PARSE, "%s: uniformgrid needs 'float density' (nx x ny x nz values)", what);
-    if (param(p, "temperature"))
-        return pfail(p, param(p, "temperature")->line, PK_ERR_UNSUPPORTED,
-                     "%s: 'temperature' grids (blackbody emission) are not supported; give 'Le' and 'Lescale'", what);
+    if ((st = param_typed(p, "temperature", TB(PT_FLOAT), "floats", &tq))) return st;
     if ((st = medium_grid_param(p, what, dq, dq->type == PT_RGB ? 3 : 1, n, count, &m->density))) return st;
     vec3 le = v3s(0.0f);
+    pparam *leq = param(p, "Le");
+    if (tq && leq) return pfail(p, leq->line, PK_ERR_PARSE, "%s: give 'Le' or 'temperature', not both", what);
     if ((st = medium_spectrum(p, what, "Le", true, &le))) return st;
     if ((st = param_typed(p, "Lescale", TB(PT_FLOAT), "floats", &lq))) return st;
     float lsc = 1.0f;
     if (lq && lq->nnum == 1) {
         if ((st = medium_float(p, what, "Lescale", 0.0f, 3.4e38f, &lsc))) return st;
-    } else if (lq && v3_max_comp(le) > 0.0f) {
+    } else if (lq && (v3_max_comp(le) > 0.0f || tq)) {
         if ((st = medium_grid_param(p, what, lq, 1, n, count, &m->emission_grid))) return st;
     }
     m->le = v3_scale(le, lsc);
     m->kind = MEDIUM_GRID;
+    if (tq) return medium_temperature(p, what, m, tq, n, count, lsc);
     return PK_OK;
 }
 

@@ -12,6 +12,7 @@
 
 #include "io/readers.h"
 #include "scene/scene.h"
+#include "scene/spectra.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -282,6 +283,63 @@ static void test_pbrt_grids(void)
     done(ctx, s);
 }
 
+static double planck_nm(double kelvin, double nm)
+{
+    const double h = 6.62607015e-34, c = 2.99792458e8, kb = 1.380649e-23, l = nm * 1e-9;
+    return 2 * h * c * c / (l * l * l * l * l) / (exp(h * c / (l * kb * kelvin)) - 1);
+}
+
+/* pbrt's blackbody at kelvin, 1 at its peak (Wien's displacement law), as
+ * linear sRGB of what pbrt's sensor records (X, Y, Z: the CIE 1931
+ * functions integrated at every nanometre, not normalised), colours
+ * outside sRGB clipped at 0. */
+static vec3 blackbody_closed_form(double kelvin)
+{
+    const double peak = planck_nm(kelvin, 2.8977721e6 / kelvin);
+    double X = 0, Y = 0, Z = 0;
+    for (int nm = 360; nm <= 830; nm++) {
+        const double b = planck_nm(kelvin, nm) / peak;
+        float xyz[3];
+        spectra_cie1931((float)nm, xyz);
+        X += b * (double)xyz[0], Y += b * (double)xyz[1], Z += b * (double)xyz[2];
+    }
+    return v3((float)fmax(0.0, 3.2404542 * X - 1.5371385 * Y - 0.4985314 * Z),
+              (float)fmax(0.0, -0.9692660 * X + 1.8760108 * Y + 0.0415560 * Z),
+              (float)fmax(0.0, 0.0556434 * X - 0.2040259 * Y + 1.0572252 * Z));
+}
+
+static void test_pbrt_temperature(void)
+{
+    pk_context *ctx;
+    pk_scene *s = pbrt(&ctx, PLAIN "LightSource \"point\"\n" TRI
+                       "MakeNamedMedium \"fire\" \"string type\" \"uniformgrid\" \"integer nx\" 3\n"
+                       "  \"float density\" [1 1 1] \"float temperature\" [50 3250 6500] \"float Lescale\" [1 1 0.5]\n"
+                       "  \"float temperaturescale\" 2 \"float temperatureoffset\" 3000\n"
+                       "MakeNamedMedium \"ember\" \"string type\" \"uniformgrid\" \"float density\" [1]\n"
+                       "  \"float temperature\" [1500] \"float Lescale\" 3\n");
+    if (s) {
+        /* (T - 3000) x 2: none (below 100 K), 500 K, 7000 K x 0.5 */
+        const medium *m = find(s, "fire");
+        REQUIRE(m->emission_grid.data && m->emission_grid.channels == 3 && m->emission_grid.nx == 3);
+        const float *e = m->emission_grid.data;
+        CHECK(e[0] == 0.0f && e[1] == 0.0f && e[2] == 0.0f);
+        const vec3 want1 = blackbody_closed_form(500.0), want2 = v3_scale(blackbody_closed_form(7000.0), 0.5f);
+        CHECKF(near3(v3(e[3], e[4], e[5]), want1, 2e-3f * v3_max_comp(want1) + 1e-12f), "%g %g %g vs %g %g %g", (double)e[3],
+               (double)e[4], (double)e[5], (double)want1.x, (double)want1.y, (double)want1.z);
+        CHECKF(near3(v3(e[6], e[7], e[8]), want2, 2e-3f * v3_max_comp(want2)), "%g %g %g vs %g %g %g", (double)e[6], (double)e[7],
+               (double)e[8], (double)want2.x, (double)want2.y, (double)want2.z);
+        CHECK(near3(m->le, v3s(1.0f), 0));
+        /* a 7000 K blackbody is bluish white and bright in pbrt's units (its
+         * spectrum is 1 at its peak, near 414 nm) */
+        CHECK(want2.z > want2.x && want2.y > 20.0f);
+        const medium *em = find(s, "ember");
+        const vec3 w3 = v3_scale(blackbody_closed_form(1500.0), 3.0f);
+        CHECK(near3(v3(em->emission_grid.data[0], em->emission_grid.data[1], em->emission_grid.data[2]), w3,
+                    2e-3f * v3_max_comp(w3)));
+    }
+    done(ctx, s);
+}
+
 static void test_pbrt_errors(void)
 {
     const char *hom = "MakeNamedMedium \"m\" \"string type\" \"homogeneous\"\n";
@@ -317,8 +375,11 @@ static void test_pbrt_errors(void)
                "  \"point3 p0\" [0 0 0] \"point3 p1\" [1 0 1]\n",
                "t.pbrt:1: ", "has no volume");
     pbrt_error("MakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"float density\" [1]\n"
-               "  \"float temperature\" [1000]\n",
-               "t.pbrt:2: ", "'temperature' grids");
+               "  \"float temperature\" [1000 2000]\n",
+               "t.pbrt:2: ", "'float temperature' has 2 values");
+    pbrt_error("MakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"float density\" [1]\n"
+               "  \"float temperature\" [1000] \"rgb Le\" [1 1 1]\n",
+               "t.pbrt:2: ", "give 'Le' or 'temperature', not both");
     pbrt_error("MakeNamedMedium \"m\" \"string type\" \"uniformgrid\" \"integer nx\" 2 \"float density\" [1 1]\n"
                "  \"rgb Le\" [1 1 1] \"float Lescale\" [1 2 3]\n",
                "t.pbrt:2: ", "'float Lescale' has 3 values");
@@ -619,6 +680,7 @@ int main(void)
     test_pbrt_homogeneous();
     test_pbrt_sides();
     test_pbrt_grids();
+    test_pbrt_temperature();
     test_pbrt_errors();
     test_gltf_volume();
     test_fog_scene();
