@@ -568,6 +568,51 @@ static void test_fog_scene(void)
     pk_scene_destroy(xs);
 }
 
+/* ---- allocation failures ---------------------------------------------------------- */
+
+typedef struct failing {
+    long calls, fail_at; /* the fail_at-th call fails (0: none) */
+    long live;
+} failing;
+
+static void *failing_realloc(void *user, void *ptr, size_t size)
+{
+    failing *f = user;
+    if (size == 0) {
+        if (ptr) f->live--;
+        free(ptr);
+        return NULL;
+    }
+    if (++f->calls == f->fail_at) return NULL;
+    void *q = realloc(ptr, size);
+    if (q && !ptr) f->live++;
+    return q;
+}
+
+/* Every allocation failing in turn while the fog scene loads: NOMEM back
+ * and nothing left allocated. */
+static void test_alloc_failures(const char *path)
+{
+    int failures_seen = 0;
+    long n = 1;
+    for (; n < 100000; n++) {
+        failing f = {0, 0, 0};
+        pk_allocator a = {failing_realloc, &f};
+        pk_context *c = NULL;
+        REQUIRE(pk_context_create(&a, &c) == PK_OK);
+        f.fail_at = f.calls + n;
+        pk_scene *s = NULL;
+        pk_status st = pk_scene_load_file(c, path, &s);
+        if (s) pk_scene_destroy(s);
+        pk_context_destroy(c);
+        CHECKF(f.live == 0, "%s: failing call %ld: %ld blocks leaked", path, n, f.live);
+        if (st == PK_OK) break;
+        CHECKF(st == PK_ERR_NOMEM, "%s: failing call %ld: status %d", path, n, (int)st);
+        failures_seen++;
+    }
+    CHECKF(failures_seen > 20 && n < 100000, "%s: %d failures", path, failures_seen);
+}
+
 int main(void)
 {
     snprintf(tmpdir, sizeof tmpdir, "%s", "/tmp/pk_test_media_mj_XXXXXX");
@@ -581,6 +626,8 @@ int main(void)
     test_xml_heterogeneous();
     test_xml_errors();
     test_fog_scene();
+    test_alloc_failures(PK_TEST_DATA "/media/fog.json");
+    test_alloc_failures(PK_TEST_DATA "/media/fog.xml");
     pk_context_destroy(ctx);
     char cmd[300];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
