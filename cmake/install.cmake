@@ -66,6 +66,10 @@ endif()
 # link the C++ libraries too (OpenEXR, Iex, IlmThread) and add Imath's
 # headers, none of which the library uses.
 list(APPEND PK_PC_LIBS_PRIVATE -ljpeg -l${PK_OPENEXR_LINK_NAME})
+# OpenVDB (where it is built in): its libraries and the C++ library.
+foreach(name ${PK_OPENVDB_LINK_NAMES})
+  list(APPEND PK_PC_LIBS_PRIVATE -l${name})
+endforeach()
 list(APPEND PK_PC_LIBS_PRIVATE -lm ${CMAKE_THREAD_LIBS_INIT})
 foreach(lib ${PK_DL_LIBS})
   list(APPEND PK_PC_LIBS_PRIVATE -l${lib})

@@ -5,7 +5,9 @@
  * infinite values, zero, negative and huge sizes, foreign versions,
  * encodings and channel counts, empty and inverted boxes) each refused
  * with one message that names the file, nothing left allocated. NanoVDB
- * and OpenVDB files further down.
+ * files written here in that format's layout, read back and refused the
+ * same way; an OpenVDB file made by OpenVDB (tests/data/media/grid.vdb),
+ * read back where the build has OpenVDB, refused with a message where not.
  */
 #include "test.h"
 
@@ -580,6 +582,69 @@ static void check_nanovdb_hostile(pk_context *ctx)
     free(grid);
 }
 
+/* ---- OpenVDB -------------------------------------------------------------------- */
+
+/* tests/data/media/grid.vdb, written by make_grid_vdb.cpp beside it: grids
+ * "temperature" (doubles) and "density" (floats, background 0.5, voxels
+ * (x, y, 7), x -2..2, y 0..1, = 100 + x + 10 y but (0, 1, 7) unset), voxel
+ * size 0.25, shifted by (1, 2, 3). */
+static void check_openvdb(pk_context *ctx)
+{
+    const char *path = PK_TEST_DATA "/media/grid.vdb";
+    medium_grid g;
+    aabb box;
+    pk_status st;
+    if (!grid_have_openvdb()) {
+        st = grid_read_openvdb(ctx, &counting, path, NULL, &g, &box);
+        expect_refused(ctx, path, st, &g, PK_ERR_UNSUPPORTED,
+                       "this build reads no .vdb files (OpenVDB was not found when it was built)");
+        fprintf(stderr, "note: this build has no OpenVDB: grid.vdb is only checked to be refused\n");
+        return;
+    }
+    for (int k = 0; k < 2; k++) {
+        st = grid_read_openvdb(ctx, &counting, path, k ? "density" : NULL, &g, &box);
+        REQUIRE(st == PK_OK);
+        CHECKF(g.nx == 5 && g.ny == 2 && g.nz == 1 && g.channels == 1, "%d x %d x %d x %d", g.nx, g.ny, g.nz,
+               g.channels);
+        int bad = 0;
+        for (int y = 0; y < 2; y++)
+            for (int x = -2; x <= 2; x++) {
+                const float want = x == 0 && y == 1 ? 0.5f : (float)(100 + x + 10 * y);
+                if (g.data[y * 5 + x + 2] != want) bad++;
+            }
+        CHECKF(bad == 0, "%d values differ", bad);
+        /* index box -2.5..2.5, -0.5..1.5, 6.5..7.5, times 0.25, plus (1, 2, 3) */
+        CHECK(box.lo.x == 0.375f && box.lo.y == 1.875f && box.lo.z == 4.625f);
+        CHECK(box.hi.x == 1.625f && box.hi.y == 2.375f && box.hi.z == 4.875f);
+        mem_free(&counting, g.data);
+    }
+    st = grid_read_openvdb(ctx, &counting, path, "temperature", &g, &box);
+    expect_refused(ctx, path, st, &g, PK_ERR_UNSUPPORTED, "grid 'temperature': values of type double");
+    st = grid_read_openvdb(ctx, &counting, path, "smoke", &g, &box);
+    expect_refused(ctx, path, st, &g, PK_ERR_PARSE, "no grid named 'smoke' (the file has 'temperature', 'density')");
+
+    /* truncated copies and foreign bytes */
+    FILE *f = fopen(path, "rb");
+    REQUIRE(f);
+    static unsigned char buf[1 << 16];
+    const size_t n = fread(buf, 1, sizeof buf, f);
+    fclose(f);
+    REQUIRE(n > 1000 && n < sizeof buf);
+    for (size_t cut = 0; cut < n; cut = cut < 64 ? cut + 8 : cut * 2) {
+        const char *p = tmp_path("cut.vdb");
+        write_file(p, buf, cut);
+        st = grid_read_openvdb(ctx, &counting, p, NULL, &g, &box);
+        expect_refused(ctx, p, st, &g, PK_ERR_PARSE, "not a readable OpenVDB file");
+    }
+    const char *p = tmp_path("foreign.vdb");
+    write_file(p, "VOL\3 this is not an OpenVDB file at all", 40);
+    st = grid_read_openvdb(ctx, &counting, p, NULL, &g, &box);
+    expect_refused(ctx, p, st, &g, PK_ERR_PARSE, "not a readable OpenVDB file");
+    p = tmp_path("missing.vdb");
+    st = grid_read_openvdb(ctx, &counting, p, NULL, &g, &box);
+    expect_refused(ctx, p, st, &g, PK_ERR_IO, "cannot open");
+}
+
 /* ---- the rest --------------------------------------------------------------- */
 
 static void cleanup(void)
@@ -601,6 +666,7 @@ int main(void)
     check_vol_trailing(ctx);
     check_nanovdb_good(ctx);
     check_nanovdb_hostile(ctx);
+    check_openvdb(ctx);
     pk_context_destroy(ctx);
     cleanup();
     return test_done("test_grid_io");
