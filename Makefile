@@ -15,7 +15,7 @@ TEST_PKGS   = $(BUILD_PKGS) libembree-dev g++ libopenmpi-dev openmpi-bin iproute
 PREFIX     ?= /usr/local
 FUZZ_PKGS   = $(TEST_PKGS) clang libclang-rt-14-dev libomp-14-dev
 FUZZ_SECONDS ?= 60
-FUZZERS     = obj mtl json xml render image tza gltf pbrt
+FUZZERS     = obj mtl json xml render image tza gltf pbrt grid
 
 .PHONY: all build demo test deps deps-test install bench clean build-asan sanitize fuzz fuzz-build fuzz-seeds fuzz-merge weights npm npm-install
 
