@@ -2722,6 +2722,107 @@ static pk_status medium_nanovdb(pp *p, const char *what, medium *m, xform *box)
     return PK_OK;
 }
 
+/* ---- pbrt-v4's procedural "cloud", baked into a grid ---- */
+
+/* Gradient noise (Perlin's construction: a gradient at each lattice point,
+ * picked by hashing the point among the 12 directions to the cube's edge
+ * midpoints, blended with the quintic fade), in about -1..1, and its
+ * gradient *d. Paprsek's own hash: not pbrt's pattern. */
+static float cloud_noise(vec3 p, vec3 *d)
+{
+    static const signed char dirs[12][3] = {{1, 1, 0}, {-1, 1, 0}, {1, -1, 0}, {-1, -1, 0}, {1, 0, 1}, {-1, 0, 1},
+                                            {1, 0, -1}, {-1, 0, -1}, {0, 1, 1}, {0, -1, 1}, {0, 1, -1}, {0, -1, -1}};
+    const float fl[3] = {floorf(p.x), floorf(p.y), floorf(p.z)};
+    const float f[3] = {p.x - fl[0], p.y - fl[1], p.z - fl[2]};
+    const int32_t ip[3] = {(int32_t)fl[0], (int32_t)fl[1], (int32_t)fl[2]};
+    float u[3], du[3];
+    for (int a = 0; a < 3; a++) {
+        const float t = f[a];
+        u[a] = t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f);
+        du[a] = 30.0f * t * t * (t * (t - 2.0f) + 1.0f);
+    }
+    float v = 0.0f, g[3] = {0.0f, 0.0f, 0.0f};
+    for (int c = 0; c < 8; c++) {
+        const int o[3] = {c & 1, (c >> 1) & 1, (c >> 2) & 1};
+        uint32_t h = (uint32_t)(ip[0] + o[0]) * 0x8da6b343u ^ (uint32_t)(ip[1] + o[1]) * 0xd8163841u ^
+                     (uint32_t)(ip[2] + o[2]) * 0xcb1ab31fu;
+        h ^= h >> 15, h *= 0x2c1b3c6du, h ^= h >> 12, h *= 0x297a2d39u, h ^= h >> 15;
+        const signed char *gr = dirs[h % 12u];
+        const float r[3] = {f[0] - (float)o[0], f[1] - (float)o[1], f[2] - (float)o[2]};
+        const float n = (float)gr[0] * r[0] + (float)gr[1] * r[1] + (float)gr[2] * r[2];
+        float w[3], dw[3];
+        for (int a = 0; a < 3; a++) w[a] = o[a] ? u[a] : 1.0f - u[a], dw[a] = o[a] ? du[a] : -du[a];
+        const float wt = w[0] * w[1] * w[2];
+        v += wt * n;
+        g[0] += dw[0] * w[1] * w[2] * n + wt * (float)gr[0];
+        g[1] += w[0] * dw[1] * w[2] * n + wt * (float)gr[1];
+        g[2] += w[0] * w[1] * dw[2] * n + wt * (float)gr[2];
+    }
+    if (d) *d = v3(g[0], g[1], g[2]);
+    return v;
+}
+
+/* The density of pbrt-v4's cloud at p (medium space): the lookup point
+ * displaced by two octaves of the noise's gradient (wispiness), five
+ * octaves of noise summed, thinning with height y and filling below
+ * y = 1/2, clamped to 0..1, as pbrt builds it. */
+static float cloud_density(vec3 p, float density, float wisp, float freq)
+{
+    vec3 q = v3_scale(p, freq);
+    if (wisp > 0.0f) {
+        float om = 0.05f * wisp, la = 10.0f;
+        for (int i = 0; i < 2; i++) {
+            vec3 dn;
+            cloud_noise(v3_scale(q, la), &dn);
+            q = v3_add(q, v3_scale(dn, om));
+            om *= 0.5f, la *= 1.99f;
+        }
+    }
+    float d = 0.0f, om = 0.5f, la = 1.0f;
+    for (int i = 0; i < 5; i++) {
+        d += om * cloud_noise(v3_scale(q, la), NULL);
+        om *= 0.5f, la *= 1.99f;
+    }
+    d = fminf(fmaxf((1.0f - p.y) * 4.5f * density * d, 0.0f), 1.0f);
+    d += 2.0f * fmaxf(0.0f, 0.5f - p.y);
+    return fminf(fmaxf(d, 0.0f), 1.0f);
+}
+
+/* pbrt-v4's "cloud" (density, wispiness, frequency in the box p0..p1):
+ * sampled at the voxel centres of a grid of 24 voxels per unit of
+ * frequency x length on each axis (16 to 128), whose trilinear lookup
+ * stands for the procedure. */
+static pk_status medium_cloud(pp *p, const char *what, medium *m, const xform *box)
+{
+    float dens = 1.0f, wisp = 1.0f, freq = 5.0f;
+    pk_status st;
+    if ((st = medium_float(p, what, "density", 0.0f, 3.4e38f, &dens)) ||
+        (st = medium_float(p, what, "wispiness", 0.0f, 1e6f, &wisp)) ||
+        (st = medium_float(p, what, "frequency", 0.0f, 1e6f, &freq)))
+        return st;
+    const vec3 lo = xform_point(box, v3s(0.0f)), ext = v3_sub(xform_point(box, v3s(1.0f)), lo);
+    const float e[3] = {ext.x, ext.y, ext.z};
+    int n[3];
+    for (int a = 0; a < 3; a++) {
+        const double v = ceil(24.0 * (double)freq * (double)e[a]);
+        n[a] = v < 16.0 ? 16 : v > 128.0 ? 128 : (int)v;
+    }
+    const size_t count = (size_t)n[0] * (size_t)n[1] * (size_t)n[2];
+    float *d = mem_calloc(&p->s->alloc, count, sizeof *d);
+    if (!d) return ctx_nomem(p->ctx);
+    for (int k = 0; k < n[2]; k++)
+        for (int j = 0; j < n[1]; j++)
+            for (int i = 0; i < n[0]; i++) {
+                const vec3 q = v3(((float)i + 0.5f) / (float)n[0], ((float)j + 0.5f) / (float)n[1],
+                                  ((float)k + 0.5f) / (float)n[2]);
+                d[((size_t)k * (size_t)n[1] + (size_t)j) * (size_t)n[0] + (size_t)i] =
+                    cloud_density(xform_point(box, q), dens, wisp, freq);
+            }
+    m->density = (medium_grid){n[0], n[1], n[2], 1, d};
+    m->kind = MEDIUM_GRID;
+    return PK_OK;
+}
+
 static pk_status d_medium(pp *p, const char *name)
 {
     char what[PB_NAME_MAX + 32];
@@ -2738,10 +2839,6 @@ static pk_status d_medium(pp *p, const char *name)
         return pfail(p, p->line, PK_ERR_PARSE,
                      "%s: unknown medium type \"%.40s\" (homogeneous, uniformgrid, rgbgrid, nanovdb and cloud are known)",
                      what, type);
-    if (cloud)
-        return pfail(p, p->line, PK_ERR_UNSUPPORTED,
-                     "%s: the procedural \"cloud\" medium is not supported; bake it into a uniformgrid or a nanovdb file",
-                     what);
     medium m;
     medium_init(&m);
     vec3 sa = v3s(1.0f), ss = v3s(1.0f);
@@ -2775,9 +2872,11 @@ static pk_status d_medium(pp *p, const char *name)
         if ((st = medium_spectrum(p, what, "Le", true, &le)) || (st = medium_float(p, what, "Lescale", 0.0f, 3.4e38f, &lsc)))
             return st;
         m.le = v3_scale(le, lsc);
-    } else if (uniform || rgb) {
+    } else if (uniform || rgb || cloud) {
         st = medium_box(p, what, &box);
-        if (st == PK_OK) st = uniform ? medium_uniformgrid(p, what, &m) : medium_rgbgrid(p, what, &m, scale);
+        if (st == PK_OK)
+            st = uniform ? medium_uniformgrid(p, what, &m) : rgb ? medium_rgbgrid(p, what, &m, scale)
+                                                                 : medium_cloud(p, what, &m, &box);
     } else {
         st = medium_nanovdb(p, what, &m, &box);
     }

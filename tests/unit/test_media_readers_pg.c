@@ -340,6 +340,47 @@ static void test_pbrt_temperature(void)
     done(ctx, s);
 }
 
+/* pbrt-v4's cloud, baked: the grid's size follows the frequency and the
+ * box, and the density follows pbrt's profile in height: full below y = 0
+ * (the filling term 2 (1/2 - y) >= 1 there), noise in 0..1 above. */
+static void test_pbrt_cloud(void)
+{
+    pk_context *ctx;
+    pk_scene *s = pbrt(&ctx, PLAIN "LightSource \"point\"\n" TRI
+                       "MakeNamedMedium \"c\" \"string type\" \"cloud\" \"float frequency\" 1\n"
+                       "  \"point3 p0\" [0 -0.5 0] \"point3 p1\" [1 1.5 0.5] \"rgb sigma_a\" [1 1 1] \"rgb sigma_s\" [3 3 3]\n"
+                       "MakeNamedMedium \"calm\" \"string type\" \"cloud\" \"float frequency\" 1 \"float wispiness\" 0\n"
+                       "  \"point3 p0\" [0 -0.5 0] \"point3 p1\" [1 1.5 0.5]\n");
+    if (s) {
+        const medium *m = find(s, "c"), *calm = find(s, "calm");
+        REQUIRE(m->kind == MEDIUM_GRID && m->density.channels == 1);
+        CHECK(m->density.nx == 24 && m->density.ny == 48 && m->density.nz == 16);
+        CHECK(near3(m->sigma_t, v3s(4.0f), 0) && near3(m->albedo, v3s(0.75f), 0));
+        CHECK(near3(grid_point(m, v3s(0.0f)), v3(0, -0.5f, 0), 1e-6f) && near3(grid_point(m, v3s(1.0f)), v3(1, 1.5f, 0.5f), 1e-6f));
+        int low = 0, high = 0, mid = 0, varied = 0, differs = 0;
+        float first = -1.0f;
+        const medium_grid *g = &m->density;
+        for (int k = 0; k < g->nz; k++)
+            for (int j = 0; j < g->ny; j++)
+                for (int i = 0; i < g->nx; i++) {
+                    const size_t v = ((size_t)k * (size_t)g->ny + (size_t)j) * (size_t)g->nx + (size_t)i;
+                    const float d = g->data[v], y = -0.5f + 2.0f * ((float)j + 0.5f) / (float)g->ny;
+                    if (y < 0.0f) low += d == 1.0f;
+                    else {
+                        high += y > 1.0f && d > 0.0f && d < 1.0f;
+                        mid += d >= 0.0f && d <= 1.0f;
+                        if (first < 0.0f) first = d;
+                        varied += d != first;
+                        differs += d != calm->density.data[v];
+                    }
+                }
+        const int layer = g->nx * g->nz;
+        CHECK(low == 12 * layer && mid == 36 * layer && high > 0);
+        CHECKF(varied > layer && differs > layer, "varied %d, differs %d", varied, differs);
+    }
+    done(ctx, s);
+}
+
 static void test_pbrt_errors(void)
 {
     const char *hom = "MakeNamedMedium \"m\" \"string type\" \"homogeneous\"\n";
@@ -388,7 +429,8 @@ static void test_pbrt_errors(void)
                "t.pbrt:2: ", "'rgb Le' needs 'rgb sigma_a'");
     pbrt_error("MakeNamedMedium \"m\" \"string type\" \"rgbgrid\" \"integer nz\" 2 \"rgb sigma_a\" [1 1 1]\n",
                "t.pbrt:1: ", "'rgb sigma_a' has 3 values; nx x ny x nz = 1 x 1 x 2 needs 6 (3 a voxel)");
-    pbrt_error("MakeNamedMedium \"m\" \"string type\" \"cloud\"\n", "t.pbrt:1: ", "\"cloud\" medium is not supported");
+    pbrt_error("MakeNamedMedium \"m\" \"string type\" \"cloud\" \"float wispiness\" -1\n", "t.pbrt:1: ",
+               "'float wispiness' -1 must lie in");
     /* a grid file that cannot be read: the grid reader's message, after where */
     pbrt_error("\nMakeNamedMedium \"m\" \"string type\" \"nanovdb\" \"string filename\" \"no_such.nvdb\"\n",
                "t.pbrt:2: MakeNamedMedium \"m\": ", "no_such.nvdb");
@@ -681,6 +723,7 @@ int main(void)
     test_pbrt_sides();
     test_pbrt_grids();
     test_pbrt_temperature();
+    test_pbrt_cloud();
     test_pbrt_errors();
     test_gltf_volume();
     test_fog_scene();
