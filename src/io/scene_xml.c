@@ -2194,6 +2194,8 @@ static pk_status parse_shape(xp *p, xnode *sh)
                 xnode *t = rid ? id_find(p, rid) : NULL;
                 if (t && strcmp(t->tag, "bsdf") != 0) {
                     if (strcmp(t->tag, "emitter") == 0 && !emitter) emitter = t;
+                    else if (strcmp(t->tag, "medium") == 0)
+                        xwarn(p, c, "a shape's medium needs name=\"interior\" or name=\"exterior\"; ignored");
                     else xwarn(p, c, "a reference to a <%.32s> in a shape is not supported; ignored", t->tag);
                     c->used = true;
                     continue;

@@ -381,6 +381,17 @@ static void test_xml_homogeneous(void)
     CHECK(s->materials[s->tris[0].material].type == MAT_DIFFUSE && s->materials[s->tris[0].material].medium_in == 0);
     pk_scene_destroy(s);
 
+    /* a medium without a side is warned about */
+    s = load_xml_ok("<medium type=\"homogeneous\" id=\"m\"/>\n<shape type=\"cube\">\n<ref id=\"m\"/>\n"
+                    "<medium type=\"homogeneous\" name=\"inside\"/></shape>",
+                    "3.0.0");
+    REQUIRE(s);
+    CHECKF(warned("scene.xml:4: a shape's medium needs name=\"interior\" or name=\"exterior\"; ignored") &&
+               warned("scene.xml:5: a shape's medium needs"),
+           "%s", wl.all);
+    CHECK(s->materials[s->tris[0].material].medium_in == MEDIUM_INHERIT);
+    pk_scene_destroy(s);
+
     /* unsupported phase functions: warned, isotropic */
     s = load_xml_ok("<medium type=\"homogeneous\" id=\"m\">\n<phase type=\"rayleigh\"/></medium>", "3.0.0");
     REQUIRE(s);
