@@ -229,6 +229,28 @@ static void test_json_grids(void)
     CHECK(near3(xform_point(&a->grid_to_world, v3(1, 1, 1)), 2, 4, 7, 0));
     CHECK(near3(xform_point(&b->grid_to_world, v3(1, 1, 1)), 1, 1, 1, 0));
     pk_scene_destroy(s);
+
+    /* albedo and emission files over the same box; a different box is refused */
+    const float alb[12] = {1, 0.5f, 0.25f, 1, 1, 1, 0, 0, 0, 0.5f, 0.5f, 0.5f};
+    write_vol("ga.vol", n, 3, lo, hi, alb);
+    write_vol("ge.vol", n, 1, lo, hi, v);
+    const float hi2[3] = {2, 4, 8};
+    write_vol("gb.vol", n, 1, lo, hi2, v);
+    s = load_json_ok("{\"media\": [{\"name\": \"a\", \"type\": \"grid\", \"file\": \"g.vol\",\n"
+                     "  \"albedo_file\": \"ga.vol\", \"emission_file\": \"ge.vol\", \"emission\": 2}],\n"
+                     " \"medium\": \"a\", \"spheres\": [{\"center\": [0, 0, 0], \"radius\": 1}]}\n");
+    REQUIRE(s);
+    a = find_medium(s, "a");
+    REQUIRE(a);
+    CHECK(a->albedo_grid.channels == 3 && a->albedo_grid.data[1] == 0.5f && a->albedo_grid.data[9] == 0.5f);
+    CHECK(a->emission_grid.channels == 1 && a->emission_grid.data[3] == 2.0f && near3(a->le, 2, 2, 2, 0));
+    pk_scene_destroy(s);
+    json_fails("{\"media\": [{\"name\": \"a\", \"type\": \"grid\", \"file\": \"g.vol\",\n"
+               "  \"albedo_file\": \"gb.vol\"}]}",
+               "scene.json:2: media[0].albedo_file: the file's box differs from the density file's");
+    json_fails("{\"media\": [{\"name\": \"a\", \"type\": \"grid\", \"file\": \"g.vol\", \"emission_file\": \"ge.vol\",\n"
+               "  \"emission_grid\": {\"size\": [1, 1, 1], \"data\": [1]}}]}",
+               "scene.json:2: media[0].emission_grid: give \"emission_file\" or \"emission_grid\", not both");
 }
 
 static void test_json_errors(void)
