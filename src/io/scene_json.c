@@ -1,7 +1,9 @@
 /*
  * scene_json.c - JSON scene files: camera, film and render settings, meshes
- * (OBJ files with optional transforms), materials, spheres, point lights and
- * ambient light, parsed with cJSON into a pk_scene (docs/scene-format.md).
+ * (OBJ files with optional transforms), materials, spheres, point lights,
+ * ambient light and participating media (homogeneous and grid media, the
+ * media on either side of materials, the camera's medium), parsed with cJSON
+ * into a pk_scene (docs/scene-format.md, docs/media.md).
  * Errors read "file:line: json.path: what is wrong". cJSON keeps no positions,
  * so a line is found by a scan of the text that numbers values in the same
  * pre-order as the parsed tree.

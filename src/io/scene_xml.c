@@ -4,7 +4,9 @@
  * mapped onto a pk_scene: shapes (obj, ply, rectangle, cube, disk, sphere),
  * BSDFs onto the material types, emitters (area, point, environment),
  * the perspective, thinlens and orthographic sensors, film, sampler and
- * integrator settings (docs/scene-format.md, "Mitsuba XML"). Errors and
+ * integrator settings (docs/scene-format.md, "Mitsuba XML"), participating
+ * media (homogeneous and heterogeneous, phase functions, grid volumes,
+ * shapes' interior and exterior, the sensor's medium: docs/media.md). Errors and
  * warnings read "file:line: what"; what is not supported is warned about
  * and skipped.
  *
