@@ -41,6 +41,10 @@
 #include "path_kernel.h"
 
 #define VOL_MAX_CROSSINGS 256   /* interfaces and holes one ray passes at most */
+/* Tentative collisions one tracking walk takes at most: past them the path
+ * (or shadow ray) ends, so that a grid with an absurd value next to empty
+ * space (a majorant cell of 1e30 over zeros) cannot stall a render. */
+#define VOL_MAX_COLLISIONS (1 << 18)
 
 enum { VOL_PASS, VOL_SCATTER, VOL_ABSORB };
 
@@ -86,6 +90,7 @@ static inline PK_HD int vol_track(const path_tracer *pt, vol_state *vs, const me
     majorant_iter it = majorant_start(m, r->o, r->d, r->tmin, tmax);
     float t0, t1, sig;
     const int h = vs->hero;
+    int budget = VOL_MAX_COLLISIONS;
     while (majorant_next(&it, &t0, &t1, &sig)) {
         if (!(sig > 0.0f)) continue;
         const float rate = sig * dlen; /* collisions per unit of the ray's parameter */
@@ -95,6 +100,7 @@ static inline PK_HD int vol_track(const path_tracer *pt, vol_state *vs, const me
             sampler_2d(&ps->smp, &ud, &ue);
             t -= log1pf(-ud) / rate;
             if (!(t < t1)) break;
+            if (--budget < 0) return VOL_ABSORB;
             const medium_point mp = medium_at(m, v3_add(r->o, v3_scale(r->d, t)));
             if (!black(mp.le) && !black(mp.sigma_a))
                 path_add(pt, ps, v3_scale(v3_mul(ps->beta, v3_mul(mp.sigma_a, mp.le)), vol_mis(vs) / sig),
@@ -142,6 +148,7 @@ static inline PK_HD vec3 vol_transmittance(const medium *m, const ray *r, float 
         return v3(expf(-m->sigma_t.x * d), expf(-m->sigma_t.y * d), expf(-m->sigma_t.z * d));
     }
     vec3 T = v3s(1.0f);
+    int budget = VOL_MAX_COLLISIONS;
     majorant_iter it = majorant_start(m, r->o, r->d, r->tmin, tmax);
     float t0, t1, sig;
     while (majorant_next(&it, &t0, &t1, &sig)) {
@@ -153,6 +160,7 @@ static inline PK_HD vec3 vol_transmittance(const medium *m, const ray *r, float 
             sampler_2d(smp, &ud, &urr);
             t -= log1pf(-ud) / rate;
             if (!(t < t1)) break;
+            if (--budget < 0) return v3s(0.0f);
             const medium_point mp = medium_at(m, v3_add(r->o, v3_scale(r->d, t)));
             const vec3 st = v3_add(mp.sigma_a, mp.sigma_s);
             T = v3_mul(T, v3_max(v3_sub(v3s(1.0f), v3_scale(st, 1.0f / sig)), v3s(0.0f)));

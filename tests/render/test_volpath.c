@@ -451,6 +451,24 @@ static void check_grid_equals_homogeneous(void)
            e[0].mean[2], e[1].mean[0], e[1].mean[1], e[1].mean[2]);
 }
 
+/* A grid with one absurd voxel among zeros (its majorant cells are 1e30
+ * over nothing): the render ends, in bounded time, with finite pixels. */
+static void check_hostile_grid(void)
+{
+    pk_scene *s = new_scene("hostile grid");
+    const float vals[4] = {0.0f, 1e30f, 0.0f, 0.0f};
+    const uint32_t med = add_zgrid(s, v3s(-1.0f), v3s(1.0f), vals, 4, v3s(1.0f), v3s(0.5f), 0.0f);
+    add_box(s, v3s(-1.0f), v3s(1.0f), interface_of(s, med));
+    s->env.radiance = v3s(1.0f);
+    pk_camera_init(&s->camera);
+    s->camera.look_from[0] = 0.3f, s->camera.look_from[2] = 4.0f;
+    s->has_camera = true;
+    const est e = render(s, 8, 1, 8, 0);
+    CHECKF(isfinite(e.mean[0]) && e.mean[0] >= 0.0 && e.mean[0] <= 1.0 + 1e-6, "mean %g", e.mean[0]);
+    printf("  hostile grid: mean %.4f, finite\n", e.mean[0]);
+    scene_destroy(s);
+}
+
 /* ---- AOVs and the denoiser on a volumetric render ---------------------------------- */
 
 /* A box of scattering medium lit from above, seen from the side. */
@@ -582,6 +600,7 @@ int main(void)
     check_single_scattering();
     check_furnaces();
     check_grid_equals_homogeneous();
+    check_hostile_grid();
     check_aov_and_denoise();
     pk_context_destroy(ctx);
     return test_done("volpath");
