@@ -571,6 +571,13 @@ static void test_fog_scene(void)
     const medium *smoke = find_medium(js, "smoke");
     REQUIRE(smoke && smoke->kind == MEDIUM_GRID);
     CHECK(near3(xform_point(&smoke->grid_to_world, v3(0, 0, 0)), 0.1f, 0.05f, -0.7f, 1e-6f));
+    CHECK(near3(xform_point(&smoke->grid_to_world, v3(1, 1, 1)), 0.8f, 0.75f, 0.0f, 1e-6f));
+    /* fog_smoke.vol: 4^3 voxels, 0.25 (4 - j) + 0.1 i + 0.05 k, denser toward the floor */
+    REQUIRE(smoke->density.nx == 4 && smoke->density.ny == 4 && smoke->density.nz == 4);
+    for (int k = 0; k < 4; k++)
+        for (int j = 0; j < 4; j++)
+            for (int i = 0; i < 4; i++)
+                CHECK_NEAR(smoke->density.data[(k * 4 + j) * 4 + i], 0.25 * (4 - j) + 0.1 * i + 0.05 * k, 1e-6);
     CHECK(same_medium_side(js, js->camera_medium, xs, xs->camera_medium) && js->camera_medium >= 0);
     CHECK(strcmp(js->media[js->camera_medium].name, "fog") == 0);
     CHECK(js->render.opt.integrator == PK_INTEGRATOR_VOLPATH && xs->render.opt.integrator == PK_INTEGRATOR_VOLPATH);
