@@ -27,7 +27,7 @@
 #
 # No figure is asserted: the script fails only when a render fails.
 # usage: bench/media.sh [PAPRSEK [BASE [SHARED]]]
-# environment: ROUNDS (5), SIZE (128), SPP (16), TIMES ("2 8"), REF_SPP (1024),
+# environment: ROUNDS (5), SIZE (128), SPP (16), TIMES ("2 8"; 0: skip part 2), REF_SPP (1024),
 # GRID (256: the smoke grid's resolution), CALLGRIND (1; 0: skip callgrind),
 # KEEP (a folder: keep the scenes and images there instead of a temporary one)
 set -euo pipefail
@@ -121,21 +121,23 @@ awk -v g="${med[smoke]}" -v h="${med[smoke_hom]}" -v ig="${ins[smoke]:-0}" -v ih
     printf "\n" }'
 
 # 2. noise at equal time
-echo
-echo "| scene | reference | --time [s] | passes (1 spp) | relMSE | relMSE x time |"
-echo "|---|---|---:|---:|---:|---:|"
-for s in $scenes; do
-    rate "$bin" "$tmp/$s.json" "$tmp/$s-ref.pfm" --width "$size" --height "$size" --spp "$ref_spp" --seed 1000 >/dev/null
-    for t in $times; do
-        "$bin" render "$tmp/$s.json" -o "$tmp/$s-t.pfm" --quiet --no-denoise --width "$size" --height "$size" \
-            --spp 1 --time "$t" --seed 7 --stats-json "$tmp/stats.json" >/dev/null 2>"$tmp/err" ||
-            die "$s --time $t failed: $(cat "$tmp/err")"
-        passes=$(($(field rays_camera <"$tmp/stats.json") / (size * size)))
-        e=$(/usr/bin/python3 "$here/imgstat.py" relmse "$tmp/$s-t.pfm" "$tmp/$s-ref.pfm")
-        awk -v l="$(label "$s")" -v rs="$ref_spp" -v t="$t" -v p="$passes" -v e="$e" 'BEGIN {
-            printf "| %s | %d spp | %g | %s | %.4g | %.4g |\n", l, rs, t, p, e, e * t }'
+if [ "$times" != 0 ]; then
+    echo
+    echo "| scene | reference | --time [s] | passes (1 spp) | relMSE | relMSE x time |"
+    echo "|---|---|---:|---:|---:|---:|"
+    for s in $scenes; do
+        rate "$bin" "$tmp/$s.json" "$tmp/$s-ref.pfm" --width "$size" --height "$size" --spp "$ref_spp" --seed 1000 >/dev/null
+        for t in $times; do
+            "$bin" render "$tmp/$s.json" -o "$tmp/$s-t.pfm" --quiet --no-denoise --width "$size" --height "$size" \
+                --spp 1 --time "$t" --seed 7 --stats-json "$tmp/stats.json" >/dev/null 2>"$tmp/err" ||
+                die "$s --time $t failed: $(cat "$tmp/err")"
+            passes=$(($(field rays_camera <"$tmp/stats.json") / (size * size)))
+            e=$(/usr/bin/python3 "$here/imgstat.py" relmse "$tmp/$s-t.pfm" "$tmp/$s-ref.pfm")
+            awk -v l="$(label "$s")" -v rs="$ref_spp" -v t="$t" -v p="$passes" -v e="$e" 'BEGIN {
+                printf "| %s | %d spp | %g | %s | %.4g | %.4g |\n", l, rs, t, p, e, e * t }'
+        done
     done
-done
+fi
 
 # 3. the path tracer without media, before and after
 [ -n "$base" ] || exit 0
