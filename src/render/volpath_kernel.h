@@ -74,6 +74,14 @@ static inline PK_HD int32_t vol_cross(const material *m, bool front, int32_t cur
     return n == MEDIUM_INHERIT ? cur : n;
 }
 
+/* exp(-(maj - sh) d) per channel: a channel's majorant transmittance over
+ * the hero's along d (1 where they are equal, also for infinite d). */
+static inline PK_HD vec3 vol_ratio(vec3 maj, float sh, float d)
+{
+    const float x = maj.x - sh, y = maj.y - sh, z = maj.z - sh;
+    return v3(x == 0.0f ? 1.0f : expf(-x * d), y == 0.0f ? 1.0f : expf(-y * d), z == 0.0f ? 1.0f : expf(-z * d));
+}
+
 /* Delta tracking along ray r (any length of d) in medium m from r->tmin to
  * tmax: adds the medium's emission to the path at every tentative
  * collision, and returns VOL_ABSORB (the path ends), VOL_SCATTER (a real
@@ -92,20 +100,45 @@ static inline PK_HD int vol_track(const path_tracer *pt, vol_state *vs, const me
     const int h = vs->hero;
     int budget = VOL_MAX_COLLISIONS;
     while (majorant_next(&it, &t0, &t1, &sig)) {
-        if (!(sig > 0.0f)) continue;
-        const float rate = sig * dlen; /* collisions per unit of the ray's parameter */
+        /* the majorant of each channel: a homogeneous medium's own
+         * extinction (no null collisions), a grid cell's bound in all three */
+        const vec3 maj = it.homogeneous ? m->sigma_t : v3s(sig);
+        const bool uniform = maj.x == maj.y && maj.y == maj.z;
+        const float sh = vol_comp(maj, h);
+        if (!(sh > 0.0f)) { /* nothing to collide with in the hero's channel: the others' transmittance */
+            if (!uniform) {
+                const vec3 w = vol_ratio(maj, 0.0f, (t1 - t0) * dlen);
+                ps->beta = v3_mul(ps->beta, w);
+                vs->r_u = v3_mul(vs->r_u, w);
+            }
+            continue;
+        }
+        const float rate = sh * dlen; /* collisions per unit of the ray's parameter */
         float t = t0;
         for (;;) {
             float ud, ue;
             sampler_2d(&ps->smp, &ud, &ue);
-            t -= log1pf(-ud) / rate;
-            if (!(t < t1)) break;
+            const float tn = t - log1pf(-ud) / rate;
+            if (!(tn < t1)) { /* past the segment: each channel's transmittance over the hero's */
+                if (!uniform) {
+                    const vec3 w = vol_ratio(maj, sh, (t1 - t) * dlen);
+                    ps->beta = v3_mul(ps->beta, w);
+                    vs->r_u = v3_mul(vs->r_u, w);
+                }
+                break;
+            }
             if (--budget < 0) return VOL_ABSORB;
+            const vec3 tr = uniform ? v3s(1.0f) : vol_ratio(maj, sh, (tn - t) * dlen); /* T_maj / T_maj,hero */
+            t = tn;
             const medium_point mp = medium_at(m, v3_add(r->o, v3_scale(r->d, t)));
-            if (!black(mp.le) && !black(mp.sigma_a))
-                path_add(pt, ps, v3_scale(v3_mul(ps->beta, v3_mul(mp.sigma_a, mp.le)), vol_mis(vs) / sig),
-                         ps->depth >= 1);
-            const float pa = vol_comp(mp.sigma_a, h) / sig, pscat = vol_comp(mp.sigma_s, h) / sig;
+            if (!black(mp.le) && !black(mp.sigma_a)) { /* emission, weighted over the channels' pdfs of this point */
+                const vec3 re = v3_mul(vs->r_u, v3_scale(v3_mul(tr, maj), 1.0f / sh));
+                const float mre = (re.x + re.y + re.z) * (1.0f / 3.0f);
+                if (mre > 0.0f)
+                    path_add(pt, ps, v3_scale(v3_mul(v3_mul(ps->beta, tr), v3_mul(mp.sigma_a, mp.le)), 1.0f / (sh * mre)),
+                             ps->depth >= 1);
+            }
+            const float pa = vol_comp(mp.sigma_a, h) / sh, pscat = vol_comp(mp.sigma_s, h) / sh;
             if (ue < pa + pscat && aov && aov->open) {
                 const vec3 st = v3_add(mp.sigma_a, mp.sigma_s);
                 const vec3 al = v3(st.x > 0.0f ? mp.sigma_s.x / st.x : 0.0f, st.y > 0.0f ? mp.sigma_s.y / st.y : 0.0f,
@@ -116,18 +149,18 @@ static inline PK_HD int vol_track(const path_tracer *pt, vol_state *vs, const me
             }
             if (ue < pa) return VOL_ABSORB;
             if (ue < pa + pscat) {
-                const vec3 w = v3_scale(mp.sigma_s, 1.0f / vol_comp(mp.sigma_s, h));
+                const vec3 w = v3_mul(tr, v3_scale(mp.sigma_s, 1.0f / vol_comp(mp.sigma_s, h)));
                 ps->beta = v3_mul(ps->beta, w);
                 vs->r_u = v3_mul(vs->r_u, w);
                 *t_out = t;
                 return VOL_SCATTER;
             }
             /* a null collision: on, weighted by sigma_n over the hero's */
-            const vec3 sn = v3_max(v3_sub(v3s(sig), v3_add(mp.sigma_a, mp.sigma_s)), v3s(0.0f));
+            const vec3 sn = v3_max(v3_sub(maj, v3_add(mp.sigma_a, mp.sigma_s)), v3s(0.0f));
             const float snh = vol_comp(sn, h);
             if (!(snh > 0.0f)) return VOL_ABSORB; /* (probability zero) */
-            if (m->chromatic) {
-                const vec3 w = v3_scale(sn, 1.0f / snh);
+            if (m->chromatic || !uniform) {
+                const vec3 w = v3_mul(tr, v3_scale(sn, 1.0f / snh));
                 ps->beta = v3_mul(ps->beta, w);
                 vs->r_u = v3_mul(vs->r_u, w);
             }

@@ -323,15 +323,15 @@ static void check_global_fog(void)
 static void check_emission(void)
 {
     pk_scene *s = new_scene("glowing slab");
-    const float sa = 1.3f, d = 0.7f;
-    const vec3 le = v3(1.0f, 0.5f, 0.25f);
-    const uint32_t med = add_homogeneous(s, v3s(sa), v3s(0.0f), 0.0f, le);
+    const float d = 0.7f;
+    const vec3 sa = v3(1.3f, 0.4f, 2.5f), le = v3(1.0f, 0.5f, 0.25f);
+    const uint32_t med = add_homogeneous(s, sa, v3s(0.0f), 0.0f, le);
     add_box(s, v3(-10.0f, -10.0f, 0.0f), v3(10.0f, 10.0f, d), interface_of(s, med));
     /* something to hit far below, black, so that the scene is not empty of lights' meaning */
     ortho_down(s, 3.0f, 2.0f);
-    const double k = 1.0 - exp(-sa * d);
-    const double want[3] = {(double)le.x * k, (double)le.y * k, (double)le.z * k};
-    expect("emissive absorbing slab", render(s, 32, 64, 16, 0), want);
+    const double want[3] = {(double)le.x * (1.0 - exp(-(double)(sa.x * d))), (double)le.y * (1.0 - exp(-(double)(sa.y * d))),
+                            (double)le.z * (1.0 - exp(-(double)(sa.z * d)))};
+    expect("emissive absorbing slab, chromatic", render(s, 32, 64, 16, 0), want);
     scene_destroy(s);
 }
 
@@ -343,12 +343,13 @@ static double hg(double g, double c) /* c = dot(wo, wi) */
     return (1 - g * g) / (4 * PI_D * den * sqrt(den));
 }
 
-static void check_single_scattering(void)
+/* Single scattering in a slab under a distant light, per channel:
+ * E sigma_s p (1 - e^(-sigma_t d k)) / (sigma_t k), k = 1 + 1 / cos. */
+static void single_scattering(const char *what, vec3 sigt, vec3 albedo)
 {
-    const float st = 0.6f, d = 0.5f, g = 0.4f;
-    const vec3 albedo = v3(0.9f, 0.6f, 0.3f);
-    pk_scene *s = new_scene("single scattering");
-    const uint32_t med = add_homogeneous(s, v3s(st), albedo, g, v3s(0.0f));
+    const float d = 0.5f, g = 0.4f;
+    pk_scene *s = new_scene(what);
+    const uint32_t med = add_homogeneous(s, sigt, albedo, g, v3s(0.0f));
     add_box(s, v3(-100.0f, -100.0f, 0.0f), v3(100.0f, 100.0f, d), interface_of(s, med));
     const vec3 wl = v3_norm(v3(0.6f, 0.0f, 0.8f)); /* toward the light */
     point_light l;
@@ -356,11 +357,19 @@ static void check_single_scattering(void)
     l.position = wl, l.intensity = v3s(3.0f), l.distant = true;
     REQUIRE(scene_add_point_light(ctx, s, &l) == PK_OK);
     ortho_down(s, 3.0f, 2.0f);
-    const double c = wl.z, k = 1.0 + 1.0 / c;
-    const double ss = 3.0 * hg(g, c) * (1.0 - exp(-(double)(st * d) * k)) / ((double)st * k); /* times sigma_s / sigma_t = albedo */
-    const double want[3] = {(double)(albedo.x * st) * ss, (double)(albedo.y * st) * ss, (double)(albedo.z * st) * ss};
-    expect("single scattering in a slab", render(s, 32, 256, 1, 0), want);
+    const double c = (double)wl.z, k = 1.0 + 1.0 / c;
+    const float st[3] = {sigt.x, sigt.y, sigt.z}, al[3] = {albedo.x, albedo.y, albedo.z};
+    double want[3];
+    for (int i = 0; i < 3; i++)
+        want[i] = 3.0 * hg(g, c) * (double)(al[i] * st[i]) * (1.0 - exp(-(double)(st[i] * d) * k)) / ((double)st[i] * k);
+    expect(what, render(s, 32, 256, 1, 0), want);
     scene_destroy(s);
+}
+
+static void check_single_scattering(void)
+{
+    single_scattering("single scattering in a slab", v3s(0.6f), v3(0.9f, 0.6f, 0.3f));
+    single_scattering("single scattering, chromatic extinction", v3(0.3f, 1.2f, 4.0f), v3(0.9f, 0.6f, 0.8f));
 }
 
 /* ---- white furnaces --------------------------------------------------------------- */
