@@ -21,14 +21,19 @@
 PK_HIDDEN pk_status grid_read_vol(pk_context *ctx, const pk_allocator *al, const char *path, medium_grid *out,
                                   aabb *box);
 
-/* A float grid of a NanoVDB file (.nvdb), by name (NULL or "": the first
- * float grid), made dense over its active bounding box. */
+/* A float grid of a NanoVDB file (.nvdb, format version 32), by name (NULL
+ * or "": the first float grid), made dense over its root's active index box
+ * with what a lookup returns (leaf values, tile values, the background).
+ * Voxel values sit at integer index coordinates, so *box is that index box
+ * widened by half a voxel on every side, mapped by the grid's index-to-world
+ * map (scales and a shift only; others are refused). Uncompressed files only. */
 PK_HIDDEN pk_status grid_read_nanovdb(pk_context *ctx, const pk_allocator *al, const char *path, const char *grid,
                                       medium_grid *out, aabb *box);
 
 /* A float grid of an OpenVDB file (.vdb), by name (NULL or "": the first
- * float grid), made dense over its active bounding box. PK_ERR_UNSUPPORTED
- * with a message when the build has no OpenVDB. */
+ * float grid), made dense over its active bounding box, *box as for NanoVDB
+ * (through the grid's linear transform). PK_ERR_UNSUPPORTED with a message
+ * when the build has no OpenVDB. */
 PK_HIDDEN pk_status grid_read_openvdb(pk_context *ctx, const pk_allocator *al, const char *path, const char *grid,
                                       medium_grid *out, aabb *box);
 
