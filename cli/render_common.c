@@ -454,6 +454,14 @@ static const char *integrator_label(const pk_render_options *ro, const pk_scene_
     return pk_integrator_name(ro->integrator);
 }
 
+/* The depth the renderer uses (the integrator's default for -1). */
+static int depth_of(const pk_render_options *ro, const pk_scene_info *si)
+{
+    pk_render_options o = *ro;
+    if (o.integrator == PK_INTEGRATOR_DEFAULT && si->has_media) o.integrator = PK_INTEGRATOR_VOLPATH;
+    return pk_render_options_max_depth(&o);
+}
+
 static const char *accel_label(const pk_render_options *ro)
 {
     return ro->device == PK_DEVICE_CUDA ? pk_accel_kind_name(PK_ACCEL_CUDA) : pk_accel_kind_name(ro->accel);
@@ -482,7 +490,7 @@ void cli_print_stats(pk_context *ctx, const char *scene, const pk_scene *sc, con
     printf("%-28s %s\n", "scene", scene);
     if (path) /* light samples and the Fresnel switch are the Whitted integrator's */
         printf("%-28s %s, %d thread%s, %dx%d, %d spp, depth %d\n", "settings", accel_label(ro),
-               st->threads, st->threads == 1 ? "" : "s", ro->width, ro->height, ro->spp, pk_render_options_max_depth(ro));
+               st->threads, st->threads == 1 ? "" : "s", ro->width, ro->height, ro->spp, depth_of(ro, &si));
     else
         printf("%-28s %s, %d thread%s, %dx%d, %d spp, %d light samples, depth %d, fresnel %s\n", "settings",
                accel_label(ro), st->threads, st->threads == 1 ? "" : "s", ro->width, ro->height, ro->spp,
@@ -567,7 +575,7 @@ int cli_write_stats_json(pk_context *ctx, const char *path, const char *scene, c
             "  \"film_bytes_per_pixel\": %d,\n  \"peak_rss_mib\": %.1f,\n  \"textures\": %zu,\n"
             "  \"texture_bytes\": %zu,\n  \"media\": %zu,\n  \"medium_bytes\": %zu,\n  \"device\": \"%s\",\n"
             "  \"config\": ",
-            accel_label(ro), ro->width, ro->height, ro->spp, ro->light_samples, pk_render_options_max_depth(ro),
+            accel_label(ro), ro->width, ro->height, ro->spp, ro->light_samples, depth_of(ro, &si),
             ro->fresnel ? "true" : "false", st->threads, st->build_us, st->render_s, (unsigned long long)rays,
             (unsigned long long)st->rays_camera, (unsigned long long)st->rays_shadow,
             (unsigned long long)st->rays_reflection, (unsigned long long)st->rays_refraction,

@@ -124,8 +124,9 @@ PK_API const char *pk_status_string(pk_status status);
 #define PK_MAX_IMAGE_PIXELS (64u * 1024u * 1024u)
 #define PK_MAX_SPP 65536
 #define PK_MAX_LIGHT_SAMPLES 4096
-#define PK_MAX_DEPTH 64
+#define PK_MAX_DEPTH 1024
 #define PK_DEFAULT_DEPTH_PATH 64    /* enough for a closed box to converge */
+#define PK_DEFAULT_DEPTH_VOLPATH 1024 /* random walks in dense media take hundreds of scatterings; roulette ends them */
 #define PK_DEFAULT_DEPTH_WHITTED 8
 #define PK_MAX_THREADS 1024
 #define PK_MAX_POLYGON_VERTICES 4096

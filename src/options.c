@@ -66,6 +66,7 @@ int pk_render_options_max_depth(const pk_render_options *opt)
 {
     if (!opt) return PK_DEFAULT_DEPTH_PATH;
     if (opt->max_depth >= 0) return opt->max_depth;
+    if (opt->integrator == PK_INTEGRATOR_VOLPATH) return PK_DEFAULT_DEPTH_VOLPATH;
     return opt->integrator == PK_INTEGRATOR_WHITTED ? PK_DEFAULT_DEPTH_WHITTED : PK_DEFAULT_DEPTH_PATH;
 }
 

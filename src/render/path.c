@@ -39,6 +39,15 @@ static pk_status ig_init(pk_context *ctx, void *self, const frame *f, const pk_r
     return path_init(ctx, self, f, opt);
 }
 
+/* The volumetric path tracer's: its own default depth (pk_render_options_max_depth
+ * for volpath), whichever way it was chosen. */
+static pk_status ig_vol_init(pk_context *ctx, void *self, const frame *f, const pk_render_options *opt)
+{
+    pk_render_options o = *opt;
+    o.integrator = PK_INTEGRATOR_VOLPATH;
+    return path_init(ctx, self, f, &o);
+}
+
 static void ig_free(const pk_allocator *al, void *self) { path_free(al, self); }
 
 static pk_status ig_thread_init(pk_context *ctx, const void *self, void *ts, bool stats)
@@ -98,6 +107,6 @@ const integrator_ops integrator_path = {
 };
 
 const integrator_ops integrator_volpath = {
-    "volpath", sizeof(path_tracer), sizeof(path_thread), ig_init, ig_free, ig_thread_init, ig_thread_free,
+    "volpath", sizeof(path_tracer), sizeof(path_thread), ig_vol_init, ig_free, ig_thread_init, ig_thread_free,
     ig_set_camera, ig_camera_sample, ig_vol_sample, ig_take_counters,
 };

@@ -157,8 +157,8 @@ put pixels.json '{ "spheres": [ { "center": [0,0,0], "radius": 1 } ],\n  "film":
 render "JSON pixel count above the limit" 1 "pixels.json:2: film: 16384x16384 is more than 67108864 pixels" pixels.json
 put spp.json '{ "spheres": [ { "center": [0,0,0], "radius": 1 } ],\n  "render": { "spp": 65537 } }\n'
 render "JSON samples above the limit" 1 "spp.json:2: render.spp: must be an integer in 1..65536" spp.json
-put depth.json '{ "spheres": [ { "center": [0,0,0], "radius": 1 } ],\n  "render": { "max_depth": 65 } }\n'
-render "JSON depth above the limit" 1 "depth.json:2: render.max_depth: must be an integer in -1..64" depth.json
+put depth.json '{ "spheres": [ { "center": [0,0,0], "radius": 1 } ],\n  "render": { "max_depth": 1025 } }\n'
+render "JSON depth above the limit" 1 "depth.json:2: render.max_depth: must be an integer in -1..1024" depth.json
 
 # ---- the command line
 expect "zero fov on the command line" 2 "--fov: '0' must be a number of degrees between 0 and 180" \
@@ -175,8 +175,8 @@ expect "non-numeric spp" 2 "--spp: 'lots' is not a whole number in 1..65536" \
   render "$tmp/tri.obj" -o "$tmp/out.png" --spp lots
 expect "absurd spp" 2 "--spp: '99999999' is not a whole number in 1..65536" \
   render "$tmp/tri.obj" -o "$tmp/out.png" --spp 99999999
-expect "absurd depth" 2 "--max-depth: '65' is not a whole number in -1..64" \
-  render "$tmp/tri.obj" -o "$tmp/out.png" --max-depth 65
+expect "absurd depth" 2 "--max-depth: '1025' is not a whole number in -1..1024" \
+  render "$tmp/tri.obj" -o "$tmp/out.png" --max-depth 1025
 expect "absurd light samples" 2 "--light-samples: '4097' is not a whole number in 0..4096" \
   render "$tmp/tri.obj" -o "$tmp/out.png" --light-samples 4097
 expect "absurd thread count" 2 "--threads: '1025' is not a whole number in 0..1024" \

@@ -49,8 +49,8 @@ static void test_options(const pk_scene *s)
     expect_refused(s, spp_big, PK_ERR_LIMIT, "samples per pixel 65537 is out of range (1..65536)");
     expect_refused(s, spp0, PK_ERR_LIMIT, "samples per pixel 0 is out of range (1..65536)");
     expect_refused(s, ls_big, PK_ERR_LIMIT, "light samples 4097 is out of range (0..4096)");
-    expect_refused(s, depth_big, PK_ERR_LIMIT, "max depth 65 is out of range (-1..64)");
-    expect_refused(s, depth_neg, PK_ERR_LIMIT, "max depth -2 is out of range (-1..64)");
+    expect_refused(s, depth_big, PK_ERR_LIMIT, "max depth 1025 is out of range (-1..1024)");
+    expect_refused(s, depth_neg, PK_ERR_LIMIT, "max depth -2 is out of range (-1..1024)");
     expect_refused(s, threads_big, PK_ERR_LIMIT, "threads 1025 is out of range (0..1024)");
     expect_refused(s, accel_bad, PK_ERR_INVALID_ARGUMENT, "unknown accelerator 99");
 

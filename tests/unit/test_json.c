@@ -362,8 +362,8 @@ static void test_errors(void)
     EXPECT_ERROR("{\"render\": {\"spp\": 0}}", PK_ERR_PARSE, "scene.json:1: render.spp: must be an integer in 1..65536");
     EXPECT_ERROR("{\"render\": {\"spp\": 1e12}}", PK_ERR_LIMIT,
                  "scene.json:1: render.spp: must be an integer in 1..65536");
-    EXPECT_ERROR("{\"render\": {\"max_depth\": 65}}", PK_ERR_LIMIT,
-                 "scene.json:1: render.max_depth: must be an integer in -1..64");
+    EXPECT_ERROR("{\"render\": {\"max_depth\": 1025}}", PK_ERR_LIMIT,
+                 "scene.json:1: render.max_depth: must be an integer in -1..1024");
     EXPECT_ERROR("{\"render\": {\"threads\": -1}}", PK_ERR_PARSE,
                  "scene.json:1: render.threads: must be an integer in 0..1024");
     /* the same range as the API and the CLI (0 = point lights only) */

@@ -751,7 +751,7 @@ static void test_sensor(void)
     }
     /* integrator depth: Mitsuba counts segments, Paprsek bounces */
     const char *depths[] = {"<integer name=\"max_depth\" value=\"3\"/>", "<integer name=\"maxDepth\" value=\"-1\"/>", "",
-                            "<integer name=\"max_depth\" value=\"200\"/>"};
+                            "<integer name=\"max_depth\" value=\"2000\"/>"};
     const int want[] = {2, PK_MAX_DEPTH, PK_MAX_DEPTH, PK_MAX_DEPTH};
     for (int i = 0; i < 4; i++) {
         char xml[512];
