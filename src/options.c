@@ -20,7 +20,7 @@ static const pk_int_option table[] = {
         "and the sun only)"),
     OPT(max_depth, "max depth", -1, PK_MAX_DEPTH, -1,
         "path length in bounces (path) or reflection and refraction depth (whitted); -1 = the integrator's "
-        "default, 64 for path and 8 for whitted"),
+        "default, 64 for path, 1024 for volpath and 8 for whitted"),
     OPT(threads, "threads", 0, PK_MAX_THREADS, 0, "worker threads (0 = all cores)"),
     OPT(seed, "seed", 0, 2147483647, 0, "the path tracer's noise pattern (another seed, other noise)"),
     OPT(regularize, "regularize", 0, 1, 0,
