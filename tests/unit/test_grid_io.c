@@ -476,6 +476,17 @@ static void check_nanovdb_good(pk_context *ctx)
     st = nvt_read(ctx, "two.nvdb", &b, "smoke", &g, &box, &path);
     expect_refused(ctx, path, st, &g, PK_ERR_PARSE, "no grid named 'smoke' (the file has 'temperature', 'density')");
     free(b.p);
+    /* two segments, one grid each */
+    b = nvt_file(two, 1, 0);
+    bytes second = nvt_file(two + 1, 1, 0);
+    put(&b, second.p, second.n);
+    free(second.p);
+    REQUIRE(nvt_read(ctx, "segments.nvdb", &b, NULL, &g, &box, &path) == PK_OK);
+    nvt_check_dense(&g, &box);
+    mem_free(&counting, g.data);
+    st = nvt_read(ctx, "segments.nvdb", &b, "nothing", &g, &box, &path);
+    expect_refused(ctx, path, st, &g, PK_ERR_PARSE, "no grid named 'nothing' (the file has 'temperature', 'density')");
+    free(b.p);
     b = nvt_file(two, 1, 0);
     st = nvt_read(ctx, "nofloat.nvdb", &b, NULL, &g, &box, &path);
     expect_refused(ctx, path, st, &g, PK_ERR_UNSUPPORTED, "no float grid (the file has 'temperature')");
