@@ -132,6 +132,17 @@ static void test_pbrt_homogeneous(void)
         CHECK(scene_has_media(s));
     }
     done(ctx, s);
+    /* Attribute "medium" gives defaults to the media of its block */
+    s = pbrt(&ctx, PLAIN "LightSource \"point\"\n" TRI
+                   "AttributeBegin\nAttribute \"medium\" \"float g\" 0.5 \"rgb sigma_s\" [2 2 2]\n"
+                   "MakeNamedMedium \"a\" \"string type\" \"homogeneous\"\n"
+                   "MakeNamedMedium \"b\" \"string type\" \"homogeneous\" \"float g\" -0.5\nAttributeEnd\n"
+                   "MakeNamedMedium \"c\" \"string type\" \"homogeneous\"\n");
+    if (s) {
+        CHECK(find(s, "a")->g == 0.5f && near3(find(s, "a")->sigma_t, v3s(3.0f), 0));
+        CHECK(find(s, "b")->g == -0.5f && find(s, "c")->g == 0.0f && near3(find(s, "c")->sigma_t, v3s(2.0f), 0));
+    }
+    done(ctx, s);
     /* a MediumInterface after Camera leaves the camera in vacuum */
     s = pbrt(&ctx, "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n"
                    "Camera \"perspective\"\nMediumInterface \"fog\" \"fog\"\nWorldBegin\n"
