@@ -81,11 +81,14 @@ static pk_status build_majorant(pk_context *ctx, pk_scene *s, medium *m)
 {
     const medium_grid *g = &m->density;
     const int n[3] = {g->nx, g->ny, g->nz};
-    for (int a = 0; a < 3; a++) m->mres[a] = n[a] < MEDIUM_MAJORANT_RES ? n[a] : MEDIUM_MAJORANT_RES;
+    for (int a = 0; a < 3; a++) {
+        int r = (n[a] + MEDIUM_MAJORANT_VOXELS - 1) / MEDIUM_MAJORANT_VOXELS;
+        if (r < 16) r = n[a] < 16 ? n[a] : 16;
+        m->mres[a] = r < MEDIUM_MAJORANT_RES ? r : MEDIUM_MAJORANT_RES;
+    }
     const size_t cells = (size_t)m->mres[0] * (size_t)m->mres[1] * (size_t)m->mres[2];
     m->majorant = mem_realloc_array(&s->alloc, NULL, cells, sizeof *m->majorant);
     if (!m->majorant) return ctx_nomem(ctx);
-    const float smax = v3_max_comp(m->sigma_t);
     /* the largest density value (over channels, weighted by sigma_t) of each voxel */
     int lo[3][MEDIUM_MAJORANT_RES], hi[3][MEDIUM_MAJORANT_RES];
     for (int a = 0; a < 3; a++)
@@ -111,18 +114,17 @@ static pk_status build_majorant(pk_context *ctx, pk_scene *s, medium *m)
                             const float *v =
                                 &g->data[(((size_t)k * (size_t)g->ny + (size_t)j) * (size_t)g->nx + (size_t)i) *
                                          (size_t)g->channels];
-                            for (int ch = 0; ch < 3; ch++) {
-                                const float d = v[g->channels == 3 ? ch : 0];
-                                best = fmaxf(best, d * sc[ch]);
+                            for (int ch = 0; ch < 3; ch++) { /* (no fmaxf: a call per voxel in libm) */
+                                const float d = v[g->channels == 3 ? ch : 0] * sc[ch];
+                                best = d > best ? d : best;
                             }
                             if (g->channels == 3 && (v[0] != v[1] || v[1] != v[2])) chromatic = true;
                         }
                 /* one ulp of headroom per factor: the lookup's arithmetic cannot exceed it */
                 const float b = best * (1.0f + 1e-5f);
                 m->majorant[((size_t)cz * (size_t)m->mres[1] + (size_t)cy) * (size_t)m->mres[0] + (size_t)cx] = b;
-                wmax = fmaxf(wmax, b);
+                wmax = b > wmax ? b : wmax;
             }
-    (void)smax;
     m->sigma_max = wmax;
     m->chromatic = chromatic || !(m->sigma_t.x == m->sigma_t.y && m->sigma_t.y == m->sigma_t.z);
     return PK_OK;

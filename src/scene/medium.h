@@ -47,8 +47,11 @@
 /* At most this many voxels per grid (2^27 = 512^3: 512 MiB of one
  * channel); larger grids are refused with a message. */
 #define MEDIUM_MAX_VOXELS ((size_t)1 << 27)
-/* Majorant cells per axis at most (fewer for smaller grids). */
-#define MEDIUM_MAJORANT_RES 16
+/* Majorant cells per axis: about one per MEDIUM_MAJORANT_VOXELS voxels, at
+ * least 16 (or one per voxel in smaller grids) and at most
+ * MEDIUM_MAJORANT_RES. */
+#define MEDIUM_MAJORANT_RES 64
+#define MEDIUM_MAJORANT_VOXELS 8
 
 typedef enum medium_kind { MEDIUM_HOMOGENEOUS = 0, MEDIUM_GRID = 1 } medium_kind;
 
