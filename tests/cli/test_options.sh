@@ -127,7 +127,7 @@ table="width 1 16384 512
 height 1 16384 512
 spp 1 65536 1
 light-samples 0 4096 32
-max-depth -1 64 -1
+max-depth -1 1024 -1
 threads 0 1024 0"
 run render --help
 flat=$(tr -s ' \n' '  ' <"$tmp/stdout")
