@@ -452,20 +452,26 @@ static pk_status get_inline_grid(jp *p, const cJSON *it, const char *path, bool 
     return PK_OK;
 }
 
-/* A grid from a file (by its extension: .vol; others refused), relative to
- * the scene's folder; *box is the box the file says it spans. */
-static pk_status get_grid_file(jp *p, const cJSON *it, const char *path, medium_grid *g, aabb *box)
+/* A grid from a file, by its extension: Mitsuba .vol, NanoVDB .nvdb,
+ * OpenVDB .vdb (the float grid named gridname, NULL: the first), relative
+ * to the scene's folder; *box is the box the file says it spans. */
+static pk_status get_grid_file(jp *p, const cJSON *it, const char *path, const char *gridname, medium_grid *g,
+                               aabb *box)
 {
     if (!cJSON_IsString(it) || !it->valuestring[0])
         return jfail(p, PK_ERR_PARSE, it, path, "must be a non-empty string (a path)");
     const char *fn = it->valuestring, *dot = strrchr(fn, '.');
-    if (!dot || strcmp(dot, ".vol") != 0)
-        return jfail(p, PK_ERR_UNSUPPORTED, it, path, "grid files are Mitsuba .vol files (the name must end in .vol)");
+    const int kind = !dot ? -1 : strcmp(dot, ".vol") == 0 ? 0 : strcmp(dot, ".nvdb") == 0 ? 1 : strcmp(dot, ".vdb") == 0 ? 2 : -1;
+    if (kind < 0)
+        return jfail(p, PK_ERR_UNSUPPORTED, it, path,
+                     "grid files are Mitsuba .vol, NanoVDB .nvdb or OpenVDB .vdb files (by the name's ending)");
     const pk_allocator *a = &p->ctx->alloc;
     char *full = path_join(a, p->base_dir, fn);
     if (!full) return ctx_nomem(p->ctx);
     pk_context scratch = io_scratch_context(p->ctx);
-    pk_status st = grid_read_vol(&scratch, &p->s->alloc, full, g, box);
+    pk_status st = kind == 0   ? grid_read_vol(&scratch, &p->s->alloc, full, g, box)
+                   : kind == 1 ? grid_read_nanovdb(&scratch, &p->s->alloc, full, gridname, g, box)
+                               : grid_read_openvdb(&scratch, &p->s->alloc, full, gridname, g, box);
     mem_free(a, full);
     if (st) return jfail(p, st, it, path, "%s", scratch.message);
     return PK_OK;
@@ -473,10 +479,10 @@ static pk_status get_grid_file(jp *p, const cJSON *it, const char *path, medium_
 
 enum { MD_NAME, MD_TYPE, MD_SIGMA_A, MD_SIGMA_S, MD_SIGMA_T, MD_ALBEDO, MD_SCALE, MD_G, MD_EMISSION, MD_FILE,
        MD_DENSITY, MD_ALBEDO_FILE, MD_ALBEDO_GRID, MD_EMISSION_FILE, MD_EMISSION_GRID, MD_BOUNDS, MD_TRANSFORM,
-       MD_COUNT };
+       MD_GRID, MD_COUNT };
 static const char *const medium_keys[MD_COUNT] = {
     "name",  "type", "sigma_a",     "sigma_s",     "sigma_t",       "albedo",        "scale",  "g",        "emission",
-    "file",  "density", "albedo_file", "albedo_grid", "emission_file", "emission_grid", "bounds", "transform"};
+    "file",  "density", "albedo_file", "albedo_grid", "emission_file", "emission_grid", "bounds", "transform", "grid"};
 
 static pk_status parse_transform(jp *p, const cJSON *it, const char *path, xform *m);
 
@@ -497,7 +503,7 @@ static pk_status read_medium(jp *p, const cJSON *it, const char *path, medium *m
     if (!grid && strcmp(ty, "homogeneous") != 0)
         return jfail(p, PK_ERR_PARSE, f[MD_TYPE], fp[MD_TYPE], "must be \"homogeneous\" or \"grid\"");
     if (!grid)
-        for (int k = MD_FILE; k <= MD_TRANSFORM; k++)
+        for (int k = MD_FILE; k <= MD_GRID; k++)
             if (f[k]) return jfail(p, PK_ERR_PARSE, f[k], fp[k], "belongs to a grid medium (\"type\": \"grid\")");
     medium_init(m);
     m->kind = grid ? MEDIUM_GRID : MEDIUM_HOMOGENEOUS;
@@ -542,11 +548,15 @@ static pk_status read_medium(jp *p, const cJSON *it, const char *path, medium *m
 
     /* the grids, each given inline or as a file */
     if (!f[MD_FILE] == !f[MD_DENSITY])
-        return jfail(p, PK_ERR_PARSE, it, path, "a grid medium needs \"file\" (a .vol file) or \"density\", one of them");
+        return jfail(p, PK_ERR_PARSE, it, path, "a grid medium needs \"file\" (a .vol, .nvdb or .vdb file) or \"density\", one of them");
     aabb box = {v3s(0.0f), v3s(1.0f)};
     bool file_box = false;
     if (f[MD_FILE]) {
-        if ((st = get_grid_file(p, f[MD_FILE], fp[MD_FILE], &m->density, &box))) return st;
+        if (f[MD_GRID] && (!cJSON_IsString(f[MD_GRID]) || !f[MD_GRID]->valuestring[0]))
+            return jfail(p, PK_ERR_PARSE, f[MD_GRID], fp[MD_GRID], "must be a grid's name");
+        if ((st = get_grid_file(p, f[MD_FILE], fp[MD_FILE], f[MD_GRID] ? f[MD_GRID]->valuestring : NULL, &m->density,
+                                &box)))
+            return st;
         file_box = true;
     } else if ((st = get_inline_grid(p, f[MD_DENSITY], fp[MD_DENSITY], true, &m->density))) {
         return st;
@@ -563,7 +573,7 @@ static pk_status read_medium(jp *p, const cJSON *it, const char *path, medium *m
                          medium_keys[extra[e].file], medium_keys[extra[e].inline_]);
         if (f[extra[e].file]) {
             aabb b2;
-            if ((st = get_grid_file(p, f[extra[e].file], fp[extra[e].file], extra[e].g, &b2))) return st;
+            if ((st = get_grid_file(p, f[extra[e].file], fp[extra[e].file], NULL, extra[e].g, &b2))) return st;
             if (file_box && memcmp(&b2, &box, sizeof box) != 0)
                 return jfail(p, PK_ERR_PARSE, f[extra[e].file], fp[extra[e].file],
                              "the file's box differs from the density file's (the grids of a medium share one box)");

@@ -10,6 +10,7 @@
 #include "chi2.h"
 #include "test.h"
 
+#include "io/grid_io.h"
 #include "paprsek.h"
 #include "render/sampling.h"
 #include "scene/scene.h"
@@ -237,6 +238,45 @@ static void check_refusals(void)
     }
 }
 
+/* JSON grid media read from OpenVDB files (where the build has OpenVDB;
+ * tests/data/media/grid.vdb: its float grid "density" holds 100 + x + 10 y
+ * over x -2..2, y 0..1, one z) and a file of no known kind refused. */
+static void check_json_grid_files(void)
+{
+    const char *dir = PK_TEST_DATA "/media";
+    const char *vdb = "{\"spheres\": [{\"center\": [0, 0, 0], \"radius\": 1}],\n"
+                      " \"media\": [{\"name\": \"smoke\", \"type\": \"grid\", \"file\": \"grid.vdb\", \"grid\": \"density\","
+                      " \"sigma_t\": 0.01}],\n \"medium\": \"smoke\"}\n";
+    pk_scene *s = NULL;
+    pk_context_clear_error(ctx);
+    pk_status st = pk_scene_load_json_memory(ctx, vdb, strlen(vdb), "vdb.json", dir, &s);
+    if (grid_have_openvdb()) {
+        CHECKF(st == PK_OK, "vdb.json: %s", pk_context_error(ctx));
+        if (st == PK_OK) {
+            CHECK(s->nmedia == 1 && s->camera_medium == 0);
+            const medium_grid *g = &s->media[0].density;
+            CHECKF(g->nx == 5 && g->ny == 2 && g->nz == 1 && g->channels == 1, "grid %dx%dx%d", g->nx, g->ny, g->nz);
+            if (g->nx == 5 && g->ny == 2 && g->nz == 1) {
+                CHECK_NEAR(g->data[0], 98.0f, 1e-4);      /* x -2, y 0 */
+                CHECK_NEAR(g->data[5 + 4], 112.0f, 1e-4); /* x 2, y 1 */
+            }
+            pk_scene_destroy(s);
+        }
+    } else {
+        CHECKF(st != PK_OK && strstr(pk_context_error(ctx), "OpenVDB"), "without OpenVDB: %s", pk_context_error(ctx));
+        printf("  (this build has no OpenVDB: a .vdb medium is only checked to be refused)\n");
+    }
+    const char *bad = "{\"spheres\": [{\"center\": [0, 0, 0], \"radius\": 1}],\n"
+                      " \"media\": [{\"name\": \"smoke\", \"type\": \"grid\", \"file\": \"smoke.raw\"}]}\n";
+    pk_context_clear_error(ctx);
+    s = NULL;
+    st = pk_scene_load_json_memory(ctx, bad, strlen(bad), "bad.json", dir, &s);
+    CHECKF(st != PK_OK && strstr(pk_context_error(ctx), "bad.json:2") && strstr(pk_context_error(ctx), ".vdb"),
+           "an unknown grid file: %s", pk_context_error(ctx));
+    pk_scene_destroy(s);
+    pk_context_clear_error(ctx);
+}
+
 int main(void)
 {
     REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
@@ -244,6 +284,7 @@ int main(void)
     check_majorants();
     check_hg();
     check_refusals();
+    check_json_grid_files();
     pk_context_destroy(ctx);
     return test_done("medium");
 }
