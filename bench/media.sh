@@ -76,7 +76,8 @@ instr() {
 
 echo "- machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(nproc) cores;" \
     "load average at the start: $(cut -d' ' -f1-3 /proc/loadavg)"
-echo "- program: $bin ($(git -C "$repo" rev-parse --short HEAD 2>/dev/null || echo unknown))${base:+; base: $base}"
+commit() { git -C "$(dirname "$1")" rev-parse --short HEAD 2>/dev/null || echo "commit unknown"; }
+echo "- program: $bin ($(commit "$bin"); the HEAD of the git tree it lies in)${base:+; base: $base ($(commit "$base"))}"
 bunny_obj=$shared/scenes/bench/stanford-bunny.obj
 if [ -f "$bunny_obj" ]; then
     stats=$(/usr/bin/python3 "$here/media_scenes.py" "$tmp" "$grid" "$bunny_obj")
