@@ -81,11 +81,7 @@ static pk_status build_majorant(pk_context *ctx, pk_scene *s, medium *m)
 {
     const medium_grid *g = &m->density;
     const int n[3] = {g->nx, g->ny, g->nz};
-    for (int a = 0; a < 3; a++) {
-        int r = (n[a] + MEDIUM_MAJORANT_VOXELS - 1) / MEDIUM_MAJORANT_VOXELS;
-        if (r < 16) r = n[a] < 16 ? n[a] : 16;
-        m->mres[a] = r < MEDIUM_MAJORANT_RES ? r : MEDIUM_MAJORANT_RES;
-    }
+    for (int a = 0; a < 3; a++) m->mres[a] = n[a] < MEDIUM_MAJORANT_RES ? n[a] : MEDIUM_MAJORANT_RES;
     const size_t cells = (size_t)m->mres[0] * (size_t)m->mres[1] * (size_t)m->mres[2];
     m->majorant = mem_realloc_array(&s->alloc, NULL, cells, sizeof *m->majorant);
     if (!m->majorant) return ctx_nomem(ctx);

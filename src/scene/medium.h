@@ -47,11 +47,10 @@
 /* At most this many voxels per grid (2^27 = 512^3: 512 MiB of one
  * channel); larger grids are refused with a message. */
 #define MEDIUM_MAX_VOXELS ((size_t)1 << 27)
-/* Majorant cells per axis: about one per MEDIUM_MAJORANT_VOXELS voxels, at
- * least 16 (or one per voxel in smaller grids) and at most
- * MEDIUM_MAJORANT_RES. */
-#define MEDIUM_MAJORANT_RES 64
-#define MEDIUM_MAJORANT_VOXELS 8
+/* Majorant cells per axis at most (fewer for smaller grids). Finer grids
+ * (32^3 cells over a 256^3 plume) cost more DDA steps than the null
+ * collisions they save (bench/media.sh, docs/performance.md). */
+#define MEDIUM_MAJORANT_RES 16
 
 typedef enum medium_kind { MEDIUM_HOMOGENEOUS = 0, MEDIUM_GRID = 1 } medium_kind;
 
