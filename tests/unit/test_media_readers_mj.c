@@ -273,7 +273,7 @@ static void test_json_errors(void)
     json_fails("{\"media\": [{\"name\": \"f\", \"type\": \"homogeneous\", \"file\": \"x.vol\"}]}",
                "media[0].file: belongs to a grid medium");
     json_fails("{\"media\": [{\"name\": \"f\", \"type\": \"grid\"}]}",
-               "media[0]: a grid medium needs \"file\" (a .vol file) or \"density\", one of them");
+               "media[0]: a grid medium needs \"file\" (a .vol, .nvdb or .vdb file) or \"density\", one of them");
     json_fails("{\"media\": [{\"name\": \"f\", \"type\": \"grid\",\n"
                " \"density\": {\"size\": [2, 2, 2],\n \"data\": [1, 2, 3]}}]}",
                "scene.json:3: media[0].density.data: holds 3 numbers; a 2x2x2 grid of 1 channel needs 8");
@@ -291,8 +291,8 @@ static void test_json_errors(void)
                "scene.json:2: media[0].bounds.max: must exceed \"min\" on every axis");
     json_fails("{\"media\": [{\"name\": \"f\", \"type\": \"grid\", \"file\": \"missing.vol\"}]}",
                "media[0].file: ");
-    json_fails("{\"media\": [{\"name\": \"f\", \"type\": \"grid\", \"file\": \"smoke.vdb\"}]}",
-               "media[0].file: grid files are Mitsuba .vol files");
+    json_fails("{\"media\": [{\"name\": \"f\", \"type\": \"grid\", \"file\": \"smoke.raw\"}]}",
+               "media[0].file: grid files are Mitsuba .vol, NanoVDB .nvdb or OpenVDB .vdb files");
     json_fails("{\"media\": [{\"name\": \"f\", \"type\": \"homogeneous\"}, {\"name\": \"f\", \"type\": "
                "\"homogeneous\"}]}",
                "media[1]: a medium named \"f\" is defined already");
