@@ -53,6 +53,7 @@ typedef struct vol_state {
     vec3 r_u;            /* each channel's pdf over the hero's (spectral MIS) */
     int hero;            /* 0, 1, 2 */
     int32_t medium;      /* the medium the ray is in, or MEDIUM_NONE */
+    rng rr;              /* tracking's random numbers after a walk's first collision (cheaper than the sampler's) */
     bool has_hit;        /* ps.h is the ray's closest hit (else it leaves the scene) */
 } vol_state;
 
@@ -99,6 +100,7 @@ static inline PK_HD int vol_track(const path_tracer *pt, vol_state *vs, const me
     float t0, t1, sig;
     const int h = vs->hero;
     int budget = VOL_MAX_COLLISIONS;
+    bool first = true;
     while (majorant_next(&it, &t0, &t1, &sig)) {
         /* the majorant of each channel: a homogeneous medium's own
          * extinction (no null collisions), a grid cell's bound in all three */
@@ -117,7 +119,12 @@ static inline PK_HD int vol_track(const path_tracer *pt, vol_state *vs, const me
         float t = t0;
         for (;;) {
             float ud, ue;
-            sampler_2d(&ps->smp, &ud, &ue);
+            if (first) { /* the walk's first collision from the sampler (stratified), the rest from a stream */
+                sampler_2d(&ps->smp, &ud, &ue);
+                first = false;
+            } else {
+                ud = rng_float(&vs->rr), ue = rng_float(&vs->rr);
+            }
             const float tn = t - log1pf(-ud) / rate;
             if (!(tn < t1)) { /* past the segment: each channel's transmittance over the hero's */
                 if (!uniform) {
@@ -172,7 +179,7 @@ static inline PK_HD int vol_track(const path_tracer *pt, vol_state *vs, const me
 /* The transmittance of medium m along ray r from r->tmin to tmax: exact in
  * a homogeneous medium, else ratio tracking (an unbiased estimate per
  * channel) with Russian roulette once it is small. */
-static inline PK_HD vec3 vol_transmittance(const medium *m, const ray *r, float tmax, sampler *smp)
+static inline PK_HD vec3 vol_transmittance(const medium *m, const ray *r, float tmax, rng *rr)
 {
     const float dlen = v3_len(r->d);
     if (m->kind == MEDIUM_HOMOGENEOUS) {
@@ -189,8 +196,7 @@ static inline PK_HD vec3 vol_transmittance(const medium *m, const ray *r, float 
         const float rate = sig * dlen;
         float t = t0;
         for (;;) {
-            float ud, urr;
-            sampler_2d(smp, &ud, &urr);
+            const float ud = rng_float(rr), urr = rng_float(rr);
             t -= log1pf(-ud) / rate;
             if (!(t < t1)) break;
             if (--budget < 0) return v3s(0.0f);
@@ -211,14 +217,14 @@ static inline PK_HD vec3 vol_transmittance(const medium *m, const ray *r, float 
 /* What arrives along shadow ray sh (tracing from sh.tmin to sh.tmax) that
  * starts in medium med: the product of the media's transmittances, through
  * interface surfaces and holes; zero when anything else is in the way. */
-static inline PK_HD vec3 vol_shadow(const path_tracer *pt, path_thread *t, const ray *sh, int32_t med, sampler *smp)
+static inline PK_HD vec3 vol_shadow(const path_tracer *pt, path_thread *t, const ray *sh, int32_t med, rng *rr)
 {
     const scene_view *s = &pt->f->v;
     if (!s->has_interfaces && (med < 0 || s->media[med].kind == MEDIUM_HOMOGENEOUS)) {
         /* nothing to pass through but holes, and a transmittance in closed
          * form: an occlusion test will do */
         if (path_occluded(pt, t, sh)) return v3s(0.0f);
-        return med < 0 ? v3s(1.0f) : vol_transmittance(&s->media[med], sh, sh->tmax, smp);
+        return med < 0 ? v3s(1.0f) : vol_transmittance(&s->media[med], sh, sh->tmax, rr);
     }
     ray r = *sh;
     vec3 T = v3s(1.0f);
@@ -227,7 +233,7 @@ static inline PK_HD vec3 vol_shadow(const path_tracer *pt, path_thread *t, const
         const bool found = PATH_TRACE(pt, t, &r, &h);
         const float tend = found ? h.t : r.tmax;
         if (med >= 0) {
-            T = v3_mul(T, vol_transmittance(&s->media[med], &r, tend, smp));
+            T = v3_mul(T, vol_transmittance(&s->media[med], &r, tend, rr));
             if (black(T)) return T;
         }
         if (!found) return T;
@@ -252,7 +258,7 @@ static inline PK_HD void vol_nee(const path_tracer *pt, path_thread *t, vol_stat
     path_state *ps = &vs->ps;
     if (black(f)) return;
     t->rays_shadow++;
-    const vec3 T = vol_shadow(pt, t, &ls->shadow, med, &ps->smp);
+    const vec3 T = vol_shadow(pt, t, &ls->shadow, med, &vs->rr);
     if (black(T)) return;
     const float w = ls->delta || pt->strategy == PATH_LIGHTS_ONLY ? 1.0f : power_heuristic(ls->pdf, pf);
     path_add(pt, ps, v3_scale(v3_mul(v3_mul(ps->beta, T), v3_mul(f, ls->le)), w * vol_mis(vs) / ls->pdf),
@@ -435,6 +441,7 @@ static inline PK_HD bool vol_camera_sample_aov(const path_tracer *pt, path_threa
     vs.has_hit = h != NULL;
     vs.medium = s->camera_medium;
     vs.r_u = v3s(1.0f);
+    vs.rr = rng_seed(((uint64_t)vs.ps.smp.pixel_seed << 32) | index, 0x766f6c70u); /* per pixel sample */
     vs.hero = (int)(sampler_1d(&vs.ps.smp) * 3.0f);
     if (vs.hero > 2) vs.hero = 2;
     path_aov pa = {aov, true};
