@@ -230,6 +230,23 @@ static inline PK_HD void path_add(const path_tracer *pt, path_state *ps, vec3 c,
     ps->L = v3_add(ps->L, c);
 }
 
+/* The MIS weight of emission that the path reached at surface sf (hit h)
+ * by its last bounce: 1 after a delta bounce (or the camera); else, against
+ * light sampling of the emitter from the vertex the path left. */
+static inline PK_HD float path_emission_weight(const path_tracer *pt, const path_state *ps, const surface *sf)
+{
+    if (ps->prev_delta) return 1.0f;
+    if (pt->strategy == PATH_LIGHTS_ONLY) return 0.0f; /* light sampling found it */
+    if (pt->strategy != PATH_MIS) return 1.0f;
+    const scene_view *s = &pt->f->v;
+    const int32_t li = pt->lights.of_prim[ps->h.prim];
+    if (li < 0) return 1.0f;
+    const light *l = &pt->lights.lights[li];
+    const float pl = light_pmf(&pt->lights, s, ps->prev_p, ps->prev_n, (size_t)li) *
+                     light_pdf_li(s, l, ps->prev_p, ps->prev_n, sf->p, l->kind == LIGHT_TRIANGLE ? l->normal : sf->ng);
+    return power_heuristic(ps->prev_pdf, pl);
+}
+
 static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_state *ps, path_aov *aov)
 {
     const frame *fr = pt->f;
@@ -251,21 +268,7 @@ static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_s
     const vec3 wo = v3_neg(v3_norm(ps->r.d));
     /* emission reached by the path */
     vec3 le = emitted(&sf);
-    if (!black(le)) {
-        float w = 1.0f;
-        if (!ps->prev_delta && pt->strategy == PATH_LIGHTS_ONLY) w = 0.0f; /* light sampling found it */
-        if (!ps->prev_delta && pt->strategy == PATH_MIS) {
-            int32_t li = pt->lights.of_prim[ps->h.prim];
-            if (li >= 0) {
-                const light *l = &pt->lights.lights[li];
-                float pl = light_pmf(&pt->lights, s, ps->prev_p, ps->prev_n, (size_t)li) *
-                           light_pdf_li(s, l, ps->prev_p, ps->prev_n, sf.p,
-                                                              l->kind == LIGHT_TRIANGLE ? l->normal : sf.ng);
-                w = power_heuristic(ps->prev_pdf, pl);
-            }
-        }
-        path_add(pt, ps, v3_mul(ps->beta, v3_scale(le, w)), ps->depth >= 2);
-    }
+    if (!black(le)) path_add(pt, ps, v3_mul(ps->beta, v3_scale(le, path_emission_weight(pt, ps, &sf))), ps->depth >= 2);
     if (ps->depth >= pt->max_depth) return false;
     shading sh = shading_at(&sf);
     if (pt->regularize && ps->rough_seen) shading_regularize(&sh);

@@ -367,21 +367,9 @@ static inline PK_HD bool vol_step(const path_tracer *pt, path_thread *t, vol_sta
     if (aov && aov->open) path_aov_vertex(aov, &sf, &ps->r, &ps->h, ps->depth, v3_scale(ps->beta, vol_mis(vs)));
     const vec3 wo = v3_neg(v3_norm(ps->r.d));
     const vec3 le = emitted(&sf);
-    if (!black(le)) {
-        float w = 1.0f;
-        if (!ps->prev_delta && pt->strategy == PATH_LIGHTS_ONLY) w = 0.0f;
-        if (!ps->prev_delta && pt->strategy == PATH_MIS) {
-            const int32_t li = pt->lights.of_prim[ps->h.prim];
-            if (li >= 0) {
-                const light *l = &pt->lights.lights[li];
-                const float pl = light_pmf(&pt->lights, s, ps->prev_p, ps->prev_n, (size_t)li) *
-                                 light_pdf_li(s, l, ps->prev_p, ps->prev_n, sf.p,
-                                              l->kind == LIGHT_TRIANGLE ? l->normal : sf.ng);
-                w = power_heuristic(ps->prev_pdf, pl);
-            }
-        }
-        path_add(pt, ps, v3_scale(v3_mul(ps->beta, le), w * vol_mis(vs)), ps->depth >= 2);
-    }
+    if (!black(le))
+        path_add(pt, ps, v3_scale(v3_mul(ps->beta, le), path_emission_weight(pt, ps, &sf) * vol_mis(vs)),
+                 ps->depth >= 2);
     if (ps->depth >= pt->max_depth) return false;
     shading sh = shading_at(&sf);
     if (pt->regularize && ps->rough_seen) shading_regularize(&sh);
