@@ -206,6 +206,11 @@ async function main() {
   check(focused && Math.abs(focused.camera.focus_distance - pick.distance) <= 1e-4 * pick.distance,
     `a ctrl-click sets the focus distance to the pick's (${focused ? focused.camera.focus_distance : 'unchanged'}, pick ${pick.distance})`);
   check(focused && focused.camera.look_from.every((v, i) => v === settled.camera.look_from[i]), 'the ctrl-click did not move the camera');
+  // the focus restarted the render: save once full passes are in again
+  await poll(async () => {
+    const s = await api('/api/status');
+    return s.spp >= 2 && (await shownFrame()) >= s.frame;
+  }, 10000);
 
   // ---- save a PNG ----
   t = performance.now();
