@@ -103,6 +103,10 @@ PK_API void pk_context_set_file_reader(pk_context *ctx, pk_file_reader_fn fn, vo
  *                   default libembree3.so.3)
  *   cuda.library    the CUDA driver to load (default libcuda.so.1)
  *   dnnl.library    oneDNN, which runs the denoiser (default libdnnl.so.2)
+ *   cuda.traversal  sorted (default) or ordered: the GPU's traversal
+ *                   (docs/gpu.md); the same closest hits
+ *   cuda.leaf       16 (default), 8 or 4: the most triangles in a leaf of
+ *                   the GPU's tree; the same closest hits
  * A library is loaded once per process: the first name that loads stays.
  * Keys not named keep their values (a new context has the defaults); an
  * empty value ("cpu.isa=") restores a key's default; blanks around keys and
@@ -187,6 +191,11 @@ typedef struct pk_camera {
  * it, then set what you need, so that fields added in later versions get
  * their defaults. */
 PK_API void pk_camera_init(pk_camera *cam);
+/* Whether cam is a camera the library accepts (the rule of
+ * pk_scene_set_camera and pk_renderer_set_camera): PK_OK, or
+ * PK_ERR_INVALID_ARGUMENT with "camera: what is wrong" latched in ctx (ctx
+ * may be NULL: nothing is latched). */
+PK_API pk_status pk_camera_check(pk_context *ctx, const pk_camera *cam);
 
 typedef enum pk_accel_kind {
     PK_ACCEL_DEFAULT = 0,  /* the best built in (PK_ACCEL_BVH) */
@@ -546,6 +555,28 @@ PK_API void pk_renderer_set_pass(pk_renderer *r, uint32_t pass);
 /* Statistics since pk_renderer_create: the build once, the rays, tests,
  * nodes, pixels and render time of every render added up. */
 PK_API void pk_renderer_get_stats(const pk_renderer *r, pk_stats *stats);
+
+/* What lies under a point of the image (pk_renderer_pick). */
+typedef struct pk_pick {
+    int hit;              /* 1: the ray hit a surface; 0: it left the scene (nothing else is set) */
+    float t;              /* distance from the ray's origin to the hit, along the ray */
+    float distance;       /* the same along the view direction: what pk_camera.focus_distance wants */
+    float position[3];    /* the hit point, world space */
+    float normal[3];      /* the shading normal there, facing the camera */
+    uint32_t prim;        /* the primitive hit, numbered as pk_hit.prim */
+    const char *material; /* the material's name ("" when it has none); owned by the scene */
+} pk_pick;
+
+/* Traces the ray through the point (x, y) of the image (pixels of the
+ * renderer's width and height, (0, 0) the top-left corner, pixel (px, py)
+ * covering px..px+1, py..py+1; a pixel's centre is px + 0.5) from the
+ * centre of the lens of cam (NULL: the renderer's camera), through holes
+ * of cut-out materials, and fills *out. Only reads what the renderer built
+ * once, so it may run on another thread while that one renders (the
+ * renderer must not be destroyed meanwhile). PK_ERR_INVALID_ARGUMENT when
+ * (x, y) is outside the image or cam is not a valid camera; nothing is
+ * latched in the renderer's context. */
+PK_API pk_status pk_renderer_pick(const pk_renderer *r, const pk_camera *cam, double x, double y, pk_pick *out);
 
 /* One call: a renderer, a film of the whole image and its resolved image
  * (*out, owned by the caller). opt NULL: the scene's settings. stats may be

@@ -408,6 +408,19 @@ void pk_renderer_get_stats(const pk_renderer *r, pk_stats *stats)
     if (r && stats) renderer_stats(r, stats);
 }
 
+pk_status pk_renderer_pick(const pk_renderer *r, const pk_camera *cam, double x, double y, pk_pick *out)
+{
+    if (!r || !out) return PK_ERR_INVALID_ARGUMENT;
+    return renderer_pick(r, cam, x, y, out);
+}
+
+pk_status pk_camera_check(pk_context *ctx, const pk_camera *cam)
+{
+    if (!cam) return PK_ERR_INVALID_ARGUMENT;
+    if (!ctx) return camera_check(cam) == CAMERA_OK ? PK_OK : PK_ERR_INVALID_ARGUMENT;
+    return camera_validate(ctx, cam, "camera");
+}
+
 pk_status pk_render(pk_context *ctx, const pk_scene *scene, const pk_render_options *opt, pk_image **out,
                     pk_stats *stats)
 {

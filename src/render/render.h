@@ -23,6 +23,10 @@ PK_HIDDEN const pk_camera *renderer_camera(const pk_renderer *r);
 PK_HIDDEN pk_status renderer_render(pk_renderer *r, const pk_region *regions, size_t n, pk_film *film);
 PK_HIDDEN void renderer_stats(const pk_renderer *r, pk_stats *stats);
 PK_HIDDEN void renderer_set_pass(pk_renderer *r, uint32_t pass);
+/* What the renderer built once (read only; pick.c). */
+PK_HIDDEN const frame *renderer_frame(const pk_renderer *r);
+/* pk_renderer_pick (pick.c); r and out are not NULL. */
+PK_HIDDEN pk_status renderer_pick(const pk_renderer *r, const pk_camera *cam, double x, double y, pk_pick *out);
 /* Tests: the path tracer's direct-light strategy (PATH_* of path.h). */
 PK_HIDDEN void renderer_set_path_strategy(pk_renderer *r, int strategy);
 
