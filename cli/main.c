@@ -3,6 +3,9 @@
  * public header alone.
  */
 #include "cli.h"
+#if PK_HAVE_VIEW
+#include "view_server.h"
+#endif
 
 #include <stdio.h>
 #include <string.h>
@@ -14,6 +17,8 @@ static void usage(FILE *f)
           "commands:\n"
           "  render [SCENE] -o OUT     render a scene (.obj, .json or .xml; without SCENE the\n"
           "                            built-in Cornell box) to OUT (.png, .pfm or .exr)\n"
+          "  view [SCENE]              render a scene progressively in the browser: move the\n"
+          "                            camera, focus, expose, save (serves http://127.0.0.1)\n"
           "  denoise IN -o OUT         denoise a rendered image (its albedo and normal too)\n"
           "  bench rays SCENE RAYS     time an accelerator on a ray file\n"
           "  bench gen-rays SCENE ...  make the standard ray files\n"
@@ -29,7 +34,15 @@ static void usage(FILE *f)
           f);
 }
 
-static const char *const commands[] = {"render", "denoise", "bench", "help"};
+static const char *const commands[] = {"render", "view", "denoise", "bench", "help"};
+
+#if !PK_HAVE_VIEW
+static int view_missing(void)
+{
+    return cli_failure("view: not built in: the viewer needs GNU libmicrohttpd (Debian: libmicrohttpd-dev); "
+                       "install it and rebuild");
+}
+#endif
 #define NCOMMANDS (sizeof commands / sizeof commands[0])
 
 static int unknown_command(const char *cmd)
@@ -49,6 +62,11 @@ int main(int argc, char **argv)
     if (strcmp(cmd, "render") == 0) return cli_render(argc - 1, argv + 1);
     if (strcmp(cmd, "bench") == 0) return cli_bench(argc - 1, argv + 1);
     if (strcmp(cmd, "denoise") == 0) return cli_denoise(argc - 1, argv + 1);
+#if PK_HAVE_VIEW
+    if (strcmp(cmd, "view") == 0) return cli_view(argc - 1, argv + 1);
+#else
+    if (strcmp(cmd, "view") == 0) return view_missing();
+#endif
     if (strcmp(cmd, "help") == 0) {
         if (argc < 3) {
             usage(stdout);
@@ -66,6 +84,14 @@ int main(int argc, char **argv)
         if (strcmp(argv[2], "denoise") == 0) {
             cli_denoise_help(stdout);
             return 0;
+        }
+        if (strcmp(argv[2], "view") == 0) {
+#if PK_HAVE_VIEW
+            cli_view_help(stdout);
+            return 0;
+#else
+            return view_missing();
+#endif
         }
         if (strcmp(argv[2], "help") == 0) {
             usage(stdout);
