@@ -1,14 +1,18 @@
 /*
  * path_kernel.h - the path tracer's sampling of one camera sample, written
- * once for the CPU (path.c) and the GPU (src/accel/cuda/path.cu): plain C
- * over the read-only structures of a render (path_tracer, its frame, the
- * scene, the light set, the environment, the textures), every function
- * PK_HD. What differs is how rays are traced; the includer defines
+ * once for the CPU (path.c, wavefront.c) and the GPU (src/render/cuda/):
+ * plain C over the read-only structures of a render (path_tracer, its
+ * frame, the scene, the light set, the environment, the textures), every
+ * function PK_HD. What differs is how rays are traced; the includer defines
  *
  *   PATH_TRACE(pt, t, r, h)   closest hit of ray *r into *h: true when hit
  *   PATH_OCCLUDED(pt, t, r)   whether anything lies on ray *r (any hit)
  *
  * before including this file (pt: const path_tracer *, t: path_thread *).
+ * A path's vertex is path_step: holes, then path_shade (which traces
+ * nothing and leaves a shadow ray and the next ray), the shadow ray's test,
+ * and path_arrive with the next ray's hit; the wavefront runs the same
+ * phases with its rays traced in queues.
  *
  * The BSDF at each vertex comes from shading.h (the material at a hit as a
  * pbsdf), the lights' sampling from lights.h. The AOVs (integrator.h
@@ -211,13 +215,6 @@ static inline PK_HD void path_begin(path_state *ps, const ray *r, const hit *h, 
     ps->smp = *smp;
 }
 
-/* One vertex of the path: the surface at its hit (emission, light sampling),
- * then the next direction and its closest hit. False when the path has
- * ended (ps->L is then its radiance). aov (NULL: not wanted) follows the
- * path to its first non-specular vertex (path_aov_vertex); it draws no
- * random numbers and changes nothing of the path. The CPU loops over it per
- * sample; GPU threads that start a new path as soon as one ends run the
- * same steps. */
 /* Adds the contribution c to the path's radiance; indirect (light that has
  * bounced at least once after the first surface the camera sees) is
  * clamped when the tracer asks for it (pk_render_options.clamp_indirect). */
@@ -247,17 +244,39 @@ static inline PK_HD float path_emission_weight(const path_tracer *pt, const path
     return power_heuristic(ps->prev_pdf, pl);
 }
 
-static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_state *ps, path_aov *aov)
+/* What a vertex leaves to trace besides the path's next ray: the shadow ray
+ * toward its light sample, and what that sample adds to the path's radiance
+ * (path_add) when nothing blocks the ray. */
+typedef struct path_shadow {
+    ray r;
+    vec3 c;
+    bool indirect; /* c is indirect light (path_add) */
+} path_shadow;
+
+/* What path_shade leaves to trace (bits): its shadow ray (*sr), the path's
+ * next ray (ps->r; none: the path has ended once the shadow ray is done). */
+enum { PATH_NEXT_SHADOW = 1, PATH_NEXT_BOUNCE = 2 };
+
+/* A path whose ray leaves the scene toward d (unit): what it gathers there
+ * (leaving), indirect as path_add; the AOVs see the surroundings if they
+ * are still open. */
+static inline PK_HD void path_miss(const path_tracer *pt, path_state *ps, path_aov *aov, vec3 d, bool indirect)
+{
+    if (aov && aov->open) path_aov_miss(pt, aov, d, ps->beta);
+    path_add(pt, ps, v3_mul(ps->beta, leaving(pt, d, ps->prev_delta, ps->prev_pdf)), indirect);
+}
+
+/* The vertex at ps's hit, which is not a hole: its emission, its light
+ * sample (the shadow ray and what it brings, in *sr, to be added by the
+ * caller unless blocked), then the next direction from the material and
+ * Russian roulette; ps->r becomes the next ray. Returns PATH_NEXT_* bits.
+ * aov as for path_step. Traces nothing: path_step traces what it leaves
+ * at once, the wavefront (wavefront.h) in queues. */
+static inline PK_HD int path_shade(const path_tracer *pt, path_state *ps, path_aov *aov, path_shadow *sr)
 {
     const frame *fr = pt->f;
     const scene_view *s = &fr->v;
     sampler *smp = &ps->smp;
-    if (s->has_cutout && !path_past_holes(pt, t, &ps->r, &ps->h)) { /* through map_d holes, out */
-        if (aov && aov->open) path_aov_miss(pt, aov, v3_norm(ps->r.d), ps->beta);
-        /* the ray came from vertex depth - 1 */
-        path_add(pt, ps, v3_mul(ps->beta, leaving(pt, v3_norm(ps->r.d), ps->prev_delta, ps->prev_pdf)), ps->depth >= 2);
-        return false;
-    }
     surface sf = surface_at(s, &ps->r, &ps->h);
     material textured;
     if (s->has_textured) { /* the ray cone, widened by the distance travelled */
@@ -269,13 +288,14 @@ static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_s
     /* emission reached by the path */
     vec3 le = emitted(&sf);
     if (!black(le)) path_add(pt, ps, v3_mul(ps->beta, v3_scale(le, path_emission_weight(pt, ps, &sf))), ps->depth >= 2);
-    if (ps->depth >= pt->max_depth) return false;
+    if (ps->depth >= pt->max_depth) return 0;
     shading sh = shading_at(&sf);
     if (pt->regularize && ps->rough_seen) shading_regularize(&sh);
     float u0, u1, u2, u3, u4, u5;
     sampler_2d(smp, &u0, &u1);
     sampler_2d(smp, &u2, &u3);
     sampler_2d(smp, &u4, &u5);
+    int next = 0;
     /* next-event estimation: one light, chosen by power */
     if (sh.nondelta && pt->lights.n && pt->strategy != PATH_BSDF_ONLY) {
         light_sample ls;
@@ -291,12 +311,11 @@ static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_s
                 ls.shadow.o = o2;
             }
             if (!black(f)) {
-                t->rays_shadow++;
-                const bool blocked = path_occluded(pt, t, &ls.shadow);
-                if (!blocked) {
-                    float w = ls.delta || pt->strategy == PATH_LIGHTS_ONLY ? 1.0f : power_heuristic(ls.pdf, pb);
-                    path_add(pt, ps, v3_mul(ps->beta, v3_scale(v3_mul(f, ls.le), w / ls.pdf)), ps->depth >= 1);
-                }
+                float w = ls.delta || pt->strategy == PATH_LIGHTS_ONLY ? 1.0f : power_heuristic(ls.pdf, pb);
+                sr->r = ls.shadow;
+                sr->c = v3_mul(ps->beta, v3_scale(v3_mul(f, ls.le), w / ls.pdf));
+                sr->indirect = ps->depth >= 1;
+                next = PATH_NEXT_SHADOW;
             }
         }
     }
@@ -304,16 +323,16 @@ static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_s
     vec3 wi, weight;
     float pdf;
     bool delta;
-    if (!shading_sample(&sf, &sh, wo, u3, u4, u5, &wi, &weight, &pdf, &delta)) return false;
+    if (!shading_sample(&sf, &sh, wo, u3, u4, u5, &wi, &weight, &pdf, &delta)) return next;
     ps->beta = v3_mul(ps->beta, weight);
-    if (black(ps->beta) || !v3_finite(ps->beta)) return false;
+    if (black(ps->beta) || !v3_finite(ps->beta)) return next;
     /* Russian roulette on the throughput: a path carrying less than 1
      * survives with probability max(beta) and is weighted up by its
      * inverse (unbiased) */
     if (ps->depth + 1 >= RR_START) {
         float q = v3_max_comp(ps->beta);
         if (q < 1.0f) {
-            if (sampler_1d(smp) >= q) return false;
+            if (sampler_1d(smp) >= q) return next;
             ps->beta = v3_scale(ps->beta, 1.0f / q);
         }
     }
@@ -324,14 +343,44 @@ static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_s
     ps->prev_pdf = pdf;
     ps->prev_p = sf.p;
     ps->prev_n = sf.ng;
-    t->rays_bounce++;
-    if (!PATH_TRACE(pt, t, &ps->r, &ps->h)) {
-        if (aov && aov->open) path_aov_miss(pt, aov, wi, ps->beta); /* (open: the vertex left was specular) */
-        path_add(pt, ps, v3_mul(ps->beta, leaving(pt, wi, ps->prev_delta, ps->prev_pdf)), ps->depth >= 1);
+    return next | PATH_NEXT_BOUNCE;
+}
+
+/* The path's next ray (path_shade's) traced: found says whether it hit,
+ * at ps->h. A miss ends the path with what the surroundings give; a hit makes
+ * it one bounce longer. False when the path has ended. */
+static inline PK_HD bool path_arrive(const path_tracer *pt, path_state *ps, path_aov *aov, bool found)
+{
+    if (!found) { /* (aov open: the vertex left was specular) */
+        path_miss(pt, ps, aov, ps->r.d, ps->depth >= 1);
         return false;
     }
     ps->depth++;
     return true;
+}
+
+/* One vertex of the path: past map_d holes to the surface at its hit,
+ * path_shade there, then its shadow ray and the next ray traced. False when
+ * the path has ended (ps->L is then its radiance). aov (NULL: not wanted)
+ * follows the path to its first non-specular vertex (path_aov_vertex); it
+ * draws no random numbers and changes nothing of the path. The CPU loops
+ * over it per sample; the wavefront (wavefront.h) runs the same phases
+ * with its rays traced in queues. */
+static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_state *ps, path_aov *aov)
+{
+    if (pt->f->v.has_cutout && !path_past_holes(pt, t, &ps->r, &ps->h)) { /* through map_d holes, out */
+        path_miss(pt, ps, aov, v3_norm(ps->r.d), ps->depth >= 2); /* the ray came from vertex depth - 1 */
+        return false;
+    }
+    path_shadow sr;
+    const int next = path_shade(pt, ps, aov, &sr);
+    if (next & PATH_NEXT_SHADOW) {
+        t->rays_shadow++;
+        if (!path_occluded(pt, t, &sr.r)) path_add(pt, ps, sr.c, sr.indirect);
+    }
+    if (!(next & PATH_NEXT_BOUNCE)) return false;
+    t->rays_bounce++;
+    return path_arrive(pt, ps, aov, PATH_TRACE(pt, t, &ps->r, &ps->h));
 }
 
 /* ---- camera samples -------------------------------------------------------------- */
