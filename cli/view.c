@@ -7,6 +7,7 @@
 #include "cli.h"
 #include "view_server.h"
 
+#include <arpa/inet.h>
 #include <fcntl.h>
 #include <pthread.h>
 #include <signal.h>
@@ -18,22 +19,62 @@
 
 enum { VIEW_PORT = 0, VIEW_BIND, VIEW_NO_OPEN };
 
+static void add_view_options(void);
+
 void cli_view_help(FILE *f)
 {
-    cli_render_usage(f, "usage: paprsek view [SCENE] [options] [--port N] [--bind ADDR] [--no-open]\n"
-                        "\n"
-                        "Renders SCENE progressively and shows it in the browser: the program serves a\n"
-                        "page at http://127.0.0.1:PORT/ (the address is printed), opens it with the\n"
-                        "desktop's browser when there is one, and refines the image pass after pass (one\n"
-                        "sample per pixel each) until it has --spp samples per pixel (default 1024).\n"
-                        "On the page: drag to orbit, shift-drag or right-drag to pan, the wheel to\n"
-                        "dolly, a click with Ctrl (or Alt) held to focus there; exposure, denoising,\n"
-                        "what is shown (colour, albedo, normal, depth, heat map), the integrator, and\n"
-                        "saving the image as PNG or EXR (docs/viewer.md).\n"
-                        "Ctrl-C or SIGTERM ends it. --output, --time, --aov, --stats and --stats-json\n"
-                        "do not apply; --exposure and --denoise set the page's first settings.\n"
-                        "With --bind other than a 127.x.x.x address, every request needs the random\n"
-                        "token printed in the address.\n");
+    add_view_options();
+    fputs("usage: paprsek view [SCENE] [options] [--port N] [--bind ADDR] [--no-open]\n"
+          "\n"
+          "Renders SCENE progressively and shows it in the browser: the program serves a\n"
+          "page at http://127.0.0.1:PORT/ (the address is printed), opens it with the\n"
+          "desktop's browser when there is one, and refines the image pass after pass (one\n"
+          "sample per pixel each) until it has --spp samples per pixel (default 1024);\n"
+          "it then waits for the next change. Any change starts again with a cheap pass\n"
+          "(1 sample per pixel at a quarter of the size), then full-size passes.\n"
+          "On the page: drag to orbit, shift-drag or right-drag to pan, the wheel to\n"
+          "dolly, a click with Ctrl (or Alt) held to focus there; exposure, denoising,\n"
+          "what is shown (colour, albedo, normal, depth, heat map), the integrator, and\n"
+          "saving the image as PNG or EXR (docs/viewer.md).\n"
+          "\n"
+          "SCENE is a Wavefront .obj, a .json scene, a Mitsuba .xml scene, a pbrt-v4 .pbrt\n"
+          "scene or a glTF 2.0 asset (.gltf, .glb); without it the built-in Cornell box.\n"
+          "\n"
+          "options (those of paprsek render that apply; --exposure and --denoise set the\n"
+          "page's first settings):\n",
+          f);
+    size_t n;
+    const cli_option *opts = cli_render_options(&n);
+    cli_option shown[64];
+    size_t k = 0;
+    static const char *const skip[] = {"output", "time", "aov", "stats", "stats-json"};
+    for (size_t i = 0; i < n && k < 64; i++) {
+        int drop = 0;
+        for (size_t j = 0; j < sizeof skip / sizeof skip[0]; j++) drop |= strcmp(opts[i].name, skip[j]) == 0;
+        if (strcmp(opts[i].name, "spp") == 0) {
+            shown[k] = opts[i];
+            shown[k].help = "the samples per pixel after which the image is left as it is (each pass adds one)";
+            shown[k].default_value = VIEW_DEFAULT_MAX_SPP;
+            k++;
+            continue;
+        }
+        if (drop) continue;
+        shown[k] = opts[i];
+        if (strcmp(opts[i].name, "exposure") == 0)
+            shown[k].help = "the page's first exposure: the linear values times 2^EV before the tone curve of the "
+                            "PNG; a number in -20..20, default 0";
+        k++;
+    }
+    cli_print_options(f, shown, k);
+    fputs("\n"
+          "Security: the server answers only requests that name it in their Host header\n"
+          "and, for changes, come from its own page (Origin); with --bind other than a\n"
+          "127.x.x.x address, every request needs the random token printed in the address.\n"
+          "\n"
+          "exit status: 0 after Ctrl-C (SIGINT) or SIGTERM, which end it within a second;\n"
+          "1 a runtime failure (a scene that cannot be read, a port in use); 2 a usage\n"
+          "error.\n",
+          f);
 }
 
 static void add_view_options(void)
@@ -98,8 +139,21 @@ int cli_view(int argc, char **argv)
     if (o.extra[VIEW_PORT] && !cli_parse_int(o.extra[VIEW_PORT], 0, 65535, &port))
         return cli_usage_error("--port: '%s' must be a port number in 0..65535", o.extra[VIEW_PORT]);
     const char *bind = o.extra[VIEW_BIND] ? o.extra[VIEW_BIND] : "127.0.0.1";
+    struct in_addr ia;
+    if (inet_pton(AF_INET, bind, &ia) != 1)
+        return cli_usage_error("--bind: '%s' is not an IPv4 address (such as 127.0.0.1 or 0.0.0.0)", bind);
     if (o.has_camera_pick && (!o.scene || (!strstr(o.scene, ".gltf") && !strstr(o.scene, ".glb"))))
         return cli_usage_error("--camera: picks a camera of a glTF asset (.gltf, .glb)");
+
+    /* SIGINT and SIGTERM are taken by sigwait below, in this thread only:
+     * blocked before any thread starts (the library's too), as threads
+     * inherit the mask */
+    sigset_t set;
+    sigemptyset(&set);
+    sigaddset(&set, SIGINT);
+    sigaddset(&set, SIGTERM);
+    pthread_sigmask(SIG_BLOCK, &set, NULL);
+    signal(SIGPIPE, SIG_IGN);
 
     pk_context *ctx = NULL;
     if (pk_context_create(NULL, &ctx) != PK_OK) return cli_failure("out of memory");
@@ -163,15 +217,6 @@ int cli_view(int argc, char **argv)
     cfg.dopt = have_denoiser ? &dopt : NULL;
     cfg.no_denoise_why = why;
     cfg.warn = o.quiet ? NULL : cli_print_warning;
-
-    /* SIGINT and SIGTERM are taken by sigwait below, in this thread only:
-     * blocked before the server's threads start, which inherit the mask */
-    sigset_t set;
-    sigemptyset(&set);
-    sigaddset(&set, SIGINT);
-    sigaddset(&set, SIGTERM);
-    pthread_sigmask(SIG_BLOCK, &set, NULL);
-    signal(SIGPIPE, SIG_IGN);
 
     char err[512];
     if (view_server_start(&cfg, &srv, err, sizeof err) != 0) {

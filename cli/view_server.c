@@ -310,14 +310,43 @@ static void sb_string(sbuf *b, const char *s)
     sb_printf(b, "\"");
 }
 
+/* A float as the shortest decimal that reads back as the same float
+ * (0.278, not 0.277999997). */
+static void sb_float(sbuf *b, float x)
+{
+    char t[32];
+    for (int digits = 6; digits <= 9; digits++) {
+        snprintf(t, sizeof t, "%.*g", digits, (double)x);
+        if (strtof(t, NULL) == x) break;
+    }
+    sb_printf(b, "%s", t);
+}
+
+static void sb_floats(sbuf *b, const float *x, int n)
+{
+    sb_printf(b, "[");
+    for (int i = 0; i < n; i++) {
+        if (i) sb_printf(b, ",");
+        sb_float(b, x[i]);
+    }
+    sb_printf(b, "]");
+}
+
 static void sb_camera(sbuf *b, const pk_camera *c)
 {
-    sb_printf(b,
-              "{\"look_from\":[%.9g,%.9g,%.9g],\"look_at\":[%.9g,%.9g,%.9g],\"up\":[%.9g,%.9g,%.9g],"
-              "\"fov\":%.9g,\"lens_radius\":%.9g,\"focus_distance\":%.9g}",
-              (double)c->look_from[0], (double)c->look_from[1], (double)c->look_from[2], (double)c->look_at[0],
-              (double)c->look_at[1], (double)c->look_at[2], (double)c->up[0], (double)c->up[1], (double)c->up[2],
-              (double)c->fov_deg, (double)c->lens_radius, (double)c->focus_distance);
+    sb_printf(b, "{\"look_from\":");
+    sb_floats(b, c->look_from, 3);
+    sb_printf(b, ",\"look_at\":");
+    sb_floats(b, c->look_at, 3);
+    sb_printf(b, ",\"up\":");
+    sb_floats(b, c->up, 3);
+    sb_printf(b, ",\"fov\":");
+    sb_float(b, c->fov_deg);
+    sb_printf(b, ",\"lens_radius\":");
+    sb_float(b, c->lens_radius);
+    sb_printf(b, ",\"focus_distance\":");
+    sb_float(b, c->focus_distance);
+    sb_printf(b, "}");
 }
 
 static const char *aov_label(unsigned aov) { return aov == AOV_COLOR ? "color" : pk_aov_name(aov); }
@@ -344,8 +373,10 @@ static char *status_json_locked(view_server *s)
     sb_string(&b, s->cfg.scene_name ? s->cfg.scene_name : "");
     sb_printf(&b, ",\"camera\":");
     sb_camera(&b, &s->cam);
-    sb_printf(&b, ",\"settings\":{\"exposure\":%.9g,\"denoise\":%s,\"aov\":\"%s\",\"integrator\":\"%s\",\"max_depth\":%d}",
-              (double)s->exposure, s->denoise ? "true" : "false", aov_label(s->aov), integrator_label(s->integrator),
+    sb_printf(&b, ",\"settings\":{\"exposure\":");
+    sb_float(&b, s->exposure);
+    sb_printf(&b, ",\"denoise\":%s,\"aov\":\"%s\",\"integrator\":\"%s\",\"max_depth\":%d}",
+              s->denoise ? "true" : "false", aov_label(s->aov), integrator_label(s->integrator),
               pk_render_options_max_depth(&ro));
     sb_printf(&b, ",\"initial_camera\":");
     sb_camera(&b, &s->initial_cam);
@@ -981,12 +1012,15 @@ static enum MHD_Result get_pick(view_server *s, struct MHD_Connection *c)
     if (!pk.hit) {
         sb_printf(&b, "{\"hit\":false}");
     } else {
-        sb_printf(&b,
-                  "{\"hit\":true,\"distance\":%.9g,\"t\":%.9g,\"position\":[%.9g,%.9g,%.9g],\"normal\":[%.9g,%.9g,%.9g],"
-                  "\"prim\":%u,\"material\":",
-                  (double)pk.distance, (double)pk.t, (double)pk.position[0], (double)pk.position[1],
-                  (double)pk.position[2], (double)pk.normal[0], (double)pk.normal[1], (double)pk.normal[2],
-                  (unsigned)pk.prim);
+        sb_printf(&b, "{\"hit\":true,\"distance\":");
+        sb_float(&b, pk.distance);
+        sb_printf(&b, ",\"t\":");
+        sb_float(&b, pk.t);
+        sb_printf(&b, ",\"position\":");
+        sb_floats(&b, pk.position, 3);
+        sb_printf(&b, ",\"normal\":");
+        sb_floats(&b, pk.normal, 3);
+        sb_printf(&b, ",\"prim\":%u,\"material\":", (unsigned)pk.prim);
         sb_string(&b, pk.material);
         sb_printf(&b, "}");
     }
