@@ -82,6 +82,55 @@ static bool quantise_axis(const bvh_node *src, gpu_node *dst, int k)
     return false;
 }
 
+/* The slot of each CPU slot (slot_of[s]) in the GPU node: children are
+ * assigned to the octants about the centre of the node's box by their
+ * centroids, greedily, the best-matching (child, octant) pair first (score:
+ * the centroid's offset from the centre along the octant's diagonal, ties
+ * to the lower child, then the lower octant); empty slots take the octants
+ * left over, in order. Slot bit k set: the positive side along axis k. */
+static void slot_order(const bvh_node *src, int slot_of[GPU_WIDTH])
+{
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int s = 0; s < BVH_WIDTH; s++) {
+        if (src->child[s] == BVH_EMPTY) continue;
+        for (int k = 0; k < 3; k++) {
+            lo[k] = fminf(lo[k], src->b[2 * k][s]);
+            hi[k] = fmaxf(hi[k], src->b[2 * k + 1][s]);
+        }
+    }
+    double score[GPU_WIDTH][GPU_WIDTH]; /* [child slot][octant] */
+    for (int s = 0; s < GPU_WIDTH; s++) {
+        slot_of[s] = -1;
+        for (int o = 0; o < GPU_WIDTH; o++) {
+            double d = 0.0;
+            if (src->child[s] != BVH_EMPTY)
+                for (int k = 0; k < 3; k++) {
+                    const double c = 0.5 * ((double)src->b[2 * k][s] + (double)src->b[2 * k + 1][s]) -
+                                     0.5 * ((double)lo[k] + (double)hi[k]);
+                    if (isfinite(c)) d += (o >> k & 1) ? c : -c;
+                }
+            score[s][o] = d;
+        }
+    }
+    bool taken[GPU_WIDTH] = {false};
+    for (int round = 0; round < GPU_WIDTH; round++) {
+        int bs = -1, bo = -1;
+        for (int s = 0; s < GPU_WIDTH; s++) {
+            if (slot_of[s] >= 0 || src->child[s] == BVH_EMPTY) continue;
+            for (int o = 0; o < GPU_WIDTH; o++)
+                if (!taken[o] && (bs < 0 || score[s][o] > score[bs][bo])) bs = s, bo = o;
+        }
+        if (bs < 0) break;
+        slot_of[bs] = bo, taken[bo] = true;
+    }
+    int o = 0;
+    for (int s = 0; s < GPU_WIDTH; s++) {
+        if (slot_of[s] >= 0) continue;
+        while (taken[o]) o++;
+        slot_of[s] = o, taken[o] = true;
+    }
+}
+
 pk_status gpu_layout_build(pk_context *ctx, const pk_allocator *al, const accel *a, gpu_layout *out)
 {
     _Static_assert(BVH_WIDTH == GPU_WIDTH, "the GPU node has the CPU node's width");
@@ -99,7 +148,9 @@ pk_status gpu_layout_build(pk_context *ctx, const pk_allocator *al, const accel 
         return ctx_error(ctx, PK_ERR_LIMIT, "BVH too large for the GPU layout (%zu triangle references)", nrec);
     out->nodes = mem_calloc(al, b->nnodes ? b->nnodes : 1, sizeof(gpu_node));
     out->tris = mem_calloc(al, nrec ? nrec : 1, sizeof(gpu_tri));
-    uint32_t *acc = mem_calloc(al, b->nnodes ? b->nnodes : 1, sizeof(uint32_t));
+    /* acc: the entries the sorted traversal's stack holds on reaching node i;
+     * depth: node i's depth (the root's is 1) */
+    uint32_t *acc = mem_calloc(al, 2 * (b->nnodes ? b->nnodes : 1), sizeof(uint32_t));
     if (!out->nodes || !out->tris || !acc) {
         mem_free(al, acc);
         gpu_layout_free(al, out);
@@ -110,10 +161,13 @@ pk_status gpu_layout_build(pk_context *ctx, const pk_allocator *al, const accel 
     if (!b->nnodes) /* (the builder always makes a root; an empty one otherwise) */
         for (int s = 0; s < GPU_WIDTH; s++) out->nodes[0].child[s] = GPU_EMPTY, out->nodes[0].ex[s % 3] = 127;
     size_t r = 0;
-    uint32_t need = 0;
+    uint32_t need = 0, need_o = 1;
+    uint32_t *depth = acc + (b->nnodes ? b->nnodes : 1);
+    depth[0] = 1;
     for (size_t i = 0; i < b->nnodes; i++) {
         const bvh_node *src = &b->nodes[i];
-        gpu_node *dst = &out->nodes[i];
+        gpu_node tmp, *dst = &tmp;
+        memset(&tmp, 0, sizeof tmp);
         for (int k = 0; k < 3; k++)
             if (!quantise_axis(src, dst, k)) {
                 mem_free(al, acc);
@@ -156,10 +210,27 @@ pk_status gpu_layout_build(pk_context *ctx, const pk_allocator *al, const accel 
                 dst->child[s] = gpu_leaf_ref((uint32_t)r0, (uint32_t)(r - r0));
             }
         }
+        /* the slots in octant order (bvh_gpu.h, gpu_trace_ordered) */
+        int slot_of[GPU_WIDTH];
+        slot_order(src, slot_of);
+        gpu_node *fin = &out->nodes[i];
+        memcpy(fin->org, tmp.org, sizeof fin->org);
+        memcpy(fin->ex, tmp.ex, sizeof fin->ex);
+        fin->pad = 0;
+        for (int s = 0; s < GPU_WIDTH; s++) {
+            fin->child[slot_of[s]] = tmp.child[s];
+            for (int row = 0; row < 6; row++) fin->q[row][slot_of[s]] = tmp.q[row][s];
+        }
+        for (int s = 0; s < GPU_WIDTH; s++)
+            if (fin->child[s] != GPU_EMPTY && !(fin->child[s] & GPU_LEAF) && fin->child[s] < b->nnodes) {
+                depth[fin->child[s]] = depth[i] + 1u;
+                if (depth[i] + 1u > need_o) need_o = depth[i] + 1u;
+            }
     }
     mem_free(al, acc);
     out->ntris = r;
     out->stack_need = need;
+    out->ordered_need = need_o;
     if (need > GPU_STACK) {
         gpu_layout_free(al, out);
         return ctx_error(ctx, PK_ERR_LIMIT, "BVH too deep for the GPU traversal stack (%u entries needed, %d there)",
@@ -185,8 +256,11 @@ bool gpu_layout_check_boxes(const gpu_layout *g, const accel *a, char *why, size
     for (size_t i = 0; i < g->nnodes; i++) {
         const gpu_node *gn = &g->nodes[i];
         const bvh_node *cn = &b->nodes[i];
-        for (int s = 0; s < GPU_WIDTH; s++) {
-            const uint32_t cr = cn->child[s], gr = gn->child[s];
+        int slot_of[GPU_WIDTH];
+        slot_order(cn, slot_of);
+        for (int cs = 0; cs < GPU_WIDTH; cs++) {
+            const int s = slot_of[cs]; /* the GPU's slot of the CPU's slot cs */
+            const uint32_t cr = cn->child[cs], gr = gn->child[s];
             if ((cr == BVH_EMPTY) != (gr == GPU_EMPTY) ||
                 (cr != BVH_EMPTY && bvh_is_leaf(cr) != ((gr & GPU_LEAF) != 0)) ||
                 (cr != BVH_EMPTY && !bvh_is_leaf(cr) && bvh_node_index(cr) != gr)) {
@@ -200,10 +274,10 @@ bool gpu_layout_check_boxes(const gpu_layout *g, const accel *a, char *why, size
                 const float hi = gpu_plane(gn->org[k], gn->q[2 * k + 1][s], sc);
                 const float lo2 = gpu_fma((float)gn->q[2 * k][s], sc, gn->org[k]);
                 const float hi2 = gpu_fma((float)gn->q[2 * k + 1][s], sc, gn->org[k]);
-                if (!(lo <= cn->b[2 * k][s] && hi >= cn->b[2 * k + 1][s] && lo2 <= cn->b[2 * k][s] &&
-                      hi2 >= cn->b[2 * k + 1][s])) {
+                if (!(lo <= cn->b[2 * k][cs] && hi >= cn->b[2 * k + 1][cs] && lo2 <= cn->b[2 * k][cs] &&
+                      hi2 >= cn->b[2 * k + 1][cs])) {
                     say(why, n, "node %zu slot %d axis %d: decoded [%a, %a] does not contain [%a, %a]", i, s, k,
-                        (double)lo, (double)hi, (double)cn->b[2 * k][s], (double)cn->b[2 * k + 1][s]);
+                        (double)lo, (double)hi, (double)cn->b[2 * k][cs], (double)cn->b[2 * k + 1][cs]);
                     return false;
                 }
             }
@@ -231,7 +305,7 @@ bool gpu_layout_check(const gpu_layout *g, const float *verts, char *why, size_t
         say(why, n, "no root node");
         return false;
     }
-    uint32_t *parents = calloc(nn, sizeof *parents), *acc = calloc(nn, sizeof *acc);
+    uint32_t *parents = calloc(nn, sizeof *parents), *acc = calloc(2 * nn, sizeof *acc);
     uint32_t *owner = calloc(g->ntris ? g->ntris : 1, sizeof *owner);
     uint32_t *refs = calloc(nt ? nt : 1, sizeof *refs);
     unsigned char *cover = calloc(nt ? nt : 1, 1), *whole = calloc(nt ? nt : 1, 1);
@@ -241,7 +315,9 @@ bool gpu_layout_check(const gpu_layout *g, const float *verts, char *why, size_t
         goto out;
     }
     for (int k = 0; k < 3; k++) path[0].lo[k] = -INFINITY, path[0].hi[k] = INFINITY;
-    uint32_t need = 0;
+    uint32_t need = 0, need_o = 1;
+    uint32_t *depth = acc ? acc + nn : NULL;
+    if (depth) depth[0] = 1;
     for (size_t i = 0; i < nn; i++) {
         const gpu_node *nd = &g->nodes[i];
         if (i > 0 && parents[i] != 1) {
@@ -275,6 +351,8 @@ bool gpu_layout_check(const gpu_layout *g, const float *verts, char *why, size_t
                 }
                 parents[ref]++;
                 acc[ref] = acc[i] + used - 1u;
+                depth[ref] = depth[i] + 1u;
+                if (depth[ref] > need_o) need_o = depth[ref];
                 path[ref] = box;
                 continue;
             }
@@ -326,6 +404,10 @@ bool gpu_layout_check(const gpu_layout *g, const float *verts, char *why, size_t
     }
     if (need != g->stack_need || need > GPU_STACK) {
         say(why, n, "traversal stack needs %u entries (layout says %u, limit %d)", need, g->stack_need, GPU_STACK);
+        goto out;
+    }
+    if (need_o != g->ordered_need) {
+        say(why, n, "the ordered traversal's stack needs %u entries (layout says %u)", need_o, g->ordered_need);
         goto out;
     }
     ok = true;

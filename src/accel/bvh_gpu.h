@@ -651,6 +651,174 @@ static inline PK_HD bool gpu_trace_box(const gpu_node *nodes, const gpu_tri *tri
     return gpu_walk_hit(&w, out);
 }
 
+/* ---- the ordered traversal (Ylitie, Karras and Laine 2017) -----------------
+ * The converter places each node's children in slots by direction (slot bit
+ * k set: the child lies on the positive side of the node's centre along
+ * axis k; gpu_layout_build), so that visiting slots j ^ o for j = 0..7,
+ * o = the ray's octant (bit k: d_k < 0), goes roughly near to far without
+ * sorting. A node visit turns its hit mask into that order (three
+ * conditional swaps), goes on with the first child and pushes one 32-bit
+ * entry (node index << 8 | the remaining 8-bit mask) when others remain;
+ * a pop takes the next child of the top entry and reads its reference (4
+ * bytes of the parent). At most one entry per ancestor: the stack needs
+ * gpu_layout.ordered_need entries (the depth of the deepest inner node),
+ * GPU_OSTACK at most (a quarter of the sorted traversal's bytes). No
+ * distances are kept: a popped child is not culled against the closest hit
+ * found since (an inner one is, by its own box tests; a leaf is tested).
+ * The closest hit is the same (smallest t, then smallest number; but for
+ * the exact ties of docs/gpu.md, as with any other visiting order). */
+#define GPU_OSTACK 64
+#define GPU_ONODE_MAX (1u << 24) /* node indices that fit an entry */
+
+static inline PK_HD unsigned gpu_octant(const gpu_ray *r)
+{
+    return (unsigned)(r->near[0] & 1) | (unsigned)(r->near[1] & 1) << 1 | (unsigned)(r->near[2] & 1) << 2;
+}
+
+/* Bit j of the result is bit j ^ o of m (m: 8 bits, o: 3 bits). */
+static inline PK_HD unsigned gpu_mask_order(unsigned m, unsigned o)
+{
+    if (o & 1u) m = ((m & 0x55u) << 1) | ((m >> 1) & 0x55u);
+    if (o & 2u) m = ((m & 0x33u) << 2) | ((m >> 2) & 0x33u);
+    if (o & 4u) m = ((m & 0x0Fu) << 4) | ((m >> 4) & 0x0Fu);
+    return m;
+}
+
+static inline PK_HD unsigned gpu_lowest_bit(unsigned m)
+{
+#if defined(__CUDA_ARCH__)
+    return (unsigned)__ffs((int)m) - 1u;
+#else
+    return (unsigned)__builtin_ctz(m);
+#endif
+}
+
+/* w[i] for a run-time i in 0..7, by selects (no indexed registers). */
+static inline PK_HD uint32_t gpu_sel8(const uint32_t w[8], unsigned i)
+{
+    const uint32_t a = (i & 1u) ? w[1] : w[0], b = (i & 1u) ? w[3] : w[2];
+    const uint32_t c = (i & 1u) ? w[5] : w[4], d = (i & 1u) ? w[7] : w[6];
+    const uint32_t ab = (i & 2u) ? b : a, cd = (i & 2u) ? d : c;
+    return (i & 4u) ? cd : ab;
+}
+
+/* One ray's ordered traversal as a state advancing a step at a time (as
+ * gpu_walk): a step goes down to a leaf, tests it and takes the next
+ * reference from the stack. ref: the next reference to visit, GPU_EMPTY
+ * when the stack must be popped. */
+typedef struct gpu_owalk {
+    gpu_ray r;
+    float best_t, best_u, best_v, tcull;
+    uint32_t best_prim, ref;
+    unsigned oct;
+    int sp;
+    bool loose;
+} gpu_owalk;
+
+static inline PK_HD bool gpu_owalk_init(gpu_owalk *w, const pk_ray *in, int box)
+{
+    w->best_t = in->tmax, w->best_u = w->best_v = 0.0f;
+    w->best_prim = PK_NO_HIT;
+    w->ref = 0, w->sp = 0, w->oct = 0;
+    if (!gpu_ray_traceable(in)) return false;
+    gpu_ray_init(&w->r, in);
+    w->oct = gpu_octant(&w->r);
+    w->tcull = gpu_cull_limit(w->best_t);
+    w->loose = box == GPU_TEST_WIDE && fabsf(w->r.rd[0]) < 0x1p64f && fabsf(w->r.rd[1]) < 0x1p64f &&
+               fabsf(w->r.rd[2]) < 0x1p64f;
+    return true;
+}
+
+/* The next child of the top entry, or GPU_EMPTY with *done when the stack is empty. */
+static inline PK_HD uint32_t gpu_opop(uint32_t *stack, int *sp, const gpu_node *nodes, unsigned oct)
+{
+    if (*sp == 0) return GPU_EMPTY;
+    const uint32_t e = stack[*sp - 1];
+    const uint32_t ni = e >> 8;
+    unsigned pm = e & 255u;
+    const unsigned j = gpu_lowest_bit(pm);
+    pm &= pm - 1u;
+    if (pm) stack[*sp - 1] = (ni << 8) | pm;
+    else --*sp;
+#if defined(__CUDA_ARCH__)
+    return __ldg(&nodes[ni].child[j ^ oct]);
+#else
+    return nodes[ni].child[j ^ oct];
+#endif
+}
+
+/* One step; true when the ray is done (gpu_owalk_hit then has the answer). */
+static inline PK_HD bool gpu_owalk_step(gpu_owalk *ws, uint32_t *stack, const gpu_node *nodes, const gpu_tri *tris,
+                                        bool any, gpu_counters *count)
+{
+    const gpu_ray *r = &ws->r;
+    const unsigned oct = ws->oct;
+    uint32_t ref = ws->ref;
+    int sp = ws->sp;
+    for (;;) {
+        while (ref != GPU_EMPTY && !(ref & GPU_LEAF)) {
+            if (count) count->nodes++;
+            uint32_t w[24];
+            gpu_node_load(&nodes[ref], w);
+            float tn[GPU_WIDTH];
+            const unsigned mask =
+                ws->loose ? gpu_node_hits_wide(w, r, ws->tcull, tn) : gpu_node_hits_fma(w, r, ws->tcull, tn);
+            unsigned pm = gpu_mask_order(mask, oct);
+            if (!pm) {
+                ref = GPU_EMPTY;
+                break;
+            }
+            const unsigned j = gpu_lowest_bit(pm);
+            pm &= pm - 1u;
+            if (pm) stack[sp++] = (ref << 8) | pm;
+            ref = gpu_sel8(w + 16, j ^ oct);
+        }
+        if (ref != GPU_EMPTY) break; /* a leaf */
+        ref = gpu_opop(stack, &sp, nodes, oct);
+        if (ref == GPU_EMPTY) return true;
+    }
+    if (count) count->nodes++;
+    const uint32_t first = gpu_leaf_first(ref), cnt = gpu_leaf_count(ref);
+    for (uint32_t i = 0; i < cnt; i++) {
+        float t, u, v;
+        uint32_t prim;
+        if (count) count->tests++;
+        if (!gpu_tri_intersect_rec(r, &tris[first + i], ws->best_t, &t, &u, &v, &prim)) continue;
+        if (t < ws->best_t || (t == ws->best_t && prim < ws->best_prim)) {
+            ws->best_t = t, ws->best_prim = prim, ws->best_u = u, ws->best_v = v;
+            if (any) return true;
+        }
+    }
+    ws->tcull = gpu_cull_limit(ws->best_t);
+    ref = gpu_opop(stack, &sp, nodes, oct);
+    ws->ref = ref, ws->sp = sp;
+    return ref == GPU_EMPTY;
+}
+
+static inline PK_HD bool gpu_owalk_hit(const gpu_owalk *w, pk_hit *out)
+{
+    const bool found = w->best_prim != PK_NO_HIT;
+    out->t = found ? w->best_t : INFINITY;
+    out->prim = w->best_prim;
+    out->u = found ? w->best_u : 0.0f;
+    out->v = found ? w->best_v : 0.0f;
+    return found;
+}
+
+/* The ordered traversal with box test box (GPU_TEST_FMA or GPU_TEST_WIDE):
+ * the same contract as gpu_trace. The layout's ordered_need must be at most
+ * GPU_OSTACK and its node count below GPU_ONODE_MAX (gpu_layout_ordered). */
+static inline PK_HD bool gpu_trace_ordered(const gpu_node *nodes, const gpu_tri *tris, const pk_ray *in, bool any,
+                                           pk_hit *out, gpu_counters *count, int box)
+{
+    gpu_owalk w;
+    uint32_t stack[GPU_OSTACK];
+    if (gpu_owalk_init(&w, in, box))
+        while (!gpu_owalk_step(&w, stack, nodes, tris, any, count)) {
+        }
+    return gpu_owalk_hit(&w, out);
+}
+
 /* Closest hit (any = false) or any hit (any = true) of *in against the
  * layout: fills *out (a miss: t = +inf, prim = PK_NO_HIT, u = v = 0) and
  * returns whether something was hit. The same closest hit as every CPU
@@ -685,7 +853,11 @@ struct accel;
  *  4. Used slots have low planes <= high planes; unused slots are GPU_EMPTY.
  *  5. The traversal stack never needs more than GPU_STACK entries:
  *     stack_need (the largest sum, over a root-to-node path, of the hit
- *     children a node can push) <= GPU_STACK. */
+ *     children a node can push) <= GPU_STACK; ordered_need is the depth
+ *     of the deepest inner node (the root's is 1).
+ *  6. Slots follow the ray octants (gpu_trace_ordered): each node's slots
+ *     are the CPU node's, permuted by gpu_layout_build's assignment of
+ *     children to the octants around the node's centre. */
 typedef struct gpu_layout {
     gpu_node *nodes;
     size_t nnodes;
@@ -693,7 +865,14 @@ typedef struct gpu_layout {
     size_t ntris;          /* triangle records (references) */
     size_t scene_tris;     /* triangles of the scene (prim < scene_tris) */
     uint32_t stack_need;
+    uint32_t ordered_need; /* gpu_trace_ordered's stack: the depth of the deepest inner node */
 } gpu_layout;
+
+/* Whether gpu_trace_ordered can run on g (its stack and entries suffice). */
+static inline bool gpu_layout_ordered(const gpu_layout *g)
+{
+    return g->ordered_need <= GPU_OSTACK && g->nnodes < GPU_ONODE_MAX;
+}
 
 /* Converts the wide BVH b (accel_bvh_create's, triangles only) into *out.
  * Errors (NOMEM, LIMIT) are latched in ctx. */

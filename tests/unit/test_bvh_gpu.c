@@ -252,10 +252,13 @@ static void check_box_tests(const built *b, const accel_input *in, rng *g, size_
 static void check_rays(const built *b, const accel_input *in, const ray *rays, size_t n, bool brute, const char *name)
 {
     long bad_brute = 0, bad_cpu = 0, bad_any = 0, bad_anyhit = 0, bad_v0 = 0, bad_loose = 0, nhits = 0, ties = 0;
-    long loose_ties = 0;
+    long loose_ties = 0, bad_ordered = 0, ordered_ties = 0;
     const long nn = (long)n;
+    CHECKF(gpu_layout_ordered(&b->g), "%s: the ordered traversal cannot run (stack %u, %zu nodes)", name,
+           b->g.ordered_need, b->g.nnodes);
 #pragma omp parallel for schedule(dynamic, 64) reduction(+ : bad_brute, bad_cpu, bad_any, bad_anyhit, bad_v0, \
-                                                              bad_loose, nhits, ties, loose_ties)
+                                                              bad_loose, nhits, ties, loose_ties, bad_ordered, \
+                                                              ordered_ties)
     for (long i = 0; i < nn; i++) {
         const ray *r = &rays[i];
         pk_hit got, any;
@@ -300,6 +303,34 @@ static void check_rays(const built *b, const accel_input *in, const ray *rays, s
                                same_bits(t, h.t) && same_bits(u, h.u) && same_bits(v, h.v));
             }
         }
+        /* the ordered traversal (octant slots, mask stack): the same closest
+         * hit but for exact ties; any hits real */
+        if (gpu_layout_ordered(&b->g))
+            for (int box = 0; box < 2; box++) {
+                const int bt = box ? GPU_TEST_WIDE : GPU_TEST_FMA;
+                bool fo = gpu_trace_ordered(b->g.nodes, b->g.tris, (const pk_ray *)r, false, &h, NULL, bt);
+                if (fo != f0) bad_ordered++;
+                else if (!same_hit(&h, &got0)) {
+                    const vec3 *p = in->verts + 3 * (size_t)h.prim;
+                    ray_pre pre = ray_prepare(r);
+                    float t, u, v;
+                    const bool tie = same_bits(h.t, got0.t) && h.prim < in->ntris &&
+                                     tri_intersect(&pre, p[0], p[1], p[2], r->tmax, &t, &u, &v) &&
+                                     same_bits(t, h.t);
+                    ordered_ties += tie;
+                    bad_ordered += !tie;
+                }
+                fo = gpu_trace_ordered(b->g.nodes, b->g.tris, (const pk_ray *)r, true, &h, NULL, bt);
+                if (fo != a0) bad_ordered++;
+                else if (fo) {
+                    const vec3 *p = in->verts + 3 * (size_t)h.prim;
+                    ray_pre pre = ray_prepare(r);
+                    float t, u, v;
+                    bad_ordered += !(h.prim < in->ntris &&
+                                     tri_intersect(&pre, p[0], p[1], p[2], r->tmax, &t, &u, &v) &&
+                                     same_bits(t, h.t) && same_bits(u, h.u) && same_bits(v, h.v));
+                }
+            }
         accel_intersect(b->cpu, r, &cpu, NULL);
         bad_cpu += !same_hit(&got, (const pk_hit *)&cpu);
         if (brute) {
@@ -342,6 +373,9 @@ static void check_rays(const built *b, const accel_input *in, const ray *rays, s
     CHECKF(bad_v0 == 0, "%s: %ld of %zu hits differ between the exact box test and gpu_trace_v0", name, bad_v0, n);
     CHECKF(bad_loose == 0, "%s: %ld of %zu hits of the loosened box test (GPU_TEST_WIDE) are wrong", name, bad_loose,
            n);
+    CHECKF(bad_ordered == 0, "%s: %ld of %zu hits of the ordered traversal are wrong", name, bad_ordered, n);
+    if (ordered_ties)
+        printf("%s: %ld exact ties went to another triangle with the ordered traversal\n", name, ordered_ties);
     CHECKF(bad_any == 0, "%s: %ld of %zu any-hit answers disagree with the closest hit", name, bad_any, n);
     CHECKF(bad_anyhit == 0, "%s: %ld of %zu any-hit answers are not real hits", name, bad_anyhit, n);
     if (ties) printf("%s: %ld exact ties went to another triangle than brute force's\n", name, ties);
@@ -676,6 +710,56 @@ static void check_file(pk_context *ctx, const char *rel, size_t nrays, size_t nb
     pk_scene_destroy(s);
 }
 
+/* ---- the ordered traversal's pieces ------------------------------------------ */
+
+static void test_ordered_pieces(pk_context *ctx)
+{
+    /* bit j of the ordered mask is bit j ^ o of the node's */
+    long bad = 0;
+    for (unsigned o = 0; o < 8; o++)
+        for (unsigned m = 0; m < 256; m++) {
+            const unsigned pm = gpu_mask_order(m, o);
+            for (unsigned j = 0; j < 8; j++) bad += (pm >> j & 1u) != (m >> (j ^ o) & 1u);
+        }
+    CHECKF(bad == 0, "gpu_mask_order: %ld bits misplaced", bad);
+    uint32_t w[8] = {11, 22, 33, 44, 55, 66, 77, 88};
+    for (unsigned i = 0; i < 8; i++) CHECK(gpu_sel8(w, i) == w[i]);
+    /* eight boxes at the corners of a cube: each child lands in the slot of
+     * its octant, so a ray of octant o meets the child of slot o first */
+    mesh m = {0};
+    for (int c = 0; c < 8; c++) {
+        const vec3 o = v3((c & 1) ? 2.0f : -3.0f, (c & 2) ? 2.0f : -3.0f, (c & 4) ? 2.0f : -3.0f);
+        for (int k = 0; k < 40; k++) { /* enough triangles that each corner is a subtree */
+            const float f = 0.02f * (float)k;
+            mesh_tri(&m, v3_add(o, v3(f, 0, 0)), v3_add(o, v3(f + 0.5f, 0.02f, 1)), v3_add(o, v3(f, 1, 0.3f)));
+        }
+    }
+    accel_input in = {m.v, m.ntris, NULL, 0, 2};
+    bvh_costs costs = {4.0f, 1, GPU_LEAF_MAX};
+    built b;
+    if (build_tree(ctx, &in, &costs, "corners", &b)) {
+        const gpu_node *root = &b.g.nodes[0];
+        int placed = 0, used = 0;
+        for (int s = 0; s < GPU_WIDTH; s++) {
+            if (root->child[s] == GPU_EMPTY) continue;
+            used++;
+            int ok = 1;
+            for (int k = 0; k < 3; k++) {
+                const float sc = gpu_scale(root->ex[k]);
+                const float mid = 0.5f * (gpu_plane(root->org[k], root->q[2 * k][s], sc) +
+                                          gpu_plane(root->org[k], root->q[2 * k + 1][s], sc));
+                ok &= (s >> k & 1) ? mid > 0.0f : mid < 0.0f;
+            }
+            placed += ok;
+        }
+        CHECKF(used == 8 && placed == 8, "corners: %d of %d children in their octant's slot", placed, used);
+        CHECKF(b.g.ordered_need >= 1 && b.g.ordered_need <= b.g.stack_need, "corners: ordered stack %u, sorted %u",
+               b.g.ordered_need, b.g.stack_need);
+    }
+    free_all(ctx, &b);
+    free(m.v);
+}
+
 /* ---- names and the public door ---------------------------------------------- */
 
 static void test_public(pk_context *ctx)
@@ -720,6 +804,7 @@ int main(void)
     test_synthetic(ctx);
     printf("synthetic cases: %.2f s\n", omp_get_wtime() - t0);
     test_checker(ctx);
+    test_ordered_pieces(ctx);
     test_public(ctx);
     const char *cornell[] = {"CornellBox-Empty-CO.obj", "CornellBox-Glossy.obj", "CornellBox-Mirror.obj",
                              "CornellBox-Original.obj", "CornellBox-Sphere.obj", "CornellBox-Water.obj"};
