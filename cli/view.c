@@ -231,7 +231,13 @@ int cli_view(int argc, char **argv)
     if (!o.extra[VIEW_NO_OPEN]) open_browser(view_server_url(srv));
     int sig = 0;
     sigwait(&set, &sig);
-    view_server_stop(srv);
+    if (view_server_stop_within(srv, 0.5) != 0) {
+        /* in the middle of a denoising, which cannot be stopped: nothing is
+         * being written, so the process may end without waiting for it */
+        fflush(stdout);
+        fflush(stderr);
+        _exit(0);
+    }
     srv = NULL;
     rc = 0;
 out:

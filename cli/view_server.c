@@ -92,6 +92,7 @@ struct view_server {
 
     pthread_t thread;
     int thread_started;
+    int thread_done;       /* the render thread has left its loop (under mu) */
     struct MHD_Daemon *daemon;
     unsigned long enc_counter; /* temporary file names (under mu) */
 };
@@ -689,6 +690,8 @@ static void *render_main(void *arg)
         pk_image_destroy(img);
     }
     s->rendering = 0;
+    s->thread_done = 1;
+    pthread_cond_broadcast(&s->frames);
     pthread_mutex_unlock(&s->mu);
     pk_image_destroy(st.den);
     pk_denoiser_destroy(st.denoiser);
@@ -1366,9 +1369,9 @@ int view_server_port(const view_server *s) { return s->port; }
 const char *view_server_url(const view_server *s) { return s->url; }
 const char *view_server_token(const view_server *s) { return s->token; }
 
-void view_server_stop(view_server *s)
+int view_server_stop_within(view_server *s, double seconds)
 {
-    if (!s) return;
+    if (!s) return 0;
     pthread_mutex_lock(&s->mu);
     s->quit = 1;
     s->cancel = 1;
@@ -1376,14 +1379,33 @@ void view_server_stop(view_server *s)
     pthread_cond_broadcast(&s->frames);
     pthread_mutex_unlock(&s->mu);
     if (s->daemon) MHD_stop_daemon(s->daemon);
+    s->daemon = NULL;
+    rmtree_flat(s->tmpdir); /* no request encodes any more */
+    s->tmpdir[0] = '\0';
+    if (s->thread_started && seconds >= 0.0) {
+        /* a render stops within a tile; the denoiser cannot be stopped */
+        pthread_mutex_lock(&s->mu);
+        struct timespec ts;
+        clock_gettime(CLOCK_REALTIME, &ts);
+        const double end = (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9 + seconds;
+        ts.tv_sec = (time_t)end;
+        ts.tv_nsec = (long)((end - (double)ts.tv_sec) * 1e9);
+        while (!s->thread_done && pthread_cond_timedwait(&s->frames, &s->mu, &ts) == 0) {
+        }
+        const int done = s->thread_done;
+        pthread_mutex_unlock(&s->mu);
+        if (!done) return 1;
+    }
     if (s->thread_started) pthread_join(s->thread, NULL);
     pk_renderer_destroy(s->r_full);
     pk_renderer_destroy(s->r_prev);
     snap_unref_locked(s->cur);
-    rmtree_flat(s->tmpdir);
     pthread_rwlock_destroy(&s->rlock);
     pthread_cond_destroy(&s->work);
     pthread_cond_destroy(&s->frames);
     pthread_mutex_destroy(&s->mu);
     free(s);
+    return 0;
 }
+
+void view_server_stop(view_server *s) { view_server_stop_within(s, -1.0); }

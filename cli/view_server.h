@@ -52,6 +52,11 @@ const char *view_server_token(const view_server *s);
 /* Stops the HTTP server (open event streams end), cancels the render and
  * frees everything but the borrowed context and scene. NULL: nothing. */
 void view_server_stop(view_server *s);
+/* The same, but waits at most seconds for the render thread, which cannot
+ * stop in the middle of a denoising: returns 0 when all is stopped and
+ * freed, 1 when the thread was still busy (the HTTP server is stopped; the
+ * rest is left for the process's exit, which should follow). */
+int view_server_stop_within(view_server *s, double seconds);
 
 /* `paprsek view ...` (cli/view.c). argv[0] is "view". Returns the exit status. */
 int cli_view(int argc, char **argv);
