@@ -6,18 +6,23 @@
 // PNG, and stops the server with SIGTERM (exit status 0 within 2 s). Any
 // error in the page fails the test. Timings go to standard output.
 //
-// usage: node view.mjs PAPRSEK NODE_MODULES_DIR [SCREENSHOT_DIR]
-//   NODE_MODULES_DIR holds playwright-core; SCREENSHOT_DIR, when given, gets
-//   the page's screenshots (first.png, orbit.png, exposure.png).
+// usage: node view.mjs PAPRSEK NODE_MODULES_DIR [SCREENSHOT_DIR] [-- VIEW_OPTIONS...]
+//   NODE_MODULES_DIR holds playwright-core; SCREENSHOT_DIR (or ''), when
+//   given, gets the page's screenshots (first.png, orbit.png, exposure.png);
+//   VIEW_OPTIONS go to paprsek view after its own (e.g. --bind ADDR, which
+//   makes the page work with a token).
 import { spawn } from 'node:child_process';
 import { createRequire } from 'node:module';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 
-const [bin, modules, shots] = process.argv.slice(2);
+const argv = process.argv.slice(2);
+const dash = argv.indexOf('--');
+const extra = dash >= 0 ? argv.splice(dash).slice(1) : [];
+const [bin, modules, shots] = argv;
 if (!bin || !modules) {
-  console.error('usage: node view.mjs PAPRSEK NODE_MODULES_DIR [SCREENSHOT_DIR]');
+  console.error('usage: node view.mjs PAPRSEK NODE_MODULES_DIR [SCREENSHOT_DIR] [-- VIEW_OPTIONS...]');
   process.exit(2);
 }
 const require = createRequire(path.join(path.resolve(modules), 'index.js'));
@@ -50,7 +55,7 @@ async function poll(fn, timeout, every = 20) {
 }
 
 // ---- the server ----
-const args = ['view', '--port', '0', '--no-open', '--width', '320', '--height', '240'];
+const args = ['view', '--port', '0', '--no-open', '--width', '320', '--height', '240', ...extra];
 const server = spawn(bin, args, { stdio: ['ignore', 'pipe', 'pipe'] });
 let serverOut = '';
 let exited = null;
@@ -75,7 +80,9 @@ async function main() {
   const found = await poll(() => exited || /http:\/\/\S+/.exec(serverOut), 30000);
   if (!found || exited) fatal(`paprsek ${args.join(' ')} printed no address:\n${serverOut}`);
   baseUrl = found[0];
-  check(/^http:\/\/127\.0\.0\.1:\d+\//.test(baseUrl), `the address printed: ${baseUrl} (${ms(t0)})`);
+  const bound = extra.includes('--bind') ? extra[extra.indexOf('--bind') + 1] : '127.0.0.1';
+  check(baseUrl.startsWith(`http://${bound}:`), `the address printed: ${baseUrl} (${ms(t0)})`);
+  if (!bound.startsWith('127.')) check(/[?&]token=[^&]+/.test(baseUrl), 'away from loopback the address carries a token');
 
   browser = await chromium.launch({
     executablePath: process.env.PAPRSEK_CHROMIUM || '/usr/bin/chromium',
