@@ -861,9 +861,11 @@ static enum MHD_Result post_camera(view_server *s, struct MHD_Connection *c, req
             if (!(why = get_number(it, &x)) && !(x >= 0.0 && x <= 3.0e38)) why = "must be 0 or more";
             *(k[0] == 'l' ? &cam.lens_radius : &cam.focus_distance) = (float)x;
         } else {
-            cJSON_Delete(root);
-            return send_error(c, MHD_HTTP_BAD_REQUEST,
-                              "unknown field '%.64s' (look_from, look_at, up, fov, lens_radius, focus_distance, reset)", k);
+            char msg[192];
+            snprintf(msg, sizeof msg,
+                     "unknown field '%.64s' (look_from, look_at, up, fov, lens_radius, focus_distance, reset)", k);
+            cJSON_Delete(root); /* k is the tree's */
+            return send_error(c, MHD_HTTP_BAD_REQUEST, "%s", msg);
         }
         if (why) {
             char msg[160];
