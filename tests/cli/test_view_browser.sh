@@ -10,7 +10,8 @@ set -u
 bin=$1
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 script=$here/../browser/view.mjs
-modules=$(dirname "$bin")/browser/node_modules
+# PAPRSEK_BROWSER_MODULES: another node_modules holding playwright-core
+modules=${PAPRSEK_BROWSER_MODULES:-$(dirname "$bin")/browser/node_modules}
 [ -x "$bin" ] || { echo "SKIP: $bin is not a program"; exit 77; }
 chromium=${PAPRSEK_CHROMIUM:-/usr/bin/chromium}
 [ -x "$chromium" ] || { echo "SKIP: $chromium is not there (Debian package chromium; make test installs it)"; exit 77; }
