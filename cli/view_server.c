@@ -553,7 +553,7 @@ static void *render_main(void *arg)
     uint64_t restart_done = 0, rebuild_done = 0;
     uint32_t passes = 0;
     int stage = 0; /* 0: the preview is next; 1: full passes */
-    pk_camera cam = s->cam;
+    pk_camera cam = s->initial_cam; /* replaced at the first restart, under the lock */
     uint64_t rays0 = 0;
     double render_s0 = 0.0;
     pthread_mutex_lock(&s->mu);
