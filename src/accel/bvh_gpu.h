@@ -657,14 +657,15 @@ static inline PK_HD bool gpu_trace_box(const gpu_node *nodes, const gpu_tri *tri
  * axis k; gpu_layout_build), so that visiting slots j ^ o for j = 0..7,
  * o = the ray's octant (bit k: d_k < 0), goes roughly near to far without
  * sorting. A node visit turns its hit mask into that order (three
- * conditional swaps), goes on with the first child and pushes one 32-bit
- * entry (node index << 8 | the remaining 8-bit mask) when others remain;
- * a pop takes the next child of the top entry and reads its reference (4
- * bytes of the parent). At most one entry per ancestor: the stack needs
- * gpu_layout.ordered_need entries (the depth of the deepest inner node),
- * GPU_OSTACK at most (a quarter of the sorted traversal's bytes). No
- * distances are kept: a popped child is not culled against the closest hit
- * found since (an inner one is, by its own box tests; a leaf is tested).
+ * conditional swaps), goes on with the first child and pushes one entry
+ * when others remain: (node index << 8 | the remaining 8-bit mask, the
+ * nearest entry distance of those children). A pop drops entries whose
+ * distance lies beyond the closest hit found since, takes the next child of
+ * the top entry and reads its reference (4 bytes of the parent). At most
+ * one entry per ancestor: the stack needs gpu_layout.ordered_need entries
+ * (the depth of the deepest inner node), GPU_OSTACK at most (half the
+ * sorted traversal's bytes). A child popped from an entry that survives is
+ * not culled on its own distance (an inner one is by its own box tests).
  * The closest hit is the same (smallest t, then smallest number; but for
  * the exact ties of docs/gpu.md, as with any other visiting order). */
 #define GPU_OSTACK 64
@@ -729,16 +730,20 @@ static inline PK_HD bool gpu_owalk_init(gpu_owalk *w, const pk_ray *in, int box)
     return true;
 }
 
-/* The next child of the top entry, or GPU_EMPTY with *done when the stack is empty. */
-static inline PK_HD uint32_t gpu_opop(uint32_t *stack, int *sp, const gpu_node *nodes, unsigned oct)
+/* The next child of the top entry whose children may still be nearer
+ * than tcull (entries all of whose children lie beyond it are dropped), or
+ * GPU_EMPTY when none is left. */
+static inline PK_HD uint32_t gpu_opop(gpu_stack_entry *stack, int *sp, const gpu_node *nodes, unsigned oct,
+                                      float tcull)
 {
+    while (*sp > 0 && !(stack[*sp - 1].t <= tcull)) --*sp;
     if (*sp == 0) return GPU_EMPTY;
-    const uint32_t e = stack[*sp - 1];
+    const uint32_t e = stack[*sp - 1].ref;
     const uint32_t ni = e >> 8;
     unsigned pm = e & 255u;
     const unsigned j = gpu_lowest_bit(pm);
     pm &= pm - 1u;
-    if (pm) stack[*sp - 1] = (ni << 8) | pm;
+    if (pm) stack[*sp - 1].ref = (ni << 8) | pm;
     else --*sp;
 #if defined(__CUDA_ARCH__)
     return __ldg(&nodes[ni].child[j ^ oct]);
@@ -748,8 +753,8 @@ static inline PK_HD uint32_t gpu_opop(uint32_t *stack, int *sp, const gpu_node *
 }
 
 /* One step; true when the ray is done (gpu_owalk_hit then has the answer). */
-static inline PK_HD bool gpu_owalk_step(gpu_owalk *ws, uint32_t *stack, const gpu_node *nodes, const gpu_tri *tris,
-                                        bool any, gpu_counters *count)
+static inline PK_HD bool gpu_owalk_step(gpu_owalk *ws, gpu_stack_entry *stack, const gpu_node *nodes,
+                                        const gpu_tri *tris, bool any, gpu_counters *count)
 {
     const gpu_ray *r = &ws->r;
     const unsigned oct = ws->oct;
@@ -770,11 +775,20 @@ static inline PK_HD bool gpu_owalk_step(gpu_owalk *ws, uint32_t *stack, const gp
             }
             const unsigned j = gpu_lowest_bit(pm);
             pm &= pm - 1u;
-            if (pm) stack[sp++] = (ref << 8) | pm;
+            if (pm) {
+                /* the nearest entry distance of the children left */
+                const unsigned left = mask & ~(1u << (j ^ oct));
+                float tl = INFINITY;
+                GPU_UNROLL
+                for (int k = 0; k < GPU_WIDTH; k++)
+                    if (left >> k & 1u) tl = gpu_min(tl, tn[k]);
+                stack[sp].ref = (ref << 8) | pm, stack[sp].t = tl;
+                sp++;
+            }
             ref = gpu_sel8(w + 16, j ^ oct);
         }
         if (ref != GPU_EMPTY) break; /* a leaf */
-        ref = gpu_opop(stack, &sp, nodes, oct);
+        ref = gpu_opop(stack, &sp, nodes, oct, ws->tcull);
         if (ref == GPU_EMPTY) return true;
     }
     if (count) count->nodes++;
@@ -790,7 +804,7 @@ static inline PK_HD bool gpu_owalk_step(gpu_owalk *ws, uint32_t *stack, const gp
         }
     }
     ws->tcull = gpu_cull_limit(ws->best_t);
-    ref = gpu_opop(stack, &sp, nodes, oct);
+    ref = gpu_opop(stack, &sp, nodes, oct, ws->tcull);
     ws->ref = ref, ws->sp = sp;
     return ref == GPU_EMPTY;
 }
@@ -812,7 +826,7 @@ static inline PK_HD bool gpu_trace_ordered(const gpu_node *nodes, const gpu_tri 
                                            pk_hit *out, gpu_counters *count, int box)
 {
     gpu_owalk w;
-    uint32_t stack[GPU_OSTACK];
+    gpu_stack_entry stack[GPU_OSTACK];
     if (gpu_owalk_init(&w, in, box))
         while (!gpu_owalk_step(&w, stack, nodes, tris, any, count)) {
         }

@@ -54,7 +54,7 @@ static void model_warp(const gpu_layout *g, const pk_ray *rays, size_t n, int k,
     gpu_walk sw[WARP];
     gpu_owalk ow[WARP];
     static _Thread_local gpu_stack_entry sstack[WARP][GPU_STACK];
-    static _Thread_local uint32_t ostack[WARP][GPU_OSTACK];
+    static _Thread_local gpu_stack_entry ostack[WARP][GPU_OSTACK];
     bool active[WARP];
     int nactive = 0;
     for (size_t i = 0; i < n; i++) {
