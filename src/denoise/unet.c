@@ -35,6 +35,7 @@ enum {
 };
 
 static int round16(int c) { return (c + 15) / 16 * 16; }
+static int unet_block(void);
 
 #if PK_HAVE_DNNL
 #include <oneapi/dnnl/dnnl.h>
@@ -107,6 +108,7 @@ struct unet {
     pk_context *ctx;
     const pk_allocator *al;
     int ic, icp;     /* input channels, and rounded to 16 */
+    int blk;         /* the channel block of the tensors, 8 or 16 (unet_block) */
     int c[6];        /* encoder channels c[1..5] */
     int d4, d3, d2a, d2b, d1a, d1b;
     conv_layer conv[UNET_CONVS];
@@ -213,6 +215,7 @@ pk_status unet_create(pk_context *ctx, const char *name, const tza_archive *a, u
     u->al = &ctx->alloc;
     u->ic = ic;
     u->icp = round16(ic);
+    u->blk = unet_block();
     u->c[1] = c1, u->c[2] = c2, u->c[3] = c3, u->c[4] = c4, u->c[5] = c5;
     u->d4 = d4, u->d3 = d3, u->d2a = d2a, u->d2b = d2b, u->d1a = d1a, u->d1b = d1b;
     /* stored input channels of each layer; for dec_conv1a the weights'
@@ -320,65 +323,86 @@ double unet_flops(const unet *u, int h, int w)
     return f;
 }
 
-/* ---- pooling and upsampling on nChw16c ---------------------------------- */
+/* ---- pooling and upsampling on nChwBc ------------------------------------
+ * Tensors are blocked by B channels (nChwBc: B = 16 where oneDNN has its
+ * AVX-512 kernels, 8 on AVX2, where its fast convolutions take nChw8c and
+ * nChw16c would fall back to its reference code, about 300x slower; see
+ * unet_block). Channel counts stay multiples of 16, so of B. */
+
+/* The channel block of the CPU: 16 with AVX-512 (F, BW, VL, DQ, which
+ * oneDNN's avx512_core kernels need), else 8. */
+static int unet_block(void)
+{
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_cpu_init();
+    if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
+        __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512dq"))
+        return 16;
+    return 8;
+#else
+    return 8;
+#endif
+}
 
 /* dst (c channels, h/2 x w/2) = 2x2 maximum of src (c, h x w). */
-static void pool2(const float *src, int c, int h, int w, float *dst, int threads)
+static void pool2(const float *src, int c, int h, int w, float *dst, int threads, int B)
 {
-    const int h2 = h / 2, w2 = w / 2, rows = c / 16 * h2;
+    const int h2 = h / 2, w2 = w / 2, rows = c / B * h2;
 #pragma omp parallel for num_threads(threads) schedule(static)
     for (int r = 0; r < rows; r++) {
         const int cb = r / h2, y = r % h2;
-        const float *a = src + (((size_t)cb * (size_t)h + 2 * (size_t)y) * (size_t)w) * 16;
-        const float *b = a + (size_t)w * 16;
-        float *o = dst + (((size_t)cb * (size_t)h2 + (size_t)y) * (size_t)w2) * 16;
+        const float *a = src + (((size_t)cb * (size_t)h + 2 * (size_t)y) * (size_t)w) * (size_t)B;
+        const float *b = a + (size_t)w * (size_t)B;
+        float *o = dst + (((size_t)cb * (size_t)h2 + (size_t)y) * (size_t)w2) * (size_t)B;
         for (int x = 0; x < w2; x++)
-            for (int k = 0; k < 16; k++) {
-                float m0 = fmaxf(a[32 * x + k], a[32 * x + 16 + k]), m1 = fmaxf(b[32 * x + k], b[32 * x + 16 + k]);
-                o[16 * x + k] = fmaxf(m0, m1);
+            for (int k = 0; k < B; k++) {
+                float m0 = fmaxf(a[2 * B * x + k], a[2 * B * x + B + k]), m1 = fmaxf(b[2 * B * x + k], b[2 * B * x + B + k]);
+                o[B * x + k] = fmaxf(m0, m1);
             }
     }
 }
 
 /* dst (c, 2h x 2w) = src (c, h x w), each pixel repeated 2x2. */
-static void upsample2(const float *src, int c, int h, int w, float *dst, int threads)
+static void upsample2(const float *src, int c, int h, int w, float *dst, int threads, int B)
 {
-    const int rows = c / 16 * h;
+    const int rows = c / B * h;
+    const size_t px = (size_t)B * sizeof(float);
 #pragma omp parallel for num_threads(threads) schedule(static)
     for (int r = 0; r < rows; r++) {
         const int cb = r / h, y = r % h;
-        const float *s = src + (((size_t)cb * (size_t)h + (size_t)y) * (size_t)w) * 16;
-        float *o = dst + (((size_t)cb * 2 * (size_t)h + 2 * (size_t)y) * 2 * (size_t)w) * 16;
+        const float *s = src + (((size_t)cb * (size_t)h + (size_t)y) * (size_t)w) * (size_t)B;
+        float *o = dst + (((size_t)cb * 2 * (size_t)h + 2 * (size_t)y) * 2 * (size_t)w) * (size_t)B;
         for (int x = 0; x < w; x++) {
-            memcpy(o + 32 * (size_t)x, s + 16 * (size_t)x, 64);
-            memcpy(o + 32 * (size_t)x + 16, s + 16 * (size_t)x, 64);
+            memcpy(o + 2 * (size_t)B * (size_t)x, s + (size_t)B * (size_t)x, px);
+            memcpy(o + 2 * (size_t)B * (size_t)x + (size_t)B, s + (size_t)B * (size_t)x, px);
         }
-        memcpy(o + (size_t)w * 32, o, (size_t)w * 32 * sizeof(float));
+        memcpy(o + (size_t)w * 2 * (size_t)B, o, (size_t)w * 2 * px);
     }
 }
 
-/* planar (c, h x w) <-> nChw16c (round16(c) channels; padding channels zero) */
-static void to_blocked(const float *planar, int c, int h, int w, float *dst, int threads)
+/* planar (c, h x w) <-> nChwBc (round16(c) channels; padding channels zero) */
+static void to_blocked(const float *planar, int c, int h, int w, float *dst, int threads, int B)
 {
-    const int cb_n = round16(c) / 16;
+    const int cb_n = round16(c) / B;
     const size_t plane = (size_t)h * (size_t)w;
 #pragma omp parallel for num_threads(threads) schedule(static)
     for (int r = 0; r < cb_n * h; r++) {
         const int cb = r / h, y = r % h;
-        float *o = dst + ((size_t)cb * plane + (size_t)y * (size_t)w) * 16;
+        float *o = dst + ((size_t)cb * plane + (size_t)y * (size_t)w) * (size_t)B;
         for (int x = 0; x < w; x++)
-            for (int k = 0; k < 16; k++) {
-                int ch = cb * 16 + k;
-                o[16 * x + k] = ch < c ? planar[(size_t)ch * plane + (size_t)y * (size_t)w + (size_t)x] : 0.0f;
+            for (int k = 0; k < B; k++) {
+                int ch = cb * B + k;
+                o[B * x + k] = ch < c ? planar[(size_t)ch * plane + (size_t)y * (size_t)w + (size_t)x] : 0.0f;
             }
     }
 }
 
-static void from_blocked(const float *src, int c, int h, int w, float *planar)
+static void from_blocked(const float *src, int c, int h, int w, float *planar, int B)
 {
     const size_t plane = (size_t)h * (size_t)w;
     for (int ch = 0; ch < c; ch++)
-        for (size_t p = 0; p < plane; p++) planar[(size_t)ch * plane + p] = src[((size_t)(ch / 16) * plane + p) * 16 + (size_t)(ch % 16)];
+        for (size_t p = 0; p < plane; p++)
+            planar[(size_t)ch * plane + p] = src[((size_t)(ch / B) * plane + p) * (size_t)B + (size_t)(ch % B)];
 }
 
 #if PK_HAVE_DNNL
@@ -403,8 +427,9 @@ static pk_status make_conv(unet *u, int k, int h, int w, float *src, float *dst)
     dnnl_memory_desc_t smd, dmd, wmd, bmd, wplain;
     dnnl_dims_t sd = {1, l->icp, h, w}, dd = {1, l->oc, h, w}, wd = {l->oc, l->icp, 3, 3}, bd = {l->oc};
     dnnl_dims_t one = {1, 1}, pad = {1, 1};
-    DN(dn.memory_desc_init_by_tag(&smd, 4, sd, dnnl_f32, dnnl_nChw16c), "describe a tensor");
-    DN(dn.memory_desc_init_by_tag(&dmd, 4, dd, dnnl_f32, dnnl_nChw16c), "describe a tensor");
+    const dnnl_format_tag_t blocked = u->blk == 16 ? dnnl_nChw16c : dnnl_nChw8c;
+    DN(dn.memory_desc_init_by_tag(&smd, 4, sd, dnnl_f32, blocked), "describe a tensor");
+    DN(dn.memory_desc_init_by_tag(&dmd, 4, dd, dnnl_f32, blocked), "describe a tensor");
     DN(dn.memory_desc_init_by_tag(&wmd, 4, wd, dnnl_f32, dnnl_format_tag_any), "describe weights");
     DN(dn.memory_desc_init_by_tag(&wplain, 4, wd, dnnl_f32, dnnl_oihw), "describe weights");
     DN(dn.memory_desc_init_by_tag(&bmd, 1, bd, dnnl_f32, dnnl_x), "describe a bias");
@@ -582,7 +607,7 @@ static pk_status report(unet *u, unet_layer_fn layer, void *user, const char *na
     int hl = u->h >> lv, wl = u->w >> lv;
     float *pl = mem_alloc(u->al, (size_t)c * (size_t)hl * (size_t)wl * sizeof(float));
     if (!pl) return ctx_nomem(u->ctx);
-    from_blocked(blocked, c, hl, wl, pl);
+    from_blocked(blocked, c, hl, wl, pl, u->blk);
     layer(user, name, c, hl, wl, pl);
     mem_free(u->al, pl);
     return PK_OK;
@@ -602,37 +627,37 @@ pk_status unet_run(pk_context *ctx, unet *u, int h, int w, int threads, const fl
     omp_set_num_threads(threads);
     const size_t p0 = (size_t)h * (size_t)w, p1 = p0 / 4, p2 = p0 / 16, p3 = p0 / 64;
     float *input = u->cat1 + (size_t)u->d2b * p0;
-    to_blocked(in, u->ic, h, w, input, threads);
+    to_blocked(in, u->ic, h, w, input, threads, u->blk);
 #define CONV(k, dstp, c, lv)                                                                                      \
     do {                                                                                                          \
         if ((st = run_conv(u, k)) || (st = report(u, layer, user, unet_conv_names[k], dstp, c, lv))) return st;  \
     } while (0)
     CONV(ENC0, u->t0b, u->c[1], 0);
     CONV(ENC1, u->t0a, u->c[1], 0);
-    pool2(u->t0a, u->c[1], h, w, u->cat2 + (size_t)u->d3 * p1, threads);
+    pool2(u->t0a, u->c[1], h, w, u->cat2 + (size_t)u->d3 * p1, threads, u->blk);
     CONV(ENC2, u->t1a, u->c[2], 1);
-    pool2(u->t1a, u->c[2], h >> 1, w >> 1, u->cat3 + (size_t)u->d4 * p2, threads);
+    pool2(u->t1a, u->c[2], h >> 1, w >> 1, u->cat3 + (size_t)u->d4 * p2, threads, u->blk);
     CONV(ENC3, u->t2a, u->c[3], 2);
-    pool2(u->t2a, u->c[3], h >> 2, w >> 2, u->cat4 + (size_t)u->c[5] * p3, threads);
+    pool2(u->t2a, u->c[3], h >> 2, w >> 2, u->cat4 + (size_t)u->c[5] * p3, threads, u->blk);
     CONV(ENC4, u->t3a, u->c[4], 3);
-    pool2(u->t3a, u->c[4], h >> 3, w >> 3, u->t4a, threads);
+    pool2(u->t3a, u->c[4], h >> 3, w >> 3, u->t4a, threads, u->blk);
     CONV(ENC5A, u->t4b, u->c[5], 4);
     CONV(ENC5B, u->t4a, u->c[5], 4);
-    upsample2(u->t4a, u->c[5], h >> 4, w >> 4, u->cat4, threads);
+    upsample2(u->t4a, u->c[5], h >> 4, w >> 4, u->cat4, threads, u->blk);
     CONV(DEC4A, u->t3a, u->d4, 3);
     CONV(DEC4B, u->t3b, u->d4, 3);
-    upsample2(u->t3b, u->d4, h >> 3, w >> 3, u->cat3, threads);
+    upsample2(u->t3b, u->d4, h >> 3, w >> 3, u->cat3, threads, u->blk);
     CONV(DEC3A, u->t2a, u->d3, 2);
     CONV(DEC3B, u->t2b, u->d3, 2);
-    upsample2(u->t2b, u->d3, h >> 2, w >> 2, u->cat2, threads);
+    upsample2(u->t2b, u->d3, h >> 2, w >> 2, u->cat2, threads, u->blk);
     CONV(DEC2A, u->t1a, u->d2a, 1);
     CONV(DEC2B, u->t1b, u->d2b, 1);
-    upsample2(u->t1b, u->d2b, h >> 1, w >> 1, u->cat1, threads);
+    upsample2(u->t1b, u->d2b, h >> 1, w >> 1, u->cat1, threads, u->blk);
     CONV(DEC1A, u->t0a, u->d1a, 0);
     CONV(DEC1B, u->t0b, u->d1b, 0);
     CONV(DEC0, u->t0a, 3, 0);
 #undef CONV
-    from_blocked(u->t0a, 3, h, w, out);
+    from_blocked(u->t0a, 3, h, w, out, u->blk);
     return PK_OK;
 }
 
@@ -642,7 +667,7 @@ pk_status unet_run(pk_context *ctx, unet *u, int h, int w, int threads, const fl
                    unet_layer_fn layer, void *user)
 {
     (void)u, (void)h, (void)w, (void)threads, (void)in, (void)out, (void)layer, (void)user;
-    (void)pool2, (void)upsample2, (void)to_blocked, (void)from_blocked;
+    (void)pool2, (void)upsample2, (void)to_blocked, (void)from_blocked, (void)unet_block;
     char why[384];
     unet_backend_available(ctx, why, sizeof why);
     return ctx_error(ctx, PK_ERR_UNSUPPORTED, "denoiser: %s", why);
