@@ -17,6 +17,8 @@ static const char *const isa_names[] = {"auto", "avx2"};
 static const char *const bvh_names[] = {"high", "fast"};
 static const char *const embree_names[] = {"low", "medium", "high"};
 static const char *const instance_names[] = {"auto", "flatten", "keep"};
+static const char *const traversal_names[] = {"sorted", "ordered"};
+static const char *const leaf_names[] = {"16", "8", "4"};
 
 /* A choice among names: its index, or -1. */
 static int choose(const char *v, size_t n, const char *const *names, size_t count)
@@ -27,11 +29,13 @@ static int choose(const char *v, size_t n, const char *const *names, size_t coun
 }
 
 typedef enum {
-    KEY_ISA, KEY_BVH, KEY_EMBREE_QUALITY, KEY_EMBREE_LIBRARY, KEY_CUDA_LIBRARY, KEY_DNNL_LIBRARY, KEY_INSTANCES, NKEYS
+    KEY_ISA, KEY_BVH, KEY_EMBREE_QUALITY, KEY_EMBREE_LIBRARY, KEY_CUDA_LIBRARY, KEY_DNNL_LIBRARY, KEY_INSTANCES,
+    KEY_CUDA_TRAVERSAL, KEY_CUDA_LEAF, NKEYS
 } key_id;
 
 static const char *const key_names[NKEYS] = {"cpu.isa",      "bvh.quality",  "embree.quality",  "embree.library",
-                                             "cuda.library", "dnnl.library", "scene.instances"};
+                                             "cuda.library", "dnnl.library", "scene.instances",
+                                             "cuda.traversal", "cuda.leaf"};
 
 /* Sets key k of c from the value v[0..n-1] (n 0: the default); false with a
  * message in ctx when the value is not one the key takes. */
@@ -56,6 +60,14 @@ static bool set_key(pk_context *ctx, pk_config *c, key_id k, const char *v, size
         if (n && (i = choose(v, n, instance_names, 3)) < 0) goto bad;
         c->instances = i;
         return true;
+    case KEY_CUDA_TRAVERSAL:
+        if (n && (i = choose(v, n, traversal_names, 2)) < 0) goto bad;
+        c->cuda_traversal = i;
+        return true;
+    case KEY_CUDA_LEAF:
+        if (n && (i = choose(v, n, leaf_names, 3)) < 0) goto bad;
+        c->cuda_leaf = i;
+        return true;
     case KEY_EMBREE_LIBRARY:
     case KEY_CUDA_LIBRARY:
     case KEY_DNNL_LIBRARY: {
@@ -76,6 +88,8 @@ bad:
               k == KEY_ISA               ? "auto or avx2"
               : k == KEY_BVH           ? "high or fast"
               : k == KEY_INSTANCES     ? "auto, flatten or keep"
+              : k == KEY_CUDA_TRAVERSAL ? "sorted or ordered"
+              : k == KEY_CUDA_LEAF     ? "16, 8 or 4"
                                        : "low, medium or high");
     return false;
 }
@@ -104,7 +118,7 @@ pk_status pk_context_set_config(pk_context *ctx, const char *config)
         if (k < 0)
             return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT,
                              "config: unknown key '%.*s' (cpu.isa, bvh.quality, embree.quality, embree.library, "
-                             "cuda.library, dnnl.library, scene.instances)", (int)(kend - a > 64 ? 64 : kend - a), a);
+                             "cuda.library, dnnl.library, scene.instances, cuda.traversal, cuda.leaf)", (int)(kend - a > 64 ? 64 : kend - a), a);
         if (!eq) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "config: %s: expected %s=VALUE", key_names[k], key_names[k]);
         const char *v = eq + 1;
         while (v < b && blank(*v)) v++;
@@ -131,12 +145,13 @@ const char *config_dnnl_library(const pk_context *ctx)
 
 size_t pk_context_get_config(const pk_context *ctx, char *buf, size_t size)
 {
-    static const pk_config defaults = {false, false, 1, "", "", "", 0};
+    static const pk_config defaults = {false, false, 1, "", "", "", 0, 0, 0};
     const pk_config *c = ctx ? &ctx->config : &defaults;
     int n = snprintf(buf, size, "cpu.isa=%s,bvh.quality=%s,embree.quality=%s,embree.library=%s,cuda.library=%s,"
-                     "dnnl.library=%s,scene.instances=%s",
+                     "dnnl.library=%s,scene.instances=%s,cuda.traversal=%s,cuda.leaf=%s",
                      isa_names[c->cpu_avx2], bvh_names[c->bvh_fast], embree_names[c->embree_quality],
                      config_embree_library(ctx), config_cuda_library(ctx), config_dnnl_library(ctx),
-                     instance_names[c->instances >= 0 && c->instances < 3 ? c->instances : 0]);
+                     instance_names[c->instances >= 0 && c->instances < 3 ? c->instances : 0],
+                     traversal_names[c->cuda_traversal == 1], leaf_names[c->cuda_leaf >= 0 && c->cuda_leaf < 3 ? c->cuda_leaf : 0]);
     return n < 0 ? 0 : (size_t)n;
 }

@@ -39,8 +39,9 @@ bool accel_cuda_built(void) { return true; }
 /* The kernels of cuda/trace.cu: the default (pk_trace_*: GPU_TEST_WIDE,
  * one thread per ray) and the reference (pk_trace_*_ref: gpu_trace_v0, the
  * first kernel, which the tests hold the others to). */
-static const char *const kernel_names[2][2] = {{"pk_trace_closest", "pk_trace_any"},
-                                               {"pk_trace_closest_ref", "pk_trace_any_ref"}};
+static const char *const kernel_names[3][2] = {{"pk_trace_closest", "pk_trace_any"},
+                                               {"pk_trace_closest_ref", "pk_trace_any_ref"},
+                                               {"pk_trace_closest_ordered", "pk_trace_any_ordered"}};
 
 /* Invariants:
  *  1. layout is the converted BVH; d_nodes and d_tris hold copies of its
@@ -223,7 +224,9 @@ static pk_status cuda_create(pk_context *ctx, const accel_input *in, int kernel,
         return ctx_error(ctx, PK_ERR_UNSUPPORTED, WHO ": the GPU traces triangles only (the scene has "
                                                   "%zu sphere%s)", in->nspheres, in->nspheres == 1 ? "" : "s");
     const double t0 = time_now();
-    const bvh_costs costs = {GPU_TREE_NODE_COST, 1, GPU_LEAF_MAX};
+    /* cuda.leaf: the largest leaf of the GPU's tree (16, 8 or 4 triangles) */
+    const uint32_t leaf_max = ctx->config.cuda_leaf == 2 ? 4u : ctx->config.cuda_leaf == 1 ? 8u : GPU_LEAF_MAX;
+    const bvh_costs costs = {GPU_TREE_NODE_COST, 1, leaf_max};
     accel *b = NULL;
     pk_status st = accel_bvh_create_costs(ctx, in, &costs, &b);
     if (st != PK_OK) return st;
@@ -249,6 +252,15 @@ static pk_status cuda_create(pk_context *ctx, const accel_input *in, int kernel,
     c->base.info.name = "cuda";
     c->base.info.build_ms = (time_now() - t0) * 1e3;
     c->base.info.bytes = c->layout.nnodes * sizeof(gpu_node) + c->layout.ntris * sizeof(gpu_tri);
+    /* cuda.traversal=ordered: the ordered kernels (cuda/trace.cu), where
+     * their stack suffices for the tree */
+    if (kernel == 0 && ctx->config.cuda_traversal == 1) {
+        if (gpu_layout_ordered(&c->layout))
+            kernel = 2;
+        else
+            ctx_warn(ctx, WHO ": cuda.traversal=ordered needs a stack of %u entries (at most %d): traversing sorted",
+                     c->layout.ordered_need, GPU_OSTACK);
+    }
     if ((st = cuda_setup(ctx, c, kernel)) != PK_OK) {
         cuda_destroy(&c->base);
         return st;

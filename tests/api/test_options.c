@@ -112,7 +112,8 @@ static void check_context_config(void)
 {
     char buf[1024];
     const char *defaults = "cpu.isa=auto,bvh.quality=high,embree.quality=medium,embree.library=libembree3.so.3,"
-                           "cuda.library=libcuda.so.1,dnnl.library=libdnnl.so.2,scene.instances=auto";
+                           "cuda.library=libcuda.so.1,dnnl.library=libdnnl.so.2,scene.instances=auto,"
+                           "cuda.traversal=sorted,cuda.leaf=16";
     size_t len = pk_context_get_config(ctx, buf, sizeof buf);
     CHECKF(strcmp(buf, defaults) == 0 && len == strlen(defaults), "default config: %s", buf);
     CHECK(pk_context_get_config(ctx, NULL, 0) == len);
@@ -123,7 +124,8 @@ static void check_context_config(void)
                                      "embree.library=/opt/e/libembree3.so.3,cuda.library=libcuda.so.1") == PK_OK);
     pk_context_get_config(ctx, buf, sizeof buf);
     CHECKF(strcmp(buf, "cpu.isa=avx2,bvh.quality=fast,embree.quality=high,embree.library=/opt/e/libembree3.so.3,"
-                       "cuda.library=libcuda.so.1,dnnl.library=libdnnl.so.2,scene.instances=auto") == 0,
+                       "cuda.library=libcuda.so.1,dnnl.library=libdnnl.so.2,scene.instances=auto,"
+                       "cuda.traversal=sorted,cuda.leaf=16") == 0,
            "config: %s", buf);
     CHECK(pk_context_set_config(ctx, "scene.instances=keep") == PK_OK);
     pk_context_get_config(ctx, buf, sizeof buf);
@@ -131,6 +133,12 @@ static void check_context_config(void)
     CHECK(pk_context_set_config(ctx, "scene.instances=flatten") == PK_OK);
     pk_context_get_config(ctx, buf, sizeof buf);
     CHECKF(strstr(buf, ",scene.instances=flatten") != NULL, "config: %s", buf);
+    CHECK(pk_context_set_config(ctx, "cuda.traversal=ordered,cuda.leaf=4") == PK_OK);
+    pk_context_get_config(ctx, buf, sizeof buf);
+    CHECKF(strstr(buf, ",cuda.traversal=ordered,cuda.leaf=4") != NULL, "config: %s", buf);
+    CHECK(pk_context_set_config(ctx, "cuda.leaf=8") == PK_OK);
+    pk_context_get_config(ctx, buf, sizeof buf);
+    CHECKF(strstr(buf, ",cuda.traversal=ordered,cuda.leaf=8") != NULL, "config: %s", buf);
     /* keys not named keep their values; the last of a key wins */
     CHECK(pk_context_set_config(ctx, "cpu.isa=auto,cpu.isa=avx2") == PK_OK);
     pk_context_get_config(ctx, buf, sizeof buf);
@@ -139,7 +147,8 @@ static void check_context_config(void)
     const char *bad[][2] = {{"cpu.isa=avx2,bvh.qualty=fast", "bvh.qualty"}, {"bvh.quality=slow", "bvh.quality=slow"},
                             {"embree.quality=extreme", "embree.quality"}, {"cpu.isa", "cpu.isa"},
                             {"cpu.isa=sse2", "cpu.isa=sse2"}, {"PAPRSEK_CPU_ISA=avx2", "PAPRSEK_CPU_ISA"},
-                            {"scene.instances=some", "scene.instances=some"}};
+                            {"scene.instances=some", "scene.instances=some"},
+                            {"cuda.traversal=fast", "cuda.traversal=fast"}, {"cuda.leaf=5", "cuda.leaf=5"}};
     for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
         pk_context_clear_error(ctx);
         CHECKF(pk_context_set_config(ctx, bad[i][0]) == PK_ERR_INVALID_ARGUMENT, "'%s' accepted", bad[i][0]);
@@ -152,7 +161,8 @@ static void check_context_config(void)
     pk_context_get_config(ctx, buf, sizeof buf);
     CHECKF(strstr(buf, "cpu.isa=avx2,bvh.quality=fast,embree.quality=high,") == buf, "config changed: %s", buf);
     /* an empty value restores the default */
-    CHECK(pk_context_set_config(ctx, "cpu.isa=,bvh.quality=,embree.quality=,embree.library=,cuda.library=,scene.instances=") ==
+    CHECK(pk_context_set_config(ctx, "cpu.isa=,bvh.quality=,embree.quality=,embree.library=,cuda.library=,scene.instances=,"
+                                     "cuda.traversal=,cuda.leaf=") ==
           PK_OK);
     pk_context_get_config(ctx, buf, sizeof buf);
     CHECKF(strcmp(buf, defaults) == 0, "config after reset: %s", buf);

@@ -5,7 +5,7 @@
  * library (see CMakeLists.txt and docs/gpu.md), with -fmad=false so that
  * the triangle test rounds as the CPU's does.
  *
- * Two kernels, giving the same hits bit for bit:
+ * Three kernels, giving the same closest hits:
  *   pk_trace_*      gpu_trace_box with GPU_TEST_WIDE (the box test with one
  *                   fma a plane, boxes loosened by a bound on the rounding,
  *                   the byte made a float by the permute itself), one thread
@@ -42,7 +42,18 @@ static __device__ __forceinline__ bool trace_wide(const gpu_node *nodes, const g
     return gpu_trace_box(nodes, tris, r, any, h, c, GPU_TEST_WIDE);
 }
 
+/* The ordered traversal (octant-ordered slots, a stack of (node, mask,
+ * distance) entries: cuda.traversal=ordered), with the same box test; 6
+ * blocks a multiprocessor (at most 80 registers: with 72 it spills). */
+static __device__ __forceinline__ bool trace_ordered(const gpu_node *nodes, const gpu_tri *tris, const pk_ray *r,
+                                                     bool any, pk_hit *h, gpu_counters *c)
+{
+    return gpu_trace_ordered(nodes, tris, r, any, h, c, GPU_TEST_WIDE);
+}
+
 PK_ONE_PER_THREAD(pk_trace_closest, trace_wide, false, 7)
 PK_ONE_PER_THREAD(pk_trace_any, trace_wide, true, 7)
 PK_ONE_PER_THREAD(pk_trace_closest_ref, gpu_trace_v0, false, 0)
 PK_ONE_PER_THREAD(pk_trace_any_ref, gpu_trace_v0, true, 0)
+PK_ONE_PER_THREAD(pk_trace_closest_ordered, trace_ordered, false, 6)
+PK_ONE_PER_THREAD(pk_trace_any_ordered, trace_ordered, true, 6)
