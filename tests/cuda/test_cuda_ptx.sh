@@ -56,5 +56,43 @@ ptx "$tmp/fused.ptx" -O3 -std=c++17 -fmad=true || fail "nvcc -fmad=true"
 n_fused=$(grep -c 'fma\.' "$tmp/fused.ptx")
 [ "$n_fused" -gt "$n_fma" ] || fail "no more fma with -fmad=true: the check proves nothing"
 echo "PTX: $n_rn rounded float operations, $n_fma fma (box tests), $n_approx approximate (with -fmad=true: $n_fused fma)"
+
+# Resources per kernel as ptxas reports them for sm_90 (the H100), with the
+# build's flags: registers, stack frame, spills. Written to
+# cuda_resources.txt in the working directory (the build's tests/), the
+# table docs/gpu.md reads; the traversal kernels must not spill, and the
+# ordered traversal's stack frame must be its 64 entries, half the sorted
+# one's.
+resources() { # SOURCE -> lines "kernel registers stack spill_stores spill_loads"
+    "$nvcc" -cubin -arch=sm_90 "${flags[@]}" -Xptxas -v -I"$src/src" -I"$src/include" -o "$tmp/r.cubin" "$1" 2>&1 |
+        awk '/Compiling entry function/ { k = $0; sub(/.*function .?/, "", k); sub(/.? for .*/, "", k) }
+             /bytes stack frame/ && k != "" { st = $1; ss = $5; sl = $9 }
+             /Used [0-9]+ registers/ && k != "" { r = $0; sub(/.*Used /, "", r); sub(/ registers.*/, "", r);
+                                                  print k, r, st + 0, ss + 0, sl + 0; k = "" }'
+}
+flags=("$@")
+{
+    resources "$src/src/accel/cuda/trace.cu"
+    resources "$src/src/render/cuda/path.cu"
+} > "$tmp/res.txt"
+{
+    echo "# kernel registers stack_bytes spill_store_bytes spill_load_bytes (ptxas, sm_90, flags: ${flags[*]})"
+    cat "$tmp/res.txt"
+} > cuda_resources.txt
+cat cuda_resources.txt
+res() { awk -v k="$1" -v f="$2" '$1 == k { print $f }' "$tmp/res.txt"; }
+for k in $kernels pk_path_render pk_path_render_camera; do
+    [ -n "$(res "$k" 2)" ] || fail "ptxas reported nothing for kernel $k"
+done
+for k in $kernels; do
+    [ "$(res "$k" 4)" = 0 ] && [ "$(res "$k" 5)" = 0 ] || fail "kernel $k spills ($(res "$k" 4) bytes stored)"
+done
+so=$(res pk_trace_closest_ordered 3)
+ss=$(res pk_trace_closest 3)
+if [ -n "$so" ] && [ -n "$ss" ]; then
+    ostack=$(awk '/#define GPU_OSTACK/ { print $3 }' "$src/src/accel/bvh_gpu.h")
+    [ "$so" -le $((8 * ostack + 64)) ] && [ "$so" -lt "$ss" ] ||
+        fail "the ordered kernel's stack frame is $so bytes (sorted: $ss, entries: $((8 * ostack)))"
+fi
 [ "$fails" = 0 ] || exit 1
 echo "all ok"
