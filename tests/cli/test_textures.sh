@@ -35,8 +35,11 @@ for integ in path whitted; do
   done
   for a in $accels; do
     if [ $a = embree ]; then
+      # Embree's own triangle test rounds t, u, v differently (its AVX2 and
+      # AVX-512 kernels differ too): a ray through a cut-out may land on the
+      # other side of a texel edge. At most 0.5 % of the 5184 samples.
       n=$(differing "$tmp/$integ-none.pfm" "$tmp/$integ-$a.pfm")
-      [ "$n" = 0 ] && ok "$integ: embree gives the image of none within rounding" ||
+      [ "$n" -le 25 ] && ok "$integ: embree gives the image of none within rounding ($n samples differ)" ||
         bad "$integ: embree differs from none in $n samples"
     else
       cmp -s "$tmp/$integ-none.pfm" "$tmp/$integ-$a.pfm" && ok "$integ: $a gives the image of none" ||

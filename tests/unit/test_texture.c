@@ -319,16 +319,24 @@ static void test_cutout(void)
         REQUIRE(accel_intersect(a, &r, &h, NULL));
         CHECK(h.prim < 2 && surface_is_hole(&v, &r, &h)); /* the sheet, in a hole */
         CHECK(trace_past_holes(a, &v, &r, &h, NULL));
-        CHECKF(h.prim >= 2 && h.t == 4.0f, "%s: prim %u t %g", pk_accel_kind_name(kinds[k]), h.prim, (double)h.t);
+        /* Embree computes t, u, v its own way (with its AVX2 kernels a t of
+         * 4 comes out an ulp or two away): the same triangle, t to 1e-6
+         * relative; our accelerators give brute force's hit bit for bit */
+        const bool own = kinds[k] != PK_ACCEL_EMBREE;
+        CHECKF(h.prim >= 2 && (own ? h.t == 4.0f : fabsf(h.t - 4.0f) <= 4e-6f), "%s: prim %u t %a",
+               pk_accel_kind_name(kinds[k]), h.prim, (double)h.t);
         if (k == 0) ref_through = h;
-        CHECK(memcmp(&h, &ref_through, sizeof h) == 0); /* the same hit as brute force */
+        if (own) CHECK(memcmp(&h, &ref_through, sizeof h) == 0); /* the same hit as brute force */
+        else CHECK(h.prim == ref_through.prim);
         r = solid;
         REQUIRE(accel_intersect(a, &r, &h, NULL));
         CHECK(!surface_is_hole(&v, &r, &h));
         CHECK(trace_past_holes(a, &v, &r, &h, NULL));
-        CHECK(h.prim < 2 && h.t == 3.0f);
+        CHECKF(h.prim < 2 && (own ? h.t == 3.0f : fabsf(h.t - 3.0f) <= 3e-6f), "%s: prim %u t %a",
+               pk_accel_kind_name(kinds[k]), h.prim, (double)h.t);
         if (k == 0) ref_solid = h;
-        CHECK(memcmp(&h, &ref_solid, sizeof h) == 0);
+        if (own) CHECK(memcmp(&h, &ref_solid, sizeof h) == 0);
+        else CHECK(h.prim == ref_solid.prim);
         /* shadow rays: through the hole nothing blocks (the back quad is beyond the end) */
         CHECK(!occluded_past_holes(a, &v, &shadow_through, NULL));
         CHECK(occluded_past_holes(a, &v, &shadow_solid, NULL));
