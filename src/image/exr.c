@@ -28,6 +28,7 @@
 typedef struct exr_sink {
     int fd;
     char msg[200]; /* the first error, from this file or from OpenEXR */
+    exr_result_t (*compress)(exr_encode_pipeline_t *); /* OpenEXR's own, wrapped by compress_chunk */
 } exr_sink;
 
 static void sink_note(exr_sink *s, const char *fmt, ...) PK_PRINTF(2, 3);
@@ -82,6 +83,26 @@ static int64_t on_exr_write(exr_const_context_t e, void *user, const void *buffe
         done += (uint64_t)w;
     }
     return (int64_t)done;
+}
+
+/* OpenEXR's compression of a chunk, then the rule of the file format that
+ * a chunk whose compressed bytes are not fewer than its raw bytes is stored
+ * raw: a reader takes a chunk of the raw size as raw. OpenEXR 3.1 (Debian
+ * 12) keeps compressed bytes of exactly the raw size, which every reader
+ * then takes as pixels (upstream issue 2306): it happens to a chunk of
+ * noisy floats now and then, and the chunk comes back as garbage. */
+static exr_result_t compress_chunk(exr_encode_pipeline_t *pipe)
+{
+    exr_sink *s = pipe->encoding_user_data;
+    exr_result_t rv = s->compress(pipe);
+    if (rv != EXR_ERR_SUCCESS || pipe->compressed_bytes < pipe->packed_bytes) return rv;
+    if (!pipe->compressed_buffer || pipe->compressed_alloc_size < pipe->packed_bytes) {
+        sink_note(s, "OpenEXR: a chunk that does not compress has no room to be stored raw");
+        return EXR_ERR_OUT_OF_MEMORY;
+    }
+    memcpy(pipe->compressed_buffer, pipe->packed_buffer, (size_t)pipe->packed_bytes);
+    pipe->compressed_bytes = (size_t)pipe->packed_bytes;
+    return EXR_ERR_SUCCESS;
 }
 
 /* Fails with why from the sink's first message, or what. */
@@ -153,7 +174,14 @@ int exr_write_channels(int fd, int width, int height, const exr_channel *ch, int
             out->user_line_stride = (int32_t)(in->row_stride * sizeof(float));
             out->encode_from_ptr = (const uint8_t *)(in->data + (size_t)cinfo.start_y * in->row_stride);
         }
-        if (rv == EXR_ERR_SUCCESS && y == 0) rv = exr_encoding_choose_default_routines(e, part, &pipe);
+        if (rv == EXR_ERR_SUCCESS && y == 0) {
+            rv = exr_encoding_choose_default_routines(e, part, &pipe);
+            if (rv == EXR_ERR_SUCCESS && pipe.compress_fn) {
+                sink.compress = pipe.compress_fn;
+                pipe.compress_fn = compress_chunk;
+                pipe.encoding_user_data = &sink;
+            }
+        }
         if (rv == EXR_ERR_SUCCESS) rv = exr_encoding_run(e, part, &pipe);
     }
     if (have_pipe) {

@@ -7,7 +7,7 @@
 # default render, a warning and the raw image); bad pixels are warned about.
 # usage: test_denoise.sh PAPRSEK SHARED_DIR DATA_DIR
 set -u
-bin=$1
+bin=$1 shared=${2:-}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 fail=0
@@ -94,4 +94,37 @@ elif [ $rc -eq 0 ]; then
 else
   bad "bad pixels: exit $rc: $(cat "$tmp/err")"
 fi
+# 4. every output format holds the same denoised pixels, at 1 and 2 threads:
+# EXR and PFM bit for bit, PNG their sRGB encoding, every value finite, as
+# read by tests/cli/imgcheck.py (its own decoders, not the program's). Among
+# them the 64x64 render of CornellBox-Original whose first ZIP chunk once
+# compressed to exactly its raw size and was stored as garbage.
+check=$(dirname "$0")/imgcheck.py
+cases=("builtin|--width 48 --height 40 --spp 4" "builtin|--width 64 --height 64 --spp 8" "builtin|--width 100 --height 37 --spp 3")
+[ -f "$shared/scenes/cornell/CornellBox-Original.obj" ] &&
+  cases+=("$shared/scenes/cornell/CornellBox-Original.obj|--width 64 --height 64 --spp 8 --look-from 0,1,3.9 --look-at 0,1,0 --fov 39.3")
+n=0
+for c in "${cases[@]}"; do
+  scene=${c%%|*} args=${c#*|} n=$((n + 1))
+  [ "$scene" = builtin ] && scene=
+  outs=()
+  for t in 1 2; do
+    for f in pfm exr png; do
+      # shellcheck disable=SC2086
+      "$bin" render $scene $args --denoise --threads $t -o "$tmp/f$n-$t.$f" --quiet && outs+=("$tmp/f$n-$t.$f")
+    done
+    # shellcheck disable=SC2086
+    "$bin" render $scene $args --aov albedo,normal --threads $t -o "$tmp/f$n-$t-raw.exr" --quiet
+    for f in exr pfm png; do
+      "$bin" denoise "$tmp/f$n-$t-raw.exr" --threads $t -o "$tmp/f$n-$t-dn.$f" --quiet && outs+=("$tmp/f$n-$t-dn.$f")
+    done
+  done
+  if [ ${#outs[@]} -ne 12 ]; then
+    bad "formats, ${scene:-built-in} $args: only ${#outs[@]} of 12 images were written"
+  elif msg=$(/usr/bin/python3 "$check" "$tmp/f$n-1.pfm" "${outs[@]:1}" 2>&1); then
+    ok "formats, ${scene:+$(basename "$scene") }$args: render --denoise and denoise to PFM, EXR and PNG, 1 and 2 threads, the same finite pixels"
+  else
+    bad "formats, ${scene:-built-in} $args: $msg"
+  fi
+done
 exit $fail

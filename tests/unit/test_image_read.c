@@ -218,6 +218,86 @@ static void test_exr(void)
     free(rgb);
 }
 
+/* A ZIP chunk that does not compress is stored raw, and then holds the raw
+ * pixels (the file format's rule: a chunk of the raw size is read as raw).
+ * One chunk of 64x16 RGB floats, its first k bytes random and the rest zero: as k
+ * grows the compressed size crosses the raw size (12288 bytes), and for
+ * some k zlib's output is exactly that long, which OpenEXR 3.1's encoder
+ * stored as it was (a denoised image came back with garbage in its first
+ * 16 rows). Each k: the stored chunk is the raw pixels whenever it has the
+ * raw size, and the image reads back bit for bit. (Three random fillings
+ * per k; with Debian 12's zlib one of them hits the exact size.) */
+static void test_exr_incompressible_chunks(void)
+{
+    enum { W = 64, H = 16, RAW = W * H * 3 * 4 };
+    float *rgb = malloc(sizeof(float) * 3 * W * H);
+    REQUIRE(rgb);
+    uint32_t seed = 12345;
+    int raw_chunks = 0, garbled = 0;
+    for (int t = 0; t < 3 * 321; t++) {
+        const int k = RAW - 320 + t / 3;
+        unsigned char *bytes = (unsigned char *)rgb;
+        for (int i = 0; i < RAW; i++) {
+            seed = seed * 1664525u + 1013904223u;
+            bytes[i] = i < k ? (unsigned char)(seed >> 24) : 0;
+            if (i % 4 == 3) bytes[i] &= 0xBF; /* the exponent below 128: finite */
+        }
+        exr_channel ch[3] = {{"R", rgb, 3, 3 * (size_t)W}, {"G", rgb + 1, 3, 3 * (size_t)W}, {"B", rgb + 2, 3, 3 * (size_t)W}};
+        char path[] = "/tmp/pk_exr_chunk_XXXXXX";
+        int fd = mkstemp(path);
+        REQUIRE(fd >= 0);
+        char why[256] = "";
+        REQUIRE(exr_write_channels(fd, W, H, ch, 3, why, sizeof why) == 0);
+        size_t n;
+        unsigned char *buf = read_fd(fd, &n);
+        close(fd);
+        unlink(path);
+        /* the one chunk: after the header (attributes up to a 0 byte) and
+         * its 8-byte offset: y, size, data */
+        size_t p = 8;
+        while (p < n && buf[p]) {
+            p += strlen((char *)buf + p) + 1;
+            p += strlen((char *)buf + p) + 1;
+            int32_t sz;
+            memcpy(&sz, buf + p, 4);
+            p += 4 + (size_t)sz;
+        }
+        uint64_t off;
+        REQUIRE(p + 9 <= n);
+        memcpy(&off, buf + p + 1, 8);
+        int32_t size;
+        REQUIRE(off + 8 <= n);
+        memcpy(&size, buf + off + 4, 4);
+        if (size >= RAW) {
+            raw_chunks++;
+            CHECKF(size == RAW, "k %d: a chunk of %d bytes, more than raw", k, (int)size);
+            /* raw layout: per line, the channels by name (B, G, R) */
+            int same = 1;
+            for (int y = 0; y < H && same; y++)
+                for (int c = 0; c < 3 && same; c++)
+                    for (int x = 0; x < W; x++) {
+                        float v;
+                        memcpy(&v, buf + off + 8 + (size_t)((y * 3 + c) * W + x) * 4, 4);
+                        if (memcmp(&v, &rgb[(y * W + x) * 3 + (2 - c)], 4) != 0) {
+                            same = 0;
+                            break;
+                        }
+                    }
+            CHECKF(same, "k %d: a chunk of the raw size that is not the raw pixels", k);
+            if (!same) garbled++;
+        }
+        image_buf img;
+        REQUIRE(image_decode(ctx, buf, n, "chunk.exr", &img) == PK_OK);
+        CHECKF(img.pxf && memcmp(img.pxf, rgb, sizeof(float) * 3 * W * H) == 0, "k %d: read back differs", k);
+        image_buf_free(&ctx->alloc, &img);
+        free(buf);
+    }
+    /* the sweep must reach chunks stored raw, or it tests nothing */
+    CHECKF(raw_chunks > 0, "no chunk was stored raw");
+    CHECK(garbled == 0);
+    free(rgb);
+}
+
 /* A tiled OpenEXR file of HALF channels R, G, B, A, tiles of tw x th
  * (partial ones at the right and bottom), written with OpenEXR's C API to
  * path. px: w*h*4 floats (RGBA), exact in HALF. Uncompressed: OpenEXR 3.1's
@@ -443,6 +523,7 @@ int main(void)
     test_png();
     test_jpeg();
     test_exr();
+    test_exr_incompressible_chunks();
     test_exr_tiled();
     test_hdr();
     test_pfm();
