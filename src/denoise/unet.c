@@ -433,24 +433,18 @@ static pk_status make_conv(unet *u, int k, int h, int w, float *src, float *dst)
     DN(dn.memory_desc_init_by_tag(&wmd, 4, wd, dnnl_f32, dnnl_format_tag_any), "describe weights");
     DN(dn.memory_desc_init_by_tag(&wplain, 4, wd, dnnl_f32, dnnl_oihw), "describe weights");
     DN(dn.memory_desc_init_by_tag(&bmd, 1, bd, dnnl_f32, dnnl_x), "describe a bias");
-    /* Winograd F(2x2, 3x3) where input and output have at least 64 channels:
-     * there it ran up to 2x faster than the direct convolution on AVX-512
-     * (80->64 at 512^2: 36 against 66 ms) and is as exact as the oracle test
-     * asks. Below, it gains little or loses (32->32: 15.6 against 13.5 ms;
-     * 64->32: 25.9 against 27.0 ms) and its set-up, paid once per image
-     * size, costs more than it saves (9 ms for 64->32 at 512^2). The direct
-     * convolution elsewhere and where the CPU has no Winograd kernel. Fixed
-     * per layer, never timed at run time, so that a machine always computes
-     * the same numbers (docs/denoising.md). */
-    const bool wino = l->icp >= 64 && l->oc >= 64;
-    dnnl_convolution_desc_t cd, cd_direct;
-    DN(dn.convolution_forward_desc_init(&cd_direct, dnnl_forward_inference, dnnl_convolution_direct, &smd, &wmd,
-                                        &bmd, &dmd, one, pad, pad),
+    /* The direct convolution only, never oneDNN's Winograd kernels: which
+     * of them it picks (F(4x4, 3x3) or F(2x2, 3x3)) and how F(4x4, 3x3)
+     * blocks its sums both depend on the thread count (measured with
+     * oneDNN 2.6 on AVX-512: 128->64 at 32x32 gives other bits with 2
+     * threads than with 1, 3 or 4; 80->64 at 256x256 switches kernel at 16
+     * threads), so an image would depend on --threads. The direct kernel
+     * sums each output in the same order whatever the threads (checked
+     * from 1 to 64 threads on every layer shape: docs/denoising.md). */
+    dnnl_convolution_desc_t cd;
+    DN(dn.convolution_forward_desc_init(&cd, dnnl_forward_inference, dnnl_convolution_direct, &smd, &wmd, &bmd,
+                                        &dmd, one, pad, pad),
        "describe a convolution");
-    cd = cd_direct;
-    if (wino && dn.convolution_forward_desc_init(&cd, dnnl_forward_inference, dnnl_convolution_winograd, &smd, &wmd,
-                                                 &bmd, &dmd, one, pad, pad) != dnnl_success)
-        cd = cd_direct;
     dnnl_primitive_attr_t attr = NULL;
     dnnl_post_ops_t po = NULL;
     DN(dn.primitive_attr_create(&attr), "make attributes");
@@ -471,7 +465,6 @@ static pk_status make_conv(unet *u, int k, int h, int w, float *src, float *dst)
     }
     dnnl_primitive_desc_t pd;
     dnnl_status_t s = dn.primitive_desc_create(&pd, &cd, attr, u->engine, NULL);
-    if (s != dnnl_success && wino) s = dn.primitive_desc_create(&pd, &cd_direct, attr, u->engine, NULL);
     dn.primitive_attr_destroy(attr);
     if (s != dnnl_success) return dnnl_fail(u->ctx, "make a convolution", s);
     const char *impl = NULL;
