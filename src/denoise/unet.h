@@ -43,6 +43,14 @@ typedef void (*unet_layer_fn)(void *user, const char *name, int channels, int hl
 PK_HIDDEN pk_status unet_run(pk_context *ctx, unet *u, int h, int w, int threads, const float *in, float *out,
                              unet_layer_fn layer, void *user);
 
+/* Layer k's input and output channels as the weights have them, and its
+ * level (its image is the input's size divided by 2^level). */
+PK_HIDDEN void unet_layer_shape(const unet *u, int k, int *ic, int *oc, int *level);
+/* Seconds of the last unet_run: planning (0 when the plan of the previous
+ * run was reused), each convolution, and the rest (pooling, upsampling,
+ * layout changes). For bench/denoise_layers.sh. */
+PK_HIDDEN void unet_last_times(const unet *u, double *plan, double conv[UNET_CONVS], double *rest);
+
 /* Whether oneDNN can be loaded (why says otherwise, n bytes). */
 PK_HIDDEN bool unet_backend_available(pk_context *ctx, char *why, size_t n);
 /* What oneDNN chose for the convolutions of the last run ("brgconv:avx512_core" ...). */
