@@ -43,7 +43,7 @@ enum {
 };
 
 static int round16(int c) { return (c + 15) / 16 * 16; }
-static int unet_block(void);
+static int unet_block(const pk_context *ctx);
 
 #if PK_HAVE_DNNL
 #include <oneapi/dnnl/dnnl.h>
@@ -224,7 +224,7 @@ pk_status unet_create(pk_context *ctx, const char *name, const tza_archive *a, u
     u->al = &ctx->alloc;
     u->ic = ic;
     u->icp = round16(ic);
-    u->blk = unet_block();
+    u->blk = unet_block(ctx);
     u->c[1] = c1, u->c[2] = c2, u->c[3] = c3, u->c[4] = c4, u->c[5] = c5;
     u->d4 = d4, u->d3 = d3, u->d2a = d2a, u->d2b = d2b, u->d1a = d1a, u->d1b = d1b;
     /* stored input channels of each layer; for dec_conv1a the weights'
@@ -353,9 +353,12 @@ double unet_flops(const unet *u, int h, int w)
  * unet_block). Channel counts stay multiples of 16, so of B. */
 
 /* The channel block of the CPU: 16 with AVX-512 (F, BW, VL, DQ, which
- * oneDNN's avx512_core kernels need), else 8. */
-static int unet_block(void)
+ * oneDNN's avx512_core kernels need), else 8; 8 also where the config says
+ * cpu.isa=avx2, so that an AVX-512 machine can run (and test) the kernels
+ * of an AVX2 one. */
+static int unet_block(const pk_context *ctx)
 {
+    if (ctx->config.cpu_avx2) return 8;
 #if defined(__x86_64__) || defined(__i386__)
     __builtin_cpu_init();
     if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&

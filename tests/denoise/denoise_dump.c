@@ -56,6 +56,16 @@ int main(int argc, char **argv)
     outdir = argv[2];
     pk_context *ctx;
     pk_context_create(NULL, &ctx);
+    /* PAPRSEK_CPU_ISA=avx2: the AVX2 path (8-channel blocks) on any CPU */
+    const char *isa = getenv("PAPRSEK_CPU_ISA");
+    if (isa && *isa) {
+        char kv[64];
+        snprintf(kv, sizeof kv, "cpu.isa=%s", isa);
+        if (pk_context_set_config(ctx, kv)) {
+            fprintf(stderr, "%s\n", pk_context_error(ctx));
+            return 2;
+        }
+    }
     char why[384];
     if (!unet_backend_available(ctx, why, sizeof why)) {
         printf("SKIP: %s\n", why);
