@@ -110,10 +110,11 @@ sanitize: build-asan
 	@$(MAKE) --no-print-directory sanitize-clang
 
 # The same sanitizers built by clang (build-asan-clang/), because clang's
-# UndefinedBehaviorSanitizer checks what gcc 12's does not: a float converted
-# to an int out of its range (float-cast-overflow, which gcc leaves out of
-# -fsanitize=undefined) and NULL + 0 (clang's pointer-overflow flags it, gcc's
-# looks for wrap-around only). Fuzzing found both (docs/fuzzing.md, issue 31).
+# UndefinedBehaviorSanitizer checks what gcc 12's does not: NULL + 0 (clang's
+# pointer-overflow flags it, gcc's looks for wrap-around only), and a float
+# converted to an int out of its range is in clang's -fsanitize=undefined
+# (the gcc build names float-cast-overflow: CMakeLists.txt). Fuzzing found
+# both (docs/fuzzing.md, issue 31).
 # It runs the unit, image, API and render tests and the fuzz replays (every
 # reader on the corpus, the fixtures and the saved crashers; load + render):
 # SAN_CLANG_TESTS less SAN_CLANG_SKIP. The rest runs under gcc's sanitizers
