@@ -64,6 +64,10 @@ enum {
     NV_LEAF_SIZE = 96 + 512 * 4,
 };
 
+/* the plausible size of the dense box for a grid of so many bytes (nv_read_grid) */
+#define NV_VOXELS_PER_BYTE 512u
+#define NV_SMALL_BOX ((uint64_t)1 << 20)
+
 #define NV_TYPE_FLOAT 1u
 #define NV_MAJOR 32u
 
@@ -301,6 +305,7 @@ static bool nv_clip(const nv_dense *t, const int64_t o[3], int64_t side, int64_t
 
 static void nv_fill(nv_dense *t, const int64_t lo[3], const int64_t hi[3], float value)
 {
+    if (!t->v) return; /* the checking walk */
     for (int64_t z = lo[2]; z <= hi[2]; z++)
         for (int64_t y = lo[1]; y <= hi[1]; y++) {
             float *row = t->v + ((size_t)(z - t->lo[2]) * (size_t)t->dim[1] + (size_t)(y - t->lo[1])) * (size_t)t->dim[0];
@@ -311,7 +316,7 @@ static void nv_fill(nv_dense *t, const int64_t lo[3], const int64_t hi[3], float
 static void nv_leaf(nv_dense *t, const unsigned char *leaf, const int64_t o[3])
 {
     int64_t lo[3], hi[3];
-    if (!nv_clip(t, o, 8, lo, hi)) return;
+    if (!t->v || !nv_clip(t, o, 8, lo, hi)) return;
     const unsigned char *vals = leaf + NV_LEAF_OFF_VALUES;
     for (int64_t z = lo[2]; z <= hi[2]; z++)
         for (int64_t y = lo[1]; y <= hi[1]; y++) {
@@ -358,6 +363,34 @@ static pk_status nv_internal(nv_dense *t, const unsigned char *node, const int64
                     if (nv_clip(t, co, (int64_t)1 << cshift, tlo, thi)) nv_fill(t, tlo, thi, nv_f32(entry));
                 }
             }
+    return PK_OK;
+}
+
+/* Every root tile that meets the dense box, and the nodes below it: fills
+ * t->v, or with t->v NULL only follows and checks the offsets (the walk
+ * before anything is allocated). */
+static pk_status nv_walk(nv_dense *t, const unsigned char *root, uint64_t ntiles)
+{
+    for (uint64_t i = 0; i < ntiles; i++) {
+        const unsigned char *tile = root + NV_ROOT_SIZE + NV_TILE_SIZE * i;
+        const uint64_t key = nv_u64(tile);
+        const uint32_t kx = (uint32_t)(key >> 42 & 0x1fffff) << 12, ky = (uint32_t)(key >> 21 & 0x1fffff) << 12,
+                       kz = (uint32_t)(key & 0x1fffff) << 12;
+        int32_t ox, oy, oz;
+        memcpy(&ox, &kx, 4), memcpy(&oy, &ky, 4), memcpy(&oz, &kz, 4);
+        const int64_t o[3] = {ox, oy, oz};
+        int64_t lo[3], hi[3];
+        if (!nv_clip(t, o, 4096, lo, hi)) continue;
+        const int64_t child = nv_i64(tile + NV_TILE_OFF_CHILD);
+        if (child == 0) {
+            nv_fill(t, lo, hi, nv_f32(tile + NV_TILE_OFF_VALUE));
+            continue;
+        }
+        const unsigned char *upper = nv_child(t, root, child, NV_UPPER_SIZE);
+        if (!upper) return nv_grid_error(t, PK_ERR_PARSE, "an upper node lies outside the grid (truncated?)");
+        pk_status st = nv_internal(t, upper, o, 5, 7);
+        if (st != PK_OK) return st;
+    }
     return PK_OK;
 }
 
@@ -435,6 +468,21 @@ static pk_status nv_read_grid(nv_reader *r, const pk_allocator *al, const nv_fou
         }
         nvox *= (uint64_t)t.dim[a];
     }
+    /* A box the grid's bytes cannot account for: active values lie in leaves,
+     * in tiles of lower and upper nodes, or in root tiles of 4096^3 voxels,
+     * and the root's box holds them all. A box within the voxel limit
+     * cannot hold a root tile, so its active values need an upper node
+     * (270 400 bytes): no grid from a NanoVDB writer has more than
+     * 2^27 / 271 232 < 495 voxels in its box per byte. A box beyond
+     * NV_VOXELS_PER_BYTE voxels per byte (and beyond NV_SMALL_BOX, which
+     * hand-made grids of constant tiles stay within) is refused before
+     * anything is allocated: a 1 KiB file would otherwise cost 512 MiB. */
+    if (nvox > NV_SMALL_BOX && nvox / NV_VOXELS_PER_BYTE > gsize)
+        return ctx_error(r->ctx, PK_ERR_PARSE,
+                         "%s: grid '%.*s': a box of %lld x %lld x %lld voxels in a grid of %llu bytes "
+                         "(more than %u voxels a byte: not a grid a NanoVDB writer makes)",
+                         r->path, t.gname_len, t.gname, (long long)t.dim[0], (long long)t.dim[1],
+                         (long long)t.dim[2], (unsigned long long)gsize, (unsigned)NV_VOXELS_PER_BYTE);
 
     /* keys must differ: each names its own block */
     pk_status st = PK_OK;
@@ -449,31 +497,12 @@ static pk_status nv_read_grid(nv_reader *r, const pk_allocator *al, const nv_fou
         if (st != PK_OK) return st;
     }
 
+    /* the tree's offsets are all checked before the dense grid is allocated */
+    if ((st = nv_walk(&t, root, ntiles)) != PK_OK) return st;
     t.v = mem_alloc(al, (size_t)nvox * sizeof(float));
     if (!t.v) return ctx_nomem(r->ctx);
     for (size_t i = 0; i < (size_t)nvox; i++) t.v[i] = background;
-    for (uint64_t i = 0; i < ntiles && st == PK_OK; i++) {
-        const unsigned char *tile = root + NV_ROOT_SIZE + NV_TILE_SIZE * i;
-        const uint64_t key = nv_u64(tile);
-        const uint32_t kx = (uint32_t)(key >> 42 & 0x1fffff) << 12, ky = (uint32_t)(key >> 21 & 0x1fffff) << 12,
-                       kz = (uint32_t)(key & 0x1fffff) << 12;
-        int32_t ox, oy, oz;
-        memcpy(&ox, &kx, 4), memcpy(&oy, &ky, 4), memcpy(&oz, &kz, 4);
-        const int64_t o[3] = {ox, oy, oz};
-        int64_t lo[3], hi[3];
-        if (!nv_clip(&t, o, 4096, lo, hi)) continue;
-        const int64_t child = nv_i64(tile + NV_TILE_OFF_CHILD);
-        if (child == 0) {
-            nv_fill(&t, lo, hi, nv_f32(tile + NV_TILE_OFF_VALUE));
-            continue;
-        }
-        const unsigned char *upper = nv_child(&t, root, child, NV_UPPER_SIZE);
-        if (!upper) {
-            st = nv_grid_error(&t, PK_ERR_PARSE, "an upper node lies outside the grid (truncated?)");
-            break;
-        }
-        st = nv_internal(&t, upper, o, 5, 7);
-    }
+    st = nv_walk(&t, root, ntiles);
     for (size_t i = 0; st == PK_OK && i < (size_t)nvox; i++)
         if (!isfinite(t.v[i])) {
             char what[160];

@@ -3122,7 +3122,10 @@ static pk_status d_object_instance(pp *p, const char *name)
 static pk_status directive(pp *p, const pbrt_token *tk)
 {
     char dn[32];
-    if (tk->len >= sizeof dn) return pfail(p, tk->line, PK_ERR_PARSE, "unknown directive '%.40s'", tk->text);
+    /* (the token's bytes are not NUL-terminated: a (data, size) buffer may end with them) */
+    if (tk->len >= sizeof dn)
+        return pfail(p, tk->line, PK_ERR_PARSE, "unknown directive '%.*s'", io_tok_len(tk->text, tk->text + tk->len),
+                     tk->text);
     memcpy(dn, tk->text, tk->len);
     dn[tk->len] = '\0';
     p->dname = dn;

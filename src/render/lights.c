@@ -111,6 +111,20 @@ static void lt_store(light_tree_node *nd, const lt_bounds *b)
 
 #define LT_BUCKETS 12
 
+/* The bucket of centroid coordinate c among LT_BUCKETS over [lo, lo + e]
+ * (e > 0), clamped in float before the conversion: for emitters more than
+ * FLT_MAX / 12 apart, 12 * (c - lo) overflows to infinity (and with e
+ * infinite, (c - lo) / e can be NaN), and converting a float out of int's
+ * range is undefined. Infinity goes to the last bucket, NaN to the first;
+ * every finite value to the bucket it always had. */
+static int lt_bucket(float c, float lo, float e)
+{
+    const float k = (float)LT_BUCKETS * (c - lo) / e;
+    if (!(k > 0.0f)) return 0;
+    if (k >= (float)(LT_BUCKETS - 1)) return LT_BUCKETS - 1;
+    return (int)k;
+}
+
 /* Builds the subtree of items [0, n) at node *at, depth deep, the path bits
  * so far in trail. Splits by the cost of pbrt-v4's SAOH over centroid
  * buckets on each axis (power x orientation measure x area, the box made
@@ -145,8 +159,7 @@ static void lt_build(lt_builder *tb, lt_item *it, size_t n, int depth, uint64_t 
             bool used[LT_BUCKETS] = {false};
             for (size_t i = 0; i < n; i++) {
                 const float c = ax == 0 ? it[i].c.x : ax == 1 ? it[i].c.y : it[i].c.z;
-                int k = (int)((float)LT_BUCKETS * (c - lo) / e);
-                k = k < 0 ? 0 : k >= LT_BUCKETS ? LT_BUCKETS - 1 : k;
+                const int k = lt_bucket(c, lo, e);
                 bk[k] = used[k] ? lt_union(&bk[k], &it[i].b) : it[i].b;
                 used[k] = true;
             }
@@ -170,9 +183,7 @@ static void lt_build(lt_builder *tb, lt_item *it, size_t n, int depth, uint64_t 
             size_t a = 0, b = n;
             while (a < b) { /* partition by bucket < best_split */
                 const float c = best_axis == 0 ? it[a].c.x : best_axis == 1 ? it[a].c.y : it[a].c.z;
-                int k = (int)((float)LT_BUCKETS * (c - lo) / e);
-                k = k < 0 ? 0 : k >= LT_BUCKETS ? LT_BUCKETS - 1 : k;
-                if (k < best_split) {
+                if (lt_bucket(c, lo, e) < best_split) {
                     a++;
                 } else {
                     const lt_item t = it[a];

@@ -202,13 +202,15 @@ int64_t scene_find_material(const pk_scene *s, const char *name)
 
 /* ---- meshes and instances ---------------------------------------------- */
 
-/* Appends n elements of size elem from src to *arr (count *len, capacity *cap). */
-static bool append_n(const pk_allocator *a, void **arr, size_t *len, size_t *cap, const void *src, size_t n,
-                     size_t elem)
+/* Appends n elements of size elem, from element first of src on, to *arr
+ * (count *len, capacity *cap). src is offset only when there is something to
+ * copy: a mesh without normals or uvs has src NULL, and NULL + 0 is undefined. */
+static bool append_n(const pk_allocator *a, void **arr, size_t *len, size_t *cap, const void *src, size_t first,
+                     size_t n, size_t elem)
 {
     if (!n) return true;
     if (!mem_grow(a, arr, cap, *len + n, elem)) return false;
-    memcpy((char *)*arr + *len * elem, src, n * elem);
+    memcpy((char *)*arr + *len * elem, (const char *)src + first * elem, n * elem);
     *len += n;
     return true;
 }
@@ -234,11 +236,11 @@ pk_status scene_capture_mesh(pk_context *ctx, pk_scene *s, size_t pos0, size_t n
     }
     const pk_allocator *a = &s->alloc;
     if (!mem_grow(a, (void **)&s->meshes, &s->cap_meshes, s->nmeshes + 1, sizeof *s->meshes) ||
-        !append_n(a, (void **)&s->mesh_positions, &s->nmesh_positions, &s->cap_mesh_positions, s->positions + pos0,
+        !append_n(a, (void **)&s->mesh_positions, &s->nmesh_positions, &s->cap_mesh_positions, s->positions, pos0,
                   m.npos, sizeof(vec3)) ||
-        !append_n(a, (void **)&s->mesh_normals, &s->nmesh_normals, &s->cap_mesh_normals, s->normals + nrm0, m.nnrm,
+        !append_n(a, (void **)&s->mesh_normals, &s->nmesh_normals, &s->cap_mesh_normals, s->normals, nrm0, m.nnrm,
                   sizeof(vec3)) ||
-        !append_n(a, (void **)&s->mesh_uvs, &s->nmesh_uvs, &s->cap_mesh_uvs, s->uvs + uv0, m.nuv, sizeof(uv2)) ||
+        !append_n(a, (void **)&s->mesh_uvs, &s->nmesh_uvs, &s->cap_mesh_uvs, s->uvs, uv0, m.nuv, sizeof(uv2)) ||
         !mem_grow(a, (void **)&s->mesh_tris, &s->cap_mesh_tris, s->nmesh_tris + m.ntris, sizeof(triangle))) {
         /* undo the partial appends: the mesh is not there */
         s->nmesh_positions = m.first_pos, s->nmesh_normals = m.first_nrm, s->nmesh_uvs = m.first_uv;

@@ -19,6 +19,7 @@
 /* ---- an allocator that counts live blocks ---------------------------------- */
 
 static long live_blocks;
+static size_t largest_block; /* the largest size asked for (reset by the tests that read it) */
 
 static void *count_realloc(void *user, void *ptr, size_t size)
 {
@@ -28,6 +29,7 @@ static void *count_realloc(void *user, void *ptr, size_t size)
         free(ptr);
         return NULL;
     }
+    if (size > largest_block) largest_block = size;
     void *p = realloc(ptr, size);
     if (p && !ptr) live_blocks++;
     return p;
@@ -544,6 +546,50 @@ static void edit_type(unsigned char *g) { set_u32(g + 636, 15); }
 static void edit_magic(unsigned char *g) { g[3] = 'X'; }
 static void edit_size(unsigned char *g) { set_u64(g + 32, NVT_SIZE + 1); }
 
+/* A box of 8 x 3 x 4194306 voxels (100 M, within the voxel limit: 403 MB
+ * dense) in a grid of 864 bytes, a root of two constant tiles and no node
+ * (as a fuzzer found it): refused for its size before the dense grid is
+ * allocated. Then the hand-made grid with a box of 512 x 512 x 500 voxels
+ * (plausible for its 307 KB) and an upper node's offset out of the grid:
+ * refused by the walk over the tree before the dense grid is allocated. */
+static void check_nanovdb_box_before_alloc(pk_context *ctx)
+{
+    enum { SMALL = NVT_GRID + NVT_TREE + NVT_ROOT + 2 * NVT_TILE };
+    unsigned char *small = nvt_grid("density", 1, "NanoVDB0"); /* its first SMALL bytes */
+    set_u64(small + 32, SMALL);
+    memset(small + NVT_GRID, 0, NVT_TREE);
+    set_u64(small + NVT_GRID + 24, NVT_ROOT_AT - NVT_GRID);
+    const int32_t lo[3] = {-3, 0, 0}, hi[3] = {4, 2, 4194305};
+    for (int a = 0; a < 3; a++)
+        set_u32(small + NVT_ROOT_AT + 4 * a, (uint32_t)lo[a]), set_u32(small + NVT_ROOT_AT + 12 + 4 * a, (uint32_t)hi[a]);
+    set_u64(small + NVT_ROOT_AT + NVT_ROOT + 8, 0); /* the tile at the origin: constant too */
+    set_f32(small + NVT_ROOT_AT + NVT_ROOT + 20, 2.0f);
+    const nvt_entry one = {"density", 1, small, SMALL};
+    bytes b = nvt_file(&one, 1, 0);
+    medium_grid g;
+    aabb box;
+    const char *path;
+    largest_block = 0;
+    pk_status st = nvt_read(ctx, "tiny_huge_box.nvdb", &b, NULL, &g, &box, &path);
+    CHECKF(largest_block < ((size_t)1 << 20), "%zu bytes allocated for a grid of %d bytes", largest_block, (int)SMALL);
+    expect_refused(ctx, path, st, &g, PK_ERR_PARSE,
+                   "grid 'density': a box of 8 x 3 x 4194306 voxels in a grid of 864 bytes (more than 512 voxels a byte");
+    free(b.p);
+    free(small);
+
+    unsigned char *grid = nvt_grid("density", 1, "NanoVDB0");
+    set_u32(grid + NVT_ROOT_AT + 12, 509), set_u32(grid + NVT_ROOT_AT + 16, 510), set_u32(grid + NVT_ROOT_AT + 20, 499);
+    edit_upper_out(grid);
+    const nvt_entry big = {"density", 1, grid, NVT_SIZE};
+    b = nvt_file(&big, 1, 0);
+    largest_block = 0;
+    st = nvt_read(ctx, "big_box_bad_upper.nvdb", &b, NULL, &g, &box, &path);
+    CHECKF(largest_block < ((size_t)1 << 20), "%zu bytes allocated before the tree was checked", largest_block);
+    expect_refused(ctx, path, st, &g, PK_ERR_PARSE, "an upper node lies outside the grid");
+    free(b.p);
+    free(grid);
+}
+
 static void check_nanovdb_hostile(pk_context *ctx)
 {
     nvt_refused(ctx, "nan.nvdb", edit_leaf_nan, 0, PK_ERR_PARSE, "grid 'density': the value at voxel (3, 2, 1) is NaN");
@@ -566,6 +612,7 @@ static void check_nanovdb_hostile(pk_context *ctx)
     nvt_refused(ctx, "gridmagic.nvdb", edit_magic, 0, PK_ERR_PARSE, "bad grid magic");
     nvt_refused(ctx, "gridsize.nvdb", edit_size, 0, PK_ERR_PARSE, "size does not match");
     nvt_refused(ctx, "zip.nvdb", NULL, 1, PK_ERR_UNSUPPORTED, "compressed with Zip (only uncompressed files are read)");
+    check_nanovdb_box_before_alloc(ctx);
     nvt_refused(ctx, "blosc.nvdb", NULL, 2, PK_ERR_UNSUPPORTED, "compressed with Blosc");
 
     /* the file's own header: magic, version, truncated anywhere */

@@ -230,12 +230,17 @@ static void check_two_level(void)
             other++;
             continue;
         }
-        if (h0[i].prim != PK_NO_HIT && fabsf(h0[i].t - h1[i].t) > 1e-4f * fabsf(h1[i].t)) far++;
+        /* relative to t, and a floor of 1e-5 in distance (a few ulps of the scene's coordinates, up
+         * to 24): a ray that starts on a triangle hits it at a t near 0, where the two transforms'
+         * roundings differ by more than 1e-4 of t (ray 911 with clang: t 2.4607e-4 against 2.4623e-4,
+         * 2e-6 apart in distance) */
+        const float len = v3_len(rays[i].d);
+        if (h0[i].prim != PK_NO_HIT && fabsf(h0[i].t - h1[i].t) * len > 1e-4f * fabsf(h1[i].t) * len + 1e-5f) far++;
     }
     CHECKF(other <= NRAYS / 1000, "general transforms: %zu of %d rays hit another triangle than flattened", other, NRAYS);
-    CHECKF(far == 0, "general transforms: %zu hits with t off by more than 1e-4", far);
+    CHECKF(far == 0, "general transforms: %zu hits with t off by more than 1e-4 (and 1e-5 in distance)", far);
     printf("general transforms: %zu hits (%zu in instances); %zu of %d rays differ from the flattened scene's "
-           "triangle (grazing edges), t within 1e-4\n", hits, inst_hits, other, NRAYS);
+           "triangle (grazing edges), t within 1e-4 (or 1e-5 in distance)\n", hits, inst_hits, other, NRAYS);
     accel_destroy(flat);
     accel_destroy(ref);
     free(rays), free(h0), free(h1), free(o1);

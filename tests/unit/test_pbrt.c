@@ -727,6 +727,24 @@ static void test_errors(void)
     expect_error("LookAt 0 0 0  0 0 0  0 1 0\n", "t.pbrt:1: ", "the same point");
     expect_error("WorldBegin\nLightSource \"spot\" \"point3 from\" [0 0 0] \"point3 to\" [0 0 0]\n", "t.pbrt:2: ",
                  "no direction");
+    /* a directive of 32 bytes or more that ends the (data, size) buffer: the
+     * message quotes its bytes and nothing past the end (fuzzed: it read up
+     * to 40 bytes from a token that is not NUL-terminated) */
+    {
+        const char text[] = "WorldBegin\nUnknownDirectiveNameOf32Bytes___PAST THE END";
+        const size_t size = sizeof text - 1 - strlen("PAST THE END");
+        pk_context *ctx;
+        REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
+        pk_scene *s = NULL;
+        REQUIRE(scene_create(ctx, "t.pbrt", &s) == PK_OK);
+        CHECK(scene_pbrt_parse(ctx, s, text, size, "t.pbrt", PK_TEST_DATA "/pbrt") == PK_ERR_PARSE);
+        const char *m = pk_context_error(ctx);
+        CHECKF(strcmp(m, "t.pbrt:2: unknown directive 'UnknownDirectiveNameOf32Bytes___'") == 0, "message \"%s\"", m);
+        scene_destroy(s);
+        pk_context_destroy(ctx);
+    }
+    expect_error("Frobnicate_the_scene_with_a_name_well_beyond_forty_bytes 1\n", "t.pbrt:1: ",
+                 "unknown directive 'Frobnicate_the_scene_with_a_name_well_be'");
     /* a world without lights renders black, as in pbrt: no default environment */
     pk_context *ctx;
     pk_scene *s = load(&ctx, "WorldBegin\nShape \"sphere\"\n");
