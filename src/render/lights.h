@@ -223,6 +223,40 @@ static inline PK_HD bool light_sample_tri_solid_angle(const scene_view *s, const
     return true;
 }
 
+/* Samples triangle light l (material m) uniformly by area from lc with
+ * (u1, u2): false when it sends nothing toward lc->p. ls->pdf is the solid
+ * angle pdf at lc->p (light_pdf_area), ls->wi and the shadow ray leave from
+ * lc->o. What light_sample_one_with does for a triangle by area (the
+ * Whitted integrator's measure, and the solid-angle modes' fallback), on
+ * its own so that a caller that knows it has a triangle light calls it
+ * without the other kinds' code. */
+static inline PK_HD bool light_sample_tri_area(const scene_view *s, const light *l, const material *m,
+                                               const light_ctx *lc, float u1, float u2, light_sample *ls)
+{
+    vec3 a, b, c;
+    view_tri_verts(s, l->index, &a, &b, &c);
+    const vec3 p = lc->p, o = lc->o, nq = l->normal;
+    const vec3 q = sample_triangle(a, b, c, u1, u2);
+    if (!lc->two_sided && !m->two_sided && !(v3_dot(nq, v3_sub(p, q)) > 0.0f)) return false;
+    /* light_pdf_area of a triangle */
+    const vec3 dp = v3_sub(q, p);
+    const float dist2p = v3_len2(dp);
+    if (!(dist2p > 0.0f)) return false;
+    const float cos_l = fabsf(v3_dot(nq, v3_scale(dp, 1.0f / sqrtf(dist2p))));
+    if (!(cos_l > 0.0f) || !(l->area > 0.0f)) return false;
+    const float pdf = dist2p / (cos_l * l->area);
+    if (!(pdf > 0.0f) || !isfinite(pdf)) return false;
+    const vec3 d = v3_sub(q, o);
+    const float dist2 = v3_len2(d);
+    if (!(dist2 > 0.0f)) return false;
+    ls->wi = v3_scale(d, 1.0f / sqrtf(dist2));
+    ls->le = m->ke;
+    ls->pdf = pdf;
+    ls->delta = false;
+    ls->shadow = (ray){o, 0.0f, d, 1.0f - SHADOW_SHORTEN};
+    return true;
+}
+
 /* The fraction of a point light's intensity it sends in the unit direction
  * w (from the light): 1 for point lights, a spot light's cone and falloff
  * (SPOT_FALLOFF_*). */
@@ -299,13 +333,7 @@ static inline PK_HD bool light_sample_one_with(const light_set *set, const scene
             sph_tri st;
             if (light_tri_spherical(s, l, p, &st)) return light_sample_tri_solid_angle(s, l, m, lc, tri, &st, u1, u2, ls);
         }
-        vec3 a, b, c;
-        view_tri_verts(s, l->index, &a, &b, &c);
-        q = sample_triangle(a, b, c, u1, u2);
-        nq = l->normal;
-        vec3 toward = v3_sub(p, q);
-        bool front = v3_dot(nq, toward) > 0.0f;
-        if (!front && !m->two_sided && !lc->two_sided) return false;
+        return light_sample_tri_area(s, l, m, lc, u1, u2, ls);
     } else {
         const sphere *sp = &s->spheres[l->index];
         m = &s->materials[sp->material];
