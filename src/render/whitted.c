@@ -55,6 +55,15 @@ static vec3 trace(const whitted *w, whitted_thread *ts, const ray *r, int depth,
     return whitted_shade(w, ts, r, &h, depth, NULL);
 }
 
+/* A light other than a triangle (the environment, the sun, a point light),
+ * out of the sampling loop's line: their code (calls to sincosf and the
+ * like) would otherwise keep the loop's values out of registers. */
+__attribute__((noinline)) static bool sample_other(const light_set *set, const scene_view *s, const env_light *e,
+                                                  size_t li, const light_ctx *lc, float u1, float u2, light_sample *ls)
+{
+    return light_sample_one_with(set, s, e, li, lc, LIGHT_TRI_AREA, u1, u2, ls);
+}
+
 /* Direct light at sf toward wo: every point light and the sun with a
  * shadow ray of its own, and light_samples samples of the other lights of
  * the frame's light set (emissive triangles and the environment; emissive
@@ -78,7 +87,7 @@ __attribute__((flatten)) static vec3 direct_light(const whitted *w, whitted_thre
         const size_t li = w->single[j];
         const uint32_t kind = set->lights[li].kind;
         const float u1 = kind == LIGHT_SUN ? rng_float(&ts->rng) : 0.5f, u2 = kind == LIGHT_SUN ? rng_float(&ts->rng) : 0.5f;
-        if (!light_sample_one_with(set, s, &fr->env, li, &lc, LIGHT_TRI_AREA, u1, u2, &ls)) continue;
+        if (!sample_other(set, s, &fr->env, li, &lc, u1, u2, &ls)) continue;
         vec3 f = brdf_cos(sf, wo, ls.wi);
         if (is_black(f)) continue;
         ts->shadow_weight[n] = v3_scale(v3_mul(f, ls.le), 1.0f / ls.pdf);
@@ -96,8 +105,13 @@ __attribute__((flatten)) static vec3 direct_light(const whitted *w, whitted_thre
             float u1 = (u - lo) / p_pick;
             u1 = u1 > 0.0f ? (u1 < 0x1.fffffep-1f ? u1 : 0x1.fffffep-1f) : 0.0f;
             const float u2 = rng_float(&ts->rng);
-            if (!(p_pick > 0.0f) || !light_sample_one_with(set, s, &fr->env, w->sampled[j], &lc, LIGHT_TRI_AREA, u1, u2, &ls))
+            if (!(p_pick > 0.0f)) continue;
+            const light *l = &set->lights[w->sampled[j]];
+            if (l->kind == LIGHT_TRIANGLE) {
+                if (!light_sample_tri_area(s, l, &s->materials[s->tris[l->index].material], &lc, u1, u2, &ls)) continue;
+            } else if (!sample_other(set, s, &fr->env, w->sampled[j], &lc, u1, u2, &ls)) {
                 continue;
+            }
             vec3 f = brdf_cos(sf, wo, ls.wi);
             if (is_black(f)) continue;
             ts->shadow_weight[n] = v3_scale(v3_mul(f, ls.le), inv_n / (p_pick * ls.pdf));
