@@ -80,15 +80,17 @@ __attribute__((flatten)) static vec3 direct_light(const whitted *w, whitted_thre
     const light_set *set = &fr->lights;
     vec3 L = v3s(0.0f);
     const light_ctx lc = {sf->p, sf->ng, offset_origin(fr->eps, sf->p, sf->ng), true};
+    const brdf_terms bt = brdf_terms_at(sf);
+    rng r = ts->rng; /* in a register, not through ts */
     size_t n = 0;
-    light_sample ls;
     /* point lights and the sun: one shadow ray each */
     for (size_t j = 0; j < w->nsingle; j++) {
         const size_t li = w->single[j];
         const uint32_t kind = set->lights[li].kind;
-        const float u1 = kind == LIGHT_SUN ? rng_float(&ts->rng) : 0.5f, u2 = kind == LIGHT_SUN ? rng_float(&ts->rng) : 0.5f;
+        const float u1 = kind == LIGHT_SUN ? rng_float(&r) : 0.5f, u2 = kind == LIGHT_SUN ? rng_float(&r) : 0.5f;
+        light_sample ls;
         if (!sample_other(set, s, &fr->env, li, &lc, u1, u2, &ls)) continue;
-        vec3 f = brdf_cos(sf, wo, ls.wi);
+        vec3 f = brdf_terms_cos(&bt, wo, ls.wi);
         if (is_black(f)) continue;
         ts->shadow_weight[n] = v3_scale(v3_mul(f, ls.le), 1.0f / ls.pdf);
         ts->shadow_rays[n] = ls.shadow;
@@ -98,27 +100,31 @@ __attribute__((flatten)) static vec3 direct_light(const whitted *w, whitted_thre
     if (w->nsampled && ns > 0) {
         const float inv_n = 1.0f / (float)ns;
         for (int k = 0; k < ns; k++) {
-            float u = ((float)k + rng_float(&ts->rng)) * inv_n;
+            float u = ((float)k + rng_float(&r)) * inv_n;
             if (u >= 1.0f) u = 0x1.fffffep-1f;
             const size_t j = cdf_pick(w->cdf, w->nsampled, u);
             const float lo = j ? w->cdf[j - 1] : 0.0f, p_pick = w->cdf[j] - lo;
             float u1 = (u - lo) / p_pick;
             u1 = u1 > 0.0f ? (u1 < 0x1.fffffep-1f ? u1 : 0x1.fffffep-1f) : 0.0f;
-            const float u2 = rng_float(&ts->rng);
+            const float u2 = rng_float(&r);
             if (!(p_pick > 0.0f)) continue;
             const light *l = &set->lights[w->sampled[j]];
+            light_sample ls;
             if (l->kind == LIGHT_TRIANGLE) {
                 if (!light_sample_tri_area(s, l, &s->materials[s->tris[l->index].material], &lc, u1, u2, &ls)) continue;
-            } else if (!sample_other(set, s, &fr->env, w->sampled[j], &lc, u1, u2, &ls)) {
-                continue;
+            } else {
+                light_sample other; /* its own, so that ls stays out of memory */
+                if (!sample_other(set, s, &fr->env, w->sampled[j], &lc, u1, u2, &other)) continue;
+                ls = other;
             }
-            vec3 f = brdf_cos(sf, wo, ls.wi);
+            vec3 f = brdf_terms_cos(&bt, wo, ls.wi);
             if (is_black(f)) continue;
             ts->shadow_weight[n] = v3_scale(v3_mul(f, ls.le), inv_n / (p_pick * ls.pdf));
             ts->shadow_rays[n] = ls.shadow;
             n++;
         }
     }
+    ts->rng = r;
     if (n == 0) return L;
     ts->rays[RAY_SHADOW] += n;
     accel_intersect_many(fr->a, ts->shadow_rays, ts->shadow_hits, n, true, ts->cp);
