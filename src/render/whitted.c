@@ -111,7 +111,7 @@ __attribute__((flatten)) static vec3 direct_light(const whitted *w, whitted_thre
             const light *l = &set->lights[w->sampled[j]];
             light_sample ls;
             if (l->kind == LIGHT_TRIANGLE) {
-                if (!light_sample_tri_area(s, l, &s->materials[s->tris[l->index].material], &lc, u1, u2, &ls)) continue;
+                if (!light_sample_tri_area(l, &lc, u1, u2, &ls)) continue;
             } else {
                 light_sample other; /* its own, so that ls stays out of memory */
                 if (!sample_other(set, s, &fr->env, w->sampled[j], &lc, u1, u2, &other)) continue;
