@@ -254,12 +254,12 @@ static inline PK_HD bool light_sample_tri_area(const light *l, const light_ctx *
     const vec3 p = lc->p, o = lc->o, nq = l->normal;
     const vec3 q = sample_triangle(l->v[0], l->v[1], l->v[2], u1, u2);
     if (!lc->two_sided && !l->two_sided && !(v3_dot(nq, v3_sub(p, q)) > 0.0f)) return false;
-    /* light_pdf_area of a triangle */
+    /* light_pdf_area of a triangle; where it would return 0 (p on the
+     * light, cos_l or the area 0 or NaN) the pdf here is 0, infinite or
+     * NaN, which the one test after it refuses, so that it is the only one */
     const vec3 dp = v3_sub(q, p);
     const float dist2p = v3_len2(dp);
-    if (!(dist2p > 0.0f)) return false;
     const float cos_l = fabsf(v3_dot(nq, v3_scale(dp, 1.0f / sqrtf(dist2p))));
-    if (!(cos_l > 0.0f) || !(l->area > 0.0f)) return false;
     const float pdf = dist2p / (cos_l * l->area);
     if (!(pdf > 0.0f) || !isfinite(pdf)) return false;
     const vec3 d = v3_sub(q, o);
