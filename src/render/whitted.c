@@ -277,14 +277,14 @@ static void ig_set_camera(void *self, const camera_frame *cf)
 static camera_sample ig_camera_sample(const void *self, int px, int py, uint64_t index, int smp, int spp)
 {
     const whitted *w = self;
-    float jx = 0.5f, jy = 0.5f;
+    camera_sample cs = {(float)px + 0.5f, (float)py + 0.5f, 0.5f, 0.5f};
+    if (spp <= 1 && !w->lens) return cs; /* the pixel centre: no stream to seed */
     rng jr = rng_seed(((uint64_t)py << 32) | (uint32_t)px, index * 2 + 1);
     if (spp > 1) {
         const int sx = (int)ceilf(sqrtf((float)spp)), sy = (spp + sx - 1) / sx;
-        jx = ((float)(smp % sx) + rng_float(&jr)) / (float)sx;
-        jy = ((float)(smp / sx) + rng_float(&jr)) / (float)sy;
+        cs.film_x = (float)px + ((float)(smp % sx) + rng_float(&jr)) / (float)sx;
+        cs.film_y = (float)py + ((float)(smp / sx) + rng_float(&jr)) / (float)sy;
     }
-    camera_sample cs = {(float)px + jx, (float)py + jy, 0.5f, 0.5f};
     if (w->lens) {
         cs.lens_u = rng_float(&jr);
         cs.lens_v = rng_float(&jr);
