@@ -10,7 +10,10 @@
  * (spherical_triangle.h), optionally warped toward the cosine at the
  * receiver, or by area (LIGHT_TRI_*): the path tracer's light_sample_li and
  * light_pdf_li use the warped solid angle, the Whitted integrator asks for
- * area (light_sample_one_with). Solid-angle sampling spends no samples on
+ * area (light_sample_tri_area for its triangles, light_sample_one_with with
+ * LIGHT_TRI_AREA for the other kinds; both give the same sample, and
+ * Whitted's loop, 32 samples a point by default, keeps the other kinds'
+ * code out of line). Solid-angle sampling spends no samples on
  * the parts of a near light that look small from the receiver (area
  * sampling's r^2 / cos in the estimate is what makes fireflies next to
  * lights), and the warp follows the receiver's cosine across the light.
