@@ -289,6 +289,7 @@ pk_status light_set_build(pk_context *ctx, const pk_scene *s, const env_light *e
         light_set_free(al, ls);
         return ctx_nomem(ctx);
     }
+    memset(ls->lights, 0, n * sizeof(light)); /* the fields a kind leaves unused are zero */
     size_t k = 0;
     /* emitted flux (luminance): pi * L * area per emitting side; 4 pi I for points */
     for (size_t i = 0; i < s->nemissive; i++) {
@@ -297,10 +298,7 @@ pk_status light_set_build(pk_context *ctx, const pk_scene *s, const env_light *e
         scene_tri_verts(s, t, &a, &b, &c);
         const material *m = &s->materials[s->tris[t].material];
         light *l = &ls->lights[k];
-        l->kind = LIGHT_TRIANGLE;
-        l->index = t;
-        l->area = 0.5f * v3_len(v3_cross(v3_sub(b, a), v3_sub(c, a)));
-        l->normal = tri_normal(a, b, c);
+        *l = light_of_triangle(t, a, b, c, m);
         power[k] = (double)fmaxf(v3_luminance(m->ke), 1e-6f) * (double)l->area * (double)PK_PI * (m->two_sided ? 2.0 : 1.0);
         ls->of_prim[t] = (int32_t)k;
         k++;
@@ -338,12 +336,12 @@ pk_status light_set_build(pk_context *ctx, const pk_scene *s, const env_light *e
         k++;
     }
     if (env->active) {
-        ls->lights[k] = (light){LIGHT_ENV, 0, 0.0f, v3s(0.0f)};
+        ls->lights[k] = (light){.kind = LIGHT_ENV};
         power[k] = fmax(env->power_env, 1e-6);
         ls->env = (int32_t)k++;
     }
     if (env->sun) {
-        ls->lights[k] = (light){LIGHT_SUN, 0, 0.0f, v3s(0.0f)};
+        ls->lights[k] = (light){.kind = LIGHT_SUN};
         power[k] = fmax(env->power_sun, 1e-6);
         ls->sun = (int32_t)k++;
     }

@@ -10,7 +10,10 @@
  * (spherical_triangle.h), optionally warped toward the cosine at the
  * receiver, or by area (LIGHT_TRI_*): the path tracer's light_sample_li and
  * light_pdf_li use the warped solid angle, the Whitted integrator asks for
- * area (light_sample_one_with). Solid-angle sampling spends no samples on
+ * area (light_sample_tri_area for its triangles, light_sample_one_with with
+ * LIGHT_TRI_AREA for the other kinds; both give the same sample, and
+ * Whitted's loop, 32 samples a point by default, keeps the other kinds'
+ * code out of line). Solid-angle sampling spends no samples on
  * the parts of a near light that look small from the receiver (area
  * sampling's r^2 / cos in the estimate is what makes fireflies next to
  * lights), and the warp follows the receiver's cosine across the light.
@@ -39,7 +42,28 @@ typedef struct light {
     uint32_t index;      /* triangle number, sphere number or point light number */
     float area;          /* triangles and spheres */
     vec3 normal;         /* triangles: unit winding normal */
+    /* Triangles: what sampling one reads, copied from the scene (which a
+     * renderer's scene may not change): its vertices and its material's
+     * emission and sidedness, so that a sample reads this record and not
+     * triangle, index, position and material in turn. */
+    vec3 v[3];
+    vec3 le;
+    bool two_sided;
 } light;
+
+/* The record of emissive triangle number index, (a, b, c) of material m. */
+static inline PK_HD light light_of_triangle(uint32_t index, vec3 a, vec3 b, vec3 c, const material *m)
+{
+    light l;
+    l.kind = LIGHT_TRIANGLE;
+    l.index = index;
+    l.area = 0.5f * v3_len(v3_cross(v3_sub(b, a), v3_sub(c, a)));
+    l.normal = tri_normal(a, b, c);
+    l.v[0] = a, l.v[1] = b, l.v[2] = c;
+    l.le = m->ke;
+    l.two_sided = m->two_sided;
+    return l;
+}
 
 /* Emissive triangles, emissive spheres, point lights, the environment and
  * the sun, chosen in proportion to their emitted power. */
@@ -131,10 +155,9 @@ static inline PK_HD float light_pdf_area(const scene_view *s, const light *l, ve
 /* Whether triangle light l is sampled by its solid angle from p (else by
  * area), with the spherical triangle *st when it is: the one rule of both
  * the sampling and the pdf. */
-static inline PK_HD bool light_tri_spherical(const scene_view *s, const light *l, vec3 p, sph_tri *st)
+static inline PK_HD bool light_tri_spherical(const light *l, vec3 p, sph_tri *st)
 {
-    vec3 a, b, c;
-    view_tri_verts(s, l->index, &a, &b, &c);
+    const vec3 a = l->v[0], b = l->v[1], c = l->v[2];
     /* Cheaply first: the solid angle, the integral of h / r^3 over the
      * triangle (h: p's distance from its plane), is at most area h / r^3
      * for any r below p's distance from it, such as the distance to the
@@ -157,7 +180,7 @@ static inline PK_HD float light_pdf_at(const scene_view *s, const light *l, vec3
 {
     if (l->kind == LIGHT_TRIANGLE && tri != LIGHT_TRI_AREA) {
         sph_tri st;
-        if (light_tri_spherical(s, l, p, &st)) {
+        if (light_tri_spherical(l, p, &st)) {
             if (tri != LIGHT_TRI_SOLID_ANGLE_COS) return 1.0f / st.area;
             float u0, u1, w[4];
             const vec3 d = v3_sub(q, p);
@@ -178,17 +201,15 @@ static inline PK_HD float light_pdf_li(const scene_view *s, const light *l, vec3
     return light_pdf_at(s, l, p, n, LIGHT_TRI_SOLID_ANGLE_COS, q, nq);
 }
 
-/* Samples triangle light l (material m) by the solid angle st it subtends
- * from lc->p: false when it sends nothing toward lc->p. */
-static inline PK_HD bool light_sample_tri_solid_angle(const scene_view *s, const light *l, const material *m,
-                                                      const light_ctx *lc, uint32_t tri, const sph_tri *st, float u1,
-                                                      float u2, light_sample *ls)
+/* Samples triangle light l by the solid angle st it subtends from lc->p:
+ * false when it sends nothing toward lc->p. */
+static inline PK_HD bool light_sample_tri_solid_angle(const light *l, const light_ctx *lc, uint32_t tri,
+                                                      const sph_tri *st, float u1, float u2, light_sample *ls)
 {
-    vec3 v0, v1, v2;
-    view_tri_verts(s, l->index, &v0, &v1, &v2);
+    const vec3 v0 = l->v[0], v1 = l->v[1], v2 = l->v[2];
     const vec3 p = lc->p, o = lc->o;
     const bool front = v3_dot(l->normal, v3_sub(p, v0)) > 0.0f;
-    if (!front && !m->two_sided && !lc->two_sided) return false;
+    if (!front && !l->two_sided && !lc->two_sided) return false;
     float x = u1, y = u2, pdf;
     if (tri == LIGHT_TRI_SOLID_ANGLE_COS) {
         float w[4];
@@ -216,7 +237,39 @@ static inline PK_HD bool light_sample_tri_solid_angle(const scene_view *s, const
     const float dist2 = v3_len2(d);
     if (!(dist2 > 0.0f)) return false;
     ls->wi = v3_scale(d, 1.0f / sph_sqrt(dist2));
-    ls->le = m->ke;
+    ls->le = l->le;
+    ls->pdf = pdf;
+    ls->delta = false;
+    ls->shadow = (ray){o, 0.0f, d, 1.0f - SHADOW_SHORTEN};
+    return true;
+}
+
+/* Samples triangle light l uniformly by area from lc with (u1, u2): false
+ * when it sends nothing toward lc->p. ls->pdf is the solid
+ * angle pdf at lc->p (light_pdf_area), ls->wi and the shadow ray leave from
+ * lc->o. What light_sample_one_with does for a triangle by area (the
+ * Whitted integrator's measure, and the solid-angle modes' fallback), on
+ * its own so that a caller that knows it has a triangle light calls it
+ * without the other kinds' code. */
+static inline PK_HD bool light_sample_tri_area(const light *l, const light_ctx *lc, float u1, float u2,
+                                               light_sample *ls)
+{
+    const vec3 p = lc->p, o = lc->o, nq = l->normal;
+    const vec3 q = sample_triangle(l->v[0], l->v[1], l->v[2], u1, u2);
+    if (!lc->two_sided && !l->two_sided && !(v3_dot(nq, v3_sub(p, q)) > 0.0f)) return false;
+    /* light_pdf_area of a triangle; where it would return 0 (p on the
+     * light, cos_l or the area 0 or NaN) the pdf here is 0, infinite or
+     * NaN, which the one test after it refuses, so that it is the only one */
+    const vec3 dp = v3_sub(q, p);
+    const float dist2p = v3_len2(dp);
+    const float cos_l = fabsf(v3_dot(nq, v3_scale(dp, 1.0f / sqrtf(dist2p))));
+    const float pdf = dist2p / (cos_l * l->area);
+    if (!(pdf > 0.0f) || !isfinite(pdf)) return false;
+    const vec3 d = v3_sub(q, o);
+    const float dist2 = v3_len2(d);
+    if (!(dist2 > 0.0f)) return false;
+    ls->wi = v3_scale(d, 1.0f / sqrtf(dist2));
+    ls->le = l->le;
     ls->pdf = pdf;
     ls->delta = false;
     ls->shadow = (ray){o, 0.0f, d, 1.0f - SHADOW_SHORTEN};
@@ -292,21 +345,15 @@ static inline PK_HD bool light_sample_one_with(const light_set *set, const scene
         ls->shadow = (ray){o, 0.0f, d, 1.0f};
         return true;
     }
-    const material *m;
     if (l->kind == LIGHT_TRIANGLE) {
-        m = &s->materials[s->tris[l->index].material];
         if (tri != LIGHT_TRI_AREA) {
             sph_tri st;
-            if (light_tri_spherical(s, l, p, &st)) return light_sample_tri_solid_angle(s, l, m, lc, tri, &st, u1, u2, ls);
+            if (light_tri_spherical(l, p, &st)) return light_sample_tri_solid_angle(l, lc, tri, &st, u1, u2, ls);
         }
-        vec3 a, b, c;
-        view_tri_verts(s, l->index, &a, &b, &c);
-        q = sample_triangle(a, b, c, u1, u2);
-        nq = l->normal;
-        vec3 toward = v3_sub(p, q);
-        bool front = v3_dot(nq, toward) > 0.0f;
-        if (!front && !m->two_sided && !lc->two_sided) return false;
-    } else {
+        return light_sample_tri_area(l, lc, u1, u2, ls);
+    }
+    const material *m;
+    {
         const sphere *sp = &s->spheres[l->index];
         m = &s->materials[sp->material];
         vec3 dc = v3_sub(sp->center, p);

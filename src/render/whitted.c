@@ -55,6 +55,15 @@ static vec3 trace(const whitted *w, whitted_thread *ts, const ray *r, int depth,
     return whitted_shade(w, ts, r, &h, depth, NULL);
 }
 
+/* A light other than a triangle (the environment, the sun, a point light),
+ * out of the sampling loop's line: their code (calls to sincosf and the
+ * like) would otherwise keep the loop's values out of registers. */
+__attribute__((noinline)) static bool sample_other(const light_set *set, const scene_view *s, const env_light *e,
+                                                  size_t li, const light_ctx *lc, float u1, float u2, light_sample *ls)
+{
+    return light_sample_one_with(set, s, e, li, lc, LIGHT_TRI_AREA, u1, u2, ls);
+}
+
 /* Direct light at sf toward wo: every point light and the sun with a
  * shadow ray of its own, and light_samples samples of the other lights of
  * the frame's light set (emissive triangles and the environment; emissive
@@ -71,15 +80,17 @@ __attribute__((flatten)) static vec3 direct_light(const whitted *w, whitted_thre
     const light_set *set = &fr->lights;
     vec3 L = v3s(0.0f);
     const light_ctx lc = {sf->p, sf->ng, offset_origin(fr->eps, sf->p, sf->ng), true};
+    const brdf_terms bt = brdf_terms_at(sf);
+    rng r = ts->rng; /* in a register, not through ts */
     size_t n = 0;
-    light_sample ls;
     /* point lights and the sun: one shadow ray each */
     for (size_t j = 0; j < w->nsingle; j++) {
         const size_t li = w->single[j];
         const uint32_t kind = set->lights[li].kind;
-        const float u1 = kind == LIGHT_SUN ? rng_float(&ts->rng) : 0.5f, u2 = kind == LIGHT_SUN ? rng_float(&ts->rng) : 0.5f;
-        if (!light_sample_one_with(set, s, &fr->env, li, &lc, LIGHT_TRI_AREA, u1, u2, &ls)) continue;
-        vec3 f = brdf_cos(sf, wo, ls.wi);
+        const float u1 = kind == LIGHT_SUN ? rng_float(&r) : 0.5f, u2 = kind == LIGHT_SUN ? rng_float(&r) : 0.5f;
+        light_sample ls;
+        if (!sample_other(set, s, &fr->env, li, &lc, u1, u2, &ls)) continue;
+        vec3 f = brdf_terms_cos(&bt, wo, ls.wi);
         if (is_black(f)) continue;
         ts->shadow_weight[n] = v3_scale(v3_mul(f, ls.le), 1.0f / ls.pdf);
         ts->shadow_rays[n] = ls.shadow;
@@ -89,22 +100,31 @@ __attribute__((flatten)) static vec3 direct_light(const whitted *w, whitted_thre
     if (w->nsampled && ns > 0) {
         const float inv_n = 1.0f / (float)ns;
         for (int k = 0; k < ns; k++) {
-            float u = ((float)k + rng_float(&ts->rng)) * inv_n;
+            float u = ((float)k + rng_float(&r)) * inv_n;
             if (u >= 1.0f) u = 0x1.fffffep-1f;
             const size_t j = cdf_pick(w->cdf, w->nsampled, u);
             const float lo = j ? w->cdf[j - 1] : 0.0f, p_pick = w->cdf[j] - lo;
             float u1 = (u - lo) / p_pick;
             u1 = u1 > 0.0f ? (u1 < 0x1.fffffep-1f ? u1 : 0x1.fffffep-1f) : 0.0f;
-            const float u2 = rng_float(&ts->rng);
-            if (!(p_pick > 0.0f) || !light_sample_one_with(set, s, &fr->env, w->sampled[j], &lc, LIGHT_TRI_AREA, u1, u2, &ls))
-                continue;
-            vec3 f = brdf_cos(sf, wo, ls.wi);
+            const float u2 = rng_float(&r);
+            if (!(p_pick > 0.0f)) continue;
+            const light *l = &set->lights[w->sampled[j]];
+            light_sample ls;
+            if (l->kind == LIGHT_TRIANGLE) {
+                if (!light_sample_tri_area(l, &lc, u1, u2, &ls)) continue;
+            } else {
+                light_sample other; /* its own, so that ls stays out of memory */
+                if (!sample_other(set, s, &fr->env, w->sampled[j], &lc, u1, u2, &other)) continue;
+                ls = other;
+            }
+            vec3 f = brdf_terms_cos(&bt, wo, ls.wi);
             if (is_black(f)) continue;
             ts->shadow_weight[n] = v3_scale(v3_mul(f, ls.le), inv_n / (p_pick * ls.pdf));
             ts->shadow_rays[n] = ls.shadow;
             n++;
         }
     }
+    ts->rng = r;
     if (n == 0) return L;
     ts->rays[RAY_SHADOW] += n;
     accel_intersect_many(fr->a, ts->shadow_rays, ts->shadow_hits, n, true, ts->cp);
@@ -257,14 +277,14 @@ static void ig_set_camera(void *self, const camera_frame *cf)
 static camera_sample ig_camera_sample(const void *self, int px, int py, uint64_t index, int smp, int spp)
 {
     const whitted *w = self;
-    float jx = 0.5f, jy = 0.5f;
+    camera_sample cs = {(float)px + 0.5f, (float)py + 0.5f, 0.5f, 0.5f};
+    if (spp <= 1 && !w->lens) return cs; /* the pixel centre: no stream to seed */
     rng jr = rng_seed(((uint64_t)py << 32) | (uint32_t)px, index * 2 + 1);
     if (spp > 1) {
         const int sx = (int)ceilf(sqrtf((float)spp)), sy = (spp + sx - 1) / sx;
-        jx = ((float)(smp % sx) + rng_float(&jr)) / (float)sx;
-        jy = ((float)(smp / sx) + rng_float(&jr)) / (float)sy;
+        cs.film_x = (float)px + ((float)(smp % sx) + rng_float(&jr)) / (float)sx;
+        cs.film_y = (float)py + ((float)(smp / sx) + rng_float(&jr)) / (float)sy;
     }
-    camera_sample cs = {(float)px + jx, (float)py + jy, 0.5f, 0.5f};
     if (w->lens) {
         cs.lens_u = rng_float(&jr);
         cs.lens_v = rng_float(&jr);

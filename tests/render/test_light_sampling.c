@@ -134,7 +134,7 @@ static void lab_init(lab *L, const vec3 *verts, int ntri, bool two_sided)
         for (int k = 0; k < 3; k++) L->pos[3 * i + k] = verts[3 * i + k];
         L->tris[i] = (triangle){{3u * (uint32_t)i, 3u * (uint32_t)i + 1u, 3u * (uint32_t)i + 2u}, {-1, -1, -1}, {-1, -1, -1}, 0};
         vec3 a = verts[3 * i], b = verts[3 * i + 1], c = verts[3 * i + 2];
-        L->lights[i] = (light){LIGHT_TRIANGLE, (uint32_t)i, 0.5f * v3_len(v3_cross(v3_sub(b, a), v3_sub(c, a))), tri_normal(a, b, c)};
+        L->lights[i] = light_of_triangle((uint32_t)i, a, b, c, &L->mat);
         L->of_prim[i] = i;
         total += (double)L->lights[i].area;
     }
@@ -649,7 +649,7 @@ static void test_bound(void)
         lab_init(&L, v, 1, true);
         sph_tri a, b;
         const bool exact = sph_tri_setup(&a, v3s(0.0f), v[0], v[1], v[2], SPH_TRI_MIN_SOLID_ANGLE, SPH_TRI_MAX_SOLID_ANGLE);
-        const bool rule = light_tri_spherical(&L.v, &L.lights[0], v3s(0.0f), &b);
+        const bool rule = light_tri_spherical(&L.lights[0], v3s(0.0f), &b);
         CHECKF(exact == rule, "size %g: exact %d, with the bound %d (solid angle %g)", (double)size, exact, rule,
                solid_angle_d((d3){0, 0, 0}, d3_of(v[0]), d3_of(v[1]), d3_of(v[2])));
         spherical += rule;
