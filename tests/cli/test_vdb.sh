@@ -3,8 +3,9 @@
 # which `make build` puts beside the program where libopenvdb-dev is
 # installed, and `make demo` does not build): with the module a .vdb scene
 # renders; without it (--config openvdb.module naming a file that is not
-# there, or a program with no module beside it) the render fails with exit
-# status 1 and one line naming OpenVDB's package.
+# there, or a program with no module beside it) or without OpenVDB (a module
+# whose library is gone) the render fails with exit status 1 and one line
+# naming OpenVDB's package.
 # usage: test_vdb.sh PAPRSEK SHARED_DIR DATA_DIR
 set -u
 bin=$1
@@ -52,6 +53,23 @@ printf 'not a shared object' >"$tmp/fake.so"
 expect_refused "openvdb.module not a module" \
   'the OpenVDB module does not load: .*fake\.so.*; is OpenVDB installed\? \(Debian: libopenvdb-dev\)$' \
   render "$bin" --config "openvdb.module=$tmp/fake.so"
+
+# a module whose OpenVDB is not installed (here: a module that needs a
+# library which is gone), as after removing libopenvdb: the loader's reason
+if command -v cc >/dev/null 2>&1; then
+  echo 'int pk_nothing(void) { return 0; }' >"$tmp/d.c"
+  if cc -shared -fPIC -o "$tmp/libopenvdb_gone.so" "$tmp/d.c" &&
+     cc -shared -fPIC -o "$tmp/paprsek_openvdb.so" "$tmp/d.c" -L"$tmp" -Wl,--no-as-needed -lopenvdb_gone; then
+    rm -f "$tmp/libopenvdb_gone.so"
+    expect_refused "OpenVDB not installed" \
+      'the OpenVDB module does not load: .*paprsek_openvdb\.so could not be loaded \(libopenvdb_gone\.so: cannot open shared object file.*\); is OpenVDB installed\? \(Debian: libopenvdb-dev\)$' \
+      render "$bin" --config "openvdb.module=$tmp/paprsek_openvdb.so"
+  else
+    echo "FAIL cc could not build the stand-in module"; fail=1
+  fi
+else
+  echo "skipped: OpenVDB not installed (no C compiler to build a stand-in module)"
+fi
 
 # the program alone in a folder (as `make demo` leaves it: no module beside it)
 mkdir -p "$tmp/alone"
