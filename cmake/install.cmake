@@ -1,6 +1,7 @@
 # install.cmake - what `cmake --install` puts under the prefix:
 #   bin/paprsek (and bin/paprsek-mpi when MPI was found), include/paprsek.h, lib/libpaprsek.so.0.1.0 (+ .so.0, .so),
-#   lib/libpaprsek.a, lib/pkgconfig/paprsek.pc and lib/cmake/paprsek/
+#   lib/libpaprsek.a, the library's modules where they were built (lib/paprsek/paprsek_openvdb.so,
+#   lib/paprsek/paprsek_cuda.so: src/device/module.h), lib/pkgconfig/paprsek.pc and lib/cmake/paprsek/
 #   (paprsekConfig.cmake, its version file, the exported targets
 #   paprsek::paprsek and paprsek::paprsek_static).
 include(CMakePackageConfigHelpers)
@@ -17,6 +18,13 @@ install(TARGETS paprsek_shared paprsek_static EXPORT paprsekTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 install(FILES include/paprsek.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+# The modules, where the library looks for them (PK_MODULE_DIR, and
+# LIBDIR/paprsek beside libpaprsek.so.0 wherever the prefix is).
+foreach(module paprsek_openvdb paprsek_cuda)
+  if(TARGET ${module})
+    install(TARGETS ${module} LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/paprsek)
+  endif()
+endforeach()
 # The denoiser's weights with their license, where the library looks for
 # them (PK_DENOISE_WEIGHTS_DIR), when the build has fetched them.
 install(DIRECTORY ${PK_WEIGHTS_DIR}/ DESTINATION ${CMAKE_INSTALL_DATADIR}/paprsek/weights OPTIONAL
@@ -34,7 +42,7 @@ install(FILES ${CMAKE_CURRENT_BINARY_DIR}/paprsekConfig.cmake
 # paprsek.pc. Static linking (pkg-config --static) needs what the library
 # links: libpng, cJSON and expat through their own .pc files where they have one,
 # libjpeg, OpenEXRCore, the OpenMP flag, libm (and libdl, the thread library where the C library
-# lacks them). Embree is not listed: it is loaded at run time.
+# lacks them). Embree, oneDNN, CUDA and OpenVDB are not listed: they are loaded at run time.
 set(PK_PC_REQUIRES_PRIVATE)
 set(PK_PC_LIBS_PRIVATE ${OpenMP_C_FLAGS})
 find_package(PkgConfig QUIET)
@@ -66,10 +74,6 @@ endif()
 # link the C++ libraries too (OpenEXR, Iex, IlmThread) and add Imath's
 # headers, none of which the library uses.
 list(APPEND PK_PC_LIBS_PRIVATE -ljpeg -l${PK_OPENEXR_LINK_NAME})
-# OpenVDB (where it is built in): its libraries and the C++ library.
-foreach(name ${PK_OPENVDB_LINK_NAMES})
-  list(APPEND PK_PC_LIBS_PRIVATE -l${name})
-endforeach()
 list(APPEND PK_PC_LIBS_PRIVATE -lm ${CMAKE_THREAD_LIBS_INIT})
 foreach(lib ${PK_DL_LIBS})
   list(APPEND PK_PC_LIBS_PRIVATE -l${lib})

@@ -107,6 +107,11 @@ PK_API void pk_context_set_file_reader(pk_context *ctx, pk_file_reader_fn fn, vo
  *                   (docs/gpu.md); the same closest hits
  *   cuda.leaf       16 (default), 8 or 4: the most triangles in a leaf of
  *                   the GPU's tree; the same closest hits
+ *   openvdb.module  the library's OpenVDB module, which reads .vdb files (a
+ *                   path; default: paprsek_openvdb.so where the library is
+ *                   installed, LIBDIR/paprsek, or beside it in the build tree)
+ *   cuda.module     the library's CUDA kernels' module (a path; default:
+ *                   paprsek_cuda.so, found as paprsek_openvdb.so is)
  * A library is loaded once per process: the first name that loads stays.
  * Keys not named keep their values (a new context has the defaults); an
  * empty value ("cpu.isa=") restores a key's default; blanks around keys and

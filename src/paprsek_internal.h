@@ -47,6 +47,8 @@ typedef struct pk_config {
     char embree_library[PK_CONFIG_NAME_MAX]; /* embree.library: "" for libembree3.so.3 */
     char cuda_library[PK_CONFIG_NAME_MAX];   /* cuda.library: "" for libcuda.so.1 */
     char dnnl_library[PK_CONFIG_NAME_MAX];   /* dnnl.library: "" for libdnnl.so.2 (the denoiser) */
+    char openvdb_module[PK_CONFIG_NAME_MAX]; /* openvdb.module: "" for the installed one (device/module.h) */
+    char cuda_module[PK_CONFIG_NAME_MAX];    /* cuda.module: "" for the installed one (device/cuda_kernels.h) */
     int instances;        /* scene.instances: 0 auto, 1 flatten every instance, 2 keep them (scene_commit) */
     int cuda_traversal;   /* cuda.traversal: 0 sorted (default), 1 ordered (bvh_gpu.h gpu_trace_ordered) */
     int cuda_leaf;        /* cuda.leaf: the GPU tree's largest leaf, 0: 16 (default), 1: 8, 2: 4 triangles */

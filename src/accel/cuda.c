@@ -7,8 +7,8 @@
  * very same functions on the host.
  *
  * The kernels are compiled by nvcc into a fat binary (machine code for sm_80
- * and sm_90, PTX for later GPUs) that the build embeds as a byte array
- * (pk_cuda_trace_fatbin.h); the device itself (driver, context, memory,
+ * and sm_90, PTX for later GPUs) that the build embeds as a byte array in
+ * the kernels' module (device/cuda_kernels.h, "trace"); the device itself (driver, context, memory,
  * launches) is device/cuda.h's. Without CUDA at build time (PK_HAVE_CUDA 0)
  * creating one is refused.
  */
@@ -20,8 +20,6 @@
 #include <string.h>
 
 #if defined(PK_HAVE_CUDA) && PK_HAVE_CUDA
-#include "pk_cuda_trace_fatbin.h" /* generated: pk_cuda_trace_fatbin[], PK_CUDA_VERSION_* */
-
 #include <omp.h>
 #include <pthread.h>
 
@@ -198,8 +196,7 @@ static const accel_ops cuda_ops = {
 /* The device side: the device with the traversal kernels, the structure on it. */
 static pk_status cuda_setup(pk_context *ctx, cuda_accel *c, int kernel)
 {
-    const cuda_image image = {pk_cuda_trace_fatbin, PK_CUDA_VERSION_MAJOR, PK_CUDA_VERSION_MINOR};
-    pk_status st = cuda_device_open(ctx, WHO, &image, &c->dev);
+    pk_status st = cuda_device_open(ctx, WHO, "trace", &c->dev);
     if (st != PK_OK) return st;
     snprintf(c->stats.device, sizeof c->stats.device, "%s", cuda_device_name(c->dev));
     if ((st = cuda_device_kernel(c->dev, kernel_names[kernel][0], &c->k_closest)) != PK_OK ||

@@ -10,7 +10,8 @@
  * PK_CHECK_CUDA_DECLS) checks every function pointer against cuda.h.
  */
 #include "cuda.h"
-#include "dynlib.h"
+#include "cuda_kernels.h"
+#include "module.h"
 
 #include <pthread.h>
 #include <stdio.h>
@@ -160,6 +161,48 @@ static pk_status driver_ready(pk_context *ctx, const char *who)
     return PK_OK;
 }
 
+/* ---- the kernels' module ------------------------------------------------ */
+
+/* A module's code: a fat binary image and the CUDA version that compiled it
+ * (for the message when the driver is too old). */
+typedef struct cuda_image {
+    const void *data;
+    int cuda_major, cuda_minor;
+} cuda_image;
+
+static dynlib kernels_module = DYNLIB_INIT;
+static cuda_kernels_fn kernels_get; /* set once under the loader's lock */
+
+static bool init_kernels(void *h, const char *name, char *why, size_t n)
+{
+    void *sym = dynlib_symbol(h, CUDA_KERNELS_ENTRY);
+    if (!sym) {
+        snprintf(why, n, "%s has no %s (not the kernels' module of this version of the library)", name,
+                 CUDA_KERNELS_ENTRY);
+        return false;
+    }
+    memcpy(&kernels_get, &sym, sizeof sym);
+    return true;
+}
+
+/* The kernels named name from the kernels' module (loaded once). */
+static pk_status kernels_image(pk_context *ctx, const char *who, const char *name, cuda_image *image)
+{
+    char why[600];
+    bool missing = false;
+    if (!module_load(&kernels_module, ctx->config.cuda_module, CUDA_KERNELS_MODULE_FILE, init_kernels, &missing, why,
+                     sizeof why)) {
+        if (missing)
+            return ctx_error(ctx, PK_ERR_UNSUPPORTED, "%s: the CUDA kernels' module is not there (%s): `make build` "
+                             "builds it where nvcc is found (`make demo` does not)", who, why);
+        return ctx_error(ctx, PK_ERR_UNSUPPORTED, "%s: the CUDA kernels' module could not be loaded: %s", who, why);
+    }
+    image->data = kernels_get(name, &image->cuda_major, &image->cuda_minor);
+    if (!image->data)
+        return ctx_error(ctx, PK_ERR_UNSUPPORTED, "%s: the CUDA kernels' module has no kernels '%s'", who, name);
+    return PK_OK;
+}
+
 /* ---- a device ------------------------------------------------------------ */
 
 /* Invariants: the primary context of dev is retained while retained is
@@ -247,11 +290,14 @@ static pk_status device_setup(cuda_device *d, const cuda_image *image)
     return PK_OK;
 }
 
-pk_status cuda_device_open(pk_context *ctx, const char *who, const cuda_image *image, cuda_device **out)
+pk_status cuda_device_open(pk_context *ctx, const char *who, const char *kernels, cuda_device **out)
 {
     *out = NULL;
     pk_status st = driver_ready(ctx, who);
     if (st != PK_OK) return st;
+    cuda_image image_s;
+    const cuda_image *image = &image_s;
+    if ((st = kernels_image(ctx, who, kernels, &image_s)) != PK_OK) return st;
     cuda_device *d = mem_calloc(&ctx->alloc, 1, sizeof *d);
     if (!d) return ctx_nomem(ctx);
     d->ctx = ctx;

@@ -4,7 +4,7 @@
  * primary context, a module of kernels, device memory, copies and kernel
  * launches. It knows no accelerator and no integrator: the ray kernels'
  * glue (accel/cuda.c) and the GPU path tracer (render/path_gpu.c) each open
- * a device with their own module. Device addresses are uint64_t; every
+ * a device with their own kernels (of the kernels' module, paprsek_cuda.so). Device addresses are uint64_t; every
  * module opened in the process shares the device's primary context, so an
  * address from one device handle is valid in the kernels of another.
  *
@@ -20,18 +20,13 @@
 
 typedef struct cuda_device cuda_device;
 
-/* A module's code: a fat binary (or PTX) image and the CUDA version that
- * compiled it (for the message when the driver is too old). */
-typedef struct cuda_image {
-    const void *data;
-    int cuda_major, cuda_minor;
-} cuda_image;
-
-/* Loads the driver (ctx's config cuda.library), opens device 0 and loads
- * image as the device's module. who prefixes messages ("accelerator 'cuda'"),
- * a static string. Errors: PK_ERR_UNSUPPORTED (no driver, no device, a
- * driver too old for the image), PK_ERR_NOMEM, PK_ERR_IO. */
-PK_HIDDEN pk_status cuda_device_open(pk_context *ctx, const char *who, const cuda_image *image, cuda_device **out);
+/* Loads the driver (ctx's config cuda.library), the kernels' module
+ * (cuda_kernels.h: ctx's config cuda.module, or the installed one), opens
+ * device 0 and loads the kernels named kernels ("trace", "path") as the
+ * device's module. who prefixes messages ("accelerator 'cuda'"), a static
+ * string. Errors: PK_ERR_UNSUPPORTED (no driver, no kernels' module, no
+ * device, a driver too old for the kernels), PK_ERR_NOMEM, PK_ERR_IO. */
+PK_HIDDEN pk_status cuda_device_open(pk_context *ctx, const char *who, const char *kernels, cuda_device **out);
 PK_HIDDEN void cuda_device_close(cuda_device *d);
 PK_HIDDEN const char *cuda_device_name(const cuda_device *d);
 PK_HIDDEN unsigned cuda_device_multiprocessors(const cuda_device *d);

@@ -1,7 +1,7 @@
 /*
  * grid_io.h - voxel grid files for participating media (scene/medium.h):
- * Mitsuba's binary .vol format, NanoVDB files (float grids) and, where the
- * build has OpenVDB, .vdb files. Each reader fills a medium_grid (x fastest,
+ * Mitsuba's binary .vol format, NanoVDB files (float grids) and, through the
+ * OpenVDB module (grid_openvdb.c) where it is installed, .vdb files. Each reader fills a medium_grid (x fastest,
  * 1 or 3 channels, values checked finite) and the box the grid spans in the
  * file's own coordinates (the reader of the scene then places that box),
  * allocating with al. Bad files are refused with one message
@@ -32,12 +32,15 @@ PK_HIDDEN pk_status grid_read_nanovdb(pk_context *ctx, const pk_allocator *al, c
 
 /* A float grid of an OpenVDB file (.vdb), by name (NULL or "": the first
  * float grid), made dense over its active bounding box, *box as for NanoVDB
- * (through the grid's linear transform). PK_ERR_UNSUPPORTED with a message
- * when the build has no OpenVDB. */
+ * (through the grid's linear transform), read by the OpenVDB module (ctx's
+ * config openvdb.module, or the installed one). PK_ERR_UNSUPPORTED with a
+ * message naming OpenVDB's package when the module is not there or does not
+ * load. */
 PK_HIDDEN pk_status grid_read_openvdb(pk_context *ctx, const pk_allocator *al, const char *path, const char *grid,
                                       medium_grid *out, aabb *box);
 
-/* Whether this build reads .vdb files. */
-PK_HIDDEN bool grid_have_openvdb(void);
+/* Whether .vdb files are read: the OpenVDB module ctx's config names (or
+ * the installed one) loads. */
+PK_HIDDEN bool grid_have_openvdb(const pk_context *ctx);
 
 #endif

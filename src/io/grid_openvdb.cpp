@@ -1,31 +1,31 @@
 /*
- * grid_openvdb.cpp - float grids of OpenVDB files (.vdb) through OpenVDB
- * (Debian's libopenvdb-dev), the library's only C++: it implements the C
- * interface of grid_io.h, catches every exception and prints nothing. The
- * build compiles it instead of grid_openvdb_none.c where OpenVDB is found.
+ * grid_openvdb.cpp - the OpenVDB module (paprsek_openvdb.so): float grids of
+ * OpenVDB files (.vdb) through OpenVDB (Debian's libopenvdb-dev). It is a
+ * shared module of its own, the only C++ of the project, built where OpenVDB
+ * is found and loaded by the library (grid_openvdb.c) the first time a .vdb
+ * file is read, so that the library and its programs link neither OpenVDB,
+ * Boost nor the C++ runtime. Its one entry point, of the C interface of
+ * grid_openvdb_module.h, catches every exception and prints nothing.
  *
- * The file's bytes come through file_read_all (so that a context's file
- * reader serves them too) and are read as an OpenVDB stream. The grid asked
- * for (or the first float grid) is made dense over its active voxels'
- * bounding box with what a lookup in its tree returns (background where
- * nothing is stored); its box is that index box, half a voxel wider on
- * every side (OpenVDB's voxel centres lie on integer index coordinates),
- * mapped to world space by the grid's transform, which must be linear and
- * only scale (by positive factors) and translate.
+ * The file's bytes come from the library (so that a context's file reader
+ * serves them too) and are read as an OpenVDB stream. The grid asked for (or
+ * the first float grid) is made dense over its active voxels' bounding box
+ * with what a lookup in its tree returns (background where nothing is
+ * stored); its box is that index box, half a voxel wider on every side
+ * (OpenVDB's voxel centres lie on integer index coordinates), mapped to
+ * world space by the grid's transform, which must be linear and only scale
+ * (by positive factors) and translate.
  */
-/* the library's C headers, read as C++: their zero-initialising compound
- * literals are fine in C and only draw C++'s field-initialiser warning */
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
-extern "C" {
-#include "grid_io.h"
-}
-#pragma GCC diagnostic pop
+#include "grid_openvdb_module.h"
+
+#include "paprsek.h" /* pk_status's values alone */
 
 #include <openvdb/io/Stream.h>
 #include <openvdb/openvdb.h>
 
 #include <cmath>
+#include <cstdarg>
+#include <cstdio>
 #include <cstring>
 #include <iostream>
 #include <istream>
@@ -57,11 +57,11 @@ protected:
 
 /* OpenVDB (built without a logging library, as Debian's is) writes its
  * warnings to std::cerr: while a file is read they are caught and passed on
- * as the context's warnings instead. (std::cerr is the process's: output
+ * to the library (host->warn), which makes them the context's warnings. (std::cerr is the process's: output
  * another thread sends there meanwhile is caught too.) */
 class CerrCapture {
 public:
-    CerrCapture(pk_context *ctx, const char *path) : ctx_(ctx), path_(path), old_(std::cerr.rdbuf(&text_)) {}
+    explicit CerrCapture(const grid_vdb_host *host) : host_(host), old_(std::cerr.rdbuf(&text_)) {}
     ~CerrCapture()
     {
         std::cerr.rdbuf(old_);
@@ -71,8 +71,7 @@ public:
             while (at < all.size()) {
                 size_t eol = all.find('\n', at);
                 if (eol == std::string::npos) eol = all.size();
-                if (eol > at)
-                    ctx_warn(ctx_, "%s: OpenVDB: %.*s", path_, int(eol - at > 300 ? 300 : eol - at), all.c_str() + at);
+                if (eol > at) host_->warn(host_->user, all.c_str() + at, eol - at);
                 at = eol + 1;
             }
         } catch (...) { /* out of memory: the warnings are lost */
@@ -82,8 +81,7 @@ public:
     CerrCapture &operator=(const CerrCapture &) = delete;
 
 private:
-    pk_context *ctx_;
-    const char *path_;
+    const grid_vdb_host *host_;
     std::stringbuf text_;
     std::streambuf *old_;
 };
@@ -110,8 +108,17 @@ void check_transform(const openvdb::math::Transform &xf, double scale[3], double
     }
 }
 
-pk_status read_float_grid(pk_context *ctx, const pk_allocator *al, const char *path, const openvdb::FloatGrid &grid,
-                          medium_grid *out, aabb *box)
+/* Fails the read: status and message (printf-style) in out. */
+__attribute__((format(printf, 3, 4))) void fail(grid_vdb_result *out, int status, const char *fmt, ...)
+{
+    out->status = status;
+    va_list ap;
+    va_start(ap, fmt);
+    std::vsnprintf(out->message, sizeof out->message, fmt, ap);
+    va_end(ap);
+}
+
+void read_float_grid(const grid_vdb_host *host, const openvdb::FloatGrid &grid, grid_vdb_result *out)
 {
     const openvdb::CoordBBox bb = grid.evalActiveVoxelBoundingBox();
     if (bb.empty()) throw Refusal{PK_ERR_PARSE, "no active voxels"};
@@ -120,10 +127,10 @@ pk_status read_float_grid(pk_context *ctx, const pk_allocator *al, const char *p
     uint64_t nvox = 1;
     for (int a = 0; a < 3; a++) {
         dim[a] = int64_t(hi[a]) - int64_t(lo[a]) + 1;
-        if (uint64_t(dim[a]) > MEDIUM_MAX_VOXELS || nvox * uint64_t(dim[a]) > MEDIUM_MAX_VOXELS)
+        if (uint64_t(dim[a]) > host->max_voxels || nvox * uint64_t(dim[a]) > host->max_voxels)
             throw Refusal{PK_ERR_LIMIT, std::to_string(dim[0]) + " x " + std::to_string(dim[1]) + " x " +
                                             std::to_string(dim[2]) + " voxels is beyond the limit of " +
-                                            std::to_string(size_t(MEDIUM_MAX_VOXELS)) + " voxels"};
+                                            std::to_string(host->max_voxels) + " voxels"};
         nvox *= uint64_t(dim[a]);
     }
     double scale[3], shift[3];
@@ -135,8 +142,8 @@ pk_status read_float_grid(pk_context *ctx, const pk_allocator *al, const char *p
         if (!(std::isfinite(blo[a]) && std::isfinite(bhi[a]) && blo[a] < bhi[a]))
             throw Refusal{PK_ERR_PARSE, "its box in world space is empty or not finite"};
     }
-    float *v = static_cast<float *>(mem_alloc(al, size_t(nvox) * sizeof(float)));
-    if (!v) return ctx_nomem(ctx);
+    float *v = static_cast<float *>(host->alloc(host->user, size_t(nvox) * sizeof(float)));
+    if (!v) throw std::bad_alloc();
     openvdb::FloatGrid::ConstAccessor acc = grid.getConstAccessor();
     size_t i = 0;
     for (int32_t z = lo[2]; z <= hi[2]; z++)
@@ -144,7 +151,7 @@ pk_status read_float_grid(pk_context *ctx, const pk_allocator *al, const char *p
             for (int32_t x = lo[0]; x <= hi[0]; x++, i++) {
                 const float f = acc.getValue(openvdb::Coord(x, y, z));
                 if (!std::isfinite(f)) {
-                    mem_free(al, v);
+                    host->free(host->user, v);
                     throw Refusal{PK_ERR_PARSE, "the value at voxel (" + std::to_string(x) + ", " + std::to_string(y) +
                                                     ", " + std::to_string(z) + ") is " +
                                                     (std::isnan(f) ? "NaN" : "infinite")};
@@ -152,31 +159,29 @@ pk_status read_float_grid(pk_context *ctx, const pk_allocator *al, const char *p
                 v[i] = f;
             }
     out->nx = int(dim[0]), out->ny = int(dim[1]), out->nz = int(dim[2]);
-    out->channels = 1;
     out->data = v;
-    box->lo = v3(blo[0], blo[1], blo[2]);
-    box->hi = v3(bhi[0], bhi[1], bhi[2]);
-    return PK_OK;
+    for (int a = 0; a < 3; a++) out->lo[a] = blo[a], out->hi[a] = bhi[a];
+    out->status = PK_OK;
 }
 
-pk_status read_vdb(pk_context *ctx, const pk_allocator *al, const char *path, char *data, size_t size, const char *want,
-                   medium_grid *out, aabb *box)
+void read_vdb(const grid_vdb_host *host, const char *data, size_t size, const char *want, grid_vdb_result *out)
 {
     std::string gname;
     try {
         openvdb::initialize();
-        MemoryBuf buf(data, size);
+        /* the stream only reads: the bytes are not written through */
+        MemoryBuf buf(const_cast<char *>(data), size);
         std::istream is(&buf);
         /* a short read throws at once: OpenVDB would otherwise go on with the
          * sizes it failed to read (gigabytes of string for a truncated name) */
         is.exceptions(std::ios_base::badbit | std::ios_base::failbit | std::ios_base::eofbit);
         openvdb::GridPtrVecPtr grids;
         {
-            CerrCapture capture(ctx, path);
+            CerrCapture capture(host);
             openvdb::io::Stream stream(is, false);
             grids = stream.getGrids();
         }
-        if (is.fail() || !grids) return ctx_error(ctx, PK_ERR_PARSE, "%s: not a readable OpenVDB file (truncated?)", path);
+        if (is.fail() || !grids) return fail(out, PK_ERR_PARSE, "not a readable OpenVDB file (truncated?)");
         openvdb::GridBase::Ptr chosen;
         std::string names;
         for (const openvdb::GridBase::Ptr &g : *grids) {
@@ -188,45 +193,37 @@ pk_status read_vdb(pk_context *ctx, const pk_allocator *al, const char *path, ch
         if (names.empty()) names = "no grids";
         else names = "the file has " + names;
         if (!chosen) {
-            if (want) return ctx_error(ctx, PK_ERR_PARSE, "%s: no grid named '%s' (%s)", path, want, names.c_str());
-            return ctx_error(ctx, PK_ERR_UNSUPPORTED, "%s: no float grid (%s)", path, names.c_str());
+            if (want) return fail(out, PK_ERR_PARSE, "no grid named '%.100s' (%s)", want, names.c_str());
+            return fail(out, PK_ERR_UNSUPPORTED, "no float grid (%s)", names.c_str());
         }
         gname = chosen->getName();
         openvdb::FloatGrid::Ptr fg = openvdb::gridPtrCast<openvdb::FloatGrid>(chosen);
         if (!fg)
             throw Refusal{PK_ERR_UNSUPPORTED, "values of type " + chosen->valueType() + " (only float grids are read)"};
-        return read_float_grid(ctx, al, path, *fg, out, box);
+        read_float_grid(host, *fg, out);
     } catch (const Refusal &r) {
-        return ctx_error(ctx, r.status, "%s: grid '%.64s': %s", path, gname.c_str(), r.what.c_str());
+        fail(out, r.status, "grid '%.64s': %s", gname.c_str(), r.what.c_str());
     } catch (const std::ios_base::failure &) {
-        return ctx_error(ctx, PK_ERR_PARSE, "%s: not a readable OpenVDB file (it ends too soon)", path);
+        fail(out, PK_ERR_PARSE, "not a readable OpenVDB file (it ends too soon)");
     } catch (const std::bad_alloc &) {
-        return ctx_nomem(ctx);
+        fail(out, PK_ERR_NOMEM, "out of memory");
     } catch (const std::exception &e) {
-        return ctx_error(ctx, PK_ERR_PARSE, "%s: not a readable OpenVDB file (%.200s)", path, e.what());
+        fail(out, PK_ERR_PARSE, "not a readable OpenVDB file (%.200s)", e.what());
     } catch (...) {
-        return ctx_error(ctx, PK_ERR_PARSE, "%s: not a readable OpenVDB file", path);
+        fail(out, PK_ERR_PARSE, "not a readable OpenVDB file");
     }
 }
 
 } // namespace
 
-pk_status grid_read_openvdb(pk_context *ctx, const pk_allocator *al, const char *path, const char *grid,
-                            medium_grid *out, aabb *box)
+extern "C" __attribute__((visibility("default"))) void pk_openvdb_read_v1(const grid_vdb_host *host, const char *data,
+                                                                          size_t size, const char *grid,
+                                                                          grid_vdb_result *out)
 {
-    *out = medium_grid{};
-    *box = aabb_empty();
-    char *data = nullptr;
-    size_t size = 0;
-    pk_status st = file_read_all(ctx, path, &data, &size);
-    if (st != PK_OK) return st;
-    st = read_vdb(ctx, al, path, data, size, grid && grid[0] ? grid : nullptr, out, box);
-    mem_free(&ctx->alloc, data);
-    if (st != PK_OK) {
-        *out = medium_grid{};
-        *box = aabb_empty();
+    *out = grid_vdb_result{};
+    read_vdb(host, data, size, grid && grid[0] ? grid : nullptr, out);
+    if (out->status != PK_OK && out->data) {
+        host->free(host->user, out->data);
+        out->data = nullptr;
     }
-    return st;
 }
-
-bool grid_have_openvdb(void) { return true; }

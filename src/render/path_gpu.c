@@ -2,7 +2,7 @@
  * path_gpu.c - the path tracer's structures copied to the GPU, and the
  * render loop around its kernel (see path_gpu.h). The device (driver,
  * memory, launches) is device/cuda.h's: this file opens one with the path
- * tracer's module (cuda/path.cu, embedded as pk_cuda_path_fatbin.h) and
+ * tracer's kernels (cuda/path.cu: "path" of the kernels' module) and
  * traces on the cuda accelerator's structure, whose device addresses the
  * accelerator gives (accel_cuda_bvh: one primary context per process).
  *
@@ -18,10 +18,6 @@
 
 #include <stddef.h>
 #include <string.h>
-
-#if defined(PK_HAVE_CUDA) && PK_HAVE_CUDA
-#include "pk_cuda_path_fatbin.h" /* generated: pk_cuda_path_fatbin[], PK_CUDA_VERSION_* */
-#endif
 
 #define WHO "device 'cuda'"
 
@@ -126,17 +122,14 @@ pk_status path_gpu_create(pk_context *ctx, const path_tracer *pt, path_gpu **out
     if (scene_has_media(s))
         return ctx_error(ctx, PK_ERR_UNSUPPORTED, "device 'cuda': the GPU does not render participating media (the "
                          "scene has %zu medi%s); render it on the CPU", s->nmedia, s->nmedia == 1 ? "um" : "a");
-#if defined(PK_HAVE_CUDA) && PK_HAVE_CUDA
-    const cuda_image image = {pk_cuda_path_fatbin, PK_CUDA_VERSION_MAJOR, PK_CUDA_VERSION_MINOR};
-#else
-    const cuda_image image = {NULL, 0, 0};
-    if (!image.data) return ctx_error(ctx, PK_ERR_UNSUPPORTED, WHO " is not available in this build");
+#if !(defined(PK_HAVE_CUDA) && PK_HAVE_CUDA)
+    return ctx_error(ctx, PK_ERR_UNSUPPORTED, WHO " is not available in this build");
 #endif
     path_gpu *g = mem_calloc(&ctx->alloc, 1, sizeof *g);
     if (!g) return ctx_nomem(ctx);
     g->ctx = ctx;
     g->samples_per_launch = 1;
-    pk_status st = cuda_device_open(ctx, WHO, &image, &g->dev);
+    pk_status st = cuda_device_open(ctx, WHO, "path", &g->dev);
     if (st != PK_OK) {
         path_gpu_destroy(g);
         return st;

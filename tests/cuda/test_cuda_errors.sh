@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # test_cuda_errors.sh - `--accel cuda` fails cleanly where it cannot run: no
-# driver, no device, a driver too old for the kernels, too little device
+# driver, no kernels' module, no device, a driver too old for the kernels, too little device
 # memory, a kernel that fails, and rendering on the GPU. Each is exit
 # status 1, one line on stderr ("paprsek: ..." saying what is wrong),
 # nothing on stdout and no hit file. The driver is replaced by a stub
@@ -74,6 +74,11 @@ PK_CUDA_STUB=kernelfail expect_failure "kernel failure, any-hit" "the traversal 
 # passes on as cuda.library); --config wins
 PAPRSEK_CUDA_LIBRARY="$tmp/no-such-dir/libcuda.so.1" PK_CUDA_STUB=kernelfail \
     expect_failure "driver from --config" "the traversal kernel failed" "${rays[@]}" --config "cuda.library=$stub"
+# the kernels' module (paprsek_cuda.so, which `make build` puts beside the
+# program and `make demo` does not build) named where it is not
+PK_CUDA_STUB=kernelfail expect_failure "no kernels' module" \
+    "the CUDA kernels' module is not there \(.*/no-such-dir/paprsek_cuda.so is not there\): .make build. builds it where nvcc is found \(.make demo. does not\)$" \
+    "${rays[@]}" --config "cuda.module=$tmp/no-such-dir/paprsek_cuda.so"
 # the kernel versions measured once are gone: their key is unknown (a usage error, 2)
 "${rays[@]}" --config cuda.kernel=v6 >"$tmp/out" 2>"$tmp/err"
 rc=$?

@@ -138,6 +138,11 @@ int main(int argc, char **argv)
         pk_context *ctx = NULL;
         pk_scene *sc = NULL;
         if (pk_context_create(NULL, &ctx) != PK_OK) return 1;
+        /* the kernels' module this build made (the library looks for it
+         * beside itself, and this test runs from tests/) */
+        char cfg[600];
+        snprintf(cfg, sizeof cfg, "cuda.module=%s", PK_CUDA_MODULE);
+        if (pk_context_set_config(ctx, cfg) != PK_OK) return 1;
         if (pk_scene_load_file(ctx, argv[a], &sc) != PK_OK) {
             fprintf(stderr, "%s: %s\n", argv[a], pk_context_error(ctx));
             pk_context_destroy(ctx);

@@ -8,6 +8,9 @@ export LC_ALL=C
 #   PK_CFLAGS   extra compile and link flags of every test program (the
 #               sanitizers, in a sanitizer build)
 #   PK_HAVE_EMBREE  1 when the Embree backend is built in
+#   PK_HAVE_OPENVDB, PK_HAVE_CUDA  1 when the OpenVDB module, the CUDA
+#               kernels' module are built (and so installed)
+#   PK_TEST_DATA  tests/data
 set -u
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 fails=0

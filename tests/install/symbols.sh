@@ -56,6 +56,14 @@ grep -q 'Library soname: \[libpaprsek.so.0\]' "$work/dynamic.txt" && ok "soname 
 echo "libpaprsek.so needs: $(needed "$lib/libpaprsek.so" | tr '\n' ' ')"
 needed "$lib/libpaprsek.so" | grep -qi embree && fail "libpaprsek.so needs Embree" \
     || ok "libpaprsek.so does not need Embree"
+# nor what the modules load (OpenVDB and with it Boost, TBB and the C++
+# runtime; the CUDA driver) nor oneDNN: all are loaded at run time, when asked for
+for dep in openvdb stdc++ boost tbb cuda dnnl; do
+    needed "$lib/libpaprsek.so" | grep -qi "$dep" && fail "libpaprsek.so needs $dep" \
+        || ok "libpaprsek.so does not need $dep"
+    needed "$PK_PREFIX/bin/paprsek" | grep -qi "$dep" && fail "bin/paprsek needs $dep" \
+        || ok "bin/paprsek does not need $dep"
+done
 # (the fields only: the prefix is a path that may hold any word)
 grep -E '^(Requires|Libs)' "$lib/pkgconfig/paprsek.pc" | grep -qi embree && fail "paprsek.pc names Embree" \
     || ok "paprsek.pc does not name Embree"

@@ -653,20 +653,46 @@ const char *__lsan_default_suppressions(void) { return "leak:libopenvdb.so\n"; }
 /* tests/data/media/grid.vdb, written by make_grid_vdb.cpp beside it: grids
  * "temperature" (doubles) and "density" (floats, background 0.5, voxels
  * (x, y, 7), x -2..2, y 0..1, = 100 + x + 10 y but (0, 1, 7) unset), voxel
- * size 0.25, shifted by (1, 2, 3). */
+ * size 0.25, shifted by (1, 2, 3); read through the OpenVDB module
+ * (PK_OPENVDB_MODULE: the one this build made, "" where it has none). */
 static void check_openvdb(pk_context *ctx)
 {
     const char *path = PK_TEST_DATA "/media/grid.vdb";
     medium_grid g;
     aabb box;
     pk_status st;
-    if (!grid_have_openvdb()) {
-        st = grid_read_openvdb(ctx, &counting, path, NULL, &g, &box);
-        expect_refused(ctx, path, st, &g, PK_ERR_UNSUPPORTED,
-                       "this build reads no .vdb files (OpenVDB was not found when it was built)");
-        fprintf(stderr, "note: this build has no OpenVDB: grid.vdb is only checked to be refused\n");
+    /* without the module (openvdb.module names a file that is not there, or
+     * one that is not a module): one message naming OpenVDB's package */
+    pk_context *bare = NULL;
+    REQUIRE(pk_context_create(NULL, &bare) == PK_OK);
+    char cfg[700];
+    snprintf(cfg, sizeof cfg, "openvdb.module=%s/no-such-dir/paprsek_openvdb.so", tmpdir);
+    REQUIRE(pk_context_set_config(bare, cfg) == PK_OK);
+    CHECK(!grid_have_openvdb(bare));
+    char expected[1200];
+    snprintf(expected, sizeof expected, "%s: .vdb files are read by the OpenVDB module, which is not here "
+             "(%s/no-such-dir/paprsek_openvdb.so is not there): install OpenVDB (Debian: libopenvdb-dev) and build "
+             "the module (make build)", path, tmpdir);
+    st = grid_read_openvdb(bare, &counting, path, NULL, &g, &box);
+    CHECKF(strcmp(pk_context_error(bare), expected) == 0, "without the module: '%s'", pk_context_error(bare));
+    expect_refused(bare, path, st, &g, PK_ERR_UNSUPPORTED, "libopenvdb-dev");
+    const char *fake = tmp_path("fake_openvdb.so");
+    write_file(fake, "not a shared object", 19);
+    snprintf(cfg, sizeof cfg, "openvdb.module=%s", fake);
+    REQUIRE(pk_context_set_config(bare, cfg) == PK_OK);
+    st = grid_read_openvdb(bare, &counting, path, NULL, &g, &box);
+    expect_refused(bare, path, st, &g, PK_ERR_UNSUPPORTED, "the OpenVDB module does not load: ");
+    st = grid_read_openvdb(bare, &counting, path, NULL, &g, &box);
+    expect_refused(bare, path, st, &g, PK_ERR_UNSUPPORTED, "; is OpenVDB installed? (Debian: libopenvdb-dev)");
+    pk_context_destroy(bare);
+    if (!PK_OPENVDB_MODULE[0]) {
+        fprintf(stderr, "note: this build has no OpenVDB module: grid.vdb is only checked to be refused\n");
         return;
     }
+    /* the module this build made (a build with OpenVDB must read the file) */
+    snprintf(cfg, sizeof cfg, "openvdb.module=%s", PK_OPENVDB_MODULE);
+    REQUIRE(pk_context_set_config(ctx, cfg) == PK_OK);
+    REQUIRE(grid_have_openvdb(ctx));
     for (int k = 0; k < 2; k++) {
         st = grid_read_openvdb(ctx, &counting, path, k ? "density" : NULL, &g, &box);
         REQUIRE(st == PK_OK);
