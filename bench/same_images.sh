@@ -2,7 +2,8 @@
 # same_images.sh - render every scene we have with two builds of paprsek and
 # compare the images byte for byte (cmp). Used to show that a restructuring
 # changes no image: both integrators, the AOVs, every shared scene that the
-# program reads (OBJ, JSON, Mitsuba XML) and the scenes of tests/data.
+# program reads (OBJ, JSON, Mitsuba XML, pbrt-v4, glTF) and the scenes of
+# tests/data (media under the volumetric path tracer too).
 # Images are linear float PFM, so any change in any bit of any pixel shows.
 #
 # usage: bench/same_images.sh OLD_PAPRSEK NEW_PAPRSEK [SHARED_DIR]
@@ -22,7 +23,7 @@ integrators=${INTEGRATORS:-path whitted}
 extra=${EXTRA:-}
 rm -rf "$out"; mkdir -p "$out/old" "$out/new"
 
-# name | scene ("-": the built-in Cornell box) | options
+# name | scene ("-": the built-in Cornell box) | options | integrators beyond INTEGRATORS
 cases() {
     local cam="--look-from 0,1,3.9 --look-at 0,1,0 --fov 39.3"
     echo "builtin|-|"
@@ -48,6 +49,24 @@ cases() {
              mitsuba/veach-door/scene.xml; do
         [ -f "$shared/scenes/$f" ] && echo "$(echo "$f" | tr '/' '_')|$shared/scenes/$f|"
     done
+    for f in pbrt-v4/cornell-box/scene-v4.pbrt pbrt-v4/material-testball/scene-v4.pbrt; do
+        [ -f "$shared/scenes/$f" ] && echo "$(echo "$f" | tr '/' '_')|$shared/scenes/$f|"
+    done
+    if [ -d "$shared/scenes/gltf" ]; then
+        for f in "$shared"/scenes/gltf/*/*.gltf "$shared"/scenes/gltf/*/*.glb; do
+            [ -f "$f" ] && echo "gltf_$(basename "$f")|$f|"
+        done
+    fi
+    for f in conformance/box.gltf conformance/box.json conformance/box_mr.json conformance/box.obj \
+             conformance/box_nomtl.obj conformance/box.pbrt conformance/box.xml \
+             pbrt/plymesh.pbrt pbrt/include_main.pbrt gltf/instanced.gltf gltf/cube.glb \
+             gltf/external.gltf; do
+        [ -f "$repo/tests/data/$f" ] && echo "data_$(echo "$f" | tr '/' '_')|$repo/tests/data/$f|"
+    done
+    # participating media: the volumetric path tracer as well
+    for f in media/fog.json media/fog.pbrt media/fog.xml; do
+        [ -f "$repo/tests/data/$f" ] && echo "data_$(echo "$f" | tr '/' '_')|$repo/tests/data/$f||volpath"
+    done
     for f in json_example.json tex_json.json fuzz_seed_full.json fuzz_seed_env.json \
              fuzz_seed_sphere.json fuzz_seed_objmaterials.json \
              fuzz_seed_full.xml tex_scene.obj \
@@ -68,8 +87,8 @@ render() { # bin dir name scene integrator options...
 }
 
 n=0; bad=0
-while IFS='|' read -r name scene opts; do
-    for integ in $integrators; do
+while IFS='|' read -r name scene opts more; do
+    for integ in $integrators $more; do
         # shellcheck disable=SC2086
         render "$old" "$out/old" "$name" "$scene" "$integ" $opts
         # shellcheck disable=SC2086
