@@ -9,7 +9,7 @@
 # usage: bench/same_images.sh OLD_PAPRSEK NEW_PAPRSEK [SHARED_DIR]
 # environment: OUT (images, default bench/out/same), SIZE (64), SPP (4),
 # THREADS (2), INTEGRATORS ("path whitted"), EXTRA (more options, such as
-# "--device cuda" on a machine with a GPU)
+# "--device cuda" on a machine with a GPU), OLD_CACHE (below)
 # exit status: 0 every image is the same, 1 some differ or failed
 set -uo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
@@ -22,6 +22,16 @@ size=${SIZE:-64}; spp=${SPP:-4}; threads=${THREADS:-2}
 integrators=${INTEGRATORS:-path whitted}
 extra=${EXTRA:-}
 rm -rf "$out"; mkdir -p "$out/old" "$out/new"
+# OLD_CACHE=DIR keeps the old build's renders there and reuses them while
+# the old program is the same file (by its SHA-256), so that a series of
+# comparisons against one base renders the base once.
+cache=${OLD_CACHE:-}
+if [ -n "$cache" ]; then
+    mkdir -p "$cache"
+    sum=$(sha256sum "$old" | cut -d' ' -f1)
+    [ "$(cat "$cache/PROGRAM" 2>/dev/null)" = "$sum $size $spp $threads $extra" ] ||
+        { rm -f "$cache"/*; echo "$sum $size $spp $threads $extra" >"$cache/PROGRAM"; }
+fi
 
 # name | scene ("-": the built-in Cornell box) | options | integrators beyond INTEGRATORS
 cases() {
@@ -89,8 +99,13 @@ render() { # bin dir name scene integrator options...
 n=0; bad=0
 while IFS='|' read -r name scene opts more; do
     for integ in $integrators $more; do
-        # shellcheck disable=SC2086
-        render "$old" "$out/old" "$name" "$scene" "$integ" $opts
+        if [ -n "$cache" ] && [ -f "$cache/$name.$integ.log" ]; then
+            cp "$cache/$name.$integ".* "$out/old/"
+        else
+            # shellcheck disable=SC2086
+            render "$old" "$out/old" "$name" "$scene" "$integ" $opts
+            [ -n "$cache" ] && cp "$out/old/$name.$integ".* "$cache/"
+        fi
         # shellcheck disable=SC2086
         render "$new" "$out/new" "$name" "$scene" "$integ" $opts
         n=$((n + 1))
