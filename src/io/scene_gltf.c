@@ -483,17 +483,17 @@ static pk_status place_light(gltf *g, int64_t li, const xform *x)
     if ((st = gltf_num(g, l, path, "intensity", 0.0, 1e30, 1.0, &inten))) return st;
     if (cJSON_GetObjectItemCaseSensitive(l, "range"))
         gltf_warn_once(g, GW_RANGE, "%s/range: lights fall off with the square of distance, without a range", path);
-    point_light pl;
-    memset(&pl, 0, sizeof pl);
-    pl.intensity = v3_scale(v3(col[0], col[1], col[2]), inten / GLTF_LUMENS_PER_WATT);
-    vec3 dir = v3_norm_scaled(xform_vector(x, v3(0.0f, 0.0f, -1.0f)));
-    pl.position = xform_point(x, v3s(0.0f));
+    const vec3 intensity = v3_scale(v3(col[0], col[1], col[2]), inten / GLTF_LUMENS_PER_WATT);
+    const vec3 dir = v3_norm_scaled(xform_vector(x, v3(0.0f, 0.0f, -1.0f)));
+    const vec3 position = xform_point(x, v3s(0.0f));
     if (strcmp(type, "directional") == 0) {
         if (!v3_finite(dir) || !(v3_len2(dir) > 0.0f))
             return gltf_fail(g, PK_ERR_PARSE, "%s: its node's transform gives no direction", path);
-        pl.distant = true;
-        pl.position = v3_neg(dir);
-    } else if (strcmp(type, "spot") == 0) {
+        return scene_light_distant(g->ctx, g->s, v3_neg(dir), intensity);
+    }
+    float cos_inner = 1.0f, cos_outer = 1.0f;
+    const bool spot = strcmp(type, "spot") == 0;
+    if (spot) {
         snprintf(sp, sizeof sp, "%s/spot", path);
         const cJSON *s = cJSON_GetObjectItemCaseSensitive(l, "spot");
         if (!cJSON_IsObject(s)) return gltf_fail(g, PK_ERR_PARSE, "%s: required, and must be an object", sp);
@@ -502,15 +502,14 @@ static pk_status place_light(gltf *g, int64_t li, const xform *x)
         if (!(inner < outer)) return gltf_fail(g, PK_ERR_PARSE, "%s: innerConeAngle must be less than outerConeAngle", sp);
         if (!v3_finite(dir) || !(v3_len2(dir) > 0.0f))
             return gltf_fail(g, PK_ERR_PARSE, "%s: its node's transform gives no direction", path);
-        pl.spot_dir = dir;
-        pl.cos_inner = cosf(inner);
-        pl.cos_outer = cosf(outer);
-        pl.spot_falloff = SPOT_FALLOFF_SQUARED;
+        cos_inner = cosf(inner);
+        cos_outer = cosf(outer);
     } else if (strcmp(type, "point") != 0) {
         return gltf_fail(g, PK_ERR_PARSE, "%s/type: '%.16s' is not point, spot or directional", path, type);
     }
-    if (!v3_finite(pl.position)) return gltf_fail(g, PK_ERR_PARSE, "%s: its node's position is not finite", path);
-    return scene_add_point_light(g->ctx, g->s, &pl);
+    if (!v3_finite(position)) return gltf_fail(g, PK_ERR_PARSE, "%s: its node's position is not finite", path);
+    if (spot) return scene_light_spot(g->ctx, g->s, position, dir, cos_inner, cos_outer, SPOT_FALLOFF_SQUARED, intensity);
+    return scene_light_point(g->ctx, g->s, position, intensity);
 }
 
 /* ---- the node tree ------------------------------------------------------------------------- */

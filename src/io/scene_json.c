@@ -1520,7 +1520,11 @@ static pk_status parse_light(jp *p, const cJSON *it, const char *path)
     l.intensity = v3_mul(intensity, color);
     if (!v3_finite(l.intensity))
         return jfail(p, PK_ERR_PARSE, it, path, "intensity * color is not finite");
-    return scene_add_point_light(p->ctx, p->s, &l);
+    if (l.distant) return scene_light_distant(p->ctx, p->s, l.position, l.intensity);
+    if (kind == 1)
+        return scene_light_spot(p->ctx, p->s, l.position, l.spot_dir, l.cos_inner, l.cos_outer, l.spot_falloff,
+                                l.intensity);
+    return scene_light_point(p->ctx, p->s, l.position, l.intensity);
 }
 
 /* Calls fn on each element of the array at the top-level key. */

@@ -1866,28 +1866,29 @@ static pk_status d_light(pp *p, const char *type)
         float cone = 30.0f, delta = 5.0f;
         if ((st = light_spectrum(p, "I", &I)) || (st = get_float(p, "power", &power)) || (st = get_vec3(p, "from", &from)))
             return st;
-        point_light l;
-        memset(&l, 0, sizeof l);
-        l.position = xform_point(&w, from);
-        float k_e = 4.0f * PK_PI;
+        const vec3 position = xform_point(&w, from);
+        vec3 axis = v3s(0.0f);
+        float cs = 1.0f, ce = 1.0f, k_e = 4.0f * PK_PI;
         if (type[0] == 's') {
             if ((st = get_vec3(p, "to", &to)) || (st = get_float(p, "coneangle", &cone)) ||
                 (st = get_float(p, "conedelta", &delta)))
                 return st;
-            float ce = cosf(cone * PK_PI / 180.0f), cs = cosf((cone - delta) * PK_PI / 180.0f);
+            ce = cosf(cone * PK_PI / 180.0f), cs = cosf((cone - delta) * PK_PI / 180.0f);
             if (!(cs > ce)) cs = fminf(ce + 1e-4f, 1.0f);
-            vec3 dir = v3_norm_scaled(xform_vector(&w, v3_sub(to, from)));
-            if (!v3_finite(dir) || v3_len2(dir) == 0.0f)
+            axis = v3_norm_scaled(xform_vector(&w, v3_sub(to, from)));
+            if (!v3_finite(axis) || v3_len2(axis) == 0.0f)
                 return pfail(p, p->line, PK_ERR_PARSE, "spot: 'from' and 'to' give no direction");
-            l.spot_dir = dir;
-            l.cos_inner = cs, l.cos_outer = ce;
+            if (!(ce >= -1.0f && ce <= cs)) return pfail(p, p->line, PK_ERR_PARSE, "spot: 'coneangle' is not a number");
             k_e = 2.0f * PK_PI * ((1.0f - cs) + (cs - ce) * 0.5f);
         }
         if (power > 0.0f) scale *= power / k_e;
-        l.intensity = v3_scale(I, scale);
-        if (!v3_finite(l.position) || !v3_finite(l.intensity))
+        const vec3 intensity = v3_scale(I, scale);
+        if (!v3_finite(position) || !v3_finite(intensity))
             return pfail(p, p->line, PK_ERR_PARSE, "light: not finite in the world");
-        if ((st = scene_add_point_light(p->ctx, p->s, &l))) return st;
+        if (!(v3_min_comp(intensity) >= 0.0f)) return pfail(p, p->line, PK_ERR_PARSE, "light: the intensity is negative");
+        st = type[0] == 's' ? scene_light_spot(p->ctx, p->s, position, axis, cs, ce, SPOT_FALLOFF_SMOOTHSTEP, intensity)
+                            : scene_light_point(p->ctx, p->s, position, intensity);
+        if (st) return st;
     } else if (strcmp(type, "distant") == 0) {
         vec3 L, from = v3s(0.0f), to = v3(0.0f, 0.0f, 1.0f);
         float illum = -1.0f;
@@ -1895,14 +1896,13 @@ static pk_status d_light(pp *p, const char *type)
             (st = get_float(p, "illuminance", &illum)))
             return st;
         if (illum > 0.0f) scale *= illum;
-        point_light l;
-        memset(&l, 0, sizeof l);
-        l.distant = true;
-        l.position = v3_norm_scaled(xform_vector(&w, v3_sub(from, to)));
-        if (!v3_finite(l.position) || v3_len2(l.position) == 0.0f)
+        const vec3 to_light = v3_norm_scaled(xform_vector(&w, v3_sub(from, to)));
+        if (!v3_finite(to_light) || v3_len2(to_light) == 0.0f)
             return pfail(p, p->line, PK_ERR_PARSE, "distant: 'from' and 'to' give no direction");
-        l.intensity = v3_scale(L, scale);
-        if ((st = scene_add_point_light(p->ctx, p->s, &l))) return st;
+        const vec3 irradiance = v3_scale(L, scale);
+        if (!v3_finite(irradiance) || !(v3_min_comp(irradiance) >= 0.0f))
+            return pfail(p, p->line, PK_ERR_PARSE, "distant: the radiance must be finite and not negative");
+        if ((st = scene_light_distant(p->ctx, p->s, to_light, irradiance))) return st;
     } else if (strcmp(type, "infinite") == 0) {
         vec3 L;
         const char *fn = NULL;
@@ -1916,11 +1916,11 @@ static pk_status d_light(pp *p, const char *type)
         if (illum > 0.0f) pwarn(p, p->line, "infinite: 'illuminance' is not supported; 'scale' alone is used");
         if (param(p, "portal")) pwarn(p, p->line, "infinite: portals are not used (the light is sampled as a whole)");
         if (has_L && fn) return pfail(p, p->line, PK_ERR_PARSE, "infinite: give either 'L' or 'filename', not both");
-        p->s->env.set = true;
         if (fn) {
+            p->s->env.set = true;
             if ((st = equal_area_env(p, fn, p->line, &w, scale))) return st;
         } else {
-            p->s->env.radiance = v3_add(p->s->env.radiance, v3_scale(L, scale));
+            scene_env_add_radiance(p->s, v3_scale(L, scale));
         }
     } else if (strcmp(type, "goniometric") == 0 || strcmp(type, "projection") == 0) {
         for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
@@ -1968,7 +1968,7 @@ static pk_status equal_area_env(pp *p, const char *file, size_t line, const xfor
         char why[PK_ERRMSG_MAX];
         if (!io_demote_error(p->ctx, st, was_ok, why, sizeof why)) return st;
         pwarn(p, line, "infinite light not read (%s); a uniform environment of radiance %g is used", why, (double)scale);
-        p->s->env.radiance = v3_add(p->s->env.radiance, v3s(scale));
+        scene_env_add_radiance(p->s, v3s(scale));
         return PK_OK;
     }
     if (w != h) {
@@ -1977,7 +1977,7 @@ static pk_status equal_area_env(pp *p, const char *file, size_t line, const xfor
               "infinite: \"%.80s\" is %dx%d, not the square equal-area image pbrt-v4 uses (lat-long images are not "
               "pbrt-v4's); a uniform environment of radiance %g is used",
               file, w, h, (double)scale);
-        p->s->env.radiance = v3_add(p->s->env.radiance, v3s(scale));
+        scene_env_add_radiance(p->s, v3s(scale));
         return PK_OK;
     }
     if (p->s->env.map || p->s->env.map_rgb) {
@@ -3439,14 +3439,9 @@ pk_status scene_pbrt_parse(pk_context *ctx, pk_scene *s, const char *data, size_
     if (st == PK_OK) st = finish_media(p);
     if (st == PK_OK) {
         s->render.opt.width = p->film_w, s->render.opt.height = p->film_h;
+        /* the image pbrt records: every emitter scaled by the sensor's ratio */
         const float k = p->exposure_time * p->film_iso / 100.0f;
-        if (k != 1.0f) {
-            /* the image pbrt records: every emitter scaled by the sensor's ratio */
-            for (size_t i = 0; i < s->nmaterials; i++) s->materials[i].ke = v3_scale(s->materials[i].ke, k);
-            for (size_t i = 0; i < s->nlights; i++) s->lights[i].intensity = v3_scale(s->lights[i].intensity, k);
-            s->env.radiance = v3_scale(s->env.radiance, k);
-            if (s->env.map_rgb) s->env.map_scale *= k;
-        }
+        if (k != 1.0f) scene_scale_emission(s, k);
         s->render.has_width = s->render.has_height = true;
         if (!s->env.set && s->nlights == 0) {
             /* pbrt renders a scene without lights black; so does this reader */

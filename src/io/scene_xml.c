@@ -2347,9 +2347,8 @@ static pk_status parse_emitter(xp *p, xnode *e)
     if (id && (st = id_add(p, id, e))) return st;
 
     if (strcmp(type, "point") == 0 || strcmp(type, "spot") == 0) {
-        point_light l;
-        memset(&l, 0, sizeof l);
-        vec3 pos = v3s(0.0f), intensity = v3s(1.0f);
+        vec3 pos = v3s(0.0f), intensity = v3s(1.0f), axis = v3s(0.0f);
+        float cos_inner = 1.0f, cos_outer = 1.0f;
         bool has_pos;
         xform m;
         if ((st = get_to_world(p, e, &m, NULL))) return st;
@@ -2368,26 +2367,25 @@ static pk_status parse_emitter(xp *p, xnode *e)
                 return xfail(p, PK_ERR_PARSE, e, "cutoff_angle must be in (0, 180] degrees");
             if (!(beam >= 0.0f)) return xfail(p, PK_ERR_PARSE, e, "beam_width must not be negative");
             if (beam > cutoff) beam = cutoff;
-            const vec3 axis = xform_vector(&m, v3(0.0f, 0.0f, 1.0f));
-            const float len = v3_len(axis);
+            const vec3 dir = xform_vector(&m, v3(0.0f, 0.0f, 1.0f));
+            const float len = v3_len(dir);
             if (!(len > 0.0f) || !isfinite(len)) return xfail(p, PK_ERR_PARSE, e, "spot light: degenerate to_world");
-            l.spot_dir = v3_scale(axis, 1.0f / len);
-            l.cos_outer = cosf(cutoff * PK_PI / 180.0f);
-            l.cos_inner = cosf(beam * PK_PI / 180.0f);
-            l.spot_falloff = SPOT_FALLOFF_ANGLE;
+            axis = v3_scale(dir, 1.0f / len);
+            cos_outer = cosf(cutoff * PK_PI / 180.0f);
+            cos_inner = cosf(beam * PK_PI / 180.0f);
         }
-        l.position = has_pos ? pos : xform_point(&m, v3s(0.0f));
-        l.intensity = intensity;
-        if (!v3_finite(l.position) || !v3_finite(l.intensity))
+        const vec3 position = has_pos ? pos : xform_point(&m, v3s(0.0f));
+        if (!v3_finite(position) || !v3_finite(intensity))
             return xfail(p, PK_ERR_PARSE, e, "point light: position and intensity must be finite");
         if (!(intensity.x >= 0.0f && intensity.y >= 0.0f && intensity.z >= 0.0f))
             return xfail(p, PK_ERR_PARSE, e, "intensity must not be negative");
-        if ((st = scene_add_point_light(p->ctx, p->s, &l))) return st;
+        st = type[0] == 's' ? scene_light_spot(p->ctx, p->s, position, axis, cos_inner, cos_outer, SPOT_FALLOFF_ANGLE, intensity)
+                            : scene_light_point(p->ctx, p->s, position, intensity);
+        if (st) return st;
     } else if (strcmp(type, "constant") == 0) {
         vec3 r = v3s(1.0f);
         if ((st = get_color(p, e, "radiance", &r))) return st;
-        env->set = true;
-        env->radiance = v3_add(env->radiance, r);
+        scene_env_add_radiance(p->s, r);
     } else if (strcmp(type, "envmap") == 0) {
         const char *fn = NULL;
         xnode *at;
@@ -2476,12 +2474,7 @@ static pk_status parse_emitter(xp *p, xnode *e)
         if (!(v3_len2(dir) > 0.0f)) return xfail(p, PK_ERR_PARSE, e, "direction must not be zero");
         if (!v3_finite(irr) || !(irr.x >= 0.0f && irr.y >= 0.0f && irr.z >= 0.0f))
             return xfail(p, PK_ERR_PARSE, e, "irradiance must be finite and not negative");
-        point_light l;
-        memset(&l, 0, sizeof l);
-        l.distant = true;
-        l.position = v3_neg(v3_norm_scaled(dir)); /* toward the light */
-        l.intensity = irr;
-        if ((st = scene_add_point_light(p->ctx, p->s, &l))) return st;
+        if ((st = scene_light_distant(p->ctx, p->s, v3_neg(v3_norm_scaled(dir)), irr))) return st;
     } else if (strcmp(type, "area") == 0) {
         xwarn(p, e, "an area emitter belongs inside a shape; ignored");
         return PK_OK;

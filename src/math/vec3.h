@@ -49,6 +49,7 @@ static inline PK_HD vec3 v3_min(vec3 a, vec3 b) { return v3(fminf(a.x, b.x), fmi
 static inline PK_HD vec3 v3_max(vec3 a, vec3 b) { return v3(fmaxf(a.x, b.x), fmaxf(a.y, b.y), fmaxf(a.z, b.z)); }
 static inline PK_HD float v3_get(vec3 a, int axis) { return axis == 0 ? a.x : axis == 1 ? a.y : a.z; }
 static inline PK_HD float v3_max_comp(vec3 a) { return fmaxf(a.x, fmaxf(a.y, a.z)); }
+static inline PK_HD float v3_min_comp(vec3 a) { return fminf(a.x, fminf(a.y, a.z)); }
 static inline PK_HD bool v3_finite(vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
 static inline PK_HD vec3 v3_lerp(vec3 a, vec3 b, float t) { return v3_add(a, v3_scale(v3_sub(b, a), t)); }
 /* Index of the largest |component|. */

@@ -135,9 +135,84 @@ pk_status scene_add_sphere(pk_context *ctx, pk_scene *s, const sphere *sp)
     APPEND(ctx, s, spheres, nspheres, cap_spheres, *sp, SCENE_MAX_PRIMS, "spheres");
 }
 
-pk_status scene_add_point_light(pk_context *ctx, pk_scene *s, const point_light *l)
+static pk_status add_light(pk_context *ctx, pk_scene *s, const point_light *l)
 {
     APPEND(ctx, s, lights, nlights, cap_lights, *l, SCENE_MAX_PRIMS, "point lights");
+}
+
+/* What every light must be; readers check their own values first (with
+ * their own messages), so these catch only callers that did not. */
+static pk_status light_check(pk_context *ctx, const char *kind, vec3 power)
+{
+    if (!v3_finite(power) || !(power.x >= 0.0f && power.y >= 0.0f && power.z >= 0.0f))
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s light: the intensity must be finite and not negative", kind);
+    return PK_OK;
+}
+
+static bool unit(vec3 d) { return v3_finite(d) && fabsf(v3_len2(d) - 1.0f) < 1e-3f; }
+
+pk_status scene_light_point(pk_context *ctx, pk_scene *s, vec3 position, vec3 intensity)
+{
+    pk_status st = light_check(ctx, "point", intensity);
+    if (st) return st;
+    if (!v3_finite(position)) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "point light: the position is not finite");
+    point_light l;
+    memset(&l, 0, sizeof l);
+    l.position = position;
+    l.intensity = intensity;
+    return add_light(ctx, s, &l);
+}
+
+pk_status scene_light_spot(pk_context *ctx, pk_scene *s, vec3 position, vec3 axis, float cos_inner, float cos_outer,
+                           int falloff, vec3 intensity)
+{
+    pk_status st = light_check(ctx, "spot", intensity);
+    if (st) return st;
+    if (!v3_finite(position)) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "spot light: the position is not finite");
+    if (!unit(axis)) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "spot light: the axis is not a unit vector");
+    if (!(cos_outer >= -1.0f && cos_outer <= cos_inner && cos_inner <= 1.0f))
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "spot light: the inner cone must lie inside the outer one");
+    if (falloff != SPOT_FALLOFF_SMOOTHSTEP && falloff != SPOT_FALLOFF_ANGLE && falloff != SPOT_FALLOFF_SQUARED)
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "spot light: unknown falloff %d", falloff);
+    point_light l;
+    memset(&l, 0, sizeof l);
+    l.position = position;
+    l.intensity = intensity;
+    l.spot_dir = axis;
+    l.cos_inner = cos_inner;
+    l.cos_outer = cos_outer;
+    l.spot_falloff = falloff;
+    return add_light(ctx, s, &l);
+}
+
+pk_status scene_light_distant(pk_context *ctx, pk_scene *s, vec3 to_light, vec3 irradiance)
+{
+    pk_status st = light_check(ctx, "distant", irradiance);
+    if (st) return st;
+    if (!unit(to_light)) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "distant light: the direction is not a unit vector");
+    point_light l;
+    memset(&l, 0, sizeof l);
+    l.distant = true;
+    l.position = to_light;
+    l.intensity = irradiance;
+    return add_light(ctx, s, &l);
+}
+
+void scene_env_add_radiance(pk_scene *s, vec3 radiance)
+{
+    s->env.set = true;
+    s->env.radiance = v3_add(s->env.radiance, radiance);
+}
+
+void scene_scale_emission(pk_scene *s, float k)
+{
+    for (size_t i = 0; i < s->nmaterials; i++) s->materials[i].ke = v3_scale(s->materials[i].ke, k);
+    for (size_t i = 0; i < s->nlights; i++) s->lights[i].intensity = v3_scale(s->lights[i].intensity, k);
+    for (size_t i = 0; i < s->nmedia; i++) s->media[i].le = v3_scale(s->media[i].le, k);
+    s->env.radiance = v3_scale(s->env.radiance, k);
+    if (s->env.map || s->env.map_rgb) s->env.map_scale *= k;
+    if (s->env.has_sun) s->env.sun_radiance = v3_scale(s->env.sun_radiance, k);
+    if (s->env.has_sky) s->env.sky_scale *= k;
 }
 
 /* FNV-1a */

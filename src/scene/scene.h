@@ -217,7 +217,27 @@ PK_HIDDEN pk_status scene_add_normal(pk_context *ctx, pk_scene *s, vec3 n);
 PK_HIDDEN pk_status scene_add_uv(pk_context *ctx, pk_scene *s, uv2 t);
 PK_HIDDEN pk_status scene_add_triangle(pk_context *ctx, pk_scene *s, const triangle *t);
 PK_HIDDEN pk_status scene_add_sphere(pk_context *ctx, pk_scene *s, const sphere *sp);
-PK_HIDDEN pk_status scene_add_point_light(pk_context *ctx, pk_scene *s, const point_light *l);
+
+/* Lights: the one way to add them (the readers and the scene API). Each
+ * checks what every light of its kind must be (finite, not negative; axes
+ * and directions of unit length, as the caller normalised them) and
+ * latches PK_ERR_INVALID_ARGUMENT otherwise; readers check first, with
+ * messages that say where in the file. */
+/* A point light at position (world) of radiant intensity (W/sr per channel). */
+PK_HIDDEN pk_status scene_light_point(pk_context *ctx, pk_scene *s, vec3 position, vec3 intensity);
+/* A spot light at position shining along the unit axis: full intensity
+ * within the cone of cosine cos_inner, nothing outside cos_outer (<=
+ * cos_inner), fading between as falloff (SPOT_FALLOFF_*) says. */
+PK_HIDDEN pk_status scene_light_spot(pk_context *ctx, pk_scene *s, vec3 position, vec3 axis, float cos_inner,
+                                     float cos_outer, int falloff, vec3 intensity);
+/* A distant light from the unit direction to_light, giving irradiance on a
+ * surface facing it. */
+PK_HIDDEN pk_status scene_light_distant(pk_context *ctx, pk_scene *s, vec3 to_light, vec3 irradiance);
+/* Adds a constant radiance to the environment (which is then set). */
+PK_HIDDEN void scene_env_add_radiance(pk_scene *s, vec3 radiance);
+/* Scales everything that emits by k: materials' emission, lights, media's
+ * emission and the environment (pbrt-v4's sensor: ISO x exposure time). */
+PK_HIDDEN void scene_scale_emission(pk_scene *s, float k);
 /* Adds a material initialised like MTL's defaults (kd 0.8, ks 0, ns 1, ni 1, d 1,
  * illum 2) named name; *index receives its number. A later material of the same
  * name replaces the earlier one for scene_find_material. */

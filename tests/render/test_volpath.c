@@ -266,10 +266,7 @@ static void check_shadow_transmittance(void)
     material_diffuse(&s->materials[floor_m], v3s(0.5f));
     add_quad(s, v3(-60.0f, -60.0f, 0.0f), v3(60.0f, -60.0f, 0.0f), v3(60.0f, 60.0f, 0.0f), v3(-60.0f, 60.0f, 0.0f),
              floor_m);
-    point_light l;
-    memset(&l, 0, sizeof l);
-    l.position = v3(0.0f, 0.0f, 1.0f), l.intensity = v3s(2.0f), l.distant = true;
-    REQUIRE(scene_add_point_light(ctx, s, &l) == PK_OK);
+    REQUIRE(scene_light_distant(ctx, s, v3(0.0f, 0.0f, 1.0f), v3s(2.0f)) == PK_OK);
     ortho_down(s, 0.5f, 2.0f);
     double integral = 0.0;
     const int steps = 500000;
@@ -300,10 +297,7 @@ static void check_global_fog(void)
     material_diffuse(&s->materials[floor_m], v3s(0.5f));
     add_quad(s, v3(-60.0f, -60.0f, 0.0f), v3(60.0f, -60.0f, 0.0f), v3(60.0f, 60.0f, 0.0f), v3(-60.0f, 60.0f, 0.0f),
              floor_m);
-    point_light l;
-    memset(&l, 0, sizeof l);
-    l.position = v3(0.0f, 0.0f, 2.0f), l.intensity = v3s(5.0f);
-    REQUIRE(scene_add_point_light(ctx, s, &l) == PK_OK);
+    REQUIRE(scene_light_point(ctx, s, v3(0.0f, 0.0f, 2.0f), v3s(5.0f)) == PK_OK);
     ortho_down(s, 1.0f, 0.5f);
     double sum = 0.0;
     const int n = 400;
@@ -352,10 +346,7 @@ static void single_scattering(const char *what, vec3 sigt, vec3 albedo)
     const uint32_t med = add_homogeneous(s, sigt, albedo, g, v3s(0.0f));
     add_box(s, v3(-100.0f, -100.0f, 0.0f), v3(100.0f, 100.0f, d), interface_of(s, med));
     const vec3 wl = v3_norm(v3(0.6f, 0.0f, 0.8f)); /* toward the light */
-    point_light l;
-    memset(&l, 0, sizeof l);
-    l.position = wl, l.intensity = v3s(3.0f), l.distant = true;
-    REQUIRE(scene_add_point_light(ctx, s, &l) == PK_OK);
+    REQUIRE(scene_light_distant(ctx, s, wl, v3s(3.0f)) == PK_OK);
     ortho_down(s, 3.0f, 2.0f);
     const double c = (double)wl.z, k = 1.0 + 1.0 / c;
     const float st[3] = {sigt.x, sigt.y, sigt.z}, al[3] = {albedo.x, albedo.y, albedo.z};
