@@ -1033,15 +1033,9 @@ static pk_status shape_material(pp *p, vec3 ke, bool two_sided, int32_t alpha_te
     snprintf(name, sizeof name, "%.*s+%zu", PB_NAME_MAX, p->s->materials[base].name ? p->s->materials[base].name : "",
              p->nvars);
     uint32_t idx;
-    pk_status st = scene_add_material(p->ctx, p->s, name, &idx);
+    pk_status st = scene_material_with_emission(p->ctx, p->s, base, name, ke, two_sided, &idx);
     if (st) return st;
-    material *m = &p->s->materials[idx];
-    char *nm = m->name;
-    *m = p->s->materials[base];
-    m->name = nm;
-    m->ke = ke;
-    m->two_sided = two_sided;
-    if (alpha_tex >= 0) m->map_d = p->tex[alpha_tex].ref;
+    if (alpha_tex >= 0) p->s->materials[idx].map_d = p->tex[alpha_tex].ref;
     mat_variant v = {base, ke, two_sided, alpha_tex, idx};
     p->vars[p->nvars++] = v;
     *out = idx;
@@ -2050,6 +2044,7 @@ static pk_status d_area_light(pp *p, const char *type)
     if (param(p, "filename")) pwarn(p, p->line, "AreaLightSource: an emission image is not supported; 'L' is used");
     l.L = v3_scale(l.L, scale);
     if (!v3_finite(l.L)) return pfail(p, p->line, PK_ERR_PARSE, "AreaLightSource: the radiance is not finite");
+    if (!(v3_min_comp(l.L) >= 0.0f)) return pfail(p, p->line, PK_ERR_PARSE, "AreaLightSource: the radiance is negative");
     if (!mem_grow(A(p), (void **)&p->areas, &p->cap_areas, p->nareas + 1, sizeof *p->areas)) return ctx_nomem(p->ctx);
     p->areas[p->nareas] = l;
     GS(p)->area = (int32_t)p->nareas++;

@@ -2265,18 +2265,9 @@ static pk_status parse_shape(xp *p, xnode *sh)
             vec3 radiance;
             if ((st = parse_emitter_area(p, emitter, &radiance))) return st;
             /* a copy of the material that also emits (one-sided, as Mitsuba's) */
-            material copy = p->s->materials[mat];
             char name[96];
-            snprintf(name, sizeof name, "%s+emitter@%lu", copy.name, emitter->line);
-            uint32_t idx;
-            if ((st = scene_add_material(p->ctx, p->s, name, &idx))) return st;
-            material *dst = &p->s->materials[idx];
-            char *owned = dst->name;
-            *dst = p->s->materials[mat];
-            dst->name = owned;
-            dst->ke = radiance;
-            dst->two_sided = false;
-            mat = idx;
+            snprintf(name, sizeof name, "%s+emitter@%lu", p->s->materials[mat].name, emitter->line);
+            if ((st = scene_material_with_emission(p->ctx, p->s, mat, name, radiance, false, &mat))) return st;
         }
     }
     /* Mitsuba orients an analytic shape's normal by the inverse transpose

@@ -211,12 +211,9 @@ pk_status scene_material_with_media(pk_context *ctx, pk_scene *s, uint32_t mat, 
         return PK_OK;
     }
     uint32_t idx;
-    pk_status st = scene_add_material(ctx, s, name, &idx);
+    pk_status st = scene_material_copy(ctx, s, mat, name, &idx);
     if (st != PK_OK) return st;
     material *c = &s->materials[idx];
-    char *own = c->name;
-    *c = s->materials[mat]; /* (the array may have moved: index again) */
-    c->name = own;
     c->medium_in = med_in, c->medium_out = med_out;
     *out = idx;
     return PK_OK;

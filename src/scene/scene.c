@@ -266,6 +266,33 @@ pk_status scene_add_material(pk_context *ctx, pk_scene *s, const char *name, uin
     return PK_OK;
 }
 
+pk_status scene_material_copy(pk_context *ctx, pk_scene *s, uint32_t mat, const char *name, uint32_t *index)
+{
+    if (mat >= s->nmaterials) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: no material %u", s->name, mat);
+    uint32_t idx;
+    pk_status st = scene_add_material(ctx, s, name, &idx);
+    if (st != PK_OK) return st;
+    material *c = &s->materials[idx];
+    char *own = c->name;
+    *c = s->materials[mat]; /* (the array may have moved: index again) */
+    c->name = own;
+    *index = idx;
+    return PK_OK;
+}
+
+pk_status scene_material_with_emission(pk_context *ctx, pk_scene *s, uint32_t mat, const char *name, vec3 ke,
+                                       bool two_sided, uint32_t *index)
+{
+    if (!v3_finite(ke) || !(v3_min_comp(ke) >= 0.0f))
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: emission must be finite and not negative", name);
+    pk_status st = scene_material_copy(ctx, s, mat, name, index);
+    if (st != PK_OK) return st;
+    material *c = &s->materials[*index];
+    c->ke = ke;
+    c->two_sided = two_sided;
+    return PK_OK;
+}
+
 int64_t scene_find_material(const pk_scene *s, const char *name)
 {
     if (!s->mat_slots) return -1;

@@ -242,6 +242,13 @@ PK_HIDDEN void scene_scale_emission(pk_scene *s, float k);
  * illum 2) named name; *index receives its number. A later material of the same
  * name replaces the earlier one for scene_find_material. */
 PK_HIDDEN pk_status scene_add_material(pk_context *ctx, pk_scene *s, const char *name, uint32_t *index);
+/* Adds a copy of material mat named name (a variant a reader makes for one
+ * shape); *index receives its number. */
+PK_HIDDEN pk_status scene_material_copy(pk_context *ctx, pk_scene *s, uint32_t mat, const char *name, uint32_t *index);
+/* Area emission on a shape: a copy of material mat named name that emits
+ * radiance ke, from its front only unless two_sided. */
+PK_HIDDEN pk_status scene_material_with_emission(pk_context *ctx, pk_scene *s, uint32_t mat, const char *name, vec3 ke,
+                                                 bool two_sided, uint32_t *index);
 /* Number of the newest material named name; -1 when absent. Constant time
  * (a hash index), so that files with many materials and usemtl statements
  * do not take quadratic time. */

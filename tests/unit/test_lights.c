@@ -2,7 +2,8 @@
  * test_lights.c - the scene's light and emission constructors: each kind is
  * stored as given, anything a light cannot be is refused with
  * PK_ERR_INVALID_ARGUMENT and leaves the scene as it was, and the sensor
- * rule (scene_scale_emission) reaches every emitter.
+ * rule (scene_scale_emission) reaches every emitter; area emission is a
+ * copy of a shape's material (scene_material_with_emission).
  */
 #include "test.h"
 
@@ -79,11 +80,35 @@ static void check_scale(void)
     scene_destroy(s);
 }
 
+static void check_emission(void)
+{
+    pk_scene *s;
+    REQUIRE(scene_create(ctx, "emission", &s) == PK_OK);
+    uint32_t m, e;
+    REQUIRE(scene_add_material(ctx, s, "white", &m) == PK_OK);
+    s->materials[m].kd = v3(0.7f, 0.6f, 0.5f);
+    s->materials[m].two_sided = true;
+    REQUIRE(scene_material_with_emission(ctx, s, m, "white+lamp", v3s(5.0f), false, &e) == PK_OK);
+    CHECK(e != m && s->nmaterials == 3);
+    CHECK(same(s->materials[e].kd, s->materials[m].kd) && same(s->materials[e].ke, v3s(5.0f)));
+    CHECK(!s->materials[e].two_sided && strcmp(s->materials[e].name, "white+lamp") == 0);
+    CHECK(same(s->materials[m].ke, v3s(0.0f)) && s->materials[m].two_sided); /* the original is untouched */
+    CHECK(scene_find_material(s, "white") == (int64_t)m);
+    uint32_t bad = 99;
+    CHECK(scene_material_with_emission(ctx, s, m, "neg", v3(1.0f, -1.0f, 1.0f), false, &bad) == PK_ERR_INVALID_ARGUMENT);
+    pk_context_clear_error(ctx);
+    CHECK(scene_material_with_emission(ctx, s, 42, "none", v3s(1.0f), false, &bad) == PK_ERR_INVALID_ARGUMENT);
+    pk_context_clear_error(ctx);
+    CHECK(s->nmaterials == 3 && bad == 99);
+    scene_destroy(s);
+}
+
 int main(void)
 {
     REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
     check_kinds();
     check_scale();
+    check_emission();
     pk_context_destroy(ctx);
     return test_done("test_lights");
 }
