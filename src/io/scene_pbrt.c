@@ -479,100 +479,6 @@ static void warn_unused(pp *p, const char *what)
 
 /* ---- colours and spectra ------------------------------------------------------------------ */
 
-/* Linear sRGB of the emission spectrum e(nm) (called at every nanometre of
- * 360..830), scaled to luminance 1: pbrt-v4 normalises its emitters'
- * spectra to one nit before "scale", and renders them spectrally (no white
- * balance: an equal-energy spectrum is not grey in sRGB). */
-static vec3 emitter_unit(double (*e)(const void *, double), const void *user)
-{
-    double X = 0, Y = 0, Z = 0;
-    for (int nm = 360; nm <= 830; nm++) {
-        double b = e(user, (double)nm);
-        float xyz[3];
-        spectra_cie1931((float)nm, xyz);
-        X += b * (double)xyz[0], Y += b * (double)xyz[1], Z += b * (double)xyz[2];
-    }
-    if (!(Y > 0.0) || !isfinite(Y)) return v3s(1.0f);
-    X /= Y, Z /= Y, Y = 1.0;
-    double r = 3.2404542 * X - 1.5371385 * Y - 0.4985314 * Z;
-    double g = -0.9692660 * X + 1.8760108 * Y + 0.0415560 * Z;
-    double bl = 0.0556434 * X - 0.2040259 * Y + 1.0572252 * Z;
-    return v3((float)fmax(r, 0.0), (float)fmax(g, 0.0), (float)fmax(bl, 0.0));
-}
-
-static double planck(const void *user, double nm)
-{
-    const double h = 6.62607015e-34, c = 2.99792458e8, kb = 1.380649e-23, l = nm * 1e-9;
-    return 2.0 * h * c * c / (l * l * l * l * l) / (exp(h * c / (l * kb * *(const double *)user)) - 1.0);
-}
-
-/* A blackbody at kelvin, at luminance 1. */
-static vec3 blackbody_unit(float kelvin)
-{
-    double k = (double)kelvin;
-    return emitter_unit(planck, &k);
-}
-
-typedef struct sampled {
-    const float *nm, *val;
-    size_t n;
-} sampled;
-
-/* pbrt's piecewise-linear spectrum: linear between the samples, 0 outside. */
-static double sampled_at(const void *user, double nm)
-{
-    const sampled *s = user;
-    if (nm < (double)s->nm[0] || nm > (double)s->nm[s->n - 1]) return 0.0;
-    size_t i = 0;
-    while (i + 1 < s->n && (double)s->nm[i + 1] < nm) i++;
-    if (i + 1 == s->n) return (double)s->val[i];
-    double t = (nm - (double)s->nm[i]) / ((double)s->nm[i + 1] - (double)s->nm[i]);
-    return (double)s->val[i] + t * ((double)s->val[i + 1] - (double)s->val[i]);
-}
-
-/* pbrt's named metal spectra "metal-XX-eta" / "metal-XX-k". */
-static bool named_metal(const char *name, bool *is_k, vec3 *v, bool *approx)
-{
-    if (strncmp(name, "metal-", 6) != 0) return false;
-    const char *el = name + 6, *dash = strrchr(el, '-');
-    if (!dash || dash == el) return false;
-    if (strcmp(dash, "-eta") == 0) *is_k = false;
-    else if (strcmp(dash, "-k") == 0) *is_k = true;
-    else return false;
-    char sym[16];
-    size_t n = (size_t)(dash - el);
-    if (n >= sizeof sym) return false;
-    memcpy(sym, el, n);
-    sym[n] = '\0';
-    vec3 eta, k;
-    *approx = false;
-    if (!spectra_named_metal(sym, &eta, &k)) {
-        if (strcmp(sym, "CuZn") && strcmp(sym, "MgO") && strcmp(sym, "TiO2")) return false;
-        spectra_named_metal("Cu", &eta, &k); /* brass and the oxides: not in the table */
-        *approx = true;
-    }
-    *v = *is_k ? k : eta;
-    return true;
-}
-
-/* pbrt's named glasses, reduced to their index at 550 nm (Schott's
- * dispersion formulas). */
-static bool named_glass(const char *name, float *eta)
-{
-    static const struct {
-        const char *name;
-        float eta;
-    } g[] = {{"glass-BK7", 1.5185f},  {"glass-BAF10", 1.6734f}, {"glass-FK51A", 1.4875f}, {"glass-LASF9", 1.8555f},
-             {"glass-F5", 1.6076f},   {"glass-SF5", 1.6776f},   {"glass-F10", 1.6289f},   {"glass-SF10", 1.7343f},
-             {"glass-F11", 1.6235f},  {"glass-SF11", 1.7919f}};
-    for (size_t i = 0; i < sizeof g / sizeof g[0]; i++)
-        if (strcmp(g[i].name, name) == 0) {
-            *eta = g[i].eta;
-            return true;
-        }
-    return false;
-}
-
 /* A spectrum parameter as linear RGB. illuminant: the light's rule (a
  * blackbody or a standard illuminant at luminance 1). */
 static pk_status spectrum_rgb(pp *p, pparam *q, bool illuminant, vec3 *out)
@@ -586,7 +492,7 @@ static pk_status spectrum_rgb(pp *p, pparam *q, bool illuminant, vec3 *out)
     if (q->type == PT_BLACKBODY) {
         if (!(q->num[0] > 0.0) || q->num[0] > 1e6)
             return pfail(p, q->line, PK_ERR_PARSE, "'blackbody %s' %g K is not a temperature", q->name, q->num[0]);
-        *out = blackbody_unit((float)q->num[0]);
+        *out = spectra_pbrt_blackbody((float)q->num[0]);
         if (!illuminant) *out = v3_scale(*out, 1.0f / fmaxf(v3_max_comp(*out), 1e-6f));
         return PK_OK;
     }
@@ -606,35 +512,19 @@ static pk_status spectrum_rgb(pp *p, pparam *q, bool illuminant, vec3 *out)
                 return pfail(p, q->line, PK_ERR_PARSE, "'spectrum %s': wavelengths must increase", q->name);
         }
         if (illuminant) {
-            sampled sp = {nm, val, n};
-            *out = emitter_unit(sampled_at, &sp);
+            *out = spectra_pbrt_emitter(nm, val, n);
         } else {
             *out = spectrum_to_rgb(nm, val, (int)n); /* a reflectance: a flat one is grey */
         }
         return PK_OK;
     }
     const char *nmn = q->str[0];
-    bool is_k, approx;
-    float eta;
-    if (named_metal(nmn, &is_k, out, &approx)) {
-        if (approx) pwarn(p, q->line, "spectrum \"%s\" is not in the table; copper's is used", nmn);
-        return PK_OK;
-    }
-    if (named_glass(nmn, &eta)) {
-        *out = v3s(eta);
-        return PK_OK;
-    }
-    if (strcmp(nmn, "stdillum-D65") == 0 || strcmp(nmn, "illum-acesD60") == 0 || strcmp(nmn, "stdillum-D50") == 0) {
+    const int known = spectra_pbrt_named(nmn, out);
+    if (known == SPECTRA_PBRT_APPROX) pwarn(p, q->line, "spectrum \"%s\" is not in the table; copper's is used", nmn);
+    if (known == SPECTRA_PBRT_UNKNOWN) {
         *out = v3s(1.0f);
-        if (strcmp(nmn, "stdillum-D50") == 0) *out = blackbody_unit(5003.0f);
-        return PK_OK;
+        pwarn(p, q->line, "spectrum \"%.60s\" is not known (spectrum files are not read); using 1", nmn);
     }
-    if (strcmp(nmn, "stdillum-A") == 0) {
-        *out = blackbody_unit(2856.0f);
-        return PK_OK;
-    }
-    *out = v3s(1.0f);
-    pwarn(p, q->line, "spectrum \"%.60s\" is not known (spectrum files are not read); using 1", nmn);
     return PK_OK;
 }
 
@@ -2518,21 +2408,6 @@ static pk_status medium_box(pp *p, const char *what, xform *box)
     return PK_OK;
 }
 
-/* The RGB radiance of pbrt's blackbody emitter at kelvin (its spectrum
- * scaled to 1 at its peak, not to a luminance), as pbrt's sensor records
- * it: the colour of luminance 1 times the spectrum's luminance. */
-static vec3 blackbody_peak_rgb(double kelvin)
-{
-    const double peak = planck(&kelvin, 2.8977721e-3 / kelvin * 1e9);
-    double y = 0.0;
-    for (int nm = 360; nm <= 830; nm++) {
-        float xyz[3];
-        spectra_cie1931((float)nm, xyz);
-        y += planck(&kelvin, (double)nm) / peak * (double)xyz[1];
-    }
-    return v3_scale(blackbody_unit((float)kelvin), (float)y);
-}
-
 #define BB_TABLE 2048
 #define BB_TMIN 100.0
 #define BB_TMAX 1e5
@@ -2562,12 +2437,12 @@ static pk_status medium_temperature(pp *p, const char *what, medium *m, const pp
     }
     /* the colours on a geometric scale of temperatures, interpolated */
     const double step = log(BB_TMAX / BB_TMIN) / (BB_TABLE - 1);
-    for (int i = 0; i < BB_TABLE; i++) table[i] = blackbody_peak_rgb(BB_TMIN * exp(step * i));
+    for (int i = 0; i < BB_TABLE; i++) table[i] = spectra_pbrt_blackbody_peak(BB_TMIN * exp(step * i));
     for (size_t v = 0; v < count; v++) {
         const double t = ((double)tg.data[v] - (double)off) * (double)sc;
         vec3 c = v3s(0.0f);
         if (t > BB_TMAX) {
-            c = blackbody_peak_rgb(t);
+            c = spectra_pbrt_blackbody_peak(t);
         } else if (t > BB_TMIN) {
             const double x = log(t / BB_TMIN) / step;
             int i = (int)x;

@@ -1325,7 +1325,8 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
     } else if (strcmp(type, "conductor") == 0 || strcmp(type, "roughconductor") == 0) {
         bool rough = type[0] == 'r';
         if (rough && (st = get_alpha(p, b, 0.1f, &alpha, &bk))) return st;
-        vec3 eta = v3(0.200438f, 0.924033f, 1.10221f), k = v3(3.91295f, 2.45285f, 2.14219f); /* Cu */
+        vec3 eta, k;
+        spectra_named_metal("Cu", &eta, &k); /* Mitsuba's default */
         vec3 spec = v3s(1.0f);
         float ext = 1.000277f;
         bool none = false;

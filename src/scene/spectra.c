@@ -24,6 +24,14 @@ void spectra_cie_xyz(float nm, float *x, float *y, float *z)
     *z = 1.217f * gauss_lobe(nm, 437.0f, 11.8f, 36.0f) + 0.681f * gauss_lobe(nm, 459.0f, 26.0f, 13.8f);
 }
 
+/* Linear sRGB (IEC 61966-2-1's matrix, D65 white) of XYZ. */
+static void srgb_from_xyz(double X, double Y, double Z, double rgb[3])
+{
+    static const double m[9] = {3.2404542, -1.5371385, -0.4985314, -0.9692660, 1.8760108,
+                                0.0415560, 0.0556434,  -0.2040259, 1.0572252};
+    for (int i = 0; i < 3; i++) rgb[i] = m[3 * i] * X + m[3 * i + 1] * Y + m[3 * i + 2] * Z;
+}
+
 vec3 spectrum_to_rgb(const float *nm, const float *val, int n)
 {
     double X = 0, Y = 0, Z = 0, X1 = 0, Y1 = 0, Z1 = 0;
@@ -42,13 +50,9 @@ vec3 spectrum_to_rgb(const float *nm, const float *val, int n)
         X += (double)(x * v), Y += (double)(y * v), Z += (double)(z * v);
         X1 += (double)x, Y1 += (double)y, Z1 += (double)z;
     }
-    const double m[9] = {3.2404542, -1.5371385, -0.4985314, -0.9692660, 1.8760108,
-                         0.0415560, 0.0556434,  -0.2040259, 1.0572252};
     double c[3], w[3];
-    for (int i = 0; i < 3; i++) {
-        c[i] = m[3 * i] * X + m[3 * i + 1] * Y + m[3 * i + 2] * Z;
-        w[i] = m[3 * i] * X1 + m[3 * i + 1] * Y1 + m[3 * i + 2] * Z1;
-    }
+    srgb_from_xyz(X, Y, Z, c);
+    srgb_from_xyz(X1, Y1, Z1, w);
     return v3((float)fmax(c[0] / w[0], 0.0), (float)fmax(c[1] / w[1], 0.0), (float)fmax(c[2] / w[2], 0.0));
 }
 
@@ -370,4 +374,119 @@ bool spectra_named_ior(const char *name, float *ior)
             return true;
         }
     return false;
+}
+
+/* ---- pbrt-v4's rules ------------------------------------------------------------------------- */
+
+/* Linear sRGB of the emission spectrum e(nm) (called at every nanometre of
+ * 360..830), scaled to luminance 1. */
+static vec3 pbrt_emitter_unit(double (*e)(const void *, double), const void *user)
+{
+    double X = 0, Y = 0, Z = 0;
+    for (int nm = 360; nm <= 830; nm++) {
+        double b = e(user, (double)nm);
+        float xyz[3];
+        spectra_cie1931((float)nm, xyz);
+        X += b * (double)xyz[0], Y += b * (double)xyz[1], Z += b * (double)xyz[2];
+    }
+    if (!(Y > 0.0) || !isfinite(Y)) return v3s(1.0f);
+    X /= Y, Z /= Y, Y = 1.0;
+    double c[3];
+    srgb_from_xyz(X, Y, Z, c);
+    return v3((float)fmax(c[0], 0.0), (float)fmax(c[1], 0.0), (float)fmax(c[2], 0.0));
+}
+
+/* Planck's law in W m^-2 sr^-1 m^-1 at nm nanometres (CODATA 2018). */
+static double pbrt_planck(const void *user, double nm)
+{
+    const double h = 6.62607015e-34, c = 2.99792458e8, kb = 1.380649e-23, l = nm * 1e-9;
+    return 2.0 * h * c * c / (l * l * l * l * l) / (exp(h * c / (l * kb * *(const double *)user)) - 1.0);
+}
+
+vec3 spectra_pbrt_blackbody(float kelvin)
+{
+    double k = (double)kelvin;
+    return pbrt_emitter_unit(pbrt_planck, &k);
+}
+
+vec3 spectra_pbrt_blackbody_peak(double kelvin)
+{
+    const double peak = pbrt_planck(&kelvin, 2.8977721e-3 / kelvin * 1e9);
+    double y = 0.0;
+    for (int nm = 360; nm <= 830; nm++) {
+        float xyz[3];
+        spectra_cie1931((float)nm, xyz);
+        y += pbrt_planck(&kelvin, (double)nm) / peak * (double)xyz[1];
+    }
+    return v3_scale(spectra_pbrt_blackbody((float)kelvin), (float)y);
+}
+
+typedef struct sampled {
+    const float *nm, *val;
+    size_t n;
+} sampled;
+
+/* pbrt's piecewise-linear spectrum: linear between the samples, 0 outside. */
+static double sampled_at(const void *user, double nm)
+{
+    const sampled *s = user;
+    if (nm < (double)s->nm[0] || nm > (double)s->nm[s->n - 1]) return 0.0;
+    size_t i = 0;
+    while (i + 1 < s->n && (double)s->nm[i + 1] < nm) i++;
+    if (i + 1 == s->n) return (double)s->val[i];
+    double t = (nm - (double)s->nm[i]) / ((double)s->nm[i + 1] - (double)s->nm[i]);
+    return (double)s->val[i] + t * ((double)s->val[i + 1] - (double)s->val[i]);
+}
+
+vec3 spectra_pbrt_emitter(const float *nm, const float *val, size_t n)
+{
+    const sampled sp = {nm, val, n};
+    return pbrt_emitter_unit(sampled_at, &sp);
+}
+
+int spectra_pbrt_named(const char *name, vec3 *out)
+{
+    if (strncmp(name, "metal-", 6) == 0) {
+        const char *el = name + 6, *dash = strrchr(el, '-');
+        bool is_k = false, ok = dash && dash != el;
+        if (ok && strcmp(dash, "-k") == 0) is_k = true;
+        else if (ok && strcmp(dash, "-eta") != 0) ok = false;
+        char sym[16];
+        const size_t n = ok ? (size_t)(dash - el) : 0;
+        if (ok && n < sizeof sym) {
+            memcpy(sym, el, n);
+            sym[n] = '\0';
+            vec3 eta, k;
+            int known = SPECTRA_PBRT_KNOWN;
+            if (!spectra_named_metal(sym, &eta, &k)) {
+                if (strcmp(sym, "CuZn") && strcmp(sym, "MgO") && strcmp(sym, "TiO2")) goto glass;
+                spectra_named_metal("Cu", &eta, &k); /* brass and the oxides: not in the table */
+                known = SPECTRA_PBRT_APPROX;
+            }
+            *out = is_k ? k : eta;
+            return known;
+        }
+    }
+glass:;
+    /* the named glasses, reduced to their index at 550 nm (Schott's dispersion formulas) */
+    static const struct {
+        const char *name;
+        float eta;
+    } g[] = {{"glass-BK7", 1.5185f},  {"glass-BAF10", 1.6734f}, {"glass-FK51A", 1.4875f}, {"glass-LASF9", 1.8555f},
+             {"glass-F5", 1.6076f},   {"glass-SF5", 1.6776f},   {"glass-F10", 1.6289f},   {"glass-SF10", 1.7343f},
+             {"glass-F11", 1.6235f},  {"glass-SF11", 1.7919f}};
+    for (size_t i = 0; i < sizeof g / sizeof g[0]; i++)
+        if (strcmp(g[i].name, name) == 0) {
+            *out = v3s(g[i].eta);
+            return SPECTRA_PBRT_KNOWN;
+        }
+    if (strcmp(name, "stdillum-D65") == 0 || strcmp(name, "illum-acesD60") == 0) {
+        *out = v3s(1.0f);
+        return SPECTRA_PBRT_KNOWN;
+    }
+    if (strcmp(name, "stdillum-D50") == 0 || strcmp(name, "stdillum-A") == 0) {
+        *out = spectra_pbrt_blackbody(name[9] == 'D' ? 5003.0f : 2856.0f);
+        return SPECTRA_PBRT_KNOWN;
+    }
+    return SPECTRA_PBRT_UNKNOWN;
 }

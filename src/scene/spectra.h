@@ -78,6 +78,30 @@ PK_HIDDEN vec3 spectra_mitsuba3_uniform_emitter(float value);
 PK_HIDDEN void spectra_mitsuba06_sun_spectrum(float zenith, float turbidity, float nm[91], float val[91]);
 PK_HIDDEN vec3 spectra_mitsuba06_sun(float zenith, float turbidity);
 
+/* ---- pbrt-v4's rules (its RGB film records what its spectral transport gives) ---- */
+
+/* An emitter's sampled spectrum (n >= 1 samples, nm strictly ascending;
+ * linear between them, zero outside) as pbrt-v4 normalises emitters: XYZ
+ * over 360..830 nm every nanometre against the tabulated matching functions,
+ * scaled to luminance Y = 1, then the sRGB matrix (no white balance: an
+ * equal-energy spectrum is not grey), negative channels clamped to 0. */
+PK_HIDDEN vec3 spectra_pbrt_emitter(const float *nm, const float *val, size_t n);
+/* A blackbody at kelvin reduced as spectra_pbrt_emitter reduces a spectrum
+ * (luminance 1). */
+PK_HIDDEN vec3 spectra_pbrt_blackbody(float kelvin);
+/* pbrt-v4's blackbody scaled to 1 at its peak (Wien's law), not to a
+ * luminance: spectra_pbrt_blackbody times that spectrum's luminance (media's
+ * "temperature" emission). */
+PK_HIDDEN vec3 spectra_pbrt_blackbody_peak(double kelvin);
+enum { SPECTRA_PBRT_UNKNOWN = 0, SPECTRA_PBRT_KNOWN = 1, SPECTRA_PBRT_APPROX = 2 };
+/* A named spectrum of pbrt-v4 as RGB: "metal-XX-eta" / "metal-XX-k" (the
+ * metals of spectra_named_metal; brass, MgO and TiO2 get copper's values
+ * and SPECTRA_PBRT_APPROX), "glass-XX" (the index at 550 nm), and the
+ * illuminants stdillum-D65, illum-acesD60 (white), stdillum-D50 and
+ * stdillum-A (blackbodies of 5003 and 2856 K). SPECTRA_PBRT_UNKNOWN,
+ * nothing written, for another name. */
+PK_HIDDEN int spectra_pbrt_named(const char *name, vec3 *out);
+
 /* The complex index of refraction (eta, k) of a named metal at the red,
  * green and blue primaries: "Cu", "Au", "Ag", "Al", "Cr" (the names of
  * Mitsuba's table). False, nothing written, for another name. */
