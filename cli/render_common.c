@@ -681,7 +681,7 @@ int cli_render_check(const cli_render_opts *o, pk_write_options *wo)
     if (o->has_exposure) wo->exposure_ev = o->exposure;
     if (o->has_exposure && o->exposure != 0.0f && !png && !o->quiet)
         cli_print_warning(NULL, "--exposure applies to PNG only; the HDR image is written unscaled");
-    if (o->has_camera_pick && (!o->scene || (!ends_with_ci(o->scene, ".gltf") && !ends_with_ci(o->scene, ".glb"))))
+    if (o->has_camera_pick && (!o->scene || !pk_scene_format(o->scene) || strcmp(pk_scene_format(o->scene), "gltf") != 0))
         return cli_usage_error("--camera: picks a camera of a glTF asset (.gltf, .glb); %s%s%s is not one",
                                o->scene ? "'" : "", o->scene ? o->scene : "the built-in Cornell box",
                                o->scene ? "'" : "");

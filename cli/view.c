@@ -142,7 +142,7 @@ int cli_view(int argc, char **argv)
     struct in_addr ia;
     if (inet_pton(AF_INET, bind, &ia) != 1)
         return cli_usage_error("--bind: '%s' is not an IPv4 address (such as 127.0.0.1 or 0.0.0.0)", bind);
-    if (o.has_camera_pick && (!o.scene || (!strstr(o.scene, ".gltf") && !strstr(o.scene, ".glb"))))
+    if (o.has_camera_pick && (!o.scene || !pk_scene_format(o.scene) || strcmp(pk_scene_format(o.scene), "gltf") != 0))
         return cli_usage_error("--camera: picks a camera of a glTF asset (.gltf, .glb)");
 
     /* SIGINT and SIGTERM are taken by sigwait below, in this thread only:

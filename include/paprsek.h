@@ -364,6 +364,18 @@ PK_API pk_status pk_scene_load_json_memory(pk_context *ctx, const char *data, si
  * parameters and ignore them. */
 PK_API pk_status pk_scene_load_file_params(pk_context *ctx, const char *path, const char *const *params,
                                            size_t nparams, pk_scene **out);
+/* A scene of any format from memory: format is "obj", "json", "xml",
+ * "pbrt", "gltf" or "glb" (what pk_scene_format returns, or a file's
+ * extension without the dot); name is used in messages (NULL: "memory.FORMAT");
+ * the files it names are relative to base_dir (NULL: the current folder;
+ * for OBJ, NULL reads no material libraries). An unknown format is
+ * PK_ERR_INVALID_ARGUMENT. */
+PK_API pk_status pk_scene_load_memory(pk_context *ctx, const char *format, const char *data, size_t size,
+                                      const char *name, const char *base_dir, pk_scene **out);
+/* The format pk_scene_load_file reads path as, chosen by its extension
+ * (ASCII case ignored): "obj", "json", "xml", "pbrt" or "gltf" (.gltf and
+ * .glb); NULL when no format has that extension. */
+PK_API const char *pk_scene_format(const char *path);
 /* Mitsuba XML scene from memory; files it names (meshes, includes) are
  * relative to base_dir (NULL: the current folder). */
 PK_API pk_status pk_scene_load_xml_memory(pk_context *ctx, const char *data, size_t size,

@@ -14,6 +14,7 @@
 #include "scene/camera.h"
 #include "scene/scene.h"
 
+#include <stdio.h>
 #include <string.h>
 
 /* ---- options ------------------------------------------------------------------ */
@@ -47,33 +48,14 @@ static const char *base_name(const char *path)
     return s ? s + 1 : path;
 }
 
-static bool has_ext(const char *path, const char *ext)
-{
-    size_t lp = strlen(path), le = strlen(ext);
-    if (lp < le) return false;
-    const char *p = path + lp - le;
-    for (size_t i = 0; i < le; i++) {
-        char c = p[i];
-        if (c >= 'A' && c <= 'Z') c = (char)(c - 'A' + 'a');
-        if (c != ext[i]) return false;
-    }
-    return true;
-}
-
-typedef enum { FMT_OBJ, FMT_JSON, FMT_XML, FMT_PBRT, FMT_GLTF } scene_format;
-
-static pk_status load_memory(pk_context *ctx, scene_format fmt, const char *data, size_t size,
+static pk_status load_memory(pk_context *ctx, const scene_reader *fmt, const char *data, size_t size,
                              const char *name, const char *base_dir, const char *const *params, size_t nparams,
                              pk_scene **out)
 {
     pk_scene *s = NULL;
     pk_status st = scene_create(ctx, name, &s);
     if (st != PK_OK) return st;
-    if (fmt == FMT_OBJ) st = obj_parse(ctx, s, data, size, name, base_dir, NULL);
-    else if (fmt == FMT_JSON) st = scene_json_parse(ctx, s, data, size, name, base_dir);
-    else if (fmt == FMT_PBRT) st = scene_pbrt_parse(ctx, s, data, size, name, base_dir);
-    else if (fmt == FMT_GLTF) st = scene_gltf_parse_params(ctx, s, data, size, name, base_dir, params, nparams);
-    else st = scene_xml_parse(ctx, s, data, size, name, base_dir, params, nparams);
+    st = fmt->parse(ctx, s, data, size, name, base_dir, params, nparams);
     if (st == PK_OK) st = scene_commit(ctx, s);
     if (st != PK_OK) {
         scene_destroy(s);
@@ -84,13 +66,36 @@ static pk_status load_memory(pk_context *ctx, scene_format fmt, const char *data
     return PK_OK;
 }
 
+pk_status pk_scene_load_memory(pk_context *ctx, const char *format, const char *data, size_t size, const char *name,
+                               const char *base_dir, pk_scene **out)
+{
+    if (!ctx || !out) return PK_ERR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!data && size) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "no data");
+    const scene_reader *fmt = format ? scene_reader_named(format) : NULL;
+    if (!fmt)
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT,
+                         "unknown scene format '%.20s' (expected obj, json, xml, pbrt, gltf or glb)", format ? format : "");
+    char def[32];
+    if (!name) snprintf(def, sizeof def, "memory.%s", fmt->name);
+    return load_memory(ctx, fmt, data ? data : "", size, name ? name : def, base_dir ? base_dir : fmt->default_dir,
+                       NULL, 0, out);
+}
+
+const char *pk_scene_format(const char *path)
+{
+    const scene_reader *fmt = path ? scene_reader_for_path(path) : NULL;
+    return fmt ? fmt->name : NULL;
+}
+
 pk_status pk_scene_load_obj_memory(pk_context *ctx, const char *data, size_t size, const char *name,
                                    const char *base_dir, pk_scene **out)
 {
     if (!ctx || !out) return PK_ERR_INVALID_ARGUMENT;
     *out = NULL;
     if (!data && size) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "no data");
-    return load_memory(ctx, FMT_OBJ, data ? data : "", size, name ? name : "memory.obj", base_dir, NULL, 0, out);
+    return load_memory(ctx, scene_reader_named("obj"), data ? data : "", size, name ? name : "memory.obj", base_dir,
+                       NULL, 0, out);
 }
 
 pk_status pk_scene_load_json_memory(pk_context *ctx, const char *data, size_t size, const char *name,
@@ -99,7 +104,7 @@ pk_status pk_scene_load_json_memory(pk_context *ctx, const char *data, size_t si
     if (!ctx || !out) return PK_ERR_INVALID_ARGUMENT;
     *out = NULL;
     if (!data && size) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "no data");
-    return load_memory(ctx, FMT_JSON, data ? data : "", size, name ? name : "memory.json",
+    return load_memory(ctx, scene_reader_named("json"), data ? data : "", size, name ? name : "memory.json",
                        base_dir ? base_dir : ".", NULL, 0, out);
 }
 
@@ -109,7 +114,7 @@ pk_status pk_scene_load_xml_memory(pk_context *ctx, const char *data, size_t siz
     if (!ctx || !out) return PK_ERR_INVALID_ARGUMENT;
     *out = NULL;
     if (!data && size) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "no data");
-    return load_memory(ctx, FMT_XML, data ? data : "", size, name ? name : "memory.xml",
+    return load_memory(ctx, scene_reader_named("xml"), data ? data : "", size, name ? name : "memory.xml",
                        base_dir ? base_dir : ".", NULL, 0, out);
 }
 
@@ -125,18 +130,8 @@ pk_status pk_scene_load_file_params(pk_context *ctx, const char *path, const cha
     *out = NULL;
     if (nparams && !params) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "no parameters");
     if (!path) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "no scene path");
-    scene_format fmt;
-    if (has_ext(path, ".obj"))
-        fmt = FMT_OBJ;
-    else if (has_ext(path, ".json"))
-        fmt = FMT_JSON;
-    else if (has_ext(path, ".xml"))
-        fmt = FMT_XML;
-    else if (has_ext(path, ".pbrt"))
-        fmt = FMT_PBRT;
-    else if (has_ext(path, ".gltf") || has_ext(path, ".glb"))
-        fmt = FMT_GLTF;
-    else
+    const scene_reader *fmt = scene_reader_for_path(path);
+    if (!fmt)
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT,
                          "%s: unknown scene format (expected .obj, .json, .xml, .pbrt, .gltf or .glb)", path);
     char *data = NULL, *dir = NULL;

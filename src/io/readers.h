@@ -2,7 +2,8 @@
  * readers.h - the scene file readers, one door each: OBJ (obj.c) and its MTL
  * libraries (mtl.c), the JSON scene (scene_json.c), Mitsuba XML
  * (scene_xml.c) and the PLY meshes it names (ply.c), glTF 2.0 (scene_gltf.c,
- * gltf_data.c, gltf_material.c). Every reader parses a (data, size) buffer,
+ * gltf_data.c, gltf_material.c), pbrt-v4 (scene_pbrt.c, pbrt_tok.c), and
+ * the table of them (readers.c). Every reader parses a (data, size) buffer,
  * reads any further file through file_read_all, and reports a bad input as
  * "file:line: what is wrong" (glTF: "file: /json/pointer: what is wrong")
  * latched in the context; none prints, exits or commits the scene.
@@ -58,6 +59,26 @@ PK_HIDDEN pk_status scene_gltf_parse_params(pk_context *ctx, pk_scene *s, const 
  * "file:line: what". Does not commit. */
 PK_HIDDEN pk_status scene_pbrt_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size, const char *name,
                                      const char *base_dir);
+
+/* ---- the formats (readers.c) ---- */
+
+#define SCENE_READER_EXTS 2
+/* One scene format: its name, the extensions that choose it (lower case,
+ * with the dot), the folder relative files come from when a buffer is
+ * given without one (NULL: none are read), and its parser (params:
+ * "NAME=VALUE" strings, which formats without parameters ignore). */
+typedef struct scene_reader {
+    const char *name;
+    const char *exts[SCENE_READER_EXTS];
+    const char *default_dir;
+    pk_status (*parse)(pk_context *ctx, pk_scene *s, const char *data, size_t size, const char *name,
+                       const char *base_dir, const char *const *params, size_t nparams);
+} scene_reader;
+/* The format a file's extension chooses (ASCII case ignored); NULL for none. */
+PK_HIDDEN const scene_reader *scene_reader_for_path(const char *path);
+/* The format of that name or extension without the dot ("obj", "json",
+ * "xml", "pbrt", "gltf", "glb"); NULL for none. */
+PK_HIDDEN const scene_reader *scene_reader_named(const char *format);
 
 /* ---- PLY meshes (Stanford polygon files): ascii, binary little and big
  * endian; vertex positions, optional normals and texture coordinates, and
