@@ -699,7 +699,9 @@ static pk_status get_eta(pp *p, const char *name, float def, float *eta)
     return PK_OK;
 }
 
-static pk_status make_conductor(pp *p, material *m, const char *prefix)
+/* A conductor from the parameters named prefix + eta, k, roughness (or
+ * reflectance), at least as rough as min_alpha (a coat's roughness). */
+static pk_status make_conductor(pp *p, material *m, const char *prefix, float min_alpha)
 {
     char ne[64], nk[64], nr[64];
     snprintf(ne, sizeof ne, "%seta", prefix);
@@ -708,6 +710,7 @@ static pk_status make_conductor(pp *p, material *m, const char *prefix)
     float alpha;
     pk_status st = get_roughness(p, prefix, &alpha);
     if (st) return st;
+    if (min_alpha > alpha) alpha = min_alpha;
     vec3 refl;
     bool has_refl;
     tex_ref tr;
@@ -804,12 +807,12 @@ static pk_status build_material(pp *p, const char *type, material *m, bool *inte
         material_plastic(m, coated_albedo(kd, eta, thick, tkd.kind != TEX_NONE), eta, alpha);
         m->map_kd = tkd;
     } else if (strcmp(type, "conductor") == 0) {
-        if ((st = make_conductor(p, m, ""))) return st;
+        if ((st = make_conductor(p, m, "", 0.0f))) return st;
     } else if (strcmp(type, "coatedconductor") == 0) {
         /* the base conductor alone, roughened by the coat (docs: an approximation) */
         float ia;
         if ((st = get_roughness(p, "interface.", &ia)) || (st = get_eta(p, "interface.eta", 1.5f, &eta)) ||
-            (st = make_conductor(p, m, "conductor.")))
+            (st = make_conductor(p, m, "conductor.", ia)))
             return st;
         float thick = 0.01f, g = 0.0f;
         vec3 albedo = v3s(0.0f);
@@ -818,7 +821,6 @@ static pk_status build_material(pp *p, const char *type, material *m, bool *inte
             (st = get_float_tex(p, "g", &g, NULL)) || (st = get_int(p, "maxdepth", 0, 1 << 20, &md)) ||
             (st = get_int(p, "nsamples", 0, 1 << 20, &ns)))
             return st;
-        if (ia > m->alpha) m->alpha = ia;
         pwarn(p, p->line, "coatedconductor is approximated by its conductor under the coat's roughness (no clear "
                           "coat layer)");
     } else if (strcmp(type, "dielectric") == 0 || strcmp(type, "thindielectric") == 0) {
