@@ -175,6 +175,12 @@ pk_status pk_scene_add_material(pk_context *ctx, pk_scene *s, const char *name, 
     material m;
     st = call_dict(ctx, &d, what, type, params);
     if (st == PK_OK) st = create_material(&d, &m);
+    /* the creator leaves the media to its caller, and the API has none yet */
+    static const char *const sides[2] = {"interior", "exterior"};
+    for (int i = 0; i < 2 && st == PK_OK; i++) {
+        const pd_entry *e = pd_get(&d, sides[i]);
+        if (e) st = pd_fail(&d, e, -1, PK_ERR_UNSUPPORTED, "media are not taken through the API yet");
+    }
     pd_free(&d);
     if (st) return st;
     uint32_t idx;

@@ -147,6 +147,10 @@ int main(void)
     REQUIRE(pk_params_set_string(p, "type", "diffuse") == PK_OK);
     CHECK(pk_scene_add_material(ctx, s, "bad", "diffuse", p, &m) == PK_ERR_PARSE);
     CHECK_MSG(ctx, "t: material \"bad\": type: duplicate key");
+    pk_params_clear(p);
+    REQUIRE(pk_params_set_string(p, "interior", "fog") == PK_OK);
+    CHECK(pk_scene_add_material(ctx, s, "bad", "dielectric", p, &m) == PK_ERR_UNSUPPORTED);
+    CHECK_MSG(ctx, "t: material \"bad\": interior: media are not taken through the API yet");
     CHECK(pk_scene_add_material(ctx, s, "", "diffuse", NULL, &m) == PK_ERR_INVALID_ARGUMENT);
     CHECK_MSG(ctx, "t: a material needs a name");
 
