@@ -437,7 +437,7 @@ PK_API int pk_scene_has_image_size(const pk_scene *scene);
  * and parameter names of the JSON scene format (docs/scene-format.md) and
  * go through the same code as the JSON reader, so they are checked with
  * the same words: a message names the scene and the thing ("box: material
- * \"white\": kd: colour components must not be negative") where the reader
+ * "white": kd: colour components must not be negative") where the reader
  * names a file line. A parameter the type does not have is the one
  * warning ("...: NAME: unknown parameter ignored", through the context's
  * warning callback) and is ignored. Every error is latched in the context
