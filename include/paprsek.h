@@ -438,6 +438,103 @@ PK_API int pk_scene_has_sample_count(const pk_scene *scene);
  * ratio). */
 PK_API int pk_scene_has_image_size(const pk_scene *scene);
 
+/* ---- building scenes ----------------------------------------------------- */
+
+/* A scene built in code rather than read from a file (docs/scene-api.md):
+ * pk_scene_create, then materials, meshes, spheres, lights, objects and
+ * instances, the camera and environment (pk_scene_set_camera,
+ * pk_scene_set_environment), then pk_scene_commit; only a committed scene
+ * renders, and a committed scene takes no more geometry, materials or
+ * lights. Materials and lights take named parameters with the type names
+ * and parameter names of the JSON scene format (docs/scene-format.md) and
+ * go through the same code as the JSON reader, so they are checked with
+ * the same words: a message names the scene and the thing ("box: material
+ * "white": kd: colour components must not be negative") where the reader
+ * names a file line. A parameter the type does not have is the one
+ * warning ("...: NAME: unknown parameter ignored", through the context's
+ * warning callback) and is ignored. Every error is latched in the context
+ * and returned; a call that fails adds nothing. */
+
+/* Named parameter values: the public face of the readers' parameter
+ * dictionary. A name set twice keeps the last value. Values are checked
+ * when a creator reads them (non-finite numbers, ranges), not when set. */
+typedef struct pk_params pk_params;
+PK_API pk_status pk_params_create(pk_context *ctx, pk_params **out);
+PK_API void pk_params_destroy(pk_params *params);
+/* Removes every value (the list can describe the next thing). */
+PK_API void pk_params_clear(pk_params *params);
+PK_API pk_status pk_params_set_float(pk_params *params, const char *name, float value);
+/* n numbers (a colour is 3, a 2D scale 2). */
+PK_API pk_status pk_params_set_floats(pk_params *params, const char *name, const float *values, size_t n);
+PK_API pk_status pk_params_set_rgb(pk_params *params, const char *name, float r, float g, float b);
+PK_API pk_status pk_params_set_int(pk_params *params, const char *name, int value);
+PK_API pk_status pk_params_set_bool(pk_params *params, const char *name, int value);
+PK_API pk_status pk_params_set_string(pk_params *params, const char *name, const char *value);
+
+/* An empty scene named name (for messages; NULL: "scene"): material 0 is
+ * the default (grey diffuse), no geometry, no camera (one is framed on the
+ * bounds unless pk_scene_set_camera gives one). */
+PK_API pk_status pk_scene_create(pk_context *ctx, const char *name, pk_scene **out);
+
+/* Adds a material named name (non-empty; a later one of the same name
+ * hides the earlier from lookups by name) and returns its number in
+ * *index. type: a JSON material type ("diffuse", "conductor",
+ * "dielectric", "plastic", "metallic_roughness", "emitter", "two_sided",
+ * "interface"), or NULL for the OBJ/MTL record (kd, ks, ke, tf, ka, ns, ni,
+ * d, illum, two_sided). params may be NULL (the defaults). Textures, nested
+ * materials ("bsdf") and media ("interior", "exterior") are not taken here
+ * yet (docs/scene-api.md). */
+PK_API pk_status pk_scene_add_material(pk_context *ctx, pk_scene *scene, const char *name, const char *type,
+                                       const pk_params *params, uint32_t *index);
+
+/* A triangle mesh. positions: npositions xyz triples; indices: ntriangles
+ * index triples (< npositions), counter-clockwise seen from the front;
+ * normals and uvs: one xyz (uv) per position, or NULL. transform: row-major,
+ * transform_rows 3 (a 3x4 affine matrix) or 4 (4x4, last row 0 0 0 1), or
+ * NULL for none; it places the positions (and the normals by its inverse
+ * transpose). material: a number from pk_scene_add_material, or 0. */
+typedef struct pk_mesh_desc {
+    const float *positions;
+    size_t npositions;
+    const uint32_t *indices;
+    size_t ntriangles;
+    const float *normals;
+    const float *uvs;
+    const float *transform;
+    int transform_rows;
+    uint32_t material;
+} pk_mesh_desc;
+
+/* Adds the mesh (checked: counts, indices, finite numbers, a transform
+ * that is affine and not singular). Between pk_scene_begin_object and
+ * pk_scene_end_object it becomes part of the object instead of the world. */
+PK_API pk_status pk_scene_add_mesh(pk_context *ctx, pk_scene *scene, const pk_mesh_desc *mesh);
+/* A sphere (radius > 0, world space). */
+PK_API pk_status pk_scene_add_sphere(pk_context *ctx, pk_scene *scene, const float center[3], float radius,
+                                     uint32_t material);
+/* A light of the JSON scene's "lights": type "point" (position), "spot"
+ * (position, direction, outer_angle, inner_angle) or "distant" (direction
+ * of travel); all take intensity (a number, or 3 with pk_params_set_rgb)
+ * and color. Area lights are meshes with an emitting material. */
+PK_API pk_status pk_scene_add_light(pk_context *ctx, pk_scene *scene, const char *type, const pk_params *params);
+
+/* Objects: the meshes added between begin and end become one object (in
+ * the space they were given in), drawn only where pk_scene_add_instance
+ * places it. Objects do not nest. *object numbers the object. */
+PK_API pk_status pk_scene_begin_object(pk_context *ctx, pk_scene *scene);
+PK_API pk_status pk_scene_end_object(pk_context *ctx, pk_scene *scene, uint32_t *object);
+/* Places object by transform (row-major, transform_rows 3 or 4, as in
+ * pk_mesh_desc; NULL: where it was defined); its triangles keep their own
+ * materials. */
+PK_API pk_status pk_scene_add_instance(pk_context *ctx, pk_scene *scene, uint32_t object, const float *transform,
+                                       int transform_rows);
+
+/* Ends building: flattens or keeps instances, finds the emitters,
+ * degenerate triangles and bounds. PK_ERR_EMPTY_SCENE when nothing can be
+ * hit; an object still open is an error. A committed scene renders
+ * (pk_render, pk_renderer_create); committing it again does nothing. */
+PK_API pk_status pk_scene_commit(pk_context *ctx, pk_scene *scene);
+
 /* ---- images ------------------------------------------------------------ */
 
 /* Linear RGB float image, rows top to bottom. */

@@ -358,7 +358,9 @@ pk_status pk_renderer_create(pk_context *ctx, const pk_scene *scene, const pk_re
         o = *opt;
     else
         pk_scene_get_render_options(scene, &o);
-    if (!scene->committed) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "scene is not committed");
+    if (!scene->committed)
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: the scene is not committed (pk_scene_commit ends building it)",
+                         scene->name);
     pk_status st = check_options(ctx, &o);
     if (st != PK_OK) return st;
     pk_camera cam;

@@ -8,6 +8,8 @@
  * so a line is found by a scan of the text that numbers values in the same
  * pre-order as the parsed tree.
  */
+#include "create_light.h"
+#include "create_material.h"
 #include "grid_io.h"
 #include "io_util.h"
 #include "readers.h"
@@ -655,390 +657,63 @@ static pk_status read_medium_sides(jp *p, const cJSON *obj, const char *path, ma
 
 /* ---- materials ------------------------------------------------------------ */
 
-enum { MF_NAME, MF_KD, MF_KS, MF_KE, MF_TF, MF_KA, MF_NS, MF_NI, MF_D, MF_ILLUM, MF_TWO_SIDED, MF_BUMP, MF_NORMAL,
-       MF_INTERIOR, MF_EXTERIOR, MF_COUNT };
-static const char *const material_keys[MF_COUNT] = {"name",  "kd",        "ks",   "ke",         "tf",
-                                                    "ka",    "ns",        "ni",   "d",          "illum",
-                                                    "two_sided", "bump",  "normal_map", "interior", "exterior"};
-
-/* A reflectance: three finite numbers in 0..1. */
-static pk_status get_reflectance(jp *p, const cJSON *it, const char *path, vec3 *out)
+/* What the parameter dictionary (pdict.h) asks of this reader: messages at
+ * "file:line: json.path", the unknown-key warning with its once-per-path
+ * rule, textures relative to the scene, nested objects. */
+static pk_status pd_json_fail(void *self, const pdict *d, const pd_entry *e, long elem, pk_status st, const char *msg)
 {
-    pk_status st = get_vec3(p, it, path, out);
-    if (st == PK_OK && !(out->x >= 0.0f && out->y >= 0.0f && out->z >= 0.0f && out->x <= 1.0f &&
-                         out->y <= 1.0f && out->z <= 1.0f))
-        return jfail(p, PK_ERR_PARSE, it, path, "components must be in 0..1");
-    return st;
+    jp *p = self;
+    if (!e) return jfail(p, st, d->node, d->path, "%s", msg);
+    if (elem == PD_AT_ENTRY) return jfail(p, st, e->node, d->path, "%s", msg);
+    char fp[JP_PATH_MAX];
+    path_key(fp, d->path, e->name);
+    const cJSON *at = elem >= 0 ? cJSON_GetArrayItem(e->node, (int)elem) : e->node;
+    return jfail(p, st, at, fp, "%s", msg);
 }
 
-/* A number in 0..1 (roughness, alpha). */
-static pk_status get_unit(jp *p, const cJSON *it, const char *path, float *out)
-{
-    pk_status st = get_float(p, it, path, out);
-    if (st == PK_OK && !(*out >= 0.0f && *out <= 1.0f)) return jfail(p, PK_ERR_PARSE, it, path, "must be in 0..1");
-    return st;
-}
-
-/* The physically based material types (docs/materials.md). The keys of each:
- * the common ones ("type", "two_sided") and the type's parameters. */
-enum { TP_ALBEDO, TP_SPECULAR, TP_ETA, TP_K, TP_ROUGHNESS, TP_ALPHA, TP_IOR, TP_TRANSMITTANCE, TP_RADIANCE, TP_BSDF,
-       TP_BASE_COLOR, TP_METALLIC, TP_TRANSMISSION, TP_MR_MAP, TP_CLEARCOAT, TP_CLEARCOAT_ROUGHNESS, TP_COUNT };
-static const char *const tp_keys[TP_COUNT] = {"albedo",     "specular", "eta",           "k",       "roughness",
-                                              "alpha",      "ior",      "transmittance", "radiance", "bsdf",
-                                              "base_color", "metallic", "transmission",  "metallic_roughness_map",
-                                              "clearcoat",  "clearcoat_roughness"};
-typedef struct mat_type_def {
-    const char *name;
-    int nparams;
-    int params[8];
-} mat_type_def;
-static const mat_type_def mat_types[] = {
-    {"diffuse", 1, {TP_ALBEDO}},
-    {"conductor", 5, {TP_ETA, TP_K, TP_SPECULAR, TP_ROUGHNESS, TP_ALPHA}},
-    {"dielectric", 3, {TP_IOR, TP_ROUGHNESS, TP_TRANSMITTANCE}},
-    {"plastic", 3, {TP_ALBEDO, TP_IOR, TP_ROUGHNESS}},
-    {"emitter", 2, {TP_RADIANCE, TP_BSDF}},
-    {"two_sided", 1, {TP_BSDF}},
-    {"metallic_roughness", 8,
-     {TP_BASE_COLOR, TP_METALLIC, TP_ROUGHNESS, TP_TRANSMISSION, TP_IOR, TP_MR_MAP, TP_CLEARCOAT, TP_CLEARCOAT_ROUGHNESS}},
-    {"interface", 0, {0}},
-};
-#define MT_METALLIC_ROUGHNESS 6 /* its index in mat_types */
-#define MT_INTERFACE 7
-#define N_MAT_TYPES (sizeof mat_types / sizeof mat_types[0])
-
-/* The maps any material may have: "d"/"opacity" as a texture (cut-out
- * holes where it is below 0.5), "bump" (heights, with "strength": -bm) and
- * "normal_map" (tangent space). Numbers for opacity are read by the callers. */
-static pk_status read_surface_maps(jp *p, const cJSON *opacity, const cJSON *bump, const cJSON *normal,
-                                   const char *path, material *m)
+static void pd_json_warn(void *self, const pdict *d, const pd_entry *e)
 {
     char fp[JP_PATH_MAX];
-    bool loaded;
-    pk_status st;
-    if (opacity && cJSON_IsObject(opacity)) {
-        path_key(fp, path, opacity->string);
-        if ((st = get_texture(p, opacity, fp, false, &m->map_d, &loaded))) return st;
-    }
-    if (normal) {
-        path_key(fp, path, "normal_map");
-        if ((st = get_texture(p, normal, fp, false, &m->map_norm, &loaded))) return st;
-    }
-    if (bump) {
-        path_key(fp, path, "bump");
-        if ((st = get_texture(p, bump, fp, false, &m->map_bump, &loaded))) return st;
-    }
-    return PK_OK;
+    path_key(fp, d->path, e->name);
+    warn_unknown(self, e->node, fp);
 }
 
-/* A nested material ("bsdf") may not name media: they belong to the outer one. */
-static pk_status nested_sides(jp *p, const cJSON *obj, const char *path)
-{
-    static const char *const sides[2] = {"interior", "exterior"};
-    for (int i = 0; i < 2; i++) {
-        const cJSON *it = cJSON_IsObject(obj) ? cJSON_GetObjectItemCaseSensitive(obj, sides[i]) : NULL;
-        if (!it) continue;
-        char fp[JP_PATH_MAX];
-        path_key(fp, path, sides[i]);
-        return jfail(p, PK_ERR_PARSE, it, fp, "media belong to the outer material, not to its \"bsdf\"");
-    }
-    return PK_OK;
-}
-
-/* Reads a material object with a "type" (type_item) into *m. */
-static pk_status read_typed_material(jp *p, const cJSON *obj, const cJSON *type_item, const char *path,
-                                     bool with_name, material *m, const cJSON **name_item)
+static pk_status pd_json_texture(void *self, const pdict *d, const pd_entry *e, bool colour, tex_ref *ref,
+                                 bool *loaded)
 {
     char fp[JP_PATH_MAX];
-    path_key(fp, path, "type");
-    size_t t = 0;
-    if (cJSON_IsString(type_item))
-        while (t < N_MAT_TYPES && strcmp(type_item->valuestring, mat_types[t].name) != 0) t++;
-    if (!cJSON_IsString(type_item) || t == N_MAT_TYPES)
-        return jfail(p, PK_ERR_PARSE, type_item, fp,
-                     "must be one of \"diffuse\", \"conductor\", \"dielectric\", \"plastic\", "
-                     "\"metallic_roughness\", \"emitter\", \"two_sided\", \"interface\"");
-    const mat_type_def *def = &mat_types[t];
-    /* the known keys: "type", "two_sided", the type's parameters, and "name"
-     * where materials are listed in an array */
-    const char *keys[18];
-    const cJSON *f[18];
-    size_t nk = 0;
-    keys[nk++] = "type", keys[nk++] = "two_sided", keys[nk++] = "opacity", keys[nk++] = "bump",
-    keys[nk++] = "normal_map";
-    for (int i = 0; i < def->nparams; i++) keys[nk++] = tp_keys[def->params[i]];
-    keys[nk++] = "interior", keys[nk++] = "exterior"; /* (read by read_material) */
-    if (with_name) keys[nk++] = "name";
-    pk_status st = object_fields(p, obj, path, keys, nk, f);
-    if (st) return st;
-    const cJSON *pv[TP_COUNT] = {NULL}; /* the parameters by their TP_ number */
-    for (int i = 0; i < def->nparams; i++) pv[def->params[i]] = f[5 + i];
-    const cJSON *two_sided = f[1];
-    if (name_item) *name_item = with_name ? f[nk - 1] : NULL;
-
-    material_init(m);
-    if (t == MT_INTERFACE) { /* no surface: the boundary of media */
-        for (int k = 1; k <= 4; k++)
-            if (f[k]) {
-                path_key(fp, path, keys[k]);
-                return jfail(p, PK_ERR_PARSE, f[k], fp, "an interface has no surface to shade");
-            }
-        material_interface(m);
-        return PK_OK;
-    }
-    if (f[2] && !cJSON_IsObject(f[2])) {
-        path_key(fp, path, "opacity");
-        return jfail(p, PK_ERR_PARSE, f[2], fp, "must be a texture object (cut-out holes where it is below 0.5)");
-    }
-    if ((st = read_surface_maps(p, f[2], f[3], f[4], path, m))) return st;
-    /* textured parameters: the texture's value alone where it loaded */
-    bool loaded;
-    vec3 tex_albedo = v3s(-1.0f), tex_specular = v3s(-1.0f);
-    float tex_alpha = -1.0f;
-    if (t == MT_METALLIC_ROUGHNESS) {
-        /* base colour: a colour or an (sRGB) texture; metallic and roughness:
-         * numbers, scaled by the metallic_roughness_map (data, not sRGB) */
-        for (int k = TP_METALLIC; k <= TP_CLEARCOAT_ROUGHNESS; k++) {
-            if (k == TP_MR_MAP || !pv[k] || !cJSON_IsObject(pv[k])) continue;
-            path_key(fp, path, tp_keys[k]);
-            return jfail(p, PK_ERR_PARSE, pv[k], fp, "must be a number in 0..1 (textures: \"metallic_roughness_map\")");
-        }
-        if (pv[TP_ROUGHNESS] && cJSON_IsObject(pv[TP_ROUGHNESS])) {
-            path_key(fp, path, "roughness");
-            return jfail(p, PK_ERR_PARSE, pv[TP_ROUGHNESS], fp,
-                         "must be a number in 0..1 (textures: \"metallic_roughness_map\")");
-        }
-        if (pv[TP_BASE_COLOR] && cJSON_IsObject(pv[TP_BASE_COLOR])) {
-            path_key(fp, path, "base_color");
-            if ((st = get_texture(p, pv[TP_BASE_COLOR], fp, true, &m->map_kd, &loaded))) return st;
-            tex_albedo = loaded ? v3s(1.0f) : v3s(0.5f);
-            pv[TP_BASE_COLOR] = NULL;
-        }
-        if (pv[TP_MR_MAP]) {
-            path_key(fp, path, "metallic_roughness_map");
-            if (!cJSON_IsObject(pv[TP_MR_MAP]))
-                return jfail(p, PK_ERR_PARSE, pv[TP_MR_MAP], fp, "must be a texture object");
-            if ((st = get_texture(p, pv[TP_MR_MAP], fp, false, &m->map_mr, &loaded))) return st;
-            pv[TP_MR_MAP] = NULL;
-        }
-    }
-    if (pv[TP_ALBEDO] && cJSON_IsObject(pv[TP_ALBEDO])) {
-        path_key(fp, path, "albedo");
-        if ((st = get_texture(p, pv[TP_ALBEDO], fp, true, &m->map_kd, &loaded))) return st;
-        tex_albedo = loaded ? v3s(1.0f) : v3s(0.5f);
-        pv[TP_ALBEDO] = NULL;
-    }
-    if (pv[TP_SPECULAR] && cJSON_IsObject(pv[TP_SPECULAR])) {
-        path_key(fp, path, "specular");
-        if ((st = get_texture(p, pv[TP_SPECULAR], fp, true, &m->map_ks, &loaded))) return st;
-        tex_specular = loaded ? v3s(1.0f) : v3s(0.04f);
-        pv[TP_SPECULAR] = NULL;
-    }
-    for (int k = TP_ROUGHNESS; k <= TP_ALPHA; k++) {
-        if (!pv[k] || !cJSON_IsObject(pv[k])) continue;
-        path_key(fp, path, tp_keys[k]);
-        if ((st = get_texture(p, pv[k], fp, false, &m->map_alpha, &loaded))) return st;
-        m->map_alpha.squared = k == TP_ROUGHNESS; /* alpha = roughness^2 */
-        tex_alpha = loaded ? 1.0f : 0.0f;
-        pv[k] = NULL;
-    }
-    char pp[TP_COUNT][JP_PATH_MAX];
-    for (int i = 0; i < TP_COUNT; i++)
-        if (pv[i]) path_key(pp[i], path, tp_keys[i]);
-    float roughness = 0.0f, alpha = 0.0f, ior = 1.5f;
-    vec3 albedo = v3s(0.5f), transmittance = v3s(1.0f);
-    if (pv[TP_ALBEDO] && (st = get_reflectance(p, pv[TP_ALBEDO], pp[TP_ALBEDO], &albedo))) return st;
-    if (t == MT_METALLIC_ROUGHNESS) {
-        albedo = v3s(1.0f); /* glTF's defaults: base colour 1, metallic 1, roughness 1 */
-        roughness = 1.0f;
-        if (pv[TP_BASE_COLOR] && (st = get_reflectance(p, pv[TP_BASE_COLOR], pp[TP_BASE_COLOR], &albedo))) return st;
-    }
-    if (pv[TP_TRANSMITTANCE] &&
-        (st = get_reflectance(p, pv[TP_TRANSMITTANCE], pp[TP_TRANSMITTANCE], &transmittance)))
-        return st;
-    if (pv[TP_ROUGHNESS]) {
-        if ((st = get_unit(p, pv[TP_ROUGHNESS], pp[TP_ROUGHNESS], &roughness))) return st;
-        alpha = roughness * roughness;
-    }
-    if (pv[TP_ALPHA]) {
-        if (pv[TP_ROUGHNESS])
-            return jfail(p, PK_ERR_PARSE, pv[TP_ALPHA], pp[TP_ALPHA], "give \"roughness\" or \"alpha\", not both");
-        if ((st = get_unit(p, pv[TP_ALPHA], pp[TP_ALPHA], &alpha))) return st;
-    }
-    if (pv[TP_IOR]) {
-        if ((st = get_float(p, pv[TP_IOR], pp[TP_IOR], &ior))) return st;
-        if (!(ior > 0.0f)) return jfail(p, PK_ERR_PARSE, pv[TP_IOR], pp[TP_IOR], "must be a positive number");
-        if (ior == 1.0f && alpha > 0.0f && t != MT_METALLIC_ROUGHNESS)
-            return jfail(p, PK_ERR_PARSE, pv[TP_IOR], pp[TP_IOR], "must not be 1 on a rough surface (roughness > 0)");
-    }
-    if (tex_albedo.x >= 0.0f) albedo = tex_albedo;
-    if (tex_alpha >= 0.0f) alpha = tex_alpha;
-    m->alpha = alpha;
-    if (t == 5) { /* two_sided: the nested material, reflecting and emitting on both sides */
-        const cJSON *in = pv[TP_BSDF];
-        const cJSON *bt = cJSON_IsObject(in) ? cJSON_GetObjectItemCaseSensitive(in, "type") : NULL;
-        if (!bt)
-            return jfail(p, PK_ERR_PARSE, in ? in : obj, in ? pp[TP_BSDF] : path,
-                         "a two_sided material needs a \"bsdf\": a material object with a \"type\"");
-        char bp[JP_PATH_MAX];
-        path_key(bp, pp[TP_BSDF], "type");
-        if (cJSON_IsString(bt) && (strcmp(bt->valuestring, "dielectric") == 0 || strcmp(bt->valuestring, "two_sided") == 0))
-            return jfail(p, PK_ERR_PARSE, bt, bp, "is two-sided already");
-        if ((st = nested_sides(p, in, pp[TP_BSDF]))) return st;
-        if ((st = read_typed_material(p, in, bt, pp[TP_BSDF], false, m, NULL))) return st;
-        m->two_sided = true;
-        if (two_sided) {
-            path_key(fp, path, "two_sided");
-            return jfail(p, PK_ERR_PARSE, two_sided, fp, "a two_sided material is two-sided by its type");
-        }
-        return PK_OK;
-    }
-    /* the material model's constructors (scene/material.h) */
-    switch (t) {
-    case 0: /* diffuse */
-        material_diffuse(m, albedo);
-        break;
-    case 1: { /* conductor */
-        vec3 eta = v3(0.2f, 0.92f, 1.1f), k = v3(3.9f, 2.45f, 2.14f); /* copper, as pbrt */
-        vec3 f0 = v3s(-1.0f); /* set: Schlick's Fresnel of this reflectance */
-        if (pv[TP_SPECULAR]) {
-            const cJSON *other = pv[TP_ETA] ? pv[TP_ETA] : pv[TP_K];
-            if (other) {
-                char op[JP_PATH_MAX];
-                path_key(op, path, pv[TP_ETA] ? "eta" : "k");
-                return jfail(p, PK_ERR_PARSE, other, op, "give \"eta\" and \"k\" or \"specular\", not both");
-            }
-            if ((st = get_reflectance(p, pv[TP_SPECULAR], pp[TP_SPECULAR], &f0))) return st;
-        } else if (tex_specular.x >= 0.0f) {
-            f0 = tex_specular;
-        } else {
-            if (pv[TP_ETA]) {
-                if ((st = get_vec3(p, pv[TP_ETA], pp[TP_ETA], &eta))) return st;
-                if (!(eta.x > 0.0f && eta.y > 0.0f && eta.z > 0.0f))
-                    return jfail(p, PK_ERR_PARSE, pv[TP_ETA], pp[TP_ETA], "components must be positive");
-            }
-            if (pv[TP_K]) {
-                if ((st = get_vec3(p, pv[TP_K], pp[TP_K], &k))) return st;
-                if (!(k.x >= 0.0f && k.y >= 0.0f && k.z >= 0.0f))
-                    return jfail(p, PK_ERR_PARSE, pv[TP_K], pp[TP_K], "components must not be negative");
-            }
-        }
-        if (f0.x >= 0.0f) material_conductor_f0(m, f0, alpha);
-        else material_conductor(m, eta, k, alpha);
-        break;
-    }
-    case 2: /* dielectric */
-        material_dielectric(m, ior, alpha, transmittance);
-        break;
-    case 3: /* plastic */
-        material_plastic(m, albedo, ior, alpha);
-        break;
-    case MT_METALLIC_ROUGHNESS: { /* glTF 2.0's material */
-        float metallic = 1.0f, transmission = 0.0f;
-        if (pv[TP_METALLIC] && (st = get_unit(p, pv[TP_METALLIC], pp[TP_METALLIC], &metallic))) return st;
-        if (pv[TP_TRANSMISSION] && (st = get_unit(p, pv[TP_TRANSMISSION], pp[TP_TRANSMISSION], &transmission)))
-            return st;
-        float clearcoat = 0.0f, clearcoat_roughness = 0.0f;
-        if (pv[TP_CLEARCOAT] && (st = get_unit(p, pv[TP_CLEARCOAT], pp[TP_CLEARCOAT], &clearcoat))) return st;
-        if (pv[TP_CLEARCOAT_ROUGHNESS] &&
-            (st = get_unit(p, pv[TP_CLEARCOAT_ROUGHNESS], pp[TP_CLEARCOAT_ROUGHNESS], &clearcoat_roughness)))
-            return st;
-        material_metallic_roughness(m, albedo, metallic, roughness);
-        m->transmission = transmission;
-        m->ni = ior;
-        m->clearcoat = clearcoat;
-        m->clearcoat_roughness = clearcoat_roughness;
-        break;
-    }
-    default: { /* emitter: black diffuse, or the surface its "bsdf" describes */
-        vec3 ke = v3s(1.0f);
-        if (pv[TP_RADIANCE] && (st = get_color(p, pv[TP_RADIANCE], pp[TP_RADIANCE], &ke))) return st;
-        if (pv[TP_BSDF]) {
-            const cJSON *bt =
-                cJSON_IsObject(pv[TP_BSDF]) ? cJSON_GetObjectItemCaseSensitive(pv[TP_BSDF], "type") : NULL;
-            if (!bt)
-                return jfail(p, PK_ERR_PARSE, pv[TP_BSDF], pp[TP_BSDF],
-                             "must be a material object with a \"type\" (the emitting surface's reflection)");
-            if (cJSON_IsString(bt) && strcmp(bt->valuestring, "emitter") == 0) {
-                char bp[JP_PATH_MAX];
-                path_key(bp, pp[TP_BSDF], "type");
-                return jfail(p, PK_ERR_PARSE, bt, bp, "an emitter's bsdf cannot be another emitter");
-            }
-            if ((st = nested_sides(p, pv[TP_BSDF], pp[TP_BSDF]))) return st;
-            if ((st = read_typed_material(p, pv[TP_BSDF], bt, pp[TP_BSDF], false, m, NULL))) return st;
-        } else {
-            material_diffuse(m, v3s(0.0f));
-        }
-        m->ke = ke;
-        break;
-    }
-    }
-    if (two_sided) {
-        path_key(fp, path, "two_sided");
-        if (!cJSON_IsBool(two_sided)) return jfail(p, PK_ERR_PARSE, two_sided, fp, "must be true or false");
-        m->two_sided = cJSON_IsTrue(two_sided);
-    }
-    return PK_OK;
+    path_key(fp, d->path, e->name);
+    return get_texture(self, e->node, fp, colour, ref, loaded);
 }
 
-/* Reads a material object into *m (name not set). with_name: "name" is known. */
+static pk_status pd_json_nested(void *self, const pdict *d, const pd_entry *e, pdict *sub)
+{
+    (void)self;
+    char fp[JP_PATH_MAX];
+    path_key(fp, d->path, e->name);
+    return pd_from_cjson(sub, e->node, fp);
+}
+
+static const pd_source pd_json = {pd_json_fail, pd_json_warn, pd_json_texture, pd_json_nested};
+
+/* Reads a material object into *m (name not set): the creators of
+ * create_material.c through the cJSON adapter, then the media on its sides.
+ * with_name: "name" is known (*name_item: its member). */
 static pk_status read_material(jp *p, const cJSON *obj, const char *path, bool with_name, material *m,
                                const cJSON **name_item)
 {
-    const cJSON *type_item = cJSON_IsObject(obj) ? cJSON_GetObjectItemCaseSensitive(obj, "type") : NULL;
-    if (type_item) {
-        pk_status st = read_typed_material(p, obj, type_item, path, with_name, m, name_item);
-        return st ? st : read_medium_sides(p, obj, path, m);
+    if (!cJSON_IsObject(obj)) return jfail(p, PK_ERR_PARSE, obj, path, "must be an object");
+    pdict d;
+    pd_init(&d, p->ctx, &pd_json, p, "material", false);
+    pk_status st = pd_from_cjson(&d, obj, path);
+    if (st == PK_OK && with_name) {
+        static const char *const name_key[1] = {"name"};
+        pd_declare(&d, name_key, 1);
     }
-    const cJSON *f[MF_COUNT];
-    pk_status st = object_fields(p, obj, path, with_name ? material_keys : material_keys + 1,
-                                 with_name ? MF_COUNT : MF_COUNT - 1, with_name ? f : f + 1);
+    if (st == PK_OK) st = create_material(&d, m);
+    pd_free(&d);
     if (st) return st;
-    if (!with_name) f[MF_NAME] = NULL;
-    if (name_item) *name_item = f[MF_NAME];
-    material_init(m);
-    vec3 *colours[] = {NULL, &m->kd, &m->ks, &m->ke, &m->tf, &m->ka};
-    char fp[JP_PATH_MAX];
-    bool loaded;
-    for (int i = MF_KD; i <= MF_KA; i++) {
-        if (!f[i]) continue;
-        path_key(fp, path, material_keys[i]);
-        if ((i == MF_KD || i == MF_KS) && cJSON_IsObject(f[i])) { /* a texture: its value alone */
-            if ((st = get_texture(p, f[i], fp, true, i == MF_KD ? &m->map_kd : &m->map_ks, &loaded))) return st;
-            if (loaded) *colours[i] = v3s(1.0f);
-            continue;
-        }
-        if ((st = get_color(p, f[i], fp, colours[i]))) return st;
-    }
-    if (f[MF_NS] && cJSON_IsObject(f[MF_NS])) {
-        path_key(fp, path, "ns");
-        if ((st = get_texture(p, f[MF_NS], fp, false, &m->map_ns, &loaded))) return st;
-        if (loaded) m->ns = 1.0f;
-    } else if (f[MF_NS]) {
-        path_key(fp, path, "ns");
-        if ((st = get_float(p, f[MF_NS], fp, &m->ns))) return st;
-        if (m->ns < 0.0f) return jfail(p, PK_ERR_PARSE, f[MF_NS], fp, "must not be negative");
-    }
-    if ((st = read_surface_maps(p, f[MF_D], f[MF_BUMP], f[MF_NORMAL], path, m))) return st;
-    if (f[MF_NI]) {
-        path_key(fp, path, "ni");
-        if ((st = get_float(p, f[MF_NI], fp, &m->ni))) return st;
-        if (!(m->ni > 0.0f)) return jfail(p, PK_ERR_PARSE, f[MF_NI], fp, "must be a positive number");
-    }
-    if (f[MF_D] && !cJSON_IsObject(f[MF_D])) {
-        path_key(fp, path, "d");
-        if ((st = get_float(p, f[MF_D], fp, &m->d))) return st;
-        if (m->d < 0.0f || m->d > 1.0f) return jfail(p, PK_ERR_PARSE, f[MF_D], fp, "must be in 0..1");
-    }
-    if (f[MF_ILLUM]) {
-        path_key(fp, path, "illum");
-        if ((st = get_int(p, f[MF_ILLUM], fp, 0, 10, &m->illum))) return st;
-    }
-    if (f[MF_TWO_SIDED]) {
-        path_key(fp, path, "two_sided");
-        if (!cJSON_IsBool(f[MF_TWO_SIDED])) return jfail(p, PK_ERR_PARSE, f[MF_TWO_SIDED], fp, "must be true or false");
-        m->two_sided = cJSON_IsTrue(f[MF_TWO_SIDED]);
-    }
+    if (name_item) *name_item = with_name ? cJSON_GetObjectItemCaseSensitive(obj, "name") : NULL;
     return read_medium_sides(p, obj, path, m);
 }
 
@@ -1437,94 +1112,13 @@ static pk_status parse_sphere(jp *p, const cJSON *it, const char *path)
 
 static pk_status parse_light(jp *p, const cJSON *it, const char *path)
 {
-    enum { L_TYPE, L_POSITION, L_INTENSITY, L_COLOR, L_DIRECTION, L_OUTER, L_INNER, L_COUNT };
-    static const char *const keys[L_COUNT] = {"type", "position", "intensity", "color",
-                                              "direction", "outer_angle", "inner_angle"};
-    const cJSON *f[L_COUNT];
-    char fp[JP_PATH_MAX];
-    pk_status st = object_fields(p, it, path, keys, L_COUNT, f);
-    if (st) return st;
-    point_light l;
-    memset(&l, 0, sizeof l);
-    int kind = 0; /* 0 point, 1 spot, 2 distant */
-    if (f[L_TYPE]) {
-        path_key(fp, path, "type");
-        const char *t = cJSON_IsString(f[L_TYPE]) ? f[L_TYPE]->valuestring : "";
-        if (strcmp(t, "point") == 0) kind = 0;
-        else if (strcmp(t, "spot") == 0) kind = 1;
-        else if (strcmp(t, "distant") == 0) kind = 2;
-        else return jfail(p, PK_ERR_PARSE, f[L_TYPE], fp, "must be \"point\", \"spot\" or \"distant\"");
-    }
-    if (kind != 2) {
-        if (!f[L_POSITION]) return jfail(p, PK_ERR_PARSE, it, path, "missing \"position\"");
-        path_key(fp, path, "position");
-        if ((st = get_vec3(p, f[L_POSITION], fp, &l.position))) return st;
-    } else if (f[L_POSITION]) {
-        return jfail(p, PK_ERR_PARSE, f[L_POSITION], path, "a distant light has no \"position\"");
-    }
-    if (kind == 0 && (f[L_DIRECTION] || f[L_OUTER] || f[L_INNER]))
-        return jfail(p, PK_ERR_PARSE, it, path, "a point light has no \"direction\" or cone angles (\"type\": \"spot\")");
-    if (kind != 0) {
-        if (!f[L_DIRECTION]) return jfail(p, PK_ERR_PARSE, it, path, "missing \"direction\"");
-        vec3 d;
-        path_key(fp, path, "direction");
-        if ((st = get_vec3(p, f[L_DIRECTION], fp, &d))) return st;
-        const float len = v3_len(d);
-        if (!(len > 0.0f) || !isfinite(len)) return jfail(p, PK_ERR_PARSE, f[L_DIRECTION], fp, "must be a non-zero vector");
-        d = v3_scale(d, 1.0f / len);
-        if (kind == 2) {
-            l.distant = true;
-            l.position = v3_neg(d); /* toward the light */
-        } else {
-            float outer = 30.0f, inner = -1.0f;
-            if (f[L_OUTER]) {
-                path_key(fp, path, "outer_angle");
-                if ((st = get_float(p, f[L_OUTER], fp, &outer))) return st;
-                if (!(outer > 0.0f && outer <= 180.0f))
-                    return jfail(p, PK_ERR_PARSE, f[L_OUTER], fp, "must be in (0, 180] degrees");
-            }
-            if (f[L_INNER]) {
-                path_key(fp, path, "inner_angle");
-                if ((st = get_float(p, f[L_INNER], fp, &inner))) return st;
-                if (!(inner >= 0.0f && inner <= outer))
-                    return jfail(p, PK_ERR_PARSE, f[L_INNER], fp, "must be in [0, outer_angle] degrees");
-            } else {
-                inner = 0.8f * outer;
-            }
-            l.spot_dir = d;
-            l.cos_outer = cosf(outer * PK_PI / 180.0f);
-            l.cos_inner = cosf(inner * PK_PI / 180.0f);
-            l.spot_falloff = SPOT_FALLOFF_SMOOTHSTEP;
-        }
-    } else if (f[L_OUTER] || f[L_INNER]) {
-        return jfail(p, PK_ERR_PARSE, it, path, "cone angles belong to a spot light");
-    }
-    vec3 intensity = v3s(1.0f), color = v3s(1.0f);
-    if (f[L_INTENSITY]) {
-        path_key(fp, path, "intensity");
-        if (cJSON_IsNumber(f[L_INTENSITY])) {
-            if ((st = get_float(p, f[L_INTENSITY], fp, &intensity.x))) return st;
-            intensity.y = intensity.z = intensity.x;
-        } else if (!cJSON_IsArray(f[L_INTENSITY])) {
-            return jfail(p, PK_ERR_PARSE, f[L_INTENSITY], fp, "must be a number or an array of 3 numbers");
-        } else if ((st = get_vec3(p, f[L_INTENSITY], fp, &intensity))) {
-            return st;
-        }
-        if (intensity.x < 0.0f || intensity.y < 0.0f || intensity.z < 0.0f)
-            return jfail(p, PK_ERR_PARSE, f[L_INTENSITY], fp, "must not be negative");
-    }
-    if (f[L_COLOR]) {
-        path_key(fp, path, "color");
-        if ((st = get_color(p, f[L_COLOR], fp, &color))) return st;
-    }
-    l.intensity = v3_mul(intensity, color);
-    if (!v3_finite(l.intensity))
-        return jfail(p, PK_ERR_PARSE, it, path, "intensity * color is not finite");
-    if (l.distant) return scene_light_distant(p->ctx, p->s, l.position, l.intensity);
-    if (kind == 1)
-        return scene_light_spot(p->ctx, p->s, l.position, l.spot_dir, l.cos_inner, l.cos_outer, l.spot_falloff,
-                                l.intensity);
-    return scene_light_point(p->ctx, p->s, l.position, l.intensity);
+    if (!cJSON_IsObject(it)) return jfail(p, PK_ERR_PARSE, it, path, "must be an object");
+    pdict d;
+    pd_init(&d, p->ctx, &pd_json, p, "light", false);
+    pk_status st = pd_from_cjson(&d, it, path);
+    if (st == PK_OK) st = create_light(&d, p->s);
+    pd_free(&d);
+    return st;
 }
 
 /* Calls fn on each element of the array at the top-level key. */

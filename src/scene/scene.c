@@ -93,6 +93,7 @@ void scene_destroy(pk_scene *s)
     for (size_t i = 0; i < s->nmedia; i++) medium_free(a, &s->media[i]);
     mem_free(a, s->media);
     scene_env_clear(a, &s->env);
+    mem_free(a, s->builder);
     mem_free(a, s->name);
     pk_allocator copy = *a;
     mem_free(&copy, s);

@@ -180,6 +180,10 @@ struct pk_scene {
     pk_camera camera;
     scene_render_settings render;
 
+    /* the graphics state of a scene built through the API (pk_scene_create;
+     * io/scene_build.h), NULL for scenes read from files; freed with the scene */
+    struct scene_builder *builder;
+
     /* derived by scene_commit */
     bool committed;
     uint8_t *degenerate;    /* ntris flags */
