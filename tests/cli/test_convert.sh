@@ -1,0 +1,68 @@
+#!/usr/bin/env bash
+# paprsek convert: the scenes of tests/data in every format (OBJ/MTL, JSON,
+# Mitsuba XML, pbrt-v4, glTF, media under volpath; tests/data/convert has
+# spot lights of each falloff, distant lights, sun and skies, rotated
+# environment maps, thin-lens and orthographic cameras) convert to JSON scenes that
+# render the same bytes (image and AOVs, path tracer and Whitted); and the
+# errors: a missing input, an unwritable output, an output that is not
+# .json, content the JSON format cannot hold, usage errors - each with a
+# message and nothing written.
+# usage: test_convert.sh PAPRSEK SHARED_DIR DATA_DIR
+set -u
+bin=$1
+data=$3
+here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+# shellcheck source=convert_same.sh
+. "$here/convert_same.sh"
+tmp=$(mktemp -d)
+trap 'chmod -R u+w "$tmp"; rm -rf "$tmp"' EXIT
+fail=0
+
+convert_same "$bin" "$tmp" \
+  "$data/conformance/box.obj" "$data/conformance/box.json" "$data/conformance/box.xml" \
+  "$data/conformance/box.pbrt" "$data/conformance/box.gltf" \
+  "$data/media/fog.json|volpath" "$data/media/fog.xml|volpath" "$data/media/fog.pbrt|volpath" \
+  "$data/gltf/instanced.gltf" "$data/pbrt/plymesh.pbrt" "$data/json_example.json" \
+  "$data/tex_json.json" "$data/fuzz_seed_env.json" "$data/gltf/cube.glb" "$data/gltf/external.gltf" \
+  "$data/conformance/box_mr.json" "$data/conformance/box_nomtl.obj" "$data/pbrt/include_main.pbrt" \
+  "$data/fuzz_seed_full.json" "$data/fuzz_seed_full.xml" "$data/tex_scene.obj" "$data/obj_mat.obj" \
+  "$data/convert/lights.xml" "$data/convert/lights.pbrt" "$data/convert/lights.json" "$data/convert/spot.gltf" \
+  "$data/../../bench/scenes/materials.json" "$data/../../bench/scenes/materials.xml" || fail=1
+
+# a converted scene (records, PLY meshes, raw pixels) converts again to the same image
+mkdir -p "$tmp/again"
+if "$bin" convert "$data/convert/lights.xml" -o "$tmp/again/first.json" -q 2>"$tmp/err"; then
+  convert_same "$bin" "$tmp/again" "$tmp/again/first.json" || fail=1
+else
+  echo "FAIL converting lights.xml: $(cat "$tmp/err")"; fail=1
+fi
+
+expect() { # name status message-fragment command...
+  local name=$1 want=$2 msg=$3; shift 3
+  "$@" >"$tmp/out" 2>"$tmp/err"
+  local rc=$?
+  if [ $rc != "$want" ]; then echo "FAIL $name: exit $rc, expected $want ($(cat "$tmp/err"))"; fail=1; return; fi
+  if ! grep -q -- "$msg" "$tmp/err"; then echo "FAIL $name: message '$(cat "$tmp/err")' lacks '$msg'"; fail=1; fi
+}
+mkdir -p "$tmp/e"
+expect missing-input 1 "nothere.obj" "$bin" convert "$tmp/nothere.obj" -o "$tmp/e/x.json"
+expect no-output 2 "no output" "$bin" convert "$data/conformance/box.obj"
+expect not-json 2 "(.json)" "$bin" convert "$data/conformance/box.obj" -o "$tmp/e/x.xml"
+expect no-folder 1 "$tmp/e/none/x.json" "$bin" convert "$data/conformance/box.obj" -o "$tmp/e/none/x.json"
+expect unknown-option 2 "unknown option" "$bin" convert "$data/conformance/box.obj" -o "$tmp/e/x.json" --frobnicate
+expect two-scenes 2 "more than one scene" "$bin" convert "$data/conformance/box.obj" "$data/conformance/box.obj" -o "$tmp/e/x.json"
+mkdir -p "$tmp/ro" && chmod a-w "$tmp/ro"
+if [ ! -w "$tmp/ro" ]; then # (root writes anywhere)
+  expect unwritable 1 "$tmp/ro" "$bin" convert "$data/conformance/box.obj" -o "$tmp/ro/x.json"
+fi
+# content the format cannot hold: instances kept as instances
+expect kept-instances 1 "scene.instances=flatten" "$bin" convert "$data/gltf/instanced.gltf" -o "$tmp/e/x.json" \
+  --config scene.instances=keep
+"$bin" convert --help | grep -q "usage: paprsek convert" || { echo "FAIL convert --help"; fail=1; }
+"$bin" help convert | grep -q "usage: paprsek convert" || { echo "FAIL help convert"; fail=1; }
+"$bin" --help | grep -q "convert SCENE" || { echo "FAIL paprsek --help does not list convert"; fail=1; }
+# every failure above left nothing behind
+if [ -n "$(ls -A "$tmp/e")" ]; then echo "FAIL files left after failures: $(ls -A "$tmp/e")"; fail=1; fi
+
+[ $fail -eq 0 ] && echo "ok"
+exit $fail
