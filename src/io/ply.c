@@ -257,7 +257,7 @@ pk_status ply_parse(pk_context *ctx, const char *data, size_t size, const char *
 
     /* ---- the data, element by element */
     size_t ncap = 0;
-    size_t nidx = 0, cap_idx = 0, cap_fmat = 0;
+    size_t nidx = 0, cap_idx = 0, cap_fmat = 0, nfmat = 0; /* nfmat: triangles face_material covers */
     bool have_vertices = false;
     for (int ei = 0; ei < nels; ei++) {
         ply_element *el = &els[ei];
@@ -357,7 +357,9 @@ pk_status ply_parse(pk_context *ctx, const char *data, size_t size, const char *
                 }
                 const double mv = vals[pmat];
                 const uint32_t m = mv >= 0.0 && mv < (double)UINT32_MAX && mv == floor(mv) ? (uint32_t)mv : UINT32_MAX;
+                for (size_t t = nfmat; t < tri_before; t++) out->face_material[t] = UINT32_MAX; /* faces without one */
                 for (size_t t = tri_before; t < nidx / 3; t++) out->face_material[t] = m;
+                nfmat = nidx / 3;
             }
             if (is_vertex) {
                 vec3 q = v3((float)vals[px], (float)vals[py], (float)vals[pz]);
@@ -382,6 +384,13 @@ pk_status ply_parse(pk_context *ctx, const char *data, size_t size, const char *
         goto out;
     }
     out->ntriangles = nidx / 3;
+    if (out->face_material && nfmat < out->ntriangles) { /* faces after the last with a material have none */
+        if (!mem_grow(&ctx->alloc, (void **)&out->face_material, &cap_fmat, out->ntriangles, sizeof *out->face_material)) {
+            st = ctx_nomem(ctx);
+            goto out;
+        }
+        for (size_t t = nfmat; t < out->ntriangles; t++) out->face_material[t] = UINT32_MAX;
+    }
     for (size_t i = 0; i < nidx; i++)
         if (out->indices[i] >= out->nvertices) {
             st = fail(&r, "triangle %zu: vertex index %u out of range (0..%zu)", i / 3, out->indices[i],

@@ -73,8 +73,8 @@ typedef struct ply_mesh {
     uint32_t *indices;    /* 3 * ntriangles, each < nvertices */
     size_t ntriangles;
     /* ntriangles: the face property "material" (an integer, as Paprsek's
-     * converter writes it; UINT32_MAX where it is not a whole number >= 0),
-     * or NULL when the faces have none */
+     * converter writes it; UINT32_MAX where it is not a whole number >= 0
+     * or a face has no such property), or NULL when no face has one */
     uint32_t *face_material;
 } ply_mesh;
 

@@ -1740,9 +1740,10 @@ static pk_status rec_raw_file(jp *p, const cJSON *it, const char *path, size_t c
     return PK_OK;
 }
 
-/* A positive size of n integers (image sides, grid sides) at key of obj. */
-static pk_status rec_sizes(jp *p, const cJSON *obj, const char *path, const char *key, int n, int hi, int *out,
-                           size_t *count)
+/* A positive size of n integers (image sides, grid sides) at key of obj,
+ * each at most hi, their product *count at most max_count. */
+static pk_status rec_sizes(jp *p, const cJSON *obj, const char *path, const char *key, int n, int hi,
+                           size_t max_count, int *out, size_t *count)
 {
     char fp[JP_PATH_MAX];
     path_key(fp, path, key);
@@ -1754,6 +1755,8 @@ static pk_status rec_sizes(jp *p, const cJSON *obj, const char *path, const char
     for (const cJSON *e = it->child; e; e = e->next, i++) {
         pk_status st = get_int(p, e, fp, 1, hi, &out[i]);
         if (st) return st;
+        if ((size_t)out[i] > max_count / *count)
+            return jfail(p, PK_ERR_LIMIT, it, fp, "more than %zu elements", max_count);
         *count *= (size_t)out[i];
     }
     return PK_OK;
@@ -1768,6 +1771,7 @@ static pk_status read_texref_record(jp *p, const cJSON *it, const char *path, te
     tex_ref_init(r);
     pk_status st = rec_read(p, it, path, rec_texref, rec_ntexref, extra, r);
     if (st) return st;
+    if (r->kind > TEX_CHECKER) return jfail(p, PK_ERR_PARSE, it, path, "kind must be 0 (none), 1 (image) or 2 (checker)");
     if (r->kind != TEX_IMAGE) return PK_OK;
     char fp[JP_PATH_MAX];
     const cJSON *img = cJSON_GetObjectItemCaseSensitive(it, "image");
@@ -1794,7 +1798,7 @@ static pk_status read_texref_record(jp *p, const cJSON *it, const char *path, te
     if ((r->tex = texture_find(p->s, key->valuestring, colour)) >= 0) return PK_OK;
     int wh[2], nc = 0;
     size_t count;
-    if ((st = rec_sizes(p, px, fp, "size", 2, PK_MAX_TEXTURE_SIDE, wh, &count))) return st;
+    if ((st = rec_sizes(p, px, fp, "size", 2, PK_MAX_TEXTURE_SIDE, PK_MAX_TEXTURE_PIXELS, wh, &count))) return st;
     char cp[JP_PATH_MAX];
     path_key(cp, fp, "channels");
     const cJSON *ch = cJSON_GetObjectItemCaseSensitive(px, "channels");
@@ -1831,6 +1835,9 @@ static pk_status parse_material_record(jp *p, const cJSON *e, const char *path)
     material m;
     material_init(&m);
     if ((st = rec_read(p, f[1], fp, rec_material, rec_nmaterial, extra, &m))) return st;
+    if (m.type < MAT_MTL || m.type > MAT_INTERFACE)
+        return jfail(p, PK_ERR_PARSE, f[1], fp, "type must be in %d..%d", (int)MAT_MTL, (int)MAT_INTERFACE);
+    if (m.illum < 0 || m.illum > 10) return jfail(p, PK_ERR_PARSE, f[1], fp, "illum must be in 0..10");
     for (int k = 0; k < REC_NMAPS; k++) {
         const cJSON *it = cJSON_GetObjectItemCaseSensitive(f[1], rec_map_names[k]);
         if (!it) continue;
@@ -1936,6 +1943,10 @@ static pk_status parse_light_record(jp *p, const cJSON *it, const char *path)
     point_light l;
     memset(&l, 0, sizeof l);
     if ((st = rec_read(p, f[0], fp, rec_light, rec_nlight, NULL, &l))) return st;
+    if (l.spot_falloff < SPOT_FALLOFF_SMOOTHSTEP || l.spot_falloff > SPOT_FALLOFF_SQUARED)
+        return jfail(p, PK_ERR_PARSE, f[0], fp, "spot_falloff must be 0, 1 or 2");
+    if (l.intensity.x < 0.0f || l.intensity.y < 0.0f || l.intensity.z < 0.0f)
+        return jfail(p, PK_ERR_PARSE, f[0], fp, "intensity must not be negative");
     return scene_add_point_light(p->ctx, p->s, &l);
 }
 
@@ -1950,12 +1961,19 @@ static pk_status parse_environment_record(jp *p, const cJSON *it)
     pk_status st = object_fields(p, it, "environment", outer, 1, f);
     if (st) return st;
     if ((st = rec_read(p, f[0], "environment.record", rec_env, rec_nenv, extra, env))) return st;
+    if (!(env->sun_angle > 0.0f && env->sun_angle <= 90.0f) || env->map_scale < 0.0f || env->sky_scale < 0.0f ||
+        env->radiance.x < 0.0f || env->radiance.y < 0.0f || env->radiance.z < 0.0f || env->sun_radiance.x < 0.0f ||
+        env->sun_radiance.y < 0.0f || env->sun_radiance.z < 0.0f)
+        return jfail(p, PK_ERR_PARSE, f[0], "environment.record",
+                     "sun_angle must be in (0, 90], scales and radiances not negative");
     const cJSON *map = cJSON_GetObjectItemCaseSensitive(f[0], "map");
     if (!map) return PK_OK;
     int wh[2];
     size_t count;
     if (!cJSON_IsObject(map)) return jfail(p, PK_ERR_PARSE, map, "environment.record.map", "must be an object");
-    if ((st = rec_sizes(p, map, "environment.record.map", "size", 2, PK_MAX_TEXTURE_SIDE, wh, &count))) return st;
+    if ((st = rec_sizes(p, map, "environment.record.map", "size", 2, PK_MAX_TEXTURE_SIDE, PK_MAX_TEXTURE_PIXELS, wh,
+                        &count)))
+        return st;
     const cJSON *file = cJSON_GetObjectItemCaseSensitive(map, "file");
     void *data;
     if ((st = rec_raw_file(p, file ? file : map, "environment.record.map.file", 3 * count, sizeof(float), &data)))
@@ -1980,9 +1998,8 @@ static pk_status rec_grid(jp *p, const cJSON *obj, const char *path, const char 
     if (!cJSON_IsObject(it)) return jfail(p, PK_ERR_PARSE, it, fp, "must be an object");
     int n[3], ch = 1;
     size_t count;
-    pk_status st = rec_sizes(p, it, fp, "size", 3, INT32_MAX, n, &count);
+    pk_status st = rec_sizes(p, it, fp, "size", 3, INT32_MAX, MEDIUM_MAX_VOXELS, n, &count);
     if (st) return st;
-    if (count > MEDIUM_MAX_VOXELS) return jfail(p, PK_ERR_LIMIT, it, fp, "more than %zu voxels", MEDIUM_MAX_VOXELS);
     path_key(cp, fp, "channels");
     const cJSON *c = cJSON_GetObjectItemCaseSensitive(it, "channels");
     if ((st = get_int(p, c ? c : it, cp, 1, 3, &ch))) return st;
@@ -2016,7 +2033,9 @@ static pk_status parse_medium_record(jp *p, const cJSON *it, const char *path)
     if ((st = rec_read(p, f[1], fp, rec_medium, rec_nmedium, extra, &m)) ||
         (st = rec_grid(p, f[1], fp, "density", &m.density)) ||
         (st = rec_grid(p, f[1], fp, "albedo_grid", &m.albedo_grid)) ||
-        (st = rec_grid(p, f[1], fp, "emission_grid", &m.emission_grid))) {
+        (st = rec_grid(p, f[1], fp, "emission_grid", &m.emission_grid)) ||
+        (m.kind != MEDIUM_HOMOGENEOUS && m.kind != MEDIUM_GRID &&
+         (st = jfail(p, PK_ERR_PARSE, f[1], fp, "kind must be 0 (homogeneous) or 1 (grid)")))) {
         medium_free(&p->s->alloc, &m);
         return st;
     }

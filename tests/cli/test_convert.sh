@@ -58,6 +58,14 @@ fi
 # content the format cannot hold: instances kept as instances
 expect kept-instances 1 "scene.instances=flatten" "$bin" convert "$data/gltf/instanced.gltf" -o "$tmp/e/x.json" \
   --config scene.instances=keep
+# the record forms refuse what no reader makes
+printf '{"materials": [{"name": "m", "record": {"type": 99}}], "spheres": [{"center": [0, 0, 0], "radius": 1}]}' >"$tmp/badtype.json"
+expect record-type 1 "badtype.json:1: materials\[0\].record: type must be in 0..6" "$bin" render "$tmp/badtype.json" -o "$tmp/e/x.pfm"
+printf '{"lights": [{"record": {"spot_falloff": 5}}], "spheres": [{"center": [0, 0, 0], "radius": 1}]}' >"$tmp/badlight.json"
+expect record-light 1 "lights\[0\].record: spot_falloff must be 0, 1 or 2" "$bin" render "$tmp/badlight.json" -o "$tmp/e/x.pfm"
+printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nproperty int material\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2 4\n' >"$tmp/tri.ply"
+printf '{"meshes": [{"ply": "tri.ply", "materials": ["default"]}]}' >"$tmp/badply.json"
+expect ply-material 1 "triangle 0: material 4 is not an index" "$bin" render "$tmp/badply.json" -o "$tmp/e/x.pfm"
 "$bin" convert --help | grep -q "usage: paprsek convert" || { echo "FAIL convert --help"; fail=1; }
 "$bin" help convert | grep -q "usage: paprsek convert" || { echo "FAIL help convert"; fail=1; }
 "$bin" --help | grep -q "convert SCENE" || { echo "FAIL paprsek --help does not list convert"; fail=1; }
