@@ -17,8 +17,8 @@ static const cli_option c_opts[] = {
     {.name = "define", .short_name = 'D', .id = C_DEFINE, .kind = CLI_STRING, .arg = "NAME=VALUE",
      .help = "a parameter of the scene, as for paprsek render (Mitsuba's $NAME, glTF's camera=N); repeatable"},
     {.name = "config", .id = C_CONFIG, .kind = CLI_STRING, .arg = "KEY=VALUE,...",
-     .help = "library configuration, as for paprsek render (scene.instances=flatten writes instances that "
-             "would be kept as instances)"},
+     .help = "library configuration, as for paprsek render; render the converted scene with the same "
+             "scene.instances"},
     {.name = "quiet", .short_name = 'q', .id = C_QUIET, .kind = CLI_FLAG, .help = "no warnings"},
     {.name = "help", .short_name = 'h', .id = C_HELP, .kind = CLI_FLAG, .help = "this text"},
 };
@@ -29,8 +29,9 @@ void cli_convert_help(FILE *f)
     fputs("usage: paprsek convert SCENE -o OUT.json [options]\n"
           "\n"
           "Writes SCENE (.obj, .json, .xml, .pbrt, .gltf or .glb) as a Paprsek JSON\n"
-          "scene (docs/scene-format.md, \"Records\"): the scene as loaded, with its\n"
-          "instances flattened into triangles (binary PLY files beside OUT), its\n"
+          "scene (docs/scene-format.md, \"Records\"): the scene as loaded, its\n"
+          "triangles in binary PLY files beside OUT (instances the renderer keeps as\n"
+          "instances stay instances; the others are flattened), its\n"
           "materials, lights, media and environment field by field, and every\n"
           "number written so that it reads back bit for bit. Rendering OUT with the\n"
           "same options gives the same image, byte for byte. The files are written\n"

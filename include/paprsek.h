@@ -377,8 +377,8 @@ PK_API void pk_scene_destroy(pk_scene *scene);
  * environment map as raw files beside it, named after path: loading that file
  * gives a scene that renders the same bytes. Written under temporary names
  * and renamed into place at the end: on failure nothing is left. A scene the
- * format cannot express (instances kept as instances, a changed default
- * material, a value that is not finite) is an error that names it. */
+ * format cannot express (a changed default material, a value that is not
+ * finite) is an error that names it. */
 PK_API pk_status pk_scene_write_json(pk_context *ctx, const pk_scene *scene, const char *path);
 
 /* Light from the surroundings, replacing the scene's own (docs/scene-format.md,

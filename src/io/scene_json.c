@@ -45,6 +45,8 @@ typedef struct jp {
 /* The record forms that `paprsek convert` writes (at the end of this file). */
 static pk_status parse_material_record(jp *p, const cJSON *e, const char *path);
 static pk_status parse_ply_mesh(jp *p, const cJSON *it, const char *path);
+static pk_status parse_instance(jp *p, const cJSON *it, const char *path);
+static pk_status place_instance(jp *p, const cJSON *it, const char *path, uint32_t mesh);
 static pk_status parse_light_record(jp *p, const cJSON *it, const char *path);
 static pk_status parse_environment_record(jp *p, const cJSON *it);
 static pk_status parse_medium_record(jp *p, const cJSON *it, const char *path);
@@ -1333,6 +1335,7 @@ static pk_status parse_mesh(jp *p, const cJSON *it, const char *path)
     char fp[JP_PATH_MAX];
     xform xf;
     if (cJSON_GetObjectItemCaseSensitive(it, "ply")) return parse_ply_mesh(p, it, path);
+    if (cJSON_GetObjectItemCaseSensitive(it, "instance")) return parse_instance(p, it, path);
     pk_status st = object_fields(p, it, path, keys, M_COUNT, f);
     if (st) return st;
     if (!f[M_OBJ]) return jfail(p, PK_ERR_PARSE, it, path, "missing \"obj\"");
@@ -1849,53 +1852,23 @@ static pk_status parse_material_record(jp *p, const cJSON *e, const char *path)
     return add_material(p, &m, f[0]->valuestring, NULL);
 }
 
-/* {"ply": FILE, "materials": [names]}: a PLY mesh in world space whose
- * faces' "material" property indexes "materials" (default: material 0);
- * corners take the file's normals and uvs when it has them. */
-static pk_status parse_ply_mesh(jp *p, const cJSON *it, const char *path)
+/* One PLY file of a "ply" mesh: its vertices and triangles added to the
+ * scene, each face's "material" an index of mats (nmat names). */
+static pk_status load_ply_file(jp *p, const cJSON *file, const char *fp, const uint32_t *mats, size_t nmat)
 {
-    enum { P_PLY, P_MATERIALS, P_COUNT };
-    static const char *const keys[P_COUNT] = {"ply", "materials"};
-    const cJSON *f[P_COUNT];
-    char fp[JP_PATH_MAX];
-    pk_status st = object_fields(p, it, path, keys, P_COUNT, f);
-    if (st) return st;
-    path_key(fp, path, "ply");
-    if (!cJSON_IsString(f[P_PLY]) || !f[P_PLY]->valuestring[0])
-        return jfail(p, PK_ERR_PARSE, f[P_PLY], fp, "must be a non-empty string (a path)");
+    if (!cJSON_IsString(file) || !file->valuestring[0])
+        return jfail(p, PK_ERR_PARSE, file, fp, "must be a non-empty string (a path)");
     pk_scene *s = p->s;
     const pk_allocator *a = &p->ctx->alloc;
-    size_t nmat = 0;
-    uint32_t *mats = NULL;
-    char mp[JP_PATH_MAX];
-    path_key(mp, path, "materials");
-    if (f[P_MATERIALS]) {
-        if ((st = get_array(p, f[P_MATERIALS], mp))) return st;
-        nmat = (size_t)cJSON_GetArraySize(f[P_MATERIALS]);
-        mats = mem_calloc(a, nmat ? nmat : 1, sizeof *mats);
-        if (!mats) return ctx_nomem(p->ctx);
-        size_t i = 0;
-        for (const cJSON *e = f[P_MATERIALS]->child; e; e = e->next, i++) {
-            const int64_t idx = cJSON_IsString(e) ? scene_find_material(s, e->valuestring) : -1;
-            if (idx < 0) {
-                mem_free(a, mats);
-                return jfail(p, PK_ERR_PARSE, e, mp, "element %zu is not the name of a material", i);
-            }
-            mats[i] = (uint32_t)idx;
-        }
-    }
-    char *full = path_join(a, p->base_dir, f[P_PLY]->valuestring), *data = NULL;
+    char *full = path_join(a, p->base_dir, file->valuestring), *data = NULL;
     size_t size = 0;
     ply_mesh m;
     memset(&m, 0, sizeof m);
-    if (!full) {
-        st = ctx_nomem(p->ctx);
-        goto out;
-    }
+    pk_status st;
+    if (!full) return ctx_nomem(p->ctx);
     pk_context scratch = io_scratch_context(p->ctx);
-    if ((st = file_read_all(&scratch, full, &data, &size)) ||
-        (st = ply_parse(&scratch, data, size, full, &m))) {
-        jfail(p, st, f[P_PLY], fp, "%s", scratch.message);
+    if ((st = file_read_all(&scratch, full, &data, &size)) || (st = ply_parse(&scratch, data, size, full, &m))) {
+        jfail(p, st, file, fp, "%s", scratch.message);
         goto out;
     }
     const size_t pos0 = s->npositions, nrm0 = s->nnormals, uv0 = s->nuvs;
@@ -1909,8 +1882,8 @@ static pk_status parse_ply_mesh(jp *p, const cJSON *it, const char *path)
         tri.material = 0;
         if (m.face_material) {
             if (m.face_material[t] >= nmat) {
-                st = jfail(p, PK_ERR_PARSE, f[P_PLY], fp, "triangle %zu: material %u is not an index of \"materials\"",
-                           t, m.face_material[t]);
+                st = jfail(p, PK_ERR_PARSE, file, fp, "triangle %zu: material %u is not an index of \"materials\"", t,
+                           m.face_material[t]);
                 break;
             }
             tri.material = mats[m.face_material[t]];
@@ -1927,8 +1900,115 @@ out:
     ply_mesh_free(p->ctx, &m);
     mem_free(a, data);
     mem_free(a, full);
-    mem_free(a, mats);
     return st;
+}
+
+/* {"ply": FILE or [FILE, ...], "materials": [names], "instances": [...]}:
+ * PLY meshes (the files in order) whose faces' "material" property indexes
+ * "materials" (default: material 0); corners take the file's normals and
+ * uvs when it has them. Without "instances" the triangles are in world
+ * space; with it they are one object-space mesh, placed by each element
+ * {"transform": T, "material": NAME} (material: all its triangles'; absent:
+ * their own), and the mesh can be placed again by {"instance": ...}. */
+static pk_status parse_ply_mesh(jp *p, const cJSON *it, const char *path)
+{
+    enum { P_PLY, P_MATERIALS, P_INSTANCES, P_COUNT };
+    static const char *const keys[P_COUNT] = {"ply", "materials", "instances"};
+    const cJSON *f[P_COUNT];
+    char fp[JP_PATH_MAX], mp[JP_PATH_MAX], ip[JP_PATH_MAX];
+    pk_status st = object_fields(p, it, path, keys, P_COUNT, f);
+    if (st) return st;
+    pk_scene *s = p->s;
+    const pk_allocator *a = &p->ctx->alloc;
+    size_t nmat = 0;
+    uint32_t *mats = NULL;
+    path_key(mp, path, "materials");
+    path_key(ip, path, "instances");
+    if (f[P_INSTANCES] && (st = get_array(p, f[P_INSTANCES], ip))) return st;
+    if (f[P_MATERIALS]) {
+        if ((st = get_array(p, f[P_MATERIALS], mp))) return st;
+        nmat = (size_t)cJSON_GetArraySize(f[P_MATERIALS]);
+        mats = mem_calloc(a, nmat ? nmat : 1, sizeof *mats);
+        if (!mats) return ctx_nomem(p->ctx);
+        size_t i = 0;
+        for (const cJSON *e = f[P_MATERIALS]->child; e; e = e->next, i++) {
+            const int64_t idx = cJSON_IsString(e) ? scene_find_material(s, e->valuestring) : -1;
+            if (idx < 0) {
+                mem_free(a, mats);
+                return jfail(p, PK_ERR_PARSE, e, mp, "element %zu is not the name of a material", i);
+            }
+            mats[i] = (uint32_t)idx;
+        }
+    }
+    const size_t pos0 = s->npositions, nrm0 = s->nnormals, uv0 = s->nuvs, tri0 = s->ntris;
+    path_key(fp, path, "ply");
+    if (cJSON_IsArray(f[P_PLY])) {
+        int i = 0;
+        for (const cJSON *e = f[P_PLY]->child; e && st == PK_OK; e = e->next, i++) {
+            char ep[JP_PATH_MAX];
+            snprintf(ep, sizeof ep, "%.*s[%d]", JP_PATH_MAX - 16, fp, i);
+            st = load_ply_file(p, e, ep, mats, nmat);
+        }
+    } else {
+        st = load_ply_file(p, f[P_PLY], fp, mats, nmat);
+    }
+    mem_free(a, mats);
+    if (st || !f[P_INSTANCES]) return st;
+    uint32_t mesh;
+    if ((st = scene_capture_mesh(p->ctx, s, pos0, nrm0, uv0, tri0, &mesh))) return st;
+    int i = 0;
+    for (const cJSON *e = f[P_INSTANCES]->child; e && st == PK_OK; e = e->next, i++) {
+        char ep[JP_PATH_MAX];
+        snprintf(ep, sizeof ep, "%.*s[%d]", JP_PATH_MAX - 16, ip, i);
+        st = place_instance(p, e, ep, mesh);
+    }
+    return st;
+}
+
+/* {"transform": T, "material": NAME}: mesh placed once (material: for all
+ * its triangles; absent: their own). */
+static pk_status place_instance(jp *p, const cJSON *it, const char *path, uint32_t mesh)
+{
+    enum { I_TRANSFORM, I_MATERIAL, I_MESH, I_COUNT };
+    static const char *const keys[I_COUNT] = {"transform", "material", "mesh"};
+    const cJSON *f[I_COUNT];
+    char fp[JP_PATH_MAX];
+    pk_status st = object_fields(p, it, path, keys, I_COUNT, f);
+    if (st) return st;
+    path_key(fp, path, "transform");
+    if (!f[I_TRANSFORM]) return jfail(p, PK_ERR_PARSE, it, path, "missing \"transform\"");
+    xform x;
+    if ((st = parse_transform(p, f[I_TRANSFORM], fp, &x))) return st;
+    uint32_t mat = SCENE_MESH_MATERIAL;
+    if (f[I_MATERIAL]) {
+        path_key(fp, path, "material");
+        const int64_t idx = cJSON_IsString(f[I_MATERIAL]) ? scene_find_material(p->s, f[I_MATERIAL]->valuestring) : -1;
+        if (idx < 0) return jfail(p, PK_ERR_PARSE, f[I_MATERIAL], fp, "must be the name of a material");
+        mat = (uint32_t)idx;
+    }
+    pk_context scratch = io_scratch_context(p->ctx);
+    if ((st = scene_add_instance(&scratch, p->s, mesh, &x, mat))) return jfail(p, st, it, path, "%s", scratch.message);
+    return PK_OK;
+}
+
+/* {"instance": {"mesh": K, "transform": T, "material": NAME}} in "meshes":
+ * the scene's mesh K (the K-th mesh with "instances" of this file, from 0)
+ * placed once more. */
+static pk_status parse_instance(jp *p, const cJSON *it, const char *path)
+{
+    static const char *const outer[] = {"instance"};
+    const cJSON *f[1];
+    pk_status st = object_fields(p, it, path, outer, 1, f);
+    if (st) return st;
+    char fp[JP_PATH_MAX], mp[JP_PATH_MAX];
+    path_key(fp, path, "instance");
+    const cJSON *mi = cJSON_IsObject(f[0]) ? cJSON_GetObjectItemCaseSensitive(f[0], "mesh") : NULL;
+    path_key(mp, fp, "mesh");
+    if (!mi) return jfail(p, PK_ERR_PARSE, f[0], fp, "missing \"mesh\"");
+    int k = 0;
+    if ((st = get_int(p, mi, mp, 0, INT32_MAX, &k))) return st;
+    if ((size_t)k >= p->s->nmeshes) return jfail(p, PK_ERR_PARSE, mi, mp, "no mesh %d (%zu so far)", k, p->s->nmeshes);
+    return place_instance(p, f[0], fp, (uint32_t)k);
 }
 
 /* {"record": {...}} in "lights": a light as the scene holds it. */

@@ -7,7 +7,8 @@
  * mirrored textures, instances flattened into world triangles, emission
  * cloned onto materials) is already in it, so writing it needs no knowledge
  * of any format, and nothing has to be re-derived by the JSON reader (where
- * a second derivation could differ in a bit). The JSON format's "record"
+ * a second derivation could differ in a bit). Instances the commit kept are
+ * written as a mesh and its placements, in order, and kept again. The JSON format's "record"
  * forms (scene_record.h) carry each material, light, medium and the
  * environment field by field; triangles go to binary PLY files beside the
  * JSON, three vertices a triangle (the renderer looks triangles up by
@@ -415,24 +416,42 @@ static pk_status write_render(jw *w)
     return PK_OK;
 }
 
-/* The triangles [t0, t1) (all with or all without normals and uvs) as one
- * binary PLY file; the materials they use are listed in the JSON. */
-static pk_status write_ply(jw *w, size_t t0, size_t t1, bool has_n, bool has_t, uint32_t *local, uint32_t *used)
+/* Triangles with their vertex arrays: the world's, or a mesh's (whose
+ * triangles index its own ranges). */
+typedef struct tri_src {
+    const triangle *tris;
+    size_t ntris;
+    const vec3 *pos, *nrm;
+    const uv2 *uv;
+} tri_src;
+
+static bool tri_has_n(const triangle *t) { return t->n[0] >= 0 && t->n[1] >= 0 && t->n[2] >= 0; }
+static bool tri_has_t(const triangle *t) { return t->t[0] >= 0 && t->t[1] >= 0 && t->t[2] >= 0; }
+
+/* Material numbering of one "ply" entry: local[m] is material m's number + 1
+ * in the entry's "materials" list, used[] the list. */
+typedef struct mat_list {
+    uint32_t *local, *used;
+    size_t nused;
+} mat_list;
+
+/* The triangles [t0, t1) of src (all with or all without normals and uvs, as
+ * the renderer reads them: all three corners or none) as one binary PLY file,
+ * three vertices a triangle; rel receives its name. */
+static pk_status write_run(jw *w, const tri_src *src, size_t t0, size_t t1, mat_list *ml, char *rel, size_t rel_size)
 {
-    const pk_scene *s = w->s;
-    char suffix[64], rel[PATH_MAX];
+    const bool has_n = tri_has_n(&src->tris[t0]), has_t = tri_has_t(&src->tris[t0]);
+    char suffix[64];
     snprintf(suffix, sizeof suffix, ".mesh%zu.ply", w->nside++);
     FILE *f;
-    pk_status st = jw_open(w, suffix, &f, rel, sizeof rel);
+    pk_status st = jw_open(w, suffix, &f, rel, rel_size);
     if (st) return st;
     const char *final = w->final[w->nfiles - 1];
-    /* materials in the order of first use; local[m] is m's number + 1 in the list */
-    size_t nused = 0;
     for (size_t t = t0; t < t1; t++) {
-        const uint32_t m = s->tris[t].material;
-        if (!local[m]) {
-            used[nused++] = m;
-            local[m] = (uint32_t)nused;
+        const uint32_t m = src->tris[t].material;
+        if (!ml->local[m]) {
+            ml->used[ml->nused++] = m;
+            ml->local[m] = (uint32_t)ml->nused;
         }
     }
     const size_t ntri = t1 - t0;
@@ -444,18 +463,18 @@ static pk_status write_ply(jw *w, size_t t0, size_t t1, bool has_n, bool has_t, 
     if (has_t) fputs("property float u\nproperty float v\n", f);
     fprintf(f, "element face %zu\nproperty list uchar uint vertex_indices\nproperty uint material\nend_header\n", ntri);
     for (size_t t = t0; t < t1; t++) {
-        const triangle *tr = &s->tris[t];
+        const triangle *tr = &src->tris[t];
         for (int j = 0; j < 3; j++) {
             float v[8];
             int n = 0;
-            const vec3 p = s->positions[tr->v[j]];
+            const vec3 p = src->pos[tr->v[j]];
             v[n++] = p.x, v[n++] = p.y, v[n++] = p.z;
             if (has_n) {
-                const vec3 q = s->normals[tr->n[j]];
+                const vec3 q = src->nrm[tr->n[j]];
                 v[n++] = q.x, v[n++] = q.y, v[n++] = q.z;
             }
             if (has_t) {
-                const uv2 q = s->uvs[tr->t[j]];
+                const uv2 q = src->uv[tr->t[j]];
                 v[n++] = q.u, v[n++] = q.v;
             }
             fwrite(v, sizeof(float), (size_t)n, f); /* the machines Paprsek builds for are little-endian */
@@ -464,20 +483,48 @@ static pk_status write_ply(jw *w, size_t t0, size_t t1, bool has_n, bool has_t, 
     for (size_t t = t0; t < t1; t++) {
         const uint32_t base = (uint32_t)(3 * (t - t0));
         unsigned char three = 3;
-        const uint32_t rec[4] = {base, base + 1, base + 2, local[s->tris[t].material] - 1};
+        const uint32_t rec[4] = {base, base + 1, base + 2, ml->local[src->tris[t].material] - 1};
         fwrite(&three, 1, 1, f);
         fwrite(rec, sizeof(uint32_t), 4, f);
     }
-    if ((st = jw_close(w, f, final))) return st;
-    fputs("\n  {\"ply\": ", w->f);
-    jw_string(w->f, rel);
+    return jw_close(w, f, final);
+}
+
+/* The end of the run that starts at t0: where normals or uvs start or stop. */
+static size_t run_end(const tri_src *src, size_t t0)
+{
+    const bool hn = tri_has_n(&src->tris[t0]), ht = tri_has_t(&src->tris[t0]);
+    size_t t1 = t0 + 1;
+    while (t1 < src->ntris && t1 - t0 < ((size_t)1 << 28) && tri_has_n(&src->tris[t1]) == hn &&
+           tri_has_t(&src->tris[t1]) == ht)
+        t1++;
+    return t1;
+}
+
+/* "materials": [...] of an entry, and the list emptied for the next. */
+static void write_mat_list(jw *w, mat_list *ml)
+{
     fputs(", \"materials\": [", w->f);
-    for (size_t i = 0; i < nused; i++) {
+    for (size_t i = 0; i < ml->nused; i++) {
         if (i) fputs(", ", w->f);
-        jw_string(w->f, w->mat_names[used[i]]);
-        local[used[i]] = 0;
+        jw_string(w->f, w->mat_names[ml->used[i]]);
+        ml->local[ml->used[i]] = 0;
     }
-    fputs("]}", w->f);
+    fputs("]", w->f);
+    ml->nused = 0;
+}
+
+/* {"mesh": K, "transform": T, "material": NAME} of an "instance" entry. */
+static pk_status write_placement(jw *w, uint32_t mesh, const xform *x, uint32_t mat)
+{
+    fprintf(w->f, "{\"mesh\": %u, \"transform\": ", mesh);
+    pk_status st = jw_floats(w, x->m, 16, "instance transform");
+    if (st) return st;
+    if (mat != SCENE_MESH_MATERIAL) {
+        fputs(", \"material\": ", w->f);
+        jw_string(w->f, w->mat_names[mat]);
+    }
+    fputc('}', w->f);
     return PK_OK;
 }
 
@@ -485,39 +532,62 @@ static pk_status write_meshes(jw *w)
 {
     const pk_scene *s = w->s;
     const pk_allocator *a = &w->ctx->alloc;
-    uint32_t *local = mem_calloc(a, s->nmaterials, sizeof *local);
-    uint32_t *used = mem_calloc(a, s->nmaterials, sizeof *used);
+    mat_list ml = {mem_calloc(a, s->nmaterials, sizeof *ml.local), mem_calloc(a, s->nmaterials, sizeof *ml.used), 0};
+    uint32_t *mesh_no = mem_calloc(a, s->nmeshes ? s->nmeshes : 1, sizeof *mesh_no); /* JSON mesh number + 1 */
     pk_status st = PK_OK;
-    if (!local || !used) {
+    char rel[PATH_MAX];
+    if (!ml.local || !ml.used || !mesh_no) {
         st = ctx_nomem(w->ctx);
         goto out;
     }
     fputs(",\n\"meshes\": [", w->f);
-    /* runs of triangles that agree on normals and uvs (as the renderer
-     * reads them: all three corners, or none) */
-    size_t t0 = 0;
+    /* the world's triangles, a file (and an entry) per run */
+    const tri_src world = {s->tris, s->ntris, s->positions, s->normals, s->uvs};
     bool first = true;
-    while (t0 < s->ntris && st == PK_OK) {
-        const triangle *a0 = &s->tris[t0];
-        const bool hn = a0->n[0] >= 0 && a0->n[1] >= 0 && a0->n[2] >= 0;
-        const bool ht = a0->t[0] >= 0 && a0->t[1] >= 0 && a0->t[2] >= 0;
-        size_t t1 = t0 + 1;
-        while (t1 < s->ntris && t1 - t0 < ((size_t)1 << 28)) {
-            const triangle *b = &s->tris[t1];
-            if ((b->n[0] >= 0 && b->n[1] >= 0 && b->n[2] >= 0) != hn ||
-                (b->t[0] >= 0 && b->t[1] >= 0 && b->t[2] >= 0) != ht)
-                break;
-            t1++;
-        }
-        if (!first) fputc(',', w->f);
+    for (size_t t0 = 0; t0 < s->ntris && st == PK_OK;) {
+        const size_t t1 = run_end(&world, t0);
+        if ((st = write_run(w, &world, t0, t1, &ml, rel, sizeof rel))) break;
+        fprintf(w->f, "%s\n  {\"ply\": ", first ? "" : ",");
         first = false;
-        st = write_ply(w, t0, t1, hn, ht, local, used);
+        jw_string(w->f, rel);
+        write_mat_list(w, &ml);
+        fputc('}', w->f);
         t0 = t1;
+    }
+    /* the kept instances: each mesh once (its files, "instances": []), then
+     * every instance in order, so that their hit numbers stay as they were */
+    uint32_t nmesh = 0;
+    for (size_t i = 0; i < s->nkept && st == PK_OK; i++) {
+        const uint32_t mi = s->kept[i].mesh;
+        if (mesh_no[mi]) continue;
+        mesh_no[mi] = ++nmesh;
+        const scene_mesh *m = &s->meshes[mi];
+        const tri_src src = {s->mesh_tris + m->first_tri, m->ntris, s->mesh_positions + m->first_pos,
+                             s->mesh_normals + m->first_nrm, s->mesh_uvs + m->first_uv};
+        fprintf(w->f, "%s\n  {\"ply\": [", first ? "" : ",");
+        first = false;
+        for (size_t t0 = 0; t0 < src.ntris && st == PK_OK;) {
+            const size_t t1 = run_end(&src, t0);
+            if ((st = write_run(w, &src, t0, t1, &ml, rel, sizeof rel))) break;
+            if (t0) fputs(", ", w->f);
+            jw_string(w->f, rel);
+            t0 = t1;
+        }
+        fputc(']', w->f);
+        write_mat_list(w, &ml);
+        fputs(", \"instances\": []}", w->f);
+    }
+    for (size_t i = 0; i < s->nkept && st == PK_OK; i++) {
+        fprintf(w->f, "%s\n  {\"instance\": ", first ? "" : ",");
+        first = false;
+        st = write_placement(w, mesh_no[s->kept[i].mesh] - 1, &s->kept[i].to_world, s->kept[i].material);
+        fputc('}', w->f);
     }
     fputs("]", w->f);
 out:
-    mem_free(a, local);
-    mem_free(a, used);
+    mem_free(a, ml.local);
+    mem_free(a, ml.used);
+    mem_free(a, mesh_no);
     return st;
 }
 
@@ -610,11 +680,20 @@ pk_status pk_scene_write_json(pk_context *ctx, const pk_scene *s, const char *pa
 {
     if (!ctx || !s || !path) return PK_ERR_INVALID_ARGUMENT;
     if (!s->committed) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: the scene is not committed", path);
-    if (s->nkept)
-        return ctx_error(ctx, PK_ERR_UNSUPPORTED,
-                         "%s: the scene keeps %zu instances as instances (config scene.instances); the JSON writer "
-                         "writes world triangles only: load it with scene.instances=flatten",
-                         path, s->nkept);
+    /* Kept instances are written as instances, and the renderer keeps them
+     * again by the same rule (scene_commit), unless under scene.instances=auto
+     * a mesh was kept for a placement that is no longer there to count
+     * (placed twice, once as an emitter: flattened) */
+    if (ctx->config.instances == 0)
+        for (size_t i = 0; i < s->nkept; i++) {
+            size_t n = 0;
+            for (size_t j = 0; j < s->nkept && n < 2; j++) n += s->kept[j].mesh == s->kept[i].mesh;
+            if (n < 2)
+                return ctx_error(ctx, PK_ERR_UNSUPPORTED,
+                                 "%s: mesh %u is kept as an instance for a placement that was flattened; its JSON "
+                                 "scene would not be kept alike: convert with scene.instances=keep or flatten",
+                                 path, s->kept[i].mesh);
+        }
     const pk_allocator *a = &ctx->alloc;
     jw w = {.ctx = ctx, .s = s, .out = path};
     pk_status st = PK_OK;

@@ -55,9 +55,20 @@ mkdir -p "$tmp/ro" && chmod a-w "$tmp/ro"
 if [ ! -w "$tmp/ro" ]; then # (root writes anywhere)
   expect unwritable 1 "$tmp/ro" "$bin" convert "$data/conformance/box.obj" -o "$tmp/ro/x.json"
 fi
-# content the format cannot hold: instances kept as instances
-expect kept-instances 1 "scene.instances=flatten" "$bin" convert "$data/gltf/instanced.gltf" -o "$tmp/e/x.json" \
-  --config scene.instances=keep
+# instances kept as instances are written as instances ("instance" entries) and kept again
+if "$bin" convert "$data/gltf/instanced.gltf" -o "$tmp/kept.json" --config scene.instances=keep -q 2>"$tmp/err"; then
+  grep -q '"instance": {"mesh": 0' "$tmp/kept.json" || { echo "FAIL kept instances not written as instances"; fail=1; }
+  for src in "$data/gltf/instanced.gltf" "$tmp/kept.json"; do
+    "$bin" render "$src" -o "$tmp/kept.$(basename "$src").pfm" --config scene.instances=keep --width 40 --height 30 \
+      --spp 2 --aov albedo,normal,depth,heatmap -q || { echo "FAIL rendering $src with kept instances"; fail=1; }
+  done
+  for x in "" .albedo .normal .depth .heatmap; do
+    cmp -s "$tmp/kept.instanced.gltf$x.pfm" "$tmp/kept.kept.json$x.pfm" ||
+      { echo "FAIL kept instances render differently (image$x)"; fail=1; }
+  done
+else
+  echo "FAIL converting with kept instances: $(cat "$tmp/err")"; fail=1
+fi
 # the record forms refuse what no reader makes
 printf '{"materials": [{"name": "m", "record": {"type": 99}}], "spheres": [{"center": [0, 0, 0], "radius": 1}]}' >"$tmp/badtype.json"
 expect record-type 1 "badtype.json:1: materials\[0\].record: type must be in 0..6" "$bin" render "$tmp/badtype.json" -o "$tmp/e/x.pfm"
