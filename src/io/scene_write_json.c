@@ -180,9 +180,11 @@ static pk_status jw_fields(jw *w, bool *first, const rec_field *t, size_t n, con
     return PK_OK;
 }
 
-/* Unique names: names[i] stays when no other entry has it, else gets "#i". */
+/* Unique names: names[i] stays when no other entry has it, else gets "#i";
+ * with keep0, entry 0 (the default material, which every scene has under
+ * its name) keeps its name whatever the others are called. */
 static pk_status unique_names(jw *w, size_t n, const char *(*name_of)(const pk_scene *, size_t), const char *fallback,
-                              char ***out)
+                              bool keep0, char ***out)
 {
     const pk_allocator *a = &w->ctx->alloc;
     char **names = mem_calloc(a, n ? n : 1, sizeof *names);
@@ -191,7 +193,7 @@ static pk_status unique_names(jw *w, size_t n, const char *(*name_of)(const pk_s
     for (size_t i = 0; i < n; i++) {
         const char *nm = name_of(w->s, i);
         bool dup = !nm || !nm[0];
-        for (size_t j = 0; j < n && !dup; j++) {
+        for (size_t j = 0; j < n && !dup && !(keep0 && i == 0); j++) {
             const char *o = name_of(w->s, j);
             dup = j != i && o && strcmp(o, nm) == 0;
         }
@@ -706,8 +708,8 @@ pk_status pk_scene_write_json(pk_context *ctx, const pk_scene *s, const char *pa
         st = ctx_nomem(ctx);
         goto out;
     }
-    if ((st = unique_names(&w, s->nmaterials, material_name, "material", &w.mat_names)) ||
-        (st = unique_names(&w, s->nmedia, medium_name, "medium", &w.med_names)))
+    if ((st = unique_names(&w, s->nmaterials, material_name, "material", true, &w.mat_names)) ||
+        (st = unique_names(&w, s->nmedia, medium_name, "medium", false, &w.med_names)))
         goto out;
     /* the JSON's temporary name first, so that an unwritable folder fails
      * before any side file is written */

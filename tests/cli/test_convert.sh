@@ -10,7 +10,7 @@
 # usage: test_convert.sh PAPRSEK SHARED_DIR DATA_DIR
 set -u
 bin=$1
-data=$3
+data=$(cd "$3" && pwd)
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 # shellcheck source=convert_same.sh
 . "$here/convert_same.sh"
@@ -28,6 +28,14 @@ convert_same "$bin" "$tmp" \
   "$data/fuzz_seed_full.json" "$data/fuzz_seed_full.xml" "$data/tex_scene.obj" "$data/obj_mat.obj" \
   "$data/convert/lights.xml" "$data/convert/lights.pbrt" "$data/convert/lights.json" "$data/convert/spot.gltf" \
   "$data/../../bench/scenes/materials.json" "$data/../../bench/scenes/materials.xml" || fail=1
+
+# names: a material named as the default one, and two of one name (renamed NAME#N)
+printf '{"materials": [{"name": "default", "kd": [0.9, 0.1, 0.1]}, {"name": "twice", "kd": [0.1, 0.9, 0.1]},
+  {"name": "twice", "kd": [0.1, 0.1, 0.9]}],
+  "meshes": [{"obj": "%s/json_floor.obj"}],
+  "spheres": [{"center": [-1, 0.5, 0], "radius": 0.5}, {"center": [0, 0.5, 0], "radius": 0.5, "material": "default"},
+  {"center": [1, 0.5, 0], "radius": 0.5, "material": "twice"}], "environment": [1, 1, 1]}' "$data" >"$tmp/names.json"
+convert_same "$bin" "$tmp" "$tmp/names.json" || fail=1
 
 # a converted scene (records, PLY meshes, raw pixels) converts again to the same image
 mkdir -p "$tmp/again"
