@@ -37,6 +37,18 @@ printf '{"materials": [{"name": "default", "kd": [0.9, 0.1, 0.1]}, {"name": "twi
   {"center": [1, 0.5, 0], "radius": 0.5, "material": "twice"}], "environment": [1, 1, 1]}' "$data" >"$tmp/names.json"
 convert_same "$bin" "$tmp" "$tmp/names.json" || fail=1
 
+# a grid medium with all three grids (density of 3 channels), emitting, in a moved box
+printf '{"media": [{"name": "g", "type": "grid", "sigma_t": [2, 3, 4], "albedo": 0.8, "g": 0.4, "emission": [0.5, 0.3, 0.1],
+  "density": {"size": [2, 2, 2], "channels": 3, "data": [1,0,1, 2,1,0, 0,1,1, 1,1,1, 3,2,1, 0,0,1, 1,2,3, 0.5,0.5,0.5]},
+  "albedo_grid": {"size": [2, 1, 1], "channels": 1, "data": [0.2, 0.9]},
+  "emission_grid": {"size": [1, 2, 1], "channels": 3, "data": [1, 0, 0, 0, 1, 1]},
+  "bounds": {"min": [-1, 0, -1], "max": [1, 2, 1]}, "transform": {"rotate": [20, 0, 1, 0]}}],
+  "materials": [{"name": "boundary", "type": "interface", "interior": "g", "exterior": null}],
+  "meshes": [{"obj": "%s/media/fog_cube.obj"}],
+  "spheres": [{"center": [0, -101, 0], "radius": 100}],
+  "lights": [{"position": [0, 5, 3], "intensity": 30}], "camera": {"look_from": [0, 1, 5], "look_at": [0, 1, 0]}}' "$data" >"$tmp/grid.json"
+convert_same "$bin" "$tmp" "$tmp/grid.json|volpath" || fail=1
+
 # a converted scene (records, PLY meshes, raw pixels) converts again to the same image
 mkdir -p "$tmp/again"
 if "$bin" convert "$data/convert/lights.xml" -o "$tmp/again/first.json" -q 2>"$tmp/err"; then
