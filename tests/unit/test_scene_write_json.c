@@ -5,6 +5,9 @@
  *    kind (tiny, huge, subnormal, -0, random bit patterns) and whose lights
  *    and materials hold awkward values comes back from its JSON with the same
  *    bits in every world triangle corner, material record field and light;
+ *  - scenes of every format (tests/data/convert, the fog scene) come back
+ *    with the same render settings and their has_ flags, ambient light,
+ *    environment (map pixels included), media and grids;
  *  - what the format cannot hold (a changed default material, a number that
  *    is not finite) is refused with a message naming it, and leaves no file;
  *  - an unwritable place fails before anything is written.
@@ -97,6 +100,69 @@ static void compare(const pk_scene *a, const pk_scene *b)
     CHECK(a->has_camera == b->has_camera && same_bits(&a->camera, &b->camera, sizeof a->camera));
 }
 
+/* The rest of the scene: render settings, ambient, environment, media. */
+static void compare_rest(const pk_scene *a, const pk_scene *b)
+{
+    const scene_render_settings *ra = &a->render, *rb = &b->render;
+    CHECK(ra->has_width == rb->has_width && ra->has_height == rb->has_height && ra->has_spp == rb->has_spp &&
+          ra->has_light_samples == rb->has_light_samples && ra->has_max_depth == rb->has_max_depth &&
+          ra->has_threads == rb->has_threads && ra->has_accel == rb->has_accel && ra->has_fresnel == rb->has_fresnel &&
+          ra->has_seed == rb->has_seed && ra->has_integrator == rb->has_integrator &&
+          ra->has_regularize == rb->has_regularize && ra->has_light_tree == rb->has_light_tree &&
+          ra->has_clamp_indirect == rb->has_clamp_indirect);
+    const pk_render_options *oa = &ra->opt, *ob = &rb->opt;
+    CHECK(oa->width == ob->width && oa->height == ob->height && oa->spp == ob->spp &&
+          oa->light_samples == ob->light_samples && oa->max_depth == ob->max_depth && oa->threads == ob->threads &&
+          oa->accel == ob->accel && oa->fresnel == ob->fresnel && oa->seed == ob->seed &&
+          oa->integrator == ob->integrator && oa->regularize == ob->regularize && oa->light_tree == ob->light_tree &&
+          same_bits(&oa->clamp_indirect, &ob->clamp_indirect, sizeof(float)));
+    CHECK(same_bits(&a->ambient, &b->ambient, sizeof(vec3)));
+    for (size_t f = 0; f < rec_nenv; f++)
+        CHECKF(same_bits((const char *)&a->env + rec_env[f].offset, (const char *)&b->env + rec_env[f].offset,
+                         rec_size(rec_env[f].type)),
+               "environment field %s", rec_env[f].name);
+    CHECK(a->env.map_w == b->env.map_w && a->env.map_h == b->env.map_h);
+    if (a->env.map_rgb && b->env.map_rgb)
+        CHECK(same_bits(a->env.map_rgb, b->env.map_rgb, 3 * sizeof(float) * (size_t)a->env.map_w * (size_t)a->env.map_h));
+    CHECK(a->camera_medium == b->camera_medium);
+    REQUIRE(a->nmedia == b->nmedia);
+    for (size_t i = 0; i < a->nmedia; i++) {
+        for (size_t f = 0; f < rec_nmedium; f++)
+            CHECKF(same_bits((const char *)&a->media[i] + rec_medium[f].offset,
+                             (const char *)&b->media[i] + rec_medium[f].offset, rec_size(rec_medium[f].type)),
+                   "medium %zu field %s", i, rec_medium[f].name);
+        const medium_grid *ga[3] = {&a->media[i].density, &a->media[i].albedo_grid, &a->media[i].emission_grid};
+        const medium_grid *gb[3] = {&b->media[i].density, &b->media[i].albedo_grid, &b->media[i].emission_grid};
+        for (int g = 0; g < 3; g++) {
+            CHECK(!ga[g]->data == !gb[g]->data);
+            if (!ga[g]->data || !gb[g]->data) continue;
+            CHECK(ga[g]->nx == gb[g]->nx && ga[g]->ny == gb[g]->ny && ga[g]->nz == gb[g]->nz &&
+                  ga[g]->channels == gb[g]->channels);
+            CHECK(same_bits(ga[g]->data, gb[g]->data,
+                            sizeof(float) * (size_t)ga[g]->nx * (size_t)ga[g]->ny * (size_t)ga[g]->nz *
+                                (size_t)ga[g]->channels));
+        }
+    }
+}
+
+/* Loads path, writes it into dir, loads that and compares every part. */
+static void round_trip(const char *path, const char *dir)
+{
+    char out[256];
+    snprintf(out, sizeof out, "%s/trip.json", dir);
+    pk_scene *a = NULL, *b = NULL;
+    REQUIRE(pk_scene_load_file(ctx, path, &a) == PK_OK);
+    REQUIRE(pk_scene_write_json(ctx, a, out) == PK_OK);
+    if (pk_scene_load_file(ctx, out, &b) != PK_OK) {
+        fprintf(stderr, "%s: reloading: %s\n", path, pk_context_error(ctx));
+        REQUIRE(0);
+    }
+    compare(a, b);
+    compare_rest(a, b);
+    pk_scene_destroy(a);
+    pk_scene_destroy(b);
+}
+
 int main(void)
 {
     REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
@@ -134,6 +200,16 @@ int main(void)
     compare(s, c);
     pk_scene_destroy(b);
     pk_scene_destroy(c);
+
+    /* ---- every part of scenes in each format ---- */
+    static const char *const scenes[] = {"convert/lights.json", "convert/lights.xml", "convert/lights.pbrt",
+                                         "convert/spot.gltf",   "media/fog.json",     "media/fog.xml",
+                                         "media/fog.pbrt",      "tex_json.json"};
+    for (size_t i = 0; i < sizeof scenes / sizeof scenes[0]; i++) {
+        char path[512];
+        snprintf(path, sizeof path, "%s/%s", PK_TEST_DATA, scenes[i]);
+        round_trip(path, dir);
+    }
 
     /* ---- refused, nothing written ---- */
     char empty[] = "/tmp/pk_write_json_e_XXXXXX";
