@@ -16,7 +16,8 @@
  * on having normals and uvs, with a face property naming the material;
  * texture images named by a file are referenced by its absolute path, others
  * (glTF's embedded and derived images), the environment map and media grids
- * are raw little-endian files of the numbers in memory.
+ * are raw files of the numbers in memory (little-endian on the machines
+ * Paprsek builds for).
  *
  * Every float is printed with the fewest digits (at most 9) that read back
  * to the same float, checked here. Files are written under temporary names
@@ -457,10 +458,11 @@ static pk_status write_run(jw *w, const tri_src *src, size_t t0, size_t t1, mat_
         }
     }
     const size_t ntri = t1 - t0;
+    const uint16_t one = 1; /* the numbers go out in this machine's order, which the header names */
     fprintf(f,
-            "ply\nformat binary_little_endian 1.0\ncomment written by paprsek convert\n"
+            "ply\nformat binary_%s_endian 1.0\ncomment written by paprsek convert\n"
             "element vertex %zu\nproperty float x\nproperty float y\nproperty float z\n",
-            3 * ntri);
+            *(const uint8_t *)&one ? "little" : "big", 3 * ntri);
     if (has_n) fputs("property float nx\nproperty float ny\nproperty float nz\n", f);
     if (has_t) fputs("property float u\nproperty float v\n", f);
     fprintf(f, "element face %zu\nproperty list uchar uint vertex_indices\nproperty uint material\nend_header\n", ntri);
@@ -479,7 +481,7 @@ static pk_status write_run(jw *w, const tri_src *src, size_t t0, size_t t1, mat_
                 const uv2 q = src->uv[tr->t[j]];
                 v[n++] = q.u, v[n++] = q.v;
             }
-            fwrite(v, sizeof(float), (size_t)n, f); /* the machines Paprsek builds for are little-endian */
+            fwrite(v, sizeof(float), (size_t)n, f);
         }
     }
     for (size_t t = t0; t < t1; t++) {
