@@ -24,6 +24,10 @@ void cli_render_help(FILE *f);
 int cli_bench(int argc, char **argv);
 void cli_bench_help(FILE *f);
 
+/* `paprsek convert SCENE -o OUT.json` (cli/convert.c). argv[0] is "convert". */
+int cli_convert(int argc, char **argv);
+void cli_convert_help(FILE *f);
+
 /* ---- options (cli/options.c) ----------------------------------------------
  * One table per command serves parsing (getopt_long: --name VALUE,
  * --name=VALUE, unique abbreviations, -o VALUE), the range checks of its

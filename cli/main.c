@@ -20,6 +20,8 @@ static void usage(FILE *f)
           "  view [SCENE]              render a scene progressively in the browser: move the\n"
           "                            camera, focus, expose, save (serves http://127.0.0.1)\n"
           "  denoise IN -o OUT         denoise a rendered image (its albedo and normal too)\n"
+          "  convert SCENE -o OUT.json write any scene as a Paprsek JSON scene that renders\n"
+          "                            the same image\n"
           "  bench rays SCENE RAYS     time an accelerator on a ray file\n"
           "  bench gen-rays SCENE ...  make the standard ray files\n"
           "  bench compare A B         check that two hit files agree\n"
@@ -34,7 +36,7 @@ static void usage(FILE *f)
           f);
 }
 
-static const char *const commands[] = {"render", "view", "denoise", "bench", "help"};
+static const char *const commands[] = {"render", "view", "denoise", "convert", "bench", "help"};
 
 #if !PK_HAVE_VIEW
 static int view_missing(void)
@@ -62,6 +64,7 @@ int main(int argc, char **argv)
     if (strcmp(cmd, "render") == 0) return cli_render(argc - 1, argv + 1);
     if (strcmp(cmd, "bench") == 0) return cli_bench(argc - 1, argv + 1);
     if (strcmp(cmd, "denoise") == 0) return cli_denoise(argc - 1, argv + 1);
+    if (strcmp(cmd, "convert") == 0) return cli_convert(argc - 1, argv + 1);
 #if PK_HAVE_VIEW
     if (strcmp(cmd, "view") == 0) return cli_view(argc - 1, argv + 1);
 #else
@@ -83,6 +86,10 @@ int main(int argc, char **argv)
         }
         if (strcmp(argv[2], "denoise") == 0) {
             cli_denoise_help(stdout);
+            return 0;
+        }
+        if (strcmp(argv[2], "convert") == 0) {
+            cli_convert_help(stdout);
             return 0;
         }
         if (strcmp(argv[2], "view") == 0) {

@@ -384,6 +384,14 @@ PK_API pk_status pk_scene_load_xml_memory(pk_context *ctx, const char *data, siz
 /* The built-in Cornell box (camera, light quad, two boxes). */
 PK_API pk_status pk_scene_create_cornell_box(pk_context *ctx, pk_scene **out);
 PK_API void pk_scene_destroy(pk_scene *scene);
+/* Writes a loaded scene as a Paprsek JSON scene at path (docs/scene-format.md,
+ * "Records"), its triangles as binary PLY files and its images, grids and
+ * environment map as raw files beside it, named after path: loading that file
+ * gives a scene that renders the same bytes. Written under temporary names
+ * and renamed into place at the end: on failure nothing is left. A scene the
+ * format cannot express (a changed default material, a value that is not
+ * finite) is an error that names it. */
+PK_API pk_status pk_scene_write_json(pk_context *ctx, const pk_scene *scene, const char *path);
 
 /* Light from the surroundings, replacing the scene's own (docs/scene-format.md,
  * "environment"): a constant radiance plus a lat-long image (PNG, JPEG,

@@ -152,6 +152,7 @@ void ply_mesh_free(pk_context *ctx, ply_mesh *m)
     mem_free(&ctx->alloc, m->normals);
     mem_free(&ctx->alloc, m->uvs);
     mem_free(&ctx->alloc, m->indices);
+    mem_free(&ctx->alloc, m->face_material);
     memset(m, 0, sizeof *m);
 }
 
@@ -256,7 +257,7 @@ pk_status ply_parse(pk_context *ctx, const char *data, size_t size, const char *
 
     /* ---- the data, element by element */
     size_t ncap = 0;
-    size_t nidx = 0, cap_idx = 0;
+    size_t nidx = 0, cap_idx = 0, cap_fmat = 0, nfmat = 0; /* nfmat: triangles face_material covers */
     bool have_vertices = false;
     for (int ei = 0; ei < nels; ei++) {
         ply_element *el = &els[ei];
@@ -273,7 +274,7 @@ pk_status ply_parse(pk_context *ctx, const char *data, size_t size, const char *
             goto out;
         }
         bool is_vertex = strcmp(el->name, "vertex") == 0, is_face = strcmp(el->name, "face") == 0;
-        int px = -1, py = -1, pz = -1, pnx = -1, pny = -1, pnz = -1, pu = -1, pv = -1, pidx = -1;
+        int px = -1, py = -1, pz = -1, pnx = -1, pny = -1, pnz = -1, pu = -1, pv = -1, pidx = -1, pmat = -1;
         for (int k = 0; k < el->nprops; k++) {
             const char *pn = el->props[k].name;
             bool list = el->props[k].count_type != T_NONE;
@@ -290,6 +291,7 @@ pk_status ply_parse(pk_context *ctx, const char *data, size_t size, const char *
                     pv = k;
             }
             if (is_face && list && (!strcmp(pn, "vertex_indices") || !strcmp(pn, "vertex_index"))) pidx = k;
+            if (is_face && !list && !strcmp(pn, "material")) pmat = k;
         }
         if (is_vertex) {
             if (have_vertices) {
@@ -318,6 +320,7 @@ pk_status ply_parse(pk_context *ctx, const char *data, size_t size, const char *
         }
         for (uint64_t it = 0; it < el->count; it++) {
             double vals[PLY_MAX_PROPS] = {0.0};
+            const size_t tri_before = nidx / 3;
             for (int k = 0; k < el->nprops; k++) {
                 ply_prop *pr = &el->props[k];
                 vals[k] = 0.0;
@@ -346,6 +349,18 @@ pk_status ply_parse(pk_context *ctx, const char *data, size_t size, const char *
                     prev = vi;
                 }
             }
+            if (pmat >= 0 && nidx / 3 > tri_before) { /* the face's triangles take its material */
+                if (!mem_grow(&ctx->alloc, (void **)&out->face_material, &cap_fmat, nidx / 3,
+                              sizeof *out->face_material)) {
+                    st = ctx_nomem(ctx);
+                    goto out;
+                }
+                const double mv = vals[pmat];
+                const uint32_t m = mv >= 0.0 && mv < (double)UINT32_MAX && mv == floor(mv) ? (uint32_t)mv : UINT32_MAX;
+                for (size_t t = nfmat; t < tri_before; t++) out->face_material[t] = UINT32_MAX; /* faces without one */
+                for (size_t t = tri_before; t < nidx / 3; t++) out->face_material[t] = m;
+                nfmat = nidx / 3;
+            }
             if (is_vertex) {
                 vec3 q = v3((float)vals[px], (float)vals[py], (float)vals[pz]);
                 if (!v3_finite(q)) {
@@ -369,6 +384,13 @@ pk_status ply_parse(pk_context *ctx, const char *data, size_t size, const char *
         goto out;
     }
     out->ntriangles = nidx / 3;
+    if (out->face_material && nfmat < out->ntriangles) { /* faces after the last with a material have none */
+        if (!mem_grow(&ctx->alloc, (void **)&out->face_material, &cap_fmat, out->ntriangles, sizeof *out->face_material)) {
+            st = ctx_nomem(ctx);
+            goto out;
+        }
+        for (size_t t = nfmat; t < out->ntriangles; t++) out->face_material[t] = UINT32_MAX;
+    }
     for (size_t i = 0; i < nidx; i++)
         if (out->indices[i] >= out->nvertices) {
             st = fail(&r, "triangle %zu: vertex index %u out of range (0..%zu)", i / 3, out->indices[i],

@@ -93,6 +93,10 @@ typedef struct ply_mesh {
     size_t nvertices;
     uint32_t *indices;    /* 3 * ntriangles, each < nvertices */
     size_t ntriangles;
+    /* ntriangles: the face property "material" (an integer, as Paprsek's
+     * converter writes it; UINT32_MAX where it is not a whole number >= 0
+     * or a face has no such property), or NULL when no face has one */
+    uint32_t *face_material;
 } ply_mesh;
 
 /* Parses a PLY file held in (data, size) into *out (zeroed first; free it

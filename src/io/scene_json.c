@@ -13,6 +13,7 @@
 #include "grid_io.h"
 #include "io_util.h"
 #include "readers.h"
+#include "scene_record.h"
 #include "../math/xform.h"
 #include "../options.h"
 #include "../scene/camera.h"
@@ -42,6 +43,15 @@ typedef struct jp {
     bool warn_full;        /* the "not reported" point was passed */
     char warned[JP_WARN_MAX][JP_PATH_MAX];
 } jp;
+
+/* The record forms that `paprsek convert` writes (at the end of this file). */
+static pk_status parse_material_record(jp *p, const cJSON *e, const char *path);
+static pk_status parse_ply_mesh(jp *p, const cJSON *it, const char *path);
+static pk_status parse_instance(jp *p, const cJSON *it, const char *path);
+static pk_status place_instance(jp *p, const cJSON *it, const char *path, uint32_t mesh);
+static pk_status parse_light_record(jp *p, const cJSON *it, const char *path);
+static pk_status parse_environment_record(jp *p, const cJSON *it);
+static pk_status parse_medium_record(jp *p, const cJSON *it, const char *path);
 
 /* ---- positions ------------------------------------------------------------ */
 
@@ -614,6 +624,7 @@ static pk_status read_medium(jp *p, const cJSON *it, const char *path, medium *m
 
 static pk_status parse_medium(jp *p, const cJSON *it, const char *path)
 {
+    if (cJSON_GetObjectItemCaseSensitive(it, "record")) return parse_medium_record(p, it, path);
     medium m;
     medium_init(&m);
     pk_status st = read_medium(p, it, path, &m);
@@ -750,6 +761,10 @@ static pk_status parse_materials(jp *p, const cJSON *it)
     for (const cJSON *e = it->child; e; e = e->next, i++) {
         const cJSON *name = NULL;
         path_index(mp, "materials", i);
+        if (cJSON_GetObjectItemCaseSensitive(e, "record")) {
+            if ((st = parse_material_record(p, e, mp))) return st;
+            continue;
+        }
         if ((st = read_material(p, e, mp, true, &m, &name))) return st;
         if (!name) return jfail(p, PK_ERR_PARSE, e, mp, "missing \"name\"");
         char np[JP_PATH_MAX];
@@ -994,6 +1009,8 @@ static pk_status parse_mesh(jp *p, const cJSON *it, const char *path)
     const cJSON *f[M_COUNT];
     char fp[JP_PATH_MAX];
     xform xf;
+    if (cJSON_GetObjectItemCaseSensitive(it, "ply")) return parse_ply_mesh(p, it, path);
+    if (cJSON_GetObjectItemCaseSensitive(it, "instance")) return parse_instance(p, it, path);
     pk_status st = object_fields(p, it, path, keys, M_COUNT, f);
     if (st) return st;
     if (!f[M_OBJ]) return jfail(p, PK_ERR_PARSE, it, path, "missing \"obj\"");
@@ -1113,6 +1130,7 @@ static pk_status parse_sphere(jp *p, const cJSON *it, const char *path)
 static pk_status parse_light(jp *p, const cJSON *it, const char *path)
 {
     if (!cJSON_IsObject(it)) return jfail(p, PK_ERR_PARSE, it, path, "must be an object");
+    if (cJSON_GetObjectItemCaseSensitive(it, "record")) return parse_light_record(p, it, path);
     pdict d;
     pd_init(&d, p->ctx, &pd_json, p, "light", false);
     pk_status st = pd_from_cjson(&d, it, path);
@@ -1196,6 +1214,7 @@ static pk_status parse_environment(jp *p, const cJSON *it)
     env->set = true;
     pk_status st;
     if (cJSON_IsString(it) && strcmp(it->valuestring, "none") == 0) return PK_OK;
+    if (cJSON_GetObjectItemCaseSensitive(it, "record")) return parse_environment_record(p, it);
     if (cJSON_IsArray(it) || cJSON_IsNumber(it)) return get_color(p, it, "environment", &env->radiance);
     enum { E_RADIANCE, E_MAP, E_SCALE, E_ROTATION, E_SUN, E_SKY, E_COUNT };
     static const char *const keys[E_COUNT] = {"radiance", "map", "scale", "rotation", "sun", "sky"};
@@ -1251,6 +1270,469 @@ static pk_status parse_environment(jp *p, const cJSON *it)
         if (st) return jfail(p, st, f[E_MAP], "environment.map", "%s", scratch.message);
     }
     return PK_OK;
+}
+
+/* ---- records (scene_record.h): what `paprsek convert` writes ----------------- */
+
+/* Reads the plain fields of table t present in obj into dst; the keys of
+ * extra are the caller's (skipped here); other keys are warned about. */
+static pk_status rec_read(jp *p, const cJSON *obj, const char *path, const rec_field *t, size_t n,
+                          const char *const *extra, void *dst)
+{
+    if (!cJSON_IsObject(obj)) return jfail(p, PK_ERR_PARSE, obj, path, "must be an object");
+    char fp[JP_PATH_MAX];
+    pk_status st;
+    for (const cJSON *m = obj->child; m; m = m->next) {
+        path_key(fp, path, m->string);
+        size_t i = 0;
+        while (i < n && (!m->string || strcmp(m->string, t[i].name) != 0)) i++;
+        if (i == n) {
+            bool known = false;
+            for (const char *const *e = extra; e && *e && !known; e++) known = m->string && strcmp(m->string, *e) == 0;
+            if (!known) warn_unknown(p, m, fp);
+            continue;
+        }
+        void *at = (char *)dst + t[i].offset;
+        switch (t[i].type) {
+        case REC_FLOAT: st = get_float(p, m, fp, (float *)at); break;
+        case REC_VEC3: st = get_vec3(p, m, fp, (vec3 *)at); break;
+        case REC_F2: st = get_floats(p, m, fp, (float *)at, 2); break;
+        case REC_F9: st = get_floats(p, m, fp, (float *)at, 9); break;
+        case REC_F16: st = get_floats(p, m, fp, (float *)at, 16); break;
+        case REC_INT: st = get_int(p, m, fp, INT32_MIN + 1, INT32_MAX, (int *)at); break;
+        case REC_U8: {
+            int v = 0;
+            st = get_int(p, m, fp, 0, 255, &v);
+            *(uint8_t *)at = (uint8_t)v;
+            break;
+        }
+        case REC_BOOL:
+            st = cJSON_IsBool(m) ? PK_OK : jfail(p, PK_ERR_PARSE, m, fp, "must be true or false");
+            *(bool *)at = cJSON_IsTrue(m);
+            break;
+        default: st = PK_OK;
+        }
+        if (st) return st;
+    }
+    return PK_OK;
+}
+
+/* A raw pixel or voxel file of a record: exactly count elements of elem
+ * bytes, read relative to the scene's folder into *out (owned). */
+static pk_status rec_raw_file(jp *p, const cJSON *it, const char *path, size_t count, size_t elem, void **out)
+{
+    *out = NULL;
+    if (!cJSON_IsString(it) || !it->valuestring[0])
+        return jfail(p, PK_ERR_PARSE, it, path, "must be a non-empty string (a path)");
+    const pk_allocator *a = &p->ctx->alloc;
+    char *full = path_join(a, p->base_dir, it->valuestring), *data = NULL;
+    if (!full) return ctx_nomem(p->ctx);
+    size_t size = 0;
+    pk_context scratch = io_scratch_context(p->ctx);
+    pk_status st = file_read_all(&scratch, full, &data, &size);
+    mem_free(a, full);
+    if (st) return jfail(p, st, it, path, "%s", scratch.message);
+    if (count > SIZE_MAX / elem || size != count * elem) {
+        mem_free(a, data);
+        return jfail(p, PK_ERR_PARSE, it, path, "holds %zu bytes; the record's sizes need %zu", size,
+                     count <= SIZE_MAX / elem ? count * elem : SIZE_MAX);
+    }
+    *out = data;
+    return PK_OK;
+}
+
+/* A positive size of n integers (image sides, grid sides) at key of obj,
+ * each at most hi, their product *count at most max_count. */
+static pk_status rec_sizes(jp *p, const cJSON *obj, const char *path, const char *key, int n, int hi,
+                           size_t max_count, int *out, size_t *count)
+{
+    char fp[JP_PATH_MAX];
+    path_key(fp, path, key);
+    const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!cJSON_IsArray(it) || cJSON_GetArraySize(it) != n)
+        return jfail(p, PK_ERR_PARSE, it ? it : obj, fp, "must be an array of %d integers", n);
+    *count = 1;
+    int i = 0;
+    for (const cJSON *e = it->child; e; e = e->next, i++) {
+        pk_status st = get_int(p, e, fp, 1, hi, &out[i]);
+        if (st) return st;
+        if ((size_t)out[i] > max_count / *count)
+            return jfail(p, PK_ERR_LIMIT, it, fp, "more than %zu elements", max_count);
+        *count *= (size_t)out[i];
+    }
+    return PK_OK;
+}
+
+/* A texture reference: its plain fields, and an image by path
+ * ("image", "colour") or by raw level-0 pixels ("pixels": {"file", "key",
+ * "size", "channels", "float", "colour"}). */
+static pk_status read_texref_record(jp *p, const cJSON *it, const char *path, tex_ref *r)
+{
+    static const char *const extra[] = {"image", "colour", "pixels", NULL};
+    tex_ref_init(r);
+    pk_status st = rec_read(p, it, path, rec_texref, rec_ntexref, extra, r);
+    if (st) return st;
+    if (r->kind > TEX_CHECKER) return jfail(p, PK_ERR_PARSE, it, path, "kind must be 0 (none), 1 (image) or 2 (checker)");
+    if (r->kind != TEX_IMAGE) return PK_OK;
+    char fp[JP_PATH_MAX];
+    const cJSON *img = cJSON_GetObjectItemCaseSensitive(it, "image");
+    const cJSON *px = cJSON_GetObjectItemCaseSensitive(it, "pixels");
+    bool colour = cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(it, "colour"));
+    if (img) {
+        path_key(fp, path, "image");
+        if (!cJSON_IsString(img) || !img->valuestring[0])
+            return jfail(p, PK_ERR_PARSE, img, fp, "must be a non-empty string (a path)");
+        char *full = path_join(&p->ctx->alloc, p->base_dir, img->valuestring);
+        if (!full) return ctx_nomem(p->ctx);
+        pk_context scratch = io_scratch_context(p->ctx);
+        st = texture_load(&scratch, p->s, full, colour, &r->tex);
+        mem_free(&p->ctx->alloc, full);
+        if (st) return jfail(p, st, img, fp, "%s", scratch.message);
+        return PK_OK;
+    }
+    path_key(fp, path, "pixels");
+    if (!cJSON_IsObject(px)) return jfail(p, PK_ERR_PARSE, px ? px : it, fp, "an image map needs \"image\" or \"pixels\"");
+    const cJSON *key = cJSON_GetObjectItemCaseSensitive(px, "key");
+    const cJSON *fl = cJSON_GetObjectItemCaseSensitive(px, "float");
+    colour = cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(px, "colour"));
+    if (!cJSON_IsString(key)) return jfail(p, PK_ERR_PARSE, px, fp, "missing \"key\" (a string)");
+    if ((r->tex = texture_find(p->s, key->valuestring, colour)) >= 0) return PK_OK;
+    int wh[2], nc = 0;
+    size_t count;
+    if ((st = rec_sizes(p, px, fp, "size", 2, PK_MAX_TEXTURE_SIDE, PK_MAX_TEXTURE_PIXELS, wh, &count))) return st;
+    char cp[JP_PATH_MAX];
+    path_key(cp, fp, "channels");
+    const cJSON *ch = cJSON_GetObjectItemCaseSensitive(px, "channels");
+    if ((st = get_int(p, ch ? ch : px, cp, 1, 4, &nc))) return st;
+    const bool isf = cJSON_IsTrue(fl);
+    void *data;
+    char filep[JP_PATH_MAX];
+    path_key(filep, fp, "file");
+    const cJSON *file = cJSON_GetObjectItemCaseSensitive(px, "file");
+    if ((st = rec_raw_file(p, file ? file : px, filep, count * (size_t)nc, isf ? sizeof(float) : 1, &data))) return st;
+    pk_context scratch = io_scratch_context(p->ctx);
+    st = texture_add_pixels(&scratch, p->s, key->valuestring, wh[0], wh[1], nc, isf ? NULL : (const uint8_t *)data,
+                            isf ? (const float *)data : NULL, colour, &r->tex);
+    mem_free(&p->ctx->alloc, data);
+    if (st) return jfail(p, st, px, fp, "%s", scratch.message);
+    return PK_OK;
+}
+
+/* {"name": ..., "record": {...}} in "materials" (array form): a material as
+ * the scene holds it (convert writes these). */
+static pk_status parse_material_record(jp *p, const cJSON *e, const char *path)
+{
+    static const char *const outer[] = {"name", "record"};
+    const cJSON *f[2];
+    pk_status st = object_fields(p, e, path, outer, 2, f);
+    if (st) return st;
+    char fp[JP_PATH_MAX];
+    path_key(fp, path, "name");
+    if (!cJSON_IsString(f[0]) || !f[0]->valuestring[0])
+        return jfail(p, PK_ERR_PARSE, f[0] ? f[0] : e, fp, "must be a non-empty string");
+    path_key(fp, path, "record");
+    static const char *const extra[] = {"map_kd",   "map_ks",   "map_ns",   "map_d",    "map_alpha",
+                                        "map_bump", "map_norm", "map_mr",   "interior", "exterior", NULL};
+    material m;
+    material_init(&m);
+    if ((st = rec_read(p, f[1], fp, rec_material, rec_nmaterial, extra, &m))) return st;
+    if (m.type < MAT_MTL || m.type > MAT_INTERFACE)
+        return jfail(p, PK_ERR_PARSE, f[1], fp, "type must be in %d..%d", (int)MAT_MTL, (int)MAT_INTERFACE);
+    if (m.illum < 0 || m.illum > 10) return jfail(p, PK_ERR_PARSE, f[1], fp, "illum must be in 0..10");
+    for (int k = 0; k < REC_NMAPS; k++) {
+        const cJSON *it = cJSON_GetObjectItemCaseSensitive(f[1], rec_map_names[k]);
+        if (!it) continue;
+        char mp[JP_PATH_MAX];
+        path_key(mp, fp, rec_map_names[k]);
+        if ((st = read_texref_record(p, it, mp, (tex_ref *)(void *)((char *)&m + rec_map_offsets[k])))) return st;
+    }
+    if ((st = read_medium_sides(p, f[1], fp, &m))) return st;
+    return add_material(p, &m, f[0]->valuestring, NULL);
+}
+
+/* One PLY file of a "ply" mesh: its vertices and triangles added to the
+ * scene, each face's "material" an index of mats (nmat names). */
+static pk_status load_ply_file(jp *p, const cJSON *file, const char *fp, const uint32_t *mats, size_t nmat)
+{
+    if (!cJSON_IsString(file) || !file->valuestring[0])
+        return jfail(p, PK_ERR_PARSE, file, fp, "must be a non-empty string (a path)");
+    pk_scene *s = p->s;
+    const pk_allocator *a = &p->ctx->alloc;
+    char *full = path_join(a, p->base_dir, file->valuestring), *data = NULL;
+    size_t size = 0;
+    ply_mesh m;
+    memset(&m, 0, sizeof m);
+    pk_status st;
+    if (!full) return ctx_nomem(p->ctx);
+    pk_context scratch = io_scratch_context(p->ctx);
+    if ((st = file_read_all(&scratch, full, &data, &size)) || (st = ply_parse(&scratch, data, size, full, &m))) {
+        jfail(p, st, file, fp, "%s", scratch.message);
+        goto out;
+    }
+    const size_t pos0 = s->npositions, nrm0 = s->nnormals, uv0 = s->nuvs;
+    for (size_t v = 0; v < m.nvertices && st == PK_OK; v++) {
+        st = scene_add_position(p->ctx, s, m.positions[v]);
+        if (st == PK_OK && m.normals) st = scene_add_normal(p->ctx, s, m.normals[v]);
+        if (st == PK_OK && m.uvs) st = scene_add_uv(p->ctx, s, (uv2){m.uvs[2 * v], m.uvs[2 * v + 1]});
+    }
+    for (size_t t = 0; t < m.ntriangles && st == PK_OK; t++) {
+        triangle tri;
+        tri.material = 0;
+        if (m.face_material) {
+            if (m.face_material[t] >= nmat) {
+                st = jfail(p, PK_ERR_PARSE, file, fp, "triangle %zu: material %u is not an index of \"materials\"", t,
+                           m.face_material[t]);
+                break;
+            }
+            tri.material = mats[m.face_material[t]];
+        }
+        for (int j = 0; j < 3; j++) {
+            const uint32_t vi = m.indices[3 * t + (size_t)j];
+            tri.v[j] = (uint32_t)(pos0 + vi);
+            tri.n[j] = m.normals ? (int32_t)(nrm0 + vi) : -1;
+            tri.t[j] = m.uvs ? (int32_t)(uv0 + vi) : -1;
+        }
+        st = scene_add_triangle(p->ctx, s, &tri);
+    }
+out:
+    ply_mesh_free(p->ctx, &m);
+    mem_free(a, data);
+    mem_free(a, full);
+    return st;
+}
+
+/* {"ply": FILE or [FILE, ...], "materials": [names], "instances": [...]}:
+ * PLY meshes (the files in order) whose faces' "material" property indexes
+ * "materials" (default: material 0); corners take the file's normals and
+ * uvs when it has them. Without "instances" the triangles are in world
+ * space; with it they are one object-space mesh, placed by each element
+ * {"transform": T, "material": NAME} (material: all its triangles'; absent:
+ * their own), and the mesh can be placed again by {"instance": ...}. */
+static pk_status parse_ply_mesh(jp *p, const cJSON *it, const char *path)
+{
+    enum { P_PLY, P_MATERIALS, P_INSTANCES, P_COUNT };
+    static const char *const keys[P_COUNT] = {"ply", "materials", "instances"};
+    const cJSON *f[P_COUNT];
+    char fp[JP_PATH_MAX], mp[JP_PATH_MAX], ip[JP_PATH_MAX];
+    pk_status st = object_fields(p, it, path, keys, P_COUNT, f);
+    if (st) return st;
+    pk_scene *s = p->s;
+    const pk_allocator *a = &p->ctx->alloc;
+    size_t nmat = 0;
+    uint32_t *mats = NULL;
+    path_key(mp, path, "materials");
+    path_key(ip, path, "instances");
+    if (f[P_INSTANCES] && (st = get_array(p, f[P_INSTANCES], ip))) return st;
+    if (f[P_MATERIALS]) {
+        if ((st = get_array(p, f[P_MATERIALS], mp))) return st;
+        nmat = (size_t)cJSON_GetArraySize(f[P_MATERIALS]);
+        mats = mem_calloc(a, nmat ? nmat : 1, sizeof *mats);
+        if (!mats) return ctx_nomem(p->ctx);
+        size_t i = 0;
+        for (const cJSON *e = f[P_MATERIALS]->child; e; e = e->next, i++) {
+            const int64_t idx = cJSON_IsString(e) ? scene_find_material(s, e->valuestring) : -1;
+            if (idx < 0) {
+                mem_free(a, mats);
+                return jfail(p, PK_ERR_PARSE, e, mp, "element %zu is not the name of a material", i);
+            }
+            mats[i] = (uint32_t)idx;
+        }
+    }
+    const size_t pos0 = s->npositions, nrm0 = s->nnormals, uv0 = s->nuvs, tri0 = s->ntris;
+    path_key(fp, path, "ply");
+    if (cJSON_IsArray(f[P_PLY])) {
+        int i = 0;
+        for (const cJSON *e = f[P_PLY]->child; e && st == PK_OK; e = e->next, i++) {
+            char ep[JP_PATH_MAX];
+            snprintf(ep, sizeof ep, "%.*s[%d]", JP_PATH_MAX - 16, fp, i);
+            st = load_ply_file(p, e, ep, mats, nmat);
+        }
+    } else {
+        st = load_ply_file(p, f[P_PLY], fp, mats, nmat);
+    }
+    mem_free(a, mats);
+    if (st || !f[P_INSTANCES]) return st;
+    uint32_t mesh;
+    if ((st = scene_capture_mesh(p->ctx, s, pos0, nrm0, uv0, tri0, &mesh))) return st;
+    int i = 0;
+    for (const cJSON *e = f[P_INSTANCES]->child; e && st == PK_OK; e = e->next, i++) {
+        char ep[JP_PATH_MAX];
+        snprintf(ep, sizeof ep, "%.*s[%d]", JP_PATH_MAX - 16, ip, i);
+        st = place_instance(p, e, ep, mesh);
+    }
+    return st;
+}
+
+/* {"transform": T, "material": NAME}: mesh placed once (material: for all
+ * its triangles; absent: their own). */
+static pk_status place_instance(jp *p, const cJSON *it, const char *path, uint32_t mesh)
+{
+    enum { I_TRANSFORM, I_MATERIAL, I_MESH, I_COUNT };
+    static const char *const keys[I_COUNT] = {"transform", "material", "mesh"};
+    const cJSON *f[I_COUNT];
+    char fp[JP_PATH_MAX];
+    pk_status st = object_fields(p, it, path, keys, I_COUNT, f);
+    if (st) return st;
+    path_key(fp, path, "transform");
+    if (!f[I_TRANSFORM]) return jfail(p, PK_ERR_PARSE, it, path, "missing \"transform\"");
+    xform x;
+    if ((st = parse_transform(p, f[I_TRANSFORM], fp, &x))) return st;
+    uint32_t mat = SCENE_MESH_MATERIAL;
+    if (f[I_MATERIAL]) {
+        path_key(fp, path, "material");
+        const int64_t idx = cJSON_IsString(f[I_MATERIAL]) ? scene_find_material(p->s, f[I_MATERIAL]->valuestring) : -1;
+        if (idx < 0) return jfail(p, PK_ERR_PARSE, f[I_MATERIAL], fp, "must be the name of a material");
+        mat = (uint32_t)idx;
+    }
+    pk_context scratch = io_scratch_context(p->ctx);
+    if ((st = scene_add_instance(&scratch, p->s, mesh, &x, mat))) return jfail(p, st, it, path, "%s", scratch.message);
+    return PK_OK;
+}
+
+/* {"instance": {"mesh": K, "transform": T, "material": NAME}} in "meshes":
+ * the scene's mesh K (the K-th mesh with "instances" of this file, from 0)
+ * placed once more. */
+static pk_status parse_instance(jp *p, const cJSON *it, const char *path)
+{
+    static const char *const outer[] = {"instance"};
+    const cJSON *f[1];
+    pk_status st = object_fields(p, it, path, outer, 1, f);
+    if (st) return st;
+    char fp[JP_PATH_MAX], mp[JP_PATH_MAX];
+    path_key(fp, path, "instance");
+    const cJSON *mi = cJSON_IsObject(f[0]) ? cJSON_GetObjectItemCaseSensitive(f[0], "mesh") : NULL;
+    path_key(mp, fp, "mesh");
+    if (!mi) return jfail(p, PK_ERR_PARSE, f[0], fp, "missing \"mesh\"");
+    int k = 0;
+    if ((st = get_int(p, mi, mp, 0, INT32_MAX, &k))) return st;
+    if ((size_t)k >= p->s->nmeshes) return jfail(p, PK_ERR_PARSE, mi, mp, "no mesh %d (%zu so far)", k, p->s->nmeshes);
+    return place_instance(p, f[0], fp, (uint32_t)k);
+}
+
+/* {"record": {...}} in "lights": a light as the scene holds it. */
+static pk_status parse_light_record(jp *p, const cJSON *it, const char *path)
+{
+    static const char *const outer[] = {"record"};
+    const cJSON *f[1];
+    pk_status st = object_fields(p, it, path, outer, 1, f);
+    if (st) return st;
+    char fp[JP_PATH_MAX];
+    path_key(fp, path, "record");
+    point_light l;
+    memset(&l, 0, sizeof l);
+    if ((st = rec_read(p, f[0], fp, rec_light, rec_nlight, NULL, &l))) return st;
+    if (l.spot_falloff < SPOT_FALLOFF_SMOOTHSTEP || l.spot_falloff > SPOT_FALLOFF_SQUARED)
+        return jfail(p, PK_ERR_PARSE, f[0], fp, "spot_falloff must be 0, 1 or 2");
+    if (l.intensity.x < 0.0f || l.intensity.y < 0.0f || l.intensity.z < 0.0f)
+        return jfail(p, PK_ERR_PARSE, f[0], fp, "intensity must not be negative");
+    const bool spot = l.spot_dir.x != 0.0f || l.spot_dir.y != 0.0f || l.spot_dir.z != 0.0f;
+    if ((l.distant || spot) && !(fabsf(v3_len2(l.distant ? l.position : l.spot_dir) - 1.0f) < 1e-3f))
+        return jfail(p, PK_ERR_PARSE, f[0], fp, "%s must be a unit vector", l.distant ? "position" : "spot_dir");
+    if (spot && !(l.cos_outer >= -1.0f && l.cos_outer <= l.cos_inner && l.cos_inner <= 1.0f))
+        return jfail(p, PK_ERR_PARSE, f[0], fp, "cos_outer <= cos_inner must lie in [-1, 1]");
+    if (l.distant) return scene_light_distant(p->ctx, p->s, l.position, l.intensity);
+    if (spot)
+        return scene_light_spot(p->ctx, p->s, l.position, l.spot_dir, l.cos_inner, l.cos_outer, l.spot_falloff,
+                                l.intensity);
+    return scene_light_point(p->ctx, p->s, l.position, l.intensity);
+}
+
+/* {"record": {...}} as "environment": the surroundings as the scene holds
+ * them, the map as raw linear RGB floats ("map": {"file", "size"}). */
+static pk_status parse_environment_record(jp *p, const cJSON *it)
+{
+    static const char *const outer[] = {"record"};
+    static const char *const extra[] = {"map", NULL};
+    const cJSON *f[1];
+    scene_environment *env = &p->s->env;
+    pk_status st = object_fields(p, it, "environment", outer, 1, f);
+    if (st) return st;
+    if ((st = rec_read(p, f[0], "environment.record", rec_env, rec_nenv, extra, env))) return st;
+    if (!(env->sun_angle > 0.0f && env->sun_angle <= 90.0f) || env->map_scale < 0.0f || env->sky_scale < 0.0f ||
+        env->radiance.x < 0.0f || env->radiance.y < 0.0f || env->radiance.z < 0.0f || env->sun_radiance.x < 0.0f ||
+        env->sun_radiance.y < 0.0f || env->sun_radiance.z < 0.0f)
+        return jfail(p, PK_ERR_PARSE, f[0], "environment.record",
+                     "sun_angle must be in (0, 90], scales and radiances not negative");
+    const cJSON *map = cJSON_GetObjectItemCaseSensitive(f[0], "map");
+    if (!map) return PK_OK;
+    int wh[2];
+    size_t count;
+    if (!cJSON_IsObject(map)) return jfail(p, PK_ERR_PARSE, map, "environment.record.map", "must be an object");
+    if ((st = rec_sizes(p, map, "environment.record.map", "size", 2, PK_MAX_TEXTURE_SIDE, PK_MAX_TEXTURE_PIXELS, wh,
+                        &count)))
+        return st;
+    const cJSON *file = cJSON_GetObjectItemCaseSensitive(map, "file");
+    void *data;
+    if ((st = rec_raw_file(p, file ? file : map, "environment.record.map.file", 3 * count, sizeof(float), &data)))
+        return st;
+    env->map = path_join(&p->ctx->alloc, p->base_dir, file->valuestring);
+    if (!env->map) {
+        mem_free(&p->ctx->alloc, data);
+        return ctx_nomem(p->ctx);
+    }
+    env->map_rgb = data;
+    env->map_w = wh[0], env->map_h = wh[1];
+    return PK_OK;
+}
+
+/* A grid of a medium record: {"file", "size": [nx, ny, nz], "channels"}. */
+static pk_status rec_grid(jp *p, const cJSON *obj, const char *path, const char *key, medium_grid *g)
+{
+    const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!it) return PK_OK;
+    char fp[JP_PATH_MAX], cp[JP_PATH_MAX];
+    path_key(fp, path, key);
+    if (!cJSON_IsObject(it)) return jfail(p, PK_ERR_PARSE, it, fp, "must be an object");
+    int n[3], ch = 1;
+    size_t count;
+    pk_status st = rec_sizes(p, it, fp, "size", 3, INT32_MAX, MEDIUM_MAX_VOXELS, n, &count);
+    if (st) return st;
+    path_key(cp, fp, "channels");
+    const cJSON *c = cJSON_GetObjectItemCaseSensitive(it, "channels");
+    if ((st = get_int(p, c ? c : it, cp, 1, 3, &ch))) return st;
+    if (ch == 2) return jfail(p, PK_ERR_PARSE, c, cp, "must be 1 or 3");
+    path_key(cp, fp, "file");
+    const cJSON *file = cJSON_GetObjectItemCaseSensitive(it, "file");
+    void *data;
+    if ((st = rec_raw_file(p, file ? file : it, cp, count * (size_t)ch, sizeof(float), &data))) return st;
+    g->nx = n[0], g->ny = n[1], g->nz = n[2], g->channels = ch;
+    g->data = data;
+    return PK_OK;
+}
+
+/* {"name": ..., "record": {...}} in "media": a medium as the scene holds it. */
+static pk_status parse_medium_record(jp *p, const cJSON *it, const char *path)
+{
+    static const char *const outer[] = {"name", "record"};
+    static const char *const extra[] = {"density", "albedo_grid", "emission_grid", NULL};
+    const cJSON *f[2];
+    pk_status st = object_fields(p, it, path, outer, 2, f);
+    if (st) return st;
+    char fp[JP_PATH_MAX];
+    path_key(fp, path, "name");
+    if (!cJSON_IsString(f[0]) || !f[0]->valuestring[0])
+        return jfail(p, PK_ERR_PARSE, f[0] ? f[0] : it, fp, "must be a non-empty string");
+    if (scene_find_medium(p->s, f[0]->valuestring) >= 0)
+        return jfail(p, PK_ERR_PARSE, f[0], fp, "a medium of this name is defined already");
+    path_key(fp, path, "record");
+    medium m;
+    medium_init(&m);
+    if ((st = rec_read(p, f[1], fp, rec_medium, rec_nmedium, extra, &m)) ||
+        (st = rec_grid(p, f[1], fp, "density", &m.density)) ||
+        (st = rec_grid(p, f[1], fp, "albedo_grid", &m.albedo_grid)) ||
+        (st = rec_grid(p, f[1], fp, "emission_grid", &m.emission_grid)) ||
+        (m.kind != MEDIUM_HOMOGENEOUS && m.kind != MEDIUM_GRID &&
+         (st = jfail(p, PK_ERR_PARSE, f[1], fp, "kind must be 0 (homogeneous) or 1 (grid)")))) {
+        medium_free(&p->s->alloc, &m);
+        return st;
+    }
+    m.name = mem_strdup(&p->s->alloc, f[0]->valuestring);
+    if (!m.name) {
+        medium_free(&p->s->alloc, &m);
+        return ctx_nomem(p->ctx);
+    }
+    uint32_t idx;
+    return scene_add_medium(p->ctx, p->s, &m, &idx);
 }
 
 /* ---- the document ---------------------------------------------------------- */
