@@ -32,6 +32,7 @@ typedef struct obj_state {
     const char *base_dir;
     size_t pos_base, nrm_base, uv_base;
     uint32_t material;           /* current usemtl, 0 = default */
+    bool fixed_material;         /* every face takes material; usemtl names are not looked up */
     int undefined_warnings;
     bool has_xform;
     xform m;                     /* the position transform */
@@ -303,9 +304,10 @@ static pk_status parse_usemtl(obj_state *st, const char *p, const char *le)
     io_rest(p, le, &ns, &ne);
     if (ns == ne) {
         io_warn(r, "usemtl without a name; the default material is used");
-        st->material = 0;
+        if (!st->fixed_material) st->material = 0;
         return PK_OK;
     }
+    if (st->fixed_material) return PK_OK;
     char buf[256], *heap;
     const char *name = name_copy(r->ctx, ns, ne, buf, sizeof buf, &heap);
     if (!name) return ctx_nomem(r->ctx);
@@ -358,8 +360,8 @@ static pk_status parse_statement(obj_state *st, const char *ls, const char *le)
     return PK_OK;
 }
 
-pk_status obj_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size, const char *name,
-                    const char *base_dir, const xform *xf)
+static pk_status parse(pk_context *ctx, pk_scene *s, const char *data, size_t size, const char *name,
+                       const char *base_dir, const xform *xf, const uint32_t *mat)
 {
     obj_state *st = mem_alloc(&ctx->alloc, sizeof *st);
     if (!st) return ctx_nomem(ctx);
@@ -370,6 +372,7 @@ pk_status obj_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,
     st->pos_base = s->npositions;
     st->nrm_base = s->nnormals;
     st->uv_base = s->nuvs;
+    if (mat) st->material = *mat, st->fixed_material = true;
 
     pk_status rc = xf ? setup_xform(st, xf) : PK_OK;
     const char *ls, *le;
@@ -385,4 +388,16 @@ pk_status obj_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,
     mem_free(&ctx->alloc, st->heap_corners);
     mem_free(&ctx->alloc, st);
     return rc;
+}
+
+pk_status obj_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size, const char *name,
+                    const char *base_dir, const xform *xf)
+{
+    return parse(ctx, s, data, size, name, base_dir, xf, NULL);
+}
+
+pk_status obj_parse_with_material(pk_context *ctx, pk_scene *s, const char *data, size_t size, const char *name,
+                                  const xform *xf, uint32_t mat)
+{
+    return parse(ctx, s, data, size, name, NULL, xf, &mat);
 }

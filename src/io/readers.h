@@ -22,6 +22,12 @@
  * transpose to normals); NULL = identity. Does not commit. */
 PK_HIDDEN pk_status obj_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,
                               const char *name, const char *base_dir, const xform *xf);
+/* The same, with material mat (< s->nmaterials) on every face: usemtl names are
+ * not looked up (nor warned about) and no material library is read. For
+ * formats whose shape gives the mesh its material (Mitsuba's obj shape
+ * with a bsdf). */
+PK_HIDDEN pk_status obj_parse_with_material(pk_context *ctx, pk_scene *s, const char *data, size_t size,
+                                            const char *name, const xform *xf, uint32_t mat);
 /* Parses MTL text, adding its materials to s. Texture maps are parsed but
  * not loaded. */
 PK_HIDDEN pk_status mtl_parse(pk_context *ctx, pk_scene *s, const char *data, size_t size,

@@ -1596,20 +1596,6 @@ out:
     return st;
 }
 
-/* A warning handler that passes on all but the OBJ reader's "material ...
- * is not defined" (the XML's bsdf replaces the OBJ's materials). */
-typedef struct warn_filter {
-    pk_warning_fn fn;
-    void *user;
-} warn_filter;
-
-static void filtered_warning(void *user, const char *msg)
-{
-    const warn_filter *f = user;
-    if (strstr(msg, "is not defined; its faces use the default material")) return;
-    if (f->fn) f->fn(f->user, msg);
-}
-
 /* Reads file (relative to the XML file of n) into *data. */
 static pk_status read_relative(xp *p, const xnode *at, const char *rel, char **full, char **data, size_t *size)
 {
@@ -1668,20 +1654,10 @@ static pk_status shape_obj(xp *p, xnode *sh, const xform *m, bool flip, bool has
         st = ctx_nomem(p->ctx);
         goto out;
     }
-    if (has_bsdf) {
-        /* the XML's bsdf replaces the OBJ's materials: its MTL is not read */
-        warn_filter f = {p->ctx->warn, p->ctx->warn_user};
-        p->ctx->warn = filtered_warning;
-        p->ctx->warn_user = &f;
-        st = obj_parse(p->ctx, p->s, data, size, full, NULL, m);
-        p->ctx->warn = f.fn;
-        p->ctx->warn_user = f.user;
-    } else {
-        st = obj_parse(p->ctx, p->s, data, size, full, dir, m);
-    }
+    /* the XML's bsdf replaces the OBJ's materials: its MTL is not read */
+    if (has_bsdf) st = obj_parse_with_material(p->ctx, p->s, data, size, full, m, mat);
+    else st = obj_parse(p->ctx, p->s, data, size, full, dir, m);
     if (st) goto out;
-    if (has_bsdf)
-        for (size_t t = t0; t < p->s->ntris; t++) p->s->tris[t].material = mat;
     finish_mesh(p, t0, face_normals, flip);
 out:
     mem_free(&p->ctx->alloc, data);

@@ -214,6 +214,27 @@ static void test_messy(void)
 
 /* ---- warnings ------------------------------------------------------------ */
 
+/* obj_parse_with_material: every face takes the given material, usemtl names
+ * are neither looked up nor warned about, mtllib is not read; an empty
+ * usemtl is still a warning. */
+static void test_with_material(void)
+{
+    warnings w;
+    pk_context *ctx = new_ctx(&w);
+    pk_scene *s = new_scene(ctx);
+    uint32_t mat, other;
+    REQUIRE(scene_add_material(ctx, s, "given", &mat) == PK_OK);
+    REQUIRE(scene_add_material(ctx, s, "other", &other) == PK_OK);
+    const char *t = "mtllib absent.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl undefined\nf 1 2 3\n"
+                    "usemtl other\nf 1 2 3\nusemtl\nf 1 2 3\n";
+    CHECKF(obj_parse_with_material(ctx, s, t, strlen(t), "fixed.obj", NULL, mat) == PK_OK, "%s", pk_context_error(ctx));
+    REQUIRE(s->ntris == 3);
+    for (size_t i = 0; i < 3; i++) CHECKF(s->tris[i].material == mat, "face %zu: %u", i, s->tris[i].material);
+    CHECKF(w.count == 1 && strstr(w.all, "fixed.obj:9: usemtl without a name"), "%d warnings:\n%s", w.count, w.all);
+    scene_destroy(s);
+    pk_context_destroy(ctx);
+}
+
 static void test_unknown_statements(void)
 {
     warnings w;
@@ -837,6 +858,7 @@ int main(void)
     test_fan_order();
     test_messy();
     test_unknown_statements();
+    test_with_material();
     test_missing_mtl();
     test_materials();
     test_oddities();
