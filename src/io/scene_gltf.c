@@ -420,16 +420,10 @@ static pk_status place_camera(gltf *g, int64_t ci, const xform *x, int64_t node)
     if ((st = gltf_string(g, c, path, "type", &type))) return st;
     if (!type) return gltf_fail(g, PK_ERR_PARSE, "%s: type is required", path);
     pk_camera cam;
-    pk_camera_init(&cam);
     vec3 o = xform_point(x, v3s(0.0f));
     vec3 fwd = v3_norm_scaled(xform_vector(x, v3(0.0f, 0.0f, -1.0f)));
     vec3 up = v3_norm_scaled(xform_vector(x, v3(0.0f, 1.0f, 0.0f)));
-    vec3 at = v3_add(o, fwd);
-    for (int k = 0; k < 3; k++) {
-        cam.look_from[k] = v3_get(o, k);
-        cam.look_at[k] = v3_get(at, k);
-        cam.up[k] = v3_get(up, k);
-    }
+    camera_look(&cam, o, v3_add(o, fwd), up);
     if (strcmp(type, "perspective") == 0) {
         snprintf(sp, sizeof sp, "%s/perspective", path);
         const cJSON *p = cJSON_GetObjectItemCaseSensitive(c, "perspective");
@@ -455,11 +449,9 @@ static pk_status place_camera(gltf *g, int64_t ci, const xform *x, int64_t node)
     } else {
         return gltf_fail(g, PK_ERR_PARSE, "%s/type: '%.16s' is not perspective or orthographic", path, type);
     }
-    if (camera_check(&cam) != CAMERA_OK)
+    if (scene_set_camera(g->s, &cam) != CAMERA_OK)
         return gltf_fail(g, PK_ERR_PARSE, "/nodes/%lld: the transform gives camera %lld no usable view", (long long)node,
                          (long long)ci);
-    g->s->camera = cam;
-    g->s->has_camera = true;
     g->camera_done = true;
     return PK_OK;
 }

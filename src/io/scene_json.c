@@ -795,11 +795,7 @@ static pk_status parse_camera(jp *p, const cJSON *it)
     if (f[C_UP] && (st = get_vec3(p, f[C_UP], "camera.up", &up))) return st;
     if (f[C_FOV] && (st = get_float(p, f[C_FOV], "camera.fov", &fov))) return st;
     pk_camera cam;
-    pk_camera_init(&cam);
-    const float v[3][3] = {{from.x, from.y, from.z}, {at.x, at.y, at.z}, {up.x, up.y, up.z}};
-    memcpy(cam.look_from, v[0], sizeof v[0]);
-    memcpy(cam.look_at, v[1], sizeof v[1]);
-    memcpy(cam.up, v[2], sizeof v[2]);
+    camera_look(&cam, from, at, up);
     cam.fov_deg = fov;
     if (f[C_LENS] && (st = get_float(p, f[C_LENS], "camera.lens_radius", &cam.lens_radius))) return st;
     if (f[C_FOCUS] && (st = get_float(p, f[C_FOCUS], "camera.focus_distance", &cam.focus_distance))) return st;
@@ -845,8 +841,7 @@ static pk_status parse_camera(jp *p, const cJSON *it)
             return jfail(p, PK_ERR_PARSE, f[C_MEDIUM], "camera.medium", "differs from the scene's \"medium\"; give one of them");
         p->s->camera_medium = med;
     }
-    p->s->camera = cam;
-    p->s->has_camera = true;
+    scene_set_camera(p->s, &cam); /* checked above */
     return PK_OK;
 }
 

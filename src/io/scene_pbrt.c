@@ -2155,12 +2155,8 @@ static pk_status finish_camera(pp *p)
         }
         (void)e;
     }
-    vec3 at = v3_add(eye, fwd);
     pk_camera cam;
-    pk_camera_init(&cam);
-    cam.look_from[0] = eye.x, cam.look_from[1] = eye.y, cam.look_from[2] = eye.z;
-    cam.look_at[0] = at.x, cam.look_at[1] = at.y, cam.look_at[2] = at.z;
-    cam.up[0] = up.x, cam.up[1] = up.y, cam.up[2] = up.z;
+    camera_look(&cam, eye, v3_add(eye, fwd), up);
     /* the screen window: pbrt's default spans [-1, 1] on the shorter axis */
     const float w = (float)p->film_w, h = (float)p->film_h;
     float aspect = p->frame_aspect > 0.0f ? p->frame_aspect : w / h;
@@ -2192,10 +2188,8 @@ static pk_status finish_camera(pp *p)
     }
     if (!(cam.fov_deg > 0.0f && cam.fov_deg < 180.0f))
         return pfail(p, p->cam_line, PK_ERR_PARSE, "camera: the vertical field of view is out of range");
-    if (camera_check(&cam) != CAMERA_OK)
+    if (scene_set_camera(p->s, &cam) != CAMERA_OK)
         return pfail(p, p->cam_line, PK_ERR_PARSE, "camera: the camera transform gives no usable camera");
-    p->s->camera = cam;
-    p->s->has_camera = true;
     return PK_OK;
 }
 

@@ -2584,25 +2584,16 @@ static pk_status parse_sensor(xp *p, xnode *sn)
     vec3 right = v3_neg(xform_vector(&m, v3(1.0f, 0.0f, 0.0f)));
     if (v3_dot(v3_cross(fwd, up), right) < 0.0f)
         xwarn(p, sn, "the camera's to_world mirrors the image; rendered unmirrored");
-    vec3 at = v3_add(o, fwd);
     pk_camera cam;
-    pk_camera_init(&cam);
-    const float v[3][3] = {{o.x, o.y, o.z}, {at.x, at.y, at.z}, {up.x, up.y, up.z}};
-    memcpy(cam.look_from, v[0], sizeof v[0]);
-    memcpy(cam.look_at, v[1], sizeof v[1]);
-    memcpy(cam.up, v[2], sizeof v[2]);
+    camera_look(&cam, o, v3_add(o, fwd), up);
     cam.lens_radius = aperture;
     cam.focus_distance = focus;
     if (ortho) {
         cam.projection = PK_PROJECTION_ORTHOGRAPHIC;
         cam.ortho_width = ortho_width;
     }
-    switch (camera_check(&cam)) {
-    case CAMERA_OK: break;
-    default: return xfail(p, PK_ERR_PARSE, sn, "the sensor's to_world gives no usable camera (singular or not finite)");
-    }
-    p->s->camera = cam;
-    p->s->has_camera = true;
+    if (scene_set_camera(p->s, &cam) != CAMERA_OK)
+        return xfail(p, PK_ERR_PARSE, sn, "the sensor's to_world gives no usable camera (singular or not finite)");
     p->sensor = sn;
 
     for (xnode *c = sn->child; c; c = c->next) {

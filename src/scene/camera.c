@@ -102,3 +102,21 @@ void scene_camera(const pk_scene *s, pk_camera *cam)
     memcpy(cam->look_at, at, sizeof at);
     cam->fov_deg = fov;
 }
+
+void camera_look(pk_camera *cam, vec3 from, vec3 at, vec3 up)
+{
+    pk_camera_init(cam);
+    const float v[3][3] = {{from.x, from.y, from.z}, {at.x, at.y, at.z}, {up.x, up.y, up.z}};
+    memcpy(cam->look_from, v[0], sizeof v[0]);
+    memcpy(cam->look_at, v[1], sizeof v[1]);
+    memcpy(cam->up, v[2], sizeof v[2]);
+}
+
+camera_problem scene_set_camera(pk_scene *s, const pk_camera *cam)
+{
+    const camera_problem why = camera_check(cam);
+    if (why != CAMERA_OK) return why;
+    s->camera = *cam;
+    s->has_camera = true;
+    return CAMERA_OK;
+}

@@ -26,6 +26,12 @@ typedef enum camera_problem {
 } camera_problem;
 
 PK_HIDDEN camera_problem camera_check(const pk_camera *cam);
+/* *cam = pk_camera_init's defaults, looking from from toward at with up. */
+PK_HIDDEN void camera_look(pk_camera *cam, vec3 from, vec3 at, vec3 up);
+/* Makes cam the scene's camera when it passes camera_check; otherwise
+ * changes nothing and returns the problem, which the caller reports with
+ * its own location. */
+PK_HIDDEN camera_problem scene_set_camera(pk_scene *s, const pk_camera *cam);
 /* Latches "what: <the problem>" in ctx (ctx may be NULL: nothing is latched). */
 PK_HIDDEN pk_status camera_validate(pk_context *ctx, const pk_camera *cam, const char *what);
 /* The scene's camera, or one framed on its bounds. */

@@ -3,10 +3,12 @@
  * stored as given, anything a light cannot be is refused with
  * PK_ERR_INVALID_ARGUMENT and leaves the scene as it was, and the sensor
  * rule (scene_scale_emission) reaches every emitter; area emission is a
- * copy of a shape's material (scene_material_with_emission).
+ * copy of a shape's material (scene_material_with_emission); the camera is
+ * set only when it passes the one camera rule (scene_set_camera).
  */
 #include "test.h"
 
+#include "scene/camera.h"
 #include "scene/scene.h"
 
 static pk_context *ctx;
@@ -103,12 +105,34 @@ static void check_emission(void)
     scene_destroy(s);
 }
 
+static void check_camera(void)
+{
+    pk_scene *s;
+    REQUIRE(scene_create(ctx, "camera", &s) == PK_OK);
+    pk_camera cam, def;
+    pk_camera_init(&def);
+    camera_look(&cam, v3(1.0f, 2.0f, 3.0f), v3(1.0f, 2.0f, 0.0f), v3(0.0f, 1.0f, 0.0f));
+    CHECK(cam.look_from[0] == 1.0f && cam.look_from[1] == 2.0f && cam.look_from[2] == 3.0f);
+    CHECK(cam.look_at[2] == 0.0f && cam.up[1] == 1.0f && cam.fov_deg == def.fov_deg && cam.projection == def.projection);
+    CHECK(!s->has_camera);
+    CHECK(scene_set_camera(s, &cam) == CAMERA_OK && s->has_camera && memcmp(&s->camera, &cam, sizeof cam) == 0);
+    pk_camera bad = cam;
+    bad.up[0] = 0.0f, bad.up[1] = 0.0f, bad.up[2] = 1.0f; /* parallel to the view */
+    CHECK(scene_set_camera(s, &bad) == CAMERA_UP_PARALLEL);
+    bad = cam;
+    bad.fov_deg = 180.0f;
+    CHECK(scene_set_camera(s, &bad) == CAMERA_FOV);
+    CHECK(memcmp(&s->camera, &cam, sizeof cam) == 0); /* refused: unchanged */
+    scene_destroy(s);
+}
+
 int main(void)
 {
     REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
     check_kinds();
     check_scale();
     check_emission();
+    check_camera();
     pk_context_destroy(ctx);
     return test_done("test_lights");
 }
