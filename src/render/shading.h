@@ -62,11 +62,7 @@ static inline PK_HD shading shading_at(const surface *sf)
         if (m->beckmann && (m->type == MAT_CONDUCTOR || m->type == MAT_DIELECTRIC || m->type == MAT_PLASTIC))
             sh.b.flags |= PBSDF_BECKMANN;
     } else if (glass) {
-        /* Tf: the hue of what enters, normalised to the brightest channel
-         * (exporters write grey Tf of any strength for clear glass) */
-        float tmax_c = v3_max_comp(m->tf);
-        vec3 tint = tmax_c > 0.0f ? v3_scale(m->tf, 1.0f / tmax_c) : v3s(1.0f);
-        sh.b = pbsdf_dielectric(m->ni, 0.0f, sf->front ? tint : v3s(1.0f));
+        sh.b = pbsdf_dielectric(m->ni, 0.0f, sf->front ? material_mtl_tint(m) : v3s(1.0f));
         if (!sf->front) n = v3_neg(n); /* the outward normal: wo.z < 0 inside */
     } else if (m->illum == 5) {
         sh.b = pbsdf_conductor_schlick(m->ks, 0.0f); /* a mirror with Fresnel */

@@ -172,10 +172,7 @@ static vec3 shade_opaque(const whitted *w, whitted_thread *ts, const ray *r, con
             float F = tir ? 1.0f : fresnel_dielectric(cos_i, eta_i, eta_t);
             vec3 wr = v3_reflect(dn, sf.ns);
             if (v3_dot(wr, sf.ng) <= 0.0f) wr = v3_reflect(dn, sf.ng);
-            /* Tf tints the light that enters: its hue, normalised to the brightest
-             * channel (exporters write grey Tf of any strength for clear glass) */
-            float tmax_c = v3_max_comp(m->tf);
-            vec3 tint = sf.front && tmax_c > 0.0f ? v3_scale(m->tf, 1.0f / tmax_c) : v3s(1.0f);
+            vec3 tint = sf.front ? material_mtl_tint(m) : v3s(1.0f); /* Tf tints the light that enters */
             vec3 kr, kt;
             if (w->fresnel) {
                 kr = v3s(F);

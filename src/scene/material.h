@@ -149,6 +149,14 @@ static inline PK_HD bool material_mtl_glossy(const material *m)
 {
     return m->illum == 2 && (m->ks.x > 0.0f || m->ks.y > 0.0f || m->ks.z > 0.0f);
 }
+/* The glass's Tf as the tint of the light that enters: its hue, normalised
+ * to the brightest channel (exporters write grey Tf of any strength for
+ * clear glass); white for a black Tf. */
+static inline PK_HD vec3 material_mtl_tint(const material *m)
+{
+    float tmax_c = v3_max_comp(m->tf);
+    return tmax_c > 0.0f ? v3_scale(m->tf, 1.0f / tmax_c) : v3s(1.0f);
+}
 
 /* Fresnel reflectance at normal incidence of a dielectric of index ior,
  * and of a conductor of index eta + i k (per channel). */
