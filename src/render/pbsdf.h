@@ -29,6 +29,7 @@
 #define PK_PBSDF_H
 
 #include "../math/vec3.h"
+#include "optics.h"
 
 #include <stdbool.h>
 
@@ -194,7 +195,8 @@ static inline PK_HD pbsdf pbsdf_glossy_mtl(vec3 kd, vec3 ks, float ns)
 /* Unpolarised Fresnel reflectance of a dielectric boundary; cos_i is the
  * cosine to the normal on the side wo is on: cos_i >= 0 means outside
  * (relative index eta = inside / outside), cos_i < 0 inside. 1 under total
- * internal reflection. */
+ * internal reflection. The Fresnel equations are optics.h's; only cos_t is
+ * found here (see fresnel_dielectric there for why it is not shared). */
 static inline PK_HD float pbsdf_fresnel_dielectric(float cos_i, float eta)
 {
     cos_i = fminf(1.0f, fmaxf(-1.0f, cos_i));
@@ -205,9 +207,7 @@ static inline PK_HD float pbsdf_fresnel_dielectric(float cos_i, float eta)
     float sin2_t = (1.0f - cos_i * cos_i) / (eta * eta);
     if (sin2_t >= 1.0f) return 1.0f;
     float cos_t = sqrtf(fmaxf(0.0f, 1.0f - sin2_t));
-    float rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    float rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    return 0.5f * (rs * rs + rp * rp);
+    return fresnel_equations(cos_i, cos_t, 1.0f, eta);
 }
 
 /* Fresnel reflectance of a conductor with complex index eta + i k (relative
@@ -622,7 +622,8 @@ static inline PK_HD float pbsdf__dielectric_pdf(const pbsdf *b, vec3 wo, vec3 wi
 }
 
 /* Refracts w (pointing away, either side) through the facet m (m.z > 0,
- * ior = inside / outside). False on total internal reflection. */
+ * ior = inside / outside). False on total internal reflection. (optics.h's
+ * refract_dir, the Whitted integrator's, rounds differently: see there.) */
 static inline PK_HD bool pbsdf__refract(vec3 w, vec3 m, float ior, vec3 *out)
 {
     float c = v3_dot(w, m), eta = ior;

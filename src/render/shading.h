@@ -33,7 +33,7 @@ static inline PK_HD shading shading_at(const surface *sf)
 {
     const material *m = sf->m;
     shading sh;
-    const bool glass = m->type == MAT_MTL && (m->illum == 4 || m->illum == 6 || m->illum == 7);
+    const bool glass = m->type == MAT_MTL && material_mtl_glass(m);
     sh.opaque = glass || m->type == MAT_DIELECTRIC ? 1.0f : fminf(fmaxf(m->d, 0.0f), 1.0f);
     vec3 n = sf->ns;
     if (m->type != MAT_MTL) { /* the physically based types of JSON scenes */
@@ -62,17 +62,13 @@ static inline PK_HD shading shading_at(const surface *sf)
         if (m->beckmann && (m->type == MAT_CONDUCTOR || m->type == MAT_DIELECTRIC || m->type == MAT_PLASTIC))
             sh.b.flags |= PBSDF_BECKMANN;
     } else if (glass) {
-        /* Tf: the hue of what enters, normalised to the brightest channel
-         * (exporters write grey Tf of any strength for clear glass) */
-        float tmax_c = v3_max_comp(m->tf);
-        vec3 tint = tmax_c > 0.0f ? v3_scale(m->tf, 1.0f / tmax_c) : v3s(1.0f);
-        sh.b = pbsdf_dielectric(m->ni, 0.0f, sf->front ? tint : v3s(1.0f));
+        sh.b = pbsdf_dielectric(m->ni, 0.0f, sf->front ? material_mtl_tint(m) : v3s(1.0f));
         if (!sf->front) n = v3_neg(n); /* the outward normal: wo.z < 0 inside */
     } else if (m->illum == 5) {
         sh.b = pbsdf_conductor_schlick(m->ks, 0.0f); /* a mirror with Fresnel */
     } else if (m->illum == 3) {
         sh.b = pbsdf_glossy(m->kd, m->ks, 0.0f); /* diffuse + an ideal mirror weighted by Ks */
-    } else if (m->illum == 2 && (m->ks.x > 0.0f || m->ks.y > 0.0f || m->ks.z > 0.0f)) {
+    } else if (material_mtl_glossy(m)) {
         sh.b = pbsdf_glossy_mtl(m->kd, m->ks, m->ns);
     } else {
         sh.b = pbsdf_diffuse(m->kd);
@@ -81,6 +77,47 @@ static inline PK_HD shading shading_at(const surface *sf)
     sh.nondelta = sh.opaque > 0.0f && pbsdf_has_nondelta(&sh.b) &&
                   (sh.b.type != PBSDF_DIFFUSE || !black(sh.b.albedo));
     return sh;
+}
+
+/* The Whitted integrator's reflectance (the MTL record as the classic
+ * models have it, not a pbsdf: Lambert of material_whitted_kd plus, for
+ * illum 2, a normalised Phong lobe of Ks and exponent Ns around the mirror
+ * direction), worked out once for the many directions in which light
+ * reaches one point. World space, like the functions above. */
+typedef struct phong_terms {
+    vec3 ns, ng;
+    vec3 diffuse;  /* the Whitted diffuse reflectance over pi */
+    vec3 ks;       /* the Phong lobe's colour, when glossy */
+    float n, norm; /* its exponent and normalisation (n + 2) / (2 pi) */
+    bool glossy;   /* illum 2 with a Ks */
+} phong_terms;
+
+static inline PK_HD phong_terms phong_terms_at(const surface *sf)
+{
+    const material *m = sf->m;
+    phong_terms b;
+    b.ns = sf->ns, b.ng = sf->ng;
+    b.diffuse = v3_scale(material_whitted_kd(m), 1.0f / PK_PI);
+    b.glossy = material_mtl_glossy(m);
+    b.ks = m->ks;
+    b.n = m->ns;
+    b.norm = (b.n + 2.0f) / (2.0f * PK_PI);
+    return b;
+}
+
+/* BRDF times cos(theta_i) for light arriving from wi, seen from wo (unit
+ * vectors pointing away from the surface); zero through the surface. */
+static inline PK_HD vec3 phong_cos(const phong_terms *b, vec3 wo, vec3 wi)
+{
+    float cos_i = v3_dot(b->ns, wi);
+    if (cos_i <= 0.0f || v3_dot(b->ng, wi) <= 0.0f) return v3s(0.0f); /* no light through surfaces */
+    vec3 f = b->diffuse;
+    if (b->glossy) {
+        vec3 r = v3_reflect(v3_neg(wi), b->ns);
+        float c = v3_dot(r, wo);
+        if (c > 0.0f) f = v3_add(f, v3_scale(b->ks, b->norm * powf(c, b->n)));
+    }
+    return v3_scale(f, cos_i);
 }
 
 /* The shading of a regularised path (pbsdf_regularize): near-specular lobes

@@ -7,8 +7,8 @@
  */
 #include "whitted.h"
 
-#include "bsdf.h"
 #include "optics.h"
+#include "shading.h"
 
 #include <string.h>
 
@@ -80,7 +80,7 @@ __attribute__((flatten)) static vec3 direct_light(const whitted *w, whitted_thre
     const light_set *set = &fr->lights;
     vec3 L = v3s(0.0f);
     const light_ctx lc = {sf->p, sf->ng, offset_origin(fr->eps, sf->p, sf->ng), true};
-    const brdf_terms bt = brdf_terms_at(sf);
+    const phong_terms bt = phong_terms_at(sf);
     rng r = ts->rng; /* in a register, not through ts */
     size_t n = 0;
     /* point lights and the sun: one shadow ray each */
@@ -90,8 +90,8 @@ __attribute__((flatten)) static vec3 direct_light(const whitted *w, whitted_thre
         const float u1 = kind == LIGHT_SUN ? rng_float(&r) : 0.5f, u2 = kind == LIGHT_SUN ? rng_float(&r) : 0.5f;
         light_sample ls;
         if (!sample_other(set, s, &fr->env, li, &lc, u1, u2, &ls)) continue;
-        vec3 f = brdf_terms_cos(&bt, wo, ls.wi);
-        if (is_black(f)) continue;
+        vec3 f = phong_cos(&bt, wo, ls.wi);
+        if (black(f)) continue;
         ts->shadow_weight[n] = v3_scale(v3_mul(f, ls.le), 1.0f / ls.pdf);
         ts->shadow_rays[n] = ls.shadow;
         n++;
@@ -117,8 +117,8 @@ __attribute__((flatten)) static vec3 direct_light(const whitted *w, whitted_thre
                 if (!sample_other(set, s, &fr->env, w->sampled[j], &lc, u1, u2, &other)) continue;
                 ls = other;
             }
-            vec3 f = brdf_terms_cos(&bt, wo, ls.wi);
-            if (is_black(f)) continue;
+            vec3 f = phong_cos(&bt, wo, ls.wi);
+            if (black(f)) continue;
             ts->shadow_weight[n] = v3_scale(v3_mul(f, ls.le), inv_n / (p_pick * ls.pdf));
             ts->shadow_rays[n] = ls.shadow;
             n++;
@@ -151,13 +151,13 @@ static vec3 shade_opaque(const whitted *w, whitted_thread *ts, const ray *r, con
     vec3 wo = v3_neg(v3_norm(r->d));
     vec3 L = m->ke; /* emitters are two-sided */
     if (m->illum == 0) return v3_add(L, m->kd);
-    bool dielectric = is_dielectric(m);
-    if (has_direct_lobe(m)) L = v3_add(L, direct_light(w, ts, &sf, wo));
-    if (!is_black(fr->s->ambient))
-        L = v3_add(L, v3_mul(fr->s->ambient, is_black(m->ka) ? material_whitted_kd(m) : m->ka));
+    bool dielectric = material_mtl_glass(m);
+    if (!black(material_whitted_kd(m)) || material_mtl_glossy(m)) L = v3_add(L, direct_light(w, ts, &sf, wo));
+    if (!black(fr->s->ambient))
+        L = v3_add(L, v3_mul(fr->s->ambient, black(m->ka) ? material_whitted_kd(m) : m->ka));
     vec3 dn = v3_norm(r->d);
     if (depth < w->max_depth) {
-        if (is_mirror(m) && !is_black(m->ks)) {
+        if (material_mtl_mirror(m) && !black(m->ks)) {
             vec3 wr = v3_reflect(dn, sf.ns);
             if (v3_dot(wr, sf.ng) <= 0.0f) wr = v3_reflect(dn, sf.ng);
             ray rr = {offset_origin(fr->eps, sf.p, sf.ng), 0.0f, wr, INFINITY};
@@ -172,10 +172,7 @@ static vec3 shade_opaque(const whitted *w, whitted_thread *ts, const ray *r, con
             float F = tir ? 1.0f : fresnel_dielectric(cos_i, eta_i, eta_t);
             vec3 wr = v3_reflect(dn, sf.ns);
             if (v3_dot(wr, sf.ng) <= 0.0f) wr = v3_reflect(dn, sf.ng);
-            /* Tf tints the light that enters: its hue, normalised to the brightest
-             * channel (exporters write grey Tf of any strength for clear glass) */
-            float tmax_c = v3_max_comp(m->tf);
-            vec3 tint = sf.front && tmax_c > 0.0f ? v3_scale(m->tf, 1.0f / tmax_c) : v3s(1.0f);
+            vec3 tint = sf.front ? material_mtl_tint(m) : v3s(1.0f); /* Tf tints the light that enters */
             vec3 kr, kt;
             if (w->fresnel) {
                 kr = v3s(F);
@@ -184,12 +181,12 @@ static vec3 shade_opaque(const whitted *w, whitted_thread *ts, const ray *r, con
                 kr = tir ? v3s(1.0f) : m->ks;
                 kt = tir ? v3s(0.0f) : tint;
             }
-            if (!is_black(kr)) {
+            if (!black(kr)) {
                 ray rr = {offset_origin(fr->eps, sf.p, sf.ng), 0.0f, wr, INFINITY};
                 ts->cone = cone;
                 L = v3_add(L, v3_mul(kr, trace(w, ts, &rr, depth + 1, RAY_REFLECTION)));
             }
-            if (!is_black(kt)) {
+            if (!black(kt)) {
                 ray rt = {offset_origin(fr->eps, sf.p, v3_neg(sf.ng)), 0.0f, wt, INFINITY};
                 ts->cone = cone;
                 L = v3_add(L, v3_mul(kt, trace(w, ts, &rt, depth + 1, RAY_REFRACTION)));

@@ -2,7 +2,7 @@
  * whitted.h - the Whitted integrator: direct light from point lights and
  * area lights with shadow rays, Lambert + Phong, recursive mirror reflection
  * and refraction. Built on the frame (accelerator, light set), surface.h
- * and bsdf.h, which a second integrator shares.
+ * and the MTL reflectance of shading.h, beside the path tracer's BSDFs.
  */
 #ifndef PK_WHITTED_H
 #define PK_WHITTED_H

@@ -136,6 +136,28 @@ static inline PK_HD vec3 material_whitted_kd(const material *m)
     return v3_scale(m->kd, (1.0f - m->metallic) * (1.0f - m->transmission));
 }
 
+/* The MTL illumination models (docs/materials.md), decoded here once for
+ * both integrators: 4, 6 and 7 a smooth dielectric of index ni tinted by tf;
+ * 3 and 5 an ideal mirror weighted by ks; 2 a glossy lobe of ks and ns over
+ * the diffuse (Phong for the Whitted integrator, GGX for the path tracer). */
+static inline PK_HD bool material_mtl_glass(const material *m)
+{
+    return m->illum == 4 || m->illum == 6 || m->illum == 7;
+}
+static inline PK_HD bool material_mtl_mirror(const material *m) { return m->illum == 3 || m->illum == 5; }
+static inline PK_HD bool material_mtl_glossy(const material *m)
+{
+    return m->illum == 2 && (m->ks.x > 0.0f || m->ks.y > 0.0f || m->ks.z > 0.0f);
+}
+/* The glass's Tf as the tint of the light that enters: its hue, normalised
+ * to the brightest channel (exporters write grey Tf of any strength for
+ * clear glass); white for a black Tf. */
+static inline PK_HD vec3 material_mtl_tint(const material *m)
+{
+    float tmax_c = v3_max_comp(m->tf);
+    return tmax_c > 0.0f ? v3_scale(m->tf, 1.0f / tmax_c) : v3s(1.0f);
+}
+
 /* Fresnel reflectance at normal incidence of a dielectric of index ior,
  * and of a conductor of index eta + i k (per channel). */
 PK_HIDDEN float material_f0_dielectric(float ior);
