@@ -41,7 +41,8 @@ static float any_float(rng *r)
     }
 }
 
-static bool same_bits(const void *a, const void *b, size_t n) { return memcmp(a, b, n) == 0; }
+/* (memcmp may not be given NULL, which empty arrays are, even for 0 bytes) */
+static bool same_bits(const void *a, const void *b, size_t n) { return n == 0 || memcmp(a, b, n) == 0; }
 
 static size_t files_in(const char *dir)
 {
