@@ -239,9 +239,6 @@ void pk_environment_init(pk_environment *env)
 pk_status pk_scene_set_environment(pk_context *ctx, pk_scene *s, const pk_environment *in)
 {
     if (!ctx || !s) return PK_ERR_INVALID_ARGUMENT;
-    scene_environment env;
-    scene_env_init(&env);
-    env.set = true;
     if (in) {
         for (int c = 0; c < 3; c++)
             if (!(in->radiance[c] >= 0.0f) || !isfinite(in->radiance[c]))
@@ -249,22 +246,22 @@ pk_status pk_scene_set_environment(pk_context *ctx, pk_scene *s, const pk_enviro
         if (!(in->map_scale >= 0.0f) || !isfinite(in->map_scale) || !isfinite(in->rotation))
             return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "environment: the scale must be finite and not negative, "
                              "the rotation finite");
-        env.radiance = v3(in->radiance[0], in->radiance[1], in->radiance[2]);
-        env.map_scale = in->map_scale;
-        scene_env_rotate_y(&env, in->rotation);
-        if (in->map) {
-            env.map = mem_strdup(&s->alloc, in->map);
-            if (!env.map) return ctx_nomem(ctx);
-            pk_status st = scene_env_load(ctx, &env);
-            if (st != PK_OK) {
-                scene_env_clear(&s->alloc, &env);
-                return st;
-            }
-        }
     }
-    scene_env_clear(&s->alloc, &s->env);
-    s->env = env;
-    return PK_OK;
+    /* built in place through the constructors; the old one comes back if the map cannot be read */
+    scene_environment old = s->env;
+    scene_env_init(&s->env);
+    s->env.set = true;
+    pk_status st = PK_OK;
+    if (in) {
+        scene_env_add_radiance(s, v3(in->radiance[0], in->radiance[1], in->radiance[2]));
+        float rot[9];
+        scene_rotation_y(in->rotation, rot);
+        scene_env_frame(s, rot);
+        if (in->map) st = scene_env_map(ctx, s, in->map, in->map_scale);
+    }
+    scene_env_clear(&s->alloc, st == PK_OK ? &old : &s->env);
+    if (st != PK_OK) s->env = old;
+    return st;
 }
 
 void pk_scene_get_render_options(const pk_scene *s, pk_render_options *opt)

@@ -1162,7 +1162,7 @@ static pk_status get_direction(jp *p, const cJSON *it, const char *path, vec3 *o
     return PK_OK;
 }
 
-static pk_status parse_sun(jp *p, const cJSON *it, const char *path, scene_environment *env)
+static pk_status parse_sun(jp *p, const cJSON *it, const char *path, vec3 *to_sun)
 {
     enum { U_DIRECTION, U_IRRADIANCE, U_RADIANCE, U_ANGLE, U_COUNT };
     static const char *const keys[U_COUNT] = {"direction", "irradiance", "radiance", "angle"};
@@ -1172,96 +1172,108 @@ static pk_status parse_sun(jp *p, const cJSON *it, const char *path, scene_envir
     if (st) return st;
     if (!f[U_DIRECTION]) return jfail(p, PK_ERR_PARSE, it, path, "missing \"direction\" (toward the sun)");
     path_key(fp, path, "direction");
-    if ((st = get_direction(p, f[U_DIRECTION], fp, &env->sun_dir))) return st;
+    if ((st = get_direction(p, f[U_DIRECTION], fp, to_sun))) return st;
+    float angle = p->s->env.sun_angle;
     if (f[U_ANGLE]) {
         path_key(fp, path, "angle");
-        if ((st = get_float(p, f[U_ANGLE], fp, &env->sun_angle))) return st;
-        if (!(env->sun_angle > 0.0f && env->sun_angle <= 90.0f))
+        if ((st = get_float(p, f[U_ANGLE], fp, &angle))) return st;
+        if (!(angle > 0.0f && angle <= 90.0f))
             return jfail(p, PK_ERR_PARSE, f[U_ANGLE], fp, "must be an angular diameter in (0, 90] degrees");
     }
     if (f[U_IRRADIANCE] && f[U_RADIANCE]) {
         path_key(fp, path, "radiance");
         return jfail(p, PK_ERR_PARSE, f[U_RADIANCE], fp, "give \"irradiance\" or \"radiance\", not both");
     }
-    env->sun_radiance = v3s(0.0f);
+    vec3 radiance = v3s(0.0f);
     if (f[U_RADIANCE]) {
         path_key(fp, path, "radiance");
-        if ((st = get_color(p, f[U_RADIANCE], fp, &env->sun_radiance))) return st;
+        if ((st = get_color(p, f[U_RADIANCE], fp, &radiance))) return st;
     } else {
-        /* irradiance E on a surface facing the sun: a uniform disc of angular
-         * radius a gives E = pi L sin^2 a (default: 100, a bright day in the
-         * units of the sky) */
+        /* irradiance on a surface facing the sun (default: 100, a bright
+         * day in the units of the sky) */
         vec3 e = v3s(100.0f);
         path_key(fp, path, "irradiance");
         if (f[U_IRRADIANCE] && (st = get_color(p, f[U_IRRADIANCE], fp, &e))) return st;
-        float a = 0.5f * env->sun_angle * (PK_PI / 180.0f), s = sinf(a);
-        env->sun_radiance = v3_scale(e, 1.0f / (PK_PI * s * s));
+        radiance = scene_sun_radiance(e, angle);
     }
-    env->has_sun = true;
-    return PK_OK;
+    return scene_env_sun(p->ctx, p->s, *to_sun, radiance, angle);
+}
+
+static pk_status parse_sky(jp *p, const cJSON *it, bool has_sun, vec3 to_sun)
+{
+    enum { K_TURBIDITY, K_SCALE, K_SUN_DIRECTION, K_N };
+    static const char *const sk[K_N] = {"turbidity", "scale", "sun_direction"};
+    const cJSON *g[K_N];
+    float turbidity = p->s->env.sky_turbidity, scale = p->s->env.sky_scale;
+    pk_status st = object_fields(p, it, "environment.sky", sk, K_N, g);
+    if (st) return st;
+    if (g[K_TURBIDITY]) {
+        if ((st = get_float(p, g[K_TURBIDITY], "environment.sky.turbidity", &turbidity))) return st;
+        if (!(turbidity >= 2.0f && turbidity <= 10.0f))
+            return jfail(p, PK_ERR_PARSE, g[K_TURBIDITY], "environment.sky.turbidity", "must be in 2..10");
+    }
+    if (g[K_SCALE]) {
+        if ((st = get_float(p, g[K_SCALE], "environment.sky.scale", &scale))) return st;
+        if (scale < 0.0f) return jfail(p, PK_ERR_PARSE, g[K_SCALE], "environment.sky.scale", "must not be negative");
+    }
+    if (g[K_SUN_DIRECTION]) {
+        if (has_sun)
+            return jfail(p, PK_ERR_PARSE, g[K_SUN_DIRECTION], "environment.sky.sun_direction",
+                         "the sky follows environment.sun.direction; give one of them");
+        if ((st = get_direction(p, g[K_SUN_DIRECTION], "environment.sky.sun_direction", &to_sun))) return st;
+    } else if (!has_sun) {
+        return jfail(p, PK_ERR_PARSE, it, "environment.sky",
+                     "needs the sun's direction: an environment.sun or a \"sun_direction\"");
+    }
+    return scene_env_sky(p->ctx, p->s, to_sun, turbidity, scale, false, v3s(0.0f));
 }
 
 static pk_status parse_environment(jp *p, const cJSON *it)
 {
     scene_environment *env = &p->s->env;
-    const pk_allocator *a = &p->ctx->alloc;
-    scene_env_clear(a, env);
+    scene_env_clear(&p->ctx->alloc, env);
     env->set = true;
     pk_status st;
     if (cJSON_IsString(it) && strcmp(it->valuestring, "none") == 0) return PK_OK;
     if (cJSON_GetObjectItemCaseSensitive(it, "record")) return parse_environment_record(p, it);
-    if (cJSON_IsArray(it) || cJSON_IsNumber(it)) return get_color(p, it, "environment", &env->radiance);
+    vec3 radiance = v3s(0.0f);
+    if (cJSON_IsArray(it) || cJSON_IsNumber(it)) {
+        if ((st = get_color(p, it, "environment", &radiance))) return st;
+        scene_env_add_radiance(p->s, radiance);
+        return PK_OK;
+    }
     enum { E_RADIANCE, E_MAP, E_SCALE, E_ROTATION, E_SUN, E_SKY, E_COUNT };
     static const char *const keys[E_COUNT] = {"radiance", "map", "scale", "rotation", "sun", "sky"};
     const cJSON *f[E_COUNT];
     if (!cJSON_IsObject(it))
         return jfail(p, PK_ERR_PARSE, it, "environment", "must be \"none\", a colour or an object");
     if ((st = object_fields(p, it, "environment", keys, E_COUNT, f))) return st;
-    if (f[E_RADIANCE] && (st = get_color(p, f[E_RADIANCE], "environment.radiance", &env->radiance))) return st;
+    if (f[E_RADIANCE]) {
+        if ((st = get_color(p, f[E_RADIANCE], "environment.radiance", &radiance))) return st;
+        scene_env_add_radiance(p->s, radiance);
+    }
+    float scale = 1.0f, rot[9], deg = 0.0f;
     if (f[E_SCALE]) {
-        if ((st = get_float(p, f[E_SCALE], "environment.scale", &env->map_scale))) return st;
-        if (env->map_scale < 0.0f) return jfail(p, PK_ERR_PARSE, f[E_SCALE], "environment.scale", "must not be negative");
+        if ((st = get_float(p, f[E_SCALE], "environment.scale", &scale))) return st;
+        if (scale < 0.0f) return jfail(p, PK_ERR_PARSE, f[E_SCALE], "environment.scale", "must not be negative");
     }
     if (f[E_ROTATION]) {
-        float deg = 0.0f;
         if ((st = get_float(p, f[E_ROTATION], "environment.rotation", &deg))) return st;
-        scene_env_rotate_y(env, deg);
+        scene_rotation_y(deg, rot);
+        scene_env_frame(p->s, rot);
     }
-    if (f[E_SUN] && (st = parse_sun(p, f[E_SUN], "environment.sun", env))) return st;
-    if (f[E_SKY]) {
-        enum { K_TURBIDITY, K_SCALE, K_SUN_DIRECTION, K_N };
-        static const char *const sk[K_N] = {"turbidity", "scale", "sun_direction"};
-        const cJSON *g[K_N];
-        if ((st = object_fields(p, f[E_SKY], "environment.sky", sk, K_N, g))) return st;
-        if (g[K_TURBIDITY]) {
-            if ((st = get_float(p, g[K_TURBIDITY], "environment.sky.turbidity", &env->sky_turbidity))) return st;
-            if (!(env->sky_turbidity >= 2.0f && env->sky_turbidity <= 10.0f))
-                return jfail(p, PK_ERR_PARSE, g[K_TURBIDITY], "environment.sky.turbidity", "must be in 2..10");
-        }
-        if (g[K_SCALE]) {
-            if ((st = get_float(p, g[K_SCALE], "environment.sky.scale", &env->sky_scale))) return st;
-            if (env->sky_scale < 0.0f)
-                return jfail(p, PK_ERR_PARSE, g[K_SCALE], "environment.sky.scale", "must not be negative");
-        }
-        if (g[K_SUN_DIRECTION]) {
-            if (env->has_sun)
-                return jfail(p, PK_ERR_PARSE, g[K_SUN_DIRECTION], "environment.sky.sun_direction",
-                             "the sky follows environment.sun.direction; give one of them");
-            if ((st = get_direction(p, g[K_SUN_DIRECTION], "environment.sky.sun_direction", &env->sun_dir))) return st;
-        } else if (!env->has_sun) {
-            return jfail(p, PK_ERR_PARSE, f[E_SKY], "environment.sky",
-                         "needs the sun's direction: an environment.sun or a \"sun_direction\"");
-        }
-        env->has_sky = true;
-    }
+    vec3 to_sun = env->sun_dir;
+    if (f[E_SUN] && (st = parse_sun(p, f[E_SUN], "environment.sun", &to_sun))) return st;
+    if (f[E_SKY] && (st = parse_sky(p, f[E_SKY], f[E_SUN] != NULL, to_sun))) return st;
     if (f[E_MAP]) {
         if (!cJSON_IsString(f[E_MAP]) || !f[E_MAP]->valuestring[0])
             return jfail(p, PK_ERR_PARSE, f[E_MAP], "environment.map", "must be a non-empty string (a path)");
-        env->map = path_join(a, p->base_dir, f[E_MAP]->valuestring);
-        if (!env->map) return ctx_nomem(p->ctx);
+        char *path = path_join(&p->ctx->alloc, p->base_dir, f[E_MAP]->valuestring);
+        if (!path) return ctx_nomem(p->ctx);
         /* loaded now, so that a bad map is reported at its line */
         pk_context scratch = io_scratch_context(p->ctx);
-        st = scene_env_load(&scratch, env);
+        st = scene_env_map(&scratch, p->s, path, scale);
+        mem_free(&p->ctx->alloc, path);
         if (st) return jfail(p, st, f[E_MAP], "environment.map", "%s", scratch.message);
     }
     return PK_OK;

@@ -24,11 +24,11 @@ void scene_env_init(scene_environment *env)
     env->sky_scale = 1.0f;
 }
 
-void scene_env_rotate_y(scene_environment *env, float deg)
+void scene_rotation_y(float deg, float m[9])
 {
     float c = cosf(deg * (PK_PI / 180.0f)), s = sinf(deg * (PK_PI / 180.0f));
-    const float m[9] = {c, 0.0f, s, 0.0f, 1.0f, 0.0f, -s, 0.0f, c};
-    memcpy(env->to_world, m, sizeof m);
+    const float r[9] = {c, 0.0f, s, 0.0f, 1.0f, 0.0f, -s, 0.0f, c};
+    memcpy(m, r, sizeof r);
 }
 
 void scene_env_clear(const pk_allocator *a, scene_environment *env)
@@ -203,6 +203,88 @@ void scene_env_add_radiance(pk_scene *s, vec3 radiance)
 {
     s->env.set = true;
     s->env.radiance = v3_add(s->env.radiance, radiance);
+}
+
+static bool unit_dir(vec3 d) { return v3_finite(d) && fabsf(v3_len2(d) - 1.0f) < 1e-3f; }
+static bool nonneg(vec3 v) { return v3_finite(v) && v.x >= 0.0f && v.y >= 0.0f && v.z >= 0.0f; }
+
+void scene_env_frame(pk_scene *s, const float to_world[9])
+{
+    s->env.set = true;
+    memcpy(s->env.to_world, to_world, sizeof s->env.to_world);
+}
+
+pk_status scene_env_map(pk_context *ctx, pk_scene *s, const char *path, float scale)
+{
+    scene_environment *env = &s->env;
+    if (!path || !path[0] || !(scale >= 0.0f) || !isfinite(scale))
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "environment map: a file and a finite scale, not negative");
+    if (env->map || env->map_rgb) return ctx_error(ctx, PK_ERR_UNSUPPORTED, "one environment map per scene");
+    if (!(env->map = mem_strdup(&s->alloc, path))) return ctx_nomem(ctx);
+    env->set = true;
+    env->map_scale = scale;
+    pk_status st = scene_env_load(ctx, env);
+    if (st != PK_OK) {
+        mem_free(&s->alloc, env->map);
+        env->map = NULL;
+    }
+    return st;
+}
+
+pk_status scene_env_map_pixels(pk_context *ctx, pk_scene *s, const char *name, float *rgb, int w, int h, float scale)
+{
+    scene_environment *env = &s->env;
+    pk_status st = PK_OK;
+    if (!rgb || !name || w <= 0 || h <= 0 || !(scale >= 0.0f) || !isfinite(scale))
+        st = ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "environment map: pixels, a size and a finite scale, not negative");
+    else if (env->map || env->map_rgb)
+        st = ctx_error(ctx, PK_ERR_UNSUPPORTED, "one environment map per scene");
+    else if (!(env->map = mem_strdup(&s->alloc, name)))
+        st = ctx_nomem(ctx);
+    if (st != PK_OK) {
+        mem_free(&s->alloc, rgb);
+        return st;
+    }
+    env->set = true;
+    env->map_rgb = rgb;
+    env->map_w = w, env->map_h = h;
+    env->map_scale = scale;
+    return PK_OK;
+}
+
+vec3 scene_sun_radiance(vec3 irradiance, float angle)
+{
+    float a = 0.5f * angle * (PK_PI / 180.0f), s = sinf(a);
+    return v3_scale(irradiance, 1.0f / (PK_PI * s * s));
+}
+
+pk_status scene_env_sun(pk_context *ctx, pk_scene *s, vec3 to_sun, vec3 radiance, float angle)
+{
+    if (!unit_dir(to_sun) || !nonneg(radiance) || !(angle > 0.0f && angle <= 90.0f))
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT,
+                         "sun: a unit direction, a finite radiance not negative and a diameter in (0, 90] degrees");
+    scene_environment *env = &s->env;
+    env->set = env->has_sun = true;
+    env->sun_dir = to_sun;
+    env->sun_radiance = radiance;
+    env->sun_angle = angle;
+    return PK_OK;
+}
+
+pk_status scene_env_sky(pk_context *ctx, pk_scene *s, vec3 to_sun, float turbidity, float scale, bool hosek, vec3 albedo)
+{
+    if (!unit_dir(to_sun) || !(turbidity >= 1.0f && turbidity <= 10.0f) || !(scale >= 0.0f) || !isfinite(scale) ||
+        !nonneg(albedo) || albedo.x > 1.0f || albedo.y > 1.0f || albedo.z > 1.0f)
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "sky: a unit sun direction, turbidity in 1..10, a finite scale "
+                                                       "not negative and an albedo in 0..1");
+    scene_environment *env = &s->env;
+    env->set = env->has_sky = true;
+    env->sun_dir = to_sun;
+    env->sky_turbidity = turbidity;
+    env->sky_scale = scale;
+    env->sky_hosek = hosek;
+    if (hosek) env->sky_albedo = albedo;
+    return PK_OK;
 }
 
 void scene_scale_emission(pk_scene *s, float k)

@@ -237,8 +237,34 @@ PK_HIDDEN pk_status scene_light_spot(pk_context *ctx, pk_scene *s, vec3 position
 /* A distant light from the unit direction to_light, giving irradiance on a
  * surface facing it. */
 PK_HIDDEN pk_status scene_light_distant(pk_context *ctx, pk_scene *s, vec3 to_light, vec3 irradiance);
-/* Adds a constant radiance to the environment (which is then set). */
+/* The environment: the one way to describe it (readers and the API). Each
+ * sets the environment (env.set) and checks what it must be, latching
+ * PK_ERR_INVALID_ARGUMENT otherwise; readers check first, with messages
+ * that say where in the file. */
+/* Adds a constant radiance to the environment. */
 PK_HIDDEN void scene_env_add_radiance(pk_scene *s, vec3 radiance);
+/* The environment's frame: the rotation to_world (row-major 3x3) that
+ * turns its map, and the grid a sky is baked on, into the world. */
+PK_HIDDEN void scene_env_frame(pk_scene *s, const float to_world[9]);
+/* The image map: the lat-long file at path (copied), multiplied by scale
+ * (>= 0). The file is read now, so that a bad one is reported where it is
+ * named; one map per scene (a second is PK_ERR_UNSUPPORTED). */
+PK_HIDDEN pk_status scene_env_map(pk_context *ctx, pk_scene *s, const char *path, float scale);
+/* The same from pixels already decoded (w x h linear RGB, row 0 on top),
+ * which the scene takes (freed on failure); name stands for the file. */
+PK_HIDDEN pk_status scene_env_map_pixels(pk_context *ctx, pk_scene *s, const char *name, float *rgb, int w, int h,
+                                         float scale);
+/* The sun: a disc of angular diameter angle (degrees, in (0, 90]) toward
+ * the unit direction to_sun, of uniform radiance (>= 0). */
+PK_HIDDEN pk_status scene_env_sun(pk_context *ctx, pk_scene *s, vec3 to_sun, vec3 radiance, float angle);
+/* The radiance of a sun disc of angular diameter angle (degrees) that gives
+ * irradiance on a surface facing it (E = pi L sin^2 of the half-angle). */
+PK_HIDDEN vec3 scene_sun_radiance(vec3 irradiance, float angle);
+/* An analytic daylight sky lit by the sun in the unit direction to_sun:
+ * Preetham's, or Hosek and Wilkie's (hosek; with the ground's albedo per
+ * channel, 0..1) as Mitsuba evaluates it; turbidity in 1..10, scale >= 0. */
+PK_HIDDEN pk_status scene_env_sky(pk_context *ctx, pk_scene *s, vec3 to_sun, float turbidity, float scale, bool hosek,
+                                  vec3 albedo);
 /* Scales everything that emits by k: materials' emission, lights, media's
  * emission and the environment (pbrt-v4's sensor: ISO x exposure time). */
 PK_HIDDEN void scene_scale_emission(pk_scene *s, float k);
@@ -283,8 +309,9 @@ PK_HIDDEN pk_status scene_media_prepare(pk_context *ctx, pk_scene *s);
 PK_HIDDEN bool scene_has_media(const pk_scene *s);
 /* The empty environment (nothing set, identity rotation, scales 1, sun 0.53 degrees). */
 PK_HIDDEN void scene_env_init(scene_environment *env);
-/* Sets env's map rotation to deg degrees about +y (counter-clockwise seen from above). */
-PK_HIDDEN void scene_env_rotate_y(scene_environment *env, float deg);
+/* The rotation by deg degrees about +y (counter-clockwise seen from above),
+ * row-major 3x3: an environment map's to_world. */
+PK_HIDDEN void scene_rotation_y(float deg, float m[9]);
 /* Frees what env owns and empties it. */
 PK_HIDDEN void scene_env_clear(const pk_allocator *a, scene_environment *env);
 /* Loads env->map into map_rgb unless loaded (a no-op without a map). */

@@ -70,7 +70,7 @@ static env_light build_map_env(const float *rgb, float rot_deg)
     scene_environment d;
     scene_env_init(&d);
     d.set = true;
-    scene_env_rotate_y(&d, rot_deg);
+    scene_rotation_y(rot_deg, d.to_world);
     aabb b = {{-1, -1, -1}, {1, 1, 1}};
     env_light e;
     REQUIRE(env_build(ctx, &d, rgb, MW, MH, b, &e) == PK_OK);

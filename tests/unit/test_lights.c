@@ -4,7 +4,10 @@
  * PK_ERR_INVALID_ARGUMENT and leaves the scene as it was, and the sensor
  * rule (scene_scale_emission) reaches every emitter; area emission is a
  * copy of a shape's material (scene_material_with_emission); the camera is
- * set only when it passes the one camera rule (scene_set_camera).
+ * set only when it passes the one camera rule (scene_set_camera); the
+ * environment's sun, sky, frame and map constructors store what they are
+ * given and refuse what the environment cannot be, and the sun's radiance
+ * from an irradiance agrees with the irradiance integrated over its disc.
  */
 #include "test.h"
 
@@ -126,6 +129,81 @@ static void check_camera(void)
     scene_destroy(s);
 }
 
+/* st must be a refusal that latched a message naming what. */
+static void env_refused(pk_status st, pk_status want, const char *what)
+{
+    CHECK(st == want);
+    CHECKF(strstr(pk_context_error(ctx), what) != NULL, "%s", pk_context_error(ctx));
+    pk_context_clear_error(ctx);
+}
+
+static void check_environment(void)
+{
+    pk_scene *s;
+    REQUIRE(scene_create(ctx, "environment", &s) == PK_OK);
+    CHECK(!s->env.set && !s->env.has_sun && !s->env.has_sky);
+    const vec3 up = v3(0.0f, 1.0f, 0.0f), L = v3(1.0f, 2.0f, 3.0f);
+    env_refused(scene_env_sun(ctx, s, v3(0.0f, 2.0f, 0.0f), L, 0.53f), PK_ERR_INVALID_ARGUMENT, "sun");
+    env_refused(scene_env_sun(ctx, s, up, v3(-1.0f, 0.0f, 0.0f), 0.53f), PK_ERR_INVALID_ARGUMENT, "sun");
+    env_refused(scene_env_sun(ctx, s, up, L, 0.0f), PK_ERR_INVALID_ARGUMENT, "sun");
+    env_refused(scene_env_sun(ctx, s, up, L, 91.0f), PK_ERR_INVALID_ARGUMENT, "sun");
+    CHECK(!s->env.set && !s->env.has_sun); /* refused: unchanged */
+    CHECK(scene_env_sun(ctx, s, up, L, 2.0f) == PK_OK);
+    CHECK(s->env.set && s->env.has_sun && same(s->env.sun_dir, up) && same(s->env.sun_radiance, L) &&
+          s->env.sun_angle == 2.0f);
+    env_refused(scene_env_sky(ctx, s, up, 11.0f, 1.0f, false, v3s(0.0f)), PK_ERR_INVALID_ARGUMENT, "sky");
+    env_refused(scene_env_sky(ctx, s, up, 3.0f, -1.0f, false, v3s(0.0f)), PK_ERR_INVALID_ARGUMENT, "sky");
+    env_refused(scene_env_sky(ctx, s, up, 3.0f, 1.0f, true, v3s(1.5f)), PK_ERR_INVALID_ARGUMENT, "sky");
+    CHECK(!s->env.has_sky);
+    CHECK(scene_env_sky(ctx, s, up, 4.0f, 0.5f, true, v3s(0.3f)) == PK_OK);
+    CHECK(s->env.has_sky && s->env.sky_hosek && s->env.sky_turbidity == 4.0f && s->env.sky_scale == 0.5f &&
+          same(s->env.sky_albedo, v3s(0.3f)));
+    float rot[9];
+    scene_rotation_y(90.0f, rot);
+    scene_env_frame(s, rot);
+    CHECK(memcmp(s->env.to_world, rot, sizeof rot) == 0);
+    CHECK(fabsf(rot[2] - 1.0f) < 1e-6f && fabsf(rot[6] + 1.0f) < 1e-6f && rot[4] == 1.0f); /* +x to -z */
+    /* decoded pixels: taken, one map per scene (the second's pixels freed) */
+    float *px = mem_calloc(&s->alloc, 3 * 2, sizeof *px);
+    REQUIRE(px);
+    CHECK(scene_env_map_pixels(ctx, s, "sky.exr", px, 2, 1, 2.0f) == PK_OK);
+    CHECK(s->env.map_rgb == px && s->env.map_w == 2 && s->env.map_h == 1 && s->env.map_scale == 2.0f &&
+          strcmp(s->env.map, "sky.exr") == 0);
+    float *px2 = mem_calloc(&s->alloc, 3, sizeof *px2);
+    REQUIRE(px2);
+    env_refused(scene_env_map_pixels(ctx, s, "b.exr", px2, 1, 1, 1.0f), PK_ERR_UNSUPPORTED, "one environment map");
+    env_refused(scene_env_map(ctx, s, "b.exr", 1.0f), PK_ERR_UNSUPPORTED, "one environment map");
+    CHECK(s->env.map_rgb == px);
+    scene_destroy(s);
+
+    /* a file that cannot be read: the error, and no map left behind */
+    REQUIRE(scene_create(ctx, "environment", &s) == PK_OK);
+    CHECK(scene_env_map(ctx, s, "/nonexistent/sky.hdr", 1.0f) != PK_OK);
+    pk_context_clear_error(ctx);
+    CHECK(!s->env.map && !s->env.map_rgb);
+    env_refused(scene_env_map(ctx, s, "sky.hdr", -1.0f), PK_ERR_INVALID_ARGUMENT, "environment map");
+    scene_destroy(s);
+
+    /* a disc of uniform radiance L and angular diameter A gives, on a surface
+     * facing it, E = int L cos(t) dw over the disc; integrated here by the
+     * midpoint rule in t (dw = 2 pi sin t dt) */
+    const float angles[3] = {0.53f, 5.0f, 60.0f};
+    for (int i = 0; i < 3; i++) {
+        const vec3 E = v3(100.0f, 50.0f, 1.0f);
+        const vec3 Ls = scene_sun_radiance(E, angles[i]);
+        const double h = 0.5 * (double)angles[i] * 3.14159265358979323846 / 180.0;
+        const int n = 20000;
+        double e = 0.0;
+        for (int k = 0; k < n; k++) {
+            const double t = (k + 0.5) * h / n;
+            e += cos(t) * 2.0 * 3.14159265358979323846 * sin(t) * (h / n);
+        }
+        CHECKF(fabs(e * (double)Ls.x / 100.0 - 1.0) < 1e-4 && fabs(e * (double)Ls.z - 1.0) < 1e-4, "angle %g: E %g",
+               (double)angles[i],
+               e * (double)Ls.x);
+    }
+}
+
 int main(void)
 {
     REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
@@ -133,6 +211,7 @@ int main(void)
     check_scale();
     check_emission();
     check_camera();
+    check_environment();
     pk_context_destroy(ctx);
     return test_done("test_lights");
 }
