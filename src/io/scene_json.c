@@ -535,21 +535,18 @@ static pk_status read_medium(jp *p, const cJSON *it, const char *path, medium *m
         if (al.x > 1.0f || al.y > 1.0f || al.z > 1.0f)
             return jfail(p, PK_ERR_PARSE, f[MD_ALBEDO], fp[MD_ALBEDO], "must lie in 0..1");
     }
-    if (as) {
-        stv = v3_add(sa, ss);
-        const float t[3] = {stv.x, stv.y, stv.z}, s[3] = {ss.x, ss.y, ss.z};
-        float a[3];
-        for (int c = 0; c < 3; c++) a[c] = t[c] > 0.0f ? fminf(s[c] / t[c], 1.0f) : 1.0f;
-        al = v3(a[0], a[1], a[2]);
-    }
     float scale = 1.0f;
     if (f[MD_SCALE]) {
         if ((st = get_float(p, f[MD_SCALE], fp[MD_SCALE], &scale))) return st;
         if (scale < 0.0f) return jfail(p, PK_ERR_PARSE, f[MD_SCALE], fp[MD_SCALE], "must not be negative");
     }
-    m->sigma_t = v3_scale(stv, scale);
+    if (as) {
+        medium_set_coefficients(m, sa, ss, scale);
+    } else {
+        m->sigma_t = v3_scale(stv, scale);
+        m->albedo = al;
+    }
     if (!v3_finite(m->sigma_t)) return jfail(p, PK_ERR_PARSE, it, path, "the extinction times \"scale\" is not finite");
-    m->albedo = al;
     if (f[MD_G]) {
         if ((st = get_float(p, f[MD_G], fp[MD_G], &m->g))) return st;
         if (!(m->g > -1.0f && m->g < 1.0f))

@@ -27,6 +27,16 @@ void medium_free(const pk_allocator *a, medium *m)
     m->majorant = NULL;
 }
 
+void medium_set_coefficients(medium *m, vec3 sigma_a, vec3 sigma_s, float scale)
+{
+    const vec3 t = v3_add(sigma_a, sigma_s);
+    const float tt[3] = {t.x, t.y, t.z}, ss[3] = {sigma_s.x, sigma_s.y, sigma_s.z};
+    float a[3];
+    for (int c = 0; c < 3; c++) a[c] = tt[c] > 0.0f ? fminf(ss[c] / tt[c], 1.0f) : 1.0f;
+    m->sigma_t = v3_scale(t, scale);
+    m->albedo = v3(a[0], a[1], a[2]);
+}
+
 pk_status scene_add_medium(pk_context *ctx, pk_scene *s, medium *m, uint32_t *index)
 {
     if (s->nmedia >= SCENE_MAX_MEDIA) {

@@ -297,6 +297,11 @@ PK_HIDDEN pk_status scene_material_with_media(pk_context *ctx, pk_scene *s, uint
                                               int32_t med_out, uint32_t *out);
 /* Number of the newest medium named name; -1 when absent. */
 PK_HIDDEN int64_t scene_find_medium(const pk_scene *s, const char *name);
+/* A medium's coefficients from absorption sigma_a and scattering sigma_s
+ * (per unit length, not negative) times scale: sigma_t = (sigma_a +
+ * sigma_s) scale and albedo sigma_s / (sigma_a + sigma_s), at most 1 (1
+ * where nothing interacts, which no path can see). */
+PK_HIDDEN void medium_set_coefficients(medium *m, vec3 sigma_a, vec3 sigma_s, float scale);
 /* Frees what a medium owns (its name, grids and majorants). */
 PK_HIDDEN void medium_free(const pk_allocator *a, medium *m);
 /* Checks every medium (values, grids, placement, the voxel limit) and the
