@@ -400,13 +400,12 @@ static pk_status add_mesh(gltf *g, int64_t mi, bool flip)
 
 static void set_film(gltf *g, float aspect)
 {
-    scene_render_settings *r = &g->s->render;
     int w = GLTF_DEFAULT_SIDE, h = GLTF_DEFAULT_SIDE;
     if (aspect >= 1.0f) h = (int)lroundf((float)GLTF_DEFAULT_SIDE / aspect);
     else w = (int)lroundf((float)GLTF_DEFAULT_SIDE * aspect);
-    r->opt.width = w < 1 ? 1 : w;
-    r->opt.height = h < 1 ? 1 : h;
-    r->has_width = r->has_height = true;
+    /* both within 1..GLTF_DEFAULT_SIDE, inside the options' ranges */
+    (void)scene_render_int(g->ctx, g->s, "width", w < 1 ? 1 : w);
+    (void)scene_render_int(g->ctx, g->s, "height", h < 1 ? 1 : h);
 }
 
 static pk_status place_camera(gltf *g, int64_t ci, const xform *x, int64_t node)

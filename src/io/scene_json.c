@@ -847,17 +847,15 @@ static pk_status parse_size(jp *p, const cJSON *wi, const cJSON *hi, const cJSON
     scene_render_settings *r = &p->s->render;
     char fp[JP_PATH_MAX];
     pk_status st;
-    if (wi) {
-        path_key(fp, path, "width");
-        const pk_int_option *o = pk_int_option_find("width");
-        if ((st = get_int(p, wi, fp, o->min, o->max, &r->opt.width))) return st;
-        r->has_width = true;
-    }
-    if (hi) {
-        path_key(fp, path, "height");
-        const pk_int_option *o = pk_int_option_find("height");
-        if ((st = get_int(p, hi, fp, o->min, o->max, &r->opt.height))) return st;
-        r->has_height = true;
+    const cJSON *side[2] = {wi, hi};
+    static const char *const names[2] = {"width", "height"};
+    for (int i = 0; i < 2; i++) {
+        if (!side[i]) continue;
+        path_key(fp, path, names[i]);
+        const pk_int_option *o = pk_int_option_find(names[i]);
+        int v = 0;
+        if ((st = get_int(p, side[i], fp, o->min, o->max, &v)) || (st = scene_render_int(p->ctx, p->s, names[i], v)))
+            return st;
     }
     if ((uint64_t)r->opt.width * (uint64_t)r->opt.height > (uint64_t)PK_MAX_IMAGE_PIXELS)
         return jfail(p, PK_ERR_LIMIT, obj, path, "%dx%d is more than %u pixels", r->opt.width, r->opt.height,
@@ -883,52 +881,42 @@ static pk_status parse_render(jp *p, const cJSON *it)
     const cJSON *f[R_COUNT];
     pk_status st = object_fields(p, it, "render", keys, R_COUNT, f);
     if (st) return st;
-    scene_render_settings *r = &p->s->render;
     /* ranges from the one option table (options.c), as the API and the CLI */
-    const struct {
-        int key;
-        const char *path;
-        bool *has;
-    } ints[] = {{R_SPP, "render.spp", &r->has_spp},
-                {R_LS, "render.light_samples", &r->has_light_samples},
-                {R_DEPTH, "render.max_depth", &r->has_max_depth},
-                {R_THREADS, "render.threads", &r->has_threads},
-                {R_SEED, "render.seed", &r->has_seed},
-                {R_REGULARIZE, "render.regularize", &r->has_regularize},
-                {R_LIGHT_TREE, "render.light_tree", &r->has_light_tree}};
+    static const int ints[] = {R_SPP, R_LS, R_DEPTH, R_THREADS, R_SEED, R_REGULARIZE, R_LIGHT_TREE};
     for (size_t i = 0; i < sizeof ints / sizeof ints[0]; i++) {
-        if (!f[ints[i].key]) continue;
-        const pk_int_option *o = pk_int_option_find(keys[ints[i].key]);
-        if ((st = get_int(p, f[ints[i].key], ints[i].path, o->min, o->max, options_int_field(&r->opt, o))))
+        const int k = ints[i];
+        if (!f[k]) continue;
+        char fp[JP_PATH_MAX];
+        path_key(fp, "render", keys[k]);
+        const pk_int_option *o = pk_int_option_find(keys[k]);
+        int v = 0;
+        if ((st = get_int(p, f[k], fp, o->min, o->max, &v)) || (st = scene_render_int(p->ctx, p->s, keys[k], v)))
             return st;
-        *ints[i].has = true;
     }
     if (f[R_ACCEL]) {
         pk_accel_kind kind;
         if (!cJSON_IsString(f[R_ACCEL]) || pk_accel_kind_parse(f[R_ACCEL]->valuestring, &kind) != PK_OK)
             return jfail(p, PK_ERR_PARSE, f[R_ACCEL], "render.accel",
                          "must be one of \"none\", \"midpoint\", \"bvh\", \"embree\"");
-        r->opt.accel = kind;
-        r->has_accel = true;
+        scene_render_accel(p->s, kind);
     }
     if (f[R_INTEGRATOR]) {
         pk_integrator_kind kind;
         if (!cJSON_IsString(f[R_INTEGRATOR]) || pk_integrator_parse(f[R_INTEGRATOR]->valuestring, &kind) != PK_OK)
             return jfail(p, PK_ERR_PARSE, f[R_INTEGRATOR], "render.integrator",
                          "must be \"path\", \"volpath\", \"whitted\" or \"default\"");
-        r->opt.integrator = kind;
-        r->has_integrator = true;
+        scene_render_integrator(p->s, kind);
     }
     if (f[R_FRESNEL]) {
         if (!cJSON_IsBool(f[R_FRESNEL])) return jfail(p, PK_ERR_PARSE, f[R_FRESNEL], "render.fresnel", "must be true or false");
-        r->opt.fresnel = cJSON_IsTrue(f[R_FRESNEL]) ? 1 : 0;
-        r->has_fresnel = true;
+        scene_render_fresnel(p->s, cJSON_IsTrue(f[R_FRESNEL]));
     }
     if (f[R_CLAMP]) {
-        if ((st = get_float(p, f[R_CLAMP], "render.clamp_indirect", &r->opt.clamp_indirect))) return st;
-        if (!(r->opt.clamp_indirect >= 0.0f))
+        float clamp = 0.0f;
+        if ((st = get_float(p, f[R_CLAMP], "render.clamp_indirect", &clamp))) return st;
+        if (!(clamp >= 0.0f))
             return jfail(p, PK_ERR_PARSE, f[R_CLAMP], "render.clamp_indirect", "must be 0 (off) or more");
-        r->has_clamp_indirect = true;
+        if ((st = scene_render_clamp(p->ctx, p->s, clamp))) return st;
     }
     return parse_size(p, f[R_W], f[R_H], it, "render");
 }

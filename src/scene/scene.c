@@ -6,7 +6,9 @@
 #include "scene.h"
 
 #include "../image/image_read.h"
+#include "../options.h"
 
+#include <stddef.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -284,6 +286,49 @@ pk_status scene_env_sky(pk_context *ctx, pk_scene *s, vec3 to_sun, float turbidi
     env->sky_scale = scale;
     env->sky_hosek = hosek;
     if (hosek) env->sky_albedo = albedo;
+    return PK_OK;
+}
+
+pk_status scene_render_int(pk_context *ctx, pk_scene *s, const char *name, int v)
+{
+    scene_render_settings *r = &s->render;
+    static const struct {
+        const char *name;
+        size_t has;
+    } marks[] = {{"width", offsetof(scene_render_settings, has_width)},
+                 {"height", offsetof(scene_render_settings, has_height)},
+                 {"spp", offsetof(scene_render_settings, has_spp)},
+                 {"light_samples", offsetof(scene_render_settings, has_light_samples)},
+                 {"max_depth", offsetof(scene_render_settings, has_max_depth)},
+                 {"threads", offsetof(scene_render_settings, has_threads)},
+                 {"seed", offsetof(scene_render_settings, has_seed)},
+                 {"regularize", offsetof(scene_render_settings, has_regularize)},
+                 {"light_tree", offsetof(scene_render_settings, has_light_tree)}};
+    const pk_int_option *o = pk_int_option_find(name);
+    for (size_t i = 0; o && i < sizeof marks / sizeof marks[0]; i++) {
+        if (strcmp(marks[i].name, o->name) != 0) continue;
+        if (v < o->min || v > o->max)
+            return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "render setting %s: %d is not in %d..%d", o->name, v, o->min,
+                             o->max);
+        *options_int_field(&r->opt, o) = v;
+        *(bool *)(void *)((char *)r + marks[i].has) = true;
+        return PK_OK;
+    }
+    return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "render setting \"%.40s\" is not known", name ? name : "");
+}
+
+void scene_render_accel(pk_scene *s, pk_accel_kind kind) { s->render.opt.accel = kind, s->render.has_accel = true; }
+void scene_render_integrator(pk_scene *s, pk_integrator_kind kind)
+{
+    s->render.opt.integrator = kind, s->render.has_integrator = true;
+}
+void scene_render_fresnel(pk_scene *s, bool on) { s->render.opt.fresnel = on ? 1 : 0, s->render.has_fresnel = true; }
+
+pk_status scene_render_clamp(pk_context *ctx, pk_scene *s, float clamp_indirect)
+{
+    if (!(clamp_indirect >= 0.0f) || !isfinite(clamp_indirect))
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "render setting clamp_indirect must be finite and not negative");
+    s->render.opt.clamp_indirect = clamp_indirect, s->render.has_clamp_indirect = true;
     return PK_OK;
 }
 

@@ -268,6 +268,17 @@ PK_HIDDEN pk_status scene_env_sky(pk_context *ctx, pk_scene *s, vec3 to_sun, flo
 /* Scales everything that emits by k: materials' emission, lights, media's
  * emission and the environment (pbrt-v4's sensor: ISO x exposure time). */
 PK_HIDDEN void scene_scale_emission(pk_scene *s, float k);
+/* Render settings a scene carries, each marked as the scene's: an integer
+ * option of pk_int_options by its name ("width", "spp", "max_depth", ...;
+ * out of the option's range, or not an option, PK_ERR_INVALID_ARGUMENT),
+ * the accelerator, the integrator, Fresnel on or off, and the clamp of
+ * indirect light (0: off; not negative). Readers check first, with messages
+ * that say where in the file. */
+PK_HIDDEN pk_status scene_render_int(pk_context *ctx, pk_scene *s, const char *name, int v);
+PK_HIDDEN void scene_render_accel(pk_scene *s, pk_accel_kind kind);
+PK_HIDDEN void scene_render_integrator(pk_scene *s, pk_integrator_kind kind);
+PK_HIDDEN void scene_render_fresnel(pk_scene *s, bool on);
+PK_HIDDEN pk_status scene_render_clamp(pk_context *ctx, pk_scene *s, float clamp_indirect);
 /* Adds a material initialised like MTL's defaults (kd 0.8, ks 0, ns 1, ni 1, d 1,
  * illum 2) named name; *index receives its number. A later material of the same
  * name replaces the earlier one for scene_find_material. */

@@ -7,7 +7,8 @@
  * set only when it passes the one camera rule (scene_set_camera); the
  * environment's sun, sky, frame and map constructors store what they are
  * given and refuse what the environment cannot be, and the sun's radiance
- * from an irradiance agrees with the irradiance integrated over its disc.
+ * from an irradiance agrees with the irradiance integrated over its disc;
+ * render settings are set and marked only within their options' ranges.
  */
 #include "test.h"
 
@@ -204,6 +205,30 @@ static void check_environment(void)
     }
 }
 
+static void check_render_settings(void)
+{
+    pk_scene *s;
+    REQUIRE(scene_create(ctx, "settings", &s) == PK_OK);
+    CHECK(!s->render.has_spp && !s->render.has_width);
+    CHECK(scene_render_int(ctx, s, "spp", 16) == PK_OK && s->render.has_spp && s->render.opt.spp == 16);
+    CHECK(scene_render_int(ctx, s, "max-depth", 5) == PK_OK && s->render.has_max_depth && s->render.opt.max_depth == 5);
+    env_refused(scene_render_int(ctx, s, "spp", 0), PK_ERR_INVALID_ARGUMENT, "spp");
+    env_refused(scene_render_int(ctx, s, "width", -3), PK_ERR_INVALID_ARGUMENT, "width");
+    env_refused(scene_render_int(ctx, s, "colour", 1), PK_ERR_INVALID_ARGUMENT, "not known");
+    CHECK(s->render.opt.spp == 16 && !s->render.has_width); /* refused: unchanged */
+    env_refused(scene_render_clamp(ctx, s, -1.0f), PK_ERR_INVALID_ARGUMENT, "clamp");
+    CHECK(!s->render.has_clamp_indirect);
+    CHECK(scene_render_clamp(ctx, s, 10.0f) == PK_OK && s->render.opt.clamp_indirect == 10.0f);
+    scene_render_fresnel(s, false);
+    scene_render_integrator(s, PK_INTEGRATOR_WHITTED);
+    CHECK(s->render.has_fresnel && s->render.opt.fresnel == 0 && s->render.has_integrator &&
+          s->render.opt.integrator == PK_INTEGRATOR_WHITTED);
+    pk_render_options o;
+    pk_scene_get_render_options(s, &o);
+    CHECK(o.spp == 16 && o.max_depth == 5 && o.fresnel == 0 && o.clamp_indirect == 10.0f);
+    scene_destroy(s);
+}
+
 int main(void)
 {
     REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
@@ -212,6 +237,7 @@ int main(void)
     check_emission();
     check_camera();
     check_environment();
+    check_render_settings();
     pk_context_destroy(ctx);
     return test_done("test_lights");
 }
