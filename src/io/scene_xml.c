@@ -1110,6 +1110,16 @@ static pk_status get_ior(xp *p, pdict *d, const char *name, float *out)
     return PK_OK;
 }
 
+/* int_ior / ext_ior (default in, and air). */
+static pk_status get_rel_ior(xp *p, pdict *d, float in, float *ior)
+{
+    float ext = 1.000277f;
+    pk_status st = get_ior(p, d, "int_ior", &in);
+    if (st == PK_OK) st = get_ior(p, d, "ext_ior", &ext);
+    *ior = in / ext;
+    return st;
+}
+
 static float clamp01(float x) { return x > 0.0f ? (x < 1.0f ? x : 1.0f) : 0.0f; }
 static vec3 clamp01v(vec3 c) { return v3(clamp01(c.x), clamp01(c.y), clamp01(c.z)); }
 
@@ -1151,6 +1161,19 @@ static pk_status get_alpha(xp *p, pdict *d, float def, float *alpha, bool *beckm
 
 static pk_status bsdf_material(xp *p, xnode *b, material *m);
 
+/* What a bsdf's creator is given (bsdf_material): the element and its
+ * properties, its type (ty: as messages show it), and what the dispatch
+ * read for its row: the roughness of a rough row (alpha, beckmann:
+ * get_alpha) and int_ior / ext_ior (ior) of a row with an int_ior default.
+ * A creator fills *m (material_init'ed). */
+typedef struct bsdf_in {
+    xnode *b;
+    pdict *d;
+    const char *type, *ty;
+    float alpha, ior;
+    bool beckmann;
+} bsdf_in;
+
 /* The nested bsdf of a wrapper (its first <bsdf> or <ref> child). */
 static xnode *nested_bsdf(xp *p, xnode *b)
 {
@@ -1167,8 +1190,11 @@ static pk_status bsdf_resolve(xp *p, xnode *b, material *m);
  * scene units, as the material's map_bump with bm the product of the scale
  * textures wrapped around the bitmap and the bumpmap's own "scale" (Mitsuba
  * 3). A height that is not a bitmap leaves the nested bsdf alone (warning). */
-static pk_status bump_material(xp *p, xnode *b, pdict *d, xnode *inner, const char *ty, material *m)
+static pk_status bsdf_bump(xp *p, const bsdf_in *in, material *m)
 {
+    xnode *b = in->b, *inner = nested_bsdf(p, b);
+    const char *ty = in->ty;
+    pdict *d = in->d;
     pk_status st;
     float scale = 1.0f;
     if ((st = get_float(p, d, "scale", &scale))) return st;
@@ -1260,7 +1286,233 @@ static pk_status bsdf_resolve(xp *p, xnode *n, material *m)
 
 static void warn_unused(pdict *d, const char *kind, const char *const *quiet);
 
-/* Fills *m (material_init'ed, name unset) from the bsdf element b. */
+/* ---- the Mitsuba BSDFs: one creator per plugin type ---------------------------------------- */
+
+static pk_status bsdf_twosided(xp *p, const bsdf_in *in, material *m)
+{
+    /* one-sided materials are shaded from either side already (the
+     * shading normal faces the viewer); only emission is one-sided */
+    xnode *inner = nested_bsdf(p, in->b);
+    if (!inner) return xfail(p, PK_ERR_PARSE, in->b, "twosided needs a nested bsdf");
+    for (xnode *c = inner->next; c; c = c->next)
+        if (strcmp(c->tag, "bsdf") == 0) {
+            xwarn(p, c, "twosided with a second bsdf for the back side is not supported; the front one is "
+                        "used on both");
+            break;
+        }
+    return bsdf_resolve(p, inner, m);
+}
+
+static pk_status bsdf_mask(xp *p, const bsdf_in *in, material *m)
+{
+    xnode *inner = nested_bsdf(p, in->b);
+    float opacity = 0.5f;
+    pk_status st = get_scalar(p, in->d, "opacity", &opacity);
+    if (st) return st;
+    if (inner && (st = bsdf_resolve(p, inner, m))) return st;
+    if (!inner) material_diffuse(m, v3s(0.5f));
+    if (m->type != MAT_DIELECTRIC) m->d = clamp01(opacity);
+    return PK_OK;
+}
+
+/* a dielectric coat over a diffuse base is Paprsek's plastic */
+static pk_status bsdf_coating(xp *p, const bsdf_in *in, material *m)
+{
+    xnode *inner = nested_bsdf(p, in->b);
+    float alpha = 0.0f, ior;
+    bool bk = false, rough = in->type[0] == 'r';
+    pk_status st;
+    if (rough && (st = get_alpha(p, in->d, 0.1f, &alpha, &bk))) return st;
+    if ((st = get_rel_ior(p, in->d, 1.5046f, &ior))) return st;
+    if (inner && (st = bsdf_resolve(p, inner, m))) return st;
+    if (inner && m->type == MAT_DIFFUSE && ior > 0.0f && ior != 1.0f) {
+        vec3 kd = m->kd;
+        float opacity = m->d;
+        material_init(m);
+        m->d = opacity;
+        material_plastic(m, kd, ior, alpha);
+        m->beckmann = bk;
+        static const char *const q[] = {"distribution", NULL};
+        warn_unused(in->d, rough ? "bsdf \"roughcoating\"" : "bsdf \"coating\"", q);
+        return PK_OK;
+    }
+    if (!inner) {
+        xwarn(p, in->b, "bsdf \"%s\" without a nested bsdf; using a grey diffuse material", in->ty);
+        material_init(m);
+        material_diffuse(m, v3s(0.5f));
+        return PK_OK;
+    }
+    xwarn(p, in->b, "bsdf \"%s\" over a non-diffuse bsdf is not supported; using its nested bsdf alone", in->ty);
+    return PK_OK;
+}
+
+/* normalmap, blendbsdf, ...: the nested bsdf alone */
+static pk_status bsdf_nested_only(xp *p, const bsdf_in *in, material *m)
+{
+    xnode *inner = nested_bsdf(p, in->b);
+    if (!inner) {
+        xwarn(p, in->b, "bsdf \"%s\" is not supported; using a grey diffuse material", in->ty);
+        material_diffuse(m, v3s(0.5f));
+        return PK_OK;
+    }
+    xwarn(p, in->b, "bsdf \"%s\" is not supported; using its nested bsdf alone", in->ty);
+    return bsdf_resolve(p, inner, m);
+}
+
+static pk_status bsdf_diffuse(xp *p, const bsdf_in *in, material *m)
+{
+    vec3 r = v3s(0.5f);
+    pk_status st = get_color_tex(p, in->d, "reflectance", &r, &m->map_kd);
+    if (st) return st;
+    if (in->type[0] == 'r') {
+        prop(in->d, "alpha");
+        if (first_time(p, "roughdiffuse"))
+            xwarn(p, in->b, "roughdiffuse is rendered as diffuse (Lambert), without the Oren-Nayar roughness");
+    }
+    material_diffuse(m, clamp01v(r));
+    return PK_OK;
+}
+
+static pk_status bsdf_conductor(xp *p, const bsdf_in *in, material *m)
+{
+    vec3 eta, k;
+    spectra_named_metal("Cu", &eta, &k); /* Mitsuba's default */
+    vec3 spec = v3s(1.0f);
+    float ext = 1.000277f;
+    bool none = false;
+    const char *mat = NULL;
+    xnode *mat_at;
+    pk_status st;
+    if ((st = get_string(p, in->d, "material", &mat, &mat_at))) return st;
+    if (mat) {
+        if (strcmp(mat, "none") == 0) none = true;
+        else if (!spectra_named_metal(mat, &eta, &k)) {
+            char sm[40];
+            shown(sm, sizeof sm, mat);
+            xwarn(p, mat_at, "conductor material \"%s\" is not in the table (Cu, Au, Ag, Al, Cr, none); using Cu", sm);
+        }
+    }
+    if ((st = get_color(p, in->d, "eta", &eta))) return st;
+    if ((st = get_color(p, in->d, "k", &k))) return st;
+    if ((st = get_ior(p, in->d, "ext_eta", &ext))) return st;
+    if ((st = get_color(p, in->d, "specular_reflectance", &spec))) return st;
+    eta = v3_scale(eta, 1.0f / ext), k = v3_scale(k, 1.0f / ext);
+    eta = v3(fmaxf(eta.x, 1e-4f), fmaxf(eta.y, 1e-4f), fmaxf(eta.z, 1e-4f));
+    k = v3(fmaxf(k.x, 0.0f), fmaxf(k.y, 0.0f), fmaxf(k.z, 0.0f));
+    spec = clamp01v(spec);
+    if (none || spec.x != 1.0f || spec.y != 1.0f || spec.z != 1.0f) {
+        /* a scaled Fresnel term: Schlick's with the scaled normal reflectance */
+        const vec3 f0 = none ? v3s(1.0f) : material_f0_conductor(eta, k);
+        material_conductor_f0(m, clamp01v(v3_mul(f0, spec)), in->alpha);
+    } else {
+        material_conductor(m, eta, k, in->alpha);
+    }
+    m->beckmann = in->beckmann;
+    return PK_OK;
+}
+
+/* The specular_reflectance of dielectric and plastic: only 1 is rendered. */
+static pk_status specular_one(xp *p, const bsdf_in *in)
+{
+    vec3 refl = v3s(1.0f);
+    pk_status st = get_color(p, in->d, "specular_reflectance", &refl);
+    if (st == PK_OK && (refl.x != 1.0f || refl.y != 1.0f || refl.z != 1.0f))
+        xwarn(p, in->b, "%s: specular_reflectance other than 1 is not supported; ignored", in->ty);
+    return st;
+}
+
+static pk_status bsdf_dielectric(xp *p, const bsdf_in *in, material *m)
+{
+    vec3 tr = v3s(1.0f);
+    float ior = in->ior, alpha = in->alpha;
+    pk_status st;
+    if ((st = get_color(p, in->d, "specular_transmittance", &tr)) || (st = specular_one(p, in))) return st;
+    if (in->type[0] == 't') {
+        /* a thin sheet: light goes through unbent; its reflection is lost */
+        xwarn(p, in->b, "thindielectric is rendered as a clear sheet that lets light through unbent, without its "
+                        "reflection");
+        ior = 1.0f;
+    }
+    if (ior == 1.0f && alpha > 0.0f) alpha = 0.0f;
+    material_dielectric(m, ior, alpha, clamp01v(tr));
+    m->beckmann = in->beckmann;
+    return PK_OK;
+}
+
+static pk_status bsdf_plastic(xp *p, const bsdf_in *in, material *m)
+{
+    vec3 kd = v3s(0.5f);
+    pk_status st;
+    if ((st = get_color_tex(p, in->d, "diffuse_reflectance", &kd, &m->map_kd)) || (st = specular_one(p, in)))
+        return st;
+    material_plastic(m, clamp01v(kd), !(in->ior > 0.0f) || in->ior == 1.0f ? 1.49f : in->ior, in->alpha);
+    m->beckmann = in->beckmann;
+    return PK_OK;
+}
+
+/* Disney's model by its main parameters: a metal (Schlick, F0 = base_color)
+ * when metallic > 0.5, else a plastic of base_color; the rest is read
+ * without a warning */
+static pk_status bsdf_principled(xp *p, const bsdf_in *in, material *m)
+{
+    vec3 base = v3s(0.5f);
+    float metallic = 0.0f, roughness = 0.5f, eta = 1.5f;
+    pk_status st;
+    if ((st = get_color(p, in->d, "base_color", &base)) || (st = get_scalar(p, in->d, "metallic", &metallic)) ||
+        (st = get_scalar(p, in->d, "roughness", &roughness)) || (st = get_float(p, in->d, "eta", &eta)))
+        return st;
+    if (first_time(p, "principled"))
+        xwarn(p, in->b, "principled is approximated by a %s of its base_color and roughness",
+              metallic > 0.5f ? "metal" : "plastic");
+    const float alpha = clamp01(roughness) * clamp01(roughness);
+    if (metallic > 0.5f) material_conductor_f0(m, clamp01v(base), alpha);
+    else material_plastic(m, clamp01v(base), eta > 1.0f ? eta : 1.5f, alpha);
+    return PK_OK;
+}
+
+/* The MITSUBA dialect's BSDFs. rough: get_alpha first (default 0.1);
+ * int_ior: the default of int_ior, read (with ext_ior) next, 0 for none;
+ * create NULL: the interface (no surface);
+ * kind: the unread properties' warning after the creator (NULL: none or
+ * the creator's own; "": bsdf "TYPE"). The names are Mitsuba's;
+ * these rules are not the JSON scene's (create_material.c): Mitsuba clamps
+ * colours, takes textures, spectra and named indices of refraction in
+ * typed elements, and reads a value only when its type asks for it. */
+typedef struct bsdf_row {
+    const char *type;
+    pk_status (*create)(xp *p, const bsdf_in *in, material *m);
+    bool rough;
+    float int_ior;
+    const char *kind;
+} bsdf_row;
+static const bsdf_row bsdf_rows[] = {
+    {"twosided", bsdf_twosided, false, 0.0f, NULL},
+    {"mask", bsdf_mask, false, 0.0f, "mask"},
+    {"coating", bsdf_coating, false, 0.0f, NULL},
+    {"roughcoating", bsdf_coating, false, 0.0f, NULL},
+    {"bumpmap", bsdf_bump, false, 0.0f, NULL},
+    {"bump", bsdf_bump, false, 0.0f, NULL},
+    {"normalmap", bsdf_nested_only, false, 0.0f, NULL},
+    {"blendbsdf", bsdf_nested_only, false, 0.0f, NULL},
+    {"mixturebsdf", bsdf_nested_only, false, 0.0f, NULL},
+    {"polarizer", bsdf_nested_only, false, 0.0f, NULL},
+    {"measured", bsdf_nested_only, false, 0.0f, NULL},
+    {"diffuse", bsdf_diffuse, false, 0.0f, ""},
+    {"roughdiffuse", bsdf_diffuse, false, 0.0f, ""},
+    {"conductor", bsdf_conductor, false, 0.0f, ""},
+    {"roughconductor", bsdf_conductor, true, 0.0f, ""},
+    {"dielectric", bsdf_dielectric, false, 1.5046f, ""},
+    {"roughdielectric", bsdf_dielectric, true, 1.5046f, ""},
+    {"thindielectric", bsdf_dielectric, false, 1.5046f, ""},
+    {"plastic", bsdf_plastic, false, 1.49f, ""},
+    {"roughplastic", bsdf_plastic, true, 1.49f, ""},
+    {"principled", bsdf_principled, false, 0.0f, NULL},
+    {"principledthin", bsdf_principled, false, 0.0f, NULL},
+    {"null", NULL, false, 0.0f, ""}, /* no surface: light passes straight through; it may bound media */
+};
+
+/* Fills *m (material_init'ed, name unset) from the bsdf element b: its
+ * row's creator, or a grey diffuse for a type with none. */
 static pk_status bsdf_material(xp *p, xnode *b, material *m)
 {
     pk_status st;
@@ -1270,191 +1522,26 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
     material_init(m);
     char ty[40];
     shown(ty, sizeof ty, type);
-    static const char *const quiet[] = {"ext_ior", "ext_eta", "nonlinear", "distribution", "sample_visible", NULL};
-
-    if (strcmp(type, "twosided") == 0) {
-        /* one-sided materials are shaded from either side already (the
-         * shading normal faces the viewer); only emission is one-sided */
-        xnode *inner = nested_bsdf(p, b);
-        if (!inner) return xfail(p, PK_ERR_PARSE, b, "twosided needs a nested bsdf");
-        for (xnode *c = inner->next; c; c = c->next)
-            if (strcmp(c->tag, "bsdf") == 0) {
-                xwarn(p, c, "twosided with a second bsdf for the back side is not supported; the front one is "
-                            "used on both");
-                break;
-            }
-        return bsdf_resolve(p, inner, m);
-    }
     pdict d;
     if ((st = xml_props(p, b, &d))) return st;
-    if (strcmp(type, "mask") == 0) {
-        xnode *inner = nested_bsdf(p, b);
-        float opacity = 0.5f;
-        if ((st = get_scalar(p, &d, "opacity", &opacity))) return st;
-        if (inner) {
-            if ((st = bsdf_resolve(p, inner, m))) return st;
-        } else {
-            material_diffuse(m, v3s(0.5f));
-        }
-        if (m->type != MAT_DIELECTRIC) m->d = clamp01(opacity);
-        warn_unused(&d, "mask", quiet);
-        return PK_OK;
-    }
-    if (strcmp(type, "coating") == 0 || strcmp(type, "roughcoating") == 0) {
-        /* a dielectric coat over a diffuse base is Paprsek's plastic */
-        xnode *inner = nested_bsdf(p, b);
-        float in = 1.5046f, ext = 1.000277f, alpha = 0.0f;
-        bool bk = false;
-        if (type[0] == 'r' && (st = get_alpha(p, &d, 0.1f, &alpha, &bk))) return st;
-        if ((st = get_ior(p, &d, "int_ior", &in))) return st;
-        if ((st = get_ior(p, &d, "ext_ior", &ext))) return st;
-        if (inner && (st = bsdf_resolve(p, inner, m))) return st;
-        float ior = in / ext;
-        if (inner && m->type == MAT_DIFFUSE && ior > 0.0f && ior != 1.0f) {
-            vec3 kd = m->kd;
-            float opacity = m->d;
-            material_init(m);
-            m->d = opacity;
-            material_plastic(m, kd, ior, alpha);
-            m->beckmann = bk;
-            static const char *const q[] = {"distribution", NULL};
-            warn_unused(&d, type[0] == 'r' ? "bsdf \"roughcoating\"" : "bsdf \"coating\"", q);
-            return PK_OK;
-        }
-        if (!inner) {
-            xwarn(p, b, "bsdf \"%s\" without a nested bsdf; using a grey diffuse material", ty);
-            material_init(m);
-            material_diffuse(m, v3s(0.5f));
-            return PK_OK;
-        }
-        xwarn(p, b, "bsdf \"%s\" over a non-diffuse bsdf is not supported; using its nested bsdf alone", ty);
-        return PK_OK;
-    }
-    if (strcmp(type, "bumpmap") == 0 || strcmp(type, "bump") == 0) {
-        xnode *inner = nested_bsdf(p, b);
-        if ((st = bump_material(p, b, &d, inner, ty, m))) return st;
-        return PK_OK;
-    }
-    if (strcmp(type, "normalmap") == 0 || strcmp(type, "blendbsdf") == 0 ||
-        strcmp(type, "mixturebsdf") == 0 || strcmp(type, "polarizer") == 0 || strcmp(type, "measured") == 0) {
-        xnode *inner = nested_bsdf(p, b);
-        if (!inner) {
-            xwarn(p, b, "bsdf \"%s\" is not supported; using a grey diffuse material", ty);
-            material_diffuse(m, v3s(0.5f));
-            return PK_OK;
-        }
-        xwarn(p, b, "bsdf \"%s\" is not supported; using its nested bsdf alone", ty);
-        return bsdf_resolve(p, inner, m);
-    }
-
-    float alpha = 0.0f;
-    bool bk = false;
-    if (strcmp(type, "diffuse") == 0 || strcmp(type, "roughdiffuse") == 0) {
-        vec3 r = v3s(0.5f);
-        if ((st = get_color_tex(p, &d, "reflectance", &r, &m->map_kd))) return st;
-        if (strcmp(type, "roughdiffuse") == 0) {
-            prop(&d, "alpha");
-            if (first_time(p, "roughdiffuse"))
-                xwarn(p, b, "roughdiffuse is rendered as diffuse (Lambert), without the Oren-Nayar roughness");
-        }
-        material_diffuse(m, clamp01v(r));
-    } else if (strcmp(type, "conductor") == 0 || strcmp(type, "roughconductor") == 0) {
-        bool rough = type[0] == 'r';
-        if (rough && (st = get_alpha(p, &d, 0.1f, &alpha, &bk))) return st;
-        vec3 eta, k;
-        spectra_named_metal("Cu", &eta, &k); /* Mitsuba's default */
-        vec3 spec = v3s(1.0f);
-        float ext = 1.000277f;
-        bool none = false;
-        const char *mat = NULL;
-        xnode *mat_at;
-        if ((st = get_string(p, &d, "material", &mat, &mat_at))) return st;
-        if (mat) {
-            if (strcmp(mat, "none") == 0) none = true;
-            else if (!spectra_named_metal(mat, &eta, &k)) {
-                char sm[40];
-                shown(sm, sizeof sm, mat);
-                xwarn(p, mat_at, "conductor material \"%s\" is not in the table (Cu, Au, Ag, Al, Cr, none); using Cu",
-                      sm);
-            }
-        }
-        if ((st = get_color(p, &d, "eta", &eta))) return st;
-        if ((st = get_color(p, &d, "k", &k))) return st;
-        if ((st = get_ior(p, &d, "ext_eta", &ext))) return st;
-        if ((st = get_color(p, &d, "specular_reflectance", &spec))) return st;
-        eta = v3_scale(eta, 1.0f / ext), k = v3_scale(k, 1.0f / ext);
-        eta = v3(fmaxf(eta.x, 1e-4f), fmaxf(eta.y, 1e-4f), fmaxf(eta.z, 1e-4f));
-        k = v3(fmaxf(k.x, 0.0f), fmaxf(k.y, 0.0f), fmaxf(k.z, 0.0f));
-        spec = clamp01v(spec);
-        if (none || spec.x != 1.0f || spec.y != 1.0f || spec.z != 1.0f) {
-            /* a scaled Fresnel term: Schlick's with the scaled normal reflectance */
-            const vec3 f0 = none ? v3s(1.0f) : material_f0_conductor(eta, k);
-            material_conductor_f0(m, clamp01v(v3_mul(f0, spec)), alpha);
-        } else {
-            material_conductor(m, eta, k, alpha);
-        }
-        m->beckmann = bk;
-    } else if (strcmp(type, "dielectric") == 0 || strcmp(type, "roughdielectric") == 0 ||
-               strcmp(type, "thindielectric") == 0) {
-        float in = 1.5046f, ext = 1.000277f;
-        vec3 tr = v3s(1.0f), refl = v3s(1.0f);
-        if (type[0] == 'r' && (st = get_alpha(p, &d, 0.1f, &alpha, &bk))) return st;
-        if ((st = get_ior(p, &d, "int_ior", &in))) return st;
-        if ((st = get_ior(p, &d, "ext_ior", &ext))) return st;
-        if ((st = get_color(p, &d, "specular_transmittance", &tr))) return st;
-        if ((st = get_color(p, &d, "specular_reflectance", &refl))) return st;
-        if (refl.x != 1.0f || refl.y != 1.0f || refl.z != 1.0f)
-            xwarn(p, b, "%s: specular_reflectance other than 1 is not supported; ignored", ty);
-        float ior = in / ext;
-        if (type[0] == 't') {
-            /* a thin sheet: light goes through unbent; its reflection is lost */
-            xwarn(p, b, "thindielectric is rendered as a clear sheet that lets light through unbent, without its "
-                        "reflection");
-            ior = 1.0f;
-        }
-        if (ior == 1.0f && alpha > 0.0f) alpha = 0.0f;
-        material_dielectric(m, ior, alpha, clamp01v(tr));
-        m->beckmann = bk;
-    } else if (strcmp(type, "plastic") == 0 || strcmp(type, "roughplastic") == 0) {
-        float in = 1.49f, ext = 1.000277f;
-        vec3 kd = v3s(0.5f), spec = v3s(1.0f);
-        if (type[0] == 'r' && (st = get_alpha(p, &d, 0.1f, &alpha, &bk))) return st;
-        if ((st = get_ior(p, &d, "int_ior", &in))) return st;
-        if ((st = get_ior(p, &d, "ext_ior", &ext))) return st;
-        if ((st = get_color_tex(p, &d, "diffuse_reflectance", &kd, &m->map_kd))) return st;
-        if ((st = get_color(p, &d, "specular_reflectance", &spec))) return st;
-        if (spec.x != 1.0f || spec.y != 1.0f || spec.z != 1.0f)
-            xwarn(p, b, "%s: specular_reflectance other than 1 is not supported; ignored", ty);
-        float ior = in / ext;
-        if (!(ior > 0.0f) || ior == 1.0f) ior = 1.49f;
-        material_plastic(m, clamp01v(kd), ior, alpha);
-        m->beckmann = bk;
-    } else if (strcmp(type, "principled") == 0 || strcmp(type, "principledthin") == 0) {
-        /* Disney's model by its main parameters: a metal (Schlick, F0 =
-         * base_color) when metallic > 0.5, else a plastic of base_color */
-        vec3 base = v3s(0.5f);
-        float metallic = 0.0f, roughness = 0.5f, eta = 1.5f;
-        if ((st = get_color(p, &d, "base_color", &base))) return st;
-        if ((st = get_scalar(p, &d, "metallic", &metallic))) return st;
-        if ((st = get_scalar(p, &d, "roughness", &roughness))) return st;
-        if ((st = get_float(p, &d, "eta", &eta))) return st;
-        props_all_read(&d);
-        if (first_time(p, "principled"))
-            xwarn(p, b, "principled is approximated by a %s of its base_color and roughness",
-                  metallic > 0.5f ? "metal" : "plastic");
-        alpha = clamp01(roughness) * clamp01(roughness);
-        if (metallic > 0.5f) material_conductor_f0(m, clamp01v(base), alpha);
-        else material_plastic(m, clamp01v(base), eta > 1.0f ? eta : 1.5f, alpha);
-    } else if (strcmp(type, "null") == 0) {
-        material_interface(m); /* no surface: light passes straight through; it may bound media */
-    } else {
+    const size_t nrows = sizeof bsdf_rows / sizeof bsdf_rows[0];
+    size_t r = 0;
+    while (r < nrows && strcmp(bsdf_rows[r].type, type) != 0) r++;
+    if (r == nrows) {
         xwarn(p, b, "bsdf \"%s\" is not supported; using a grey diffuse material", ty);
         material_diffuse(m, v3s(0.5f));
         return PK_OK;
     }
+    const bsdf_row *row = &bsdf_rows[r];
+    bsdf_in in = {.b = b, .d = &d, .type = type, .ty = ty};
+    if (row->rough && (st = get_alpha(p, &d, 0.1f, &in.alpha, &in.beckmann))) return st;
+    if (row->int_ior > 0.0f && (st = get_rel_ior(p, &d, row->int_ior, &in.ior))) return st;
+    if (!row->create) material_interface(m);
+    else if ((st = row->create(p, &in, m)) || !row->kind) return st;
+    static const char *const quiet[] = {"ext_ior", "ext_eta", "nonlinear", "distribution", "sample_visible", NULL};
     char kind[64];
     snprintf(kind, sizeof kind, "bsdf \"%s\"", ty);
-    warn_unused(&d, kind, quiet);
+    warn_unused(&d, row->kind[0] ? row->kind : kind, quiet);
     return PK_OK;
 }
 
