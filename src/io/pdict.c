@@ -127,7 +127,7 @@ pk_status pd_report_unused(pdict *d)
             else ctx_warn(d->ctx, "%s: %s: unknown parameter ignored", d->what, e->name);
             continue;
         }
-        for (size_t k = 0; k < i; k++)
+        for (size_t k = 0; k < i && !d->dups; k++)
             if (strcmp(d->e[k].name, e->name) == 0) return pd_fail(d, e, -1, PK_ERR_PARSE, "duplicate key");
     }
     return PK_OK;

@@ -44,6 +44,7 @@ typedef struct pd_entry {
     size_t n, first_other;
     const char *str;
     const void *node;   /* the front end's own node (a cJSON item), for locations */
+    const char *tag;    /* the front end's type of the value where it has one (Mitsuba's <float>, <rgb>, <ref>) */
 } pd_entry;
 
 typedef struct pdict pdict;
@@ -81,6 +82,7 @@ struct pdict {
     size_t n, cap;
     bool owns;
     bool own_lists;
+    bool dups;          /* a name may be given twice, the first read (Mitsuba): no "duplicate key" */
 };
 
 /* An empty dictionary; src NULL: the default messages. */
@@ -104,8 +106,8 @@ static inline bool pd_has(pdict *d, const char *name) { return pd_get(d, name) !
 PK_HIDDEN void pd_declare(pdict *d, const char *const *names, size_t n);
 /* The one "ignored" warning (the source's, or "WHAT: NAME: unknown
  * parameter ignored"), for each unmarked entry, in the order given; a
- * marked name given twice is an error ("duplicate key"), which stops the
- * walk. */
+ * marked name given twice is an error ("duplicate key", unless dups),
+ * which stops the walk. */
 PK_HIDDEN pk_status pd_report_unused(pdict *d);
 
 /* A message about e (NULL: the dictionary; elem >= 0: an element of its

@@ -16,6 +16,7 @@
  */
 #include "grid_io.h"
 #include "io_util.h"
+#include "pdict.h"
 #include "readers.h"
 #include "scene_build.h"
 #include "../math/xform.h"
@@ -69,7 +70,6 @@ typedef struct xnode {
     int64_t mat;         /* material made of this bsdf, -1 before */
     int64_t mesh;        /* mesh made of this shapegroup, -1 before */
     int64_t medium;      /* scene medium made of this medium, -1 before */
-    bool used;           /* a property that a plugin read */
     bool busy;           /* a bsdf being converted (reference cycles) */
 } xnode;
 
@@ -116,6 +116,9 @@ typedef struct xp {
     /* the scene's version: 0 for Mitsuba 0.x, 3 for Mitsuba 2/3 (spectra
      * are reduced to RGB by that version's rules) */
     int version_major;
+    /* attr_st fails without a message (xml_props: a property's name that
+     * cannot be substituted is reported where a search by name meets it) */
+    bool quiet_attr;
     scene_builder sb;     /* every shape's triangles go in through it */
 } xp;
 
@@ -364,7 +367,7 @@ static const char *attr_st(xp *p, const xnode *n, const char *name, pk_status *s
                 char nm[48];
                 shown(nm, sizeof nm, s);
                 nm[e - s < 47 ? e - s : 47] = '\0';
-                *st = xfail(p, PK_ERR_PARSE, n, "%s=\"...$%s...\": no <default name=\"%s\"> defines $%s", name, nm,
+                *st = p->quiet_attr ? PK_ERR_PARSE : xfail(p, PK_ERR_PARSE, n, "%s=\"...$%s...\": no <default name=\"%s\"> defines $%s", name, nm,
                             nm, nm);
                 return NULL;
             }
@@ -383,7 +386,7 @@ static const char *attr_st(xp *p, const xnode *n, const char *name, pk_status *s
     if (!r) *st = ctx_nomem(p->ctx);
     return r;
 too_long:
-    *st = xfail(p, PK_ERR_LIMIT, n, "attribute %s is longer than %d bytes after $ substitution", name, XML_MAX_VALUE);
+    *st = p->quiet_attr ? PK_ERR_LIMIT : xfail(p, PK_ERR_LIMIT, n, "attribute %s is longer than %d bytes after $ substitution", name, XML_MAX_VALUE);
     return NULL;
 }
 
@@ -453,25 +456,59 @@ static void snake(char *out, size_t n, const char *in)
     out[o] = '\0';
 }
 
-static bool name_is(xp *p, const xnode *c, const char *want)
+/* ---- a plugin's properties as a pdict ------------------------------------------------------ */
+
+static void xml_warn_unused(void *self, const pdict *d, const pd_entry *e);
+static const pd_source xml_source = {.warn_unused = xml_warn_unused};
+
+/* Fills *d with the named children of plugin, in order: each entry's name
+ * is the property's in snake_case ($ substituted; "" where that fails), its
+ * node the element and its tag the element's tag. Values stay in the
+ * elements, read by the getters below when a plugin asks for them, so that
+ * a property nobody reads is never checked. A name may come twice: the
+ * first is read. Invariant: the entries live in the load's arena (cap is
+ * the number of children, so pd_add never grows them): d is never
+ * pd_free'd. */
+static pk_status xml_props(xp *p, xnode *plugin, pdict *d)
 {
-    pk_status st;
-    const char *nm = attr_st(p, c, "name", &st);
-    if (!nm) return false;
-    char sn[64];
-    snake(sn, sizeof sn, nm);
-    return strcmp(sn, want) == 0;
+    pd_init(d, p->ctx, &xml_source, p, NULL, false);
+    d->node = plugin;
+    d->dups = true;
+    size_t n = 0;
+    for (xnode *c = plugin->child; c; c = c->next) n++;
+    if (n && !(d->e = arena_alloc(p, n * sizeof *d->e))) return ctx_nomem(p->ctx);
+    d->cap = n;
+    for (xnode *c = plugin->child; c; c = c->next) {
+        pk_status st;
+        p->quiet_attr = true;
+        const char *nm = attr_st(p, c, "name", &st);
+        p->quiet_attr = false;
+        if (st == PK_ERR_NOMEM) return st;
+        if (!nm && !st) continue;
+        char sn[64] = "";
+        if (nm) snake(sn, sizeof sn, nm);
+        const pd_entry e = {.name = arena_strdup(p, sn), .kind = PD_OTHER, .node = c, .tag = c->tag};
+        if (!e.name) return ctx_nomem(p->ctx);
+        pd_add(d, &e);
+    }
+    return PK_OK;
 }
 
-/* The child of plugin holding property name (snake_case), marked used. */
-static xnode *prop(xp *p, xnode *plugin, const char *name)
+/* The element holding property name (snake_case), marked read. A name
+ * before it that could not be substituted is an error (latched). */
+static xnode *prop(pdict *d, const char *name)
 {
-    for (xnode *c = plugin->child; c; c = c->next)
-        if (name_is(p, c, name)) {
-            c->used = true;
-            return c;
-        }
-    return NULL;
+    const pd_entry *e = pd_get(d, name);
+    for (size_t i = 0; i < d->n && &d->e[i] != e; i++)
+        if (!d->e[i].name[0]) attr_st(d->self, d->e[i].node, "name", &(pk_status){0});
+    return e ? (xnode *)e->node : NULL;
+}
+
+/* Every property marked read: a plugin that is not translated, or whose
+ * options are another part's (textures), warns about none of them. */
+static void props_all_read(pdict *d)
+{
+    for (size_t i = 0; i < d->n; i++) d->e[i].used = true;
 }
 
 /* ---- values ------------------------------------------------------------------------- */
@@ -526,18 +563,18 @@ static pk_status node_float(xp *p, const xnode *n, float *out)
 }
 
 /* A float (or integer) property; absent leaves *out. */
-static pk_status get_float(xp *p, xnode *plugin, const char *name, float *out)
+static pk_status get_float(xp *p, pdict *d, const char *name, float *out)
 {
-    xnode *c = prop(p, plugin, name);
+    xnode *c = prop(d, name);
     if (!c) return PK_OK;
     if (strcmp(c->tag, "float") != 0 && strcmp(c->tag, "integer") != 0)
         return xfail(p, PK_ERR_PARSE, c, "%s must be a <float>, found <%.32s>", name, c->tag);
     return node_float(p, c, out);
 }
 
-static pk_status get_int(xp *p, xnode *plugin, const char *name, int64_t *out, bool *found)
+static pk_status get_int(xp *p, pdict *d, const char *name, int64_t *out, bool *found)
 {
-    xnode *c = prop(p, plugin, name);
+    xnode *c = prop(d, name);
     if (found) *found = c != NULL;
     if (!c) return PK_OK;
     const char *v;
@@ -555,9 +592,9 @@ static pk_status get_int(xp *p, xnode *plugin, const char *name, int64_t *out, b
     return PK_OK;
 }
 
-static pk_status get_bool(xp *p, xnode *plugin, const char *name, bool *out)
+static pk_status get_bool(xp *p, pdict *d, const char *name, bool *out)
 {
-    xnode *c = prop(p, plugin, name);
+    xnode *c = prop(d, name);
     if (!c) return PK_OK;
     const char *v;
     pk_status st = value_attr(p, c, &v);
@@ -572,9 +609,9 @@ static pk_status get_bool(xp *p, xnode *plugin, const char *name, bool *out)
     return PK_OK;
 }
 
-static pk_status get_string(xp *p, xnode *plugin, const char *name, const char **out, xnode **at)
+static pk_status get_string(xp *p, pdict *d, const char *name, const char **out, xnode **at)
 {
-    xnode *c = prop(p, plugin, name);
+    xnode *c = prop(d, name);
     if (at) *at = c;
     if (!c) return PK_OK;
     return value_attr(p, c, out);
@@ -612,9 +649,9 @@ static pk_status attr_xyz(xp *p, const xnode *n, float def, vec3 *out)
 /* A <point> or <vector>: x, y, z attributes (0 when absent) or value. */
 static pk_status node_vec(xp *p, const xnode *n, vec3 *out) { return attr_xyz(p, n, 0.0f, out); }
 
-static pk_status get_vec(xp *p, xnode *plugin, const char *name, vec3 *out, bool *found)
+static pk_status get_vec(xp *p, pdict *d, const char *name, vec3 *out, bool *found)
 {
-    xnode *c = prop(p, plugin, name);
+    xnode *c = prop(d, name);
     if (found) *found = c != NULL;
     if (!c) return PK_OK;
     if (strcmp(c->tag, "point") != 0 && strcmp(c->tag, "vector") != 0)
@@ -656,7 +693,8 @@ static pk_status node_spectrum(xp *p, const xnode *n, vec3 *out)
     if (st) return st;
     if (ty && strcmp(ty, "blackbody") == 0) {
         float kelvin = 0.0f;
-        if ((st = get_float(p, (xnode *)n, "temperature", &kelvin))) return st;
+        pdict d;
+        if ((st = xml_props(p, (xnode *)n, &d)) || (st = get_float(p, &d, "temperature", &kelvin))) return st;
         if (!(kelvin > 0.0f) || !isfinite(kelvin))
             return xfail(p, PK_ERR_PARSE, n, "<spectrum type=\"blackbody\"> needs a positive temperature");
         *out = spectra_mitsuba3_blackbody(kelvin);
@@ -857,16 +895,17 @@ static pk_status texture_value(xp *p, xnode *tex, const char *param, vec3 fallba
     const char *type = attr_st(p, tex, "type", &st);
     if (st) return st;
     if (!type) return xfail(p, PK_ERR_PARSE, tex, "<texture> needs a type");
-    for (xnode *c = tex->child; c; c = c->next) c->used = true; /* texture options are the texture system's */
+    pdict d; /* (no warnings: texture options are the texture system's) */
+    if ((st = xml_props(p, tex, &d))) return st;
     if (strcmp(type, "bitmap") == 0) {
         const char *fn = NULL;
         xnode *at;
-        if ((st = get_string(p, tex, "filename", &fn, &at))) return st;
+        if ((st = get_string(p, &d, "filename", &fn, &at))) return st;
         if (!fn) return xfail(p, PK_ERR_PARSE, tex, "bitmap texture needs a filename");
         char *full = path_join(&p->ctx->alloc, tex->file->dir, fn);
         if (!full) return ctx_nomem(p->ctx);
         float us = 1.0f, vs = 1.0f;
-        if ((st = get_float(p, tex, "uscale", &us)) || (st = get_float(p, tex, "vscale", &vs))) {
+        if ((st = get_float(p, &d, "uscale", &us)) || (st = get_float(p, &d, "vscale", &vs))) {
             mem_free(&p->ctx->alloc, full);
             return st;
         }
@@ -876,16 +915,16 @@ static pk_status texture_value(xp *p, xnode *tex, const char *param, vec3 fallba
     }
     if (strcmp(type, "checkerboard") == 0) {
         vec3 c0 = v3s(0.4f), c1 = v3s(0.2f);
-        xnode *a = prop(p, tex, "color0"), *b = prop(p, tex, "color1");
+        xnode *a = prop(&d, "color0"), *b = prop(&d, "color1");
         if (a && (st = node_color(p, a, &c0))) return st;
         if (b && (st = node_color(p, b, &c1))) return st;
         float us = 1.0f, vs = 1.0f;
-        if ((st = get_float(p, tex, "uscale", &us)) || (st = get_float(p, tex, "vscale", &vs))) return st;
+        if ((st = get_float(p, &d, "uscale", &us)) || (st = get_float(p, &d, "vscale", &vs))) return st;
         return texture_param(p, tex, param, NULL, c0, c1, us, vs, v3_scale(v3_add(c0, c1), 0.5f), out);
     }
     if (strcmp(type, "scale") == 0) {
         float scale = 1.0f;
-        if ((st = get_float(p, tex, "scale", &scale))) return st;
+        if ((st = get_float(p, &d, "scale", &scale))) return st;
         tex_ref *want = p->want_tex;
         p->want_tex = NULL; /* a scaled texture stands in as a constant */
         for (xnode *c = tex->child; c; c = c->next)
@@ -910,9 +949,9 @@ static pk_status texture_value(xp *p, xnode *tex, const char *param, vec3 fallba
 
 /* A colour property: absent leaves *out (the default); a texture goes
  * through texture_value with *out as its stand-in. */
-static pk_status get_color(xp *p, xnode *plugin, const char *name, vec3 *out)
+static pk_status get_color(xp *p, pdict *d, const char *name, vec3 *out)
 {
-    xnode *c = prop(p, plugin, name);
+    xnode *c = prop(d, name);
     if (!c) return PK_OK;
     if (strcmp(c->tag, "texture") == 0 || strcmp(c->tag, "ref") == 0) return texture_value(p, c, name, *out, out, 0);
     pk_status st = node_color(p, c, out);
@@ -922,18 +961,18 @@ static pk_status get_color(xp *p, xnode *plugin, const char *name, vec3 *out)
 
 /* A colour property that may be a texture, which goes to *tex (a diffuse
  * reflectance: the texture multiplies *out, which becomes 1). */
-static pk_status get_color_tex(xp *p, xnode *plugin, const char *name, vec3 *out, tex_ref *tex)
+static pk_status get_color_tex(xp *p, pdict *d, const char *name, vec3 *out, tex_ref *tex)
 {
     p->want_tex = tex;
-    pk_status st = get_color(p, plugin, name, out);
+    pk_status st = get_color(p, d, name, out);
     p->want_tex = NULL;
     return st;
 }
 
 /* A scalar property that may be a texture (roughness, opacity). */
-static pk_status get_scalar(xp *p, xnode *plugin, const char *name, float *out)
+static pk_status get_scalar(xp *p, pdict *d, const char *name, float *out)
 {
-    xnode *c = prop(p, plugin, name);
+    xnode *c = prop(d, name);
     if (!c) return PK_OK;
     vec3 v = v3s(*out);
     pk_status st;
@@ -1035,10 +1074,10 @@ static pk_status parse_transform(xp *p, xnode *t, xform *m)
 }
 
 /* The to_world of a plugin (identity when absent); *found says whether given. */
-static pk_status get_to_world(xp *p, xnode *plugin, xform *m, bool *found)
+static pk_status get_to_world(xp *p, pdict *d, xform *m, bool *found)
 {
     *m = xform_identity();
-    xnode *t = prop(p, plugin, "to_world");
+    xnode *t = prop(d, "to_world");
     if (found) *found = t != NULL;
     if (!t) return PK_OK;
     return parse_transform(p, t, m);
@@ -1047,9 +1086,9 @@ static pk_status get_to_world(xp *p, xnode *plugin, xform *m, bool *found)
 /* ---- materials ------------------------------------------------------------------------------- */
 
 /* An index of refraction: a number or one of Mitsuba's names. */
-static pk_status get_ior(xp *p, xnode *plugin, const char *name, float *out)
+static pk_status get_ior(xp *p, pdict *d, const char *name, float *out)
 {
-    xnode *c = prop(p, plugin, name);
+    xnode *c = prop(d, name);
     if (!c) return PK_OK;
     pk_status st;
     if (strcmp(c->tag, "string") == 0) {
@@ -1071,6 +1110,16 @@ static pk_status get_ior(xp *p, xnode *plugin, const char *name, float *out)
     return PK_OK;
 }
 
+/* int_ior / ext_ior (default in, and air). */
+static pk_status get_rel_ior(xp *p, pdict *d, float in, float *ior)
+{
+    float ext = 1.000277f;
+    pk_status st = get_ior(p, d, "int_ior", &in);
+    if (st == PK_OK) st = get_ior(p, d, "ext_ior", &ext);
+    *ior = in / ext;
+    return st;
+}
+
 static float clamp01(float x) { return x > 0.0f ? (x < 1.0f ? x : 1.0f) : 0.0f; }
 static vec3 clamp01v(vec3 c) { return v3(clamp01(c.x), clamp01(c.y), clamp01(c.z)); }
 
@@ -1078,22 +1127,23 @@ static vec3 clamp01v(vec3 c) { return v3(clamp01(c.x), clamp01(c.y), clamp01(c.z
  * and the microfacet distribution (*beckmann: Mitsuba's default "beckmann",
  * and "phong" by Mitsuba's own equivalence of the two for one alpha; false
  * for "ggx"). */
-static pk_status get_alpha(xp *p, xnode *b, float def, float *alpha, bool *beckmann)
+static pk_status get_alpha(xp *p, pdict *d, float def, float *alpha, bool *beckmann)
 {
+    const xnode *b = d->node;
     pk_status st;
     float a = def, au = -1.0f, av = -1.0f;
-    if ((st = get_scalar(p, b, "alpha", &a))) return st;
-    xnode *cu = prop(p, b, "alpha_u"), *cv = prop(p, b, "alpha_v");
+    if ((st = get_scalar(p, d, "alpha", &a))) return st;
+    xnode *cu = prop(d, "alpha_u"), *cv = prop(d, "alpha_v");
     if (cu || cv) {
         au = av = a;
-        if ((st = get_scalar(p, b, "alpha_u", &au))) return st;
-        if ((st = get_scalar(p, b, "alpha_v", &av))) return st;
+        if ((st = get_scalar(p, d, "alpha_u", &au))) return st;
+        if ((st = get_scalar(p, d, "alpha_v", &av))) return st;
         if (au != av) xwarn(p, b, "anisotropic roughness is not supported; using alpha %g", (double)(0.5f * (au + av)));
         a = 0.5f * (au + av);
     }
     const char *dist = NULL;
     xnode *dist_at = NULL;
-    if ((st = get_string(p, b, "distribution", &dist, &dist_at))) return st;
+    if ((st = get_string(p, d, "distribution", &dist, &dist_at))) return st;
     *beckmann = true;
     if (dist && strcmp(dist, "ggx") == 0) *beckmann = false;
     else if (dist && strcmp(dist, "phong") == 0) {
@@ -1111,14 +1161,25 @@ static pk_status get_alpha(xp *p, xnode *b, float def, float *alpha, bool *beckm
 
 static pk_status bsdf_material(xp *p, xnode *b, material *m);
 
+/* What a bsdf's creator is given (bsdf_material): the element and its
+ * properties, its type (ty: as messages show it), and what the dispatch
+ * read for its row: the roughness of a rough row (alpha, beckmann:
+ * get_alpha) and int_ior / ext_ior (ior) of a row with an int_ior default.
+ * A creator fills *m (material_init'ed). */
+typedef struct bsdf_in {
+    xnode *b;
+    pdict *d;
+    const char *type, *ty;
+    float alpha, ior;
+    bool beckmann;
+} bsdf_in;
+
 /* The nested bsdf of a wrapper (its first <bsdf> or <ref> child). */
 static xnode *nested_bsdf(xp *p, xnode *b)
 {
     for (xnode *c = b->child; c; c = c->next)
-        if (strcmp(c->tag, "bsdf") == 0 || (strcmp(c->tag, "ref") == 0 && !attr_st(p, c, "name", &(pk_status){0}))) {
-            c->used = true;
+        if (strcmp(c->tag, "bsdf") == 0 || (strcmp(c->tag, "ref") == 0 && !attr_st(p, c, "name", &(pk_status){0})))
             return c;
-        }
     return NULL;
 }
 
@@ -1129,11 +1190,14 @@ static pk_status bsdf_resolve(xp *p, xnode *b, material *m);
  * scene units, as the material's map_bump with bm the product of the scale
  * textures wrapped around the bitmap and the bumpmap's own "scale" (Mitsuba
  * 3). A height that is not a bitmap leaves the nested bsdf alone (warning). */
-static pk_status bump_material(xp *p, xnode *b, xnode *inner, const char *ty, material *m)
+static pk_status bsdf_bump(xp *p, const bsdf_in *in, material *m)
 {
+    xnode *b = in->b, *inner = nested_bsdf(p, b);
+    const char *ty = in->ty;
+    pdict *d = in->d;
     pk_status st;
     float scale = 1.0f;
-    if ((st = get_float(p, b, "scale", &scale))) return st;
+    if ((st = get_float(p, d, "scale", &scale))) return st;
     if (!inner) {
         xwarn(p, b, "bsdf \"%s\" without a nested bsdf; using a grey diffuse material", ty);
         material_diffuse(m, v3s(0.5f));
@@ -1149,16 +1213,16 @@ static pk_status bump_material(xp *p, xnode *b, xnode *inner, const char *ty, ma
             const char *id = attr_st(p, c, "id", &st);
             if (st) return st;
             xnode *r = id ? id_find(p, id) : NULL;
-            if (r && strcmp(r->tag, "texture") == 0) t = r, c->used = true;
+            if (r && strcmp(r->tag, "texture") == 0) t = r;
         }
     }
     for (int depth = 0; t && depth <= XML_MAX_BSDF_DEPTH; depth++) {
-        t->used = true;
         const char *tt = attr_st(p, t, "type", &st);
         if (st) return st;
         if (!tt || strcmp(tt, "scale") != 0) break;
         float f = 1.0f;
-        if ((st = get_float(p, t, "scale", &f))) return st;
+        pdict td;
+        if ((st = xml_props(p, t, &td)) || (st = get_float(p, &td, "scale", &f))) return st;
         scale *= f;
         xnode *next = NULL;
         for (xnode *c = t->child; c && !next; c = c->next) {
@@ -1220,9 +1284,235 @@ static pk_status bsdf_resolve(xp *p, xnode *n, material *m)
     return st;
 }
 
-static void warn_unused(xp *p, xnode *plugin, const char *kind, const char *const *quiet);
+static void warn_unused(pdict *d, const char *kind, const char *const *quiet);
 
-/* Fills *m (material_init'ed, name unset) from the bsdf element b. */
+/* ---- the Mitsuba BSDFs: one creator per plugin type ---------------------------------------- */
+
+static pk_status bsdf_twosided(xp *p, const bsdf_in *in, material *m)
+{
+    /* one-sided materials are shaded from either side already (the
+     * shading normal faces the viewer); only emission is one-sided */
+    xnode *inner = nested_bsdf(p, in->b);
+    if (!inner) return xfail(p, PK_ERR_PARSE, in->b, "twosided needs a nested bsdf");
+    for (xnode *c = inner->next; c; c = c->next)
+        if (strcmp(c->tag, "bsdf") == 0) {
+            xwarn(p, c, "twosided with a second bsdf for the back side is not supported; the front one is "
+                        "used on both");
+            break;
+        }
+    return bsdf_resolve(p, inner, m);
+}
+
+static pk_status bsdf_mask(xp *p, const bsdf_in *in, material *m)
+{
+    xnode *inner = nested_bsdf(p, in->b);
+    float opacity = 0.5f;
+    pk_status st = get_scalar(p, in->d, "opacity", &opacity);
+    if (st) return st;
+    if (inner && (st = bsdf_resolve(p, inner, m))) return st;
+    if (!inner) material_diffuse(m, v3s(0.5f));
+    if (m->type != MAT_DIELECTRIC) m->d = clamp01(opacity);
+    return PK_OK;
+}
+
+/* a dielectric coat over a diffuse base is Paprsek's plastic */
+static pk_status bsdf_coating(xp *p, const bsdf_in *in, material *m)
+{
+    xnode *inner = nested_bsdf(p, in->b);
+    float alpha = 0.0f, ior;
+    bool bk = false, rough = in->type[0] == 'r';
+    pk_status st;
+    if (rough && (st = get_alpha(p, in->d, 0.1f, &alpha, &bk))) return st;
+    if ((st = get_rel_ior(p, in->d, 1.5046f, &ior))) return st;
+    if (inner && (st = bsdf_resolve(p, inner, m))) return st;
+    if (inner && m->type == MAT_DIFFUSE && ior > 0.0f && ior != 1.0f) {
+        vec3 kd = m->kd;
+        float opacity = m->d;
+        material_init(m);
+        m->d = opacity;
+        material_plastic(m, kd, ior, alpha);
+        m->beckmann = bk;
+        static const char *const q[] = {"distribution", NULL};
+        warn_unused(in->d, rough ? "bsdf \"roughcoating\"" : "bsdf \"coating\"", q);
+        return PK_OK;
+    }
+    if (!inner) {
+        xwarn(p, in->b, "bsdf \"%s\" without a nested bsdf; using a grey diffuse material", in->ty);
+        material_init(m);
+        material_diffuse(m, v3s(0.5f));
+        return PK_OK;
+    }
+    xwarn(p, in->b, "bsdf \"%s\" over a non-diffuse bsdf is not supported; using its nested bsdf alone", in->ty);
+    return PK_OK;
+}
+
+/* normalmap, blendbsdf, ...: the nested bsdf alone */
+static pk_status bsdf_nested_only(xp *p, const bsdf_in *in, material *m)
+{
+    xnode *inner = nested_bsdf(p, in->b);
+    if (!inner) {
+        xwarn(p, in->b, "bsdf \"%s\" is not supported; using a grey diffuse material", in->ty);
+        material_diffuse(m, v3s(0.5f));
+        return PK_OK;
+    }
+    xwarn(p, in->b, "bsdf \"%s\" is not supported; using its nested bsdf alone", in->ty);
+    return bsdf_resolve(p, inner, m);
+}
+
+static pk_status bsdf_diffuse(xp *p, const bsdf_in *in, material *m)
+{
+    vec3 r = v3s(0.5f);
+    pk_status st = get_color_tex(p, in->d, "reflectance", &r, &m->map_kd);
+    if (st) return st;
+    if (in->type[0] == 'r') {
+        prop(in->d, "alpha");
+        if (first_time(p, "roughdiffuse"))
+            xwarn(p, in->b, "roughdiffuse is rendered as diffuse (Lambert), without the Oren-Nayar roughness");
+    }
+    material_diffuse(m, clamp01v(r));
+    return PK_OK;
+}
+
+static pk_status bsdf_conductor(xp *p, const bsdf_in *in, material *m)
+{
+    vec3 eta, k;
+    spectra_named_metal("Cu", &eta, &k); /* Mitsuba's default */
+    vec3 spec = v3s(1.0f);
+    float ext = 1.000277f;
+    bool none = false;
+    const char *mat = NULL;
+    xnode *mat_at;
+    pk_status st;
+    if ((st = get_string(p, in->d, "material", &mat, &mat_at))) return st;
+    if (mat) {
+        if (strcmp(mat, "none") == 0) none = true;
+        else if (!spectra_named_metal(mat, &eta, &k)) {
+            char sm[40];
+            shown(sm, sizeof sm, mat);
+            xwarn(p, mat_at, "conductor material \"%s\" is not in the table (Cu, Au, Ag, Al, Cr, none); using Cu", sm);
+        }
+    }
+    if ((st = get_color(p, in->d, "eta", &eta))) return st;
+    if ((st = get_color(p, in->d, "k", &k))) return st;
+    if ((st = get_ior(p, in->d, "ext_eta", &ext))) return st;
+    if ((st = get_color(p, in->d, "specular_reflectance", &spec))) return st;
+    eta = v3_scale(eta, 1.0f / ext), k = v3_scale(k, 1.0f / ext);
+    eta = v3(fmaxf(eta.x, 1e-4f), fmaxf(eta.y, 1e-4f), fmaxf(eta.z, 1e-4f));
+    k = v3(fmaxf(k.x, 0.0f), fmaxf(k.y, 0.0f), fmaxf(k.z, 0.0f));
+    spec = clamp01v(spec);
+    if (none || spec.x != 1.0f || spec.y != 1.0f || spec.z != 1.0f) {
+        /* a scaled Fresnel term: Schlick's with the scaled normal reflectance */
+        const vec3 f0 = none ? v3s(1.0f) : material_f0_conductor(eta, k);
+        material_conductor_f0(m, clamp01v(v3_mul(f0, spec)), in->alpha);
+    } else {
+        material_conductor(m, eta, k, in->alpha);
+    }
+    m->beckmann = in->beckmann;
+    return PK_OK;
+}
+
+/* The specular_reflectance of dielectric and plastic: only 1 is rendered. */
+static pk_status specular_one(xp *p, const bsdf_in *in)
+{
+    vec3 refl = v3s(1.0f);
+    pk_status st = get_color(p, in->d, "specular_reflectance", &refl);
+    if (st == PK_OK && (refl.x != 1.0f || refl.y != 1.0f || refl.z != 1.0f))
+        xwarn(p, in->b, "%s: specular_reflectance other than 1 is not supported; ignored", in->ty);
+    return st;
+}
+
+static pk_status bsdf_dielectric(xp *p, const bsdf_in *in, material *m)
+{
+    vec3 tr = v3s(1.0f);
+    float ior = in->ior, alpha = in->alpha;
+    pk_status st;
+    if ((st = get_color(p, in->d, "specular_transmittance", &tr)) || (st = specular_one(p, in))) return st;
+    if (in->type[0] == 't') {
+        /* a thin sheet: light goes through unbent; its reflection is lost */
+        xwarn(p, in->b, "thindielectric is rendered as a clear sheet that lets light through unbent, without its "
+                        "reflection");
+        ior = 1.0f;
+    }
+    if (ior == 1.0f && alpha > 0.0f) alpha = 0.0f;
+    material_dielectric(m, ior, alpha, clamp01v(tr));
+    m->beckmann = in->beckmann;
+    return PK_OK;
+}
+
+static pk_status bsdf_plastic(xp *p, const bsdf_in *in, material *m)
+{
+    vec3 kd = v3s(0.5f);
+    pk_status st;
+    if ((st = get_color_tex(p, in->d, "diffuse_reflectance", &kd, &m->map_kd)) || (st = specular_one(p, in)))
+        return st;
+    material_plastic(m, clamp01v(kd), !(in->ior > 0.0f) || in->ior == 1.0f ? 1.49f : in->ior, in->alpha);
+    m->beckmann = in->beckmann;
+    return PK_OK;
+}
+
+/* Disney's model by its main parameters: a metal (Schlick, F0 = base_color)
+ * when metallic > 0.5, else a plastic of base_color; the rest is read
+ * without a warning */
+static pk_status bsdf_principled(xp *p, const bsdf_in *in, material *m)
+{
+    vec3 base = v3s(0.5f);
+    float metallic = 0.0f, roughness = 0.5f, eta = 1.5f;
+    pk_status st;
+    if ((st = get_color(p, in->d, "base_color", &base)) || (st = get_scalar(p, in->d, "metallic", &metallic)) ||
+        (st = get_scalar(p, in->d, "roughness", &roughness)) || (st = get_float(p, in->d, "eta", &eta)))
+        return st;
+    if (first_time(p, "principled"))
+        xwarn(p, in->b, "principled is approximated by a %s of its base_color and roughness",
+              metallic > 0.5f ? "metal" : "plastic");
+    const float alpha = clamp01(roughness) * clamp01(roughness);
+    if (metallic > 0.5f) material_conductor_f0(m, clamp01v(base), alpha);
+    else material_plastic(m, clamp01v(base), eta > 1.0f ? eta : 1.5f, alpha);
+    return PK_OK;
+}
+
+/* The MITSUBA dialect's BSDFs. rough: get_alpha first (default 0.1);
+ * int_ior: the default of int_ior, read (with ext_ior) next, 0 for none;
+ * create NULL: the interface (no surface);
+ * kind: the unread properties' warning after the creator (NULL: none or
+ * the creator's own; "": bsdf "TYPE"). The names are Mitsuba's;
+ * these rules are not the JSON scene's (create_material.c): Mitsuba clamps
+ * colours, takes textures, spectra and named indices of refraction in
+ * typed elements, and reads a value only when its type asks for it. */
+typedef struct bsdf_row {
+    const char *type;
+    pk_status (*create)(xp *p, const bsdf_in *in, material *m);
+    bool rough;
+    float int_ior;
+    const char *kind;
+} bsdf_row;
+static const bsdf_row bsdf_rows[] = {
+    {"twosided", bsdf_twosided, false, 0.0f, NULL},
+    {"mask", bsdf_mask, false, 0.0f, "mask"},
+    {"coating", bsdf_coating, false, 0.0f, NULL},
+    {"roughcoating", bsdf_coating, false, 0.0f, NULL},
+    {"bumpmap", bsdf_bump, false, 0.0f, NULL},
+    {"bump", bsdf_bump, false, 0.0f, NULL},
+    {"normalmap", bsdf_nested_only, false, 0.0f, NULL},
+    {"blendbsdf", bsdf_nested_only, false, 0.0f, NULL},
+    {"mixturebsdf", bsdf_nested_only, false, 0.0f, NULL},
+    {"polarizer", bsdf_nested_only, false, 0.0f, NULL},
+    {"measured", bsdf_nested_only, false, 0.0f, NULL},
+    {"diffuse", bsdf_diffuse, false, 0.0f, ""},
+    {"roughdiffuse", bsdf_diffuse, false, 0.0f, ""},
+    {"conductor", bsdf_conductor, false, 0.0f, ""},
+    {"roughconductor", bsdf_conductor, true, 0.0f, ""},
+    {"dielectric", bsdf_dielectric, false, 1.5046f, ""},
+    {"roughdielectric", bsdf_dielectric, true, 1.5046f, ""},
+    {"thindielectric", bsdf_dielectric, false, 1.5046f, ""},
+    {"plastic", bsdf_plastic, false, 1.49f, ""},
+    {"roughplastic", bsdf_plastic, true, 1.49f, ""},
+    {"principled", bsdf_principled, false, 0.0f, NULL},
+    {"principledthin", bsdf_principled, false, 0.0f, NULL},
+    {"null", NULL, false, 0.0f, ""}, /* no surface: light passes straight through; it may bound media */
+};
+
+/* Fills *m (material_init'ed, name unset) from the bsdf element b: its
+ * row's creator, or a grey diffuse for a type with none. */
 static pk_status bsdf_material(xp *p, xnode *b, material *m)
 {
     pk_status st;
@@ -1232,194 +1522,26 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
     material_init(m);
     char ty[40];
     shown(ty, sizeof ty, type);
-    static const char *const quiet[] = {"ext_ior", "ext_eta", "nonlinear", "distribution", "sample_visible", NULL};
-
-    if (strcmp(type, "twosided") == 0) {
-        /* one-sided materials are shaded from either side already (the
-         * shading normal faces the viewer); only emission is one-sided */
-        xnode *inner = nested_bsdf(p, b);
-        if (!inner) return xfail(p, PK_ERR_PARSE, b, "twosided needs a nested bsdf");
-        for (xnode *c = inner->next; c; c = c->next)
-            if (strcmp(c->tag, "bsdf") == 0) {
-                xwarn(p, c, "twosided with a second bsdf for the back side is not supported; the front one is "
-                            "used on both");
-                c->used = true;
-                break;
-            }
-        return bsdf_resolve(p, inner, m);
-    }
-    if (strcmp(type, "mask") == 0) {
-        xnode *inner = nested_bsdf(p, b);
-        float opacity = 0.5f;
-        if ((st = get_scalar(p, b, "opacity", &opacity))) return st;
-        if (inner) {
-            if ((st = bsdf_resolve(p, inner, m))) return st;
-        } else {
-            material_diffuse(m, v3s(0.5f));
-        }
-        if (m->type != MAT_DIELECTRIC) m->d = clamp01(opacity);
-        warn_unused(p, b, "mask", quiet);
-        return PK_OK;
-    }
-    if (strcmp(type, "coating") == 0 || strcmp(type, "roughcoating") == 0) {
-        /* a dielectric coat over a diffuse base is Paprsek's plastic */
-        xnode *inner = nested_bsdf(p, b);
-        float in = 1.5046f, ext = 1.000277f, alpha = 0.0f;
-        bool bk = false;
-        if (type[0] == 'r' && (st = get_alpha(p, b, 0.1f, &alpha, &bk))) return st;
-        if ((st = get_ior(p, b, "int_ior", &in))) return st;
-        if ((st = get_ior(p, b, "ext_ior", &ext))) return st;
-        if (inner && (st = bsdf_resolve(p, inner, m))) return st;
-        float ior = in / ext;
-        if (inner && m->type == MAT_DIFFUSE && ior > 0.0f && ior != 1.0f) {
-            vec3 kd = m->kd;
-            float d = m->d;
-            material_init(m);
-            m->d = d;
-            material_plastic(m, kd, ior, alpha);
-            m->beckmann = bk;
-            static const char *const q[] = {"distribution", NULL};
-            warn_unused(p, b, type[0] == 'r' ? "bsdf \"roughcoating\"" : "bsdf \"coating\"", q);
-            return PK_OK;
-        }
-        for (xnode *c = b->child; c; c = c->next) c->used = true;
-        if (!inner) {
-            xwarn(p, b, "bsdf \"%s\" without a nested bsdf; using a grey diffuse material", ty);
-            material_init(m);
-            material_diffuse(m, v3s(0.5f));
-            return PK_OK;
-        }
-        xwarn(p, b, "bsdf \"%s\" over a non-diffuse bsdf is not supported; using its nested bsdf alone", ty);
-        return PK_OK;
-    }
-    if (strcmp(type, "bumpmap") == 0 || strcmp(type, "bump") == 0) {
-        xnode *inner = nested_bsdf(p, b);
-        if ((st = bump_material(p, b, inner, ty, m))) return st;
-        return PK_OK;
-    }
-    if (strcmp(type, "normalmap") == 0 || strcmp(type, "blendbsdf") == 0 ||
-        strcmp(type, "mixturebsdf") == 0 || strcmp(type, "polarizer") == 0 || strcmp(type, "measured") == 0) {
-        xnode *inner = nested_bsdf(p, b);
-        for (xnode *c = b->child; c; c = c->next) c->used = true;
-        if (!inner) {
-            xwarn(p, b, "bsdf \"%s\" is not supported; using a grey diffuse material", ty);
-            material_diffuse(m, v3s(0.5f));
-            return PK_OK;
-        }
-        xwarn(p, b, "bsdf \"%s\" is not supported; using its nested bsdf alone", ty);
-        return bsdf_resolve(p, inner, m);
-    }
-
-    float alpha = 0.0f;
-    bool bk = false;
-    if (strcmp(type, "diffuse") == 0 || strcmp(type, "roughdiffuse") == 0) {
-        vec3 r = v3s(0.5f);
-        if ((st = get_color_tex(p, b, "reflectance", &r, &m->map_kd))) return st;
-        if (strcmp(type, "roughdiffuse") == 0) {
-            xnode *a = prop(p, b, "alpha");
-            (void)a;
-            if (first_time(p, "roughdiffuse"))
-                xwarn(p, b, "roughdiffuse is rendered as diffuse (Lambert), without the Oren-Nayar roughness");
-        }
-        material_diffuse(m, clamp01v(r));
-    } else if (strcmp(type, "conductor") == 0 || strcmp(type, "roughconductor") == 0) {
-        bool rough = type[0] == 'r';
-        if (rough && (st = get_alpha(p, b, 0.1f, &alpha, &bk))) return st;
-        vec3 eta, k;
-        spectra_named_metal("Cu", &eta, &k); /* Mitsuba's default */
-        vec3 spec = v3s(1.0f);
-        float ext = 1.000277f;
-        bool none = false;
-        const char *mat = NULL;
-        xnode *mat_at;
-        if ((st = get_string(p, b, "material", &mat, &mat_at))) return st;
-        if (mat) {
-            if (strcmp(mat, "none") == 0) none = true;
-            else if (!spectra_named_metal(mat, &eta, &k)) {
-                char sm[40];
-                shown(sm, sizeof sm, mat);
-                xwarn(p, mat_at, "conductor material \"%s\" is not in the table (Cu, Au, Ag, Al, Cr, none); using Cu",
-                      sm);
-            }
-        }
-        if ((st = get_color(p, b, "eta", &eta))) return st;
-        if ((st = get_color(p, b, "k", &k))) return st;
-        if ((st = get_ior(p, b, "ext_eta", &ext))) return st;
-        if ((st = get_color(p, b, "specular_reflectance", &spec))) return st;
-        eta = v3_scale(eta, 1.0f / ext), k = v3_scale(k, 1.0f / ext);
-        eta = v3(fmaxf(eta.x, 1e-4f), fmaxf(eta.y, 1e-4f), fmaxf(eta.z, 1e-4f));
-        k = v3(fmaxf(k.x, 0.0f), fmaxf(k.y, 0.0f), fmaxf(k.z, 0.0f));
-        spec = clamp01v(spec);
-        if (none || spec.x != 1.0f || spec.y != 1.0f || spec.z != 1.0f) {
-            /* a scaled Fresnel term: Schlick's with the scaled normal reflectance */
-            const vec3 f0 = none ? v3s(1.0f) : material_f0_conductor(eta, k);
-            material_conductor_f0(m, clamp01v(v3_mul(f0, spec)), alpha);
-        } else {
-            material_conductor(m, eta, k, alpha);
-        }
-        m->beckmann = bk;
-    } else if (strcmp(type, "dielectric") == 0 || strcmp(type, "roughdielectric") == 0 ||
-               strcmp(type, "thindielectric") == 0) {
-        float in = 1.5046f, ext = 1.000277f;
-        vec3 tr = v3s(1.0f), refl = v3s(1.0f);
-        if (type[0] == 'r' && (st = get_alpha(p, b, 0.1f, &alpha, &bk))) return st;
-        if ((st = get_ior(p, b, "int_ior", &in))) return st;
-        if ((st = get_ior(p, b, "ext_ior", &ext))) return st;
-        if ((st = get_color(p, b, "specular_transmittance", &tr))) return st;
-        if ((st = get_color(p, b, "specular_reflectance", &refl))) return st;
-        if (refl.x != 1.0f || refl.y != 1.0f || refl.z != 1.0f)
-            xwarn(p, b, "%s: specular_reflectance other than 1 is not supported; ignored", ty);
-        float ior = in / ext;
-        if (type[0] == 't') {
-            /* a thin sheet: light goes through unbent; its reflection is lost */
-            xwarn(p, b, "thindielectric is rendered as a clear sheet that lets light through unbent, without its "
-                        "reflection");
-            ior = 1.0f;
-        }
-        if (ior == 1.0f && alpha > 0.0f) alpha = 0.0f;
-        material_dielectric(m, ior, alpha, clamp01v(tr));
-        m->beckmann = bk;
-    } else if (strcmp(type, "plastic") == 0 || strcmp(type, "roughplastic") == 0) {
-        float in = 1.49f, ext = 1.000277f;
-        vec3 kd = v3s(0.5f), spec = v3s(1.0f);
-        if (type[0] == 'r' && (st = get_alpha(p, b, 0.1f, &alpha, &bk))) return st;
-        if ((st = get_ior(p, b, "int_ior", &in))) return st;
-        if ((st = get_ior(p, b, "ext_ior", &ext))) return st;
-        if ((st = get_color_tex(p, b, "diffuse_reflectance", &kd, &m->map_kd))) return st;
-        if ((st = get_color(p, b, "specular_reflectance", &spec))) return st;
-        if (spec.x != 1.0f || spec.y != 1.0f || spec.z != 1.0f)
-            xwarn(p, b, "%s: specular_reflectance other than 1 is not supported; ignored", ty);
-        float ior = in / ext;
-        if (!(ior > 0.0f) || ior == 1.0f) ior = 1.49f;
-        material_plastic(m, clamp01v(kd), ior, alpha);
-        m->beckmann = bk;
-    } else if (strcmp(type, "principled") == 0 || strcmp(type, "principledthin") == 0) {
-        /* Disney's model by its main parameters: a metal (Schlick, F0 =
-         * base_color) when metallic > 0.5, else a plastic of base_color */
-        vec3 base = v3s(0.5f);
-        float metallic = 0.0f, roughness = 0.5f, eta = 1.5f;
-        if ((st = get_color(p, b, "base_color", &base))) return st;
-        if ((st = get_scalar(p, b, "metallic", &metallic))) return st;
-        if ((st = get_scalar(p, b, "roughness", &roughness))) return st;
-        if ((st = get_float(p, b, "eta", &eta))) return st;
-        for (xnode *c = b->child; c; c = c->next) c->used = true;
-        if (first_time(p, "principled"))
-            xwarn(p, b, "principled is approximated by a %s of its base_color and roughness",
-                  metallic > 0.5f ? "metal" : "plastic");
-        alpha = clamp01(roughness) * clamp01(roughness);
-        if (metallic > 0.5f) material_conductor_f0(m, clamp01v(base), alpha);
-        else material_plastic(m, clamp01v(base), eta > 1.0f ? eta : 1.5f, alpha);
-    } else if (strcmp(type, "null") == 0) {
-        material_interface(m); /* no surface: light passes straight through; it may bound media */
-    } else {
-        for (xnode *c = b->child; c; c = c->next) c->used = true;
+    pdict d;
+    if ((st = xml_props(p, b, &d))) return st;
+    const size_t nrows = sizeof bsdf_rows / sizeof bsdf_rows[0];
+    size_t r = 0;
+    while (r < nrows && strcmp(bsdf_rows[r].type, type) != 0) r++;
+    if (r == nrows) {
         xwarn(p, b, "bsdf \"%s\" is not supported; using a grey diffuse material", ty);
         material_diffuse(m, v3s(0.5f));
         return PK_OK;
     }
+    const bsdf_row *row = &bsdf_rows[r];
+    bsdf_in in = {.b = b, .d = &d, .type = type, .ty = ty};
+    if (row->rough && (st = get_alpha(p, &d, 0.1f, &in.alpha, &in.beckmann))) return st;
+    if (row->int_ior > 0.0f && (st = get_rel_ior(p, &d, row->int_ior, &in.ior))) return st;
+    if (!row->create) material_interface(m);
+    else if ((st = row->create(p, &in, m)) || !row->kind) return st;
+    static const char *const quiet[] = {"ext_ior", "ext_eta", "nonlinear", "distribution", "sample_visible", NULL};
     char kind[64];
     snprintf(kind, sizeof kind, "bsdf \"%s\"", ty);
-    warn_unused(p, b, kind, quiet);
+    warn_unused(&d, row->kind[0] ? row->kind : kind, quiet);
     return PK_OK;
 }
 
@@ -1469,28 +1591,32 @@ static bool is_property_tag(const char *t)
     return false;
 }
 
-/* Warns once per (kind, property) about the properties of plugin that no
- * code read, except those in quiet (NULL-terminated, snake_case). */
-static void warn_unused(xp *p, xnode *plugin, const char *kind, const char *const *quiet)
+/* The source's warning for a property no code read: once per (kind,
+ * property), kind the dictionary's what; only for the property elements
+ * (not nested bsdfs, media, references). */
+static void xml_warn_unused(void *self, const pdict *d, const pd_entry *e)
 {
-    for (xnode *c = plugin->child; c; c = c->next) {
-        if (c->used || !is_property_tag(c->tag)) continue;
-        pk_status st;
-        const char *nm = attr_st(p, c, "name", &st);
-        if (!nm) continue;
-        char sn[64];
-        snake(sn, sizeof sn, nm);
-        bool q = false;
-        for (int i = 0; quiet && quiet[i]; i++)
-            if (strcmp(quiet[i], sn) == 0) q = true;
-        if (q) continue;
-        char key[128];
-        snprintf(key, sizeof key, "%s/%s", kind, sn);
-        if (!first_time(p, key)) continue;
-        char snm[48];
-        shown(snm, sizeof snm, nm);
-        xwarn(p, c, "%s: property \"%s\" is not supported; ignored", kind, snm);
-    }
+    xp *p = self;
+    const xnode *c = e->node;
+    pk_status st;
+    const char *nm = is_property_tag(c->tag) ? attr_st(p, c, "name", &st) : NULL;
+    char key[128];
+    snprintf(key, sizeof key, "%s/%s", d->what, e->name);
+    if (!nm || !first_time(p, key)) return;
+    char snm[48];
+    shown(snm, sizeof snm, nm);
+    xwarn(p, c, "%s: property \"%s\" is not supported; ignored", d->what, snm);
+}
+
+/* Warns about the properties of d that no code read (kind: "bsdf \"x\""),
+ * except those in quiet (NULL-terminated, snake_case). */
+static void warn_unused(pdict *d, const char *kind, const char *const *quiet)
+{
+    size_t nq = 0;
+    while (quiet && quiet[nq]) nq++;
+    d->what = kind;
+    pd_declare(d, quiet, nq);
+    pd_report_unused(d);
 }
 
 /* ---- meshes ---------------------------------------------------------------------------------- */
@@ -1636,15 +1762,16 @@ static void finish_mesh(xp *p, size_t t0, bool face_normals, bool flip)
     }
 }
 
-static pk_status shape_obj(xp *p, xnode *sh, const xform *m, bool flip, bool has_bsdf, uint32_t mat)
+static pk_status shape_obj(xp *p, pdict *d, const xform *m, bool flip, bool has_bsdf, uint32_t mat)
 {
+    const xnode *sh = d->node;
     pk_status st;
     const char *fn = NULL;
     xnode *at;
-    if ((st = get_string(p, sh, "filename", &fn, &at))) return st;
+    if ((st = get_string(p, d, "filename", &fn, &at))) return st;
     if (!fn) return xfail(p, PK_ERR_PARSE, sh, "shape obj needs a filename");
     bool face_normals = false;
-    if ((st = get_bool(p, sh, "face_normals", &face_normals))) return st;
+    if ((st = get_bool(p, d, "face_normals", &face_normals))) return st;
     char *full = NULL, *data = NULL, *dir = NULL;
     size_t size = 0;
     size_t t0 = p->s->ntris;
@@ -1666,15 +1793,16 @@ out:
     return st;
 }
 
-static pk_status shape_ply(xp *p, xnode *sh, const xform *m, bool flip, uint32_t mat)
+static pk_status shape_ply(xp *p, pdict *d, const xform *m, bool flip, uint32_t mat)
 {
+    const xnode *sh = d->node;
     pk_status st;
     const char *fn = NULL;
     xnode *at;
-    if ((st = get_string(p, sh, "filename", &fn, &at))) return st;
+    if ((st = get_string(p, d, "filename", &fn, &at))) return st;
     if (!fn) return xfail(p, PK_ERR_PARSE, sh, "shape ply needs a filename");
     bool face_normals = false;
-    if ((st = get_bool(p, sh, "face_normals", &face_normals))) return st;
+    if ((st = get_bool(p, d, "face_normals", &face_normals))) return st;
     char *full = NULL, *data = NULL;
     size_t size = 0;
     ply_mesh mesh = {0};
@@ -1708,33 +1836,31 @@ static pk_status medium_phase(xp *p, xnode *med, float *g)
             if (st) return st;
             xnode *t = id ? id_find(p, id) : NULL;
             if (t && strcmp(t->tag, "phase") == 0) ph = t;
-        } else {
-            continue;
         }
-        c->used = true;
     }
     *g = 0.0f;
     if (!ph) return PK_OK;
     const char *type = attr_st(p, ph, "type", &st);
     if (st) return st;
     if (!type) return xfail(p, PK_ERR_PARSE, ph, "<phase> needs a type");
+    pdict d;
+    if ((st = xml_props(p, ph, &d))) return st;
     char ty[40];
     shown(ty, sizeof ty, type);
     if (strcmp(type, "hg") == 0) {
         *g = 0.8f;
-        xnode *gn = prop(p, ph, "g");
-        if ((st = get_float(p, ph, "g", g))) return st;
+        xnode *gn = prop(&d, "g");
+        if ((st = get_float(p, &d, "g", g))) return st;
         if (!(*g > -1.0f && *g < 1.0f))
             return xfail(p, PK_ERR_PARSE, gn ? gn : ph, "phase \"hg\": g = %g must lie strictly between -1 and 1",
                          (double)*g);
     } else if (strcmp(type, "isotropic") != 0) {
-        for (xnode *c = ph->child; c; c = c->next) c->used = true;
         xwarn(p, ph, "phase function \"%s\" is not supported (isotropic and hg are); isotropic used", ty);
         return PK_OK;
     }
     char kind[64];
     snprintf(kind, sizeof kind, "phase \"%s\"", ty);
-    warn_unused(p, ph, kind, NULL);
+    warn_unused(&d, kind, NULL);
     return PK_OK;
 }
 
@@ -1749,11 +1875,11 @@ typedef struct xvol {
     xnode *at;
 } xvol;
 
-static pk_status medium_volume_read(xp *p, xnode *med, const char *name, vec3 def, xvol *v)
+static pk_status medium_volume_read(xp *p, pdict *md, const char *name, vec3 def, xvol *v)
 {
     pk_status st;
     *v = (xvol){.value = def, .to_world = xform_identity()};
-    xnode *c = prop(p, med, name);
+    xnode *c = prop(md, name);
     if (!c) return PK_OK;
     v->present = true;
     v->at = c;
@@ -1769,18 +1895,20 @@ static pk_status medium_volume_read(xp *p, xnode *med, const char *name, vec3 de
     if (st) return st;
     char ty[40];
     shown(ty, sizeof ty, type ? type : "");
+    pdict d;
+    if ((st = xml_props(p, c, &d))) return st;
     if (type && strcmp(type, "constvolume") == 0) {
-        xnode *val = prop(p, c, "value");
+        xnode *val = prop(&d, "value");
         if (val && (st = node_color(p, val, &v->value))) return st;
         if (!v3_finite(v->value)) return xfail(p, PK_ERR_PARSE, c, "%s is not finite", name);
-        warn_unused(p, c, "volume \"constvolume\"", NULL);
+        warn_unused(&d, "volume \"constvolume\"", NULL);
         return PK_OK;
     }
     if (!type || strcmp(type, "gridvolume") != 0)
         return xfail(p, PK_ERR_UNSUPPORTED, c, "volume \"%s\" is not supported (constvolume and gridvolume are)", ty);
     const char *fn = NULL;
     xnode *fat;
-    if ((st = get_string(p, c, "filename", &fn, &fat))) return st;
+    if ((st = get_string(p, &d, "filename", &fn, &fat))) return st;
     if (!fn) return xfail(p, PK_ERR_PARSE, c, "volume \"gridvolume\" needs a filename");
     char *full = path_join(&p->ctx->alloc, fat->file->dir, fn);
     if (!full) return ctx_nomem(p->ctx);
@@ -1793,11 +1921,11 @@ static pk_status medium_volume_read(xp *p, xnode *med, const char *name, vec3 de
     /* the grid's box: Mitsuba 0.x, the file's (or min and max); Mitsuba 3,
      * the unit cube unless use_grid_bbox */
     bool use_box = p->version_major < 2;
-    if ((st = get_bool(p, c, "use_grid_bbox", &use_box))) return st;
+    if ((st = get_bool(p, &d, "use_grid_bbox", &use_box))) return st;
     if (p->version_major < 2) {
         bool has_lo, has_hi;
         vec3 lo = box.lo, hi = box.hi;
-        if ((st = get_vec(p, c, "min", &lo, &has_lo)) || (st = get_vec(p, c, "max", &hi, &has_hi))) return st;
+        if ((st = get_vec(p, &d, "min", &lo, &has_lo)) || (st = get_vec(p, &d, "max", &hi, &has_hi))) return st;
         if (has_lo && has_hi) box.lo = lo, box.hi = hi;
         if (!(box.hi.x > box.lo.x && box.hi.y > box.lo.y && box.hi.z > box.lo.z))
             return xfail(p, PK_ERR_PARSE, c, "the grid's box is empty or inverted");
@@ -1817,18 +1945,18 @@ static pk_status medium_volume_read(xp *p, xnode *med, const char *name, vec3 de
         box = (aabb){v3(lo[0], lo[1], lo[2]), v3(hi[0], hi[1], hi[2])};
     }
     xform tw;
-    if ((st = get_to_world(p, c, &tw, NULL))) return st;
+    if ((st = get_to_world(p, &d, &tw, NULL))) return st;
     const xform t = xform_translate(box.lo), sc = xform_scale(v3_sub(box.hi, box.lo)), ts = xform_mul(&t, &sc);
     v->to_world = xform_mul(&tw, &ts);
     static const char *const quiet[] = {"filter_type", "wrap_mode", "raw", "accel", "send_data", "max_value", NULL};
-    warn_unused(p, c, "volume \"gridvolume\"", quiet);
+    warn_unused(&d, "volume \"gridvolume\"", quiet);
     return PK_OK;
 }
 
 /* medium_volume_read, leaving nothing allocated on failure. */
-static pk_status medium_volume(xp *p, xnode *med, const char *name, vec3 def, xvol *v)
+static pk_status medium_volume(xp *p, pdict *md, const char *name, vec3 def, xvol *v)
 {
-    pk_status st = medium_volume_read(p, med, name, def, v);
+    pk_status st = medium_volume_read(p, md, name, def, v);
     if (st) {
         mem_free(&p->s->alloc, v->g.data);
         v->g.data = NULL;
@@ -1871,10 +1999,12 @@ static pk_status medium_convert(xp *p, xnode *mn, medium *m)
     if (!homog && !het)
         return xfail(p, PK_ERR_UNSUPPORTED, mn, "medium \"%s\" is not supported (homogeneous and heterogeneous are)", ty);
     const bool v0 = p->version_major < 2;
+    pdict d;
+    if ((st = xml_props(p, mn, &d))) return st;
     medium_init(m);
     float scale = 1.0f;
-    if ((st = get_float(p, mn, "scale", &scale))) return st;
-    xnode *dm = prop(p, mn, "density_multiplier");
+    if ((st = get_float(p, &d, "scale", &scale))) return st;
+    xnode *dm = prop(&d, "density_multiplier");
     if (dm) { /* Mitsuba 0.4's name of scale */
         float f = 1.0f;
         if ((st = node_float(p, dm, &f))) return st;
@@ -1883,7 +2013,7 @@ static pk_status medium_convert(xp *p, xnode *mn, medium *m)
     }
     if (!(scale >= 0.0f)) return xfail(p, PK_ERR_PARSE, mn, "medium: scale must not be negative");
     if ((st = medium_phase(p, mn, &m->g))) return st;
-    if (prop(p, mn, "material"))
+    if (prop(&d, "material"))
         return xfail(p, PK_ERR_UNSUPPORTED, mn, "medium presets (\"material\") are not supported; give sigma_a and "
                                                 "sigma_s, or sigma_t and albedo");
     static const char *const quiet[] = {"sample_emitters", "method", "step_size", "strategy", "has_spectral_extinction",
@@ -1892,23 +2022,23 @@ static pk_status medium_convert(xp *p, xnode *mn, medium *m)
     char kind[64];
     snprintf(kind, sizeof kind, "medium \"%s\"", ty);
     if (homog) {
-        xnode *na = prop(p, mn, "sigma_a"), *ns = prop(p, mn, "sigma_s");
-        xnode *nt = prop(p, mn, "sigma_t"), *nl = prop(p, mn, "albedo");
+        xnode *na = prop(&d, "sigma_a"), *ns = prop(&d, "sigma_s");
+        xnode *nt = prop(&d, "sigma_t"), *nl = prop(&d, "albedo");
         if ((na || ns) && (nt || nl))
             return xfail(p, PK_ERR_PARSE, nt ? nt : nl, "medium: give sigma_a and sigma_s, or sigma_t and albedo, not "
                                                         "both");
         vec3 sa, ss;
         if (na || ns) {
             sa = ss = v3s(0.0f);
-            if ((st = get_color(p, mn, "sigma_a", &sa)) || (st = get_color(p, mn, "sigma_s", &ss))) return st;
+            if ((st = get_color(p, &d, "sigma_a", &sa)) || (st = get_color(p, &d, "sigma_s", &ss))) return st;
             if (v0 && !(na && ns))
                 xwarn(p, mn, "medium: %s missing; Mitsuba 0.6 takes it from its default preset, which is not "
                              "supported: 0 used", na ? "sigmaS" : "sigmaA");
         } else {
             vec3 sig = v3s(1.0f);
-            if ((st = get_color(p, mn, "sigma_t", &sig))) return st;
+            if ((st = get_color(p, &d, "sigma_t", &sig))) return st;
             xvol al;
-            if ((st = medium_volume(p, mn, "albedo", v3s(0.75f), &al))) return st;
+            if ((st = medium_volume(p, &d, "albedo", v3s(0.75f), &al))) return st;
             if (al.grid) {
                 double sum[3] = {0, 0, 0};
                 const size_t nv = (size_t)al.g.nx * (size_t)al.g.ny * (size_t)al.g.nz;
@@ -1928,9 +2058,9 @@ static pk_status medium_convert(xp *p, xnode *mn, medium *m)
         }
         if (!(sa.x >= 0.0f && sa.y >= 0.0f && sa.z >= 0.0f && ss.x >= 0.0f && ss.y >= 0.0f && ss.z >= 0.0f))
             return xfail(p, PK_ERR_PARSE, na ? na : ns, "medium: sigma_a and sigma_s must not be negative");
-        if (v0 && prop(p, mn, "g")) { /* Mitsuba 0.6: g scales sigma_s to the reduced (1 - g) sigma_s */
+        if (v0 && prop(&d, "g")) { /* Mitsuba 0.6: g scales sigma_s to the reduced (1 - g) sigma_s */
             vec3 gv = v3s(0.0f);
-            if ((st = get_color(p, mn, "g", &gv))) return st;
+            if ((st = get_color(p, &d, "g", &gv))) return st;
             const float g = (gv.x + gv.y + gv.z) / 3.0f;
             if (!(g > -1.0f && g < 1.0f)) return xfail(p, PK_ERR_PARSE, mn, "medium: g must lie in (-1, 1)");
             ss = v3_scale(ss, 1.0f - g);
@@ -1943,20 +2073,20 @@ static pk_status medium_convert(xp *p, xnode *mn, medium *m)
         m->sigma_t = v3_scale(t, scale);
         m->albedo = v3(a[0], a[1], a[2]);
         if ((st = medium_values(p, mn, m->sigma_t, m->albedo))) return st;
-        warn_unused(p, mn, kind, quiet);
+        warn_unused(&d, kind, quiet);
         return PK_OK;
     }
     /* heterogeneous: Mitsuba 3's sigma_t and albedo (each a value or a
      * volume), Mitsuba 0.6's density and albedo volumes */
-    if (prop(p, mn, "sigma_a") || prop(p, mn, "sigma_s"))
+    if (prop(&d, "sigma_a") || prop(&d, "sigma_s"))
         return xfail(p, PK_ERR_PARSE, mn, "a heterogeneous medium takes sigma_t (or density) and albedo, not sigma_a "
                                           "and sigma_s");
     xform mw;
-    if ((st = get_to_world(p, mn, &mw, NULL))) return st;
+    if ((st = get_to_world(p, &d, &mw, NULL))) return st;
     xvol sig, al;
-    const char *sname = prop(p, mn, "density") ? "density" : "sigma_t";
-    if ((st = medium_volume(p, mn, sname, v3s(1.0f), &sig))) return st;
-    if ((st = medium_volume(p, mn, "albedo", v3s(0.75f), &al))) {
+    const char *sname = prop(&d, "density") ? "density" : "sigma_t";
+    if ((st = medium_volume(p, &d, sname, v3s(1.0f), &sig))) return st;
+    if ((st = medium_volume(p, &d, "albedo", v3s(0.75f), &al))) {
         mem_free(&p->s->alloc, sig.g.data);
         return st;
     }
@@ -1968,7 +2098,7 @@ static pk_status medium_convert(xp *p, xnode *mn, medium *m)
     if ((st = medium_values(p, mn, m->sigma_t, m->albedo))) return st;
     if (!sig.grid && !al.grid) { /* constants everywhere: a homogeneous medium */
         m->kind = MEDIUM_HOMOGENEOUS;
-        warn_unused(p, mn, kind, quiet);
+        warn_unused(&d, kind, quiet);
         return PK_OK;
     }
     m->kind = MEDIUM_GRID;
@@ -1985,7 +2115,7 @@ static pk_status medium_convert(xp *p, xnode *mn, medium *m)
     m->grid_to_world = xform_mul(&mw, gw);
     if (!xform_finite(&m->grid_to_world) || !(xform_det3(&m->grid_to_world) != 0.0))
         return xfail(p, PK_ERR_PARSE, mn, "the grid's placement (to_world) is singular or not finite");
-    warn_unused(p, mn, kind, quiet);
+    warn_unused(&d, kind, quiet);
     return PK_OK;
 }
 
@@ -2006,7 +2136,6 @@ static pk_status medium_of(xp *p, xnode *n, int32_t *index)
             return xfail(p, PK_ERR_PARSE, n, "no medium has the id \"%s\"%s", sid, target ? "" : " (defined before here)");
         }
     }
-    n->used = true;
     if (target->medium >= 0) {
         *index = (int32_t)target->medium;
         return PK_OK;
@@ -2042,12 +2171,14 @@ static pk_status medium_of(xp *p, xnode *n, int32_t *index)
 static pk_status parse_emitter_area(xp *p, xnode *e, vec3 *radiance)
 {
     pk_status st;
+    pdict d;
+    if ((st = xml_props(p, e, &d))) return st;
     *radiance = v3s(1.0f);
-    if ((st = get_color(p, e, "radiance", radiance))) return st;
+    if ((st = get_color(p, &d, "radiance", radiance))) return st;
     if (!(radiance->x >= 0.0f && radiance->y >= 0.0f && radiance->z >= 0.0f))
         return xfail(p, PK_ERR_PARSE, e, "radiance must not be negative");
     static const char *const quiet[] = {"sampling_weight", NULL};
-    warn_unused(p, e, "emitter \"area\"", quiet);
+    warn_unused(&d, "emitter \"area\"", quiet);
     return PK_OK;
 }
 
@@ -2087,12 +2218,13 @@ static pk_status parse_instance(xp *p, xnode *sh)
     const char *id = attr_st(p, sh, "id", &st);
     if (st) return st;
     if (id && (st = id_add(p, id, sh))) return st;
+    pdict d;
+    if ((st = xml_props(p, sh, &d))) return st;
     xform m;
-    if ((st = get_to_world(p, sh, &m, NULL))) return st;
+    if ((st = get_to_world(p, &d, &m, NULL))) return st;
     xnode *group = NULL, *ref = NULL;
     for (xnode *c = sh->child; c; c = c->next) {
         if (strcmp(c->tag, "ref") != 0) continue;
-        c->used = true;
         if (ref) {
             xwarn(p, c, "an instance takes one shapegroup; this one is ignored");
             continue;
@@ -2112,7 +2244,7 @@ static pk_status parse_instance(xp *p, xnode *sh)
     if (!(det != 0.0) || !isfinite(det)) return xfail(p, PK_ERR_PARSE, sh, "instance: to_world is singular");
     sb_set_transform(&p->sb, &m);
     if ((st = sb_add_instance(&p->sb, (uint32_t)group->mesh))) return st;
-    warn_unused(p, sh, "shape \"instance\"", NULL);
+    warn_unused(&d, "shape \"instance\"", NULL);
     return PK_OK;
 }
 
@@ -2137,11 +2269,13 @@ static pk_status parse_shape(xp *p, xnode *sh)
     const char *id = attr_st(p, sh, "id", &st);
     if (st) return st;
     if (id && (st = id_add(p, id, sh))) return st;
+    pdict d;
+    if ((st = xml_props(p, sh, &d))) return st;
 
     xform m;
-    if ((st = get_to_world(p, sh, &m, NULL))) return st;
+    if ((st = get_to_world(p, &d, &m, NULL))) return st;
     bool flip = false;
-    if ((st = get_bool(p, sh, "flip_normals", &flip))) return st;
+    if ((st = get_bool(p, &d, "flip_normals", &flip))) return st;
 
     /* its bsdf (a nested one or a reference), its area emitter and the
      * media inside and outside it */
@@ -2155,7 +2289,6 @@ static pk_status parse_shape(xp *p, xnode *sh)
         const bool medium_ref = cname && strcmp(c->tag, "ref") == 0 &&
                                 (strcmp(cname, "interior") == 0 || strcmp(cname, "exterior") == 0);
         if (strcmp(c->tag, "medium") == 0 || medium_ref) {
-            c->used = true;
             const int side = cname && strcmp(cname, "interior") == 0 ? 0 : cname && strcmp(cname, "exterior") == 0 ? 1 : -1;
             if (side < 0) {
                 xwarn(p, c, "a shape's medium needs name=\"interior\" or name=\"exterior\"; ignored");
@@ -2176,25 +2309,21 @@ static pk_status parse_shape(xp *p, xnode *sh)
                     else if (strcmp(t->tag, "medium") == 0)
                         xwarn(p, c, "a shape's medium needs name=\"interior\" or name=\"exterior\"; ignored");
                     else xwarn(p, c, "a reference to a <%.32s> in a shape is not supported; ignored", t->tag);
-                    c->used = true;
                     continue;
                 }
             }
-            c->used = true;
             if (bsdf) {
                 xwarn(p, c, "a shape takes one bsdf; this one is ignored");
                 continue;
             }
             bsdf = c;
         } else if (strcmp(c->tag, "emitter") == 0) {
-            c->used = true;
             if (emitter) {
                 xwarn(p, c, "a shape takes one emitter; this one is ignored");
                 continue;
             }
             emitter = c;
         } else if (strcmp(c->tag, "subsurface") == 0) {
-            c->used = true;
             if (first_time(p, "subsurface"))
                 xwarn(p, c, "subsurface integrators are not supported (media inside a dielectric are); ignored");
         }
@@ -2211,23 +2340,23 @@ static pk_status parse_shape(xp *p, xnode *sh)
     if (bsdf && (st = material_of(p, bsdf, &mat))) return st;
     if (!bsdf && (sides[0] || sides[1]) && p->version_major < 2) {
         /* Mitsuba 0.x: a medium transition without a bsdf is index-matched */
-        int64_t d = scene_find_material(p->s, "mitsuba-index-matched");
-        if (d < 0) {
+        int64_t found = scene_find_material(p->s, "mitsuba-index-matched");
+        if (found < 0) {
             uint32_t idx;
             if ((st = scene_add_material(p->ctx, p->s, "mitsuba-index-matched", &idx))) return st;
             material_interface(&p->s->materials[idx]);
-            d = idx;
+            found = idx;
         }
-        mat = (uint32_t)d;
+        mat = (uint32_t)found;
     } else if (!bsdf) { /* Mitsuba's default: diffuse, reflectance 0.5 */
-        int64_t d = scene_find_material(p->s, "mitsuba-default-diffuse");
-        if (d < 0) {
+        int64_t found = scene_find_material(p->s, "mitsuba-default-diffuse");
+        if (found < 0) {
             uint32_t idx;
             if ((st = scene_add_material(p->ctx, p->s, "mitsuba-default-diffuse", &idx))) return st;
             material_diffuse(&p->s->materials[idx], v3s(0.5f));
-            d = idx;
+            found = idx;
         }
-        mat = (uint32_t)d;
+        mat = (uint32_t)found;
     }
     if ((sides[0] || sides[1]) && (st = scene_material_with_media(p->ctx, p->s, mat, med[0], med[1], &mat)))
         return st;
@@ -2252,16 +2381,16 @@ static pk_status parse_shape(xp *p, xnode *sh)
      * such a transform reverses, is turned back. */
     bool mirror = xform_det3(&m) < 0.0;
     switch (kind) {
-    case SH_OBJ: st = shape_obj(p, sh, &m, flip, has_bsdf, mat); break;
-    case SH_PLY: st = shape_ply(p, sh, &m, flip, mat); break;
+    case SH_OBJ: st = shape_obj(p, &d, &m, flip, has_bsdf, mat); break;
+    case SH_PLY: st = shape_ply(p, &d, &m, flip, mat); break;
     case SH_RECT: st = shape_rectangle(p, &m, flip != mirror, mat); break;
     case SH_CUBE: st = shape_cube(p, &m, flip != mirror, mat); break;
     case SH_DISK: st = shape_disk(p, &m, flip != mirror, mat); break;
     case SH_SPHERE: {
         vec3 center = v3s(0.0f);
         float radius = 1.0f;
-        if ((st = get_vec(p, sh, "center", &center, NULL))) return st;
-        if ((st = get_float(p, sh, "radius", &radius))) return st;
+        if ((st = get_vec(p, &d, "center", &center, NULL))) return st;
+        if ((st = get_float(p, &d, "radius", &radius))) return st;
         if (!(radius > 0.0f)) return xfail(p, PK_ERR_PARSE, sh, "sphere: radius must be positive");
         /* to_world * translate(center) * scale(radius) */
         xform local = xform_scale(v3s(radius));
@@ -2293,7 +2422,7 @@ static pk_status parse_shape(xp *p, xnode *sh)
     static const char *const quiet[] = {"flip_tex_coords", "collapse", NULL};
     char kindname[64];
     snprintf(kindname, sizeof kindname, "shape \"%s\"", ty);
-    warn_unused(p, sh, kindname, quiet);
+    warn_unused(&d, kindname, quiet);
     return PK_OK;
 }
 
@@ -2313,23 +2442,25 @@ static pk_status parse_emitter(xp *p, xnode *e)
     scene_environment *env = &p->s->env;
     const char *id = attr_st(p, e, "id", &st);
     if (id && (st = id_add(p, id, e))) return st;
+    pdict d;
+    if ((st = xml_props(p, e, &d))) return st;
 
     if (strcmp(type, "point") == 0 || strcmp(type, "spot") == 0) {
         vec3 pos = v3s(0.0f), intensity = v3s(1.0f), axis = v3s(0.0f);
         float cos_inner = 1.0f, cos_outer = 1.0f;
         bool has_pos;
         xform m;
-        if ((st = get_to_world(p, e, &m, NULL))) return st;
-        if ((st = get_vec(p, e, "position", &pos, &has_pos))) return st;
-        if ((st = get_color(p, e, "intensity", &intensity))) return st;
+        if ((st = get_to_world(p, &d, &m, NULL))) return st;
+        if ((st = get_vec(p, &d, "position", &pos, &has_pos))) return st;
+        if ((st = get_color(p, &d, "intensity", &intensity))) return st;
         if (type[0] == 's') {
             /* Mitsuba's spot shines along +z of its to_world: full within
              * beam_width, fading linearly in the angle to nothing at
              * cutoff_angle (degrees, half-angles; beam_width defaults to
              * three quarters of the cutoff) */
             float cutoff = 20.0f, beam = -1.0f;
-            if ((st = get_float(p, e, "cutoff_angle", &cutoff))) return st;
-            if ((st = get_float(p, e, "beam_width", &beam))) return st;
+            if ((st = get_float(p, &d, "cutoff_angle", &cutoff))) return st;
+            if ((st = get_float(p, &d, "beam_width", &beam))) return st;
             if (beam < 0.0f) beam = 0.75f * cutoff;
             if (!(cutoff > 0.0f && cutoff <= 180.0f))
                 return xfail(p, PK_ERR_PARSE, e, "cutoff_angle must be in (0, 180] degrees");
@@ -2352,17 +2483,17 @@ static pk_status parse_emitter(xp *p, xnode *e)
         if (st) return st;
     } else if (strcmp(type, "constant") == 0) {
         vec3 r = v3s(1.0f);
-        if ((st = get_color(p, e, "radiance", &r))) return st;
+        if ((st = get_color(p, &d, "radiance", &r))) return st;
         scene_env_add_radiance(p->s, r);
     } else if (strcmp(type, "envmap") == 0) {
         const char *fn = NULL;
         xnode *at;
         float scale = 1.0f;
         xform m;
-        if ((st = get_string(p, e, "filename", &fn, &at))) return st;
+        if ((st = get_string(p, &d, "filename", &fn, &at))) return st;
         if (!fn) return xfail(p, PK_ERR_PARSE, e, "envmap needs a filename");
-        if ((st = get_float(p, e, "scale", &scale))) return st;
-        if ((st = get_to_world(p, e, &m, NULL))) return st;
+        if ((st = get_float(p, &d, "scale", &scale))) return st;
+        if ((st = get_to_world(p, &d, &m, NULL))) return st;
         if (env->map) {
             xwarn(p, e, "a second envmap is not supported; ignored");
         } else {
@@ -2379,21 +2510,21 @@ static pk_status parse_emitter(xp *p, xnode *e)
             if ((st = scene_env_load(&scratch, env))) return xfail(p, st, e, "envmap: %s", scratch.message);
         }
         static const char *const q2[] = {"sampling_weight", "gamma", "filter_type", "cache", NULL};
-        warn_unused(p, e, kind, q2);
+        warn_unused(&d, kind, q2);
         env->set = true;
         return PK_OK;
     } else if (strcmp(type, "sun") == 0 || strcmp(type, "sky") == 0 || strcmp(type, "sunsky") == 0) {
         float turbidity = 3.0f, sun_scale, sky_scale, radius_scale = 1.0f, scale = 1.0f;
         vec3 dir = v3(0.0f, 1.0f, 0.0f), albedo = v3s(0.2f);
         bool has_dir;
-        if ((st = get_float(p, e, "turbidity", &turbidity))) return st;
-        if ((st = get_float(p, e, "scale", &scale))) return st;
+        if ((st = get_float(p, &d, "turbidity", &turbidity))) return st;
+        if ((st = get_float(p, &d, "scale", &scale))) return st;
         sun_scale = sky_scale = scale; /* sunsky: scale is the default of both */
-        if ((st = get_float(p, e, "sun_scale", &sun_scale))) return st;
-        if ((st = get_float(p, e, "sky_scale", &sky_scale))) return st;
-        if ((st = get_color(p, e, "albedo", &albedo))) return st;
-        if ((st = get_float(p, e, "sun_radius_scale", &radius_scale))) return st;
-        if ((st = get_vec(p, e, "sun_direction", &dir, &has_dir))) return st;
+        if ((st = get_float(p, &d, "sun_scale", &sun_scale))) return st;
+        if ((st = get_float(p, &d, "sky_scale", &sky_scale))) return st;
+        if ((st = get_color(p, &d, "albedo", &albedo))) return st;
+        if ((st = get_float(p, &d, "sun_radius_scale", &radius_scale))) return st;
+        if ((st = get_vec(p, &d, "sun_direction", &dir, &has_dir))) return st;
         if (!has_dir) {
             xwarn(p, e, "%s: the sun's position from date, time and place is not computed; give sun_direction "
                         "(the sun is put at 45 degrees)",
@@ -2428,17 +2559,17 @@ static pk_status parse_emitter(xp *p, xnode *e)
             env->sky_scale = sky_scale;
         }
         static const char *const q2[] = {"sampling_weight", "resolution", "stretch", "extend", NULL};
-        warn_unused(p, e, kind, q2);
+        warn_unused(&d, kind, q2);
         return PK_OK;
     } else if (strcmp(type, "directional") == 0 || strcmp(type, "distant") == 0) {
         vec3 dir = v3(0.0f, 0.0f, 1.0f), irr = v3s(1.0f);
         bool has_dir;
         xform m;
         bool has_m;
-        if ((st = get_to_world(p, e, &m, &has_m))) return st;
-        if ((st = get_vec(p, e, "direction", &dir, &has_dir))) return st;
+        if ((st = get_to_world(p, &d, &m, &has_m))) return st;
+        if ((st = get_vec(p, &d, "direction", &dir, &has_dir))) return st;
         if (!has_dir && has_m) dir = xform_vector(&m, v3(0.0f, 0.0f, 1.0f));
-        if ((st = get_color(p, e, "irradiance", &irr))) return st;
+        if ((st = get_color(p, &d, "irradiance", &irr))) return st;
         if (!(v3_len2(dir) > 0.0f)) return xfail(p, PK_ERR_PARSE, e, "direction must not be zero");
         if (!v3_finite(irr) || !(irr.x >= 0.0f && irr.y >= 0.0f && irr.z >= 0.0f))
             return xfail(p, PK_ERR_PARSE, e, "irradiance must be finite and not negative");
@@ -2447,11 +2578,10 @@ static pk_status parse_emitter(xp *p, xnode *e)
         xwarn(p, e, "an area emitter belongs inside a shape; ignored");
         return PK_OK;
     } else {
-        for (xnode *c = e->child; c; c = c->next) c->used = true;
         xwarn(p, e, "emitter \"%s\" is not supported; ignored", ty);
         return PK_OK;
     }
-    warn_unused(p, e, kind, quiet);
+    warn_unused(&d, kind, quiet);
     return PK_OK;
 }
 
@@ -2460,10 +2590,12 @@ static pk_status parse_emitter(xp *p, xnode *e)
 static pk_status parse_film(xp *p, xnode *f)
 {
     pk_status st;
+    pdict d;
+    if ((st = xml_props(p, f, &d))) return st;
     int64_t w = XML_DEFAULT_WIDTH, h = XML_DEFAULT_HEIGHT;
     bool hw, hh;
-    if ((st = get_int(p, f, "width", &w, &hw))) return st;
-    if ((st = get_int(p, f, "height", &h, &hh))) return st;
+    if ((st = get_int(p, &d, "width", &w, &hw))) return st;
+    if ((st = get_int(p, &d, "height", &h, &hh))) return st;
     const pk_int_option *ow = pk_int_option_find("width"), *oh = pk_int_option_find("height");
     if (w < ow->min || w > ow->max || h < oh->min || h > oh->max)
         return xfail(p, (w > ow->max || h > oh->max) ? PK_ERR_LIMIT : PK_ERR_PARSE, f,
@@ -2475,24 +2607,24 @@ static pk_status parse_film(xp *p, xnode *f)
     r->opt.width = (int)w, r->opt.height = (int)h;
     r->has_width = r->has_height = true;
     p->film_w = (int)w, p->film_h = (int)h;
-    for (xnode *c = f->child; c; c = c->next)
-        if (strcmp(c->tag, "rfilter") == 0) c->used = true; /* pixel filters: Paprsek's is a box */
-    xnode *crop = prop(p, f, "crop_width");
+    xnode *crop = prop(&d, "crop_width");
     if (crop) xwarn(p, crop, "film: crop windows are not supported; the whole image is rendered");
-    prop(p, f, "crop_height"), prop(p, f, "crop_offset_x"), prop(p, f, "crop_offset_y");
+    prop(&d, "crop_height"), prop(&d, "crop_offset_x"), prop(&d, "crop_offset_y");
     static const char *const quiet[] = {"file_format", "pixel_format", "component_format", "banner", "gamma",
                                         "high_quality_edges", "attach_log", "exposure", "tonemap_method",
                                         "rfilter", "label", "key", "burn", NULL};
-    warn_unused(p, f, "film", quiet);
+    warn_unused(&d, "film", quiet);
     return PK_OK;
 }
 
 static pk_status parse_sampler(xp *p, xnode *smp)
 {
     pk_status st;
+    pdict d;
+    if ((st = xml_props(p, smp, &d))) return st;
     int64_t spp = 4;
     bool found;
-    if ((st = get_int(p, smp, "sample_count", &spp, &found))) return st;
+    if ((st = get_int(p, &d, "sample_count", &spp, &found))) return st;
     if (found) {
         const pk_int_option *o = pk_int_option_find("spp");
         if (spp < o->min || spp > o->max) {
@@ -2505,7 +2637,7 @@ static pk_status parse_sampler(xp *p, xnode *smp)
         p->s->render.has_spp = true;
     }
     static const char *const quiet[] = {"seed", "scramble", "dimension", "jitter", NULL};
-    warn_unused(p, smp, "sampler", quiet);
+    warn_unused(&d, "sampler", quiet);
     return PK_OK;
 }
 
@@ -2517,25 +2649,26 @@ static pk_status parse_sensor(xp *p, xnode *sn)
     if (!type) return xfail(p, PK_ERR_PARSE, sn, "<sensor> needs a type");
     char ty[40];
     shown(ty, sizeof ty, type);
+    pdict d;
+    if ((st = xml_props(p, sn, &d))) return st;
     const bool thinlens = strcmp(type, "thinlens") == 0, ortho = strcmp(type, "orthographic") == 0;
     if (strcmp(type, "perspective") != 0 && !thinlens && !ortho) {
         xwarn(p, sn, "sensor \"%s\" is not supported; rendered as a perspective camera", ty);
-        for (xnode *c = sn->child; c; c = c->next)
-            if (is_property_tag(c->tag) && strcmp(c->tag, "transform") != 0) c->used = true;
+        for (size_t i = 0; i < d.n; i++) d.e[i].used = strcmp(d.e[i].tag, "transform") != 0;
     }
     xform m;
     bool has_m;
-    if ((st = get_to_world(p, sn, &m, &has_m))) return st;
+    if ((st = get_to_world(p, &d, &m, &has_m))) return st;
     float fov = XML_DEFAULT_FOV;
     const char *axis = "x";
     if (!ortho) { /* (the orthographic sensor's view is its to_world's scale) */
-        xnode *fn = prop(p, sn, "fov");
+        xnode *fn = prop(&d, "fov");
         if (fn && (st = node_float(p, fn, &fov))) return st;
         if (fn && !(fov > 0.0f && fov < 180.0f)) return xfail(p, PK_ERR_PARSE, fn, "fov must be in (0, 180) degrees");
-        if (!fn && prop(p, sn, "focal_length"))
+        if (!fn && prop(&d, "focal_length"))
             xwarn(p, sn, "focal_length is not supported; using fov %g", (double)fov);
         xnode *an;
-        if ((st = get_string(p, sn, "fov_axis", &axis, &an))) return st;
+        if ((st = get_string(p, &d, "fov_axis", &axis, &an))) return st;
         if (strcmp(axis, "x") && strcmp(axis, "y") && strcmp(axis, "diagonal") && strcmp(axis, "smaller") &&
             strcmp(axis, "larger"))
             return xfail(p, PK_ERR_PARSE, an, "fov_axis must be x, y, diagonal, smaller or larger");
@@ -2548,15 +2681,15 @@ static pk_status parse_sensor(xp *p, xnode *sn)
      * Mitsuba's default is far_clip, itself 10^4 by default) */
     float aperture = 0.0f, focus = 0.0f, far_clip = 1e4f;
     if (thinlens) {
-        xnode *ap = prop(p, sn, "aperture_radius");
+        xnode *ap = prop(&d, "aperture_radius");
         if (!ap) return xfail(p, PK_ERR_PARSE, sn, "sensor \"thinlens\" needs aperture_radius");
-        if ((st = get_float(p, sn, "aperture_radius", &aperture))) return st;
+        if ((st = get_float(p, &d, "aperture_radius", &aperture))) return st;
         if (!(aperture >= 0.0f && isfinite(aperture)))
             return xfail(p, PK_ERR_PARSE, ap, "aperture_radius must be a finite number, not negative");
-        if ((st = get_float(p, sn, "far_clip", &far_clip))) return st;
+        if ((st = get_float(p, &d, "far_clip", &far_clip))) return st;
         focus = far_clip;
-        xnode *fd = prop(p, sn, "focus_distance");
-        if ((st = get_float(p, sn, "focus_distance", &focus))) return st;
+        xnode *fd = prop(&d, "focus_distance");
+        if ((st = get_float(p, &d, "focus_distance", &focus))) return st;
         if (!(focus > 0.0f && isfinite(focus)))
             return xfail(p, PK_ERR_PARSE, fd ? fd : sn, "focus_distance must be a finite number above 0");
     }
@@ -2598,10 +2731,8 @@ static pk_status parse_sensor(xp *p, xnode *sn)
 
     for (xnode *c = sn->child; c; c = c->next) {
         if (strcmp(c->tag, "film") == 0) {
-            c->used = true;
             if ((st = parse_film(p, c))) return st;
         } else if (strcmp(c->tag, "sampler") == 0) {
-            c->used = true;
             if ((st = parse_sampler(p, c))) return st;
         } else if (strcmp(c->tag, "medium") == 0 || strcmp(c->tag, "ref") == 0) { /* the camera's medium */
             if (strcmp(c->tag, "ref") == 0) {
@@ -2617,7 +2748,7 @@ static pk_status parse_sensor(xp *p, xnode *sn)
     }
     static const char *const quiet[] = {"near_clip", "far_clip", "focus_distance", "shutter_open", "shutter_close",
                                         "principal_point_offset_x", "principal_point_offset_y", NULL};
-    warn_unused(p, sn, "sensor", quiet);
+    warn_unused(&d, "sensor", quiet);
     return PK_OK;
 }
 
@@ -2652,12 +2783,12 @@ static pk_status parse_integrator(xp *p, xnode *in, int depth)
     shown(ty, sizeof ty, type);
     if (strcmp(type, "aov") == 0 || strcmp(type, "moment") == 0 || strcmp(type, "adaptive") == 0 ||
         strcmp(type, "irrcache") == 0 || strcmp(type, "multichannel") == 0) {
-        for (xnode *c = in->child; c; c = c->next) {
-            c->used = true;
+        for (xnode *c = in->child; c; c = c->next)
             if (strcmp(c->tag, "integrator") == 0) return parse_integrator(p, c, depth + 1);
-        }
         return PK_OK;
     }
+    pdict d;
+    if ((st = xml_props(p, in, &d))) return st;
     static const char *const pathlike[] = {"path", "volpath", "volpath_simple", "volpathmis", "prb", "prbvolpath",
                                            "direct_projective", "prb_projective", "path_reparam", NULL};
     bool path = false;
@@ -2675,12 +2806,12 @@ static pk_status parse_integrator(xp *p, xnode *in, int depth)
     if (strcmp(type, "direct") == 0) {
         md = 2;
         path = true;
-        prop(p, in, "emitter_samples"), prop(p, in, "bsdf_samples"), prop(p, in, "shading_samples");
-    } else if ((st = get_int(p, in, "max_depth", &md, &found))) {
+        prop(&d, "emitter_samples"), prop(&d, "bsdf_samples"), prop(&d, "shading_samples");
+    } else if ((st = get_int(p, &d, "max_depth", &md, &found))) {
         return st;
     }
     if (!path) {
-        for (xnode *c = in->child; c; c = c->next) c->used = true;
+        props_all_read(&d);
         char depth_text[32];
         if (md < 0) snprintf(depth_text, sizeof depth_text, "unbounded");
         else snprintf(depth_text, sizeof depth_text, "%lld", (long long)md);
@@ -2700,7 +2831,7 @@ static pk_status parse_integrator(xp *p, xnode *in, int depth)
     r->has_max_depth = true;
     static const char *const quiet[] = {"rr_depth", "strict_normals", "hide_emitters", "samples_per_pass",
                                         "block_size", "timeout", "luminance_samples", NULL};
-    warn_unused(p, in, "integrator", quiet);
+    warn_unused(&d, "integrator", quiet);
     return PK_OK;
 }
 
