@@ -26,6 +26,7 @@
 #include "grid_io.h"
 #include "io_util.h"
 #include "pbrt_tok.h"
+#include "pdict.h"
 #include "scene_build.h"
 
 #include <math.h>
@@ -62,7 +63,6 @@ typedef struct pparam {
     size_t nnum, cap_num;
     char **str;
     size_t nstr, cap_str;
-    bool used;
     bool from_attribute; /* a default of an Attribute directive */
 } pparam;
 
@@ -145,6 +145,7 @@ typedef struct pp {
     size_t line;         /* of the directive being carried out */
     const char *dname;   /* its name */
     plist pl;
+    pdict pd;            /* pl as a dictionary (pd_from_pbrt): what the directive used */
 
     gstate gs[SB_MAX_DEPTH];
     bool in_world;
@@ -231,6 +232,7 @@ static void plist_clear(pp *p)
 {
     for (size_t i = 0; i < p->pl.n; i++) param_free(p, &p->pl.p[i]);
     p->pl.n = 0;
+    pd_free(&p->pd);
 }
 
 /* A deep copy of q into out. */
@@ -247,6 +249,45 @@ static pk_status param_copy(pp *p, const pparam *q, pparam *out)
 nomem:
     param_free(p, out);
     return ctx_nomem(p->ctx);
+}
+
+/* The dictionary's messages: pbrt's, at the parameter's line. */
+static pk_status pd_pbrt_fail(void *self, const pdict *d, const pd_entry *e, long elem, pk_status st, const char *msg)
+{
+    (void)d, (void)elem;
+    pp *p = self;
+    return pfail(p, e ? e->line : p->line, st, "%s", msg);
+}
+static void pd_pbrt_unused(void *self, const pdict *d, const pd_entry *e)
+{
+    pwarn(self, e->line, "%s: parameter '%s %s' is not supported; ignored", d->what, e->type, e->name);
+}
+static const pd_source pbrt_source = {.fail = pd_pbrt_fail, .warn_unused = pd_pbrt_unused};
+
+/* The directive's parameter list (read_params, apply_defaults) as p->pd:
+ * one borrowed entry per parameter, in order, keeping its type name and
+ * line, node the parameter itself. The Attribute defaults are marked: they
+ * are not the directive's own, and what it does not use of them is no news.
+ * Rebuilt whenever the list changes (its array may move). */
+static pk_status pd_from_pbrt(pp *p)
+{
+    pd_free(&p->pd);
+    pd_init(&p->pd, p->ctx, &pbrt_source, p, NULL, false);
+    for (size_t i = 0; i < p->pl.n; i++) {
+        const pparam *q = &p->pl.p[i];
+        pd_entry e = {.name = q->name, .type = q->tname, .line = q->line, .node = q, .used = q->from_attribute};
+        if (q->type == PT_BOOL && q->nnum == 1) {
+            e.kind = PD_BOOL, e.b = q->num[0] != 0.0;
+        } else if (q->nstr) {
+            e.kind = q->nstr == 1 ? PD_STRING : PD_OTHER, e.str = q->str[0];
+        } else {
+            e.kind = q->nnum == 1 ? PD_NUMBER : PD_NUMBERS, e.num = q->nnum ? q->num[0] : 0.0;
+            e.nums = q->num, e.n = e.first_other = q->nnum;
+        }
+        pk_status st = pd_add(&p->pd, &e);
+        if (st) return st;
+    }
+    return PK_OK;
 }
 
 /* Drops the Attribute defaults of blocks deeper than depth. */
@@ -268,10 +309,9 @@ static pk_status apply_defaults(pp *p, attr_target target)
         if (!mem_grow(A(p), (void **)&p->pl.p, &p->pl.cap, p->pl.n + 1, sizeof *p->pl.p)) return ctx_nomem(p->ctx);
         pk_status st = param_copy(p, &d->prm, &p->pl.p[p->pl.n]);
         if (st) return st;
-        p->pl.p[p->pl.n].from_attribute = true;
-        p->pl.p[p->pl.n++].used = false;
+        p->pl.p[p->pl.n++].from_attribute = true;
     }
-    return PK_OK;
+    return pd_from_pbrt(p);
 }
 
 static bool is_stringish(ptype t) { return t == PT_STRING || t == PT_TEXTURE; }
@@ -332,7 +372,7 @@ static pk_status read_params(pp *p)
     plist_clear(p);
     for (;;) {
         pbrt_token tk = pbrt_tok_peek(t);
-        if (tk.kind != PBRT_TOK_STRING) return tk.kind == PBRT_TOK_ERROR ? tok_error(p, &tk) : PK_OK;
+        if (tk.kind != PBRT_TOK_STRING) return tk.kind == PBRT_TOK_ERROR ? tok_error(p, &tk) : pd_from_pbrt(p);
         pbrt_tok_next(t);
         char decl[160];
         pbrt_tok_string(&tk, decl, sizeof decl);
@@ -386,14 +426,11 @@ static pk_status read_params(pp *p)
     }
 }
 
+/* The parameter named name, marked used; NULL when there is none. */
 static pparam *param(pp *p, const char *name)
 {
-    for (size_t i = 0; i < p->pl.n; i++)
-        if (strcmp(p->pl.p[i].name, name) == 0) {
-            p->pl.p[i].used = true;
-            return &p->pl.p[i];
-        }
-    return NULL;
+    const pd_entry *e = pd_get(&p->pd, name);
+    return e ? (pparam *)e->node : NULL;
 }
 
 /* A parameter of one of the types (a bit mask of 1 << ptype); a present
@@ -467,14 +504,12 @@ static pk_status get_vec3(pp *p, const char *name, vec3 *v)
 }
 
 /* Warns about the parameters the directive did not use (pbrt refuses them;
- * a scene written for a later pbrt still renders here). */
+ * a scene written for a later pbrt still renders here). what: the
+ * directive, as the message names it. */
 static void warn_unused(pp *p, const char *what)
 {
-    for (size_t i = 0; i < p->pl.n; i++) {
-        pparam *q = &p->pl.p[i];
-        if (!q->used && !q->from_attribute)
-            pwarn(p, q->line, "%s: parameter '%s %s' is not supported; ignored", what, q->tname, q->name);
-    }
+    p->pd.what = what;
+    (void)pd_report_unused(&p->pd); /* read_params refuses duplicates: it cannot fail */
 }
 
 /* ---- colours and spectra ------------------------------------------------------------------ */
@@ -858,7 +893,7 @@ static pk_status build_material(pp *p, const char *type, material *m, bool *inte
         material_interface(m);
         *interface = true;
     } else if (strcmp(type, "measured") == 0 || strcmp(type, "hair") == 0 || strcmp(type, "subsurface") == 0) {
-        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        pd_mark_all(&p->pd);
         pwarn(p, p->line, "material \"%s\" is not supported; rendered as diffuse grey 0.5", type);
         material_diffuse(m, v3s(0.5f));
     } else {
@@ -1698,7 +1733,7 @@ static pk_status d_shape(pp *p, const char *type)
     if (st) return st;
     param(p, "emissionfilename");
     if (skip) {
-        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        pd_mark_all(&p->pd);
         return PK_OK;
     }
     if (strcmp(type, "trianglemesh") == 0) st = shape_trianglemesh(p, alpha);
@@ -1709,7 +1744,7 @@ static pk_status d_shape(pp *p, const char *type)
     else if (strcmp(type, "bilinearmesh") == 0) st = shape_bilinear(p, alpha);
     else if (strcmp(type, "loopsubdiv") == 0) st = shape_loopsubdiv(p, alpha);
     else if (strcmp(type, "curve") == 0) {
-        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        pd_mark_all(&p->pd);
         pwarn(p, p->line, "shape \"curve\" is not supported; skipped");
     } else {
         return pfail(p, p->line, PK_ERR_PARSE, "unknown shape \"%.40s\"", type);
@@ -1742,7 +1777,7 @@ static pk_status d_light(pp *p, const char *type)
     float scale = 1.0f, power = -1.0f;
     if ((st = get_float(p, "scale", &scale))) return st;
     if (p->b.in_object) {
-        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        pd_mark_all(&p->pd);
         pwarn(p, p->line, "a light inside an object definition is ignored (as pbrt-v4 does not allow it)");
         return PK_OK;
     }
@@ -1809,7 +1844,7 @@ static pk_status d_light(pp *p, const char *type)
             scene_env_add_radiance(p->s, v3_scale(L, scale));
         }
     } else if (strcmp(type, "goniometric") == 0 || strcmp(type, "projection") == 0) {
-        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        pd_mark_all(&p->pd);
         pwarn(p, p->line, "light \"%s\" is not supported; skipped", type);
     } else {
         return pfail(p, p->line, PK_ERR_PARSE, "unknown light \"%.40s\"", type);
@@ -1923,7 +1958,7 @@ static pk_status d_area_light(pp *p, const char *type)
 {
     pk_status st;
     if (strcmp(type, "diffuse") != 0) {
-        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        pd_mark_all(&p->pd);
         pwarn(p, p->line, "area light \"%.40s\" is not supported; the shapes do not emit", type);
         GS(p)->area = -1;
         return PK_OK;
@@ -2054,7 +2089,7 @@ static pk_status d_texture(pp *p, const char *name, const char *kind, const char
             if ((st = get_float_tex(p, "scale", &s, NULL))) return st;
             c = v3_scale(c, s);
         } else {
-            for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+            pd_mark_all(&p->pd);
             pwarn(p, p->line, "Texture \"%.60s\": \"%s\" is rendered as its first texture", name, cls);
         }
         t.value = c;
@@ -2064,7 +2099,7 @@ static pk_status d_texture(pp *p, const char *name, const char *kind, const char
         }
         us = 1.0f, vs = 1.0f, ud = 0.0f, vd = 0.0f; /* the inner texture's mapping stands */
     } else {
-        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        pd_mark_all(&p->pd);
         pwarn(p, p->line, "texture \"%.30s\" is not supported; \"%.60s\" is the constant 1", cls, name);
     }
     if (t.cls != TC_CONST && cls[0] != 's' && strcmp(cls, "mix") != 0 && strcmp(cls, "directionmix") != 0) {
@@ -2091,7 +2126,7 @@ static pk_status d_camera(pp *p, const char *type)
     else if (strcmp(type, "orthographic") == 0) p->ortho = true;
     else {
         pwarn(p, p->line, "camera \"%.40s\" is not supported; rendered as a perspective camera", type);
-        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        pd_mark_all(&p->pd);
     }
     p->fov = 90.0f;
     if ((st = get_float(p, "fov", &p->fov)) || (st = get_float(p, "lensradius", &p->lens_radius)) ||
@@ -2112,8 +2147,8 @@ static pk_status d_camera(pp *p, const char *type)
     if ((st = get_float(p, "shutteropen", &so)) || (st = get_float(p, "shutterclose", &sc))) return st;
     if (!(sc > so)) return pfail(p, p->line, PK_ERR_PARSE, "camera: 'shutterclose' must be after 'shutteropen'");
     p->exposure_time = sc - so;
-    static const char *const quiet[] = {"near", "far", "hither", "yon", NULL};
-    for (int i = 0; quiet[i]; i++) param(p, quiet[i]);
+    static const char *const quiet[] = {"near", "far", "hither", "yon"};
+    pd_declare(&p->pd, quiet, sizeof quiet / sizeof quiet[0]);
     xform inv;
     if (!xform_invert(sb_transform(&p->b), &inv))
         return pfail(p, p->line, PK_ERR_PARSE, "camera: the current transform is singular (no camera can be placed)");
@@ -2221,8 +2256,8 @@ static pk_status d_film(pp *p, const char *type)
               sensor);
     if (param(p, "whitebalance")) pwarn(p, p->line, "Film: white balance is not applied");
     /* the output file is named on the command line; the rest is the film's look */
-    static const char *const quiet[] = {"filename", "diagonal", "maxcomponentvalue", "savefp16", "writefp16", NULL};
-    for (int i = 0; quiet[i]; i++) param(p, quiet[i]);
+    static const char *const quiet[] = {"filename", "diagonal", "maxcomponentvalue", "savefp16", "writefp16"};
+    pd_declare(&p->pd, quiet, sizeof quiet / sizeof quiet[0]);
     warn_unused(p, "Film");
     return PK_OK;
 }
@@ -2242,8 +2277,8 @@ static pk_status d_sampler(pp *p, const char *type)
         p->s->render.opt.spp = (int)spp;
         p->s->render.has_spp = true;
     }
-    static const char *const quiet[] = {"seed", "randomization", "jitter", "xsamples", "ysamples", "dimensions", NULL};
-    for (int i = 0; quiet[i]; i++) param(p, quiet[i]);
+    static const char *const quiet[] = {"seed", "randomization", "jitter", "xsamples", "ysamples", "dimensions"};
+    pd_declare(&p->pd, quiet, sizeof quiet / sizeof quiet[0]);
     warn_unused(p, "Sampler");
     return PK_OK;
 }
@@ -2259,7 +2294,7 @@ static pk_status d_integrator(pp *p, const char *type)
     pk_status st;
     if ((st = get_int(p, "maxdepth", 0, INT32_MAX, &md)) || (st = get_bool(p, "regularize", &reg))) return st;
     if (!ok) {
-        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        pd_mark_all(&p->pd);
         pwarn(p, p->line, "integrator \"%.40s\" is not supported; rendered with the path tracer", type);
     } else if (strcmp(type, "simplevolpath") == 0) {
         pwarn(p, p->line, "integrator \"simplevolpath\" is rendered with the volumetric path tracer (volpath)");
@@ -2276,8 +2311,8 @@ static pk_status d_integrator(pp *p, const char *type)
     r->has_regularize = true;
     static const char *const quiet[] = {"lightsampler", "samplelights", "samplebsdf", "iterations", "photonsperiteration",
                                         "radius", "seed", "visualizestrategies", "visualizeweights", "mutationsperpixel",
-                                        "largestepprobability", "sigma", "bootstrapsamples", "chains", NULL};
-    for (int i = 0; quiet[i]; i++) param(p, quiet[i]);
+                                        "largestepprobability", "sigma", "bootstrapsamples", "chains"};
+    pd_declare(&p->pd, quiet, sizeof quiet / sizeof quiet[0]);
     warn_unused(p, "Integrator");
     return PK_OK;
 }
@@ -2326,9 +2361,7 @@ static pk_status medium_spectrum(pp *p, const char *what, const char *name, bool
 /* A medium's float parameter, which must lie in [lo, hi]. */
 static pk_status medium_float(pp *p, const char *what, const char *name, float lo, float hi, float *v)
 {
-    pparam *q = NULL;
-    for (size_t i = 0; i < p->pl.n && !q; i++)
-        if (strcmp(p->pl.p[i].name, name) == 0) q = &p->pl.p[i];
+    const pparam *q = param(p, name);
     pk_status st = get_float(p, name, v);
     if (st) return st;
     if (q && !(*v >= lo && *v <= hi))
@@ -3142,7 +3175,6 @@ static pk_status directive(pp *p, const pbrt_token *tk)
         if ((st = read_params(p))) return st;
         for (size_t i = 0; i < p->pl.n; i++) {
             pparam *q = &p->pl.p[i];
-            q->used = true;
             if (strcmp(q->name, "seed") == 0 && q->type == PT_INT && q->nnum == 1 && q->num[0] >= 0 &&
                 q->num[0] <= 2147483647.0) {
                 p->s->render.opt.seed = (int)q->num[0];
@@ -3230,7 +3262,7 @@ static pk_status directive(pp *p, const pbrt_token *tk)
     case 5: return d_sampler(p, a);
     case 6: return d_integrator(p, a);
     default:
-        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        pd_mark_all(&p->pd);
         return PK_OK; /* Paprsek's pixel filter is a box; its accelerator its own */
     }
 }
@@ -3274,6 +3306,7 @@ pk_status scene_pbrt_parse(pk_context *ctx, pk_scene *s, const char *data, size_
     if (!p) return ctx_nomem(ctx);
     p->ctx = ctx;
     p->s = s;
+    pd_init(&p->pd, ctx, &pbrt_source, p, NULL, false);
     sb_init(&p->b, ctx, s);
     p->gs[0].material = 0;
     p->gs[0].area = -1;
