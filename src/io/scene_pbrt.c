@@ -540,6 +540,20 @@ static vec3 coated_albedo(vec3 rho, float eta, float thickness, bool textured)
     return v3(c[0], c[1], c[2]);
 }
 
+/* The coat's layer (both coated materials): *thick, and an albedo, g,
+ * maxdepth and nsamples that are read (checked) but not rendered. */
+static pk_status coat_layer(pp *p, float *thick, vec3 *albedo)
+{
+    float g = 0.0f;
+    int64_t md = 10, ns = 1;
+    *thick = 0.01f, *albedo = v3s(0.0f);
+    pk_status st;
+    if ((st = get_float_tex(p, "thickness", thick, NULL)) || (st = get_colour(p, "albedo", albedo, NULL, NULL)) ||
+        (st = get_float_tex(p, "g", &g, NULL)) || (st = pb_int(&p->pd, "maxdepth", 0, 1 << 20, &md)))
+        return st;
+    return pb_int(&p->pd, "nsamples", 0, 1 << 20, &ns);
+}
+
 /* Fills m from a material's type and the current parameters. */
 static pk_status build_material(pp *p, const char *type, material *m, bool *interface, int depth)
 {
@@ -554,15 +568,10 @@ static pk_status build_material(pp *p, const char *type, material *m, bool *inte
         material_diffuse(m, kd);
         m->map_kd = tkd;
     } else if (strcmp(type, "coateddiffuse") == 0) {
+        float thick;
+        vec3 albedo;
         if ((st = get_colour(p, "reflectance", &kd, &tkd, NULL)) || (st = get_roughness(p, "", &alpha)) ||
-            (st = get_eta(p, "eta", 1.5f, &eta)))
-            return st;
-        float thick = 0.01f, g = 0.0f;
-        vec3 albedo = v3s(0.0f);
-        int64_t md = 10, ns = 1;
-        if ((st = get_float_tex(p, "thickness", &thick, NULL)) || (st = get_colour(p, "albedo", &albedo, NULL, NULL)) ||
-            (st = get_float_tex(p, "g", &g, NULL)) || (st = pb_int(&p->pd, "maxdepth", 0, 1 << 20, &md)) ||
-            (st = pb_int(&p->pd, "nsamples", 0, 1 << 20, &ns)))
+            (st = get_eta(p, "eta", 1.5f, &eta)) || (st = coat_layer(p, &thick, &albedo)))
             return st;
         if (v3_max_comp(albedo) > 0.0f)
             pwarn(p, p->line, "coateddiffuse: a scattering layer (albedo) is not rendered; the coat is clear");
@@ -573,16 +582,10 @@ static pk_status build_material(pp *p, const char *type, material *m, bool *inte
         if ((st = make_conductor(p, m, "", 0.0f))) return st;
     } else if (strcmp(type, "coatedconductor") == 0) {
         /* the base conductor alone, roughened by the coat (docs: an approximation) */
-        float ia;
+        float ia, thick;
+        vec3 albedo;
         if ((st = get_roughness(p, "interface.", &ia)) || (st = get_eta(p, "interface.eta", 1.5f, &eta)) ||
-            (st = make_conductor(p, m, "conductor.", ia)))
-            return st;
-        float thick = 0.01f, g = 0.0f;
-        vec3 albedo = v3s(0.0f);
-        int64_t md = 10, ns = 1;
-        if ((st = get_float_tex(p, "thickness", &thick, NULL)) || (st = get_colour(p, "albedo", &albedo, NULL, NULL)) ||
-            (st = get_float_tex(p, "g", &g, NULL)) || (st = pb_int(&p->pd, "maxdepth", 0, 1 << 20, &md)) ||
-            (st = pb_int(&p->pd, "nsamples", 0, 1 << 20, &ns)))
+            (st = make_conductor(p, m, "conductor.", ia)) || (st = coat_layer(p, &thick, &albedo)))
             return st;
         pwarn(p, p->line, "coatedconductor is approximated by its conductor under the coat's roughness (no clear "
                           "coat layer)");
