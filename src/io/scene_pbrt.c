@@ -307,8 +307,8 @@ static pk_status get_colour(pp *p, const char *name, vec3 *c, tex_ref *tex, bool
 {
     pparam *q;
     pk_status st = pb_typed(&p->pd, name,
-                               TB(PT_RGB) | TB(PT_SPECTRUM) | TB(PT_BLACKBODY) | TB(PT_TEXTURE) | TB(PT_FLOAT),
-                               "a colour (rgb, spectrum, blackbody, float or texture)", &q);
+                            TB(PT_RGB) | TB(PT_SPECTRUM) | TB(PT_BLACKBODY) | TB(PT_TEXTURE) | TB(PT_FLOAT),
+                            "a colour (rgb, spectrum, blackbody, float or texture)", &q);
     if (found) *found = q != NULL;
     if (st || !q) return st;
     if (q->type != PT_TEXTURE) return spectrum_rgb(p, q, false, c);
@@ -336,7 +336,7 @@ static pk_status get_float_tex(pp *p, const char *name, float *v, bool *found)
 {
     pparam *q;
     pk_status st = pb_typed(&p->pd, name, TB(PT_FLOAT) | TB(PT_TEXTURE) | TB(PT_SPECTRUM) | TB(PT_RGB),
-                               "a float or a float texture", &q);
+                            "a float or a float texture", &q);
     if (found) *found = q != NULL;
     if (st || !q) return st;
     if (q->type == PT_FLOAT) {
@@ -2086,7 +2086,7 @@ static pk_status medium_spectrum(pp *p, const char *what, const char *name, bool
 {
     pparam *q;
     pk_status st = pb_typed(&p->pd, name, TB(PT_RGB) | TB(PT_SPECTRUM) | TB(PT_BLACKBODY) | TB(PT_FLOAT),
-                               "a spectrum (rgb, spectrum, blackbody or float)", &q);
+                            "a spectrum (rgb, spectrum, blackbody or float)", &q);
     if (st || !q) return st;
     if (q->type == PT_RGB && q->nnum != 3)
         return pfail(p, q->line, PK_ERR_PARSE, "%s: 'rgb %s' takes 3 values, not %zu", what, name, q->nnum);
