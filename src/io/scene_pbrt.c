@@ -232,10 +232,17 @@ static pk_status apply_defaults(pp *p, attr_target target)
 }
 
 /* Warns about the parameters the directive did not use (pbrt refuses them;
- * a scene written for a later pbrt still renders here). what: the
- * directive, as the message names it. */
-static void warn_unused(pp *p, const char *what)
+ * a scene written for a later pbrt still renders here). fmt...: the
+ * directive, as the message names it (the dictionary's what, read only
+ * while it reports). */
+static void warn_unused(pp *p, const char *fmt, ...) PK_PRINTF(2, 3);
+static void warn_unused(pp *p, const char *fmt, ...)
 {
+    char what[96];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(what, sizeof what, fmt, ap);
+    va_end(ap);
     p->pd.what = what;
     (void)pd_report_unused(&p->pd); /* read_params refuses duplicates: it cannot fail */
 }
@@ -1482,11 +1489,7 @@ static pk_status d_shape(pp *p, const char *type)
     } else {
         return pfail(p, p->line, PK_ERR_PARSE, "unknown shape \"%.40s\"", type);
     }
-    if (st == PK_OK) {
-        char what[64];
-        snprintf(what, sizeof what, "Shape \"%.40s\"", type);
-        warn_unused(p, what);
-    }
+    if (st == PK_OK) warn_unused(p, "Shape \"%.40s\"", type);
     return st;
 }
 
@@ -1585,9 +1588,7 @@ static pk_status d_light(pp *p, const char *type)
     } else {
         return pfail(p, p->line, PK_ERR_PARSE, "unknown light \"%.40s\"", type);
     }
-    char what[64];
-    snprintf(what, sizeof what, "LightSource \"%.40s\"", type);
-    warn_unused(p, what);
+    warn_unused(p, "LightSource \"%.40s\"", type);
     return PK_OK;
 }
 
@@ -1847,9 +1848,7 @@ static pk_status d_texture(pp *p, const char *name, const char *kind, const char
     t.name = mem_strdup(A(p), name);
     if (!t.name) return ctx_nomem(p->ctx);
     p->tex[p->ntex++] = t;
-    char what[96];
-    snprintf(what, sizeof what, "Texture \"%.30s\"", cls);
-    warn_unused(p, what);
+    warn_unused(p, "Texture \"%.30s\"", cls);
     return PK_OK;
 }
 
@@ -2533,9 +2532,7 @@ static pk_status d_medium(pp *p, const char *name)
     }
     uint32_t idx;
     if ((st = scene_add_medium(p->ctx, p->s, &m, &idx))) return st;
-    char w2[64];
-    snprintf(w2, sizeof w2, "medium \"%.40s\"", type);
-    warn_unused(p, w2);
+    warn_unused(p, "medium \"%.40s\"", type);
     return PK_OK;
 }
 
@@ -2963,9 +2960,7 @@ static pk_status directive(pp *p, const pbrt_token *tk)
         if (!type) return pfail(p, p->line, PK_ERR_PARSE, "MakeNamedMaterial \"%.80s\" needs 'string type'", a);
         uint32_t idx;
         if ((st = new_material(p, a, type, &idx))) return st;
-        char what[96];
-        snprintf(what, sizeof what, "material \"%.40s\"", type);
-        warn_unused(p, what);
+        warn_unused(p, "material \"%.40s\"", type);
         return PK_OK;
     }
     if (strcmp(dn, "Material") == 0) {
@@ -2976,9 +2971,7 @@ static pk_status directive(pp *p, const pbrt_token *tk)
         if ((st = new_material(p, nm, a, &idx))) return st;
         GS(p)->material = idx;
         GS(p)->interface = mat_is_interface(p, idx);
-        char what[96];
-        snprintf(what, sizeof what, "material \"%.40s\"", a);
-        warn_unused(p, what);
+        warn_unused(p, "material \"%.40s\"", a);
         return PK_OK;
     }
     /* the rest: a type name and parameters */
