@@ -101,6 +101,11 @@ void pd_clear_marks(pdict *d)
     for (size_t i = 0; i < d->n; i++) d->e[i].used = false;
 }
 
+void pd_mark_all(pdict *d)
+{
+    for (size_t i = 0; i < d->n; i++) d->e[i].used = true;
+}
+
 const pd_entry *pd_get(pdict *d, const char *name)
 {
     for (size_t i = 0; i < d->n; i++)

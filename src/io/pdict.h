@@ -44,7 +44,9 @@ typedef struct pd_entry {
     size_t n, first_other;
     const char *str;
     const void *node;   /* the front end's own node (a cJSON item), for locations */
-    const char *tag;    /* the front end's type of the value where it has one (Mitsuba's <float>, <rgb>, <ref>) */
+    const char *type;   /* the front end's type of the value or NULL, never copied: pbrt's "rgb", "float";
+                           Mitsuba's element, <float>, <rgb>, <ref> */
+    size_t line;        /* where the front end read it (0: unknown) */
 } pd_entry;
 
 typedef struct pdict pdict;
@@ -96,6 +98,9 @@ PK_HIDDEN pk_status pd_add(pdict *d, const pd_entry *e);
 PK_HIDDEN pk_status pd_set(pdict *d, const pd_entry *e);
 /* Every entry unmarked again (a dictionary used for a second thing). */
 PK_HIDDEN void pd_clear_marks(pdict *d);
+/* Every entry marked: a thing that takes whatever it is given (an
+ * unsupported type, rendered as a stand-in, warns once for all). */
+PK_HIDDEN void pd_mark_all(pdict *d);
 
 /* The first entry named name, marked; NULL when there is none. */
 PK_HIDDEN const pd_entry *pd_get(pdict *d, const char *name);

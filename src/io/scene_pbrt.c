@@ -25,7 +25,7 @@
 #include "../scene/spectra.h"
 #include "grid_io.h"
 #include "io_util.h"
-#include "pbrt_tok.h"
+#include "pbrt_param.h"
 #include "scene_build.h"
 
 #include <math.h>
@@ -36,40 +36,6 @@
 #define PB_MAX_INCLUDE_DEPTH 16
 #define PB_NAME_MAX 256
 #define PB_MAX_SUBDIV_TRIS (1u << 24) /* triangles one loopsubdiv shape may make */
-
-/* ---- parameters -------------------------------------------------------------------- */
-
-typedef enum ptype {
-    PT_INT, PT_FLOAT, PT_POINT2, PT_VECTOR2, PT_POINT3, PT_VECTOR3, PT_NORMAL, PT_RGB, PT_SPECTRUM,
-    PT_BLACKBODY, PT_STRING, PT_TEXTURE, PT_BOOL
-} ptype;
-
-static const struct {
-    const char *name;
-    ptype type;
-} ptype_names[] = {{"integer", PT_INT},    {"float", PT_FLOAT},     {"point2", PT_POINT2},   {"vector2", PT_VECTOR2},
-                   {"point3", PT_POINT3},  {"point", PT_POINT3},    {"vector3", PT_VECTOR3}, {"vector", PT_VECTOR3},
-                   {"normal", PT_NORMAL},  {"normal3", PT_NORMAL},  {"rgb", PT_RGB},         {"color", PT_RGB},
-                   {"spectrum", PT_SPECTRUM}, {"blackbody", PT_BLACKBODY}, {"string", PT_STRING},
-                   {"texture", PT_TEXTURE}, {"bool", PT_BOOL}};
-
-typedef struct pparam {
-    ptype type;
-    char tname[16];
-    char name[64];
-    size_t line;
-    double *num;
-    size_t nnum, cap_num;
-    char **str;
-    size_t nstr, cap_str;
-    bool used;
-    bool from_attribute; /* a default of an Attribute directive */
-} pparam;
-
-typedef struct plist {
-    pparam *p;
-    size_t n, cap;
-} plist;
 
 /* ---- the reader's state ------------------------------------------------------------ */
 
@@ -145,6 +111,7 @@ typedef struct pp {
     size_t line;         /* of the directive being carried out */
     const char *dname;   /* its name */
     plist pl;
+    pdict pd;            /* pl as a dictionary (pd_from_pbrt): what the directive used */
 
     gstate gs[SB_MAX_DEPTH];
     bool in_world;
@@ -219,40 +186,31 @@ static gstate *GS(pp *p) { return &p->gs[p->b.depth]; }
 
 /* ---- parameter lists ------------------------------------------------------------------ */
 
-static void param_free(pp *p, pparam *q)
+static pk_status tok_error(pp *p, const pbrt_token *tk)
 {
-    mem_free(A(p), q->num);
-    for (size_t k = 0; k < q->nstr; k++) mem_free(A(p), q->str[k]);
-    mem_free(A(p), q->str);
-    q->num = NULL, q->str = NULL, q->nnum = q->nstr = 0;
+    return pfail(p, tk->line, PK_ERR_PARSE, "%s", p->f->tok.why);
 }
 
-static void plist_clear(pp *p)
-{
-    for (size_t i = 0; i < p->pl.n; i++) param_free(p, &p->pl.p[i]);
-    p->pl.n = 0;
-}
+static void plist_clear(pp *p) { pb_list_clear(&p->pd, &p->pl); }
+static pk_status read_params(pp *p) { return pb_read_params(&p->pd, &p->pl, &p->f->tok); }
 
-/* A deep copy of q into out. */
-static pk_status param_copy(pp *p, const pparam *q, pparam *out)
+/* The dictionary's messages: pbrt's, at the parameter's line. */
+static pk_status pd_pbrt_fail(void *self, const pdict *d, const pd_entry *e, long elem, pk_status st, const char *msg)
 {
-    *out = *q;
-    out->num = NULL, out->str = NULL, out->cap_num = q->nnum, out->cap_str = q->nstr;
-    if (q->nnum && !(out->num = mem_calloc(A(p), q->nnum, sizeof *q->num))) goto nomem;
-    if (q->nnum) memcpy(out->num, q->num, q->nnum * sizeof *q->num);
-    if (q->nstr && !(out->str = mem_calloc(A(p), q->nstr, sizeof *q->str))) goto nomem;
-    for (size_t k = 0; k < q->nstr; k++)
-        if (!(out->str[k] = mem_strdup(A(p), q->str[k]))) goto nomem;
-    return PK_OK;
-nomem:
-    param_free(p, out);
-    return ctx_nomem(p->ctx);
+    (void)d, (void)elem;
+    pp *p = self;
+    return pfail(p, e ? e->line : p->line, st, "%s", msg);
 }
+static void pd_pbrt_unused(void *self, const pdict *d, const pd_entry *e)
+{
+    pwarn(self, e->line, "%s: parameter '%s %s' is not supported; ignored", d->what, e->type, e->name);
+}
+static const pd_source pbrt_source = {.fail = pd_pbrt_fail, .warn_unused = pd_pbrt_unused};
 
 /* Drops the Attribute defaults of blocks deeper than depth. */
 static void defs_pop(pp *p, int depth)
 {
-    while (p->ndefs && p->defs[p->ndefs - 1].depth > depth) param_free(p, &p->defs[--p->ndefs].prm);
+    while (p->ndefs && p->defs[p->ndefs - 1].depth > depth) pb_param_free(A(p), &p->defs[--p->ndefs].prm);
 }
 
 /* Appends the Attribute defaults of target that the directive did not give
@@ -266,222 +224,34 @@ static pk_status apply_defaults(pp *p, attr_target target)
         for (size_t k = 0; k < p->pl.n && !given; k++) given = strcmp(p->pl.p[k].name, d->prm.name) == 0;
         if (given) continue;
         if (!mem_grow(A(p), (void **)&p->pl.p, &p->pl.cap, p->pl.n + 1, sizeof *p->pl.p)) return ctx_nomem(p->ctx);
-        pk_status st = param_copy(p, &d->prm, &p->pl.p[p->pl.n]);
+        pk_status st = pb_param_copy(p->ctx, &d->prm, &p->pl.p[p->pl.n]);
         if (st) return st;
-        p->pl.p[p->pl.n].from_attribute = true;
-        p->pl.p[p->pl.n++].used = false;
+        p->pl.p[p->pl.n++].from_attribute = true;
     }
-    return PK_OK;
-}
-
-static bool is_stringish(ptype t) { return t == PT_STRING || t == PT_TEXTURE; }
-
-static pk_status push_num(pp *p, pparam *q, double v)
-{
-    if (!mem_grow(A(p), (void **)&q->num, &q->cap_num, q->nnum + 1, sizeof *q->num)) return ctx_nomem(p->ctx);
-    q->num[q->nnum++] = v;
-    return PK_OK;
-}
-
-static pk_status push_str(pp *p, pparam *q, const pbrt_token *tk)
-{
-    if (!mem_grow(A(p), (void **)&q->str, &q->cap_str, q->nstr + 1, sizeof *q->str)) return ctx_nomem(p->ctx);
-    char *s = mem_alloc(A(p), tk->len + 1);
-    if (!s) return ctx_nomem(p->ctx);
-    pbrt_tok_string(tk, s, tk->len + 1);
-    q->str[q->nstr++] = s;
-    return PK_OK;
-}
-
-static pk_status tok_error(pp *p, const pbrt_token *tk)
-{
-    return pfail(p, tk->line, PK_ERR_PARSE, "%s", p->f->tok.why);
-}
-
-/* One value token of parameter q. */
-static pk_status param_value(pp *p, pparam *q, const pbrt_token *tk)
-{
-    if (tk->kind == PBRT_TOK_ERROR) return tok_error(p, tk);
-    if (q->type == PT_BOOL) {
-        if (pbrt_tok_is(tk, "true")) return push_num(p, q, 1.0);
-        if (pbrt_tok_is(tk, "false")) return push_num(p, q, 0.0);
-        return pfail(p, tk->line, PK_ERR_PARSE, "'bool %s' takes true or false, not '%.*s'", q->name,
-                     io_tok_len(tk->text, tk->text + tk->len), tk->text);
-    }
-    if (tk->kind == PBRT_TOK_NUMBER && !is_stringish(q->type)) {
-        if (q->type == PT_INT && !tk->integer)
-            return pfail(p, tk->line, PK_ERR_PARSE, "'integer %s' takes integers, not '%.*s'", q->name,
-                         io_tok_len(tk->text, tk->text + tk->len), tk->text);
-        if (!isfinite(tk->number))
-            return pfail(p, tk->line, PK_ERR_PARSE, "'%s %s': number '%.*s' is not finite", q->tname, q->name,
-                         io_tok_len(tk->text, tk->text + tk->len), tk->text);
-        return push_num(p, q, tk->number);
-    }
-    if (tk->kind == PBRT_TOK_STRING && (is_stringish(q->type) || q->type == PT_SPECTRUM)) return push_str(p, q, tk);
-    const char *want = is_stringish(q->type) ? "strings" : q->type == PT_SPECTRUM ? "numbers or a name" : "numbers";
-    return pfail(p, tk->line, PK_ERR_PARSE, "'%s %s' takes %s, not '%.*s'", q->tname, q->name, want,
-                 io_tok_len(tk->text, tk->text + tk->len), tk->text);
-}
-
-/* The parameter list that follows a directive's arguments: "type name"
- * followed by one value or a bracketed list of values. */
-static pk_status read_params(pp *p)
-{
-    pbrt_tokenizer *t = &p->f->tok;
-    pk_status st;
-    plist_clear(p);
-    for (;;) {
-        pbrt_token tk = pbrt_tok_peek(t);
-        if (tk.kind != PBRT_TOK_STRING) return tk.kind == PBRT_TOK_ERROR ? tok_error(p, &tk) : PK_OK;
-        pbrt_tok_next(t);
-        char decl[160];
-        pbrt_tok_string(&tk, decl, sizeof decl);
-        char tn[32] = "", nm[96] = "", extra[8] = "";
-        int got = sscanf(decl, "%31s %95s %7s", tn, nm, extra);
-        if (got != 2)
-            return pfail(p, tk.line, PK_ERR_PARSE, "expected a parameter \"type name\", found \"%.*s\"",
-                         io_tok_len(tk.text, tk.text + tk.len), tk.text);
-        int type = -1;
-        for (size_t i = 0; i < sizeof ptype_names / sizeof ptype_names[0]; i++)
-            if (strcmp(tn, ptype_names[i].name) == 0) type = (int)ptype_names[i].type;
-        if (type < 0) return pfail(p, tk.line, PK_ERR_PARSE, "unknown parameter type '%s' (in \"%s\")", tn, decl);
-        if (strlen(nm) >= sizeof p->pl.p[0].name)
-            return pfail(p, tk.line, PK_ERR_PARSE, "parameter name '%.40s...' is too long", nm);
-        for (size_t i = 0; i < p->pl.n; i++)
-            if (strcmp(p->pl.p[i].name, nm) == 0)
-                return pfail(p, tk.line, PK_ERR_PARSE, "parameter '%s' is given twice", nm);
-        if (!mem_grow(A(p), (void **)&p->pl.p, &p->pl.cap, p->pl.n + 1, sizeof *p->pl.p)) return ctx_nomem(p->ctx);
-        pparam *q = &p->pl.p[p->pl.n++];
-        memset(q, 0, sizeof *q);
-        q->type = (ptype)type;
-        snprintf(q->tname, sizeof q->tname, "%s", tn);
-        snprintf(q->name, sizeof q->name, "%s", nm);
-        q->line = tk.line;
-        pbrt_token v = pbrt_tok_next(t);
-        if (v.kind == PBRT_TOK_LBRACK) {
-            for (;;) {
-                v = pbrt_tok_next(t);
-                if (v.kind == PBRT_TOK_RBRACK) break;
-                if (v.kind == PBRT_TOK_END)
-                    return pfail(p, q->line, PK_ERR_PARSE, "'%s %s': the list has no closing ']'", tn, nm);
-                if ((st = param_value(p, q, &v))) return st;
-            }
-        } else if (v.kind == PBRT_TOK_END) {
-            return pfail(p, q->line, PK_ERR_PARSE, "'%s %s' has no value", tn, nm);
-        } else if ((st = param_value(p, q, &v))) {
-            return st;
-        }
-        /* counts */
-        size_t n = q->nnum + q->nstr, per = 1;
-        if (q->type == PT_POINT2 || q->type == PT_VECTOR2) per = 2;
-        if (q->type == PT_POINT3 || q->type == PT_VECTOR3 || q->type == PT_NORMAL || q->type == PT_RGB) per = 3;
-        if (n == 0) return pfail(p, q->line, PK_ERR_PARSE, "'%s %s' has no value", tn, nm);
-        if (n % per)
-            return pfail(p, q->line, PK_ERR_PARSE, "'%s %s' has %zu values, not a multiple of %zu", tn, nm, n, per);
-        if (q->type == PT_SPECTRUM && q->nnum && (q->nstr || q->nnum % 2))
-            return pfail(p, q->line, PK_ERR_PARSE,
-                         "'spectrum %s' takes (wavelength, value) pairs or one name, not %zu values", nm, n);
-        if (q->type == PT_SPECTRUM && q->nstr > 1)
-            return pfail(p, q->line, PK_ERR_PARSE, "'spectrum %s' takes one name", nm);
-    }
-}
-
-static pparam *param(pp *p, const char *name)
-{
-    for (size_t i = 0; i < p->pl.n; i++)
-        if (strcmp(p->pl.p[i].name, name) == 0) {
-            p->pl.p[i].used = true;
-            return &p->pl.p[i];
-        }
-    return NULL;
-}
-
-/* A parameter of one of the types (a bit mask of 1 << ptype); a present
- * parameter of another type is an error. */
-static pk_status param_typed(pp *p, const char *name, unsigned types, const char *want, pparam **out)
-{
-    pparam *q = param(p, name);
-    *out = NULL;
-    if (!q) return PK_OK;
-    if (!(types & (1u << q->type)))
-        return pfail(p, q->line, PK_ERR_PARSE, "parameter '%s %s' should be %s", q->tname, q->name, want);
-    *out = q;
-    return PK_OK;
-}
-
-#define TB(t) (1u << (t))
-
-static pk_status get_float(pp *p, const char *name, float *v)
-{
-    pparam *q;
-    pk_status st = param_typed(p, name, TB(PT_FLOAT) | TB(PT_INT), "a float", &q);
-    if (st || !q) return st;
-    if (q->nnum != 1) return pfail(p, q->line, PK_ERR_PARSE, "'%s %s' takes one value, not %zu", q->tname, name, q->nnum);
-    *v = (float)q->num[0];
-    if (!isfinite(*v)) return pfail(p, q->line, PK_ERR_PARSE, "'%s %s' is not a finite float", q->tname, name);
-    return PK_OK;
-}
-
-static pk_status get_int(pp *p, const char *name, int64_t lo, int64_t hi, int64_t *v)
-{
-    pparam *q;
-    pk_status st = param_typed(p, name, TB(PT_INT), "an integer", &q);
-    if (st || !q) return st;
-    if (q->nnum != 1) return pfail(p, q->line, PK_ERR_PARSE, "'integer %s' takes one value, not %zu", name, q->nnum);
-    if (q->num[0] < (double)lo || q->num[0] > (double)hi)
-        return pfail(p, q->line, PK_ERR_PARSE, "'integer %s' %.0f is outside %lld..%lld", name, q->num[0],
-                     (long long)lo, (long long)hi);
-    *v = (int64_t)q->num[0];
-    return PK_OK;
-}
-
-static pk_status get_bool(pp *p, const char *name, bool *v)
-{
-    pparam *q;
-    pk_status st = param_typed(p, name, TB(PT_BOOL), "a bool", &q);
-    if (st || !q) return st;
-    if (q->nnum != 1) return pfail(p, q->line, PK_ERR_PARSE, "'bool %s' takes one value, not %zu", name, q->nnum);
-    *v = q->num[0] != 0.0;
-    return PK_OK;
-}
-
-static pk_status get_string(pp *p, const char *name, const char **v)
-{
-    pparam *q;
-    pk_status st = param_typed(p, name, TB(PT_STRING), "a string", &q);
-    if (st || !q) return st;
-    if (q->nstr != 1) return pfail(p, q->line, PK_ERR_PARSE, "'string %s' takes one value, not %zu", name, q->nstr);
-    *v = q->str[0];
-    return PK_OK;
-}
-
-static pk_status get_vec3(pp *p, const char *name, vec3 *v)
-{
-    pparam *q;
-    pk_status st = param_typed(p, name, TB(PT_POINT3) | TB(PT_VECTOR3) | TB(PT_NORMAL) | TB(PT_RGB), "3 numbers", &q);
-    if (st || !q) return st;
-    if (q->nnum != 3) return pfail(p, q->line, PK_ERR_PARSE, "'%s %s' takes 3 values, not %zu", q->tname, name, q->nnum);
-    *v = v3((float)q->num[0], (float)q->num[1], (float)q->num[2]);
-    if (!v3_finite(*v)) return pfail(p, q->line, PK_ERR_PARSE, "'%s %s' is not finite in float", q->tname, name);
-    return PK_OK;
+    return pd_from_pbrt(&p->pd, &p->pl);
 }
 
 /* Warns about the parameters the directive did not use (pbrt refuses them;
- * a scene written for a later pbrt still renders here). */
-static void warn_unused(pp *p, const char *what)
+ * a scene written for a later pbrt still renders here). fmt...: the
+ * directive, as the message names it (the dictionary's what, read only
+ * while it reports). */
+static void warn_unused(pp *p, const char *fmt, ...) PK_PRINTF(2, 3);
+static void warn_unused(pp *p, const char *fmt, ...)
 {
-    for (size_t i = 0; i < p->pl.n; i++) {
-        pparam *q = &p->pl.p[i];
-        if (!q->used && !q->from_attribute)
-            pwarn(p, q->line, "%s: parameter '%s %s' is not supported; ignored", what, q->tname, q->name);
-    }
+    char what[96];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(what, sizeof what, fmt, ap);
+    va_end(ap);
+    p->pd.what = what;
+    (void)pd_report_unused(&p->pd); /* read_params refuses duplicates: it cannot fail */
 }
 
 /* ---- colours and spectra ------------------------------------------------------------------ */
 
 /* A spectrum parameter as linear RGB. illuminant: the light's rule (a
  * blackbody or a standard illuminant at luminance 1). */
-static pk_status spectrum_rgb(pp *p, pparam *q, bool illuminant, vec3 *out)
+static pk_status spectrum_rgb(pp *p, const pparam *q, bool illuminant, vec3 *out)
 {
     if (q->type == PT_RGB) {
         *out = v3((float)q->num[0], (float)q->num[1], (float)q->num[2]);
@@ -543,9 +313,9 @@ static named_tex *find_tex(pp *p, const char *name)
 static pk_status get_colour(pp *p, const char *name, vec3 *c, tex_ref *tex, bool *found)
 {
     pparam *q;
-    pk_status st = param_typed(p, name,
-                               TB(PT_RGB) | TB(PT_SPECTRUM) | TB(PT_BLACKBODY) | TB(PT_TEXTURE) | TB(PT_FLOAT),
-                               "a colour (rgb, spectrum, blackbody, float or texture)", &q);
+    pk_status st = pb_typed(&p->pd, name,
+                            TB(PT_RGB) | TB(PT_SPECTRUM) | TB(PT_BLACKBODY) | TB(PT_TEXTURE) | TB(PT_FLOAT),
+                            "a colour (rgb, spectrum, blackbody, float or texture)", &q);
     if (found) *found = q != NULL;
     if (st || !q) return st;
     if (q->type != PT_TEXTURE) return spectrum_rgb(p, q, false, c);
@@ -572,8 +342,8 @@ static pk_status get_colour(pp *p, const char *name, vec3 *c, tex_ref *tex, bool
 static pk_status get_float_tex(pp *p, const char *name, float *v, bool *found)
 {
     pparam *q;
-    pk_status st = param_typed(p, name, TB(PT_FLOAT) | TB(PT_TEXTURE) | TB(PT_SPECTRUM) | TB(PT_RGB),
-                               "a float or a float texture", &q);
+    pk_status st = pb_typed(&p->pd, name, TB(PT_FLOAT) | TB(PT_TEXTURE) | TB(PT_SPECTRUM) | TB(PT_RGB),
+                            "a float or a float texture", &q);
     if (found) *found = q != NULL;
     if (st || !q) return st;
     if (q->type == PT_FLOAT) {
@@ -668,7 +438,7 @@ static pk_status get_roughness(pp *p, const char *prefix, float *alpha)
     bool remap = true, fu, fv;
     pk_status st;
     if ((st = get_float_tex(p, n1, &r, NULL)) || (st = get_float_tex(p, n2, &u, &fu)) ||
-        (st = get_float_tex(p, n3, &v, &fv)) || (st = get_bool(p, n4, &remap)))
+        (st = get_float_tex(p, n3, &v, &fv)) || (st = pb_bool(&p->pd, n4, &remap)))
         return st;
     if (fu || fv) {
         if (!fu) u = r;
@@ -777,6 +547,20 @@ static vec3 coated_albedo(vec3 rho, float eta, float thickness, bool textured)
     return v3(c[0], c[1], c[2]);
 }
 
+/* The coat's layer (both coated materials): *thick, and an albedo, g,
+ * maxdepth and nsamples that are read (checked) but not rendered. */
+static pk_status coat_layer(pp *p, float *thick, vec3 *albedo)
+{
+    float g = 0.0f;
+    int64_t md = 10, ns = 1;
+    *thick = 0.01f, *albedo = v3s(0.0f);
+    pk_status st;
+    if ((st = get_float_tex(p, "thickness", thick, NULL)) || (st = get_colour(p, "albedo", albedo, NULL, NULL)) ||
+        (st = get_float_tex(p, "g", &g, NULL)) || (st = pb_int(&p->pd, "maxdepth", 0, 1 << 20, &md)))
+        return st;
+    return pb_int(&p->pd, "nsamples", 0, 1 << 20, &ns);
+}
+
 /* Fills m from a material's type and the current parameters. */
 static pk_status build_material(pp *p, const char *type, material *m, bool *interface, int depth)
 {
@@ -791,15 +575,10 @@ static pk_status build_material(pp *p, const char *type, material *m, bool *inte
         material_diffuse(m, kd);
         m->map_kd = tkd;
     } else if (strcmp(type, "coateddiffuse") == 0) {
+        float thick;
+        vec3 albedo;
         if ((st = get_colour(p, "reflectance", &kd, &tkd, NULL)) || (st = get_roughness(p, "", &alpha)) ||
-            (st = get_eta(p, "eta", 1.5f, &eta)))
-            return st;
-        float thick = 0.01f, g = 0.0f;
-        vec3 albedo = v3s(0.0f);
-        int64_t md = 10, ns = 1;
-        if ((st = get_float_tex(p, "thickness", &thick, NULL)) || (st = get_colour(p, "albedo", &albedo, NULL, NULL)) ||
-            (st = get_float_tex(p, "g", &g, NULL)) || (st = get_int(p, "maxdepth", 0, 1 << 20, &md)) ||
-            (st = get_int(p, "nsamples", 0, 1 << 20, &ns)))
+            (st = get_eta(p, "eta", 1.5f, &eta)) || (st = coat_layer(p, &thick, &albedo)))
             return st;
         if (v3_max_comp(albedo) > 0.0f)
             pwarn(p, p->line, "coateddiffuse: a scattering layer (albedo) is not rendered; the coat is clear");
@@ -810,16 +589,10 @@ static pk_status build_material(pp *p, const char *type, material *m, bool *inte
         if ((st = make_conductor(p, m, "", 0.0f))) return st;
     } else if (strcmp(type, "coatedconductor") == 0) {
         /* the base conductor alone, roughened by the coat (docs: an approximation) */
-        float ia;
+        float ia, thick;
+        vec3 albedo;
         if ((st = get_roughness(p, "interface.", &ia)) || (st = get_eta(p, "interface.eta", 1.5f, &eta)) ||
-            (st = make_conductor(p, m, "conductor.", ia)))
-            return st;
-        float thick = 0.01f, g = 0.0f;
-        vec3 albedo = v3s(0.0f);
-        int64_t md = 10, ns = 1;
-        if ((st = get_float_tex(p, "thickness", &thick, NULL)) || (st = get_colour(p, "albedo", &albedo, NULL, NULL)) ||
-            (st = get_float_tex(p, "g", &g, NULL)) || (st = get_int(p, "maxdepth", 0, 1 << 20, &md)) ||
-            (st = get_int(p, "nsamples", 0, 1 << 20, &ns)))
+            (st = make_conductor(p, m, "conductor.", ia)) || (st = coat_layer(p, &thick, &albedo)))
             return st;
         pwarn(p, p->line, "coatedconductor is approximated by its conductor under the coat's roughness (no clear "
                           "coat layer)");
@@ -832,8 +605,8 @@ static pk_status build_material(pp *p, const char *type, material *m, bool *inte
         vec3 tr = v3s(0.25f);
         float sc = 1.0f;
         kd = v3s(0.25f);
-        if ((st = get_colour(p, "reflectance", &kd, &tkd, NULL)) || (st = get_colour(p, "transmittance", &tr, NULL, NULL)) ||
-            (st = get_float(p, "scale", &sc)))
+        if ((st = get_colour(p, "reflectance", &kd, &tkd, NULL)) ||
+            (st = get_colour(p, "transmittance", &tr, NULL, NULL)) || (st = pb_float(&p->pd, "scale", &sc)))
             return st;
         pwarn(p, p->line, "diffusetransmission: the transmitted part is not rendered; a diffuse reflector of the "
                           "reflectance");
@@ -841,7 +614,7 @@ static pk_status build_material(pp *p, const char *type, material *m, bool *inte
         m->map_kd = tkd;
     } else if (strcmp(type, "mix") == 0) {
         pparam *q;
-        if ((st = param_typed(p, "materials", TB(PT_STRING), "two material names", &q))) return st;
+        if ((st = pb_typed(&p->pd, "materials", TB(PT_STRING), "two material names", &q))) return st;
         if (!q || q->nstr != 2) return pfail(p, p->line, PK_ERR_PARSE, "mix needs 'string materials' with two names");
         float amount = 0.5f;
         if ((st = get_float_tex(p, "amount", &amount, NULL))) return st;
@@ -858,7 +631,7 @@ static pk_status build_material(pp *p, const char *type, material *m, bool *inte
         material_interface(m);
         *interface = true;
     } else if (strcmp(type, "measured") == 0 || strcmp(type, "hair") == 0 || strcmp(type, "subsurface") == 0) {
-        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        pd_mark_all(&p->pd);
         pwarn(p, p->line, "material \"%s\" is not supported; rendered as diffuse grey 0.5", type);
         material_diffuse(m, v3s(0.5f));
     } else {
@@ -866,7 +639,7 @@ static pk_status build_material(pp *p, const char *type, material *m, bool *inte
     }
     /* shared parameters */
     pparam *q;
-    if ((st = param_typed(p, "normalmap", TB(PT_STRING), "a file name", &q))) return st;
+    if ((st = pb_typed(&p->pd, "normalmap", TB(PT_STRING), "a file name", &q))) return st;
     if (q && q->nstr == 1) {
         char *path = path_join(A(p), p->f->dir, q->str[0]);
         if (!path) return ctx_nomem(p->ctx);
@@ -884,7 +657,7 @@ static pk_status build_material(pp *p, const char *type, material *m, bool *inte
             m->map_norm.tex = idx;
         }
     }
-    if (param(p, "displacement")) pwarn(p, p->line, "bump mapping by 'displacement' is not supported; ignored");
+    if (pb_param(&p->pd, "displacement")) pwarn(p, p->line, "bump mapping by 'displacement' is not supported; ignored");
     return PK_OK;
 }
 
@@ -1119,7 +892,7 @@ static pk_status shape_alpha(pp *p, int32_t *tex, bool *skip)
     pparam *q;
     *tex = -1;
     *skip = false;
-    pk_status st = param_typed(p, "alpha", TB(PT_FLOAT) | TB(PT_TEXTURE), "a float or a float texture", &q);
+    pk_status st = pb_typed(&p->pd, "alpha", TB(PT_FLOAT) | TB(PT_TEXTURE), "a float or a float texture", &q);
     if (st || !q) return st;
     if (q->type == PT_FLOAT) {
         if (q->nnum != 1) return pfail(p, q->line, PK_ERR_PARSE, "'float alpha' takes one value");
@@ -1149,12 +922,13 @@ static pk_status read_mesh_params(pp *p, const char *what, size_t per_face, mesh
 {
     pparam *P, *N, *UV, *I;
     pk_status st;
-    if ((st = param_typed(p, "P", TB(PT_POINT3), "point3", &P)) || (st = param_typed(p, "N", TB(PT_NORMAL), "normal", &N)) ||
-        (st = param_typed(p, "uv", TB(PT_POINT2) | TB(PT_FLOAT), "point2", &UV)) ||
-        (st = param_typed(p, "indices", TB(PT_INT), "integer", &I)))
+    if ((st = pb_typed(&p->pd, "P", TB(PT_POINT3), "point3", &P)) ||
+        (st = pb_typed(&p->pd, "N", TB(PT_NORMAL), "normal", &N)) ||
+        (st = pb_typed(&p->pd, "uv", TB(PT_POINT2) | TB(PT_FLOAT), "point2", &UV)) ||
+        (st = pb_typed(&p->pd, "indices", TB(PT_INT), "integer", &I)))
         return st;
-    if (!UV && (st = param_typed(p, "st", TB(PT_POINT2) | TB(PT_FLOAT), "point2", &UV))) return st;
-    param(p, "S"), param(p, "faceIndices");
+    if (!UV && (st = pb_typed(&p->pd, "st", TB(PT_POINT2) | TB(PT_FLOAT), "point2", &UV))) return st;
+    pb_param(&p->pd, "S"), pb_param(&p->pd, "faceIndices");
     if (!P) return pfail(p, p->line, PK_ERR_PARSE, "%s needs 'point3 P'", what);
     size_t npos = P->nnum / 3;
     if (npos > UINT32_MAX / 2) return pfail(p, P->line, PK_ERR_LIMIT, "%s: too many vertices", what);
@@ -1461,7 +1235,7 @@ done:
 static pk_status shape_loopsubdiv(pp *p, int32_t alpha)
 {
     int64_t levels = 3;
-    pk_status st = get_int(p, "levels", 0, 16, &levels);
+    pk_status st = pb_int(&p->pd, "levels", 0, 16, &levels);
     if (st) return st;
     mesh_in m;
     uint32_t *f;
@@ -1595,9 +1369,10 @@ static pk_status shape_sphere(pp *p, int32_t alpha)
 {
     float radius = 1.0f, zmin, zmax, phimax = 360.0f;
     pk_status st;
-    if ((st = get_float(p, "radius", &radius))) return st;
+    if ((st = pb_float(&p->pd, "radius", &radius))) return st;
     zmin = -radius, zmax = radius;
-    if ((st = get_float(p, "zmin", &zmin)) || (st = get_float(p, "zmax", &zmax)) || (st = get_float(p, "phimax", &phimax)))
+    if ((st = pb_float(&p->pd, "zmin", &zmin)) || (st = pb_float(&p->pd, "zmax", &zmax)) ||
+        (st = pb_float(&p->pd, "phimax", &phimax)))
         return st;
     if (!(radius > 0.0f)) return pfail(p, p->line, PK_ERR_PARSE, "sphere: radius %g must be positive", (double)radius);
     float zlo = fmaxf(fminf(zmin, zmax), -radius), zhi = fminf(fmaxf(zmin, zmax), radius);
@@ -1634,8 +1409,8 @@ static pk_status shape_disk(pp *p, int32_t alpha)
 {
     float h = 0.0f, r = 1.0f, ri = 0.0f, phimax = 360.0f;
     pk_status st;
-    if ((st = get_float(p, "height", &h)) || (st = get_float(p, "radius", &r)) ||
-        (st = get_float(p, "innerradius", &ri)) || (st = get_float(p, "phimax", &phimax)))
+    if ((st = pb_float(&p->pd, "height", &h)) || (st = pb_float(&p->pd, "radius", &r)) ||
+        (st = pb_float(&p->pd, "innerradius", &ri)) || (st = pb_float(&p->pd, "phimax", &phimax)))
         return st;
     phimax = fminf(fmaxf(phimax, 0.0f), 360.0f);
     if (!(r > 0.0f) || !(ri >= 0.0f) || !(ri < r) || !(phimax > 0.0f)) return PK_OK;
@@ -1647,8 +1422,8 @@ static pk_status shape_cylinder(pp *p, int32_t alpha)
 {
     float r = 1.0f, zmin = -1.0f, zmax = 1.0f, phimax = 360.0f;
     pk_status st;
-    if ((st = get_float(p, "radius", &r)) || (st = get_float(p, "zmin", &zmin)) || (st = get_float(p, "zmax", &zmax)) ||
-        (st = get_float(p, "phimax", &phimax)))
+    if ((st = pb_float(&p->pd, "radius", &r)) || (st = pb_float(&p->pd, "zmin", &zmin)) ||
+        (st = pb_float(&p->pd, "zmax", &zmax)) || (st = pb_float(&p->pd, "phimax", &phimax)))
         return st;
     phimax = fminf(fmaxf(phimax, 0.0f), 360.0f);
     if (!(r > 0.0f) || zmin == zmax || !(phimax > 0.0f)) return PK_OK;
@@ -1659,12 +1434,12 @@ static pk_status shape_cylinder(pp *p, int32_t alpha)
 static pk_status shape_plymesh(pp *p, int32_t alpha)
 {
     const char *fn = NULL;
-    pk_status st = get_string(p, "filename", &fn);
+    pk_status st = pb_string(&p->pd, "filename", &fn);
     if (st) return st;
     if (!fn) return pfail(p, p->line, PK_ERR_PARSE, "plymesh needs 'string filename'");
-    if (param(p, "displacement"))
+    if (pb_param(&p->pd, "displacement"))
         pwarn(p, p->line, "plymesh: 'displacement' is not supported; the mesh is rendered undisplaced");
-    param(p, "edgelength");
+    pb_param(&p->pd, "edgelength");
     size_t n = strlen(fn);
     if (n > 3 && strcmp(fn + n - 3, ".gz") == 0)
         return pfail(p, p->line, PK_ERR_PARSE, "plymesh \"%.80s\": compressed PLY files are not read (gunzip it)", fn);
@@ -1696,9 +1471,9 @@ static pk_status d_shape(pp *p, const char *type)
     bool skip;
     pk_status st = shape_alpha(p, &alpha, &skip);
     if (st) return st;
-    param(p, "emissionfilename");
+    pb_param(&p->pd, "emissionfilename");
     if (skip) {
-        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        pd_mark_all(&p->pd);
         return PK_OK;
     }
     if (strcmp(type, "trianglemesh") == 0) st = shape_trianglemesh(p, alpha);
@@ -1709,16 +1484,12 @@ static pk_status d_shape(pp *p, const char *type)
     else if (strcmp(type, "bilinearmesh") == 0) st = shape_bilinear(p, alpha);
     else if (strcmp(type, "loopsubdiv") == 0) st = shape_loopsubdiv(p, alpha);
     else if (strcmp(type, "curve") == 0) {
-        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        pd_mark_all(&p->pd);
         pwarn(p, p->line, "shape \"curve\" is not supported; skipped");
     } else {
         return pfail(p, p->line, PK_ERR_PARSE, "unknown shape \"%.40s\"", type);
     }
-    if (st == PK_OK) {
-        char what[64];
-        snprintf(what, sizeof what, "Shape \"%.40s\"", type);
-        warn_unused(p, what);
-    }
+    if (st == PK_OK) warn_unused(p, "Shape \"%.40s\"", type);
     return st;
 }
 
@@ -1729,7 +1500,8 @@ static pk_status light_spectrum(pp *p, const char *name, vec3 *c)
 {
     pparam *q;
     *c = v3s(1.0f);
-    pk_status st = param_typed(p, name, TB(PT_RGB) | TB(PT_SPECTRUM) | TB(PT_BLACKBODY), "a spectrum (rgb, spectrum, blackbody)", &q);
+    pk_status st = pb_typed(&p->pd, name, TB(PT_RGB) | TB(PT_SPECTRUM) | TB(PT_BLACKBODY),
+                            "a spectrum (rgb, spectrum, blackbody)", &q);
     if (st || !q) return st;
     return spectrum_rgb(p, q, true, c);
 }
@@ -1740,9 +1512,9 @@ static pk_status d_light(pp *p, const char *type)
 {
     pk_status st;
     float scale = 1.0f, power = -1.0f;
-    if ((st = get_float(p, "scale", &scale))) return st;
+    if ((st = pb_float(&p->pd, "scale", &scale))) return st;
     if (p->b.in_object) {
-        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        pd_mark_all(&p->pd);
         pwarn(p, p->line, "a light inside an object definition is ignored (as pbrt-v4 does not allow it)");
         return PK_OK;
     }
@@ -1750,14 +1522,15 @@ static pk_status d_light(pp *p, const char *type)
     if (strcmp(type, "point") == 0 || strcmp(type, "spot") == 0) {
         vec3 I, from = v3s(0.0f), to = v3(0.0f, 0.0f, 1.0f);
         float cone = 30.0f, delta = 5.0f;
-        if ((st = light_spectrum(p, "I", &I)) || (st = get_float(p, "power", &power)) || (st = get_vec3(p, "from", &from)))
+        if ((st = light_spectrum(p, "I", &I)) || (st = pb_float(&p->pd, "power", &power)) ||
+            (st = pb_vec3(&p->pd, "from", &from)))
             return st;
         const vec3 position = xform_point(&w, from);
         vec3 axis = v3s(0.0f);
         float cs = 1.0f, ce = 1.0f, k_e = 4.0f * PK_PI;
         if (type[0] == 's') {
-            if ((st = get_vec3(p, "to", &to)) || (st = get_float(p, "coneangle", &cone)) ||
-                (st = get_float(p, "conedelta", &delta)))
+            if ((st = pb_vec3(&p->pd, "to", &to)) || (st = pb_float(&p->pd, "coneangle", &cone)) ||
+                (st = pb_float(&p->pd, "conedelta", &delta)))
                 return st;
             ce = cosf(cone * PK_PI / 180.0f), cs = cosf((cone - delta) * PK_PI / 180.0f);
             if (!(cs > ce)) cs = fminf(ce + 1e-4f, 1.0f);
@@ -1778,8 +1551,8 @@ static pk_status d_light(pp *p, const char *type)
     } else if (strcmp(type, "distant") == 0) {
         vec3 L, from = v3s(0.0f), to = v3(0.0f, 0.0f, 1.0f);
         float illum = -1.0f;
-        if ((st = light_spectrum(p, "L", &L)) || (st = get_vec3(p, "from", &from)) || (st = get_vec3(p, "to", &to)) ||
-            (st = get_float(p, "illuminance", &illum)))
+        if ((st = light_spectrum(p, "L", &L)) || (st = pb_vec3(&p->pd, "from", &from)) ||
+            (st = pb_vec3(&p->pd, "to", &to)) || (st = pb_float(&p->pd, "illuminance", &illum)))
             return st;
         if (illum > 0.0f) scale *= illum;
         const vec3 to_light = v3_norm_scaled(xform_vector(&w, v3_sub(from, to)));
@@ -1794,13 +1567,14 @@ static pk_status d_light(pp *p, const char *type)
         const char *fn = NULL;
         bool has_L;
         pparam *q;
-        if ((st = param_typed(p, "L", TB(PT_RGB) | TB(PT_SPECTRUM) | TB(PT_BLACKBODY), "a spectrum", &q))) return st;
+        if ((st = pb_typed(&p->pd, "L", TB(PT_RGB) | TB(PT_SPECTRUM) | TB(PT_BLACKBODY), "a spectrum", &q))) return st;
         has_L = q != NULL;
-        if ((st = light_spectrum(p, "L", &L)) || (st = get_string(p, "filename", &fn))) return st;
+        if ((st = light_spectrum(p, "L", &L)) || (st = pb_string(&p->pd, "filename", &fn))) return st;
         float illum = -1.0f;
-        if ((st = get_float(p, "illuminance", &illum))) return st;
+        if ((st = pb_float(&p->pd, "illuminance", &illum))) return st;
         if (illum > 0.0f) pwarn(p, p->line, "infinite: 'illuminance' is not supported; 'scale' alone is used");
-        if (param(p, "portal")) pwarn(p, p->line, "infinite: portals are not used (the light is sampled as a whole)");
+        if (pb_param(&p->pd, "portal"))
+            pwarn(p, p->line, "infinite: portals are not used (the light is sampled as a whole)");
         if (has_L && fn) return pfail(p, p->line, PK_ERR_PARSE, "infinite: give either 'L' or 'filename', not both");
         if (fn) {
             p->s->env.set = true;
@@ -1809,14 +1583,12 @@ static pk_status d_light(pp *p, const char *type)
             scene_env_add_radiance(p->s, v3_scale(L, scale));
         }
     } else if (strcmp(type, "goniometric") == 0 || strcmp(type, "projection") == 0) {
-        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        pd_mark_all(&p->pd);
         pwarn(p, p->line, "light \"%s\" is not supported; skipped", type);
     } else {
         return pfail(p, p->line, PK_ERR_PARSE, "unknown light \"%.40s\"", type);
     }
-    char what[64];
-    snprintf(what, sizeof what, "LightSource \"%.40s\"", type);
-    warn_unused(p, what);
+    warn_unused(p, "LightSource \"%.40s\"", type);
     return PK_OK;
 }
 
@@ -1923,17 +1695,18 @@ static pk_status d_area_light(pp *p, const char *type)
 {
     pk_status st;
     if (strcmp(type, "diffuse") != 0) {
-        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        pd_mark_all(&p->pd);
         pwarn(p, p->line, "area light \"%.40s\" is not supported; the shapes do not emit", type);
         GS(p)->area = -1;
         return PK_OK;
     }
     area_light l = {v3s(1.0f), false, -1.0f};
     float scale = 1.0f;
-    if ((st = light_spectrum(p, "L", &l.L)) || (st = get_float(p, "scale", &scale)) || (st = get_bool(p, "twosided", &l.two_sided)) ||
-        (st = get_float(p, "power", &l.power)))
+    if ((st = light_spectrum(p, "L", &l.L)) || (st = pb_float(&p->pd, "scale", &scale)) ||
+        (st = pb_bool(&p->pd, "twosided", &l.two_sided)) || (st = pb_float(&p->pd, "power", &l.power)))
         return st;
-    if (param(p, "filename")) pwarn(p, p->line, "AreaLightSource: an emission image is not supported; 'L' is used");
+    if (pb_param(&p->pd, "filename"))
+        pwarn(p, p->line, "AreaLightSource: an emission image is not supported; 'L' is used");
     l.L = v3_scale(l.L, scale);
     if (!v3_finite(l.L)) return pfail(p, p->line, PK_ERR_PARSE, "AreaLightSource: the radiance is not finite");
     if (!(v3_min_comp(l.L) >= 0.0f)) return pfail(p, p->line, PK_ERR_PARSE, "AreaLightSource: the radiance is negative");
@@ -1961,19 +1734,20 @@ static pk_status d_texture(pp *p, const char *name, const char *kind, const char
     t.cls = TC_CONST;
     float us = 1.0f, vs = 1.0f, ud = 0.0f, vd = 0.0f, sc = 1.0f;
     const char *mapping = "uv";
-    if ((st = get_float(p, "uscale", &us)) || (st = get_float(p, "vscale", &vs)) || (st = get_float(p, "udelta", &ud)) ||
-        (st = get_float(p, "vdelta", &vd)) || (st = get_string(p, "mapping", &mapping)))
+    if ((st = pb_float(&p->pd, "uscale", &us)) || (st = pb_float(&p->pd, "vscale", &vs)) ||
+        (st = pb_float(&p->pd, "udelta", &ud)) || (st = pb_float(&p->pd, "vdelta", &vd)) ||
+        (st = pb_string(&p->pd, "mapping", &mapping)))
         return st;
     if (strcmp(mapping, "uv") != 0)
         pwarn(p, p->line, "Texture \"%.60s\": mapping \"%.20s\" is not supported; uv is used", name, mapping);
     if (strcmp(cls, "imagemap") == 0) {
         const char *fn = NULL, *enc = NULL, *wrap = "repeat", *filter = NULL;
         bool invert = false;
-        if ((st = get_string(p, "filename", &fn)) || (st = get_string(p, "encoding", &enc)) ||
-            (st = get_string(p, "wrap", &wrap)) || (st = get_string(p, "filter", &filter)) ||
-            (st = get_float(p, "scale", &sc)) || (st = get_bool(p, "invert", &invert)))
+        if ((st = pb_string(&p->pd, "filename", &fn)) || (st = pb_string(&p->pd, "encoding", &enc)) ||
+            (st = pb_string(&p->pd, "wrap", &wrap)) || (st = pb_string(&p->pd, "filter", &filter)) ||
+            (st = pb_float(&p->pd, "scale", &sc)) || (st = pb_bool(&p->pd, "invert", &invert)))
             return st;
-        param(p, "maxanisotropy");
+        pb_param(&p->pd, "maxanisotropy");
         if (!fn) return pfail(p, p->line, PK_ERR_PARSE, "imagemap \"%.60s\" needs 'string filename'", name);
         /* pbrt-v4's default: sRGB for PNG files, linear for the others */
         size_t fl = strlen(fn);
@@ -2003,7 +1777,7 @@ static pk_status d_texture(pp *p, const char *name, const char *kind, const char
         }
     } else if (strcmp(cls, "checkerboard") == 0) {
         int64_t dim = 2;
-        if ((st = get_int(p, "dimension", 2, 3, &dim))) return st;
+        if ((st = pb_int(&p->pd, "dimension", 2, 3, &dim))) return st;
         vec3 c1 = v3s(1.0f), c2 = v3s(0.0f);
         if (is_float) {
             float f1 = 1.0f, f2 = 0.0f;
@@ -2038,7 +1812,7 @@ static pk_status d_texture(pp *p, const char *name, const char *kind, const char
         if (is_float) {
             float v = 1.0f;
             pparam *q = NULL;
-            if ((st = param_typed(p, a, TB(PT_TEXTURE) | TB(PT_FLOAT), "a float texture", &q))) return st;
+            if ((st = pb_typed(&p->pd, a, TB(PT_TEXTURE) | TB(PT_FLOAT), "a float texture", &q))) return st;
             if (q && q->type == PT_TEXTURE && q->nstr == 1) {
                 named_tex *src = find_tex(p, q->str[0]);
                 if (!src) return pfail(p, q->line, PK_ERR_PARSE, "no texture named \"%.60s\"", q->str[0]);
@@ -2054,7 +1828,7 @@ static pk_status d_texture(pp *p, const char *name, const char *kind, const char
             if ((st = get_float_tex(p, "scale", &s, NULL))) return st;
             c = v3_scale(c, s);
         } else {
-            for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+            pd_mark_all(&p->pd);
             pwarn(p, p->line, "Texture \"%.60s\": \"%s\" is rendered as its first texture", name, cls);
         }
         t.value = c;
@@ -2064,7 +1838,7 @@ static pk_status d_texture(pp *p, const char *name, const char *kind, const char
         }
         us = 1.0f, vs = 1.0f, ud = 0.0f, vd = 0.0f; /* the inner texture's mapping stands */
     } else {
-        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        pd_mark_all(&p->pd);
         pwarn(p, p->line, "texture \"%.30s\" is not supported; \"%.60s\" is the constant 1", cls, name);
     }
     if (t.cls != TC_CONST && cls[0] != 's' && strcmp(cls, "mix") != 0 && strcmp(cls, "directionmix") != 0) {
@@ -2074,9 +1848,7 @@ static pk_status d_texture(pp *p, const char *name, const char *kind, const char
     t.name = mem_strdup(A(p), name);
     if (!t.name) return ctx_nomem(p->ctx);
     p->tex[p->ntex++] = t;
-    char what[96];
-    snprintf(what, sizeof what, "Texture \"%.30s\"", cls);
-    warn_unused(p, what);
+    warn_unused(p, "Texture \"%.30s\"", cls);
     return PK_OK;
 }
 
@@ -2091,16 +1863,17 @@ static pk_status d_camera(pp *p, const char *type)
     else if (strcmp(type, "orthographic") == 0) p->ortho = true;
     else {
         pwarn(p, p->line, "camera \"%.40s\" is not supported; rendered as a perspective camera", type);
-        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        pd_mark_all(&p->pd);
     }
     p->fov = 90.0f;
-    if ((st = get_float(p, "fov", &p->fov)) || (st = get_float(p, "lensradius", &p->lens_radius)) ||
-        (st = get_float(p, "focaldistance", &p->focal_distance)) || (st = get_float(p, "frameaspectratio", &p->frame_aspect)))
+    if ((st = pb_float(&p->pd, "fov", &p->fov)) || (st = pb_float(&p->pd, "lensradius", &p->lens_radius)) ||
+        (st = pb_float(&p->pd, "focaldistance", &p->focal_distance)) ||
+        (st = pb_float(&p->pd, "frameaspectratio", &p->frame_aspect)))
         return st;
     if (!(p->fov > 0.0f && p->fov < 180.0f))
         return pfail(p, p->line, PK_ERR_PARSE, "camera: fov %g must be between 0 and 180 degrees", (double)p->fov);
     pparam *q;
-    if ((st = param_typed(p, "screenwindow", TB(PT_FLOAT), "4 floats", &q))) return st;
+    if ((st = pb_typed(&p->pd, "screenwindow", TB(PT_FLOAT), "4 floats", &q))) return st;
     if (q) {
         if (q->nnum != 4) return pfail(p, q->line, PK_ERR_PARSE, "'float screenwindow' takes 4 values, not %zu", q->nnum);
         for (int i = 0; i < 4; i++) p->screen[i] = (float)q->num[i];
@@ -2109,11 +1882,11 @@ static pk_status d_camera(pp *p, const char *type)
         p->has_screen = true;
     }
     float so = 0.0f, sc = 1.0f;
-    if ((st = get_float(p, "shutteropen", &so)) || (st = get_float(p, "shutterclose", &sc))) return st;
+    if ((st = pb_float(&p->pd, "shutteropen", &so)) || (st = pb_float(&p->pd, "shutterclose", &sc))) return st;
     if (!(sc > so)) return pfail(p, p->line, PK_ERR_PARSE, "camera: 'shutterclose' must be after 'shutteropen'");
     p->exposure_time = sc - so;
-    static const char *const quiet[] = {"near", "far", "hither", "yon", NULL};
-    for (int i = 0; quiet[i]; i++) param(p, quiet[i]);
+    static const char *const quiet[] = {"near", "far", "hither", "yon"};
+    pd_declare(&p->pd, quiet, sizeof quiet / sizeof quiet[0]);
     xform inv;
     if (!xform_invert(sb_transform(&p->b), &inv))
         return pfail(p, p->line, PK_ERR_PARSE, "camera: the current transform is singular (no camera can be placed)");
@@ -2199,30 +1972,31 @@ static pk_status d_film(pp *p, const char *type)
     pk_status st;
     const pk_int_option *ow = pk_int_option_find("width"), *oh = pk_int_option_find("height");
     int64_t w = p->film_w, h = p->film_h;
-    if ((st = get_int(p, "xresolution", ow->min, ow->max, &w)) || (st = get_int(p, "yresolution", oh->min, oh->max, &h)))
+    if ((st = pb_int(&p->pd, "xresolution", ow->min, ow->max, &w)) ||
+        (st = pb_int(&p->pd, "yresolution", oh->min, oh->max, &h)))
         return st;
     if ((uint64_t)w * (uint64_t)h > (uint64_t)PK_MAX_IMAGE_PIXELS)
         return pfail(p, p->line, PK_ERR_LIMIT, "Film: %lldx%lld is more than %u pixels", (long long)w, (long long)h,
                      (unsigned)PK_MAX_IMAGE_PIXELS);
     p->film_w = (int)w, p->film_h = (int)h;
     pparam *q;
-    if ((st = param_typed(p, "cropwindow", TB(PT_FLOAT), "4 floats", &q))) return st;
+    if ((st = pb_typed(&p->pd, "cropwindow", TB(PT_FLOAT), "4 floats", &q))) return st;
     if (q) pwarn(p, q->line, "Film: crop windows are not supported; the whole image is rendered");
-    if ((st = param_typed(p, "pixelbounds", TB(PT_INT), "4 integers", &q))) return st;
+    if ((st = pb_typed(&p->pd, "pixelbounds", TB(PT_INT), "4 integers", &q))) return st;
     if (q) pwarn(p, q->line, "Film: pixel bounds are not supported; the whole image is rendered");
     /* pbrt's sensor scales what it records by exposure time x ISO / 100 */
     float iso = 100.0f;
     const char *sensor = "cie1931";
-    if ((st = get_float(p, "iso", &iso)) || (st = get_string(p, "sensor", &sensor))) return st;
+    if ((st = pb_float(&p->pd, "iso", &iso)) || (st = pb_string(&p->pd, "sensor", &sensor))) return st;
     if (!(iso > 0.0f)) return pfail(p, p->line, PK_ERR_PARSE, "Film: 'iso' %g must be positive", (double)iso);
     p->film_iso = iso;
     if (strcmp(sensor, "cie1931") != 0)
         pwarn(p, p->line, "Film: the sensor \"%.40s\" is not simulated (colours as the CIE 1931 observer sees them)",
               sensor);
-    if (param(p, "whitebalance")) pwarn(p, p->line, "Film: white balance is not applied");
+    if (pb_param(&p->pd, "whitebalance")) pwarn(p, p->line, "Film: white balance is not applied");
     /* the output file is named on the command line; the rest is the film's look */
-    static const char *const quiet[] = {"filename", "diagonal", "maxcomponentvalue", "savefp16", "writefp16", NULL};
-    for (int i = 0; quiet[i]; i++) param(p, quiet[i]);
+    static const char *const quiet[] = {"filename", "diagonal", "maxcomponentvalue", "savefp16", "writefp16"};
+    pd_declare(&p->pd, quiet, sizeof quiet / sizeof quiet[0]);
     warn_unused(p, "Film");
     return PK_OK;
 }
@@ -2232,7 +2006,7 @@ static pk_status d_sampler(pp *p, const char *type)
     (void)type;
     int64_t spp = -1;
     const pk_int_option *o = pk_int_option_find("spp");
-    pk_status st = get_int(p, "pixelsamples", 1, INT64_C(1) << 40, &spp);
+    pk_status st = pb_int(&p->pd, "pixelsamples", 1, INT64_C(1) << 40, &spp);
     if (st) return st;
     if (spp > 0) {
         if (spp > o->max) {
@@ -2242,8 +2016,8 @@ static pk_status d_sampler(pp *p, const char *type)
         p->s->render.opt.spp = (int)spp;
         p->s->render.has_spp = true;
     }
-    static const char *const quiet[] = {"seed", "randomization", "jitter", "xsamples", "ysamples", "dimensions", NULL};
-    for (int i = 0; quiet[i]; i++) param(p, quiet[i]);
+    static const char *const quiet[] = {"seed", "randomization", "jitter", "xsamples", "ysamples", "dimensions"};
+    pd_declare(&p->pd, quiet, sizeof quiet / sizeof quiet[0]);
     warn_unused(p, "Sampler");
     return PK_OK;
 }
@@ -2257,9 +2031,9 @@ static pk_status d_integrator(pp *p, const char *type)
     int64_t md = 5;
     bool reg = false;
     pk_status st;
-    if ((st = get_int(p, "maxdepth", 0, INT32_MAX, &md)) || (st = get_bool(p, "regularize", &reg))) return st;
+    if ((st = pb_int(&p->pd, "maxdepth", 0, INT32_MAX, &md)) || (st = pb_bool(&p->pd, "regularize", &reg))) return st;
     if (!ok) {
-        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        pd_mark_all(&p->pd);
         pwarn(p, p->line, "integrator \"%.40s\" is not supported; rendered with the path tracer", type);
     } else if (strcmp(type, "simplevolpath") == 0) {
         pwarn(p, p->line, "integrator \"simplevolpath\" is rendered with the volumetric path tracer (volpath)");
@@ -2276,8 +2050,8 @@ static pk_status d_integrator(pp *p, const char *type)
     r->has_regularize = true;
     static const char *const quiet[] = {"lightsampler", "samplelights", "samplebsdf", "iterations", "photonsperiteration",
                                         "radius", "seed", "visualizestrategies", "visualizeweights", "mutationsperpixel",
-                                        "largestepprobability", "sigma", "bootstrapsamples", "chains", NULL};
-    for (int i = 0; quiet[i]; i++) param(p, quiet[i]);
+                                        "largestepprobability", "sigma", "bootstrapsamples", "chains"};
+    pd_declare(&p->pd, quiet, sizeof quiet / sizeof quiet[0]);
     warn_unused(p, "Integrator");
     return PK_OK;
 }
@@ -2310,8 +2084,8 @@ static const struct {
 static pk_status medium_spectrum(pp *p, const char *what, const char *name, bool illuminant, vec3 *v)
 {
     pparam *q;
-    pk_status st = param_typed(p, name, TB(PT_RGB) | TB(PT_SPECTRUM) | TB(PT_BLACKBODY) | TB(PT_FLOAT),
-                               "a spectrum (rgb, spectrum, blackbody or float)", &q);
+    pk_status st = pb_typed(&p->pd, name, TB(PT_RGB) | TB(PT_SPECTRUM) | TB(PT_BLACKBODY) | TB(PT_FLOAT),
+                            "a spectrum (rgb, spectrum, blackbody or float)", &q);
     if (st || !q) return st;
     if (q->type == PT_RGB && q->nnum != 3)
         return pfail(p, q->line, PK_ERR_PARSE, "%s: 'rgb %s' takes 3 values, not %zu", what, name, q->nnum);
@@ -2326,10 +2100,8 @@ static pk_status medium_spectrum(pp *p, const char *what, const char *name, bool
 /* A medium's float parameter, which must lie in [lo, hi]. */
 static pk_status medium_float(pp *p, const char *what, const char *name, float lo, float hi, float *v)
 {
-    pparam *q = NULL;
-    for (size_t i = 0; i < p->pl.n && !q; i++)
-        if (strcmp(p->pl.p[i].name, name) == 0) q = &p->pl.p[i];
-    pk_status st = get_float(p, name, v);
+    const pparam *q = pb_param(&p->pd, name);
+    pk_status st = pb_float(&p->pd, name, v);
     if (st) return st;
     if (q && !(*v >= lo && *v <= hi))
         return pfail(p, q->line, PK_ERR_PARSE, "%s: '%s %s' %g must lie in %g..%g", what, q->tname, name, (double)*v,
@@ -2353,7 +2125,7 @@ static pk_status medium_dims(pp *p, const char *what, int n[3], size_t *count)
     double total = 1.0;
     for (int a = 0; a < 3; a++) {
         int64_t v = 1;
-        pk_status st = get_int(p, names[a], 1, (int64_t)MEDIUM_MAX_VOXELS, &v);
+        pk_status st = pb_int(&p->pd, names[a], 1, (int64_t)MEDIUM_MAX_VOXELS, &v);
         if (st) return st;
         n[a] = (int)v;
         total *= (double)v;
@@ -2394,7 +2166,7 @@ static pk_status medium_box(pp *p, const char *what, xform *box)
 {
     vec3 p0 = v3s(0.0f), p1 = v3s(1.0f);
     pk_status st;
-    if ((st = get_vec3(p, "p0", &p0)) || (st = get_vec3(p, "p1", &p1))) return st;
+    if ((st = pb_vec3(&p->pd, "p0", &p0)) || (st = pb_vec3(&p->pd, "p1", &p1))) return st;
     const vec3 lo = v3_min(p0, p1), ext = v3_sub(v3_max(p0, p1), lo);
     if (!(ext.x > 0.0f && ext.y > 0.0f && ext.z > 0.0f) || !v3_finite(ext))
         return pfail(p, p->line, PK_ERR_PARSE, "%s: the box p0 (%g, %g, %g) .. p1 (%g, %g, %g) has no volume", what,
@@ -2418,9 +2190,9 @@ static pk_status medium_temperature(pp *p, const char *what, medium *m, const pp
 {
     float off = 0.0f, sc = 1.0f;
     pk_status st;
-    if (param(p, "temperatureoffset")) st = get_float(p, "temperatureoffset", &off);
-    else st = get_float(p, "temperaturecutoff", &off);
-    if (st || (st = get_float(p, "temperaturescale", &sc))) return st;
+    if (pb_param(&p->pd, "temperatureoffset")) st = pb_float(&p->pd, "temperatureoffset", &off);
+    else st = pb_float(&p->pd, "temperaturecutoff", &off);
+    if (st || (st = pb_float(&p->pd, "temperaturescale", &sc))) return st;
     medium_grid tg = {0};
     if ((st = medium_grid_param(p, what, tq, 1, n, count, &tg))) return st;
     float *e = mem_calloc(&p->s->alloc, count * 3, sizeof *e);
@@ -2479,15 +2251,15 @@ static pk_status medium_uniformgrid(pp *p, const char *what, medium *m)
     pk_status st;
     pparam *dq, *lq, *tq;
     if ((st = medium_dims(p, what, n, &count))) return st;
-    if ((st = param_typed(p, "density", TB(PT_FLOAT) | TB(PT_RGB), "floats (or rgb triples)", &dq))) return st;
+    if ((st = pb_typed(&p->pd, "density", TB(PT_FLOAT) | TB(PT_RGB), "floats (or rgb triples)", &dq))) return st;
     if (!dq) return pfail(p, p->line, PK_ERR_PARSE, "%s: uniformgrid needs 'float density' (nx x ny x nz values)", what);
-    if ((st = param_typed(p, "temperature", TB(PT_FLOAT), "floats", &tq))) return st;
+    if ((st = pb_typed(&p->pd, "temperature", TB(PT_FLOAT), "floats", &tq))) return st;
     if ((st = medium_grid_param(p, what, dq, dq->type == PT_RGB ? 3 : 1, n, count, &m->density))) return st;
     vec3 le = v3s(0.0f);
-    pparam *leq = param(p, "Le");
+    pparam *leq = pb_param(&p->pd, "Le");
     if (tq && leq) return pfail(p, leq->line, PK_ERR_PARSE, "%s: give 'Le' or 'temperature', not both", what);
     if ((st = medium_spectrum(p, what, "Le", true, &le))) return st;
-    if ((st = param_typed(p, "Lescale", TB(PT_FLOAT), "floats", &lq))) return st;
+    if ((st = pb_typed(&p->pd, "Lescale", TB(PT_FLOAT), "floats", &lq))) return st;
     float lsc = 1.0f;
     if (lq && lq->nnum == 1) {
         if ((st = medium_float(p, what, "Lescale", 0.0f, 3.4e38f, &lsc))) return st;
@@ -2511,9 +2283,9 @@ static pk_status medium_rgbgrid(pp *p, const char *what, medium *m, float scale)
     pk_status st;
     pparam *qa, *qs, *ql;
     if ((st = medium_dims(p, what, n, &count))) return st;
-    if ((st = param_typed(p, "sigma_a", TB(PT_RGB), "rgb values", &qa)) ||
-        (st = param_typed(p, "sigma_s", TB(PT_RGB), "rgb values", &qs)) ||
-        (st = param_typed(p, "Le", TB(PT_RGB), "rgb values", &ql)))
+    if ((st = pb_typed(&p->pd, "sigma_a", TB(PT_RGB), "rgb values", &qa)) ||
+        (st = pb_typed(&p->pd, "sigma_s", TB(PT_RGB), "rgb values", &qs)) ||
+        (st = pb_typed(&p->pd, "Le", TB(PT_RGB), "rgb values", &ql)))
         return st;
     if (!qa && !qs)
         return pfail(p, p->line, PK_ERR_PARSE, "%s: rgbgrid needs 'rgb sigma_a' and/or 'rgb sigma_s' (nx x ny x nz rgb values)",
@@ -2561,13 +2333,13 @@ static pk_status medium_nanovdb(pp *p, const char *what, medium *m, xform *box)
 {
     const char *fn = NULL, *gname = "density";
     pk_status st;
-    if ((st = get_string(p, "filename", &fn)) || (st = get_string(p, "gridname", &gname))) return st;
+    if ((st = pb_string(&p->pd, "filename", &fn)) || (st = pb_string(&p->pd, "gridname", &gname))) return st;
     if (!fn) return pfail(p, p->line, PK_ERR_PARSE, "%s: nanovdb needs 'string filename'", what);
     static const char *const temp[] = {"temperaturename", "temperaturecutoff", "temperatureoffset", "temperaturescale",
                                        "Lescale", NULL};
     for (int i = 0; temp[i]; i++)
-        if (param(p, temp[i]))
-            pwarn(p, param(p, temp[i])->line,
+        if (pb_param(&p->pd, temp[i]))
+            pwarn(p, pb_param(&p->pd, temp[i])->line,
                   "%s: temperature grids are not read; the medium does not emit ('%s' ignored)", what, temp[i]);
     char *path = path_join(A(p), p->f->dir, fn);
     if (!path) return ctx_nomem(p->ctx);
@@ -2696,7 +2468,7 @@ static pk_status d_medium(pp *p, const char *name)
     if (scene_find_medium(p->s, name) >= 0)
         return pfail(p, p->line, PK_ERR_PARSE, "%s: a medium of that name is defined already", what);
     const char *type = NULL;
-    pk_status st = get_string(p, "type", &type);
+    pk_status st = pb_string(&p->pd, "type", &type);
     if (st) return st;
     if (!type) return pfail(p, p->line, PK_ERR_PARSE, "%s needs 'string type'", what);
     const bool homogeneous = strcmp(type, "homogeneous") == 0, uniform = strcmp(type, "uniformgrid") == 0,
@@ -2714,12 +2486,12 @@ static pk_status d_medium(pp *p, const char *name)
         return st;
     m.g = g;
     const char *preset = NULL;
-    if (homogeneous && (st = get_string(p, "preset", &preset))) return st;
+    if (homogeneous && (st = pb_string(&p->pd, "preset", &preset))) return st;
     if (preset) {
         size_t k = 0, np = sizeof medium_presets / sizeof medium_presets[0];
         while (k < np && strcmp(medium_presets[k].name, preset) != 0) k++;
         if (k == np)
-            return pfail(p, param(p, "preset")->line, PK_ERR_UNSUPPORTED,
+            return pfail(p, pb_param(&p->pd, "preset")->line, PK_ERR_UNSUPPORTED,
                          "%s: preset \"%.60s\" is not known (Paprsek knows the measured media of Jensen et al. 2001: "
                          "Apple, Chicken1, Chicken2, Cream, Ketchup, Marble, Potato, Skimmilk, Skin1, Skin2, Spectralon, "
                          "Wholemilk)",
@@ -2760,9 +2532,7 @@ static pk_status d_medium(pp *p, const char *name)
     }
     uint32_t idx;
     if ((st = scene_add_medium(p->ctx, p->s, &m, &idx))) return st;
-    char w2[64];
-    snprintf(w2, sizeof w2, "medium \"%.40s\"", type);
-    warn_unused(p, w2);
+    warn_unused(p, "medium \"%.40s\"", type);
     return PK_OK;
 }
 
@@ -3142,7 +2912,6 @@ static pk_status directive(pp *p, const pbrt_token *tk)
         if ((st = read_params(p))) return st;
         for (size_t i = 0; i < p->pl.n; i++) {
             pparam *q = &p->pl.p[i];
-            q->used = true;
             if (strcmp(q->name, "seed") == 0 && q->type == PT_INT && q->nnum == 1 && q->num[0] >= 0 &&
                 q->num[0] <= 2147483647.0) {
                 p->s->render.opt.seed = (int)q->num[0];
@@ -3169,7 +2938,7 @@ static pk_status directive(pp *p, const pbrt_token *tk)
             attr_def *d = &p->defs[p->ndefs];
             d->target = (attr_target)tg;
             d->depth = p->b.depth;
-            if ((st = param_copy(p, &p->pl.p[i], &d->prm))) return st;
+            if ((st = pb_param_copy(p->ctx, &p->pl.p[i], &d->prm))) return st;
             p->ndefs++;
         }
         return PK_OK;
@@ -3187,13 +2956,11 @@ static pk_status directive(pp *p, const pbrt_token *tk)
     if (strcmp(dn, "MakeNamedMaterial") == 0) {
         if ((st = read_name(p, a, sizeof a)) || (st = read_params(p)) || (st = apply_defaults(p, AT_MATERIAL))) return st;
         const char *type = NULL;
-        if ((st = get_string(p, "type", &type))) return st;
+        if ((st = pb_string(&p->pd, "type", &type))) return st;
         if (!type) return pfail(p, p->line, PK_ERR_PARSE, "MakeNamedMaterial \"%.80s\" needs 'string type'", a);
         uint32_t idx;
         if ((st = new_material(p, a, type, &idx))) return st;
-        char what[96];
-        snprintf(what, sizeof what, "material \"%.40s\"", type);
-        warn_unused(p, what);
+        warn_unused(p, "material \"%.40s\"", type);
         return PK_OK;
     }
     if (strcmp(dn, "Material") == 0) {
@@ -3204,9 +2971,7 @@ static pk_status directive(pp *p, const pbrt_token *tk)
         if ((st = new_material(p, nm, a, &idx))) return st;
         GS(p)->material = idx;
         GS(p)->interface = mat_is_interface(p, idx);
-        char what[96];
-        snprintf(what, sizeof what, "material \"%.40s\"", a);
-        warn_unused(p, what);
+        warn_unused(p, "material \"%.40s\"", a);
         return PK_OK;
     }
     /* the rest: a type name and parameters */
@@ -3230,7 +2995,7 @@ static pk_status directive(pp *p, const pbrt_token *tk)
     case 5: return d_sampler(p, a);
     case 6: return d_integrator(p, a);
     default:
-        for (size_t i = 0; i < p->pl.n; i++) p->pl.p[i].used = true;
+        pd_mark_all(&p->pd);
         return PK_OK; /* Paprsek's pixel filter is a box; its accelerator its own */
     }
 }
@@ -3274,6 +3039,7 @@ pk_status scene_pbrt_parse(pk_context *ctx, pk_scene *s, const char *data, size_
     if (!p) return ctx_nomem(ctx);
     p->ctx = ctx;
     p->s = s;
+    pd_init(&p->pd, ctx, &pbrt_source, p, NULL, false);
     sb_init(&p->b, ctx, s);
     p->gs[0].material = 0;
     p->gs[0].area = -1;

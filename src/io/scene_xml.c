@@ -463,7 +463,7 @@ static const pd_source xml_source = {.warn_unused = xml_warn_unused};
 
 /* Fills *d with the named children of plugin, in order: each entry's name
  * is the property's in snake_case ($ substituted; "" where that fails), its
- * node the element and its tag the element's tag. Values stay in the
+ * node the element and its type the element's tag. Values stay in the
  * elements, read by the getters below when a plugin asks for them, so that
  * a property nobody reads is never checked. A name may come twice: the
  * first is read. Invariant: the entries live in the load's arena (cap is
@@ -487,7 +487,7 @@ static pk_status xml_props(xp *p, xnode *plugin, pdict *d)
         if (!nm && !st) continue;
         char sn[64] = "";
         if (nm) snake(sn, sizeof sn, nm);
-        const pd_entry e = {.name = arena_strdup(p, sn), .kind = PD_OTHER, .node = c, .tag = c->tag};
+        const pd_entry e = {.name = arena_strdup(p, sn), .kind = PD_OTHER, .node = c, .type = c->tag};
         if (!e.name) return ctx_nomem(p->ctx);
         pd_add(d, &e);
     }
@@ -2654,7 +2654,7 @@ static pk_status parse_sensor(xp *p, xnode *sn)
     const bool thinlens = strcmp(type, "thinlens") == 0, ortho = strcmp(type, "orthographic") == 0;
     if (strcmp(type, "perspective") != 0 && !thinlens && !ortho) {
         xwarn(p, sn, "sensor \"%s\" is not supported; rendered as a perspective camera", ty);
-        for (size_t i = 0; i < d.n; i++) d.e[i].used = strcmp(d.e[i].tag, "transform") != 0;
+        for (size_t i = 0; i < d.n; i++) d.e[i].used = strcmp(d.e[i].type, "transform") != 0;
     }
     xform m;
     bool has_m;
