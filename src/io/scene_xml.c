@@ -2066,12 +2066,7 @@ static pk_status medium_convert(xp *p, xnode *mn, medium *m)
             ss = v3_scale(ss, 1.0f - g);
         }
         m->kind = MEDIUM_HOMOGENEOUS;
-        const vec3 t = v3_add(sa, ss);
-        const float tt[3] = {t.x, t.y, t.z}, s3[3] = {ss.x, ss.y, ss.z};
-        float a[3];
-        for (int c = 0; c < 3; c++) a[c] = tt[c] > 0.0f ? fminf(s3[c] / tt[c], 1.0f) : 1.0f;
-        m->sigma_t = v3_scale(t, scale);
-        m->albedo = v3(a[0], a[1], a[2]);
+        medium_set_coefficients(m, sa, ss, scale);
         if ((st = medium_values(p, mn, m->sigma_t, m->albedo))) return st;
         warn_unused(&d, kind, quiet);
         return PK_OK;
@@ -2439,7 +2434,6 @@ static pk_status parse_emitter(xp *p, xnode *e)
     char kind[64];
     snprintf(kind, sizeof kind, "emitter \"%s\"", ty);
     static const char *const quiet[] = {"sampling_weight", NULL};
-    scene_environment *env = &p->s->env;
     const char *id = attr_st(p, e, "id", &st);
     if (id && (st = id_add(p, id, e))) return st;
     pdict d;
@@ -2494,24 +2488,26 @@ static pk_status parse_emitter(xp *p, xnode *e)
         if (!fn) return xfail(p, PK_ERR_PARSE, e, "envmap needs a filename");
         if ((st = get_float(p, &d, "scale", &scale))) return st;
         if ((st = get_to_world(p, &d, &m, NULL))) return st;
-        if (env->map) {
+        if (p->s->env.map) {
             xwarn(p, e, "a second envmap is not supported; ignored");
         } else {
-            env->map = path_join(&p->s->alloc, e->file->dir, fn);
-            if (!env->map) return ctx_nomem(p->ctx);
-            env->map_scale = scale;
             /* the rotation part, columns normalised (a scale means nothing here) */
+            float rot[9];
             for (int c = 0; c < 3; c++) {
                 vec3 col = v3_norm_scaled(v3(m.m[c], m.m[4 + c], m.m[8 + c]));
-                env->to_world[c] = col.x, env->to_world[3 + c] = col.y, env->to_world[6 + c] = col.z;
+                rot[c] = col.x, rot[3 + c] = col.y, rot[6 + c] = col.z;
             }
+            scene_env_frame(p->s, rot);
+            char *path = path_join(&p->s->alloc, e->file->dir, fn);
+            if (!path) return ctx_nomem(p->ctx);
             /* read now, so that a bad map is reported at its element */
             pk_context scratch = io_scratch_context(p->ctx);
-            if ((st = scene_env_load(&scratch, env))) return xfail(p, st, e, "envmap: %s", scratch.message);
+            st = scene_env_map(&scratch, p->s, path, scale);
+            mem_free(&p->s->alloc, path);
+            if (st) return xfail(p, st, e, "envmap: %s", scratch.message);
         }
         static const char *const q2[] = {"sampling_weight", "gamma", "filter_type", "cache", NULL};
         warn_unused(&d, kind, q2);
-        env->set = true;
         return PK_OK;
     } else if (strcmp(type, "sun") == 0 || strcmp(type, "sky") == 0 || strcmp(type, "sunsky") == 0) {
         float turbidity = 3.0f, sun_scale, sky_scale, radius_scale = 1.0f, scale = 1.0f;
@@ -2540,24 +2536,18 @@ static pk_status parse_emitter(xp *p, xnode *e)
         bool sun = type[2] == 'n', sky = strcmp(type, "sky") == 0 || strcmp(type, "sunsky") == 0;
         if (strcmp(type, "sun") == 0) sun_scale = scale;
         if (strcmp(type, "sky") == 0) sky_scale = scale;
-        env->set = true;
-        env->sun_dir = dir;
+        pk_context scratch = io_scratch_context(p->ctx);
         if (sun) {
             /* sun_radius_scale widens the disc keeping its power */
             float rs = radius_scale > 0.0f ? fminf(radius_scale, 90.0f / 0.5358f) : 1.0f;
-            env->has_sun = true;
-            env->sun_angle = 0.5358f * rs;
-            env->sun_radiance =
+            vec3 le =
                 v3_scale(spectra_mitsuba06_sun(acosf(fminf(fmaxf(dir.y, 0.0f), 1.0f)), turbidity), sun_scale / (rs * rs));
+            if ((st = scene_env_sun(&scratch, p->s, dir, le, 0.5358f * rs)))
+                return xfail(p, st, e, "%s: %s", ty, scratch.message);
         }
-        if (sky) {
-            /* the Hosek-Wilkie sky as Mitsuba 0.6 evaluates it (env.h) */
-            env->has_sky = true;
-            env->sky_hosek = true;
-            env->sky_turbidity = turbidity;
-            env->sky_albedo = clamp01v(albedo);
-            env->sky_scale = sky_scale;
-        }
+        /* the Hosek-Wilkie sky as Mitsuba 0.6 evaluates it (env.h) */
+        if (sky && (st = scene_env_sky(&scratch, p->s, dir, turbidity, sky_scale, true, clamp01v(albedo))))
+            return xfail(p, st, e, "%s: %s", ty, scratch.message);
         static const char *const q2[] = {"sampling_weight", "resolution", "stretch", "extend", NULL};
         warn_unused(&d, kind, q2);
         return PK_OK;
@@ -2603,9 +2593,8 @@ static pk_status parse_film(xp *p, xnode *f)
     if ((uint64_t)w * (uint64_t)h > (uint64_t)PK_MAX_IMAGE_PIXELS)
         return xfail(p, PK_ERR_LIMIT, f, "film: %dx%d is more than %u pixels", (int)w, (int)h,
                      (unsigned)PK_MAX_IMAGE_PIXELS);
-    scene_render_settings *r = &p->s->render;
-    r->opt.width = (int)w, r->opt.height = (int)h;
-    r->has_width = r->has_height = true;
+    if ((st = scene_render_int(p->ctx, p->s, "width", (int)w)) || (st = scene_render_int(p->ctx, p->s, "height", (int)h)))
+        return st;
     p->film_w = (int)w, p->film_h = (int)h;
     xnode *crop = prop(&d, "crop_width");
     if (crop) xwarn(p, crop, "film: crop windows are not supported; the whole image is rendered");
@@ -2633,8 +2622,7 @@ static pk_status parse_sampler(xp *p, xnode *smp)
                   (long long)c);
             spp = c;
         }
-        p->s->render.opt.spp = (int)spp;
-        p->s->render.has_spp = true;
+        if ((st = scene_render_int(p->ctx, p->s, "spp", (int)spp))) return st;
     }
     static const char *const quiet[] = {"seed", "scramble", "dimension", "jitter", NULL};
     warn_unused(&d, "sampler", quiet);
@@ -2798,9 +2786,7 @@ static pk_status parse_integrator(xp *p, xnode *in, int depth)
     bool volumetric = false;
     for (int i = 0; vol[i]; i++)
         if (strcmp(type, vol[i]) == 0) volumetric = true;
-    scene_render_settings *r = &p->s->render;
-    r->opt.integrator = volumetric ? PK_INTEGRATOR_VOLPATH : PK_INTEGRATOR_PATH;
-    r->has_integrator = true;
+    scene_render_integrator(p->s, volumetric ? PK_INTEGRATOR_VOLPATH : PK_INTEGRATOR_PATH);
     int64_t md = -1;
     bool found = false;
     if (strcmp(type, "direct") == 0) {
@@ -2827,8 +2813,7 @@ static pk_status parse_integrator(xp *p, xnode *in, int depth)
         xwarn(p, in, "max_depth 0 renders nothing in Mitsuba; rendering the emitters seen directly");
         pd = 0;
     } else pd = md - 1 > PK_MAX_DEPTH ? PK_MAX_DEPTH : (int)(md - 1);
-    r->opt.max_depth = pd;
-    r->has_max_depth = true;
+    if ((st = scene_render_int(p->ctx, p->s, "max_depth", pd))) return st;
     static const char *const quiet[] = {"rr_depth", "strict_normals", "hide_emitters", "samples_per_pass",
                                         "block_size", "timeout", "luminance_samples", NULL};
     warn_unused(&d, "integrator", quiet);
