@@ -1216,8 +1216,7 @@ static pk_status parse_sky(jp *p, const cJSON *it, bool has_sun, vec3 to_sun)
 static pk_status parse_environment(jp *p, const cJSON *it)
 {
     scene_environment *env = &p->s->env;
-    scene_env_clear(&p->ctx->alloc, env);
-    env->set = true;
+    scene_env_none(p->s); /* what the description below adds to */
     pk_status st;
     if (cJSON_IsString(it) && strcmp(it->valuestring, "none") == 0) return PK_OK;
     if (cJSON_GetObjectItemCaseSensitive(it, "record")) return parse_environment_record(p, it);

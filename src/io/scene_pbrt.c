@@ -1577,7 +1577,6 @@ static pk_status d_light(pp *p, const char *type)
             pwarn(p, p->line, "infinite: portals are not used (the light is sampled as a whole)");
         if (has_L && fn) return pfail(p, p->line, PK_ERR_PARSE, "infinite: give either 'L' or 'filename', not both");
         if (fn) {
-            p->s->env.set = true;
             if ((st = equal_area_env(p, fn, p->line, &w, scale))) return st;
         } else {
             scene_env_add_radiance(p->s, v3_scale(L, scale));
@@ -1651,11 +1650,8 @@ static pk_status equal_area_env(pp *p, const char *file, size_t line, const xfor
     int ow = 2 * w, oh = w;
     if (ow > 8192) ow = 8192, oh = 4096;
     float *dst = mem_calloc(A(p), (size_t)ow * (size_t)oh, 3 * sizeof(float));
-    char *name = mem_strdup(A(p), file);
-    if (!dst || !name) {
+    if (!dst) {
         mem_free(A(p), src);
-        mem_free(A(p), dst);
-        mem_free(A(p), name);
         return ctx_nomem(p->ctx);
     }
     for (int j = 0; j < oh; j++)
@@ -1684,11 +1680,7 @@ static pk_status equal_area_env(pp *p, const char *file, size_t line, const xfor
             }
         }
     mem_free(A(p), src);
-    p->s->env.map = name;
-    p->s->env.map_rgb = dst;
-    p->s->env.map_w = ow, p->s->env.map_h = oh;
-    p->s->env.map_scale = 1.0f;
-    return PK_OK;
+    return scene_env_map_pixels(p->ctx, p->s, file, dst, ow, oh, 1.0f);
 }
 
 static pk_status d_area_light(pp *p, const char *type)
@@ -2013,8 +2005,7 @@ static pk_status d_sampler(pp *p, const char *type)
             pwarn(p, p->line, "pixelsamples %lld is more than %d; using %d", (long long)spp, o->max, o->max);
             spp = o->max;
         }
-        p->s->render.opt.spp = (int)spp;
-        p->s->render.has_spp = true;
+        if ((st = scene_render_int(p->ctx, p->s, "spp", (int)spp))) return st;
     }
     static const char *const quiet[] = {"seed", "randomization", "jitter", "xsamples", "ysamples", "dimensions"};
     pd_declare(&p->pd, quiet, sizeof quiet / sizeof quiet[0]);
@@ -2040,14 +2031,12 @@ static pk_status d_integrator(pp *p, const char *type)
     } else if (strcmp(type, "path") != 0 && strcmp(type, "volpath") != 0) {
         pwarn(p, p->line, "integrator \"%.40s\" is rendered with the path tracer", type);
     }
-    scene_render_settings *r = &p->s->render;
-    r->opt.integrator = strcmp(type, "volpath") == 0 || strcmp(type, "simplevolpath") == 0 ? PK_INTEGRATOR_VOLPATH
-                                                                                          : PK_INTEGRATOR_PATH;
-    r->has_integrator = true;
-    r->opt.max_depth = md > PK_MAX_DEPTH ? PK_MAX_DEPTH : (int)md;
-    r->has_max_depth = true;
-    r->opt.regularize = reg ? 1 : 0;
-    r->has_regularize = true;
+    scene_render_integrator(p->s, strcmp(type, "volpath") == 0 || strcmp(type, "simplevolpath") == 0
+                                      ? PK_INTEGRATOR_VOLPATH
+                                      : PK_INTEGRATOR_PATH);
+    if ((st = scene_render_int(p->ctx, p->s, "max_depth", md > PK_MAX_DEPTH ? PK_MAX_DEPTH : (int)md)) ||
+        (st = scene_render_int(p->ctx, p->s, "regularize", reg ? 1 : 0)))
+        return st;
     static const char *const quiet[] = {"lightsampler", "samplelights", "samplebsdf", "iterations", "photonsperiteration",
                                         "radius", "seed", "visualizestrategies", "visualizeweights", "mutationsperpixel",
                                         "largestepprobability", "sigma", "bootstrapsamples", "chains"};
@@ -2107,15 +2096,6 @@ static pk_status medium_float(pp *p, const char *what, const char *name, float l
         return pfail(p, q->line, PK_ERR_PARSE, "%s: '%s %s' %g must lie in %g..%g", what, q->tname, name, (double)*v,
                      (double)lo, (double)hi);
     return PK_OK;
-}
-
-/* sigma_t and the albedo of absorption sa and scattering ss times scale. */
-static void medium_coeffs(medium *m, vec3 sa, vec3 ss, float scale)
-{
-    const vec3 t = v3_add(sa, ss);
-    m->sigma_t = v3_scale(t, scale);
-    m->albedo = v3(t.x > 0.0f ? fminf(ss.x / t.x, 1.0f) : 0.0f, t.y > 0.0f ? fminf(ss.y / t.y, 1.0f) : 0.0f,
-                   t.z > 0.0f ? fminf(ss.z / t.z, 1.0f) : 0.0f);
 }
 
 /* The grid's size: nx, ny, nz (pbrt's defaults 1), within the voxel limit. */
@@ -2502,7 +2482,7 @@ static pk_status d_medium(pp *p, const char *name)
         if ((st = medium_spectrum(p, what, "sigma_a", false, &sa)) || (st = medium_spectrum(p, what, "sigma_s", false, &ss)))
             return st;
     }
-    medium_coeffs(&m, sa, ss, scale);
+    medium_set_coefficients(&m, sa, ss, scale);
     xform box = xform_identity();
     if (homogeneous) {
         vec3 le = v3s(0.0f);
@@ -2914,8 +2894,7 @@ static pk_status directive(pp *p, const pbrt_token *tk)
             pparam *q = &p->pl.p[i];
             if (strcmp(q->name, "seed") == 0 && q->type == PT_INT && q->nnum == 1 && q->num[0] >= 0 &&
                 q->num[0] <= 2147483647.0) {
-                p->s->render.opt.seed = (int)q->num[0];
-                p->s->render.has_seed = true;
+                if ((st = scene_render_int(p->ctx, p->s, "seed", (int)q->num[0]))) return st;
             } else if (strcmp(q->name, "disablepixeljitter") != 0 && strcmp(q->name, "disabletexturefiltering") != 0 &&
                        strcmp(q->name, "disablewavelengthjitter") != 0 && strcmp(q->name, "forcediffuse") != 0 &&
                        strcmp(q->name, "pixelstats") != 0 && strcmp(q->name, "wavefront") != 0 &&
@@ -3058,11 +3037,8 @@ pk_status scene_pbrt_parse(pk_context *ctx, pk_scene *s, const char *data, size_
     pk_status st = key ? PK_OK : ctx_nomem(ctx);
     /* pbrt's defaults: the material "diffuse" 0.5 (material 0 is that grey),
      * 16 samples are the sampler's own (not set), depth 5 */
-    if (st == PK_OK) {
-        s->render.opt.max_depth = 5;
-        s->render.has_max_depth = true;
-        st = parse_file(p, data, size, name, dir, key);
-    }
+    if (st == PK_OK) st = scene_render_int(ctx, s, "max_depth", 5);
+    if (st == PK_OK) st = parse_file(p, data, size, name, dir, key);
     p->top.name = name, p->top.dir = dir;
     p->f = &p->top;
     if (st == PK_OK && !p->in_world) st = finish_camera(p); /* no WorldBegin: nothing but the camera */
@@ -3070,16 +3046,18 @@ pk_status scene_pbrt_parse(pk_context *ctx, pk_scene *s, const char *data, size_
         st = pfail(p, p->obj_line, PK_ERR_PARSE, "ObjectBegin \"%.80s\" has no ObjectEnd", p->obj_name ? p->obj_name : "");
     if (st == PK_OK) st = finish_media(p);
     if (st == PK_OK) {
-        s->render.opt.width = p->film_w, s->render.opt.height = p->film_h;
         /* the image pbrt records: every emitter scaled by the sensor's ratio */
         const float k = p->exposure_time * p->film_iso / 100.0f;
         if (k != 1.0f) scene_scale_emission(s, k);
-        s->render.has_width = s->render.has_height = true;
+        if ((st = scene_render_int(ctx, s, "width", p->film_w)) == PK_OK)
+            st = scene_render_int(ctx, s, "height", p->film_h);
+    }
+    if (st == PK_OK) {
         if (!s->env.set && s->nlights == 0) {
             /* pbrt renders a scene without lights black; so does this reader */
             bool emits = false;
             for (size_t i = 0; i < s->nmaterials && !emits; i++) emits = v3_max_comp(s->materials[i].ke) > 0.0f;
-            if (!emits) s->env.set = true;
+            if (!emits) scene_env_none(s);
         }
     }
     plist_clear(p);

@@ -201,6 +201,12 @@ pk_status scene_light_distant(pk_context *ctx, pk_scene *s, vec3 to_light, vec3 
     return add_light(ctx, s, &l);
 }
 
+void scene_env_none(pk_scene *s)
+{
+    scene_env_clear(&s->alloc, &s->env);
+    s->env.set = true;
+}
+
 void scene_env_add_radiance(pk_scene *s, vec3 radiance)
 {
     s->env.set = true;

@@ -241,6 +241,9 @@ PK_HIDDEN pk_status scene_light_distant(pk_context *ctx, pk_scene *s, vec3 to_li
  * sets the environment (env.set) and checks what it must be, latching
  * PK_ERR_INVALID_ARGUMENT otherwise; readers check first, with messages
  * that say where in the file. */
+/* The scene describes its environment as nothing: no light from it, and
+ * no default white one for a scene without lights. */
+PK_HIDDEN void scene_env_none(pk_scene *s);
 /* Adds a constant radiance to the environment. */
 PK_HIDDEN void scene_env_add_radiance(pk_scene *s, vec3 radiance);
 /* The environment's frame: the rotation to_world (row-major 3x3) that
