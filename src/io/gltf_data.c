@@ -165,17 +165,9 @@ pk_status gltf_read_uri_file(gltf *g, const char *uri, const char *path, char **
         }
     }
     dec[o] = '\0';
-    char *full = path_join(&g->ctx->alloc, g->base_dir ? g->base_dir : ".", dec);
-    if (!full) return ctx_nomem(g->ctx);
     pk_context scratch = io_scratch_context(g->ctx);
-    pk_status st = file_read_all(&scratch, full, out, size);
-    if (st == PK_ERR_NOMEM) {
-        mem_free(&g->ctx->alloc, full);
-        return ctx_nomem(g->ctx);
-    }
-    if (st != PK_OK) st = gltf_fail(g, st, "%s: %s", path, scratch.message);
-    mem_free(&g->ctx->alloc, full);
-    return st;
+    pk_status st = io_read_relative(g->ctx, &scratch, g->base_dir ? g->base_dir : ".", dec, NULL, out, size);
+    return st ? gltf_fail(g, st, "%s: %s", path, scratch.message) : PK_OK;
 }
 
 /* ---- buffers and views --------------------------------------------------------- */

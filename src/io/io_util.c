@@ -339,3 +339,16 @@ bool io_demote_error(pk_context *ctx, pk_status st, bool was_ok, char *why, size
     pk_context_clear_error(ctx);
     return true;
 }
+
+pk_status io_read_relative(pk_context *ctx, pk_context *scratch, const char *dir, const char *rel, char **full,
+                           char **data, size_t *size)
+{
+    *data = NULL;
+    if (full) *full = NULL;
+    char *path = path_join(&ctx->alloc, dir, rel);
+    pk_status st = path ? file_read_all(scratch, path, data, size) : ctx_nomem(scratch);
+    if (st == PK_ERR_NOMEM) ctx_nomem(ctx);
+    if (st == PK_OK && full) *full = path;
+    else mem_free(&ctx->alloc, path);
+    return st;
+}

@@ -110,6 +110,15 @@ static inline pk_context io_scratch_context(const pk_context *ctx)
     return c;
 }
 
+/* The file rel that a scene file in folder dir names (dir NULL: rel as it
+ * or empty, or rel absolute: rel as it is), read whole through scratch (an io_scratch_context of ctx), whose
+ * message the reader latches again with where the name stood. On success
+ * *data, and *full when full is not NULL (the joined path), are the
+ * caller's to mem_free; on failure nothing is left to free. Out of memory
+ * is latched in ctx as well, so that it stands whatever the caller adds. */
+PK_HIDDEN pk_status io_read_relative(pk_context *ctx, pk_context *scratch, const char *dir, const char *rel, char **full,
+                                     char **data, size_t *size);
+
 /* Printing width for a token in a message (long tokens are cut). */
 static inline int io_tok_len(const char *s, const char *e)
 {

@@ -402,3 +402,17 @@ out:
     mem_free(&ctx->alloc, els);
     return st;
 }
+
+pk_status ply_read_relative(pk_context *ctx, pk_context *scratch, const char *dir, const char *rel, ply_mesh *out)
+{
+    memset(out, 0, sizeof *out);
+    char *full, *data;
+    size_t size;
+    pk_status st = io_read_relative(ctx, scratch, dir, rel, &full, &data, &size);
+    if (st != PK_OK) return st;
+    st = ply_parse(scratch, data, size, full, out);
+    if (st == PK_ERR_NOMEM) ctx_nomem(ctx);
+    mem_free(&ctx->alloc, data);
+    mem_free(&ctx->alloc, full);
+    return st;
+}

@@ -110,5 +110,11 @@ typedef struct ply_mesh {
  * ("name: what" or "name:line: what" in the header). */
 PK_HIDDEN pk_status ply_parse(pk_context *ctx, const char *data, size_t size, const char *name, ply_mesh *out);
 PK_HIDDEN void ply_mesh_free(pk_context *ctx, ply_mesh *m);
+/* The PLY file rel that a scene file in folder dir names, read and parsed
+ * into *out (ply_mesh_free it, also on failure); errors as
+ * io_read_relative's (io_util.h): in scratch, to be latched again where the
+ * name stood. */
+PK_HIDDEN pk_status ply_read_relative(pk_context *ctx, pk_context *scratch, const char *dir, const char *rel,
+                                      ply_mesh *out);
 
 #endif

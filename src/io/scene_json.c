@@ -1316,12 +1316,10 @@ static pk_status rec_raw_file(jp *p, const cJSON *it, const char *path, size_t c
     if (!cJSON_IsString(it) || !it->valuestring[0])
         return jfail(p, PK_ERR_PARSE, it, path, "must be a non-empty string (a path)");
     const pk_allocator *a = &p->ctx->alloc;
-    char *full = path_join(a, p->base_dir, it->valuestring), *data = NULL;
-    if (!full) return ctx_nomem(p->ctx);
-    size_t size = 0;
+    char *data;
+    size_t size;
     pk_context scratch = io_scratch_context(p->ctx);
-    pk_status st = file_read_all(&scratch, full, &data, &size);
-    mem_free(a, full);
+    pk_status st = io_read_relative(p->ctx, &scratch, p->base_dir, it->valuestring, NULL, &data, &size);
     if (st) return jfail(p, st, it, path, "%s", scratch.message);
     if (count > SIZE_MAX / elem || size != count * elem) {
         mem_free(a, data);
@@ -1448,15 +1446,10 @@ static pk_status load_ply_file(jp *p, const cJSON *file, const char *fp, const u
     if (!cJSON_IsString(file) || !file->valuestring[0])
         return jfail(p, PK_ERR_PARSE, file, fp, "must be a non-empty string (a path)");
     pk_scene *s = p->s;
-    const pk_allocator *a = &p->ctx->alloc;
-    char *full = path_join(a, p->base_dir, file->valuestring), *data = NULL;
-    size_t size = 0;
     ply_mesh m;
-    memset(&m, 0, sizeof m);
-    pk_status st;
-    if (!full) return ctx_nomem(p->ctx);
     pk_context scratch = io_scratch_context(p->ctx);
-    if ((st = file_read_all(&scratch, full, &data, &size)) || (st = ply_parse(&scratch, data, size, full, &m))) {
+    pk_status st = ply_read_relative(p->ctx, &scratch, p->base_dir, file->valuestring, &m);
+    if (st) {
         jfail(p, st, file, fp, "%s", scratch.message);
         goto out;
     }
@@ -1487,8 +1480,6 @@ static pk_status load_ply_file(jp *p, const cJSON *file, const char *fp, const u
     }
 out:
     ply_mesh_free(p->ctx, &m);
-    mem_free(a, data);
-    mem_free(a, full);
     return st;
 }
 

@@ -1443,20 +1443,10 @@ static pk_status shape_plymesh(pp *p, int32_t alpha)
     size_t n = strlen(fn);
     if (n > 3 && strcmp(fn + n - 3, ".gz") == 0)
         return pfail(p, p->line, PK_ERR_PARSE, "plymesh \"%.80s\": compressed PLY files are not read (gunzip it)", fn);
-    char *path = path_join(A(p), p->f->dir, fn);
-    if (!path) return ctx_nomem(p->ctx);
-    char *data = NULL;
-    size_t size = 0;
     pk_context tmp = io_scratch_context(p->ctx);
-    st = file_read_all(&tmp, path, &data, &size);
     ply_mesh pm;
-    memset(&pm, 0, sizeof pm);
-    if (st == PK_OK) st = ply_parse(&tmp, data, size, path, &pm);
-    mem_free(A(p), data);
-    mem_free(A(p), path);
-    if (st != PK_OK) {
+    if ((st = ply_read_relative(p->ctx, &tmp, p->f->dir, fn, &pm))) {
         ply_mesh_free(p->ctx, &pm);
-        if (st == PK_ERR_NOMEM) return ctx_nomem(p->ctx);
         return pfail(p, p->line, st, "plymesh: %s", tmp.message);
     }
     mesh_in m = {pm.positions, pm.normals, pm.uvs, pm.nvertices, pm.indices, pm.ntriangles};

@@ -1725,13 +1725,9 @@ out:
 /* Reads file (relative to the XML file of n) into *data. */
 static pk_status read_relative(xp *p, const xnode *at, const char *rel, char **full, char **data, size_t *size)
 {
-    *data = NULL;
-    *full = path_join(&p->ctx->alloc, at->file->dir, rel);
-    if (!*full) return ctx_nomem(p->ctx);
     pk_context scratch = io_scratch_context(p->ctx);
-    pk_status st = file_read_all(&scratch, *full, data, size);
-    if (st) return xfail(p, st, at, "%s", scratch.message);
-    return PK_OK;
+    pk_status st = io_read_relative(p->ctx, &scratch, at->file->dir, rel, full, data, size);
+    return st ? xfail(p, st, at, "%s", scratch.message) : PK_OK;
 }
 
 /* Mitsuba emits (and tells inside from outside) by a mesh's shading
