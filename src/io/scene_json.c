@@ -836,7 +836,7 @@ static pk_status parse_camera(jp *p, const cJSON *it)
         const cJSON *top = cJSON_GetObjectItemCaseSensitive(p->root, "medium");
         if (top && med != p->s->camera_medium)
             return jfail(p, PK_ERR_PARSE, f[C_MEDIUM], "camera.medium", "differs from the scene's \"medium\"; give one of them");
-        p->s->camera_medium = med;
+        scene_set_camera_medium(p->s, med);
     }
     scene_set_camera(p->s, &cam); /* checked above */
     return PK_OK;
@@ -1792,7 +1792,7 @@ pk_status scene_json_parse(pk_context *ctx, pk_scene *s, const char *data, size_
     if (f[K_MEDIUM]) {
         int32_t med;
         if ((st = get_medium_ref(p, f[K_MEDIUM], "medium", &med))) goto out;
-        s->camera_medium = med;
+        scene_set_camera_medium(s, med);
     }
     if (f[K_MATERIALS] && (st = parse_materials(p, f[K_MATERIALS]))) goto out;
     if (f[K_CAMERA] && (st = parse_camera(p, f[K_CAMERA]))) goto out;

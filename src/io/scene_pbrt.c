@@ -2523,7 +2523,7 @@ static pk_status finish_media(pp *p)
             p->f = &p->top;
             return st;
         }
-        p->s->camera_medium = (int32_t)m;
+        scene_set_camera_medium(p->s, (int32_t)m);
     }
     for (size_t i = p->media_start; i < p->s->nmedia; i++)
         p->s->media[i].grid_to_world = xform_mul(&p->mirror, &p->s->media[i].grid_to_world);

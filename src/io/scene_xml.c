@@ -2727,7 +2727,7 @@ static pk_status parse_sensor(xp *p, xnode *sn)
             }
             int32_t med;
             if ((st = medium_of(p, c, &med))) return st;
-            p->s->camera_medium = med;
+            scene_set_camera_medium(p->s, med);
         }
     }
     static const char *const quiet[] = {"near_clip", "far_clip", "focus_distance", "shutter_open", "shutter_close",
@@ -2751,8 +2751,10 @@ static pk_status finish_camera(xp *p)
     else if (strcmp(ax, "y") == 0) ty = t;
     else ty = t * (double)h / sqrt((double)w * w + (double)h * h);
     float fov = (float)(2.0 * atan(ty) * 180.0 / (double)PK_PI);
-    if (!(fov > 0.0f && fov < 180.0f)) return xfail(p, PK_ERR_PARSE, p->sensor, "the vertical fov is out of range");
-    p->s->camera.fov_deg = fov;
+    pk_camera cam = p->s->camera;
+    cam.fov_deg = fov;
+    if (!(fov > 0.0f && fov < 180.0f) || scene_set_camera(p->s, &cam) != CAMERA_OK)
+        return xfail(p, PK_ERR_PARSE, p->sensor, "the vertical fov is out of range");
     return PK_OK;
 }
 

@@ -309,6 +309,9 @@ PK_HIDDEN pk_status scene_add_medium(pk_context *ctx, pk_scene *s, medium *m, ui
  * readers whose shapes name their media apart from their materials. */
 PK_HIDDEN pk_status scene_material_with_media(pk_context *ctx, pk_scene *s, uint32_t mat, int32_t med_in,
                                               int32_t med_out, uint32_t *out);
+/* The medium the camera sits in: MEDIUM_NONE or a medium's number (checked
+ * by scene_commit with the media materials name). */
+static inline void scene_set_camera_medium(pk_scene *s, int32_t med) { s->camera_medium = med; }
 /* Number of the newest medium named name; -1 when absent. */
 PK_HIDDEN int64_t scene_find_medium(const pk_scene *s, const char *name);
 /* A medium's coefficients from absorption sigma_a and scattering sigma_s
