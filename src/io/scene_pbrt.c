@@ -249,6 +249,74 @@ static void warn_unused(pp *p, const char *fmt, ...)
 
 /* ---- colours and spectra ------------------------------------------------------------------ */
 
+/* Sampled spectrum values (wavelengths in nm, increasing) as linear RGB:
+ * an emitter by pbrt's rule, anything else as a reflectance (a flat one is
+ * grey, and a flat index of refraction its value). */
+#define PB_MAX_SPECTRUM 4096
+static pk_status spectrum_samples(pp *p, const pparam *q, const float *nm, const float *val, size_t n, bool illuminant,
+                                  vec3 *out)
+{
+    for (size_t i = 1; i < n; i++)
+        if (!(nm[i] > nm[i - 1]))
+            return pfail(p, q->line, PK_ERR_PARSE, "'spectrum %s': wavelengths must increase", q->name);
+    *out = illuminant ? spectra_pbrt_emitter(nm, val, n) : spectrum_to_rgb(nm, val, (int)n);
+    return PK_OK;
+}
+
+/* A spectrum named by a file (pbrt-v4's .spd: wavelength and value pairs,
+ * '#' to the end of a line a comment), relative to the file that names
+ * it. A file that cannot be read or is not such a list is a warning, and
+ * 1 stands in (as pbrt would stop, a scene still renders here). */
+static pk_status spectrum_file(pp *p, const pparam *q, const char *name, bool illuminant, vec3 *out)
+{
+    *out = v3s(1.0f);
+    char *data;
+    size_t size, n = 0, k = 0;
+    pk_context tmp = io_scratch_context(p->ctx);
+    pk_status st = io_read_relative(p->ctx, &tmp, p->f->dir, name, NULL, &data, &size);
+    if (st == PK_ERR_NOMEM) return st;
+    if (st) {
+        pwarn(p, q->line, "spectrum \"%.60s\" is neither a named spectrum nor a file that can be read (%s); using 1",
+              name, tmp.message);
+        return PK_OK;
+    }
+    float *nm = mem_alloc(A(p), 2 * PB_MAX_SPECTRUM * sizeof(float)), *val = nm + PB_MAX_SPECTRUM;
+    const char *why = NULL, *c = data, *e = data + size;
+    if (!nm) st = ctx_nomem(p->ctx);
+    while (st == PK_OK && !why && c < e) {
+        if (*c == '#') {
+            while (c < e && *c != '\n') c++;
+        } else if (*c == ' ' || *c == '\t' || *c == '\r' || *c == '\n' || *c == ',') {
+            c++;
+        } else if (k == 2 * PB_MAX_SPECTRUM) {
+            why = "more than 4096 samples";
+        } else {
+            float v;
+            const char *next = io_parse_float(c, e, &v);
+            if (!next || next == c || !isfinite(v)) why = "something that is not a number";
+            else {
+                if (k % 2) val[k / 2] = v;
+                else nm[k / 2] = v;
+                k++;
+                c = next;
+            }
+        }
+    }
+    n = k / 2;
+    if (st == PK_OK && !why && (k % 2 || n == 0)) why = k % 2 ? "an odd count of numbers" : "no samples";
+    if (st == PK_OK && !why)
+        for (size_t i = 1; i < n && !why; i++)
+            if (!(nm[i] > nm[i - 1])) why = "wavelengths that do not increase";
+    if (st == PK_OK && why)
+        pwarn(p, q->line, "spectrum file \"%.60s\" holds %s (wavelength and value pairs were expected); using 1", name,
+              why);
+    else if (st == PK_OK)
+        st = spectrum_samples(p, q, nm, val, n, illuminant, out);
+    mem_free(A(p), nm);
+    mem_free(A(p), data);
+    return st;
+}
+
 /* A spectrum parameter as linear RGB. illuminant: the light's rule (a
  * blackbody or a standard illuminant at luminance 1). */
 static pk_status spectrum_rgb(pp *p, const pparam *q, bool illuminant, vec3 *out)
@@ -271,30 +339,18 @@ static pk_status spectrum_rgb(pp *p, const pparam *q, bool illuminant, vec3 *out
         *out = v3s((float)q->num[0]);
         return PK_OK;
     }
-    /* spectrum: pairs or a name */
+    /* spectrum: pairs, a name, or a file of pairs */
     if (q->nnum) {
         size_t n = q->nnum / 2;
-        if (n > 4096) return pfail(p, q->line, PK_ERR_LIMIT, "'spectrum %s': more than 4096 samples", q->name);
-        float nm[4096], val[4096];
-        for (size_t i = 0; i < n; i++) {
-            nm[i] = (float)q->num[2 * i], val[i] = (float)q->num[2 * i + 1];
-            if (i && !(nm[i] > nm[i - 1]))
-                return pfail(p, q->line, PK_ERR_PARSE, "'spectrum %s': wavelengths must increase", q->name);
-        }
-        if (illuminant) {
-            *out = spectra_pbrt_emitter(nm, val, n);
-        } else {
-            *out = spectrum_to_rgb(nm, val, (int)n); /* a reflectance: a flat one is grey */
-        }
-        return PK_OK;
+        if (n > PB_MAX_SPECTRUM) return pfail(p, q->line, PK_ERR_LIMIT, "'spectrum %s': more than %d samples", q->name, PB_MAX_SPECTRUM);
+        float nm[PB_MAX_SPECTRUM], val[PB_MAX_SPECTRUM];
+        for (size_t i = 0; i < n; i++) nm[i] = (float)q->num[2 * i], val[i] = (float)q->num[2 * i + 1];
+        return spectrum_samples(p, q, nm, val, n, illuminant, out);
     }
     const char *nmn = q->str[0];
     const int known = spectra_pbrt_named(nmn, out);
     if (known == SPECTRA_PBRT_APPROX) pwarn(p, q->line, "spectrum \"%s\" is not in the table; copper's is used", nmn);
-    if (known == SPECTRA_PBRT_UNKNOWN) {
-        *out = v3s(1.0f);
-        pwarn(p, q->line, "spectrum \"%.60s\" is not known (spectrum files are not read); using 1", nmn);
-    }
+    if (known == SPECTRA_PBRT_UNKNOWN) return spectrum_file(p, q, nmn, illuminant, out);
     return PK_OK;
 }
 

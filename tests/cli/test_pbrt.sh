@@ -2,7 +2,7 @@
 # pbrt-v4 scenes on the command line: a scene split over included files
 # renders at its Film's size; bad scenes give exactly one line naming the
 # file and line, exit status 1 and no image; Bitterli's Cornell box in
-# pbrt-v4 form renders when ../shared is there.
+# pbrt-v4 form renders when ../shared is there; spectrum files are read.
 # usage: test_pbrt.sh PAPRSEK SHARED_DIR DATA_DIR
 set -u
 bin=$1
@@ -50,6 +50,42 @@ expect "missing mesh" 1 "missing_ply.pbrt:3: plymesh: $data/no_such_mesh.ply: ca
 printf 'WorldBegin\n\nShape "trianglemesh" "point3 P" [0 0 0 1 0 0 0 1 0] "integer indices" [0 1 7]\n' > "$tmp/bad.pbrt"
 expect "index out of range" 1 "bad.pbrt:3: trianglemesh: index 7 (number 2) is out of range (3 vertices)" \
   render "$tmp/bad.pbrt" -o "$tmp/out.png"
+
+# spectrum files (pbrt-v4's .spd): read relative to the scene, the same
+# image as the same samples given inline (and not the image of the 1 that
+# stands in for a file that cannot be read); bad files are one warning
+mkdir -p "$tmp/spd/spds"
+printf '# gold (test values)\n400 1.66\n500 0.97 # a comment\n600 0.25\n700 0.16\n' > "$tmp/spd/spds/eta.spd"
+printf '400 1.95  500 1.87\r\n600 2.98  700 3.96\n' > "$tmp/spd/spds/k.spd"
+printf '400 1 500\n' > "$tmp/spd/spds/odd.spd"
+spd_scene() {
+  printf 'LookAt 0 0 5  0 0 0  0 1 0\nCamera "perspective" "float fov" 30\n'
+  printf 'Film "rgb" "integer xresolution" 24 "integer yresolution" 24 "string filename" "x.exr"\nWorldBegin\n'
+  printf 'LightSource "infinite" "rgb L" [1 1 1]\nMaterial "conductor" %s "float roughness" 0.2\n' "$1"
+  printf 'Shape "sphere" "float radius" 1\n'
+}
+spd_scene '"spectrum eta" "spds/eta.spd" "spectrum k" "spds/k.spd"' > "$tmp/spd/file.pbrt"
+spd_scene '"spectrum eta" [400 1.66 500 0.97 600 0.25 700 0.16] "spectrum k" [400 1.95 500 1.87 600 2.98 700 3.96]' \
+  > "$tmp/spd/inline.pbrt"
+spd_scene '"spectrum eta" "spds/none.spd" "spectrum k" "spds/k.spd"' > "$tmp/spd/missing.pbrt"
+spd_scene '"spectrum eta" "spds/odd.spd" "spectrum k" "spds/k.spd"' > "$tmp/spd/odd.pbrt"
+for v in file inline missing odd; do
+  "$bin" render "$tmp/spd/$v.pbrt" -o "$tmp/spd/$v.pfm" --spp 2 2>"$tmp/spd/$v.err" >/dev/null ||
+    { echo "FAIL spectrum file: $v did not render: $(cat "$tmp/spd/$v.err")"; fail=1; }
+done
+if [ -s "$tmp/spd/file.err" ] || ! cmp -s "$tmp/spd/file.pfm" "$tmp/spd/inline.pfm"; then
+  echo "FAIL spectrum file: not the image of the same samples inline ($(cat "$tmp/spd/file.err"))"; fail=1
+elif cmp -s "$tmp/spd/file.pfm" "$tmp/spd/missing.pfm"; then
+  echo "FAIL spectrum file: the file's values made no difference"; fail=1
+else
+  echo "ok   spectrum file"
+fi
+want="paprsek: warning: missing.pbrt:6: spectrum \"spds/none.spd\" is neither a named spectrum nor a file that can be read ($tmp/spd/spds/none.spd: cannot open: No such file or directory); using 1"
+[ "$(cat "$tmp/spd/missing.err")" = "$want" ] && echo "ok   spectrum file missing" ||
+  { echo "FAIL spectrum file missing: $(cat "$tmp/spd/missing.err")"; fail=1; }
+want="paprsek: warning: odd.pbrt:6: spectrum file \"spds/odd.spd\" holds an odd count of numbers (wavelength and value pairs were expected); using 1"
+[ "$(cat "$tmp/spd/odd.err")" = "$want" ] && echo "ok   spectrum file odd" ||
+  { echo "FAIL spectrum file odd: $(cat "$tmp/spd/odd.err")"; fail=1; }
 
 if [ -r "$shared/scenes/pbrt-v4/cornell-box/scene-v4.pbrt" ]; then
   expect "cornell box" 0 "" render "$shared/scenes/pbrt-v4/cornell-box/scene-v4.pbrt" -o "$tmp/out.png" \
