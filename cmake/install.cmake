@@ -40,7 +40,7 @@ install(FILES ${CMAKE_CURRENT_BINARY_DIR}/paprsekConfig.cmake
   ${CMAKE_CURRENT_BINARY_DIR}/paprsekConfigVersion.cmake DESTINATION ${PK_CMAKE_DIR})
 
 # paprsek.pc. Static linking (pkg-config --static) needs what the library
-# links: libpng, cJSON and expat through their own .pc files where they have one,
+# links: libpng, cJSON, expat and zlib through their own .pc files where they have one,
 # libjpeg, OpenEXRCore, the OpenMP flag, libm (and libdl, the thread library where the C library
 # lacks them). Embree, oneDNN, CUDA and OpenVDB are not listed: they are loaded at run time.
 set(PK_PC_REQUIRES_PRIVATE)
@@ -50,6 +50,7 @@ if(PKG_CONFIG_FOUND)
   pkg_check_modules(PK_PC_LIBPNG QUIET libpng)
   pkg_check_modules(PK_PC_LIBCJSON QUIET libcjson)
   pkg_check_modules(PK_PC_EXPAT QUIET expat)
+  pkg_check_modules(PK_PC_ZLIB QUIET zlib)
 endif()
 if(PK_PC_LIBPNG_FOUND)
   list(APPEND PK_PC_REQUIRES_PRIVATE libpng)
@@ -69,6 +70,11 @@ if(PK_PC_EXPAT_FOUND)
   list(APPEND PK_PC_REQUIRES_PRIVATE expat)
 else()
   list(APPEND PK_PC_LIBS_PRIVATE -lexpat)
+endif()
+if(PK_PC_ZLIB_FOUND)
+  list(APPEND PK_PC_REQUIRES_PRIVATE zlib)
+else()
+  list(APPEND PK_PC_LIBS_PRIVATE -lz)
 endif()
 # OpenEXR: the C library OpenEXRCore alone, by name. Its OpenEXR.pc would
 # link the C++ libraries too (OpenEXR, Iex, IlmThread) and add Imath's

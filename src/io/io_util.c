@@ -13,6 +13,8 @@
 #include <stdio.h>
 #include <string.h>
 
+#include <zlib.h>
+
 void io_reader_init(io_reader *r, pk_context *ctx, const char *name, const char *data, size_t size)
 {
     memset(r, 0, sizeof *r);
@@ -347,8 +349,81 @@ pk_status io_read_relative(pk_context *ctx, pk_context *scratch, const char *dir
     if (full) *full = NULL;
     char *path = path_join(&ctx->alloc, dir, rel);
     pk_status st = path ? file_read_all(scratch, path, data, size) : ctx_nomem(scratch);
+    if (st == PK_OK && io_is_gzip_name(rel)) {
+        char *raw = *data;
+        st = io_gunzip(scratch, path, raw, *size, data, size);
+        mem_free(&ctx->alloc, raw);
+        if (st != PK_OK) *data = NULL;
+    }
     if (st == PK_ERR_NOMEM) ctx_nomem(ctx);
     if (st == PK_OK && full) *full = path;
     else mem_free(&ctx->alloc, path);
     return st;
+}
+
+bool io_is_gzip_name(const char *name)
+{
+    size_t n = strlen(name);
+    return n > 3 && strcmp(name + n - 3, ".gz") == 0;
+}
+
+pk_status io_gunzip(pk_context *ctx, const char *name, const char *data, size_t size, char **out, size_t *out_size)
+{
+    *out = NULL;
+    *out_size = 0;
+    if (size < 2 || (unsigned char)data[0] != 0x1f || (unsigned char)data[1] != 0x8b)
+        return ctx_error(ctx, PK_ERR_PARSE, "%s: not a gzip file", name);
+    z_stream z;
+    memset(&z, 0, sizeof z);
+    if (inflateInit2(&z, 15 + 16) != Z_OK) return ctx_nomem(ctx); /* gzip wrapper only */
+    size_t cap = size < ((size_t)1 << 20) ? (size_t)1 << 20 : size, len = 0, in = 0;
+    char *buf = mem_alloc(&ctx->alloc, cap + 1);
+    pk_status st = buf ? PK_OK : ctx_nomem(ctx);
+    int zr = Z_OK;
+    while (st == PK_OK) {
+        if (len == cap) {
+            if (cap >= PK_MAX_FILE_BYTES) {
+                st = ctx_error(ctx, PK_ERR_LIMIT, "%s: inflates to more than %zu bytes", name, (size_t)PK_MAX_FILE_BYTES);
+                break;
+            }
+            size_t nc = cap * 2 > PK_MAX_FILE_BYTES ? PK_MAX_FILE_BYTES : cap * 2;
+            char *nb = mem_realloc_array(&ctx->alloc, buf, nc + 1, 1);
+            if (!nb) {
+                st = ctx_nomem(ctx);
+                break;
+            }
+            buf = nb, cap = nc;
+        }
+        /* zlib counts in uInt: feed and take at most 1 GiB a step */
+        const size_t step = (size_t)1 << 30;
+        z.next_in = (Bytef *)(uintptr_t)(data + in);
+        z.avail_in = (uInt)(size - in < step ? size - in : step);
+        z.next_out = (Bytef *)(buf + len);
+        z.avail_out = (uInt)(cap - len < step ? cap - len : step);
+        const uInt avail_in = z.avail_in, avail_out = z.avail_out;
+        zr = inflate(&z, Z_NO_FLUSH);
+        in += avail_in - z.avail_in;
+        len += avail_out - z.avail_out;
+        if (zr == Z_STREAM_END) {
+            /* another member follows (files joined by cat), or the end */
+            if (in == size) break;
+            if (size - in < 2 || (unsigned char)data[in] != 0x1f || (unsigned char)data[in + 1] != 0x8b) break;
+            if (inflateReset(&z) != Z_OK) st = ctx_nomem(ctx);
+        } else if (zr == Z_MEM_ERROR) {
+            st = ctx_nomem(ctx);
+        } else if (zr != Z_OK && zr != Z_BUF_ERROR) {
+            st = ctx_error(ctx, PK_ERR_PARSE, "%s: damaged gzip data (%s)", name, z.msg ? z.msg : "inflate failed");
+        } else if (in == size && z.avail_out > 0) {
+            st = ctx_error(ctx, PK_ERR_PARSE, "%s: the gzip data ends early", name);
+        }
+    }
+    inflateEnd(&z);
+    if (st != PK_OK) {
+        mem_free(&ctx->alloc, buf);
+        return st;
+    }
+    buf[len] = '\0';
+    *out = buf;
+    *out_size = len;
+    return PK_OK;
 }

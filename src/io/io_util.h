@@ -114,10 +114,21 @@ static inline pk_context io_scratch_context(const pk_context *ctx)
  * or empty, or rel absolute: rel as it is), read whole through scratch (an io_scratch_context of ctx), whose
  * message the reader latches again with where the name stood. On success
  * *data, and *full when full is not NULL (the joined path), are the
- * caller's to mem_free; on failure nothing is left to free. Out of memory
+ * caller's to mem_free; on failure nothing is left to free. A name ending
+ * in ".gz" is inflated (io_gunzip): *data holds what it holds. Out of memory
  * is latched in ctx as well, so that it stands whatever the caller adds. */
 PK_HIDDEN pk_status io_read_relative(pk_context *ctx, pk_context *scratch, const char *dir, const char *rel, char **full,
                                      char **data, size_t *size);
+
+/* Whether name ends in ".gz" (a gzip file that io_read_relative inflates). */
+PK_HIDDEN bool io_is_gzip_name(const char *name);
+/* Inflates the gzip data (size bytes; several members are read one after
+ * another, as gunzip does) into a new NUL-terminated buffer *out of *out_size
+ * bytes (mem_free it); at most PK_MAX_FILE_BYTES. Errors (latched in ctx,
+ * name in front): not gzip data, damaged or cut short (PK_ERR_PARSE), too
+ * large (PK_ERR_LIMIT), out of memory. */
+PK_HIDDEN pk_status io_gunzip(pk_context *ctx, const char *name, const char *data, size_t size, char **out,
+                              size_t *out_size);
 
 /* Printing width for a token in a message (long tokens are cut). */
 static inline int io_tok_len(const char *s, const char *e)

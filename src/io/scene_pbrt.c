@@ -1496,9 +1496,6 @@ static pk_status shape_plymesh(pp *p, int32_t alpha)
     if (pb_param(&p->pd, "displacement"))
         pwarn(p, p->line, "plymesh: 'displacement' is not supported; the mesh is rendered undisplaced");
     pb_param(&p->pd, "edgelength");
-    size_t n = strlen(fn);
-    if (n > 3 && strcmp(fn + n - 3, ".gz") == 0)
-        return pfail(p, p->line, PK_ERR_PARSE, "plymesh \"%.80s\": compressed PLY files are not read (gunzip it)", fn);
     pk_context tmp = io_scratch_context(p->ctx);
     ply_mesh pm;
     if ((st = ply_read_relative(p->ctx, &tmp, p->f->dir, fn, &pm))) {
@@ -2644,15 +2641,15 @@ static pk_status d_include(pp *p)
             mem_free(A(p), path);
             return st;
         }
-    size_t n = strlen(rel);
-    if (n > 3 && strcmp(rel + n - 3, ".gz") == 0) {
-        mem_free(A(p), path);
-        return pfail(p, p->line, PK_ERR_PARSE, "%s \"%.200s\": compressed files are not read (gunzip it)", p->dname, rel);
-    }
     char *data = NULL;
     size_t size = 0;
     pk_context tmp = io_scratch_context(p->ctx);
     st = file_read_all(&tmp, path, &data, &size);
+    if (st == PK_OK && io_is_gzip_name(rel)) { /* pbrt-v4 reads gzip files by their name */
+        char *raw = data;
+        st = io_gunzip(&tmp, path, raw, size, &data, &size);
+        mem_free(A(p), raw);
+    }
     if (st) {
         mem_free(A(p), path);
         if (st == PK_ERR_NOMEM) return ctx_nomem(p->ctx);

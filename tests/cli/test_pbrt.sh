@@ -2,7 +2,8 @@
 # pbrt-v4 scenes on the command line: a scene split over included files
 # renders at its Film's size; bad scenes give exactly one line naming the
 # file and line, exit status 1 and no image; Bitterli's Cornell box in
-# pbrt-v4 form renders when ../shared is there; spectrum files are read.
+# pbrt-v4 form renders when ../shared is there; spectrum files and gzip files
+# are read.
 # usage: test_pbrt.sh PAPRSEK SHARED_DIR DATA_DIR
 set -u
 bin=$1
@@ -86,6 +87,35 @@ want="paprsek: warning: missing.pbrt:6: spectrum \"spds/none.spd\" is neither a 
 want="paprsek: warning: odd.pbrt:6: spectrum file \"spds/odd.spd\" holds an odd count of numbers (wavelength and value pairs were expected); using 1"
 [ "$(cat "$tmp/spd/odd.err")" = "$want" ] && echo "ok   spectrum file odd" ||
   { echo "FAIL spectrum file odd: $(cat "$tmp/spd/odd.err")"; fail=1; }
+
+# gzip files by name (a .ply.gz mesh, an included .pbrt.gz, two members
+# joined by cat): the bytes of the same files uncompressed
+mkdir -p "$tmp/gz"
+cp "$data/../fuzz_seed_mesh.ply" "$tmp/gz/mesh.ply"
+gzip -c "$tmp/gz/mesh.ply" > "$tmp/gz/mesh.ply.gz"
+printf 'LightSource "infinite" "rgb L" [ 1 1 1 ]\nTranslate 0 0 3\n' > "$tmp/gz/light.pbrt"
+{ head -c 20 "$tmp/gz/light.pbrt" | gzip -c; tail -c +21 "$tmp/gz/light.pbrt" | gzip -c; } > "$tmp/gz/light.pbrt.gz"
+printf 'Camera "perspective"\nFilm "rgb" "integer xresolution" 24 "integer yresolution" 24\nWorldBegin\nInclude "light.pbrt%s"\nShape "plymesh" "string filename" "mesh.ply%s"\n' "" "" > "$tmp/gz/plain.pbrt"
+printf 'Camera "perspective"\nFilm "rgb" "integer xresolution" 24 "integer yresolution" 24\nWorldBegin\nInclude "light.pbrt%s"\nShape "plymesh" "string filename" "mesh.ply%s"\n' ".gz" ".gz" > "$tmp/gz/gz.pbrt"
+"$bin" render "$tmp/gz/plain.pbrt" -o "$tmp/gz/plain.pfm" --spp 2 -q 2>"$tmp/gz/plain.err"
+"$bin" render "$tmp/gz/gz.pbrt" -o "$tmp/gz/gz.pfm" --spp 2 -q 2>"$tmp/gz/gz.err"
+head -n 4 "$tmp/gz/plain.pbrt" > "$tmp/gz/nomesh.pbrt"
+"$bin" render "$tmp/gz/nomesh.pbrt" -o "$tmp/gz/nomesh.pfm" --spp 2 -q 2>/dev/null
+if [ -s "$tmp/gz/gz.err" ] || ! cmp -s "$tmp/gz/plain.pfm" "$tmp/gz/gz.pfm"; then
+  echo "FAIL gzip files: not the image of the files uncompressed ($(cat "$tmp/gz/gz.err"))"; fail=1
+elif cmp -s "$tmp/gz/gz.pfm" "$tmp/gz/nomesh.pfm"; then
+  echo "FAIL gzip files: the mesh is not in the image"; fail=1
+else
+  echo "ok   gzip files"
+fi
+head -c 60 "$tmp/gz/mesh.ply.gz" > "$tmp/gz/cut.ply.gz"
+printf 'WorldBegin\nShape "plymesh" "string filename" "cut.ply.gz"\n' > "$tmp/gz/cut.pbrt"
+expect "gzip cut short" 1 "cut.pbrt:2: plymesh: $tmp/gz/cut.ply.gz: the gzip data ends early" \
+  render "$tmp/gz/cut.pbrt" -o "$tmp/out.png"
+cp "$tmp/gz/mesh.ply" "$tmp/gz/plain.ply.gz"
+printf 'WorldBegin\nShape "plymesh" "string filename" "plain.ply.gz"\n' > "$tmp/gz/notgz.pbrt"
+expect "not gzip" 1 "notgz.pbrt:2: plymesh: $tmp/gz/plain.ply.gz: not a gzip file" \
+  render "$tmp/gz/notgz.pbrt" -o "$tmp/out.png"
 
 if [ -r "$shared/scenes/pbrt-v4/cornell-box/scene-v4.pbrt" ]; then
   expect "cornell box" 0 "" render "$shared/scenes/pbrt-v4/cornell-box/scene-v4.pbrt" -o "$tmp/out.png" \
