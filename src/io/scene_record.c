@@ -17,7 +17,7 @@ const rec_field rec_material[] = {
     F(material, schlick, REC_BOOL),     F(material, beckmann, REC_BOOL),
     F(material, metallic, REC_FLOAT),   F(material, roughness, REC_FLOAT),
     F(material, transmission, REC_FLOAT), F(material, clearcoat, REC_FLOAT),
-    F(material, clearcoat_roughness, REC_FLOAT),
+    F(material, clearcoat_roughness, REC_FLOAT), F(material, tint, REC_VEC3),
 };
 const size_t rec_nmaterial = sizeof rec_material / sizeof rec_material[0];
 

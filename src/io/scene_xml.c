@@ -1400,13 +1400,15 @@ static pk_status bsdf_conductor(xp *p, const bsdf_in *in, material *m)
     eta = v3(fmaxf(eta.x, 1e-4f), fmaxf(eta.y, 1e-4f), fmaxf(eta.z, 1e-4f));
     k = v3(fmaxf(k.x, 0.0f), fmaxf(k.y, 0.0f), fmaxf(k.z, 0.0f));
     spec = clamp01v(spec);
-    if (none || spec.x != 1.0f || spec.y != 1.0f || spec.z != 1.0f) {
-        /* a scaled Fresnel term: Schlick's with the scaled normal reflectance */
-        const vec3 f0 = none ? v3s(1.0f) : material_f0_conductor(eta, k);
-        material_conductor_f0(m, clamp01v(v3_mul(f0, spec)), in->alpha);
-    } else {
-        material_conductor(m, eta, k, in->alpha);
-    }
+    /* "none": a perfect mirror (Schlick's Fresnel of F0 = 1 is 1 at every
+     * angle). Mitsuba (0.6 and 3) multiplies the conductor's Fresnel term by
+     * specular_reflectance, and Tungsten its whole BRDF by albedo (which is
+     * where Bitterli's 0.3 on the "Veach, MIS" plates comes from): a factor
+     * at every angle, not a smaller F0 that grazing light would raise back
+     * to 1 (tests/render/test_veach_plates.c) */
+    if (none) material_conductor_f0(m, v3s(1.0f), in->alpha);
+    else material_conductor(m, eta, k, in->alpha);
+    if (spec.x != 1.0f || spec.y != 1.0f || spec.z != 1.0f) material_conductor_tint(m, spec);
     m->beckmann = in->beckmann;
     return PK_OK;
 }

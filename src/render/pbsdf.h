@@ -59,6 +59,8 @@ typedef enum pbsdf_type {
  *   albedo        [0, 1] per channel       diffuse, plastic; glossy (kd)
  *   specular      [0, 1] per channel       glossy (ks, with albedo + specular <= 1
  *                                          per channel), conductor F0 with PBSDF_SCHLICK
+ *   tint          [0, 1] per channel       conductor: a factor on the Fresnel reflectance
+ *                                          (Mitsuba's specular_reflectance); 1 by default
  *   eta, k        eta > 0, k >= 0          conductor: complex index of the metal
  *                                          relative to the outside medium, per channel
  *   transmittance [0, 1] per channel       dielectric: tint of refracted light (MTL Tf)
@@ -77,6 +79,7 @@ typedef struct pbsdf {
     unsigned flags;      /* PBSDF_SCHLICK */
     vec3 albedo;
     vec3 specular;
+    vec3 tint;
     vec3 eta, k;
     vec3 transmittance;
     float alpha;
@@ -93,6 +96,7 @@ static inline PK_HD pbsdf pbsdf__blank(int type)
     b.type = type;
     b.flags = 0;
     b.albedo = b.specular = b.transmittance = v3s(0.0f);
+    b.tint = v3s(1.0f);
     b.eta = v3s(1.0f);
     b.k = v3s(0.0f);
     b.alpha = 0.0f;
@@ -234,11 +238,11 @@ static inline PK_HD vec3 pbsdf__fresnel_conductor(const pbsdf *b, float cos_i)
     if (b->flags & PBSDF_SCHLICK) {
         float m = 1.0f - fminf(1.0f, fmaxf(0.0f, cos_i));
         float m5 = m * m * m * m * m;
-        return v3_add(b->specular, v3_scale(v3_sub(v3s(1.0f), b->specular), m5));
+        return v3_mul(b->tint, v3_add(b->specular, v3_scale(v3_sub(v3s(1.0f), b->specular), m5)));
     }
-    return v3(pbsdf__fresnel_conductor1(cos_i, b->eta.x, b->k.x),
-              pbsdf__fresnel_conductor1(cos_i, b->eta.y, b->k.y),
-              pbsdf__fresnel_conductor1(cos_i, b->eta.z, b->k.z));
+    return v3_mul(b->tint, v3(pbsdf__fresnel_conductor1(cos_i, b->eta.x, b->k.x),
+                              pbsdf__fresnel_conductor1(cos_i, b->eta.y, b->k.y),
+                              pbsdf__fresnel_conductor1(cos_i, b->eta.z, b->k.z)));
 }
 
 /* ---- GGX (Trowbridge-Reitz), isotropic, local frame ---------------------- */

@@ -40,6 +40,7 @@ static inline PK_HD shading shading_at(const surface *sf)
         switch (m->type) {
         case MAT_CONDUCTOR:
             sh.b = m->schlick ? pbsdf_conductor_schlick(m->ks, m->alpha) : pbsdf_conductor(m->eta, m->k, m->alpha);
+            sh.b.tint = m->tint;
             break;
         case MAT_DIELECTRIC:
             sh.b = pbsdf_dielectric(m->ni, m->alpha, sf->front ? m->tf : v3s(1.0f));

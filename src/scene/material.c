@@ -10,6 +10,7 @@ void material_init(material *m)
     memset(m, 0, sizeof *m);
     m->kd = v3s(0.8f);
     m->tf = v3s(1.0f);
+    m->tint = v3s(1.0f);
     m->ns = 1.0f;
     m->ni = 1.0f;
     m->d = 1.0f;
@@ -75,6 +76,12 @@ void material_conductor_f0(material *m, vec3 f0, float alpha)
     m->alpha = alpha;
     m->kd = v3s(0.0f), m->ks = f0;
     whitted_gloss(m, alpha);
+}
+
+void material_conductor_tint(material *m, vec3 tint)
+{
+    m->tint = tint;
+    if (!m->schlick) m->ks = v3_mul(m->ks, tint);
 }
 
 void material_dielectric(material *m, float ior, float alpha, vec3 transmittance)

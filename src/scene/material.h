@@ -74,6 +74,10 @@ typedef struct material {
     float alpha;
     vec3 eta, k;
     bool schlick;
+    /* conductor: a factor on its Fresnel reflectance, per channel in [0, 1]
+     * (Mitsuba's specular_reflectance, Tungsten's albedo: both multiply the
+     * whole microfacet BRDF by it); 1 (material_init) leaves it alone */
+    vec3 tint;
     /* conductor, dielectric, plastic: alpha is the roughness of the Beckmann
      * distribution instead of GGX (Mitsuba's default microfacet model) */
     bool beckmann;
@@ -109,6 +113,11 @@ PK_HIDDEN void material_diffuse(material *m, vec3 albedo);
 PK_HIDDEN void material_conductor(material *m, vec3 eta, vec3 k, float alpha);
 /* A metal by its normal-incidence reflectance f0 (Schlick's Fresnel). */
 PK_HIDDEN void material_conductor_f0(material *m, vec3 f0, float alpha);
+/* Scales a conductor's Fresnel reflectance by tint (after one of the two
+ * above): Mitsuba's specular_reflectance. The Whitted approximation (ks) of
+ * a metal given by eta and k is scaled too; a Schlick metal's ks is its F0
+ * for the path tracer as well, so its Whitted mirror keeps F0 unscaled. */
+PK_HIDDEN void material_conductor_tint(material *m, vec3 tint);
 /* Glass of relative index ior; transmittance tints the light that enters. */
 PK_HIDDEN void material_dielectric(material *m, float ior, float alpha, vec3 transmittance);
 /* An index-matched boundary between media (Mitsuba's null BSDF, pbrt's

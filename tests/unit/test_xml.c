@@ -527,11 +527,14 @@ static void test_bsdfs(void)
     m = bsdf("<bsdf type=\"roughplastic\"><string name=\"distribution\" value=\"as\"/></bsdf>");
     CHECK(m.beckmann && warned("microfacet distribution \"as\" is unknown; using beckmann"));
     m = bsdf("<bsdf type=\"roughconductor\"><string name=\"material\" value=\"none\"/><rgb name=\"specular_reflectance\" value=\"0.5\"/></bsdf>");
-    CHECK(m.type == MAT_CONDUCTOR && m.schlick && near3(m.ks, v3s(0.5f), 1e-6f) && fabsf(m.alpha - 0.1f) < 1e-6f);
-    /* a specular_reflectance scales the Fresnel term: Schlick with the scaled F0 */
+    CHECK(m.type == MAT_CONDUCTOR && m.schlick && near3(m.ks, v3s(1.0f), 1e-6f) && near3(m.tint, v3s(0.5f), 1e-6f) &&
+          fabsf(m.alpha - 0.1f) < 1e-6f);
+    /* a specular_reflectance multiplies the exact Fresnel term at every angle
+     * (as Mitsuba does), not a Schlick F0; the Whitted mirror is F0 times it */
     m = bsdf("<bsdf type=\"conductor\"><rgb name=\"eta\" value=\"1 1 1\"/><rgb name=\"k\" value=\"2 2 2\"/>"
              "<float name=\"extEta\" value=\"1\"/><spectrum name=\"specularReflectance\" value=\"0.5\"/></bsdf>");
-    CHECK(m.schlick && near3(m.ks, v3s(0.5f * 4.0f / 8.0f), 1e-3f));
+    CHECK(!m.schlick && near3(m.eta, v3s(1.0f), 1e-6f) && near3(m.k, v3s(2.0f), 1e-6f) &&
+          near3(m.tint, v3s(0.5f), 1e-6f) && near3(m.ks, v3s(0.5f * 4.0f / 8.0f), 1e-3f));
     m = bsdf("<bsdf type=\"conductor\"><string name=\"material\" value=\"Xx\"/></bsdf>");
     CHECK(m.type == MAT_CONDUCTOR && warned("scene.xml:3: conductor material \"Xx\" is not in the table"));
     m = bsdf("<bsdf type=\"dielectric\"><float name=\"int_ior\" value=\"1.5\"/><float name=\"ext_ior\" value=\"1.2\"/></bsdf>");
