@@ -37,13 +37,17 @@ PK_HIDDEN void spectra_cie1931(float nm, float xyz[3]);
 
 /* Mitsuba 0.5/0.6's reduction of a sampled spectrum to linear sRGB in its
  * RGB mode (reflectances and emitters alike): the n >= 2 samples (nm
- * strictly ascending), linear between them, zero beyond a zero sample added
- * one mean spacing past each end whose value is not zero; XYZ = the
- * integrals over 360..830 nm of the spectrum times the tabulated matching
- * functions, divided by the integral of y; then the Rec. 709 matrix;
- * negative channels clamped to 0. No white normalisation: a flat spectrum
- * of 1 is XYZ (1, 1, 1), the equal-energy white, pinkish in sRGB.
- * Black for n < 2. */
+ * strictly ascending), zero beyond a zero sample added one mean spacing
+ * past each end whose value is not zero; XYZ = the integrals over
+ * 360..830 nm of the spectrum times the tabulated matching functions,
+ * divided by the integral of y; then the Rec. 709 matrix; negative
+ * channels clamped to 0. Between samples both the spectrum and the
+ * matching functions are evaluated as released Mitsuba 0.5/0.6 evaluates
+ * them, each linear segment mirrored within its interval (a swapped lerp,
+ * fixed only in 2020): sparse spectra such as 100 nm emitters differ by
+ * ~10 % from the straight interpolation, dense reflectances by < 1 %.
+ * No white normalisation: a flat spectrum of 1 is XYZ (1, 1, 1), the
+ * equal-energy white, pinkish in sRGB. Black for n < 2. */
 PK_HIDDEN vec3 spectra_mitsuba06_rgb(const float *nm, const float *val, int n);
 
 /* Mitsuba 0.5/0.6's <blackbody temperature=kelvin>: Planck's law in
