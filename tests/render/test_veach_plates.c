@@ -50,7 +50,7 @@ static d3 d3norm(d3 a) { return d3mul(a, 1.0 / sqrt(d3dot(a, a))); }
  * cos_i, from the amplitude coefficients rs, rp (Born & Wolf). */
 static double fresnel_conductor(double cos_i, double eta, double k)
 {
-    const double complex n = CMPLX(eta, k);
+    const double complex n = eta + k * (double complex)I; /* CMPLX, which clang 14 with glibc lacks; finite parts */
     const double sin2 = 1.0 - cos_i * cos_i;
     const double complex ct = csqrt(n * n - sin2); /* n cos_t */
     const double complex rs = (cos_i - ct) / (cos_i + ct);
