@@ -1549,7 +1549,8 @@ static pk_status light_spectrum(pp *p, const char *name, vec3 *c)
     return spectrum_rgb(p, q, true, c);
 }
 
-static pk_status equal_area_env(pp *p, const char *file, size_t line, const xform *light_to_world, float scale);
+static pk_status equal_area_env(pp *p, const char *file, size_t line, const xform *light_to_world, float scale,
+                                float illuminance);
 
 static pk_status d_light(pp *p, const char *type)
 {
@@ -1615,13 +1616,14 @@ static pk_status d_light(pp *p, const char *type)
         if ((st = light_spectrum(p, "L", &L)) || (st = pb_string(&p->pd, "filename", &fn))) return st;
         float illum = -1.0f;
         if ((st = pb_float(&p->pd, "illuminance", &illum))) return st;
-        if (illum > 0.0f) pwarn(p, p->line, "infinite: 'illuminance' is not supported; 'scale' alone is used");
         if (pb_param(&p->pd, "portal"))
             pwarn(p, p->line, "infinite: portals are not used (the light is sampled as a whole)");
         if (has_L && fn) return pfail(p, p->line, PK_ERR_PARSE, "infinite: give either 'L' or 'filename', not both");
         if (fn) {
-            if ((st = equal_area_env(p, fn, p->line, &w, scale))) return st;
+            if ((st = equal_area_env(p, fn, p->line, &w, scale, illum))) return st;
         } else {
+            /* a uniform sky of one nit gives pi lux on a level surface */
+            if (illum > 0.0f) scale *= illum / PK_PI;
             scene_env_add_radiance(p->s, v3_scale(L, scale));
         }
     } else if (strcmp(type, "goniometric") == 0 || strcmp(type, "projection") == 0) {
@@ -1655,7 +1657,31 @@ static void sphere_to_square(vec3 d, float *u, float *v)
  * square, looked up through the light's transform; it is resampled here
  * into the lat-long map of the environment, already in the world (so its
  * rotation stays the identity). */
-static pk_status equal_area_env(pp *p, const char *file, size_t line, const xform *light_to_world, float scale)
+/* The illuminance that pbrt-v4 computes for an equal-area environment image
+ * (w x h pixels, linear sRGB) to honour an infinite light's "illuminance":
+ * the luminance of the pixels whose direction points up (+z in the light's
+ * space) times that direction's cosine, summed and multiplied by 2 pi / (w h).
+ * (Each pixel spans 4 pi / (w h) steradians; pbrt-v4 uses 2 pi, so the
+ * illuminance its images show is twice the one asked for. The scene's author
+ * saw pbrt's image, so its factor is kept.) Only the z of the pixel's
+ * direction is needed: on the octahedral square it is 1 - r^2, r the distance
+ * of the point from the square's diamond edge, with the sign of its side. */
+static double pbrt_equal_area_illuminance(const float *rgb, int w, int h)
+{
+    double sum = 0.0;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            double u = 2.0 * ((double)x + 0.5) / (double)w - 1.0, v = 2.0 * ((double)y + 0.5) / (double)h - 1.0;
+            double sd = 1.0 - (fabs(u) + fabs(v)), r = 1.0 - fabs(sd), z = sd >= 0.0 ? 1.0 - r * r : r * r - 1.0;
+            if (z <= 0.0) continue;
+            const float *px = &rgb[3 * ((size_t)y * (size_t)w + (size_t)x)];
+            sum += (0.212639 * (double)px[0] + 0.715169 * (double)px[1] + 0.072192 * (double)px[2]) * z;
+        }
+    return sum * 2.0 * (double)PK_PI / ((double)w * (double)h);
+}
+
+static pk_status equal_area_env(pp *p, const char *file, size_t line, const xform *light_to_world, float scale,
+                                float illuminance)
 {
     char *path = path_join(A(p), p->f->dir, file);
     if (!path) return ctx_nomem(p->ctx);
@@ -1684,6 +1710,11 @@ static pk_status equal_area_env(pp *p, const char *file, size_t line, const xfor
         mem_free(A(p), src);
         pwarn(p, line, "a second image environment is ignored (one map per scene)");
         return PK_OK;
+    }
+    if (illuminance > 0.0f) {
+        const double k_e = pbrt_equal_area_illuminance(src, w, h);
+        if (k_e > 0.0) scale = (float)((double)scale * (double)illuminance / k_e);
+        else pwarn(p, line, "infinite: \"%.80s\" is black above the horizon; 'illuminance' is not used", file);
     }
     xform to_light;
     if (!xform_invert(light_to_world, &to_light)) {

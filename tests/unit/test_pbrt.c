@@ -491,6 +491,37 @@ static void test_equal_area(void)
         }
         done(ctx, s);
     }
+    /* "illuminance": pbrt-v4 scales the map so that the luminance above the
+     * horizon times the cosine, summed with 2 pi / (pixels) per pixel, is the
+     * value given. For a uniform image of c that sum is c pi / 2 (the pixels
+     * of the upper half cover 2 pi steradians at 4 pi / pixels each, and the
+     * cosine averages 1/2 over them), so every pixel becomes 2 E / pi. The
+     * midpoint sum over the inner diamond at n = 32 is 4 / n^2 = 0.4 % short
+     * of the integral: 1 % covers it. */
+    f = fopen(path, "wb");
+    REQUIRE(f);
+    fprintf(f, "PF\n%d %d\n-1\n", n, n);
+    for (int i = 0; i < 3 * n * n; i++) fwrite(&(float){0.25f}, sizeof(float), 1, f);
+    fclose(f);
+    {
+        pk_context *ctx;
+        char text[512];
+        snprintf(text, sizeof text,
+                 PLAIN "LightSource \"infinite\" \"string filename\" \"%s\" \"float illuminance\" 3\nShape \"sphere\"\n",
+                 path);
+        pk_scene *s = load(&ctx, text);
+        if (s) {
+            REQUIRE(s->env.map_rgb);
+            const float *px = &s->env.map_rgb[3 * ((size_t)(s->env.map_h / 2) * (size_t)s->env.map_w + 5)];
+            CHECKF(fabs((double)px[1] / (2.0 * 3.0 / M_PI) - 1.0) < 0.01, "illuminance 3: pixel %g, expected %g", (double)px[1],
+                   2.0 * 3.0 / M_PI);
+        }
+        done(ctx, s);
+        /* a uniform light of one nit gives pi lux on a level surface */
+        s = load(&ctx, PLAIN "LightSource \"infinite\" \"rgb L\" [1 1 1] \"float illuminance\" 10\nShape \"sphere\"\n");
+        if (s) CHECK_NEAR(v3_luminance(s->env.radiance), 10.0 / M_PI, 1e-4);
+        done(ctx, s);
+    }
     /* a lat-long (2:1) image is refused with a warning */
     f = fopen(path, "wb");
     REQUIRE(f);
