@@ -143,7 +143,15 @@ static pk_status create_emitter(pdict *d, const mat_row *row, const mat_common *
     (void)c;
     vec3 ke = v3s(1.0f);
     pk_status st;
-    if ((st = pd_vec3(d, "radiance", ke, PD_V_COLOUR, &ke))) return st;
+    tex_ref map;
+    tex_ref_init(&map);
+    const pd_entry *re = param(d, row, "radiance");
+    if (is_obj(re)) { /* an emission map: its linear colour (decoded from sRGB for 8-bit images) times its scale */
+        bool loaded;
+        if ((st = pd_texture(d, re, true, &map, &loaded))) return st;
+    } else if ((st = pd_vec3(d, "radiance", ke, PD_V_COLOUR, &ke))) {
+        return st;
+    }
     const pd_entry *b = param(d, row, "bsdf");
     if (b) {
         pdict sub;
@@ -165,6 +173,7 @@ static pk_status create_emitter(pdict *d, const mat_row *row, const mat_common *
         material_diffuse(m, v3s(0.0f));
     }
     m->ke = ke;
+    m->map_ke = map;
     return PK_OK;
 }
 

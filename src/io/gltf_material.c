@@ -275,15 +275,6 @@ static pk_status make_mask(gltf *g, int64_t mi, int32_t tex, float factor, float
     return st;
 }
 
-/* The mean linear colour of a texture (its last mip level). */
-static vec3 texture_mean(const texture *t)
-{
-    float c[4] = {1, 1, 1, 1};
-    const tex_level *l = &t->lv[t->nlevels - 1];
-    tex_fetch(t, l, 0, 0, c);
-    return t->nc >= 3 ? v3(c[0], c[1], c[2]) : v3s(c[0]);
-}
-
 /* ---- materials ------------------------------------------------------------------------ */
 
 /* KHR_materials_volume on a transmissive material (thickness > 0): the mesh
@@ -485,13 +476,7 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
     if (t_emit.present && v3_max_comp(m.ke) > 0.0f) {
         tex_ref er;
         if ((st = make_ref(g, &t_emit, true, bake, path, &er))) goto fail;
-        if (er.kind == TEX_IMAGE) {
-            m.ke = v3_mul(m.ke, texture_mean(&g->s->textures[er.tex]));
-            gltf_warn_once(g, GW_EMISSIVE_TEX,
-                           "%s/emissiveTexture: emission is uniform over a surface: the texture's mean colour "
-                           "is used (further ones not reported)",
-                           path);
-        }
+        m.map_ke = er;
     }
     if (amode == 1 || amode == 2) {
         const bool tex_alpha =

@@ -1,7 +1,7 @@
 /*
  * mtl.c - Wavefront MTL reader: newmtl, Kd/Ks/Ka/Ke/Tf colours (three values
  * or one grey value), Ns, Ni, d, Tr (d = 1 - Tr), illum, and the texture maps
- * map_Kd, map_Ks, map_Ns, map_d, map_bump/bump, norm with their -s, -o,
+ * map_Kd, map_Ks, map_Ns, map_Ke, map_d, map_bump/bump, norm with their -s, -o,
  * -clamp and -bm options (docs/materials.md). A texture that cannot be used
  * is warned about and its material keeps its constant. Other statements are
  * warned about once per kind. Keywords are matched without regard to case,
@@ -271,15 +271,17 @@ static pk_status parse_statement(mtl_state *st, const char *ls, const char *le)
                 {"map_d", false, "the surface has no holes"},
                 {"map_bump", false, "the surface is not bumped"},
                 {"bump", false, "the surface is not bumped"},
-                {"norm", false, "the surface's normals are not changed"}};
-    for (int i = 0; i < 7; i++) {
+                {"norm", false, "the surface's normals are not changed"},
+                {"map_Ke", true, "Ke is used alone"}};
+    for (int i = 0; i < 8; i++) {
         if (!kw_ci(kw, n, maps[i].kw)) continue;
         if (st->cur < 0) {
             io_warn_once(r, "(before newmtl)", 15, "material statement before the first newmtl ignored");
             return PK_OK;
         }
         material *m = &st->s->materials[st->cur];
-        tex_ref *refs[7] = {&m->map_kd, &m->map_ks, &m->map_ns, &m->map_d, &m->map_bump, &m->map_bump, &m->map_norm};
+        tex_ref *refs[8] = {&m->map_kd, &m->map_ks, &m->map_ns, &m->map_d,
+                            &m->map_bump, &m->map_bump, &m->map_norm, &m->map_ke};
         /* texture_load may grow the texture table, never the materials */
         return parse_map(st, kw, n, p, le, refs[i], maps[i].colour, maps[i].constant);
     }

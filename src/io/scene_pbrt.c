@@ -53,6 +53,8 @@ typedef struct area_light {
     vec3 L;           /* radiance (scale applied) */
     bool two_sided;
     float power;      /* > 0: the emitted power the shape is scaled to */
+    int32_t image;    /* "filename": the scene's texture that multiplies L (the emission map, looked up with its edges
+                         clamped, as pbrt-v4 does), -1 none */
 } area_light;
 
 typedef struct mat_variant {
@@ -60,6 +62,7 @@ typedef struct mat_variant {
     vec3 ke;
     bool two_sided;
     int32_t alpha_tex;   /* named texture index, -1 none */
+    int32_t ke_tex;      /* the emission map (a scene texture), -1 none */
     uint32_t mat;
 } mat_variant;
 
@@ -734,7 +737,7 @@ static pk_status new_material(pp *p, const char *name, const char *type, uint32_
 
 /* The material a shape gets: the current one with the current area light's
  * emission and an alpha map, made once per combination. */
-static pk_status shape_material(pp *p, vec3 ke, bool two_sided, int32_t alpha_tex, uint32_t *out)
+static pk_status shape_material(pp *p, vec3 ke, int32_t ke_tex, bool two_sided, int32_t alpha_tex, uint32_t *out)
 {
     uint32_t base = GS(p)->material;
     if (ke.x == 0.0f && ke.y == 0.0f && ke.z == 0.0f && alpha_tex < 0) {
@@ -744,7 +747,7 @@ static pk_status shape_material(pp *p, vec3 ke, bool two_sided, int32_t alpha_te
     for (size_t i = 0; i < p->nvars; i++) {
         const mat_variant *v = &p->vars[i];
         if (v->base == base && v->ke.x == ke.x && v->ke.y == ke.y && v->ke.z == ke.z && v->two_sided == two_sided &&
-            v->alpha_tex == alpha_tex) {
+            v->alpha_tex == alpha_tex && v->ke_tex == ke_tex) {
             *out = v->mat;
             return PK_OK;
         }
@@ -757,7 +760,14 @@ static pk_status shape_material(pp *p, vec3 ke, bool two_sided, int32_t alpha_te
     pk_status st = scene_material_with_emission(p->ctx, p->s, base, name, ke, two_sided, &idx);
     if (st) return st;
     if (alpha_tex >= 0) p->s->materials[idx].map_d = p->tex[alpha_tex].ref;
-    mat_variant v = {base, ke, two_sided, alpha_tex, idx};
+    if (ke_tex >= 0 && v3_max_comp(ke) > 0.0f) {
+        tex_ref *r = &p->s->materials[idx].map_ke;
+        tex_ref_init(r);
+        r->kind = TEX_IMAGE;
+        r->tex = ke_tex;
+        r->clamp = true;
+    }
+    mat_variant v = {base, ke, two_sided, alpha_tex, ke_tex, idx};
     p->vars[p->nvars++] = v;
     *out = idx;
     return PK_OK;
@@ -851,17 +861,22 @@ static double mesh_area(const xform *x, const mesh_in *m)
     return a;
 }
 
-/* Emission of the current area light on a shape of world area area. */
-static vec3 area_emission(pp *p, double area, bool *two_sided)
+/* Emission of the current area light on a shape of world area area, and
+ * its emission map (*image, -1 none). With "power", pbrt-v4 divides by the
+ * image's mean luminance too. */
+static vec3 area_emission(pp *p, double area, bool *two_sided, int32_t *image)
 {
     int32_t a = GS(p)->area;
     *two_sided = false;
+    *image = -1;
     if (a < 0) return v3s(0.0f);
     const area_light *l = &p->areas[a];
     *two_sided = l->two_sided;
+    *image = l->image;
     vec3 L = l->L;
     if (l->power > 0.0f) {
         double k = (l->two_sided ? 2.0 : 1.0) * area * (double)PK_PI;
+        if (l->image >= 0) k *= (double)v3_luminance(texture_mean_rgb(&p->s->textures[l->image]));
         if (k > 0.0) L = v3_scale(L, (float)((double)l->power / k));
     }
     return L;
@@ -896,11 +911,12 @@ static pk_status add_mesh(pp *p, mesh_in *m, int32_t alpha_tex)
     }
     bool two = false;
     vec3 ke = v3s(0.0f);
+    int32_t ke_tex = -1;
     /* interfaces do not emit (as in pbrt) */
     if (GS(p)->area >= 0 && !GS(p)->interface)
-        ke = area_emission(p, p->areas[GS(p)->area].power > 0.0f ? mesh_area(&w, m) : 0.0, &two);
+        ke = area_emission(p, p->areas[GS(p)->area].power > 0.0f ? mesh_area(&w, m) : 0.0, &two, &ke_tex);
     uint32_t mat;
-    pk_status st = shape_material(p, ke, two, alpha_tex, &mat);
+    pk_status st = shape_material(p, ke, ke_tex, two, alpha_tex, &mat);
     if (st == PK_OK) st = shape_media(p, &mat);
     if (st) return st;
     xform saved = *sb_transform(&p->b);
@@ -1451,8 +1467,10 @@ static pk_status shape_sphere(pp *p, int32_t alpha)
             return pfail(p, p->line, PK_ERR_PARSE, "sphere: its centre or radius in the world is not a usable number (not finite, or the radius too small)");
         bool two = false;
         vec3 ke = v3s(0.0f);
-        if (!GS(p)->interface) ke = area_emission(p, 4.0 * (double)PK_PI * (double)sp.radius * (double)sp.radius, &two);
-        if ((st = shape_material(p, ke, two, -1, &sp.material)) || (st = shape_media(p, &sp.material))) return st;
+        int32_t ke_tex = -1;
+        if (!GS(p)->interface)
+            ke = area_emission(p, 4.0 * (double)PK_PI * (double)sp.radius * (double)sp.radius, &two, &ke_tex);
+        if ((st = shape_material(p, ke, ke_tex, two, -1, &sp.material)) || (st = shape_media(p, &sp.material))) return st;
         return scene_add_sphere(p->ctx, p->s, &sp);
     }
     /* partial, inside out, stretched or cut out: tessellated */
@@ -1766,13 +1784,34 @@ static pk_status d_area_light(pp *p, const char *type)
         GS(p)->area = -1;
         return PK_OK;
     }
-    area_light l = {v3s(1.0f), false, -1.0f};
+    area_light l = {v3s(1.0f), false, -1.0f, -1};
     float scale = 1.0f;
+    const char *fn = NULL;
     if ((st = light_spectrum(p, "L", &l.L)) || (st = pb_float(&p->pd, "scale", &scale)) ||
-        (st = pb_bool(&p->pd, "twosided", &l.two_sided)) || (st = pb_float(&p->pd, "power", &l.power)))
+        (st = pb_bool(&p->pd, "twosided", &l.two_sided)) || (st = pb_float(&p->pd, "power", &l.power)) ||
+        (st = pb_string(&p->pd, "filename", &fn)))
         return st;
-    if (pb_param(&p->pd, "filename"))
-        pwarn(p, p->line, "AreaLightSource: an emission image is not supported; 'L' is used");
+    if (fn) { /* the image's linear RGB is the radiance (times scale), looked up by the shape's uv */
+        if (pb_param(&p->pd, "L"))
+            return pfail(p, p->line, PK_ERR_PARSE, "AreaLightSource: give either 'L' or 'filename', not both");
+        size_t fl = strlen(fn);
+        const bool colour = fl >= 4 && (strcmp(fn + fl - 4, ".png") == 0 || strcmp(fn + fl - 4, ".PNG") == 0);
+        char *path = path_join(A(p), p->f->dir, fn);
+        if (!path) return ctx_nomem(p->ctx);
+        int32_t idx;
+        const bool was_ok = p->ctx->status == PK_OK;
+        st = texture_load(p->ctx, p->s, path, colour, &idx);
+        mem_free(A(p), path);
+        if (st != PK_OK) {
+            char why[PK_ERRMSG_MAX];
+            if (!io_demote_error(p->ctx, st, was_ok, why, sizeof why)) return st;
+            pwarn(p, p->line, "AreaLightSource: the emission image is not used (%s); a uniform radiance %g is",
+                  why, (double)scale);
+        } else {
+            l.image = idx;
+        }
+        l.L = v3s(1.0f);
+    }
     l.L = v3_scale(l.L, scale);
     if (!v3_finite(l.L)) return pfail(p, p->line, PK_ERR_PARSE, "AreaLightSource: the radiance is not finite");
     if (!(v3_min_comp(l.L) >= 0.0f)) return pfail(p, p->line, PK_ERR_PARSE, "AreaLightSource: the radiance is negative");

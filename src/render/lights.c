@@ -7,6 +7,16 @@
 
 static bool emits(vec3 ke) { return ke.x > 0.0f || ke.y > 0.0f || ke.z > 0.0f; }
 
+/* The luminance that chooses among emitters: ke's, times the mean of an
+ * emission map (over the whole image: a triangle's own part of it is not
+ * looked at). */
+static double emitted_luminance(const pk_scene *s, const material *m)
+{
+    vec3 ke = m->ke;
+    if (m->map_ke.kind == TEX_IMAGE) ke = v3_mul(ke, texture_mean_rgb(&s->textures[m->map_ke.tex]));
+    return (double)fmaxf(v3_luminance(ke), 1e-6f);
+}
+
 /* The radius of a sphere about the centre of the scene's bounds that holds
  * its triangles and spheres (1 for an empty scene). */
 static double scene_radius(const pk_scene *s)
@@ -299,7 +309,7 @@ pk_status light_set_build(pk_context *ctx, const pk_scene *s, const env_light *e
         const material *m = &s->materials[s->tris[t].material];
         light *l = &ls->lights[k];
         *l = light_of_triangle(t, a, b, c, m);
-        power[k] = (double)fmaxf(v3_luminance(m->ke), 1e-6f) * (double)l->area * (double)PK_PI * (m->two_sided ? 2.0 : 1.0);
+        power[k] = emitted_luminance(s, m) * (double)l->area * (double)PK_PI * (m->two_sided ? 2.0 : 1.0);
         ls->of_prim[t] = (int32_t)k;
         k++;
     }
@@ -312,7 +322,7 @@ pk_status light_set_build(pk_context *ctx, const pk_scene *s, const env_light *e
         l->index = (uint32_t)i;
         l->area = 4.0f * PK_PI * sp->radius * sp->radius;
         l->normal = v3s(0.0f);
-        power[k] = (double)fmaxf(v3_luminance(m->ke), 1e-6f) * (double)l->area * (double)PK_PI * (m->two_sided ? 2.0 : 1.0);
+        power[k] = emitted_luminance(s, m) * (double)l->area * (double)PK_PI * (m->two_sided ? 2.0 : 1.0);
         ls->of_prim[s->ntris + i] = (int32_t)k;
         k++;
     }

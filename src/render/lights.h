@@ -34,6 +34,7 @@
 #include "sampling.h"
 #include "light_tree.h"
 #include "spherical_triangle.h"
+#include "surface.h"
 
 enum { LIGHT_TRIANGLE, LIGHT_SPHERE, LIGHT_POINT, LIGHT_ENV, LIGHT_SUN };
 
@@ -294,6 +295,31 @@ static inline PK_HD float spot_falloff(const point_light *pl, vec3 w)
     return t * t * (3.0f - 2.0f * t);
 }
 
+/* The radiance that emitter l (a triangle or sphere) sends from its point q
+ * when its material has an emission map (map_ke): ke times the map at q's
+ * texture coordinates, found as a hit there would find them (the finest
+ * level: a light sample has no ray cone). Otherwise le as it is. */
+static inline PK_HD vec3 light_le_at(const scene_view *s, const light *l, vec3 q, vec3 le)
+{
+    const uint32_t prim = l->kind == LIGHT_TRIANGLE ? l->index : (uint32_t)s->ntris + l->index;
+    const material *m = &s->materials[view_prim_material(s, prim)];
+    if (!m->map_ke.kind) return le;
+    hit h = {0.0f, prim, 0.0f, 0.0f};
+    if (l->kind == LIGHT_TRIANGLE) { /* q's barycentric coordinates (of v[1] and v[2]) */
+        const vec3 e1 = v3_sub(l->v[1], l->v[0]), e2 = v3_sub(l->v[2], l->v[0]), d = v3_sub(q, l->v[0]);
+        const float d00 = v3_dot(e1, e1), d01 = v3_dot(e1, e2), d11 = v3_dot(e2, e2);
+        const float d20 = v3_dot(d, e1), d21 = v3_dot(d, e2), den = d00 * d11 - d01 * d01;
+        if (!(den > 0.0f)) return le;
+        h.u = fminf(fmaxf((d11 * d20 - d01 * d21) / den, 0.0f), 1.0f);
+        h.v = fminf(fmaxf((d00 * d21 - d01 * d20) / den, 0.0f), 1.0f - h.u);
+    }
+    const ray r = {q, 0.0f, v3s(0.0f), 1.0f}; /* a sphere's uv is that of r.o + t r.d = q */
+    const surface_uv uv = surface_uv_at(s, &r, &h);
+    const tex_query tq = {uv.u, uv.v, 0.0f};
+    const vec3 c = tex_eval_rgb(s->textures, &m->map_ke, tq);
+    return v3_mul(le, v3(fmaxf(c.x, 0.0f), fmaxf(c.y, 0.0f), fmaxf(c.z, 0.0f)));
+}
+
 /* Samples light li of the set from lc with (u1, u2), triangles as tri
  * says (LIGHT_TRI_*): false when it sends nothing toward lc->p. ls->pdf
  * excludes the light's choice; it is light_pdf_at(s, l, lc->p, lc->n, tri,
@@ -346,11 +372,14 @@ static inline PK_HD bool light_sample_one_with(const light_set *set, const scene
         return true;
     }
     if (l->kind == LIGHT_TRIANGLE) {
+        bool ok = false, done = false;
         if (tri != LIGHT_TRI_AREA) {
             sph_tri st;
-            if (light_tri_spherical(l, p, &st)) return light_sample_tri_solid_angle(l, lc, tri, &st, u1, u2, ls);
+            if (light_tri_spherical(l, p, &st)) ok = light_sample_tri_solid_angle(l, lc, tri, &st, u1, u2, ls), done = true;
         }
-        return light_sample_tri_area(l, lc, u1, u2, ls);
+        if (!done) ok = light_sample_tri_area(l, lc, u1, u2, ls);
+        if (ok && s->has_emission_maps) ls->le = light_le_at(s, l, v3_add(ls->shadow.o, ls->shadow.d), ls->le);
+        return ok;
     }
     const material *m;
     {
@@ -382,7 +411,7 @@ static inline PK_HD bool light_sample_one_with(const light_set *set, const scene
             if (!m->two_sided && !lc->two_sided) return false;
         }
     }
-    le = m->ke;
+    le = s->has_emission_maps ? light_le_at(s, l, q, m->ke) : m->ke;
     pdf = light_pdf_area(s, l, p, q, nq);
     if (!(pdf > 0.0f) || !isfinite(pdf)) return false;
     vec3 d = v3_sub(q, o);

@@ -167,6 +167,11 @@ static inline PK_HD void surface_texture_at(const scene_view *s, const ray *r, c
         tm->roughness = fminf(fmaxf(m->roughness * rg, 0.0f), 1.0f);
         tm->alpha = tm->roughness * tm->roughness;
     }
+    if (m->map_ke.kind) { /* the finest level, as light sampling sees it (lights.h), so that both agree */
+        const tex_query qe = {uv.u, uv.v, 0.0f};
+        const vec3 e = tex_eval_rgb(s->textures, &m->map_ke, qe);
+        tm->ke = v3_mul(m->ke, v3(fmaxf(e.x, 0.0f), fmaxf(e.y, 0.0f), fmaxf(e.z, 0.0f)));
+    }
     sf->m = tm;
     if (!m->map_bump.kind && !m->map_norm.kind) return;
     /* a frame on the surface, z = the shading normal as it faces the ray */

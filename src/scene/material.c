@@ -24,6 +24,7 @@ void material_init(material *m)
     tex_ref_init(&m->map_bump);
     tex_ref_init(&m->map_norm);
     tex_ref_init(&m->map_mr);
+    tex_ref_init(&m->map_ke);
 }
 
 float material_f0_dielectric(float ior)

@@ -89,8 +89,9 @@ typedef struct material {
      * (a grey texture multiplies both). map_d cuts holes: where its opacity is below 0.5 the
      * surface is not there for any ray (the constant d still dissolves the
      * rest). map_bump is a height field (heights times bm, in scene units);
-     * map_norm a tangent-space normal map. */
-    tex_ref map_kd, map_ks, map_ns, map_d, map_alpha, map_bump, map_norm, map_mr;
+     * map_norm a tangent-space normal map. map_ke multiplies the emission ke
+     * (linear colour, values above 1 allowed): a textured emitter. */
+    tex_ref map_kd, map_ks, map_ns, map_d, map_alpha, map_bump, map_norm, map_mr, map_ke;
     /* The media on either side (medium.h): medium_out on the side the
      * geometric normal points to, medium_in on the other; an index into the
      * scene's media, MEDIUM_NONE (vacuum) or MEDIUM_INHERIT (the surface

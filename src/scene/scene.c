@@ -718,16 +718,17 @@ pk_status scene_commit(pk_context *ctx, pk_scene *s)
     s->emissive = NULL;
     s->ndegenerate = s->nemissive = 0;
     s->bounds = aabb_empty();
-    s->has_cutout = s->has_textured = s->has_interfaces = false;
+    s->has_cutout = s->has_textured = s->has_interfaces = s->has_emission_maps = false;
     for (size_t i = 0; i < s->nmaterials; i++) {
         material *m = &s->materials[i];
         m->cutout = m->map_d.kind != TEX_NONE;
         m->textured = m->map_kd.kind != TEX_NONE || m->map_ks.kind != TEX_NONE || m->map_ns.kind != TEX_NONE ||
                       m->map_alpha.kind != TEX_NONE || m->map_bump.kind != TEX_NONE || m->map_norm.kind != TEX_NONE ||
-                      m->map_mr.kind != TEX_NONE;
+                      m->map_mr.kind != TEX_NONE || m->map_ke.kind != TEX_NONE;
         s->has_cutout |= m->cutout;
         s->has_interfaces |= m->type == MAT_INTERFACE;
         s->has_textured |= m->textured;
+        s->has_emission_maps |= m->map_ke.kind != TEX_NONE && v3_max_comp(m->ke) > 0.0f;
     }
     if (s->ntris) {
         s->degenerate = mem_calloc(&s->alloc, s->ntris, 1);

@@ -190,6 +190,7 @@ struct pk_scene {
     size_t ndegenerate;
     bool has_cutout;        /* a material has map_d */
     bool has_textured;      /* a material has a map other than map_d (its textured flag) */
+    bool has_emission_maps; /* an emitting material has map_ke */
     bool has_interfaces;    /* a material is MAT_INTERFACE */
     uint32_t *emissive;     /* indices of emissive triangles */
     size_t nemissive;

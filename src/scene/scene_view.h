@@ -22,6 +22,7 @@ typedef struct scene_view {
     size_t npositions, nnormals, nuvs, ntris, nspheres, nmaterials, nlights, ntextures;
     bool has_cutout;          /* a material has map_d */
     bool has_textured;        /* a material has a map other than map_d */
+    bool has_emission_maps;   /* an emitting material has map_ke (lights.h looks it up where it samples) */
     /* Kept instances (scene_kept): hit numbers from ntris + nspheres on
      * are their triangles, in object space in the mesh arrays. The GPU
      * renders scenes without them only (nkept 0). */
@@ -48,6 +49,7 @@ static inline scene_view scene_view_of(const pk_scene *s)
     v.npositions = s->npositions, v.nnormals = s->nnormals, v.nuvs = s->nuvs, v.ntris = s->ntris;
     v.nspheres = s->nspheres, v.nmaterials = s->nmaterials, v.nlights = s->nlights, v.ntextures = s->ntextures;
     v.has_cutout = s->has_cutout, v.has_textured = s->has_textured;
+    v.has_emission_maps = s->has_emission_maps;
     v.kept = s->kept, v.nkept = s->nkept, v.meshes = s->meshes;
     v.mesh_positions = s->mesh_positions, v.mesh_normals = s->mesh_normals, v.mesh_uvs = s->mesh_uvs;
     v.mesh_tris = s->mesh_tris;

@@ -157,3 +157,11 @@ pk_status texture_add_pixels(pk_context *ctx, pk_scene *s, const char *key, int 
     *index = (int32_t)s->ntextures++;
     return PK_OK;
 }
+
+vec3 texture_mean_rgb(const texture *t)
+{
+    float c[4] = {1, 1, 1, 1};
+    const tex_level *l = &t->lv[t->nlevels - 1];
+    tex_fetch(t, l, 0, 0, c);
+    return t->nc >= 3 ? v3(c[0], c[1], c[2]) : v3s(c[0]);
+}

@@ -86,6 +86,8 @@ PK_HIDDEN pk_status texture_load(pk_context *ctx, struct pk_scene *s, const char
 PK_HIDDEN pk_status texture_add_pixels(pk_context *ctx, struct pk_scene *s, const char *key, int w, int h, int nc,
                                        const uint8_t *px8, const float *pxf, bool colour, int32_t *index);
 /* The index of the texture loaded under key in that decode mode, or -1. */
+/* The mean linear colour of a texture (its coarsest mip level); grey for one channel. */
+PK_HIDDEN vec3 texture_mean_rgb(const texture *t);
 PK_HIDDEN int32_t texture_find(const struct pk_scene *s, const char *key, bool colour);
 
 
