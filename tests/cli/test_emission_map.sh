@@ -126,6 +126,21 @@ for seed in 1 2; do
     { echo "FAIL pbrt render: $(cat "$tmp/err")"; exit 1; }
   [ -s "$tmp/err" ] && { echo "FAIL pbrt warned: $(cat "$tmp/err")"; fail=1; }
 done
+# JSON: an emitter's radiance given as a texture; `paprsek convert` keeps it
+cat >"$tmp/tex.json" <<J
+{"camera": {"look_from": [0, 0.5, 4.5], "look_at": [0, 0.4, 0], "fov": 50},
+ "materials": {"floor": {"type": "diffuse", "albedo": [0.8, 0.8, 0.8]},
+               "light": {"type": "emitter", "radiance": {"texture": "half.pfm", "clamp": true}}},
+ "meshes": [{"obj": "tex.obj"}]}
+J
+for seed in 1 2; do
+  "$bin" render "$tmp/tex.json" -o "$tmp/json-$seed.pfm" --width 60 --height 40 --spp ${PBRT_SPP:-64} --threads 2 \
+    --max-depth 2 --seed $seed --quiet 2>"$tmp/err" || { echo "FAIL json render: $(cat "$tmp/err")"; exit 1; }
+done
+"$bin" convert "$tmp/tex.json" -o "$tmp/conv.json" 2>"$tmp/err" &&
+  "$bin" render "$tmp/conv.json" -o "$tmp/conv.pfm" --width 60 --height 40 --spp ${PBRT_SPP:-64} --threads 2 \
+    --max-depth 2 --seed 1 --quiet 2>>"$tmp/err" && cmp -s "$tmp/conv.pfm" "$tmp/json-1.pfm" &&
+  echo "ok   paprsek convert keeps an emission map" || { echo "FAIL convert: $(cat "$tmp/err")"; fail=1; }
 # pbrt's camera sees the world mirrored (its image's right is world -x here):
 # its bands are the OBJ scene's in reverse order
 python3 - "$tmp" <<'PY'
@@ -150,14 +165,15 @@ def bands(name):
         var = sum((p - q - dm) ** 2 for p, q in s) / (n - 1)
         out.append((sum(p + q for p, q in s) / (2 * n), var / 2 / (2 * n)))
     return out
-obj, pb = bands('tex'), bands('pbrt')
+obj, pb, js = bands('tex'), bands('pbrt'), bands('json')
 bad = 0
 for k in range(5):
-    o, p = obj[4 - k], pb[k]
+    o, p, j = obj[4 - k], pb[k], js[4 - k]
     z = abs(o[0] - p[0]) / math.sqrt(o[1] + p[1])
-    print('pbrt band %d: %.5f  obj band %d: %.5f  (%.1f sd)' % (k, p[0], 4 - k, o[0], z))
-    if not z < 4: bad = 1
+    zj = abs(o[0] - j[0]) / math.sqrt(o[1] + j[1])
+    print('pbrt band %d: %.5f  json %.5f  obj band %d: %.5f  (%.1f sd, %.1f sd)' % (k, p[0], j[0], 4 - k, o[0], z, zj))
+    if not (z < 4 and zj < 4): bad = 1
 sys.exit(bad)
 PY
-[ $? = 0 ] && echo "ok   pbrt-v4 AreaLightSource filename" || { echo "FAIL pbrt-v4 AreaLightSource filename"; fail=1; }
+[ $? = 0 ] && echo "ok   pbrt-v4 AreaLightSource filename and JSON radiance textures" || { echo "FAIL pbrt-v4 / JSON emission maps"; fail=1; }
 exit $fail

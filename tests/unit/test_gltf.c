@@ -500,6 +500,7 @@ static void test_materials(void)
              "\"KHR_materials_clearcoat\":{\"clearcoatFactor\":1,\"clearcoatRoughnessFactor\":0.5},"
              "\"KHR_materials_sheen\":{}}},"
              "{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0},\"baseColorFactor\":[1,1,1,0.5]},"
+             "\"emissiveFactor\":[1,0.5,1],\"emissiveTexture\":{\"index\":1},"
              "\"alphaMode\":\"MASK\",\"alphaCutoff\":0.25},"
              "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,1,1,0.3],"
              "\"baseColorTexture\":{\"index\":1,\"extensions\":{\"KHR_texture_transform\":{\"offset\":[0.5,0.25],"
@@ -526,6 +527,8 @@ static void test_materials(void)
     /* MASK: a cut-out of alpha * 0.5 >= 0.25 (tex_holes: alpha 0 or 1) */
     CHECK(m1->map_kd.kind == TEX_IMAGE && m1->map_d.kind == TEX_IMAGE && m1->map_d.tex != m1->map_kd.tex);
     CHECK(m1->d == 1.0f && !m1->two_sided);
+    /* an emission map: the factor times the texture, decoded from sRGB (the image m2's base colour uses) */
+    CHECK(vnear(m1->ke, v3(1, 0.5f, 1), 0) && m1->map_ke.kind == TEX_IMAGE && m1->map_ke.tex == m2->map_kd.tex);
     /* BLEND: the constant alpha as stochastic opacity; one transform for the
      * material's textures: baked into the uvs, the references plain */
     CHECK(m2->d == 0.3f && m2->map_kd.kind == TEX_IMAGE && m2->map_mr.kind == TEX_IMAGE && m2->map_kd.clamp);
