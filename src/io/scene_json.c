@@ -1602,7 +1602,22 @@ static pk_status parse_light_record(jp *p, const cJSON *it, const char *path)
     path_key(fp, path, "record");
     point_light l;
     memset(&l, 0, sizeof l);
-    if ((st = rec_read(p, f[0], fp, rec_light, rec_nlight, NULL, &l))) return st;
+    static const char *const extra[] = {"map", NULL};
+    if ((st = rec_read(p, f[0], fp, rec_light, rec_nlight, extra, &l))) return st;
+    if (l.map_kind != LIGHT_MAP_NONE) { /* an image-shaped point light: its image, then the constructor's checks */
+        const cJSON *mj = cJSON_GetObjectItemCaseSensitive(f[0], "map");
+        char mp[JP_PATH_MAX];
+        path_key(mp, fp, "map");
+        tex_ref r;
+        tex_ref_init(&r);
+        if (!mj) return jfail(p, PK_ERR_PARSE, f[0], fp, "map_kind %d needs a \"map\"", l.map_kind);
+        if ((st = read_texref_record(p, mj, mp, &r))) return st;
+        if (r.kind != TEX_IMAGE) return jfail(p, PK_ERR_PARSE, mj, mp, "must be an image");
+        if (l.intensity.x < 0.0f || l.intensity.y < 0.0f || l.intensity.z < 0.0f)
+            return jfail(p, PK_ERR_PARSE, f[0], fp, "intensity must not be negative");
+        return scene_light_mapped(p->ctx, p->s, l.position, l.intensity, l.map_kind, r.tex, l.to_light, l.proj_tan,
+                                  l.proj_sx, l.proj_sy, -1.0f);
+    }
     if (l.spot_falloff < SPOT_FALLOFF_SMOOTHSTEP || l.spot_falloff > SPOT_FALLOFF_SQUARED)
         return jfail(p, PK_ERR_PARSE, f[0], fp, "spot_falloff must be 0, 1 or 2");
     if (l.intensity.x < 0.0f || l.intensity.y < 0.0f || l.intensity.z < 0.0f)

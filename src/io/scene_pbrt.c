@@ -22,6 +22,7 @@
 #include "../image/image_read.h"
 #include "../options.h"
 #include "../scene/camera.h"
+#include "../math/distrib.h"
 #include "../scene/spectra.h"
 #include "grid_io.h"
 #include "io_util.h"
@@ -1570,6 +1571,71 @@ static pk_status light_spectrum(pp *p, const char *name, vec3 *c)
 static pk_status equal_area_env(pp *p, const char *file, size_t line, const xform *light_to_world, float scale,
                                 float illuminance);
 
+/* pbrt-v4's goniometric light (an intensity I shaped by an equal-area
+ * image of directions, grey: the mean of its channels; the image's up, the
+ * +z of its square, is the light's +y) and projection light (an image
+ * projected along the light's +z through a field of view "fov" across the
+ * image's shorter side, 90 by default, its top toward +y). Both sit at the
+ * light's origin and take nearest texels, as pbrt-v4 does. */
+static pk_status mapped_light(pp *p, bool gonio, const xform *w, float scale)
+{
+    pk_status st;
+    vec3 I = v3s(1.0f);
+    const char *fn = NULL;
+    float fov = 90.0f, power = -1.0f;
+    if ((gonio && (st = light_spectrum(p, "I", &I))) || (st = pb_string(&p->pd, "filename", &fn)) ||
+        (st = pb_float(&p->pd, "power", &power)) || (!gonio && (st = pb_float(&p->pd, "fov", &fov))))
+        return st;
+    const char *what = gonio ? "goniometric" : "projection";
+    if (!fn) {
+        if (!gonio) return pfail(p, p->line, PK_ERR_PARSE, "projection: 'string filename' is required");
+        pwarn(p, p->line, "goniometric: no 'filename'; the light emits nothing (as in pbrt-v4)");
+        return PK_OK;
+    }
+    if (!gonio && !(fov > 0.0f && fov < 180.0f))
+        return pfail(p, p->line, PK_ERR_PARSE, "projection: fov %g must be between 0 and 180 degrees", (double)fov);
+    const size_t fl = strlen(fn);
+    const bool colour = fl >= 4 && (strcmp(fn + fl - 4, ".png") == 0 || strcmp(fn + fl - 4, ".PNG") == 0);
+    char *path = path_join(A(p), p->f->dir, fn);
+    if (!path) return ctx_nomem(p->ctx);
+    int32_t idx;
+    const bool was_ok = p->ctx->status == PK_OK;
+    st = texture_load(p->ctx, p->s, path, colour, &idx);
+    mem_free(A(p), path);
+    if (st != PK_OK) {
+        char why[PK_ERRMSG_MAX];
+        if (!io_demote_error(p->ctx, st, was_ok, why, sizeof why)) return st;
+        pwarn(p, p->line, "%s: the image is not used (%s); the light is skipped", what, why);
+        return PK_OK;
+    }
+    const tex_level *lv = &p->s->textures[idx].lv[0];
+    if (gonio && lv->w != lv->h)
+        return pfail(p, p->line, PK_ERR_PARSE, "goniometric: \"%.80s\" is %dx%d, not a square equal-area image", fn,
+                     lv->w, lv->h);
+    xform inv;
+    if (!xform_invert(w, &inv)) return pfail(p, p->line, PK_ERR_PARSE, "%s: the light's transform is singular", what);
+    /* world -> light directions: the inverse's linear part */
+    float m[9];
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++) m[3 * r + c] = inv.m[4 * r + c];
+    if (gonio) { /* the square's frame is the light's with y and z swapped */
+        for (int c = 0; c < 3; c++) {
+            const float t = m[3 + c];
+            m[3 + c] = m[6 + c], m[6 + c] = t;
+        }
+    } else { /* the image's rows run down: its frame's y is the light's -y */
+        for (int c = 0; c < 3; c++) m[3 + c] = -m[3 + c];
+    }
+    const float aspect = (float)lv->w / (float)lv->h;
+    const float sx = aspect > 1.0f ? aspect : 1.0f, sy = aspect > 1.0f ? 1.0f : 1.0f / aspect;
+    const vec3 position = xform_point(w, v3s(0.0f));
+    const vec3 intensity = v3_scale(I, scale);
+    if (!v3_finite(position) || !v3_finite(intensity) || !(v3_min_comp(intensity) >= 0.0f))
+        return pfail(p, p->line, PK_ERR_PARSE, "%s: the intensity or position is not finite and positive", what);
+    return scene_light_mapped(p->ctx, p->s, position, intensity, gonio ? LIGHT_MAP_GONIOMETRIC : LIGHT_MAP_PROJECTION,
+                              idx, m, tanf(fov * (PK_PI / 360.0f)), sx, sy, power);
+}
+
 static pk_status d_light(pp *p, const char *type)
 {
     pk_status st;
@@ -1645,30 +1711,12 @@ static pk_status d_light(pp *p, const char *type)
             scene_env_add_radiance(p->s, v3_scale(L, scale));
         }
     } else if (strcmp(type, "goniometric") == 0 || strcmp(type, "projection") == 0) {
-        pd_mark_all(&p->pd);
-        pwarn(p, p->line, "light \"%s\" is not supported; skipped", type);
+        if ((st = mapped_light(p, type[0] == 'g', &w, scale))) return st;
     } else {
         return pfail(p, p->line, PK_ERR_PARSE, "unknown light \"%.40s\"", type);
     }
     warn_unused(p, "LightSource \"%.40s\"", type);
     return PK_OK;
-}
-
-/* pbrt-v4's equal-area octahedral square: the point of the unit square
- * whose direction (light space) is d (Clarberg's mapping). */
-static void sphere_to_square(vec3 d, float *u, float *v)
-{
-    float x = fabsf(d.x), y = fabsf(d.y), z = fabsf(d.z);
-    float r = sqrtf(fmaxf(1.0f - z, 0.0f));
-    float phi = atan2f(y, x); /* [0, pi/2] */
-    float b = r * (phi * (2.0f / PK_PI));  /* v' */
-    float a = r - b;                        /* u' */
-    if (d.z < 0.0f) {
-        float t = a;
-        a = 1.0f - b, b = 1.0f - t;
-    }
-    a = copysignf(a, d.x), b = copysignf(b, d.y);
-    *u = 0.5f * (a + 1.0f), *v = 0.5f * (b + 1.0f);
 }
 
 /* An infinite light's image: pbrt-v4 keeps it as an equal-area octahedral
@@ -1752,7 +1800,7 @@ static pk_status equal_area_env(pp *p, const char *file, size_t line, const xfor
             vec3 d = v3(sinf(th) * sinf(ph), cosf(th), -sinf(th) * cosf(ph));
             vec3 dl = v3_norm_scaled(xform_vector(&to_light, d));
             float u, v;
-            sphere_to_square(dl, &u, &v);
+            equal_area_sphere_to_square(dl, &u, &v);
             /* bilinear, clamped at the edges */
             float x = u * (float)w - 0.5f, y = v * (float)h - 0.5f;
             int x0 = (int)floorf(x), y0 = (int)floorf(y);

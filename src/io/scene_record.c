@@ -40,6 +40,8 @@ const rec_field rec_light[] = {
     F(point_light, position, REC_VEC3), F(point_light, intensity, REC_VEC3), F(point_light, spot_dir, REC_VEC3),
     F(point_light, cos_inner, REC_FLOAT), F(point_light, cos_outer, REC_FLOAT),
     F(point_light, spot_falloff, REC_INT), F(point_light, distant, REC_BOOL),
+    F(point_light, map_kind, REC_INT), F(point_light, to_light, REC_F9),
+    F(point_light, proj_tan, REC_FLOAT), F(point_light, proj_sx, REC_FLOAT), F(point_light, proj_sy, REC_FLOAT),
 };
 const size_t rec_nlight = sizeof rec_light / sizeof rec_light[0];
 

@@ -621,8 +621,17 @@ static pk_status write_lights(jw *w)
     for (size_t i = 0; i < s->nlights; i++) {
         bool first = true;
         fprintf(w->f, "%s\n  {\"record\": {", i ? "," : "");
-        pk_status st = jw_fields(w, &first, rec_light, rec_nlight, &s->lights[i], "lights");
+        const point_light *l = &s->lights[i];
+        pk_status st = jw_fields(w, &first, rec_light, rec_nlight, l, "lights");
         if (st) return st;
+        if (l->map_kind != LIGHT_MAP_NONE) { /* the image, as a texture reference */
+            tex_ref r;
+            tex_ref_init(&r);
+            r.kind = TEX_IMAGE;
+            r.tex = l->map_tex;
+            jw_key(w, &first, "map");
+            if ((st = write_texref(w, &r, "lights"))) return st;
+        }
         fputs("}}", w->f);
     }
     fputs("]", w->f);

@@ -342,6 +342,7 @@ pk_status light_set_build(pk_context *ctx, const pk_scene *s, const env_light *e
             /* the cone, its falloff counted as half the band between the cones */
             flux = 2.0 * (double)PK_PI * (1.0 - 0.5 * ((double)pl->cos_inner + (double)pl->cos_outer));
         }
+        if (pl->map_kind != LIGHT_MAP_NONE) flux *= (double)pl->map_mean; /* the image's mean over the cone */
         power[k] = (double)fmaxf(v3_luminance(pl->intensity), 1e-6f) * fmax(flux, 1e-9);
         k++;
     }

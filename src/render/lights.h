@@ -295,6 +295,36 @@ static inline PK_HD float spot_falloff(const point_light *pl, vec3 w)
     return t * t * (3.0f - 2.0f * t);
 }
 
+/* What a point light's image map (LIGHT_MAP_*) multiplies its intensity by
+ * in the direction w (from the light, world space; scene.h, point_light). */
+static inline PK_HD vec3 point_light_map(const scene_view *s, const point_light *pl, vec3 w)
+{
+    const float *m = pl->to_light;
+    vec3 d = v3(m[0] * w.x + m[1] * w.y + m[2] * w.z, m[3] * w.x + m[4] * w.y + m[5] * w.z,
+                m[6] * w.x + m[7] * w.y + m[8] * w.z);
+    d = v3_norm_scaled(d);
+    if (!v3_finite(d)) return v3s(0.0f);
+    float x, y;
+    if (pl->map_kind == LIGHT_MAP_GONIOMETRIC) {
+        equal_area_sphere_to_square(d, &x, &y);
+    } else {
+        if (!(d.z >= 1e-3f)) return v3s(0.0f); /* behind the projector (pbrt-v4's near plane) */
+        const float px = d.x / (d.z * pl->proj_tan), py = d.y / (d.z * pl->proj_tan);
+        if (!(fabsf(px) <= pl->proj_sx && fabsf(py) <= pl->proj_sy)) return v3s(0.0f);
+        x = 0.5f * (px / pl->proj_sx + 1.0f), y = 0.5f * (py / pl->proj_sy + 1.0f);
+    }
+    const texture *t = &s->textures[pl->map_tex];
+    const tex_level *l = &t->lv[0];
+    int ix = (int)(x * (float)l->w), iy = (int)(y * (float)l->h);
+    ix = ix < 0 ? 0 : ix >= l->w ? l->w - 1 : ix;
+    iy = iy < 0 ? 0 : iy >= l->h ? l->h - 1 : iy;
+    float c[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+    tex_fetch(t, l, ix, iy, c);
+    if (t->nc < 3) c[1] = c[2] = c[0];
+    if (pl->map_kind == LIGHT_MAP_GONIOMETRIC) return v3s(fmaxf((c[0] + c[1] + c[2]) * (1.0f / 3.0f), 0.0f));
+    return v3(fmaxf(c[0], 0.0f), fmaxf(c[1], 0.0f), fmaxf(c[2], 0.0f));
+}
+
 /* The radiance that emitter l (a triangle or sphere) sends from its point q
  * when its material has an emission map (map_ke): ke times the map at q's
  * texture coordinates, found as a hit there would find them (the finest
@@ -366,6 +396,10 @@ static inline PK_HD bool light_sample_one_with(const light_set *set, const scene
         const float f = spot_falloff(pl, v3_neg(ls->wi));
         if (!(f > 0.0f)) return false;
         ls->le = v3_scale(pl->intensity, f / dist2);
+        if (pl->map_kind != LIGHT_MAP_NONE) {
+            ls->le = v3_mul(ls->le, point_light_map(s, pl, v3_neg(ls->wi)));
+            if (!(ls->le.x > 0.0f || ls->le.y > 0.0f || ls->le.z > 0.0f)) return false;
+        }
         ls->pdf = 1.0f;
         ls->delta = true;
         ls->shadow = (ray){o, 0.0f, d, 1.0f};

@@ -188,6 +188,92 @@ pk_status scene_light_spot(pk_context *ctx, pk_scene *s, vec3 position, vec3 axi
     return add_light(ctx, s, &l);
 }
 
+/* The direction from the light of a projection map's screen point (x, y): in the map's frame (x t, y t, 1). */
+static vec3 frame_to_world(const float m[9], vec3 d)
+{
+    /* m is world -> frame; its inverse by the cofactors */
+    const double a = m[0], b = m[1], c = m[2], e = m[3], f = m[4], g = m[5], h = m[6], i = m[7], j = m[8];
+    const double det = a * (f * j - g * i) - b * (e * j - g * h) + c * (e * i - f * h);
+    const double inv[9] = {(f * j - g * i) / det, (c * i - b * j) / det, (b * g - c * f) / det,
+                           (g * h - e * j) / det, (a * j - c * h) / det, (c * e - a * g) / det,
+                           (e * i - f * h) / det, (b * h - a * i) / det, (a * f - b * e) / det};
+    return v3((float)(inv[0] * (double)d.x + inv[1] * (double)d.y + inv[2] * (double)d.z),
+              (float)(inv[3] * (double)d.x + inv[4] * (double)d.y + inv[5] * (double)d.z),
+              (float)(inv[6] * (double)d.x + inv[7] * (double)d.y + inv[8] * (double)d.z));
+}
+
+pk_status scene_light_mapped(pk_context *ctx, pk_scene *s, vec3 position, vec3 intensity, int kind, int32_t map_tex,
+                             const float to_light[9], float tan_half_fov, float sx, float sy, float power)
+{
+    pk_status st = light_check(ctx, "mapped point", intensity);
+    if (st) return st;
+    if (!v3_finite(position)) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "point light: the position is not finite");
+    if (kind != LIGHT_MAP_GONIOMETRIC && kind != LIGHT_MAP_PROJECTION)
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "point light: unknown map kind %d", kind);
+    if (map_tex < 0 || (size_t)map_tex >= s->ntextures)
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "point light: no texture %d", (int)map_tex);
+    double tm[9];
+    for (int k = 0; k < 9; k++) tm[k] = (double)to_light[k];
+    const double det = tm[0] * (tm[4] * tm[8] - tm[5] * tm[7]) - tm[1] * (tm[3] * tm[8] - tm[5] * tm[6]) +
+                       tm[2] * (tm[3] * tm[7] - tm[4] * tm[6]);
+    if (!(fabs(det) > 1e-20) || !isfinite(det))
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "point light: the map's frame is singular");
+    if (kind == LIGHT_MAP_PROJECTION && !(tan_half_fov > 0.0f && isfinite(tan_half_fov) && sx > 0.0f && sy > 0.0f))
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "projection light: the field of view must be in (0, 180)");
+    point_light l;
+    memset(&l, 0, sizeof l);
+    l.position = position;
+    l.intensity = intensity;
+    l.map_kind = kind;
+    l.map_tex = map_tex;
+    memcpy(l.to_light, to_light, sizeof l.to_light);
+    const texture *t = &s->textures[map_tex];
+    const tex_level *lv = &t->lv[0];
+    double sum = 0.0, wsum = 0.0;
+    for (int y = 0; y < lv->h; y++)
+        for (int x = 0; x < lv->w; x++) {
+            float c[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+            tex_fetch(t, lv, x, y, c);
+            const double g = t->nc >= 3 ? kind == LIGHT_MAP_PROJECTION ? (double)v3_luminance(v3(c[0], c[1], c[2]))
+                                                                         : ((double)c[0] + (double)c[1] + (double)c[2]) / 3.0
+                                        : (double)c[0];
+            double wt = 1.0; /* goniometric: texels of equal solid angle */
+            if (kind == LIGHT_MAP_PROJECTION) { /* solid angle per screen area: cos^3 / t^2 */
+                const double px = (2.0 * (x + 0.5) / lv->w - 1.0) * (double)sx * (double)tan_half_fov;
+                const double py = (2.0 * (y + 0.5) / lv->h - 1.0) * (double)sy * (double)tan_half_fov;
+                wt = pow(1.0 + px * px + py * py, -1.5);
+            }
+            sum += fmax(g, 0.0) * wt, wsum += wt;
+        }
+    l.map_mean = wsum > 0.0 ? (float)(sum / wsum) : 0.0f;
+    if (kind == LIGHT_MAP_PROJECTION) {
+        l.proj_tan = tan_half_fov, l.proj_sx = sx, l.proj_sy = sy;
+        /* the cone around the frame's +z through the window's corners bounds it (a spot with one cone) */
+        const vec3 axis = v3_norm_scaled(frame_to_world(to_light, v3(0.0f, 0.0f, 1.0f)));
+        float cos_min = 1.0f;
+        for (int k = 0; k < 4; k++) {
+            const vec3 cw = v3_norm_scaled(frame_to_world(
+                to_light, v3((k & 1 ? sx : -sx) * tan_half_fov, (k & 2 ? sy : -sy) * tan_half_fov, 1.0f)));
+            cos_min = fminf(cos_min, v3_dot(cw, axis));
+        }
+        if (!v3_finite(axis) || !(cos_min > -1.0f))
+            return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "projection light: the frame gives no direction");
+        l.spot_dir = axis;
+        l.cos_inner = l.cos_outer = fmaxf(cos_min - 1e-4f, -1.0f); /* a little wider: never cuts the map */
+        /* the map's power over the cone's solid angle, as map_mean is used (lights.c) */
+        const double cone = 2.0 * (double)PK_PI * (1.0 - (double)l.cos_outer);
+        const double omega = 4.0 * (double)sx * (double)sy * (double)tan_half_fov * (double)tan_half_fov;
+        l.map_mean = (float)((double)l.map_mean * omega * (wsum > 0.0 ? wsum / ((double)lv->w * lv->h) : 0.0) / cone);
+    }
+    if (power > 0.0f) {
+        const double flux = (kind == LIGHT_MAP_PROJECTION ? 2.0 * (double)PK_PI * (1.0 - (double)l.cos_outer)
+                                                          : 4.0 * (double)PK_PI) *
+                            (double)l.map_mean;
+        if (flux > 0.0) l.intensity = v3_scale(l.intensity, (float)((double)power / flux));
+    }
+    return add_light(ctx, s, &l);
+}
+
 pk_status scene_light_distant(pk_context *ctx, pk_scene *s, vec3 to_light, vec3 irradiance)
 {
     pk_status st = light_check(ctx, "distant", irradiance);

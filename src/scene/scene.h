@@ -55,7 +55,28 @@ typedef struct point_light {
     float cos_outer; /* spot: nothing outside this one (cos_outer < cos_inner) */
     int spot_falloff;/* SPOT_FALLOFF_* */
     bool distant;
+    /* An image that multiplies the intensity by direction (LIGHT_MAP_*;
+     * LIGHT_MAP_NONE: none): map_tex is the scene's texture, looked up at
+     * its nearest texel (row 0 on top), in the light's frame: a world
+     * direction d from the light is to_light d (row-major 3x3, normalised
+     * after). A goniometric map is the equal-area octahedral square
+     * (equal_area_sphere_to_square) of that direction, its value the mean of
+     * the texel's channels (grey); a projection map covers the screen window
+     * [-proj_sx, proj_sx] x [-proj_sy, proj_sy] of the perspective
+     * projection x/(z t), y/(z t) (t = proj_tan = tan(fov/2)) along +z, its
+     * value the texel's colour, nothing outside it (row 0 at -proj_sy).
+     * map_mean is the map's mean over the directions it covers (the spot
+     * cone bounds a projection's), for the light's share of samples. */
+    int map_kind;
+    int32_t map_tex;
+    float to_light[9];
+    float proj_tan, proj_sx, proj_sy;
+    float map_mean;
 } point_light;
+
+#define LIGHT_MAP_NONE 0
+#define LIGHT_MAP_GONIOMETRIC 1
+#define LIGHT_MAP_PROJECTION 2
 
 /* Light from the surroundings (docs/scene-format.md, "environment"): what a
  * ray that leaves the scene sees. Every part is optional and they add up.
@@ -235,6 +256,17 @@ PK_HIDDEN pk_status scene_light_point(pk_context *ctx, pk_scene *s, vec3 positio
  * cos_inner), fading between as falloff (SPOT_FALLOFF_*) says. */
 PK_HIDDEN pk_status scene_light_spot(pk_context *ctx, pk_scene *s, vec3 position, vec3 axis, float cos_inner,
                                      float cos_outer, int falloff, vec3 intensity);
+/* A point light at position whose intensity is multiplied, by direction,
+ * by the image map_tex (a texture of the scene) as kind (LIGHT_MAP_
+ * GONIOMETRIC or _PROJECTION) says, in the frame to_light (row-major 3x3,
+ * world to the map's frame; invertible); a projection covers the window
+ * [-sx, sx] x [-sy, sy] at tan_half_fov (point_light). The map's mean and a
+ * projection's bounding cone are computed here. power > 0 multiplies the
+ * intensity by power over the map's integral over directions (pbrt-v4's
+ * "power" of these lights, which leaves the intensity's own size in). */
+PK_HIDDEN pk_status scene_light_mapped(pk_context *ctx, pk_scene *s, vec3 position, vec3 intensity, int kind,
+                                       int32_t map_tex, const float to_light[9], float tan_half_fov, float sx,
+                                       float sy, float power);
 /* A distant light from the unit direction to_light, giving irradiance on a
  * surface facing it. */
 PK_HIDDEN pk_status scene_light_distant(pk_context *ctx, pk_scene *s, vec3 to_light, vec3 irradiance);
