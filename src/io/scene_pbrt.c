@@ -1192,7 +1192,73 @@ static pk_status shape_trianglemesh(pp *p, int32_t alpha)
     return st;
 }
 
-/* Bilinear patches (p00 p10 p01 p11) as two triangles each. */
+/* Whether patch q's uv are not an affine function of its parameters
+ * (u00 + u11 != u10 + u01): pbrt interpolates them bilinearly, which two
+ * triangles cannot. */
+static bool patch_twisted(const mesh_in *m, const uint32_t *q)
+{
+    for (int c = 0; c < 2; c++) {
+        const float a = m->uv[2 * q[0] + c], b = m->uv[2 * q[1] + c], d = m->uv[2 * q[2] + c], e = m->uv[2 * q[3] + c];
+        if (fabsf(a + e - b - d) > 1e-6f * (1.0f + fabsf(a) + fabsf(b) + fabsf(d) + fabsf(e))) return true;
+    }
+    return false;
+}
+
+/* The patches of m with twisted uv as grids of g x g cells (positions,
+ * normals and uv interpolated bilinearly, as pbrt evaluates the patch),
+ * the others as two triangles; into *out. */
+static pk_status patches_as_grids(pp *p, const mesh_in *m, const uint32_t *f, size_t nf, size_t ntw, mesh_in *out)
+{
+    const size_t g = ntw <= 64 ? 64 : ntw <= 1024 ? 16 : 4;
+    const size_t gv = (g + 1) * (g + 1);
+    if (ntw > (UINT32_MAX / 2 - m->npos) / gv || nf > SIZE_MAX / 4 / (2 * g * g))
+        return pfail(p, p->line, PK_ERR_LIMIT, "bilinearmesh: too many patches with twisted texture coordinates");
+    pk_status st = mesh_alloc(p, out, m->npos + ntw * gv, 2 * (nf - ntw) + ntw * 2 * g * g, m->nrm != NULL, true);
+    if (st) return st;
+    memcpy(out->pos, m->pos, m->npos * sizeof *m->pos);
+    if (m->nrm) memcpy(out->nrm, m->nrm, m->npos * sizeof *m->nrm);
+    memcpy(out->uv, m->uv, 2 * m->npos * sizeof *m->uv);
+    size_t nv = m->npos, nt = 0;
+    for (size_t i = 0; i < nf; i++) {
+        const uint32_t *q = &f[4 * i];
+        if (!patch_twisted(m, q)) {
+            const uint32_t a[6] = {q[0], q[1], q[3], q[0], q[3], q[2]};
+            memcpy(&out->tris[3 * nt], a, sizeof a);
+            nt += 2;
+            continue;
+        }
+        const size_t base = nv;
+        for (size_t j = 0; j <= g; j++)
+            for (size_t k = 0; k <= g; k++) {
+                const float s = (float)k / (float)g, t = (float)j / (float)g;
+                const float w[4] = {(1.0f - s) * (1.0f - t), s * (1.0f - t), (1.0f - s) * t, s * t};
+                vec3 P = v3s(0.0f), N = v3s(0.0f);
+                float u = 0.0f, v = 0.0f;
+                for (int c = 0; c < 4; c++) {
+                    P = v3_add(P, v3_scale(m->pos[q[c]], w[c]));
+                    if (m->nrm) N = v3_add(N, v3_scale(m->nrm[q[c]], w[c]));
+                    u += w[c] * m->uv[2 * q[c]], v += w[c] * m->uv[2 * q[c] + 1];
+                }
+                out->pos[nv] = P;
+                if (m->nrm) out->nrm[nv] = N;
+                out->uv[2 * nv] = u, out->uv[2 * nv + 1] = v;
+                nv++;
+            }
+        for (size_t j = 0; j < g; j++)
+            for (size_t k = 0; k < g; k++) {
+                const uint32_t c00 = (uint32_t)(base + j * (g + 1) + k), c10 = c00 + 1, c01 = c00 + (uint32_t)(g + 1),
+                               c11 = c01 + 1;
+                const uint32_t a[6] = {c00, c10, c11, c00, c11, c01};
+                memcpy(&out->tris[3 * nt], a, sizeof a);
+                nt += 2;
+            }
+    }
+    out->ntris = nt;
+    return PK_OK;
+}
+
+/* Bilinear patches (p00 p10 p01 p11) as two triangles each (textured
+ * patches with twisted uv as grids). */
 static pk_status shape_bilinear(pp *p, int32_t alpha)
 {
     mesh_in m;
@@ -1211,6 +1277,20 @@ static pk_status shape_bilinear(pp *p, int32_t alpha)
         }
         mesh_free(p, &m);
         m = un;
+    }
+    if (m.uv && needs_uv(p, alpha)) {
+        size_t ntw = 0;
+        for (size_t i = 0; i < nf; i++) ntw += patch_twisted(&m, &f[4 * i]);
+        if (ntw) {
+            mesh_in gm;
+            st = patches_as_grids(p, &m, f, nf, ntw, &gm);
+            mem_free(A(p), f);
+            mesh_free(p, &m);
+            if (st) return st;
+            st = add_mesh(p, &gm, alpha);
+            mesh_free(p, &gm);
+            return st;
+        }
     }
     uint32_t *t = mem_calloc(A(p), nf ? 2 * nf : 1, 3 * sizeof(uint32_t));
     if (!t) {
