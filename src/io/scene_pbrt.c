@@ -40,14 +40,21 @@
 
 /* ---- the reader's state ------------------------------------------------------------ */
 
-typedef enum tex_class { TC_IMAGE, TC_CHECKER, TC_CONST } tex_class;
+typedef enum tex_class { TC_IMAGE, TC_CHECKER, TC_CONST, TC_EXPR } tex_class;
 
+/* A named texture: a constant, an image or a uv checkerboard of constants
+ * (the scene's own map kinds), or an expression of procedural nodes
+ * (TC_EXPR). Every class also keeps its nodes, so that another texture can
+ * take it as an operand. */
 typedef struct named_tex {
     char *name;
     bool is_float;
     tex_class cls;
-    tex_ref ref;      /* TC_IMAGE, TC_CHECKER */
-    vec3 value;       /* TC_CONST: the value; else the constant the map multiplies */
+    tex_ref ref;      /* TC_IMAGE, TC_CHECKER; TC_EXPR once added to the scene (added) */
+    bool added;
+    vec3 value;       /* TC_CONST: the value; TC_EXPR: its mean; else the constant the map multiplies */
+    tex_node *nodes;  /* owned, nnodes (1..TEX_MAX_NODES) */
+    int nnodes;
 } named_tex;
 
 typedef struct area_light {
@@ -367,6 +374,19 @@ static named_tex *find_tex(pp *p, const char *name)
     return NULL;
 }
 
+/* The scene's copy of an expression texture's nodes, made once (later
+ * uses share it). */
+static pk_status tex_add_expr(pp *p, named_tex *t, tex_ref *out)
+{
+    if (!t->added) {
+        pk_status st = scene_add_tex_nodes(p->ctx, p->s, t->nodes, t->nnodes, &t->ref);
+        if (st) return st;
+        t->added = true;
+    }
+    *out = t->ref;
+    return PK_OK;
+}
+
 /* A colour parameter (reflectance, ...): *c the constant, *tex the map
  * (when tex is non-NULL and the parameter names an image or checkerboard
  * texture). found: whether the parameter was there. */
@@ -387,9 +407,15 @@ static pk_status get_colour(pp *p, const char *name, vec3 *c, tex_ref *tex, bool
         return PK_OK;
     }
     if (!tex) {
-        pwarn(p, q->line, "a texture for '%s' is not supported; using its mean %g", name, (double)v3_luminance(t->value));
+        pwarn(p, q->line, "a texture for '%s' is not supported (the material has no texture map for it); using its mean %g",
+              name, (double)v3_luminance(t->value));
         *c = t->value;
         return PK_OK;
+    }
+    if (t->cls == TC_EXPR) {
+        pk_status st2 = tex_add_expr(p, t, tex);
+        *c = v3s(1.0f);
+        return st2;
     }
     *tex = t->ref;
     *c = t->value;
@@ -423,6 +449,12 @@ static pk_status get_float_tex(pp *p, const char *name, float *v, bool *found)
     if (!t) return pfail(p, q->line, PK_ERR_PARSE, "'texture %s': no texture named \"%.60s\"", name, q->str[0]);
     if (t->cls == TC_CONST) {
         *v = t->value.x;
+        return PK_OK;
+    }
+    if (t->cls == TC_EXPR) {
+        *v = t->value.x;
+        pwarn(p, q->line, "a texture for '%s' is not supported (the material has no texture map for it); using its mean %g",
+              name, (double)*v);
         return PK_OK;
     }
     pwarn(p, q->line, "a texture for '%s' is not supported; using %g", name, (double)*v);
@@ -485,9 +517,31 @@ static float rough_alpha(float r, bool remap)
     return a < 1e-3f ? 0.0f : a; /* pbrt treats these as smooth */
 }
 
+/* A roughness texture as a map of the GGX alpha (map non-NULL): the
+ * texture's nodes, then their square root when remap (pbrt's
+ * RoughnessToAlpha); the constant alpha becomes 1. False when the texture
+ * does not fit (warned by the caller's float path). */
+static pk_status roughness_map(pp *p, const named_tex *t, bool remap, tex_ref *map, bool *done)
+{
+    *done = false;
+    if (t->nnodes + (remap ? 1 : 0) > TEX_MAX_NODES) return PK_OK;
+    tex_node nodes[TEX_MAX_NODES];
+    memcpy(nodes, t->nodes, (size_t)t->nnodes * sizeof *nodes);
+    int n = t->nnodes;
+    if (remap) {
+        memset(&nodes[n], 0, sizeof nodes[n]);
+        nodes[n].op = TN_SQRT, nodes[n].a = (int8_t)(n - 1), nodes[n].b = nodes[n].c = -1;
+        n++;
+    }
+    pk_status st = scene_add_tex_nodes(p->ctx, p->s, nodes, n, map);
+    *done = st == PK_OK;
+    return st;
+}
+
 /* roughness / uroughness / vroughness and remaproughness (prefix: "" or
- * "interface." / "conductor."). */
-static pk_status get_roughness(pp *p, const char *prefix, float *alpha)
+ * "interface." / "conductor."). map: where a roughness texture goes (the
+ * material's map_alpha; its alpha is then 1), NULL where there is none. */
+static pk_status get_roughness(pp *p, const char *prefix, float *alpha, tex_ref *map)
 {
     char n1[64], n2[64], n3[64], n4[64];
     snprintf(n1, sizeof n1, "%sroughness", prefix);
@@ -497,6 +551,23 @@ static pk_status get_roughness(pp *p, const char *prefix, float *alpha)
     float r = 0.0f, u = -1.0f, v = -1.0f;
     bool remap = true, fu, fv;
     pk_status st;
+    if (map) {
+        pparam *rq = NULL;
+        if ((st = pb_typed(&p->pd, n1, TB(PT_FLOAT) | TB(PT_TEXTURE) | TB(PT_SPECTRUM) | TB(PT_RGB),
+                           "a float or a float texture", &rq)))
+            return st;
+        named_tex *rt = rq && rq->type == PT_TEXTURE && rq->nstr == 1 ? find_tex(p, rq->str[0]) : NULL;
+        if (rt && rt->cls != TC_CONST) {
+            if (!pd_has(&p->pd, n2) && !pd_has(&p->pd, n3)) {
+                bool done;
+                if ((st = pb_bool(&p->pd, n4, &remap)) || (st = roughness_map(p, rt, remap, map, &done))) return st;
+                if (done) {
+                    *alpha = 1.0f;
+                    return PK_OK;
+                }
+            }
+        }
+    }
     if ((st = get_float_tex(p, n1, &r, NULL)) || (st = get_float_tex(p, n2, &u, &fu)) ||
         (st = get_float_tex(p, n3, &v, &fv)) || (st = pb_bool(&p->pd, n4, &remap)))
         return st;
@@ -531,14 +602,16 @@ static pk_status get_eta(pp *p, const char *name, float def, float *eta)
 
 /* A conductor from the parameters named prefix + eta, k, roughness (or
  * reflectance), at least as rough as min_alpha (a coat's roughness). */
-static pk_status make_conductor(pp *p, material *m, const char *prefix, float min_alpha)
+static pk_status make_conductor(pp *p, material *m, const char *prefix, float min_alpha, bool maps)
 {
     char ne[64], nk[64], nr[64];
     snprintf(ne, sizeof ne, "%seta", prefix);
     snprintf(nk, sizeof nk, "%sk", prefix);
     snprintf(nr, sizeof nr, "%sroughness", prefix);
     float alpha;
-    pk_status st = get_roughness(p, prefix, &alpha);
+    tex_ref ta;
+    tex_ref_init(&ta);
+    pk_status st = get_roughness(p, prefix, &alpha, maps ? &ta : NULL);
     if (st) return st;
     if (min_alpha > alpha) alpha = min_alpha;
     vec3 refl;
@@ -557,6 +630,7 @@ static pk_status make_conductor(pp *p, material *m, const char *prefix, float mi
     } else {
         material_conductor(m, eta, k, alpha);
     }
+    m->map_alpha = ta;
     return PK_OK;
 }
 
@@ -637,7 +711,9 @@ static pk_status build_material(pp *p, const char *type, material *m, bool *inte
     } else if (strcmp(type, "coateddiffuse") == 0) {
         float thick;
         vec3 albedo;
-        if ((st = get_colour(p, "reflectance", &kd, &tkd, NULL)) || (st = get_roughness(p, "", &alpha)) ||
+        tex_ref ta;
+        tex_ref_init(&ta);
+        if ((st = get_colour(p, "reflectance", &kd, &tkd, NULL)) || (st = get_roughness(p, "", &alpha, &ta)) ||
             (st = get_eta(p, "eta", 1.5f, &eta)) || (st = coat_layer(p, &thick, &albedo)))
             return st;
         if (v3_max_comp(albedo) > 0.0f)
@@ -645,22 +721,26 @@ static pk_status build_material(pp *p, const char *type, material *m, bool *inte
         if (!(thick >= 0.0f) || !isfinite(thick)) thick = 0.01f;
         material_plastic(m, coated_albedo(kd, eta, thick, tkd.kind != TEX_NONE), eta, alpha);
         m->map_kd = tkd;
+        m->map_alpha = ta;
     } else if (strcmp(type, "conductor") == 0) {
-        if ((st = make_conductor(p, m, "", 0.0f))) return st;
+        if ((st = make_conductor(p, m, "", 0.0f, true))) return st;
     } else if (strcmp(type, "coatedconductor") == 0) {
         /* the base conductor alone, roughened by the coat (docs: an approximation) */
         float ia, thick;
         vec3 albedo;
-        if ((st = get_roughness(p, "interface.", &ia)) || (st = get_eta(p, "interface.eta", 1.5f, &eta)) ||
-            (st = make_conductor(p, m, "conductor.", ia)) || (st = coat_layer(p, &thick, &albedo)))
+        if ((st = get_roughness(p, "interface.", &ia, NULL)) || (st = get_eta(p, "interface.eta", 1.5f, &eta)) ||
+            (st = make_conductor(p, m, "conductor.", ia, false)) || (st = coat_layer(p, &thick, &albedo)))
             return st;
         pwarn(p, p->line, "coatedconductor is approximated by its conductor under the coat's roughness (no clear "
                           "coat layer)");
     } else if (strcmp(type, "dielectric") == 0 || strcmp(type, "thindielectric") == 0) {
-        if ((st = get_eta(p, "eta", 1.5f, &eta)) || (st = get_roughness(p, "", &alpha))) return st;
+        tex_ref ta;
+        tex_ref_init(&ta);
+        if ((st = get_eta(p, "eta", 1.5f, &eta)) || (st = get_roughness(p, "", &alpha, &ta))) return st;
         if (type[0] == 't')
             pwarn(p, p->line, "thindielectric is rendered as a solid dielectric of the same index (no thin sheet)");
         material_dielectric(m, eta, alpha, v3s(1.0f));
+        m->map_alpha = ta;
     } else if (strcmp(type, "diffusetransmission") == 0) {
         vec3 tr = v3s(0.25f);
         float sc = 1.0f;
@@ -760,7 +840,14 @@ static pk_status shape_material(pp *p, vec3 ke, int32_t ke_tex, bool two_sided, 
     uint32_t idx;
     pk_status st = scene_material_with_emission(p->ctx, p->s, base, name, ke, two_sided, &idx);
     if (st) return st;
-    if (alpha_tex >= 0) p->s->materials[idx].map_d = p->tex[alpha_tex].ref;
+    if (alpha_tex >= 0) {
+        named_tex *at = &p->tex[alpha_tex];
+        tex_ref r = at->ref;
+        if (at->cls == TC_EXPR) {
+            if ((st = tex_add_expr(p, at, &r))) return st;
+        }
+        p->s->materials[idx].map_d = r;
+    }
     if (ke_tex >= 0 && v3_max_comp(ke) > 0.0f) {
         tex_ref *r = &p->s->materials[idx].map_ke;
         tex_ref_init(r);
@@ -888,7 +975,62 @@ static vec3 area_emission(pp *p, double area, bool *two_sided, int32_t *image)
  * normals' side when the mesh has them, else the winding's (reversed by
  * ReverseOrientation); the winding is swapped wherever the transform to the
  * world mirrors. alpha_tex: the cut-out texture, -1 none. */
+static pk_status add_mesh_uv(pp *p, mesh_in *m, int32_t alpha_tex);
+static pk_status mesh_alloc(pp *p, mesh_in *m, size_t npos, size_t ntris, bool nrm, bool uv);
+static void mesh_free(pp *p, mesh_in *m);
+
+/* Whether the shape's material (or its alpha texture) reads texture
+ * coordinates: then meshes without them get pbrt's defaults. */
+static bool needs_uv(pp *p, int32_t alpha_tex)
+{
+    const material *m = &p->s->materials[GS(p)->material];
+    return alpha_tex >= 0 || m->map_kd.kind || m->map_ks.kind || m->map_ns.kind || m->map_d.kind ||
+           m->map_alpha.kind || m->map_bump.kind || m->map_norm.kind || m->map_mr.kind;
+}
+
+/* A copy of m in which every face (per_face corners of faces[]) has
+ * vertices of its own with the texture coordinates cuv[corner] (pbrt's
+ * defaults for a shape without uv); faces[] is renumbered to them. */
+static pk_status unshare_uv(pp *p, const mesh_in *m, uint32_t *faces, size_t nfaces, size_t per_face,
+                            const float (*cuv)[2], mesh_in *out)
+{
+    memset(out, 0, sizeof *out);
+    if (nfaces > (size_t)(UINT32_MAX / 2) / per_face) return pfail(p, p->line, PK_ERR_LIMIT, "too many vertices");
+    const size_t n = nfaces * per_face;
+    pk_status st = mesh_alloc(p, out, n, 0, m->nrm != NULL, true);
+    if (st) return st;
+    for (size_t i = 0; i < n; i++) {
+        const uint32_t v = faces[i];
+        out->pos[i] = m->pos[v];
+        if (m->nrm) out->nrm[i] = m->nrm[v];
+        out->uv[2 * i] = cuv[i % per_face][0], out->uv[2 * i + 1] = cuv[i % per_face][1];
+        faces[i] = (uint32_t)i;
+    }
+    return PK_OK;
+}
+
 static pk_status add_mesh(pp *p, mesh_in *m, int32_t alpha_tex)
+{
+    if (m->uv || !needs_uv(p, alpha_tex)) return add_mesh_uv(p, m, alpha_tex);
+    /* pbrt's triangles without uv: (0,0), (1,0), (1,1) at their corners */
+    static const float tri_uv[3][2] = {{0.0f, 0.0f}, {1.0f, 0.0f}, {1.0f, 1.0f}};
+    uint32_t *faces = mem_realloc_array(A(p), NULL, m->ntris ? 3 * m->ntris : 1, sizeof *faces);
+    if (!faces) return ctx_nomem(p->ctx);
+    memcpy(faces, m->tris, 3 * m->ntris * sizeof *faces);
+    mesh_in un;
+    pk_status st = unshare_uv(p, m, faces, m->ntris, 3, tri_uv, &un);
+    if (st == PK_OK) {
+        mem_free(A(p), un.tris);
+        un.tris = faces, un.ntris = m->ntris;
+        faces = NULL;
+        st = add_mesh_uv(p, &un, alpha_tex);
+        mesh_free(p, &un);
+    }
+    mem_free(A(p), faces);
+    return st;
+}
+
+static pk_status add_mesh_uv(pp *p, mesh_in *m, int32_t alpha_tex)
 {
     /* an interface that bounds no media changes nothing: left out */
     if (GS(p)->interface && !medium_transition(p)) return PK_OK;
@@ -981,10 +1123,7 @@ static pk_status shape_alpha(pp *p, int32_t *tex, bool *skip)
         if (t->value.x <= 0.0f) *skip = true;
         return PK_OK;
     }
-    if (t->cls != TC_IMAGE) {
-        pwarn(p, q->line, "an alpha texture that is not an image is not supported; the shape is opaque");
-        return PK_OK;
-    }
+    /* images, checkerboards and procedural textures cut holes */
     *tex = (int32_t)(t - p->tex);
     return PK_OK;
 }
@@ -1070,7 +1209,73 @@ static pk_status shape_trianglemesh(pp *p, int32_t alpha)
     return st;
 }
 
-/* Bilinear patches (p00 p10 p01 p11) as two triangles each. */
+/* Whether patch q's uv are not an affine function of its parameters
+ * (u00 + u11 != u10 + u01): pbrt interpolates them bilinearly, which two
+ * triangles cannot. */
+static bool patch_twisted(const mesh_in *m, const uint32_t *q)
+{
+    for (int c = 0; c < 2; c++) {
+        const float a = m->uv[2 * q[0] + c], b = m->uv[2 * q[1] + c], d = m->uv[2 * q[2] + c], e = m->uv[2 * q[3] + c];
+        if (fabsf(a + e - b - d) > 1e-6f * (1.0f + fabsf(a) + fabsf(b) + fabsf(d) + fabsf(e))) return true;
+    }
+    return false;
+}
+
+/* The patches of m with twisted uv as grids of g x g cells (positions,
+ * normals and uv interpolated bilinearly, as pbrt evaluates the patch),
+ * the others as two triangles; into *out. */
+static pk_status patches_as_grids(pp *p, const mesh_in *m, const uint32_t *f, size_t nf, size_t ntw, mesh_in *out)
+{
+    const size_t g = ntw <= 64 ? 64 : ntw <= 1024 ? 16 : 4;
+    const size_t gv = (g + 1) * (g + 1);
+    if (ntw > (UINT32_MAX / 2 - m->npos) / gv || nf > SIZE_MAX / 4 / (2 * g * g))
+        return pfail(p, p->line, PK_ERR_LIMIT, "bilinearmesh: too many patches with twisted texture coordinates");
+    pk_status st = mesh_alloc(p, out, m->npos + ntw * gv, 2 * (nf - ntw) + ntw * 2 * g * g, m->nrm != NULL, true);
+    if (st) return st;
+    memcpy(out->pos, m->pos, m->npos * sizeof *m->pos);
+    if (m->nrm) memcpy(out->nrm, m->nrm, m->npos * sizeof *m->nrm);
+    memcpy(out->uv, m->uv, 2 * m->npos * sizeof *m->uv);
+    size_t nv = m->npos, nt = 0;
+    for (size_t i = 0; i < nf; i++) {
+        const uint32_t *q = &f[4 * i];
+        if (!patch_twisted(m, q)) {
+            const uint32_t a[6] = {q[0], q[1], q[3], q[0], q[3], q[2]};
+            memcpy(&out->tris[3 * nt], a, sizeof a);
+            nt += 2;
+            continue;
+        }
+        const size_t base = nv;
+        for (size_t j = 0; j <= g; j++)
+            for (size_t k = 0; k <= g; k++) {
+                const float s = (float)k / (float)g, t = (float)j / (float)g;
+                const float w[4] = {(1.0f - s) * (1.0f - t), s * (1.0f - t), (1.0f - s) * t, s * t};
+                vec3 P = v3s(0.0f), N = v3s(0.0f);
+                float u = 0.0f, v = 0.0f;
+                for (int c = 0; c < 4; c++) {
+                    P = v3_add(P, v3_scale(m->pos[q[c]], w[c]));
+                    if (m->nrm) N = v3_add(N, v3_scale(m->nrm[q[c]], w[c]));
+                    u += w[c] * m->uv[2 * q[c]], v += w[c] * m->uv[2 * q[c] + 1];
+                }
+                out->pos[nv] = P;
+                if (m->nrm) out->nrm[nv] = N;
+                out->uv[2 * nv] = u, out->uv[2 * nv + 1] = v;
+                nv++;
+            }
+        for (size_t j = 0; j < g; j++)
+            for (size_t k = 0; k < g; k++) {
+                const uint32_t c00 = (uint32_t)(base + j * (g + 1) + k), c10 = c00 + 1, c01 = c00 + (uint32_t)(g + 1),
+                               c11 = c01 + 1;
+                const uint32_t a[6] = {c00, c10, c11, c00, c11, c01};
+                memcpy(&out->tris[3 * nt], a, sizeof a);
+                nt += 2;
+            }
+    }
+    out->ntris = nt;
+    return PK_OK;
+}
+
+/* Bilinear patches (p00 p10 p01 p11) as two triangles each (textured
+ * patches with twisted uv as grids). */
 static pk_status shape_bilinear(pp *p, int32_t alpha)
 {
     mesh_in m;
@@ -1078,6 +1283,32 @@ static pk_status shape_bilinear(pp *p, int32_t alpha)
     size_t nf;
     pk_status st = read_mesh_params(p, "bilinearmesh", 4, &m, &f, &nf);
     if (st) return st;
+    if (!m.uv && needs_uv(p, alpha)) {
+        /* pbrt's patches without uv: (0,0), (1,0), (0,1), (1,1) at p00 p10 p01 p11 */
+        static const float quad_uv[4][2] = {{0.0f, 0.0f}, {1.0f, 0.0f}, {0.0f, 1.0f}, {1.0f, 1.0f}};
+        mesh_in un;
+        if ((st = unshare_uv(p, &m, f, nf, 4, quad_uv, &un))) {
+            mem_free(A(p), f);
+            mesh_free(p, &m);
+            return st;
+        }
+        mesh_free(p, &m);
+        m = un;
+    }
+    if (m.uv && needs_uv(p, alpha)) {
+        size_t ntw = 0;
+        for (size_t i = 0; i < nf; i++) ntw += patch_twisted(&m, &f[4 * i]);
+        if (ntw) {
+            mesh_in gm;
+            st = patches_as_grids(p, &m, f, nf, ntw, &gm);
+            mem_free(A(p), f);
+            mesh_free(p, &m);
+            if (st) return st;
+            st = add_mesh(p, &gm, alpha);
+            mesh_free(p, &gm);
+            return st;
+        }
+    }
     uint32_t *t = mem_calloc(A(p), nf ? 2 * nf : 1, 3 * sizeof(uint32_t));
     if (!t) {
         mem_free(A(p), f);
@@ -1459,7 +1690,9 @@ static pk_status shape_sphere(pp *p, int32_t alpha)
                    fabsf(v3_dot(c0, c1)) <= 1e-5f * l0 * l1 && fabsf(v3_dot(c0, c2)) <= 1e-5f * l0 * l2 &&
                    fabsf(v3_dot(c1, c2)) <= 1e-5f * l1 * l2;
     bool full = zlo <= -radius && zhi >= radius && phimax >= 360.0f;
-    if (full && similar && !GS(p)->reverse && alpha < 0) {
+    /* textured spheres are tessellated: pbrt's uv follow the sphere's own
+     * frame (phi about its z axis), which an analytic sphere does not keep */
+    if (full && similar && !GS(p)->reverse && alpha < 0 && !needs_uv(p, alpha)) {
         if (GS(p)->interface && !medium_transition(p)) return PK_OK;
         sphere sp;
         sp.center = xform_point(&w, v3s(0.0f));
@@ -1872,6 +2105,194 @@ static pk_status d_area_light(pp *p, const char *type)
 
 /* ---- textures ------------------------------------------------------------------------------------- */
 
+/* The texture-building state: the nodes of the expression so far. */
+typedef struct tex_build {
+    tex_node n[TEX_MAX_NODES];
+    int count;
+    bool full;           /* an operand did not fit */
+} tex_build;
+
+static int tb_push(tex_build *b, const tex_node *d)
+{
+    if (b->count >= TEX_MAX_NODES) {
+        b->full = true;
+        return -1;
+    }
+    b->n[b->count] = *d;
+    return b->count++;
+}
+
+static tex_node tn_new(tex_op op)
+{
+    tex_node d;
+    memset(&d, 0, sizeof d);
+    d.op = (uint8_t)op;
+    d.a = d.b = d.c = -1;
+    d.su = d.sv = 1.0f;
+    d.k[0] = v3s(1.0f);
+    return d;
+}
+
+static int tb_const(tex_build *b, vec3 c)
+{
+    tex_node d = tn_new(TN_CONST);
+    d.k[0] = c;
+    return tb_push(b, &d);
+}
+
+/* Appends a named texture's nodes (its operands moved along); its root. */
+static int tb_append(tex_build *b, const named_tex *t)
+{
+    if (b->count + t->nnodes > TEX_MAX_NODES) {
+        b->full = true;
+        return -1;
+    }
+    const int base = b->count;
+    for (int i = 0; i < t->nnodes; i++) {
+        tex_node d = t->nodes[i];
+        if (d.a >= 0) d.a = (int8_t)(d.a + base);
+        if (d.b >= 0) d.b = (int8_t)(d.b + base);
+        if (d.c >= 0) d.c = (int8_t)(d.c + base);
+        b->n[b->count++] = d;
+    }
+    return b->count - 1;
+}
+
+/* An operand of a texture: a named texture or a constant (float or
+ * colour as the texture is), def when absent. Its node's index in *idx. */
+static pk_status tex_operand(pp *p, tex_build *b, const char *name, bool is_float, vec3 def, int *idx)
+{
+    pparam *q;
+    pk_status st = pb_typed(&p->pd, name,
+                            TB(PT_RGB) | TB(PT_SPECTRUM) | TB(PT_BLACKBODY) | TB(PT_TEXTURE) | TB(PT_FLOAT),
+                            is_float ? "a float or a float texture" : "a colour (rgb, spectrum, blackbody, float or texture)",
+                            &q);
+    if (st) return st;
+    if (q && q->type == PT_TEXTURE) {
+        if (q->nstr != 1) return pfail(p, q->line, PK_ERR_PARSE, "'texture %s' takes one name", name);
+        named_tex *t = find_tex(p, q->str[0]);
+        if (!t) return pfail(p, q->line, PK_ERR_PARSE, "'texture %s': no texture named \"%.60s\"", name, q->str[0]);
+        *idx = tb_append(b, t);
+        return PK_OK;
+    }
+    vec3 c = def;
+    if (q) {
+        if (is_float) {
+            float f = def.x;
+            if ((st = get_float_tex(p, name, &f, NULL))) return st;
+            c = v3s(f);
+        } else if ((st = get_colour(p, name, &c, NULL, NULL))) {
+            return st;
+        }
+    }
+    *idx = tb_const(b, c);
+    return PK_OK;
+}
+
+/* The texture space: the inverse of the transform at the Texture
+ * directive (with the reader's mirror), as the node's three rows. */
+static pk_status tex_space(pp *p, tex_node *d)
+{
+    xform w = world_xf(p), inv;
+    if (!xform_invert(&w, &inv) || !xform_finite(&inv))
+        return pfail(p, p->line, PK_ERR_PARSE, "Texture: the transform cannot be inverted");
+    memcpy(d->xf, inv.m, sizeof d->xf);
+    return PK_OK;
+}
+
+/* pbrt's 2D mappings: "uv" (uscale, vscale, udelta, vdelta), "spherical",
+ * "cylindrical" and "planar" (v1, v2, udelta, vdelta), into d. */
+static pk_status tex_mapping2d(pp *p, tex_node *d)
+{
+    const char *mapping = "uv";
+    pk_status st = pb_string(&p->pd, "mapping", &mapping);
+    if (st) return st;
+    if (strcmp(mapping, "uv") == 0) {
+        d->map = TMAP_UV;
+        return (st = pb_float(&p->pd, "uscale", &d->su)) || (st = pb_float(&p->pd, "vscale", &d->sv)) ||
+                       (st = pb_float(&p->pd, "udelta", &d->du)) || (st = pb_float(&p->pd, "vdelta", &d->dv))
+                   ? st
+                   : PK_OK;
+    }
+    if (strcmp(mapping, "spherical") == 0) d->map = TMAP_SPHERICAL;
+    else if (strcmp(mapping, "cylindrical") == 0) d->map = TMAP_CYLINDRICAL;
+    else if (strcmp(mapping, "planar") == 0) {
+        d->map = TMAP_PLANAR;
+        d->v1 = v3(1.0f, 0.0f, 0.0f), d->v2 = v3(0.0f, 1.0f, 0.0f);
+        if ((st = pb_vec3(&p->pd, "v1", &d->v1)) || (st = pb_vec3(&p->pd, "v2", &d->v2)) ||
+            (st = pb_float(&p->pd, "udelta", &d->du)) || (st = pb_float(&p->pd, "vdelta", &d->dv)))
+            return st;
+    } else {
+        pwarn(p, p->line, "Texture: mapping \"%.20s\" is unknown; uv is used", mapping);
+        d->map = TMAP_UV;
+        return PK_OK;
+    }
+    return tex_space(p, d);
+}
+
+/* pbrt's 3D mapping: the texture-space point. */
+static pk_status tex_mapping3d(pp *p, tex_node *d)
+{
+    d->map = TMAP_3D;
+    return tex_space(p, d);
+}
+
+/* The noise textures' octaves and roughness (omega). */
+static pk_status tex_octaves(pp *p, tex_node *d)
+{
+    int64_t oct = 8;
+    d->omega = 0.5f;
+    pk_status st;
+    if ((st = pb_int(&p->pd, "octaves", 0, 64, &oct)) || (st = pb_float(&p->pd, "roughness", &d->omega))) return st;
+    d->octaves = (int32_t)oct;
+    if (!isfinite(d->omega)) return pfail(p, p->line, PK_ERR_PARSE, "Texture: 'roughness' must be finite");
+    return PK_OK;
+}
+
+/* A texture's mean over a fixed spread of points (uv in [0, 1)^2, points
+ * in a box of side 8, normals all around): what stands in where a
+ * parameter takes no map. */
+static vec3 tex_mean(pp *p, const tex_node *nodes, int n)
+{
+    tex_ref r;
+    tex_ref_init(&r);
+    r.kind = TEX_EXPR, r.node = 0, r.nnodes = n;
+    vec3 sum = v3s(0.0f);
+    const int k = 16;
+    for (int i = 0; i < k; i++)
+        for (int j = 0; j < k; j++) {
+            const float u = ((float)i + 0.5f) / (float)k, v = ((float)j + 0.5f) / (float)k;
+            const float ph = 2.0f * PK_PI * u, ct = 2.0f * v - 1.0f, sn = sqrtf(fmaxf(0.0f, 1.0f - ct * ct));
+            tex_query q = {u, v, 0.0f, v3(8.0f * u - 4.0f, 8.0f * v - 4.0f, 8.0f * fmodf(u * 7.0f + v * 3.0f, 1.0f) - 4.0f),
+                           v3(sn * cosf(ph), ct, sn * sinf(ph)), nodes};
+            sum = v3_add(sum, tex_expr_eval(p->s->textures, &r, q));
+        }
+    return v3_scale(sum, 1.0f / (float)(k * k));
+}
+
+/* The nodes of a texture of the scene's own kinds (constant, image, uv
+ * checkerboard of constants), so that other textures can use it. */
+static void tex_own_nodes(const named_tex *t, tex_build *b)
+{
+    b->count = 0;
+    if (t->cls == TC_CONST) {
+        tb_const(b, t->value);
+    } else if (t->cls == TC_IMAGE) {
+        tex_node d = tn_new(TN_IMAGE);
+        d.tex = t->ref.tex, d.clamp = t->ref.clamp, d.grey = t->is_float;
+        d.su = t->ref.s[0], d.sv = t->ref.s[1], d.du = t->ref.o[0], d.dv = t->ref.o[1];
+        d.k[0] = t->value;
+        tb_push(b, &d);
+    } else if (t->cls == TC_CHECKER) {
+        tex_node d = tn_new(TN_CHECKER);
+        d.a = (int8_t)tb_const(b, t->ref.even);
+        d.b = (int8_t)tb_const(b, t->ref.odd);
+        d.su = t->ref.s[0] * t->ref.checker_scale, d.sv = t->ref.s[1] * t->ref.checker_scale;
+        d.du = t->ref.o[0] * t->ref.checker_scale, d.dv = t->ref.o[1] * t->ref.checker_scale;
+        tb_push(b, &d);
+    }
+}
+
 static pk_status d_texture(pp *p, const char *name, const char *kind, const char *cls)
 {
     pk_status st;
@@ -1885,17 +2306,15 @@ static pk_status d_texture(pp *p, const char *name, const char *kind, const char
     tex_ref_init(&t.ref);
     t.value = v3s(1.0f);
     t.cls = TC_CONST;
-    float us = 1.0f, vs = 1.0f, ud = 0.0f, vd = 0.0f, sc = 1.0f;
-    const char *mapping = "uv";
-    if ((st = pb_float(&p->pd, "uscale", &us)) || (st = pb_float(&p->pd, "vscale", &vs)) ||
-        (st = pb_float(&p->pd, "udelta", &ud)) || (st = pb_float(&p->pd, "vdelta", &vd)) ||
-        (st = pb_string(&p->pd, "mapping", &mapping)))
-        return st;
-    if (strcmp(mapping, "uv") != 0)
-        pwarn(p, p->line, "Texture \"%.60s\": mapping \"%.20s\" is not supported; uv is used", name, mapping);
+    tex_build b;
+    b.count = 0, b.full = false;
+    const vec3 zero = v3s(0.0f), one = v3s(1.0f);
     if (strcmp(cls, "imagemap") == 0) {
         const char *fn = NULL, *enc = NULL, *wrap = "repeat", *filter = NULL;
         bool invert = false;
+        float sc = 1.0f;
+        tex_node d = tn_new(TN_IMAGE);
+        if ((st = tex_mapping2d(p, &d))) return st;
         if ((st = pb_string(&p->pd, "filename", &fn)) || (st = pb_string(&p->pd, "encoding", &enc)) ||
             (st = pb_string(&p->pd, "wrap", &wrap)) || (st = pb_string(&p->pd, "filter", &filter)) ||
             (st = pb_float(&p->pd, "scale", &sc)) || (st = pb_bool(&p->pd, "invert", &invert)))
@@ -1921,32 +2340,40 @@ static pk_status d_texture(pp *p, const char *name, const char *kind, const char
             pwarn(p, p->line, "texture \"%.60s\" not used (%s); the constant %g stands in", name, why, (double)sc);
             t.value = v3s(sc);
         } else {
-            t.cls = TC_IMAGE;
+            t.value = v3s(sc);
             t.ref.kind = TEX_IMAGE;
             t.ref.tex = idx;
             t.ref.clamp = strcmp(wrap, "clamp") == 0 || strcmp(wrap, "black") == 0;
             if (strcmp(wrap, "black") == 0) pwarn(p, p->line, "imagemap: wrap \"black\" is rendered as \"clamp\"");
-            t.value = v3s(sc);
+            if (d.map == TMAP_UV) {
+                t.cls = TC_IMAGE;
+                t.ref.s[0] = d.su, t.ref.s[1] = d.sv, t.ref.o[0] = d.du, t.ref.o[1] = d.dv;
+            } else {
+                d.tex = idx, d.clamp = t.ref.clamp, d.grey = is_float, d.k[0] = t.value;
+                tb_push(&b, &d);
+                t.cls = TC_EXPR;
+            }
         }
     } else if (strcmp(cls, "checkerboard") == 0) {
         int64_t dim = 2;
         if ((st = pb_int(&p->pd, "dimension", 2, 3, &dim))) return st;
-        vec3 c1 = v3s(1.0f), c2 = v3s(0.0f);
-        if (is_float) {
-            float f1 = 1.0f, f2 = 0.0f;
-            if ((st = get_float_tex(p, "tex1", &f1, NULL)) || (st = get_float_tex(p, "tex2", &f2, NULL))) return st;
-            c1 = v3s(f1), c2 = v3s(f2);
-        } else if ((st = get_colour(p, "tex1", &c1, NULL, NULL)) || (st = get_colour(p, "tex2", &c2, NULL, NULL))) {
+        tex_node d = tn_new(TN_CHECKER);
+        int a, c;
+        if ((st = tex_operand(p, &b, "tex1", is_float, one, &a)) || (st = tex_operand(p, &b, "tex2", is_float, zero, &c)))
             return st;
-        }
-        if (dim == 3) {
-            pwarn(p, p->line, "a 3D checkerboard is not supported; its mean colour is used");
-            t.value = v3_scale(v3_add(c1, c2), 0.5f);
-        } else {
+        if ((st = dim == 3 ? tex_mapping3d(p, &d) : tex_mapping2d(p, &d))) return st;
+        d.a = (int8_t)a, d.b = (int8_t)c;
+        if (!b.full && d.map == TMAP_UV && b.count == 2 && b.n[0].op == TN_CONST && b.n[1].op == TN_CONST) {
+            /* two constants in uv: the scene's own checker */
             t.cls = TC_CHECKER;
             t.ref.kind = TEX_CHECKER;
-            t.ref.even = c1, t.ref.odd = c2;
+            t.ref.even = b.n[0].k[0], t.ref.odd = b.n[1].k[0];
             t.ref.checker_scale = 1.0f;
+            t.ref.s[0] = d.su, t.ref.s[1] = d.sv, t.ref.o[0] = d.du, t.ref.o[1] = d.dv;
+            b.count = 0;
+        } else {
+            tb_push(&b, &d);
+            t.cls = TC_EXPR;
         }
     } else if (strcmp(cls, "constant") == 0) {
         if (is_float) {
@@ -1956,50 +2383,112 @@ static pk_status d_texture(pp *p, const char *name, const char *kind, const char
         } else if ((st = get_colour(p, "value", &t.value, NULL, NULL))) {
             return st;
         }
-    } else if (strcmp(cls, "scale") == 0 || strcmp(cls, "mix") == 0 || strcmp(cls, "directionmix") == 0) {
-        /* the first texture, times the scale (mixes: the first, warned) */
-        const char *a = cls[0] == 's' ? "tex" : "tex1";
-        tex_ref r;
-        tex_ref_init(&r);
-        vec3 c = v3s(1.0f);
-        if (is_float) {
-            float v = 1.0f;
-            pparam *q = NULL;
-            if ((st = pb_typed(&p->pd, a, TB(PT_TEXTURE) | TB(PT_FLOAT), "a float texture", &q))) return st;
-            if (q && q->type == PT_TEXTURE && q->nstr == 1) {
-                named_tex *src = find_tex(p, q->str[0]);
-                if (!src) return pfail(p, q->line, PK_ERR_PARSE, "no texture named \"%.60s\"", q->str[0]);
-                r = src->ref, c = src->value;
-            } else if (q) {
-                v = (float)q->num[0], c = v3s(v);
+    } else if (strcmp(cls, "bilerp") == 0) {
+        tex_node d = tn_new(TN_BILERP);
+        if ((st = tex_mapping2d(p, &d))) return st;
+        const char *nm[4] = {"v00", "v01", "v10", "v11"};
+        for (int i = 0; i < 4; i++) {
+            d.k[i] = v3s(i & 1 ? 1.0f : 0.0f);
+            if (is_float) {
+                float f = d.k[i].x;
+                if ((st = pb_float(&p->pd, nm[i], &f))) return st;
+                d.k[i] = v3s(f);
+            } else if ((st = get_colour(p, nm[i], &d.k[i], NULL, NULL))) {
+                return st;
             }
-        } else if ((st = get_colour(p, a, &c, &r, NULL))) {
+        }
+        tb_push(&b, &d);
+        t.cls = TC_EXPR;
+    } else if (strcmp(cls, "dots") == 0) {
+        tex_node d = tn_new(TN_DOTS);
+        int a, c;
+        if ((st = tex_operand(p, &b, "inside", is_float, one, &a)) ||
+            (st = tex_operand(p, &b, "outside", is_float, zero, &c)) || (st = tex_mapping2d(p, &d)))
+            return st;
+        d.a = (int8_t)a, d.b = (int8_t)c;
+        tb_push(&b, &d);
+        t.cls = TC_EXPR;
+    } else if (strcmp(cls, "fbm") == 0 || strcmp(cls, "wrinkled") == 0 || strcmp(cls, "windy") == 0 ||
+               strcmp(cls, "marble") == 0) {
+        const bool marble = cls[1] == 'a';
+        if (marble && is_float) return pfail(p, p->line, PK_ERR_PARSE, "Texture \"%.60s\": marble is a spectrum texture", name);
+        if (!marble && !is_float)
+            return pfail(p, p->line, PK_ERR_PARSE, "Texture \"%.60s\": %s is a float texture", name, cls);
+        tex_node d = tn_new(cls[0] == 'f' ? TN_FBM : cls[1] == 'r' ? TN_WRINKLED : cls[1] == 'i' ? TN_WINDY : TN_MARBLE);
+        if ((st = tex_mapping3d(p, &d))) return st;
+        if (d.op != TN_WINDY && (st = tex_octaves(p, &d))) return st;
+        if (marble) {
+            d.scale = 1.0f, d.variation = 0.2f;
+            if ((st = pb_float(&p->pd, "scale", &d.scale)) || (st = pb_float(&p->pd, "variation", &d.variation))) return st;
+        }
+        tb_push(&b, &d);
+        t.cls = TC_EXPR;
+    } else if (strcmp(cls, "scale") == 0) {
+        int a, c;
+        if ((st = tex_operand(p, &b, "tex", is_float, one, &a)) || (st = tex_operand(p, &b, "scale", true, one, &c)))
+            return st;
+        named_tex *src = NULL;
+        pparam *q = pb_param(&p->pd, "tex");
+        if (q && q->type == PT_TEXTURE && q->nstr == 1) src = find_tex(p, q->str[0]);
+        const bool cscale = !b.full && b.n[c].op == TN_CONST;
+        if (!b.full && b.n[a].op == TN_CONST && cscale) {
+            t.value = v3_mul(b.n[a].k[0], b.n[c].k[0]); /* a constant */
+            b.count = 0;
+        } else if (cscale && src && (src->cls == TC_IMAGE || src->cls == TC_CHECKER)) {
+            /* the image (or checker) with its constant scaled, as pbrt does */
+            t.cls = src->cls, t.ref = src->ref, t.value = v3_scale(src->value, b.n[c].k[0].x);
+            b.count = 0;
+        } else {
+            tex_node d = tn_new(TN_SCALE);
+            d.a = (int8_t)a, d.b = (int8_t)c;
+            tb_push(&b, &d);
+            t.cls = TC_EXPR;
+        }
+    } else if (strcmp(cls, "mix") == 0 || strcmp(cls, "directionmix") == 0) {
+        const bool dir = cls[0] == 'd';
+        tex_node d = tn_new(dir ? TN_DIRMIX : TN_MIX);
+        int a, c, m = -1;
+        if ((st = tex_operand(p, &b, "tex1", is_float, zero, &a)) || (st = tex_operand(p, &b, "tex2", is_float, one, &c)))
+            return st;
+        if (dir) {
+            vec3 v = v3(0.0f, 1.0f, 0.0f);
+            if ((st = pb_vec3(&p->pd, "dir", &v))) return st;
+            const xform w = world_xf(p);
+            v = xform_vector(&w, v);
+            if (!(v3_len2(v) > 0.0f) || !v3_finite(v))
+                return pfail(p, p->line, PK_ERR_PARSE, "directionmix: 'dir' must be a nonzero finite vector");
+            d.v1 = v3_norm(v);
+        } else if ((st = tex_operand(p, &b, "amount", true, v3s(0.5f), &m))) {
             return st;
         }
-        if (cls[0] == 's') {
-            float s = 1.0f;
-            if ((st = get_float_tex(p, "scale", &s, NULL))) return st;
-            c = v3_scale(c, s);
-        } else {
-            pd_mark_all(&p->pd);
-            pwarn(p, p->line, "Texture \"%.60s\": \"%s\" is rendered as its first texture", name, cls);
-        }
-        t.value = c;
-        if (r.kind != TEX_NONE) {
-            t.ref = r;
-            t.cls = r.kind == TEX_IMAGE ? TC_IMAGE : TC_CHECKER;
-        }
-        us = 1.0f, vs = 1.0f, ud = 0.0f, vd = 0.0f; /* the inner texture's mapping stands */
+        d.a = (int8_t)a, d.b = (int8_t)c, d.c = (int8_t)m;
+        tb_push(&b, &d);
+        t.cls = TC_EXPR;
     } else {
         pd_mark_all(&p->pd);
         pwarn(p, p->line, "texture \"%.30s\" is not supported; \"%.60s\" is the constant 1", cls, name);
     }
-    if (t.cls != TC_CONST && cls[0] != 's' && strcmp(cls, "mix") != 0 && strcmp(cls, "directionmix") != 0) {
-        t.ref.s[0] = us, t.ref.s[1] = vs, t.ref.o[0] = ud, t.ref.o[1] = vd;
+    if (t.cls == TC_EXPR && b.full) {
+        pd_mark_all(&p->pd);
+        pwarn(p, p->line, "Texture \"%.60s\": the expression has more than %d parts; the constant 1 stands in", name,
+              TEX_MAX_NODES);
+        t.cls = TC_CONST, t.value = v3s(1.0f), b.count = 0;
     }
-    if (!mem_grow(A(p), (void **)&p->tex, &p->cap_tex, p->ntex + 1, sizeof *p->tex)) return ctx_nomem(p->ctx);
+    if (t.cls == TC_EXPR) t.value = tex_mean(p, b.n, b.count);
+    else tex_own_nodes(&t, &b);
+    t.nnodes = b.count;
+    t.nodes = mem_realloc_array(A(p), NULL, (size_t)b.count, sizeof *t.nodes);
+    if (!t.nodes) return ctx_nomem(p->ctx);
+    memcpy(t.nodes, b.n, (size_t)b.count * sizeof *t.nodes);
+    if (!mem_grow(A(p), (void **)&p->tex, &p->cap_tex, p->ntex + 1, sizeof *p->tex)) {
+        mem_free(A(p), t.nodes);
+        return ctx_nomem(p->ctx);
+    }
     t.name = mem_strdup(A(p), name);
-    if (!t.name) return ctx_nomem(p->ctx);
+    if (!t.name) {
+        mem_free(A(p), t.nodes);
+        return ctx_nomem(p->ctx);
+    }
     p->tex[p->ntex++] = t;
     warn_unused(p, "Texture \"%.30s\"", cls);
     return PK_OK;
@@ -3225,7 +3714,7 @@ pk_status scene_pbrt_parse(pk_context *ctx, pk_scene *s, const char *data, size_
     defs_pop(p, -1);
     mem_free(&ctx->alloc, p->defs);
     mem_free(&ctx->alloc, p->pl.p);
-    for (size_t i = 0; i < p->ntex; i++) mem_free(&ctx->alloc, p->tex[i].name);
+    for (size_t i = 0; i < p->ntex; i++) mem_free(&ctx->alloc, p->tex[i].name), mem_free(&ctx->alloc, p->tex[i].nodes);
     for (size_t i = 0; i < p->ncoords; i++) mem_free(&ctx->alloc, p->coords[i].name);
     for (size_t i = 0; i < p->nobjs; i++) mem_free(&ctx->alloc, p->objs[i].name);
     for (size_t i = 0; i < p->nmnames; i++) mem_free(&ctx->alloc, p->mnames[i]);

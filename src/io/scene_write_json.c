@@ -227,6 +227,9 @@ static bool is_file(const char *path)
 static pk_status write_texref(jw *w, const tex_ref *r, const char *what)
 {
     bool first = true;
+    if (r->kind == TEX_EXPR)
+        return ctx_error(w->ctx, PK_ERR_UNSUPPORTED,
+                         "%s: %s: a procedural texture (pbrt-v4's) cannot be written in the JSON format", w->out, what);
     fputc('{', w->f);
     pk_status st = jw_fields(w, &first, rec_texref, rec_ntexref, r, what);
     if (st) return st;

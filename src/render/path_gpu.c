@@ -152,6 +152,7 @@ pk_status path_gpu_create(pk_context *ctx, const path_tracer *pt, path_gpu **out
     UP(uvs, s->nuvs)
     UP(tris, s->ntris)
     UP(lights, s->nlights)
+    UP(tex_nodes, s->ntex_nodes) /* procedural textures: plain data, evaluated by the same code */
 #undef UP
     material *mats = mem_realloc_array(&ctx->alloc, NULL, s->nmaterials ? s->nmaterials : 1, sizeof *mats);
     if (!mats && st == PK_OK) st = ctx_nomem(ctx);

@@ -135,7 +135,7 @@ static inline PK_HD vec3 surface_clamp_rgb(vec3 c)
 /* Height of a bump map at (u, v), the fine level. */
 static inline PK_HD float surface_bump_height(const scene_view *s, const tex_ref *ref, float u, float v)
 {
-    tex_query q = {u, v, 0.0f};
+    tex_query q = {u, v, 0.0f, v3s(0.0f), v3s(0.0f), s->tex_nodes};
     return tex_eval_scalar(s->textures, ref, q);
 }
 
@@ -146,7 +146,7 @@ static inline PK_HD void surface_texture_at(const scene_view *s, const ray *r, c
     const surface_uv uv = surface_uv_at(s, r, h);
     const float dl = v3_len(r->d);
     const float cosv = dl > 0.0f ? fabsf(v3_dot(r->d, sf->ng)) / dl : 1.0f;
-    tex_query q = {uv.u, uv.v, cone_width / fmaxf(cosv, SURFACE_MIN_COS) * uv.uv_per_len};
+    tex_query q = {uv.u, uv.v, cone_width / fmaxf(cosv, SURFACE_MIN_COS) * uv.uv_per_len, sf->p, sf->ng, s->tex_nodes};
     if (!isfinite(q.width)) q.width = 0.0f;
 #ifdef PK_TEX_NO_CONES /* (-D for measurements: the finest level always, bilinear) */
     q.width = 0.0f;
@@ -168,7 +168,7 @@ static inline PK_HD void surface_texture_at(const scene_view *s, const ray *r, c
         tm->alpha = tm->roughness * tm->roughness;
     }
     if (m->map_ke.kind) { /* the finest level, as light sampling sees it (lights.h), so that both agree */
-        const tex_query qe = {uv.u, uv.v, 0.0f};
+        const tex_query qe = {uv.u, uv.v, 0.0f, sf->p, sf->ng, s->tex_nodes};
         const vec3 e = tex_eval_rgb(s->textures, &m->map_ke, qe);
         tm->ke = v3_mul(m->ke, v3(fmaxf(e.x, 0.0f), fmaxf(e.y, 0.0f), fmaxf(e.z, 0.0f)));
     }
@@ -228,7 +228,11 @@ static inline PK_HD bool surface_is_hole(const scene_view *s, const ray *r, cons
     const material *m = &s->materials[view_prim_material(s, h->prim)];
     if (!m->cutout) return false;
     const surface_uv uv = surface_uv_at(s, r, h);
-    tex_query q = {uv.u, uv.v, 0.0f};
+    tex_query q = {uv.u, uv.v, 0.0f, v3s(0.0f), v3s(0.0f), s->tex_nodes};
+    if (m->map_d.kind == TEX_EXPR) {
+        const surface sf = surface_at(s, r, h);
+        q.p = sf.p, q.n = sf.ng;
+    }
     return tex_eval_alpha(s->textures, &m->map_d, q) < 0.5f;
 }
 

@@ -80,6 +80,7 @@ void scene_destroy(pk_scene *s)
     mem_free(a, s->uvs);
     for (size_t i = 0; i < s->ntextures; i++) texture_free(a, &s->textures[i]);
     mem_free(a, s->textures);
+    mem_free(a, s->tex_nodes);
     mem_free(a, s->tris);
     mem_free(a, s->spheres);
     mem_free(a, s->lights);
@@ -136,6 +137,37 @@ pk_status scene_add_triangle(pk_context *ctx, pk_scene *s, const triangle *t)
 pk_status scene_add_sphere(pk_context *ctx, pk_scene *s, const sphere *sp)
 {
     APPEND(ctx, s, spheres, nspheres, cap_spheres, *sp, SCENE_MAX_PRIMS, "spheres");
+}
+
+bool tex_nodes_valid(const tex_node *nodes, int n, size_t ntextures)
+{
+    if (n < 1 || n > TEX_MAX_NODES) return false;
+    for (int i = 0; i < n; i++) {
+        const tex_node *d = &nodes[i];
+        if (d->op >= TN_COUNT || d->map >= TMAP_COUNT) return false;
+        if (d->a >= i || d->b >= i || d->c >= i || d->a < -1 || d->b < -1 || d->c < -1) return false;
+        if (d->op == TN_IMAGE && (d->tex < 0 || (size_t)d->tex >= ntextures)) return false;
+        if ((d->op == TN_FBM || d->op == TN_WRINKLED || d->op == TN_MARBLE) && (d->octaves < 0 || d->octaves > 64))
+            return false;
+    }
+    return true;
+}
+
+pk_status scene_add_tex_nodes(pk_context *ctx, pk_scene *s, const tex_node *nodes, int n, tex_ref *r)
+{
+    if (!tex_nodes_valid(nodes, n, s->ntextures))
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "a malformed texture expression");
+    if (s->ntex_nodes > (size_t)INT32_MAX - (size_t)n)
+        return ctx_error(ctx, PK_ERR_LIMIT, "too many texture nodes");
+    if (!mem_grow(&s->alloc, (void **)&s->tex_nodes, &s->cap_tex_nodes, s->ntex_nodes + (size_t)n, sizeof *s->tex_nodes))
+        return ctx_nomem(ctx);
+    memcpy(s->tex_nodes + s->ntex_nodes, nodes, (size_t)n * sizeof *nodes);
+    tex_ref_init(r);
+    r->kind = TEX_EXPR;
+    r->node = (int32_t)s->ntex_nodes;
+    r->nnodes = n;
+    s->ntex_nodes += (size_t)n;
+    return PK_OK;
 }
 
 static pk_status add_light(pk_context *ctx, pk_scene *s, const point_light *l)
@@ -881,8 +913,15 @@ bool scene_check(const pk_scene *s, char *why, size_t n)
         const tex_ref *maps[8] = {&m->map_kd, &m->map_ks,   &m->map_ns,   &m->map_d,
                                   &m->map_alpha, &m->map_bump, &m->map_norm, &m->map_mr};
         for (int j = 0; j < 8; j++)
+        {
             if (maps[j]->kind == TEX_IMAGE && (maps[j]->tex < 0 || (size_t)maps[j]->tex >= s->ntextures))
                 FAIL("material %zu: texture index out of range", i);
+            if (maps[j]->kind == TEX_EXPR &&
+                (maps[j]->node < 0 || maps[j]->nnodes < 1 || (size_t)maps[j]->node > s->ntex_nodes ||
+                 (size_t)maps[j]->nnodes > s->ntex_nodes - (size_t)maps[j]->node ||
+                 !tex_nodes_valid(s->tex_nodes + maps[j]->node, maps[j]->nnodes, s->ntextures)))
+                FAIL("material %zu: texture expression out of range", i);
+        }
     }
     for (size_t k = 0; k < s->ntris; k++) {
         const triangle *t = &s->tris[k];

@@ -189,6 +189,9 @@ struct pk_scene {
      * (texture_load). */
     texture *textures; size_t ntextures, cap_textures;
     size_t texture_bytes;
+    /* The nodes of procedural texture expressions (TEX_EXPR maps name runs
+     * of them; scene_add_tex_nodes). */
+    tex_node *tex_nodes; size_t ntex_nodes, cap_tex_nodes;
 
     /* Participating media (medium.h), numbered as materials name them. */
     medium *media; size_t nmedia, cap_media;
@@ -243,6 +246,13 @@ PK_HIDDEN pk_status scene_add_normal(pk_context *ctx, pk_scene *s, vec3 n);
 PK_HIDDEN pk_status scene_add_uv(pk_context *ctx, pk_scene *s, uv2 t);
 PK_HIDDEN pk_status scene_add_triangle(pk_context *ctx, pk_scene *s, const triangle *t);
 PK_HIDDEN pk_status scene_add_sphere(pk_context *ctx, pk_scene *s, const sphere *sp);
+/* Appends an expression of n procedural nodes (1 <= n <= TEX_MAX_NODES,
+ * operands earlier in the run) and sets *r to it (kind TEX_EXPR, the
+ * identity uv transform). Refuses a malformed run. */
+PK_HIDDEN pk_status scene_add_tex_nodes(pk_context *ctx, pk_scene *s, const tex_node *nodes, int n, tex_ref *r);
+/* Whether nodes[0..n-1] is a well-formed expression for a scene with
+ * ntextures textures (operands earlier, kinds and images in range). */
+PK_HIDDEN bool tex_nodes_valid(const tex_node *nodes, int n, size_t ntextures);
 
 /* Lights: the one way to add them (the readers and the scene API). Each
  * checks what every light of its kind must be (finite, not negative; axes

@@ -19,6 +19,7 @@ typedef struct scene_view {
     const material *materials;
     const point_light *lights;
     const texture *textures;
+    const tex_node *tex_nodes;  /* procedural texture expressions' nodes */
     size_t npositions, nnormals, nuvs, ntris, nspheres, nmaterials, nlights, ntextures;
     bool has_cutout;          /* a material has map_d */
     bool has_textured;        /* a material has a map other than map_d */
@@ -46,6 +47,7 @@ static inline scene_view scene_view_of(const pk_scene *s)
     scene_view v;
     v.positions = s->positions, v.normals = s->normals, v.uvs = s->uvs, v.tris = s->tris;
     v.spheres = s->spheres, v.materials = s->materials, v.lights = s->lights, v.textures = s->textures;
+    v.tex_nodes = s->tex_nodes;
     v.npositions = s->npositions, v.nnormals = s->nnormals, v.nuvs = s->nuvs, v.ntris = s->ntris;
     v.nspheres = s->nspheres, v.nmaterials = s->nmaterials, v.nlights = s->nlights, v.ntextures = s->ntextures;
     v.has_cutout = s->has_cutout, v.has_textured = s->has_textured;

@@ -12,6 +12,8 @@
 #include <math.h>
 #include <string.h>
 
+const uint8_t tex_noise_perm[256] = PK_NOISE_PERM_INIT;
+
 void tex_ref_init(tex_ref *r)
 {
     memset(r, 0, sizeof *r);

@@ -42,12 +42,15 @@ typedef struct texture {
     size_t bytes;  /* texels of all levels */
 } texture;
 
-typedef enum tex_kind { TEX_NONE, TEX_IMAGE, TEX_CHECKER } tex_kind;
+typedef enum tex_kind { TEX_NONE, TEX_IMAGE, TEX_CHECKER, TEX_EXPR } tex_kind;
 
 /* A material parameter's texture. The texture's value multiplies the
  * parameter's constant. Lookups use uv' = (s[0] u + o[0], s[1] v + o[1]);
  * outside [0,1) the image repeats, or with clamp its edge texels continue.
- * A checker is even where floor(scale u') + floor(scale v') is even, else odd. */
+ * A checker is even where floor(scale u') + floor(scale v') is even, else odd.
+ * TEX_EXPR: an expression of procedural nodes (tex_node), nnodes of the
+ * scene's node table from index node on, evaluated in order; the last is
+ * the value. */
 typedef struct tex_ref {
     uint8_t kind;      /* tex_kind; TEX_NONE (0) = the constant alone */
     bool clamp;
@@ -57,11 +60,18 @@ typedef struct tex_ref {
     float bm;          /* bump maps: the multiplier of the heights (-bm) */
     vec3 even, odd;    /* TEX_CHECKER */
     float checker_scale;
+    int32_t node, nnodes; /* TEX_EXPR */
 } tex_ref;
 
-/* A lookup: the uv and the footprint width in uv units (0 = the finest level). */
+struct tex_node;
+
+/* A lookup: the uv and the footprint width in uv units (0 = the finest
+ * level); for procedural expressions also the world-space point p, the
+ * geometric normal n and the scene's node table. */
 typedef struct tex_query {
     float u, v, width;
+    vec3 p, n;
+    const struct tex_node *nodes;
 } tex_query;
 
 /* Sets a reference to none with the identity transform. */
@@ -195,9 +205,299 @@ static inline PK_HD void texture_lookup(const texture *t, float u, float v, floa
     }
 }
 
-/* The raw channels at q (nc returned), for an image or a checker (3 channels). */
+/* ---- procedural expressions (compiled for the GPU as well) ------------------------- */
+
+/* Nodes of a procedural texture expression (pbrt-v4's textures,
+ * docs/scene-format.md). An expression is a run of nodes in the scene's
+ * node table; operands (a, b, c) are earlier nodes of the same run, given
+ * as offsets from its first node (-1: none), so that one pass in order
+ * evaluates it without recursion. Every node's value is an RGB triple
+ * (float textures hold the same value in all three). */
+#define TEX_MAX_NODES 32
+
+typedef enum tex_op {
+    TN_CONST,    /* k[0] */
+    TN_IMAGE,    /* image tex at the mapped (s, t), times k[0]; grey: the mean of its channels */
+    TN_CHECKER,  /* a where the cell (floor of each coordinate) sums even, else b; 2D or (map TMAP_3D) 3D */
+    TN_BILERP,   /* (1-s)(1-t) k[0] + (1-s) t k[1] + s (1-t) k[2] + s t k[3] */
+    TN_DOTS,     /* a inside the polka dots, b outside */
+    TN_FBM,      /* FBm(p, omega, octaves) */
+    TN_WRINKLED, /* Turbulence(p, omega, octaves) */
+    TN_WINDY,    /* |FBm(p / 10, 0.5, 3)| FBm(p, 0.5, 6) */
+    TN_MARBLE,   /* pbrt's marble spline at sin(scale p.y + variation FBm(scale p)) */
+    TN_SCALE,    /* a times b (b a float) */
+    TN_MIX,      /* (1 - c) a + c b */
+    TN_DIRMIX,   /* |n . v1| a + (1 - |n . v1|) b */
+    TN_SQRT,     /* sqrt(max(a, 0)) (pbrt's roughness remapping) */
+    TN_COUNT
+} tex_op;
+
+/* How a node finds its coordinates: uv (s, t) = (su u + du, sv v + dv);
+ * spherical, cylindrical and planar from the texture-space point xf p; 3D
+ * is the texture-space point itself. */
+typedef enum tex_mapping { TMAP_UV, TMAP_SPHERICAL, TMAP_CYLINDRICAL, TMAP_PLANAR, TMAP_3D, TMAP_COUNT } tex_mapping;
+
+typedef struct tex_node {
+    uint8_t op, map;
+    bool clamp;      /* TN_IMAGE: clamp instead of repeat */
+    bool grey;       /* TN_IMAGE: a float texture (the mean of the channels) */
+    int8_t a, b, c;  /* operands */
+    int32_t tex;     /* TN_IMAGE: index into the scene's textures */
+    int32_t octaves; /* TN_FBM, TN_WRINKLED, TN_MARBLE */
+    float xf[12];    /* texture space from world: three rows of an affine matrix */
+    float su, sv, du, dv;
+    vec3 v1, v2;     /* planar: the axes; TN_DIRMIX: v1, the direction in world space (unit) */
+    vec3 k[4];       /* constants (TN_CONST, TN_IMAGE's scale, TN_BILERP's corners) */
+    float omega, scale, variation;
+} tex_node;
+
+/* Perlin's permutation table (his improved noise, 2002): the CPU's copy, or
+ * the same numbers in the GPU's constant memory. */
+#define PK_NOISE_PERM_INIT                                                                                             \
+    {151, 160, 137, 91,  90,  15,  131, 13,  201, 95,  96,  53,  194, 233, 7,   225, 140, 36,  103, 30,  69,  142,   \
+     8,   99,  37,  240, 21,  10,  23,  190, 6,   148, 247, 120, 234, 75,  0,   26,  197, 62,  94,  252, 219, 203,   \
+     117, 35,  11,  32,  57,  177, 33,  88,  237, 149, 56,  87,  174, 20,  125, 136, 171, 168, 68,  175, 74,  165,   \
+     71,  134, 139, 48,  27,  166, 77,  146, 158, 231, 83,  111, 229, 122, 60,  211, 133, 230, 220, 105, 92,  41,    \
+     55,  46,  245, 40,  244, 102, 143, 54,  65,  25,  63,  161, 1,   216, 80,  73,  209, 76,  132, 187, 208, 89,    \
+     18,  169, 200, 196, 135, 130, 116, 188, 159, 86,  164, 100, 109, 198, 173, 186, 3,   64,  52,  217, 226, 250,   \
+     124, 123, 5,   202, 38,  147, 118, 126, 255, 82,  85,  212, 207, 206, 59,  227, 47,  16,  58,  17,  182, 189,   \
+     28,  42,  223, 183, 170, 213, 119, 248, 152, 2,   44,  154, 163, 70,  221, 153, 101, 155, 167, 43,  172, 9,     \
+     129, 22,  39,  253, 19,  98,  108, 110, 79,  113, 224, 232, 178, 185, 112, 104, 218, 246, 97,  228, 251, 34,    \
+     242, 193, 238, 210, 144, 12,  191, 179, 162, 241, 81,  51,  145, 235, 249, 14,  239, 107, 49,  192, 214, 31,    \
+     181, 199, 106, 157, 184, 84,  204, 176, 115, 121, 50,  45,  127, 4,   150, 254, 138, 236, 205, 93,  222, 114,   \
+     67,  29,  24,  72,  243, 141, 128, 195, 78,  66,  215, 61,  156, 180}
+PK_HIDDEN extern const uint8_t tex_noise_perm[256];
+#if defined(__CUDACC__)
+static __constant__ uint8_t tex_noise_perm_dev[256] = PK_NOISE_PERM_INIT;
+#endif
+static inline PK_HD int tex_perm(int i)
+{
+#if defined(__CUDA_ARCH__)
+    return tex_noise_perm_dev[i & 255];
+#else
+    return tex_noise_perm[i & 255];
+#endif
+}
+
+/* The dot product of the gradient that hash h picks (one of the 12 edge
+ * directions of a cube, 4 of them twice) with (x, y, z). */
+static inline PK_HD float tex_grad(int h, float x, float y, float z)
+{
+    h &= 15;
+    const float a = h < 8 ? x : y;
+    const float b = h < 4 ? y : (h == 12 || h == 14) ? x : z;
+    return ((h & 1) ? -a : a) + ((h & 2) ? -b : b);
+}
+
+static inline PK_HD float tex_fade(float t) { return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f); }
+static inline PK_HD float tex_lerp(float t, float a, float b) { return a + t * (b - a); }
+
+/* Perlin's improved noise at (x, y, z): 0 at every lattice point, in
+ * [-2, 2] (in practice about [-1, 1]), C2-continuous. Non-finite input: 0. */
+static inline PK_HD float tex_noise(float x, float y, float z)
+{
+    if (!isfinite(x) || !isfinite(y) || !isfinite(z)) return 0.0f;
+    const float big = 1073741824.0f; /* 2^30: keeps the cell in an int */
+    x = fmodf(x, big), y = fmodf(y, big), z = fmodf(z, big);
+    const float fx = floorf(x), fy = floorf(y), fz = floorf(z);
+    const int X = (int)fx & 255, Y = (int)fy & 255, Z = (int)fz & 255;
+    x -= fx, y -= fy, z -= fz;
+    const float u = tex_fade(x), v = tex_fade(y), w = tex_fade(z);
+    const int A = tex_perm(X) + Y, AA = tex_perm(A) + Z, AB = tex_perm(A + 1) + Z;
+    const int B = tex_perm(X + 1) + Y, BA = tex_perm(B) + Z, BB = tex_perm(B + 1) + Z;
+    const float x00 = tex_lerp(u, tex_grad(tex_perm(AA), x, y, z), tex_grad(tex_perm(BA), x - 1.0f, y, z));
+    const float x10 = tex_lerp(u, tex_grad(tex_perm(AB), x, y - 1.0f, z), tex_grad(tex_perm(BB), x - 1.0f, y - 1.0f, z));
+    const float x01 =
+        tex_lerp(u, tex_grad(tex_perm(AA + 1), x, y, z - 1.0f), tex_grad(tex_perm(BA + 1), x - 1.0f, y, z - 1.0f));
+    const float x11 = tex_lerp(u, tex_grad(tex_perm(AB + 1), x, y - 1.0f, z - 1.0f),
+                               tex_grad(tex_perm(BB + 1), x - 1.0f, y - 1.0f, z - 1.0f));
+    return tex_lerp(w, tex_lerp(v, x00, x10), tex_lerp(v, x01, x11));
+}
+
+/* Fractional Brownian motion: octaves of noise, each at 1.99 times the
+ * frequency and omega times the weight of the one before. (pbrt fades
+ * out the octaves finer than a pixel's footprint; here every octave is
+ * summed, and the pixel samples average them.) */
+static inline PK_HD float tex_fbm(vec3 p, float omega, int octaves)
+{
+    float sum = 0.0f, lambda = 1.0f, o = 1.0f;
+    for (int i = 0; i < octaves; i++) {
+        sum += o * tex_noise(lambda * p.x, lambda * p.y, lambda * p.z);
+        lambda *= 1.99f;
+        o *= omega;
+    }
+    return sum;
+}
+
+/* Turbulence: the same sum of |noise|, plus pbrt's allowance of 0.2 (the
+ * mean of |noise|) for the octave after the last. */
+static inline PK_HD float tex_turbulence(vec3 p, float omega, int octaves)
+{
+    float sum = 0.0f, lambda = 1.0f, o = 1.0f;
+    for (int i = 0; i < octaves; i++) {
+        sum += o * fabsf(tex_noise(lambda * p.x, lambda * p.y, lambda * p.z));
+        lambda *= 1.99f;
+        o *= omega;
+    }
+    return sum + 0.2f * o;
+}
+
+/* Whether (s, t) lies in a polka dot: cells of side 1 centred on the
+ * integers; about half of them (noise > 0) hold a dot of radius 0.35,
+ * moved by noise up to 0.15 from the centre. */
+static inline PK_HD bool tex_in_dot(float s, float t)
+{
+    const float sc = floorf(s + 0.5f), tc = floorf(t + 0.5f);
+    if (!(tex_noise(sc + 0.5f, tc + 0.5f, 0.5f) > 0.0f)) return false;
+    const float radius = 0.35f, shift = 0.5f - radius;
+    const float cs = sc + shift * tex_noise(sc + 1.5f, tc + 2.8f, 0.5f);
+    const float ct = tc + shift * tex_noise(sc + 4.5f, tc + 9.8f, 0.5f);
+    const float ds = s - cs, dt = t - ct;
+    return ds * ds + dt * dt < radius * radius;
+}
+
+/* pbrt's marble: a cubic Bezier spline through nine greys and a blue at
+ * t in [0, 1], times 1.5. */
+static inline PK_HD vec3 tex_marble_colour(float t)
+{
+    const float c[9][3] = {{.58f, .58f, .6f}, {.58f, .58f, .6f}, {.58f, .58f, .6f},
+                           {.5f, .5f, .5f},   {.6f, .59f, .58f}, {.58f, .58f, .6f},
+                           {.58f, .58f, .6f}, {.2f, .2f, .33f},  {.58f, .58f, .6f}};
+    const int nseg = 6;
+    if (!(t >= 0.0f)) t = 0.0f; /* also NaN */
+    if (t > 1.0f) t = 1.0f;
+    int first = (int)floorf(t * (float)nseg);
+    if (first > nseg - 1) first = nseg - 1;
+    t = t * (float)nseg - (float)first;
+    float out[3];
+    for (int k = 0; k < 3; k++) {
+        /* de Casteljau */
+        float s0 = tex_lerp(t, c[first][k], c[first + 1][k]), s1 = tex_lerp(t, c[first + 1][k], c[first + 2][k]);
+        float s2 = tex_lerp(t, c[first + 2][k], c[first + 3][k]);
+        s0 = tex_lerp(t, s0, s1), s1 = tex_lerp(t, s1, s2);
+        out[k] = 1.5f * tex_lerp(t, s0, s1);
+    }
+    return v3(out[0], out[1], out[2]);
+}
+
+static inline PK_HD vec3 tex_node_point(const tex_node *d, vec3 p)
+{
+    const float *m = d->xf;
+    return v3(m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3], m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7],
+              m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]);
+}
+
+/* A node's 2D coordinates (s, t) at q. */
+static inline PK_HD void tex_node_st(const tex_node *d, tex_query q, float *s, float *t)
+{
+    if (d->map == TMAP_UV) {
+        *s = d->su * q.u + d->du, *t = d->sv * q.v + d->dv;
+        return;
+    }
+    const vec3 p = tex_node_point(d, q.p);
+    if (d->map == TMAP_SPHERICAL) {
+        const float l = sqrtf(p.x * p.x + p.y * p.y + p.z * p.z);
+        const float z = l > 0.0f ? fminf(fmaxf(p.z / l, -1.0f), 1.0f) : 1.0f;
+        float phi = atan2f(p.y, p.x);
+        if (phi < 0.0f) phi += 2.0f * PK_PI;
+        *s = acosf(z) * (1.0f / PK_PI), *t = phi * (0.5f / PK_PI);
+    } else if (d->map == TMAP_CYLINDRICAL) {
+        *s = (PK_PI + atan2f(p.y, p.x)) * (0.5f / PK_PI), *t = p.z;
+    } else { /* planar */
+        *s = d->du + v3_dot(p, d->v1), *t = d->dv + v3_dot(p, d->v2);
+    }
+}
+
+/* The value of the expression of r (kind TEX_EXPR) at q. */
+static inline PK_HD vec3 tex_expr_eval(const texture *textures, const tex_ref *r, tex_query q)
+{
+    vec3 val[TEX_MAX_NODES];
+    const tex_node *e = q.nodes + r->node;
+    const int n = r->nnodes < TEX_MAX_NODES ? r->nnodes : TEX_MAX_NODES;
+    if (n <= 0) return v3s(0.0f);
+    for (int i = 0; i < n; i++) {
+        const tex_node *d = &e[i];
+        const vec3 A = d->a >= 0 && d->a < i ? val[d->a] : v3s(0.0f);
+        const vec3 B = d->b >= 0 && d->b < i ? val[d->b] : v3s(0.0f);
+        const vec3 C = d->c >= 0 && d->c < i ? val[d->c] : v3s(0.0f);
+        vec3 out = v3s(0.0f);
+        float s = 0.0f, t = 0.0f;
+        switch (d->op) {
+        case TN_CONST: out = d->k[0]; break;
+        case TN_IMAGE: {
+            tex_node_st(d, q, &s, &t);
+            const texture *tx = &textures[d->tex];
+            float c[4];
+            const float sc = d->map == TMAP_UV ? fmaxf(fabsf(d->su), fabsf(d->sv)) : 1.0f;
+            texture_lookup(tx, s, t, q.width * sc, d->clamp, c);
+            if (d->grey) {
+                const float g = tx->nc >= 3 ? (c[0] + c[1] + c[2]) * (1.0f / 3.0f) : c[0];
+                out = v3s(g);
+            } else {
+                out = tx->nc >= 3 ? v3(c[0], c[1], c[2]) : v3s(c[0]);
+            }
+            out = v3_mul(out, d->k[0]);
+            break;
+        }
+        case TN_CHECKER: {
+            float cell;
+            if (d->map == TMAP_3D) {
+                const vec3 p = tex_node_point(d, q.p);
+                cell = floorf(p.x) + floorf(p.y) + floorf(p.z);
+            } else {
+                tex_node_st(d, q, &s, &t);
+                cell = floorf(s) + floorf(t);
+            }
+            const bool odd = isfinite(cell) && fmodf(fabsf(cell), 2.0f) == 1.0f;
+            out = odd ? B : A;
+            break;
+        }
+        case TN_BILERP:
+            tex_node_st(d, q, &s, &t);
+            out = v3_add(v3_add(v3_scale(d->k[0], (1.0f - s) * (1.0f - t)), v3_scale(d->k[1], (1.0f - s) * t)),
+                         v3_add(v3_scale(d->k[2], s * (1.0f - t)), v3_scale(d->k[3], s * t)));
+            break;
+        case TN_DOTS:
+            tex_node_st(d, q, &s, &t);
+            out = tex_in_dot(s, t) ? A : B;
+            break;
+        case TN_FBM: out = v3s(tex_fbm(tex_node_point(d, q.p), d->omega, d->octaves)); break;
+        case TN_WRINKLED: out = v3s(tex_turbulence(tex_node_point(d, q.p), d->omega, d->octaves)); break;
+        case TN_WINDY: {
+            const vec3 p = tex_node_point(d, q.p);
+            out = v3s(fabsf(tex_fbm(v3_scale(p, 0.1f), 0.5f, 3)) * tex_fbm(p, 0.5f, 6));
+            break;
+        }
+        case TN_MARBLE: {
+            const vec3 p = v3_scale(tex_node_point(d, q.p), d->scale);
+            const float m = p.y + d->variation * tex_fbm(p, d->omega, d->octaves);
+            out = tex_marble_colour(0.5f + 0.5f * sinf(m));
+            break;
+        }
+        case TN_SCALE: out = v3_mul(A, B); break;
+        case TN_MIX: out = v3_add(v3_mul(v3_sub(v3s(1.0f), C), A), v3_mul(C, B)); break;
+        case TN_DIRMIX: {
+            const float amt = fminf(fabsf(v3_dot(q.n, d->v1)), 1.0f);
+            out = v3_add(v3_scale(A, amt), v3_scale(B, 1.0f - amt));
+            break;
+        }
+        case TN_SQRT: out = v3(sqrtf(fmaxf(A.x, 0.0f)), sqrtf(fmaxf(A.y, 0.0f)), sqrtf(fmaxf(A.z, 0.0f))); break;
+        default: break;
+        }
+        val[i] = out;
+    }
+    return val[n - 1];
+}
+
+/* The raw channels at q (nc returned), for an image, a checker or an
+ * expression (3 channels). */
 static inline PK_HD int tex_eval_raw(const texture *textures, const tex_ref *r, tex_query q, float out[4])
 {
+    if (r->kind == TEX_EXPR) {
+        const vec3 c = tex_expr_eval(textures, r, q);
+        out[0] = c.x, out[1] = c.y, out[2] = c.z;
+        return 3;
+    }
     const float u = r->s[0] * q.u + r->o[0], v = r->s[1] * q.v + r->o[1];
     if (r->kind == TEX_CHECKER) {
         float fu = floorf(u * r->checker_scale), fv = floorf(v * r->checker_scale);

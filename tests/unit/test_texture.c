@@ -122,7 +122,7 @@ static void test_srgb(void)
     r.kind = TEX_IMAGE;
     r.tex = 0;
     texture arr[1] = {c};
-    tex_query q = {0.25f, 0.5f, 0.0f}; /* the black, transparent texel */
+    tex_query q = {0.25f, 0.5f, 0.0f, v3s(0.0f), v3s(0.0f), NULL}; /* the black, transparent texel */
     CHECK(tex_eval_alpha(arr, &r, q) == 0.0f);
     q.u = 0.75f;
     CHECK(tex_eval_alpha(arr, &r, q) == 1.0f);
@@ -146,7 +146,7 @@ static void test_checker(void)
     r.even = v3(1, 0, 0);
     r.odd = v3(0, 0, 1);
     r.checker_scale = 4.0f;
-    tex_query q = {0.1f, 0.1f, 0.0f}; /* cell (0, 0): even */
+    tex_query q = {0.1f, 0.1f, 0.0f, v3s(0.0f), v3s(0.0f), NULL}; /* cell (0, 0): even */
     CHECK(tex_eval_rgb(NULL, &r, q).x == 1.0f);
     q.u = 0.3f; /* cell (1, 0): odd */
     CHECK(tex_eval_rgb(NULL, &r, q).z == 1.0f);
