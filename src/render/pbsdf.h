@@ -80,7 +80,7 @@ typedef enum pbsdf_type {
  *   ms, ms_albedo                          set by pbsdf_compensate (the multiple-scattering lobe) */
 typedef struct pbsdf {
     int type;            /* pbsdf_type */
-    unsigned flags;      /* PBSDF_SCHLICK */
+    unsigned flags;      /* PBSDF_SCHLICK, PBSDF_BECKMANN, PBSDF_ENERGY */
     vec3 albedo;
     vec3 specular;
     vec3 tint;
@@ -438,10 +438,10 @@ static inline PK_HD float pbsdf__mf_refl_pdf(const pbsdf *b, vec3 wo, vec3 wi)
  *    cosine-weighted direction (the conductor chooses it with probability
  *    pbsdf__ms_prob; plastic and glTF through their diffuse lobe's sampler);
  *  - rough dielectric: Turquin's (2019) scaling, f / E_d(cos_o), E_d the
- *    single-scattering R + T toward wo; a closed dielectric cannot hold a
- *    lobe like the conductor's (it would have to split into reflection and
- *    transmission by tables in eta as well), while the scaling keeps the
- *    lobe's shape, sampler and pdf and makes R + T = 1. It is a factor of
+ *    single-scattering R + T toward wo. A lobe like the conductor's would
+ *    have to split its light between reflection and transmission by more
+ *    tables in eta; the scaling keeps the lobe's shape, sampler and pdf and
+ *    makes R + T = 1. It is a factor of
  *    wo alone, so the compensated reflection is not reciprocal (the
  *    transmission was not before either). */
 
