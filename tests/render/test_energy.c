@@ -14,7 +14,9 @@
  *    the single-scattering one by F_ms (1 - E_avg), and differs from Kulla
  *    and Conty's closed form F_avg E_avg / (1 - F_avg (1 - E_avg)) by
  *    exactly what the single-scattering albedo differs from F_avg E_avg;
- *  - F_avg by the 8-point rule against a fine quadrature.
+ *  - F_avg by the 4-point rule against a fine quadrature, for metals and
+ *    glass: within 1e-3 (F_ms moves by about twice that times 1 - E_avg,
+ *    a tenth of the 1 % budget).
  *  - the path tracer: a rough white metal ball and a rough glass ball
  *    (transmittance 1) in a white furnace (a constant environment of 1)
  *    render 1 everywhere within 1 % with compensation on (and visibly less
@@ -234,13 +236,20 @@ static void avg_albedo(const pbsdf *b, double out[3])
 
 static void test_coloured(void)
 {
-    /* F_avg: the 8-point rule against a fine quadrature */
+    /* F_avg: the 4-point rule against a fine quadrature (metals: gold, copper,
+     * silver, aluminium, a made-up dark and a bright one; glass k < 0) */
     const float etas[3] = {0.143f, 0.374f, 1.442f}, ks[3] = {3.983f, 2.385f, 1.603f};
-    for (int c = 0; c < 3; c++)
-        CHECKF(fabs((double)pbsdf__favg(etas[c], ks[c]) - favg_fine(etas[c], ks[c])) <= 2e-4,
-               "gold F_avg[%d]: %.6f vs %.6f", c, (double)pbsdf__favg(etas[c], ks[c]), favg_fine(etas[c], ks[c]));
-    CHECKF(fabs((double)pbsdf__favg(1.5f, -1.0f) - favg_fine(1.5f, -1.0f)) <= 2e-4, "dielectric F_avg: %.6f vs %.6f",
-           (double)pbsdf__favg(1.5f, -1.0f), favg_fine(1.5f, -1.0f));
+    static const float metals[][2] = {{0.143f, 3.983f}, {0.374f, 2.385f}, {1.442f, 1.603f}, {0.2f, 3.91f},
+                                      {0.92f, 2.45f},   {1.1f, 2.39f},   {0.155f, 4.83f},   {1.66f, 8.06f},
+                                      {2.9f, 3.0f},     {0.05f, 0.5f},   {4.0f, 0.1f},      {1.33f, -1.0f},
+                                      {1.5f, -1.0f},    {2.4f, -1.0f}};
+    double worst = 0.0;
+    for (size_t i = 0; i < sizeof metals / sizeof metals[0]; i++) {
+        const double a = (double)pbsdf__favg(metals[i][0], metals[i][1]), f = favg_fine(metals[i][0], metals[i][1]);
+        worst = fmax(worst, fabs(a - f));
+        CHECKF(fabs(a - f) <= 1e-3, "F_avg(%g, %g): %.6f vs %.6f", (double)metals[i][0], (double)metals[i][1], a, f);
+    }
+    printf("F_avg by 4 points: worst difference %.2g from a fine quadrature\n", worst);
 
     printf("coloured conductors: cosine-weighted albedo A, single scattering -> compensated; Kulla-Conty's\n"
            "F_avg E_avg / (1 - F_avg (1 - E_avg)):\n");
