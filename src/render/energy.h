@@ -25,6 +25,7 @@
 #ifndef PK_ENERGY_H
 #define PK_ENERGY_H
 
+#include "../paprsek_internal.h"
 #include "../pk_hd.h"
 
 #include <math.h>
@@ -38,12 +39,13 @@
 #define PK_EN_ETA_MAX 3.0f
 #define PK_EN_MU_MIN 1e-3f /* where node mu = 0 is computed */
 
-#include "energy_tables.inc"
-
-static const float pk_energy_e[2][PK_EN_ALPHA][PK_EN_MU] = PK_ENERGY_E_INIT;
-static const float pk_energy_eavg[2][PK_EN_ALPHA] = PK_ENERGY_EAVG_INIT;
-static const float pk_energy_d[2][2][PK_EN_DETA][PK_EN_DALPHA][PK_EN_DMU] = PK_ENERGY_D_INIT;
+/* The CPU's tables (energy.c), and under nvcc the same numbers in the
+ * GPU's memory (each kernel module its own copy). */
+PK_HIDDEN extern const float pk_energy_e[2][PK_EN_ALPHA][PK_EN_MU];
+PK_HIDDEN extern const float pk_energy_eavg[2][PK_EN_ALPHA];
+PK_HIDDEN extern const float pk_energy_d[2][2][PK_EN_DETA][PK_EN_DALPHA][PK_EN_DMU];
 #if defined(__CUDACC__)
+#include "energy_tables.inc"
 static __device__ const float pk_energy_e_dev[2][PK_EN_ALPHA][PK_EN_MU] = PK_ENERGY_E_INIT;
 static __device__ const float pk_energy_eavg_dev[2][PK_EN_ALPHA] = PK_ENERGY_EAVG_INIT;
 static __device__ const float pk_energy_d_dev[2][2][PK_EN_DETA][PK_EN_DALPHA][PK_EN_DMU] = PK_ENERGY_D_INIT;
