@@ -99,6 +99,7 @@ typedef struct cli_render_opts {
     int int_set[CLI_RENDER_MAX_OPTIONS]; /* per table entry: given on the command line */
     int int_value[CLI_RENDER_MAX_OPTIONS];
     int fresnel;         /* -1: not given */
+    int energy;          /* --energy-compensation: -1 not given */
     int has_clamp_indirect;
     float clamp_indirect;
     int has_accel;

@@ -25,6 +25,7 @@ enum {
     OPT_CONFIG,
     OPT_INTEGRATOR,
     OPT_FRESNEL,
+    OPT_ENERGY,
     OPT_CLAMP_INDIRECT,
     OPT_LOOK_FROM,
     OPT_LOOK_AT,
@@ -107,6 +108,11 @@ const cli_option *cli_render_options(size_t *n)
                                  "emitters two-sided)"});
         add((cli_option){.name = "fresnel", .id = OPT_FRESNEL, .kind = CLI_STRING, .arg = "on|off",
                          .help = "on: exact dielectric Fresnel (default); off: fixed Ks/Tf weights"});
+        add((cli_option){.name = "energy-compensation", .id = OPT_ENERGY, .kind = CLI_STRING, .arg = "on|off",
+                         .help = "path tracers: on gives back the light that rough metals, glass and coatings "
+                                 "lose between their microfacets (brighter rough surfaces, as Cycles and glTF "
+                                 "viewers render them); off: single scattering only. Default: on for glTF "
+                                 "scenes, else off (or the scene's render setting)"});
         add((cli_option){.name = "clamp-indirect", .id = OPT_CLAMP_INDIRECT, .kind = CLI_STRING, .arg = "X",
                          .help = "path tracer: scale down the light each sample brings after a bounce so that "
                                  "no channel exceeds X (fewer fireflies, a darker, biased image); 0 = off "
@@ -226,6 +232,7 @@ int cli_render_parse(int argc, char **argv, cli_render_opts *o, void (*help)(FIL
 {
     memset(o, 0, sizeof *o);
     o->fresnel = -1;
+    o->energy = -1;
     o->denoise = -1;
     size_t n;
     const cli_option *opts = cli_render_options(&n);
@@ -306,6 +313,14 @@ int cli_render_parse(int argc, char **argv, cli_render_opts *o, void (*help)(FIL
                 o->fresnel = 0;
             else
                 return cli_usage_error("--fresnel: expected on or off, not '%s'", v);
+            break;
+        case OPT_ENERGY:
+            if (strcmp(v, "on") == 0)
+                o->energy = 1;
+            else if (strcmp(v, "off") == 0)
+                o->energy = 0;
+            else
+                return cli_usage_error("--energy-compensation: expected on or off, not '%s'", v);
             break;
         case OPT_LOOK_FROM:
         case OPT_LOOK_AT:
@@ -731,6 +746,7 @@ pk_status cli_render_settings(pk_context *ctx, const cli_render_opts *o, pk_scen
         else ro->width = v;
     }
     if (o->fresnel >= 0) ro->fresnel = o->fresnel;
+    if (o->energy >= 0) ro->energy_compensation = o->energy;
     if (o->has_clamp_indirect) ro->clamp_indirect = o->clamp_indirect;
     if (o->has_accel) ro->accel = o->accel;
     if (o->has_device) {

@@ -286,6 +286,12 @@ typedef struct pk_render_options {
      * rest of the fireflies at the price of a darker, biased image; 0 (the
      * default) is off. */
     float clamp_indirect;
+    /* Energy compensation of rough microfacet surfaces (the path tracers):
+     * 1 gives back the light that a rough conductor, glass, plastic coat or
+     * glTF material loses to scattering between its microfacets (brighter,
+     * more saturated rough metals; docs/materials.md), 0 (the default) is
+     * off. glTF scenes ask for 1 (pk_scene_get_render_options). */
+    int energy_compensation;
 } pk_render_options;
 
 /* Arbitrary output variables: what the camera ray of each sample found,

@@ -729,6 +729,9 @@ pk_status scene_gltf_parse_params(pk_context *ctx, pk_scene *s, const char *data
         st = gltf_fail(g, PK_ERR_INVALID_ARGUMENT, "camera %d: no node of the scene places it", g->camera_pick);
         goto out;
     }
+    /* glTF viewers (and Blender's Cycles, which imports glTF) give back the
+     * energy that rough microfacet lobes lose: so do we, unless told not to */
+    scene_render_energy_compensation(s, true);
     st = PK_OK;
 out:
     if (w.state) mem_free(&ctx->alloc, w.state);

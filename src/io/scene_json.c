@@ -874,10 +874,10 @@ static pk_status parse_film(jp *p, const cJSON *it)
 
 static pk_status parse_render(jp *p, const cJSON *it)
 {
-    enum { R_W, R_H, R_SPP, R_LS, R_DEPTH, R_THREADS, R_SEED, R_ACCEL, R_FRESNEL, R_INTEGRATOR, R_REGULARIZE, R_LIGHT_TREE, R_CLAMP, R_COUNT };
+    enum { R_W, R_H, R_SPP, R_LS, R_DEPTH, R_THREADS, R_SEED, R_ACCEL, R_FRESNEL, R_INTEGRATOR, R_REGULARIZE, R_LIGHT_TREE, R_CLAMP, R_ENERGY, R_COUNT };
     static const char *const keys[R_COUNT] = {"width",   "height", "spp",   "light_samples", "max_depth",
                                               "threads", "seed",   "accel", "fresnel",       "integrator",
-                                              "regularize", "light_tree", "clamp_indirect"};
+                                              "regularize", "light_tree", "clamp_indirect", "energy_compensation"};
     const cJSON *f[R_COUNT];
     pk_status st = object_fields(p, it, "render", keys, R_COUNT, f);
     if (st) return st;
@@ -910,6 +910,11 @@ static pk_status parse_render(jp *p, const cJSON *it)
     if (f[R_FRESNEL]) {
         if (!cJSON_IsBool(f[R_FRESNEL])) return jfail(p, PK_ERR_PARSE, f[R_FRESNEL], "render.fresnel", "must be true or false");
         scene_render_fresnel(p->s, cJSON_IsTrue(f[R_FRESNEL]));
+    }
+    if (f[R_ENERGY]) {
+        if (!cJSON_IsBool(f[R_ENERGY]))
+            return jfail(p, PK_ERR_PARSE, f[R_ENERGY], "render.energy_compensation", "must be true or false");
+        scene_render_energy_compensation(p->s, cJSON_IsTrue(f[R_ENERGY]));
     }
     if (f[R_CLAMP]) {
         float clamp = 0.0f;

@@ -413,6 +413,10 @@ static pk_status write_render(jw *w)
         jw_key(w, &first, "fresnel");
         fputs(o->fresnel ? "true" : "false", w->f);
     }
+    if (r->has_energy_compensation) {
+        jw_key(w, &first, "energy_compensation");
+        fputs(o->energy_compensation ? "true" : "false", w->f);
+    }
     if (r->has_clamp_indirect) {
         jw_key(w, &first, "clamp_indirect");
         pk_status st = jw_floats(w, &o->clamp_indirect, 1, "render.clamp_indirect");

@@ -21,6 +21,7 @@ pk_status path_init(pk_context *ctx, path_tracer *pt, const frame *f, const pk_r
     pt->f = f;
     pt->max_depth = pk_render_options_max_depth(opt);
     pt->regularize = opt->regularize;
+    pt->energy = opt->energy_compensation;
     pt->clamp_indirect = opt->clamp_indirect > 0.0f && isfinite(opt->clamp_indirect) ? opt->clamp_indirect : 0.0f;
     pt->seed = (uint32_t)opt->seed;
     pt->lights = f->lights;

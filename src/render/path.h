@@ -31,6 +31,7 @@ typedef struct path_tracer {
     int lens;            /* camera samples take the sampler's lens dimensions (camera_has_lens) */
     int regularize;      /* pk_render_options.regularize */
     float clamp_indirect; /* pk_render_options.clamp_indirect (0: off) */
+    int energy;          /* pk_render_options.energy_compensation */
     const void *gpu_nodes, *gpu_tris;  /* in the GPU's copy only: the device BVH (bvh_gpu.h) */
 } path_tracer;
 

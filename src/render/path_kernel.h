@@ -291,6 +291,7 @@ static inline PK_HD int path_shade(const path_tracer *pt, path_state *ps, path_a
     if (ps->depth >= pt->max_depth) return 0;
     shading sh = shading_at(&sf);
     if (pt->regularize && ps->rough_seen) shading_regularize(&sh);
+    if (pt->energy) pbsdf_compensate(&sh.b);
     float u0, u1, u2, u3, u4, u5;
     sampler_2d(smp, &u0, &u1);
     sampler_2d(smp, &u2, &u3);

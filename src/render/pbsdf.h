@@ -29,6 +29,7 @@
 #define PK_PBSDF_H
 
 #include "../math/vec3.h"
+#include "energy.h"
 #include "optics.h"
 
 #include <stdbool.h>
@@ -48,6 +49,8 @@ typedef enum pbsdf_type {
 /* conductor, dielectric, plastic: the Beckmann distribution of slopes
  * instead of GGX (the same alpha: the RMS slope of the microfacets) */
 #define PBSDF_BECKMANN 2u
+/* energy compensation of the rough lobes (pbsdf_compensate sets it) */
+#define PBSDF_ENERGY 4u
 
 /* Below this roughness a microfacet lobe is treated as perfectly smooth (a
  * delta lobe): the GGX density would exceed float range long before 0. */
@@ -73,10 +76,11 @@ typedef enum pbsdf_type {
  *   transmission  [0, 1]                   metallic-roughness: the share of the dielectric's
  *                                          base that is transmitted rather than diffuse
  *   coat          [0, 1]                   metallic-roughness: the clearcoat's weight
- *   coat_alpha    [0, 1]                   metallic-roughness: the clearcoat's GGX alpha */
+ *   coat_alpha    [0, 1]                   metallic-roughness: the clearcoat's GGX alpha
+ *   ms, ms_albedo                          set by pbsdf_compensate (the multiple-scattering lobe) */
 typedef struct pbsdf {
     int type;            /* pbsdf_type */
-    unsigned flags;      /* PBSDF_SCHLICK */
+    unsigned flags;      /* PBSDF_SCHLICK, PBSDF_BECKMANN, PBSDF_ENERGY */
     vec3 albedo;
     vec3 specular;
     vec3 tint;
@@ -86,6 +90,8 @@ typedef struct pbsdf {
     float ior;
     float metallic, transmission;
     float coat, coat_alpha;
+    vec3 ms;             /* F_ms / (pi (1 - E_avg)) per channel, with PBSDF_ENERGY */
+    float ms_albedo;     /* the mean of F_ms: the lobe's albedo is ms_albedo (1 - E(wo.z)) */
 } pbsdf;
 
 /* ---- constructors ------------------------------------------------------- */
@@ -103,6 +109,8 @@ static inline PK_HD pbsdf pbsdf__blank(int type)
     b.ior = 1.5f;
     b.metallic = b.transmission = 0.0f;
     b.coat = b.coat_alpha = 0.0f;
+    b.ms = v3s(0.0f);
+    b.ms_albedo = 0.0f;
     return b;
 }
 static inline PK_HD pbsdf pbsdf_diffuse(vec3 albedo)
@@ -414,6 +422,115 @@ static inline PK_HD float pbsdf__mf_refl_pdf(const pbsdf *b, vec3 wo, vec3 wi)
     return pbsdf_mf_pdf(b, wo, h) / (4.0f * oh);
 }
 
+/* ---- energy compensation ------------------------------------------------------ */
+
+/* A single-scattering microfacet lobe loses the light that meets a second
+ * microfacet before it leaves: a white GGX conductor of alpha 1 reflects
+ * 0.31 at normal incidence. With PBSDF_ENERGY (pbsdf_compensate) that light
+ * is given back (docs/materials.md, "Energy compensation"):
+ *  - conductor, plastic's coat, glTF's metal and specular lobes: Kulla and
+ *    Conty's (2017) multiple-scattering lobe, added to the lobe,
+ *      f_ms cos = F_ms (1 - E(cos_o)) (1 - E(cos_i)) / (pi (1 - E_avg)) cos_i,
+ *      F_ms = F_avg^2 E_avg / (1 - F_avg (1 - E_avg)),
+ *    F_avg the cosine-weighted mean of the Fresnel term. For F = 1 it makes
+ *    the albedo exactly 1 (up to the table's interpolation); it is symmetric
+ *    in wo and wi (reciprocal) and diffuse-like, so it is sampled by a
+ *    cosine-weighted direction (the conductor chooses it with probability
+ *    pbsdf__ms_prob; plastic and glTF through their diffuse lobe's sampler);
+ *  - rough dielectric: Turquin's (2019) scaling, f / E_d(cos_o), E_d the
+ *    single-scattering R + T toward wo. A lobe like the conductor's would
+ *    have to split its light between reflection and transmission by more
+ *    tables in eta; the scaling keeps the lobe's shape, sampler and pdf and
+ *    makes R + T = 1. It is a factor of
+ *    wo alone, so the compensated reflection is not reciprocal (the
+ *    transmission was not before either). */
+
+/* F_avg = 2 * integral of F(mu) mu dmu over [0, 1], by 4-point
+ * Gauss-Legendre (nodes 0.5 -+ d[i], weights w[i]; within 5e-4 of a fine
+ * quadrature for metals and glass, test_energy): of a conductor's channel
+ * (eta, k), or of a dielectric (k < 0: index eta, from outside). Once per
+ * shading point, so few nodes. */
+static inline PK_HD float pbsdf__favg(float eta, float k)
+{
+    const float d[2] = {0.1699905218f, 0.4305681558f};
+    const float w[2] = {0.3260725774f, 0.1739274226f};
+    float s = 0.0f;
+    for (int i = 0; i < 2; i++)
+        for (int j = 0; j < 2; j++) {
+            const float mu = j ? 0.5f + d[i] : 0.5f - d[i];
+            const float f = k < 0.0f ? pbsdf_fresnel_dielectric(mu, eta) : pbsdf__fresnel_conductor1(mu, eta, k);
+            s += w[i] * f * mu;
+        }
+    return 2.0f * s;
+}
+/* F_avg of Schlick's F0 + (1 - F0) (1 - mu)^5: F0 + (1 - F0) / 21. */
+static inline PK_HD float pbsdf__favg_schlick(float f0) { return f0 + (1.0f - f0) * (1.0f / 21.0f); }
+static inline PK_HD float pbsdf__fms(float favg, float eavg)
+{
+    return favg * favg * eavg / (1.0f - favg * (1.0f - eavg));
+}
+
+/* E(mu) of the BSDF's lobe (alpha, distribution). */
+static inline PK_HD float pbsdf__e(const pbsdf *b, float mu) { return energy_e(pbsdf__bk(b), b->alpha, mu); }
+
+/* Turns energy compensation on for a rough conductor, dielectric, plastic
+ * or metallic-roughness BSDF (others, and smooth lobes, stay as they are).
+ * Call it after anything that changes the roughness (pbsdf_regularize). */
+static inline PK_HD void pbsdf_compensate(pbsdf *b)
+{
+    if (pbsdf__smooth(b)) return;
+    if (b->type == PBSDF_DIELECTRIC) {
+        b->flags |= PBSDF_ENERGY;
+        return;
+    }
+    if (b->type != PBSDF_CONDUCTOR && b->type != PBSDF_PLASTIC && b->type != PBSDF_METALLIC_ROUGHNESS) return;
+    const float eavg = energy_eavg(pbsdf__bk(b), b->alpha);
+    if (!(eavg < 0.99999f)) return;
+    vec3 fms;
+    if (b->type == PBSDF_CONDUCTOR) {
+        vec3 favg;
+        if (b->flags & PBSDF_SCHLICK)
+            favg = v3(pbsdf__favg_schlick(b->specular.x), pbsdf__favg_schlick(b->specular.y),
+                      pbsdf__favg_schlick(b->specular.z));
+        else
+            favg = v3(pbsdf__favg(b->eta.x, b->k.x), pbsdf__favg(b->eta.y, b->k.y), pbsdf__favg(b->eta.z, b->k.z));
+        favg = v3_mul(favg, b->tint);
+        fms = v3(pbsdf__fms(favg.x, eavg), pbsdf__fms(favg.y, eavg), pbsdf__fms(favg.z, eavg));
+    } else if (b->type == PBSDF_PLASTIC) {
+        fms = v3s(pbsdf__fms(pbsdf__favg(b->ior, -1.0f), eavg));
+    } else { /* glTF: the dielectric's specular lobe (Schlick, f0 of ior) and the metal (Schlick, f0 = base) */
+        const float r = (b->ior - 1.0f) / (b->ior + 1.0f), m = b->metallic;
+        const float fd = (1.0f - m) * pbsdf__fms(pbsdf__favg_schlick(r * r), eavg);
+        fms = v3(fd + m * pbsdf__fms(pbsdf__favg_schlick(b->albedo.x), eavg),
+                 fd + m * pbsdf__fms(pbsdf__favg_schlick(b->albedo.y), eavg),
+                 fd + m * pbsdf__fms(pbsdf__favg_schlick(b->albedo.z), eavg));
+    }
+    b->ms = v3_scale(fms, 1.0f / (PK_PI * (1.0f - eavg)));
+    b->ms_albedo = pbsdf__mean(fms);
+    b->flags |= PBSDF_ENERGY;
+}
+
+/* f_ms cos of the multiple-scattering lobe (wo.z > 0, wi.z > 0). */
+static inline PK_HD vec3 pbsdf__ms_cos(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    return v3_scale(b->ms, (1.0f - pbsdf__e(b, wo.z)) * (1.0f - pbsdf__e(b, wi.z)) * wi.z);
+}
+/* Its albedo toward wo. */
+static inline PK_HD float pbsdf__ms_alb(const pbsdf *b, vec3 wo) { return b->ms_albedo * (1.0f - pbsdf__e(b, wo.z)); }
+/* The compensated conductor's probability of sampling the multiple-scattering
+ * lobe: its albedo's share, the single-scattering lobe's taken as E(wo.z). */
+static inline PK_HD float pbsdf__ms_prob(const pbsdf *b, vec3 wo)
+{
+    const float e = pbsdf__e(b, wo.z), ms = b->ms_albedo * (1.0f - e);
+    return ms + e > 0.0f ? ms / (ms + e) : 0.0f;
+}
+/* Turquin's factor of the dielectric: 1 / E_d toward wo. */
+static inline PK_HD float pbsdf__dielectric_comp(const pbsdf *b, vec3 wo)
+{
+    const float e = energy_dielectric(pbsdf__bk(b), b->ior, b->alpha, wo.z);
+    return e > 0.05f ? 1.0f / e : 20.0f;
+}
+
 /* Probability of choosing the specular lobe over the diffuse one, from
  * estimates of their albedos. */
 static inline PK_HD float pbsdf__spec_prob(const pbsdf *b, vec3 wo)
@@ -423,6 +540,7 @@ static inline PK_HD float pbsdf__spec_prob(const pbsdf *b, vec3 wo)
         float f = pbsdf_fresnel_dielectric(wo.z, b->ior);
         es = f;
         ed = (1.0f - f) * pbsdf__mean(b->albedo);
+        if (b->flags & PBSDF_ENERGY) ed += pbsdf__ms_alb(b, wo); /* sampled by the cosine lobe */
     } else { /* glossy */
         es = pbsdf__mean(b->specular);
         ed = pbsdf__mean(b->albedo);
@@ -490,7 +608,9 @@ static inline PK_HD void pbsdf__mr_probs(const pbsdf *b, vec3 wo, float p[4])
     const float f = f0 + (1.0f - f0) * w, base = pbsdf__mean(b->albedo), cw = pbsdf__mr_coat(b, wo);
     const float es = ((1.0f - m) * f + m * (base + (1.0f - base) * w)) * (1.0f - cw);
     const float eb = (1.0f - m) * (1.0f - f) * base * (1.0f - cw);
-    const float ed = eb * (1.0f - t), et = eb * t, sum = es + ed + et + cw;
+    float ed = eb * (1.0f - t);
+    if (b->flags & PBSDF_ENERGY) ed += pbsdf__ms_alb(b, wo) * (1.0f - cw); /* sampled by the cosine lobe */
+    const float et = eb * t, sum = es + ed + et + cw;
     if (!(sum > 0.0f)) {
         p[0] = 1.0f, p[1] = p[2] = p[3] = 0.0f;
         return;
@@ -539,6 +659,7 @@ static inline PK_HD vec3 pbsdf__mr_eval_base(const pbsdf *b, vec3 wo, vec3 wi)
             const vec3 fm = v3_add(b->albedo, v3_scale(v3_sub(v3s(1.0f), b->albedo), w));
             r = v3_add(r, v3_scale(v3_add(v3s((1.0f - m) * f), v3_scale(fm, m)), s));
         }
+        if (b->flags & PBSDF_ENERGY) r = v3_add(r, pbsdf__ms_cos(b, wo, wi));
     }
     return r;
 }
@@ -602,6 +723,7 @@ static inline PK_HD vec3 pbsdf__dielectric_eval(const pbsdf *b, vec3 wo, vec3 wi
     if (pbsdf__smooth(b) || !pbsdf__dielectric_half(b, wo, wi, &m, &e)) return v3s(0.0f);
     float f = pbsdf_fresnel_dielectric(v3_dot(wo, m), b->ior);
     float dg = pbsdf_mf_d(b, m) * pbsdf_mf_g2(b, wo, wi);
+    if (b->flags & PBSDF_ENERGY) dg *= pbsdf__dielectric_comp(b, wo);
     if (wo.z * wi.z > 0.0f) return v3s(dg * f / (4.0f * fabsf(wo.z)));
     float im = v3_dot(wi, m), om = v3_dot(wo, m);
     float den = im + om / e;
@@ -673,13 +795,17 @@ static inline PK_HD vec3 pbsdf_eval(const pbsdf *b, vec3 wo, vec3 wi)
     if (b->type == PBSDF_DIELECTRIC) return pbsdf__dielectric_eval(b, wo, wi);
     if (b->type == PBSDF_METALLIC_ROUGHNESS) return pbsdf__mr_eval(b, wo, wi);
     if (!(wo.z > 0.0f && wi.z > 0.0f)) return v3s(0.0f);
-    vec3 h;
+    vec3 h = v3(0.0f, 0.0f, 1.0f);
     switch (b->type) {
     case PBSDF_DIFFUSE:
         return v3_scale(b->albedo, wi.z / PK_PI);
     case PBSDF_CONDUCTOR: {
         if (pbsdf__smooth(b)) return v3s(0.0f);
         float s = pbsdf__mf_refl_cos(b, wo, wi, &h);
+        if (b->flags & PBSDF_ENERGY) {
+            vec3 r = pbsdf__ms_cos(b, wo, wi);
+            return s > 0.0f ? v3_add(r, v3_scale(pbsdf__fresnel_conductor(b, v3_dot(wo, h)), s)) : r;
+        }
         if (s <= 0.0f) return v3s(0.0f);
         return v3_scale(pbsdf__fresnel_conductor(b, v3_dot(wo, h)), s);
     }
@@ -688,6 +814,7 @@ static inline PK_HD vec3 pbsdf_eval(const pbsdf *b, vec3 wo, vec3 wi)
         if (!pbsdf__smooth(b)) {
             float s = pbsdf__mf_refl_cos(b, wo, wi, &h);
             if (s > 0.0f) r = v3_add(r, v3s(s * pbsdf_fresnel_dielectric(v3_dot(wo, h), b->ior)));
+            if (b->flags & PBSDF_ENERGY) r = v3_add(r, pbsdf__ms_cos(b, wo, wi));
         }
         return r;
     }
@@ -715,7 +842,12 @@ static inline PK_HD float pbsdf_pdf(const pbsdf *b, vec3 wo, vec3 wi)
     case PBSDF_DIFFUSE:
         return wi.z / PK_PI;
     case PBSDF_CONDUCTOR:
-        return pbsdf__smooth(b) ? 0.0f : pbsdf__mf_refl_pdf(b, wo, wi);
+        if (pbsdf__smooth(b)) return 0.0f;
+        if (b->flags & PBSDF_ENERGY) {
+            const float pc = pbsdf__ms_prob(b, wo);
+            return (1.0f - pc) * pbsdf__mf_refl_pdf(b, wo, wi) + pc * wi.z / PK_PI;
+        }
+        return pbsdf__mf_refl_pdf(b, wo, wi);
     case PBSDF_PLASTIC:
     case PBSDF_GLOSSY: {
         float ps = pbsdf__spec_prob(b, wo);
@@ -791,6 +923,24 @@ static inline PK_HD bool pbsdf_sample(const pbsdf *b, vec3 wo, const float u[3],
             *weight = pbsdf__fresnel_conductor(b, wo.z);
             *pdf = 1.0f;
             *is_delta = true;
+            return true;
+        }
+        if (b->flags & PBSDF_ENERGY) { /* the lobe or the multiple-scattering one, by u[0] */
+            if (u[0] < pbsdf__ms_prob(b, wo)) {
+                float r = sqrtf(u[1]), phi = 2.0f * PK_PI * u[2];
+                w = v3(r * cosf(phi), r * sinf(phi), sqrtf(fmaxf(0.0f, 1.0f - u[1])));
+            } else {
+                vec3 m = pbsdf_mf_sample(b, wo, u[1], u[2]);
+                float om = v3_dot(wo, m);
+                if (!(om > 0.0f)) return false;
+                w = v3_sub(v3_scale(m, 2.0f * om), wo);
+            }
+            if (!(w.z > 0.0f)) return false;
+            float p = pbsdf_pdf(b, wo, w);
+            if (!(p > 0.0f)) return false;
+            *wi = w;
+            *pdf = p;
+            *weight = v3_scale(pbsdf_eval(b, wo, w), 1.0f / p);
             return true;
         }
         vec3 m = pbsdf_mf_sample(b, wo, u[1], u[2]);

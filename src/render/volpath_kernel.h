@@ -373,6 +373,7 @@ static inline PK_HD bool vol_step(const path_tracer *pt, path_thread *t, vol_sta
     if (ps->depth >= pt->max_depth) return false;
     shading sh = shading_at(&sf);
     if (pt->regularize && ps->rough_seen) shading_regularize(&sh);
+    if (pt->energy) pbsdf_compensate(&sh.b);
     float u0, u1, u2, u3, u4, u5;
     sampler_2d(&ps->smp, &u0, &u1);
     sampler_2d(&ps->smp, &u2, &u3);

@@ -447,6 +447,10 @@ void scene_render_integrator(pk_scene *s, pk_integrator_kind kind)
     s->render.opt.integrator = kind, s->render.has_integrator = true;
 }
 void scene_render_fresnel(pk_scene *s, bool on) { s->render.opt.fresnel = on ? 1 : 0, s->render.has_fresnel = true; }
+void scene_render_energy_compensation(pk_scene *s, bool on)
+{
+    s->render.opt.energy_compensation = on ? 1 : 0, s->render.has_energy_compensation = true;
+}
 
 pk_status scene_render_clamp(pk_context *ctx, pk_scene *s, float clamp_indirect)
 {

@@ -185,6 +185,15 @@ static void check_device(void)
     o.device = (pk_device_kind)7;
     CHECK(pk_render_options_check(ctx, &o) == PK_ERR_INVALID_ARGUMENT && strstr(pk_context_error(ctx), "device"));
     pk_context_clear_error(ctx);
+    /* energy compensation: off by default, 0 or 1 */
+    pk_render_options_init(&o);
+    CHECK(o.energy_compensation == 0);
+    o.energy_compensation = 1;
+    CHECK(pk_render_options_check(ctx, &o) == PK_OK);
+    o.energy_compensation = 2;
+    CHECK(pk_render_options_check(ctx, &o) == PK_ERR_INVALID_ARGUMENT &&
+          strstr(pk_context_error(ctx), "energy compensation 2 is not 0 or 1"));
+    pk_context_clear_error(ctx);
     const int gpu = pk_accel_available(PK_ACCEL_CUDA);
     for (int spelling = 0; spelling < 2; spelling++) {
         pk_render_options_init(&o);

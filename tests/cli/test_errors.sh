@@ -186,6 +186,8 @@ expect "absurd pixel count" 1 "image of 16384x16384 pixels is larger than 671088
 expect "unknown accelerator" 2 "--accel: unknown accelerator 'kd' (none, midpoint, bvh, embree)" \
   render "$tmp/tri.obj" -o "$tmp/out.png" --accel kd
 expect "bad fresnel" 2 "--fresnel: expected on or off, not 'yes'" render "$tmp/tri.obj" -o "$tmp/out.png" --fresnel yes
+expect "bad energy compensation" 2 "--energy-compensation: expected on or off, not '1'" \
+  render "$tmp/tri.obj" -o "$tmp/out.png" --energy-compensation 1
 expect "unknown option" 2 "render: unknown option '--bogus' (see paprsek render --help)" \
   render "$tmp/tri.obj" -o "$tmp/out.png" --bogus
 expect "option without its value" 2 "--width needs a value" render "$tmp/tri.obj" -o "$tmp/out.png" --width

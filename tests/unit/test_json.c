@@ -189,7 +189,7 @@ static void test_defaults(void)
     CHECK(s->camera.fov_deg == 45.0f);
     CHECK(!s->render.has_width && !s->render.has_height && !s->render.has_spp && !s->render.has_accel &&
           !s->render.has_fresnel && !s->render.has_threads && !s->render.has_max_depth &&
-          !s->render.has_light_samples);
+          !s->render.has_light_samples && !s->render.has_energy_compensation);
     CHECK(s->render.opt.width == 512 && s->render.opt.height == 512);
     CHECK(near3(s->ambient, 0, 0, 0, 0));
     REQUIRE(s->nspheres == 1 && s->nlights == 1);
@@ -312,6 +312,8 @@ static void test_errors(void)
     EXPECT_ERROR("{\"lights\": [{\"position\": [0, 1, 0],\n \"intensity\": \"bright\"}]}", PK_ERR_PARSE,
                  "scene.json:2: lights[0].intensity: must be a number or an array of 3 numbers");
     EXPECT_ERROR("{\"render\": {\"fresnel\": 1}}", PK_ERR_PARSE, "scene.json:1: render.fresnel: must be true or false");
+    EXPECT_ERROR("{\"render\": {\"energy_compensation\": \"on\"}}", PK_ERR_PARSE,
+                 "scene.json:1: render.energy_compensation: must be true or false");
     EXPECT_ERROR("{\"render\": {\"accel\": \"kd-tree\"}}", PK_ERR_PARSE,
                  "scene.json:1: render.accel: must be one of \"none\", \"midpoint\", \"bvh\", \"embree\"");
     EXPECT_ERROR("{\"camera\": {\"look_from\": [0, 0, 1], \"look_at\": [0, 0, 0]},\n"

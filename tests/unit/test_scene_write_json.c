@@ -110,13 +110,15 @@ static void compare_rest(const pk_scene *a, const pk_scene *b)
           ra->has_threads == rb->has_threads && ra->has_accel == rb->has_accel && ra->has_fresnel == rb->has_fresnel &&
           ra->has_seed == rb->has_seed && ra->has_integrator == rb->has_integrator &&
           ra->has_regularize == rb->has_regularize && ra->has_light_tree == rb->has_light_tree &&
-          ra->has_clamp_indirect == rb->has_clamp_indirect);
+          ra->has_clamp_indirect == rb->has_clamp_indirect &&
+          ra->has_energy_compensation == rb->has_energy_compensation);
     const pk_render_options *oa = &ra->opt, *ob = &rb->opt;
     CHECK(oa->width == ob->width && oa->height == ob->height && oa->spp == ob->spp &&
           oa->light_samples == ob->light_samples && oa->max_depth == ob->max_depth && oa->threads == ob->threads &&
           oa->accel == ob->accel && oa->fresnel == ob->fresnel && oa->seed == ob->seed &&
           oa->integrator == ob->integrator && oa->regularize == ob->regularize && oa->light_tree == ob->light_tree &&
-          same_bits(&oa->clamp_indirect, &ob->clamp_indirect, sizeof(float)));
+          same_bits(&oa->clamp_indirect, &ob->clamp_indirect, sizeof(float)) &&
+          oa->energy_compensation == ob->energy_compensation);
     CHECK(same_bits(&a->ambient, &b->ambient, sizeof(vec3)));
     for (size_t f = 0; f < rec_nenv; f++)
         CHECKF(same_bits((const char *)&a->env + rec_env[f].offset, (const char *)&b->env + rec_env[f].offset,
@@ -210,6 +212,20 @@ int main(void)
         char path[512];
         snprintf(path, sizeof path, "%s/%s", PK_TEST_DATA, scenes[i]);
         round_trip(path, dir);
+    }
+    /* energy compensation: a glTF asset asks for it, the others do not say */
+    for (size_t i = 0; i < sizeof scenes / sizeof scenes[0]; i++) {
+        char path[512];
+        snprintf(path, sizeof path, "%s/%s", PK_TEST_DATA, scenes[i]);
+        pk_scene *g = NULL;
+        REQUIRE(pk_scene_load_file(ctx, path, &g) == PK_OK);
+        const bool gltf = strstr(scenes[i], ".gltf") != NULL;
+        CHECKF(g->render.has_energy_compensation == gltf && g->render.opt.energy_compensation == (gltf ? 1 : 0), "%s",
+               scenes[i]);
+        pk_render_options ro;
+        pk_scene_get_render_options(g, &ro);
+        CHECKF(ro.energy_compensation == (gltf ? 1 : 0), "%s: render options", scenes[i]);
+        pk_scene_destroy(g);
     }
 
     /* ---- refused, nothing written ---- */
