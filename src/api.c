@@ -282,6 +282,7 @@ void pk_scene_get_render_options(const pk_scene *s, pk_render_options *opt)
     if (r->has_regularize) opt->regularize = r->opt.regularize;
     if (r->has_light_tree) opt->light_tree = r->opt.light_tree;
     if (r->has_clamp_indirect) opt->clamp_indirect = r->opt.clamp_indirect;
+    if (r->has_filter) opt->filter = r->opt.filter;
     if (r->has_integrator) opt->integrator = r->opt.integrator;
 }
 
