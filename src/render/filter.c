@@ -52,6 +52,11 @@ static pk_status build_axis(pk_context *ctx, const pk_filter *f, float radius, c
         a->cdf[i + 1] = (float)(c / sum_abs);
     }
     a->cdf[FILTER_CELLS] = 1.0f;
+    for (int j = 0, i = 0; j < FILTER_GUIDE; j++) {
+        const float u = (float)j / (float)FILTER_GUIDE;
+        while (i < FILTER_CELLS - 1 && a->cdf[i + 1] <= u) i++;
+        a->guide[j] = (uint8_t)i;
+    }
     a->weight = (float)(sum_abs / sum);
     return PK_OK;
 }

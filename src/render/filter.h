@@ -28,6 +28,8 @@
 #include <stdint.h>
 
 #define FILTER_CELLS 128
+#define FILTER_GUIDE 128 /* entries of the guide table: where in cdf[] the search for u starts */
+_Static_assert(FILTER_CELLS <= 256, "guide[] holds cell numbers in bytes");
 
 /* How an axis is sampled. */
 enum {
@@ -45,6 +47,9 @@ typedef struct filter_axis {
      * cdf[FILTER_CELLS] = 1), cell i covering [-r + 2r i / N, -r + 2r (i + 1) / N) */
     float cdf[FILTER_CELLS + 1];
     uint32_t negative[FILTER_CELLS / 32]; /* bit i: the filter is negative over cell i */
+    /* guide[j]: the last cell i with cdf[i] <= j / FILTER_GUIDE (a search for
+     * u starts there, usually ending within a step or two) */
+    uint8_t guide[FILTER_GUIDE];
 } filter_axis;
 
 typedef struct pixel_filter {
@@ -62,14 +67,11 @@ static inline PK_HD float filter_axis_sample(const filter_axis *a, float u, floa
         const float t = u < 0.5f ? sqrtf(2.0f * u) - 1.0f : 1.0f - sqrtf(2.0f - 2.0f * u);
         return 0.5f + r * t;
     }
-    int lo = 0, hi = FILTER_CELLS; /* the cell i with cdf[i] <= u < cdf[i + 1] */
-    while (hi - lo > 1) {
-        const int mid = (lo + hi) >> 1;
-        if (a->cdf[mid] <= u)
-            lo = mid;
-        else
-            hi = mid;
-    }
+    /* the cell lo with cdf[lo] <= u < cdf[lo + 1], from the guide's start */
+    int j = (int)(u * (float)FILTER_GUIDE);
+    j = j < 0 ? 0 : j >= FILTER_GUIDE ? FILTER_GUIDE - 1 : j;
+    int lo = a->guide[j];
+    while (lo < FILTER_CELLS - 1 && a->cdf[lo + 1] <= u) lo++;
     const float du = a->cdf[lo + 1] - a->cdf[lo];
     float t = du > 0.0f ? (u - a->cdf[lo]) / du : 0.5f;
     t = fminf(fmaxf(t, 0.0f), 0.99999994f);
