@@ -272,6 +272,7 @@ static void check_edge(const char *what, const char *json, const pk_filter *f, d
         }
         pk_image_destroy(img);
     }
+    double worst = 0.0, worst_tol = 0.0, worst_se = 0.0;
     for (int x = 0; x < SW; x++) {
         const double mean = sum[x] / SEEDS, var = (sum2[x] - SEEDS * mean * mean) / (SEEDS - 1);
         const double se = sqrt(var > 0.0 ? var / SEEDS : 0.0);
@@ -279,7 +280,11 @@ static void check_edge(const char *what, const char *json, const pk_filter *f, d
         const double tol = 5.0 * se + table_bound + 1e-6;
         CHECKF(fabs(mean - want) <= tol, "%s: column %d is %.6f, the filter gives %.6f (tolerance %.2g, se %.2g)",
                what, x, mean, want, tol, se);
+        if (fabs(mean - want) / tol > (worst_tol > 0.0 ? worst / worst_tol : 0.0))
+            worst = fabs(mean - want), worst_tol = tol, worst_se = se;
     }
+    printf("edge, %s: %d columns; closest to its tolerance: off by %.2g (tolerance %.2g, standard error %.2g)\n",
+           what, SW, worst, worst_tol, worst_se);
     pk_scene_destroy(s);
 }
 
