@@ -102,6 +102,8 @@ typedef struct cli_render_opts {
     int energy;          /* --energy-compensation: -1 not given */
     int has_clamp_indirect;
     float clamp_indirect;
+    int has_filter;
+    pk_filter filter;
     int has_accel;
     pk_accel_kind accel;
     int has_device;

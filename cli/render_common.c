@@ -27,6 +27,7 @@ enum {
     OPT_FRESNEL,
     OPT_ENERGY,
     OPT_CLAMP_INDIRECT,
+    OPT_FILTER,
     OPT_LOOK_FROM,
     OPT_LOOK_AT,
     OPT_UP,
@@ -117,6 +118,13 @@ const cli_option *cli_render_options(size_t *n)
                          .help = "path tracer: scale down the light each sample brings after a bounce so that "
                                  "no channel exceeds X (fewer fireflies, a darker, biased image); 0 = off "
                                  "(default)"});
+        add((cli_option){.name = "filter", .id = OPT_FILTER, .kind = CLI_STRING, .arg = "NAME[:KEY=V,...]",
+                         .help = "the pixel filter, replacing the scene's: box (radius 0.5, the default for OBJ, "
+                                 "JSON and the built-in scene), triangle (2), gaussian (1.5, sigma=0.5: the "
+                                 "default for pbrt-v4 and Mitsuba scenes), mitchell (2, b=1/3, c=1/3), "
+                                 "blackman-harris (1.5) or lanczos (4, tau=3); keys: radius=R (both axes), "
+                                 "xradius=R, yradius=R (pixels, at most 16) and the filter's own (sigma, b, c, "
+                                 "tau), e.g. gaussian:radius=2,sigma=0.7"});
         add((cli_option){.name = "look-from", .id = OPT_LOOK_FROM, .kind = CLI_STRING, .arg = "X,Y,Z",
                          .help = "camera position"});
         add((cli_option){.name = "look-at", .id = OPT_LOOK_AT, .kind = CLI_STRING, .arg = "X,Y,Z",
@@ -228,6 +236,61 @@ void cli_render_usage(FILE *f, const char *usage_line)
 }
 
 
+/* --filter NAME[:KEY=VALUE,...] into *f; 0, or cli_usage_error's status. */
+static int parse_filter(const char *v, pk_filter *f)
+{
+    char name[32];
+    const char *colon = strchr(v, ':');
+    const size_t n = colon ? (size_t)(colon - v) : strlen(v);
+    pk_filter_type type;
+    if (n >= sizeof name || (memcpy(name, v, n), name[n] = '\0', pk_filter_parse(name, &type) != PK_OK))
+        return cli_usage_error("--filter: unknown filter '%.*s' (box, triangle, gaussian, mitchell, "
+                               "blackman-harris, lanczos)",
+                               (int)(n > 40 ? 40 : n), v);
+    pk_filter_init(f, type);
+    for (const char *c = colon ? colon + 1 : NULL; c && *c;) {
+        const char *e = strchr(c, ',');
+        const size_t len = e ? (size_t)(e - c) : strlen(c);
+        const char *eq = memchr(c, '=', len);
+        if (!eq) return cli_usage_error("--filter: '%.*s' is not KEY=VALUE", (int)len, c);
+        const size_t klen = (size_t)(eq - c);
+        char num[48];
+        const size_t vlen = len - klen - 1;
+        char *end = num;
+        float x = NAN;
+        if (vlen > 0 && vlen < sizeof num) {
+            memcpy(num, eq + 1, vlen);
+            num[vlen] = '\0';
+            x = strtof(num, &end);
+        }
+        if (vlen == 0 || vlen >= sizeof num || *end || !isfinite(x))
+            return cli_usage_error("--filter: %.*s needs a number", (int)len, c);
+#define KEY(s) (klen == strlen(s) && strncmp(c, s, klen) == 0)
+        if (KEY("radius")) f->radius_x = f->radius_y = x;
+        else if (KEY("xradius")) f->radius_x = x;
+        else if (KEY("yradius")) f->radius_y = x;
+        else if (KEY("sigma") && type == PK_FILTER_GAUSSIAN) f->sigma = x;
+        else if ((KEY("b") || KEY("B")) && type == PK_FILTER_MITCHELL) f->b = x;
+        else if ((KEY("c") || KEY("C")) && type == PK_FILTER_MITCHELL) f->c = x;
+        else if (KEY("tau") && type == PK_FILTER_LANCZOS) f->tau = x;
+        else
+            return cli_usage_error("--filter: %s has no parameter '%.*s'", pk_filter_name(type), (int)klen, c);
+#undef KEY
+        c = e ? e + 1 : NULL;
+    }
+    /* the library's own check, its message */
+    pk_context *ctx = NULL;
+    if (pk_context_create(NULL, &ctx) != PK_OK) return cli_usage_error("--filter: out of memory");
+    pk_render_options ro;
+    pk_render_options_init(&ro);
+    ro.filter = *f;
+    const pk_status st = pk_render_options_check(ctx, &ro);
+    int rc = 0;
+    if (st != PK_OK) rc = cli_usage_error("--filter: %s", pk_context_error(ctx));
+    pk_context_destroy(ctx);
+    return rc;
+}
+
 int cli_render_parse(int argc, char **argv, cli_render_opts *o, void (*help)(FILE *f))
 {
     memset(o, 0, sizeof *o);
@@ -306,6 +369,10 @@ int cli_render_parse(int argc, char **argv, cli_render_opts *o, void (*help)(FIL
             o->has_clamp_indirect = 1;
             break;
         }
+        case OPT_FILTER:
+            if (parse_filter(v, &o->filter) != 0) return 2;
+            o->has_filter = 1;
+            break;
         case OPT_FRESNEL:
             if (strcmp(v, "on") == 0)
                 o->fresnel = 1;
@@ -748,6 +815,7 @@ pk_status cli_render_settings(pk_context *ctx, const cli_render_opts *o, pk_scen
     if (o->fresnel >= 0) ro->fresnel = o->fresnel;
     if (o->energy >= 0) ro->energy_compensation = o->energy;
     if (o->has_clamp_indirect) ro->clamp_indirect = o->clamp_indirect;
+    if (o->has_filter) ro->filter = o->filter;
     if (o->has_accel) ro->accel = o->accel;
     if (o->has_device) {
         ro->device = o->device;

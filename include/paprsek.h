@@ -240,6 +240,38 @@ PK_API const char *pk_integrator_name(pk_integrator_kind kind);
 /* Returns PK_OK and sets *out for "whitted", "path", "default". */
 PK_API pk_status pk_integrator_parse(const char *name, pk_integrator_kind *out);
 
+/* The pixel filter: how a pixel weighs what its samples see at each offset
+ * from its centre. Each sample's position is drawn from the filter's shape
+ * (importance sampling) and counts for the pixel it was drawn for only, so
+ * images do not depend on threads or tiles. The default, a box of radius
+ * 0.5, spreads the samples evenly over the pixel. */
+typedef enum pk_filter_type {
+    PK_FILTER_BOX = 0,             /* 1 inside the radius */
+    PK_FILTER_TRIANGLE = 1,        /* a tent: radius - |x| */
+    PK_FILTER_GAUSSIAN = 2,        /* exp(-x^2 / (2 sigma^2)), less its value at the radius */
+    PK_FILTER_MITCHELL = 3,        /* Mitchell-Netravali's cubic (b, c) stretched over the radius */
+    PK_FILTER_BLACKMAN_HARRIS = 4, /* the 4-term Blackman-Harris window over the radius */
+    PK_FILTER_LANCZOS = 5          /* sinc(x) sinc(x / tau) (pbrt-v4's "sinc", Mitsuba's "lanczos") */
+} pk_filter_type;
+
+typedef struct pk_filter {
+    pk_filter_type type;
+    /* half the width of the filter in pixels along x and y (0 < radius <= 16);
+     * the filter is the product of its 1-D profile along each axis */
+    float radius_x, radius_y;
+    float sigma; /* gaussian: the standard deviation in pixels (> 0) */
+    float b, c;  /* mitchell: B and C (finite) */
+    float tau;   /* lanczos: the number of lobes of the window (> 0) */
+} pk_filter;
+
+/* The filter of type with pbrt-v4's defaults: box radius 0.5, triangle 2,
+ * gaussian 1.5 (sigma 0.5), mitchell 2 (B = C = 1/3), lanczos 4 (tau 3);
+ * blackman-harris (not in pbrt-v4) 1.5. */
+PK_API void pk_filter_init(pk_filter *f, pk_filter_type type);
+/* "box", "triangle", "gaussian", "mitchell", "blackman-harris", "lanczos". */
+PK_API const char *pk_filter_name(pk_filter_type type);
+PK_API pk_status pk_filter_parse(const char *name, pk_filter_type *out);
+
 /* Progress of a render: done of total work units (tiles) finished, elapsed
  * seconds since the render call began. Called from one thread, at most a few
  * times per second, and once more at the end (done == total unless the render
@@ -292,6 +324,10 @@ typedef struct pk_render_options {
      * more saturated rough metals; docs/materials.md), 0 (the default) is
      * off. glTF scenes ask for 1 (pk_scene_get_render_options). */
     int energy_compensation;
+    /* The pixel filter (pk_filter; a box of radius 0.5 by default). Filters
+     * with negative lobes (mitchell, lanczos) give samples negative weights
+     * there, which makes them noisier than the others at equal samples. */
+    pk_filter filter;
 } pk_render_options;
 
 /* Arbitrary output variables: what the camera ray of each sample found,
@@ -310,7 +346,8 @@ PK_API unsigned pk_aov_parse(const char *name);
 PK_API const char *pk_aov_name(unsigned aov);
 
 /* Defaults: 512x512, 1 spp, 32 light samples, depth 8, all threads, default
- * accelerator, Fresnel on, no statistics, no progress callback. */
+ * accelerator, Fresnel on, no statistics, no progress callback, a box
+ * filter of radius 0.5. */
 PK_API void pk_render_options_init(pk_render_options *opt);
 
 /* The integer render options and their ranges: one table serves the API

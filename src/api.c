@@ -283,6 +283,7 @@ void pk_scene_get_render_options(const pk_scene *s, pk_render_options *opt)
     if (r->has_light_tree) opt->light_tree = r->opt.light_tree;
     if (r->has_clamp_indirect) opt->clamp_indirect = r->opt.clamp_indirect;
     if (r->has_energy_compensation) opt->energy_compensation = r->opt.energy_compensation;
+    if (r->has_filter) opt->filter = r->opt.filter;
     if (r->has_integrator) opt->integrator = r->opt.integrator;
 }
 

@@ -6,6 +6,7 @@
  */
 #include "options.h"
 
+#include <math.h>
 #include <stddef.h>
 #include <string.h>
 
@@ -77,6 +78,7 @@ void pk_render_options_init(pk_render_options *opt)
     for (size_t i = 0; i < NOPTS; i++) *options_int_field(opt, &table[i]) = table[i].default_value;
     opt->accel = PK_ACCEL_DEFAULT;
     opt->fresnel = 1;
+    pk_filter_init(&opt->filter, PK_FILTER_BOX);
 }
 
 pk_status options_check(pk_context *ctx, const pk_render_options *o)
@@ -98,7 +100,60 @@ pk_status options_check(pk_context *ctx, const pk_render_options *o)
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "energy compensation %d is not 0 or 1", o->energy_compensation);
     if ((unsigned)o->device > PK_DEVICE_CUDA)
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "unknown device %d", (int)o->device);
+    return options_check_filter(ctx, &o->filter);
+}
+
+pk_status options_check_filter(pk_context *ctx, const pk_filter *f)
+{
+    if ((unsigned)f->type > PK_FILTER_LANCZOS)
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "unknown filter type %d", (int)f->type);
+    const char *name = pk_filter_name(f->type);
+    if (!(f->radius_x > 0.0f && f->radius_x <= PK_FILTER_MAX_RADIUS && f->radius_y > 0.0f &&
+          f->radius_y <= PK_FILTER_MAX_RADIUS))
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "filter %s: radius %g x %g is not in (0, %g]", name,
+                         (double)f->radius_x, (double)f->radius_y, (double)PK_FILTER_MAX_RADIUS);
+    if (f->type == PK_FILTER_GAUSSIAN && !(f->sigma > 0.0f && isfinite(f->sigma)))
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "filter gaussian: sigma %g must be positive", (double)f->sigma);
+    if (f->type == PK_FILTER_MITCHELL && !(fabsf(f->b) <= 16.0f && fabsf(f->c) <= 16.0f))
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "filter mitchell: B %g and C %g must be in [-16, 16]",
+                         (double)f->b, (double)f->c);
+    if (f->type == PK_FILTER_LANCZOS && !(f->tau > 0.0f && f->tau <= 1024.0f))
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "filter lanczos: tau %g must be in (0, 1024]", (double)f->tau);
     return PK_OK;
+}
+
+/* ---- pixel filters ------------------------------------------------------------ */
+
+static const char *const filter_names[] = {"box", "triangle", "gaussian", "mitchell", "blackman-harris", "lanczos"};
+
+void pk_filter_init(pk_filter *f, pk_filter_type type)
+{
+    if (!f) return;
+    static const float radius[] = {0.5f, 2.0f, 1.5f, 2.0f, 1.5f, 4.0f};
+    memset(f, 0, sizeof *f);
+    if ((unsigned)type > PK_FILTER_LANCZOS) type = PK_FILTER_BOX;
+    f->type = type;
+    f->radius_x = f->radius_y = radius[type];
+    f->sigma = 0.5f;
+    f->b = f->c = 1.0f / 3.0f;
+    f->tau = 3.0f;
+}
+
+const char *pk_filter_name(pk_filter_type type)
+{
+    if ((unsigned)type >= sizeof filter_names / sizeof filter_names[0]) return "unknown";
+    return filter_names[type];
+}
+
+pk_status pk_filter_parse(const char *name, pk_filter_type *out)
+{
+    if (!name || !out) return PK_ERR_INVALID_ARGUMENT;
+    for (int k = PK_FILTER_BOX; k <= PK_FILTER_LANCZOS; k++)
+        if (strcmp(name, filter_names[k]) == 0) {
+            *out = (pk_filter_type)k;
+            return PK_OK;
+        }
+    return PK_ERR_INVALID_ARGUMENT;
 }
 
 void options_resolve_device(pk_render_options *o)

@@ -12,6 +12,10 @@ PK_HIDDEN int *options_int_field(pk_render_options *opt, const pk_int_option *o)
 /* Ranges of the table, the pixel budget, a known accelerator kind (whether it
  * is built in is api.c's check). Latches "name v is out of range (lo..hi)". */
 PK_HIDDEN pk_status options_check(pk_context *ctx, const pk_render_options *opt);
+/* Whether f is a filter the renderer can use: a known type, radii in
+ * (0, PK_FILTER_MAX_RADIUS], its parameters in range. Latches "filter ...". */
+PK_HIDDEN pk_status options_check_filter(pk_context *ctx, const pk_filter *f);
+#define PK_FILTER_MAX_RADIUS 16.0f
 /* Makes device and accel agree: device PK_DEVICE_CUDA renders on the GPU's
  * structure (accel becomes PK_ACCEL_CUDA); accel PK_ACCEL_CUDA alone is the
  * older spelling of device PK_DEVICE_CUDA. */

@@ -872,12 +872,72 @@ static pk_status parse_film(jp *p, const cJSON *it)
     return parse_size(p, f[0], f[1], it, "film");
 }
 
+/* render.filter: {"type", "radius" (a number or [x, y]), "sigma", "b", "c",
+ * "tau"}; what the type does not name keeps the type's default. */
+static pk_status parse_filter(jp *p, const cJSON *it)
+{
+    enum { F_TYPE, F_RADIUS, F_SIGMA, F_B, F_C, F_TAU, F_COUNT };
+    static const char *const keys[F_COUNT] = {"type", "radius", "sigma", "b", "c", "tau"};
+    const char *path = "render.filter";
+    const cJSON *f[F_COUNT];
+    if (!cJSON_IsObject(it)) return jfail(p, PK_ERR_PARSE, it, path, "must be an object with a \"type\"");
+    pk_status st = object_fields(p, it, path, keys, F_COUNT, f);
+    if (st) return st;
+    pk_filter_type type;
+    if (!f[F_TYPE] || !cJSON_IsString(f[F_TYPE]) || pk_filter_parse(f[F_TYPE]->valuestring, &type) != PK_OK)
+        return jfail(p, PK_ERR_PARSE, f[F_TYPE] ? f[F_TYPE] : it, "render.filter.type",
+                     "must be one of \"box\", \"triangle\", \"gaussian\", \"mitchell\", \"blackman-harris\", "
+                     "\"lanczos\"");
+    pk_filter flt;
+    pk_filter_init(&flt, type);
+    if (f[F_RADIUS]) {
+        if (cJSON_IsNumber(f[F_RADIUS])) {
+            if ((st = get_float(p, f[F_RADIUS], "render.filter.radius", &flt.radius_x))) return st;
+            flt.radius_y = flt.radius_x;
+        } else {
+            float r[2];
+            if ((st = get_floats(p, f[F_RADIUS], "render.filter.radius", r, 2))) return st;
+            flt.radius_x = r[0], flt.radius_y = r[1];
+        }
+        if (!(flt.radius_x > 0.0f && flt.radius_x <= PK_FILTER_MAX_RADIUS && flt.radius_y > 0.0f &&
+              flt.radius_y <= PK_FILTER_MAX_RADIUS))
+            return jfail(p, PK_ERR_PARSE, f[F_RADIUS], "render.filter.radius", "must be in (0, %g]",
+                         (double)PK_FILTER_MAX_RADIUS);
+    }
+    /* each parameter where its type has it */
+    static const struct {
+        int key;
+        pk_filter_type type;
+        const char *path;
+    } params[] = {{F_SIGMA, PK_FILTER_GAUSSIAN, "render.filter.sigma"},
+                  {F_B, PK_FILTER_MITCHELL, "render.filter.b"},
+                  {F_C, PK_FILTER_MITCHELL, "render.filter.c"},
+                  {F_TAU, PK_FILTER_LANCZOS, "render.filter.tau"}};
+    float *dst[] = {&flt.sigma, &flt.b, &flt.c, &flt.tau};
+    for (size_t i = 0; i < sizeof params / sizeof params[0]; i++) {
+        const cJSON *v = f[params[i].key];
+        if (!v) continue;
+        if (params[i].type != type)
+            return jfail(p, PK_ERR_PARSE, v, params[i].path, "is not a parameter of the %s filter",
+                         pk_filter_name(type));
+        if ((st = get_float(p, v, params[i].path, dst[i]))) return st;
+    }
+    if (type == PK_FILTER_GAUSSIAN && !(flt.sigma > 0.0f))
+        return jfail(p, PK_ERR_PARSE, f[F_SIGMA], "render.filter.sigma", "must be positive");
+    if (type == PK_FILTER_MITCHELL && !(fabsf(flt.b) <= 16.0f && fabsf(flt.c) <= 16.0f))
+        return jfail(p, PK_ERR_PARSE, f[F_B] ? f[F_B] : f[F_C], "render.filter", "b and c must be in [-16, 16]");
+    if (type == PK_FILTER_LANCZOS && !(flt.tau > 0.0f && flt.tau <= 1024.0f))
+        return jfail(p, PK_ERR_PARSE, f[F_TAU], "render.filter.tau", "must be in (0, 1024]");
+    return scene_render_filter(p->ctx, p->s, &flt);
+}
+
 static pk_status parse_render(jp *p, const cJSON *it)
 {
-    enum { R_W, R_H, R_SPP, R_LS, R_DEPTH, R_THREADS, R_SEED, R_ACCEL, R_FRESNEL, R_INTEGRATOR, R_REGULARIZE, R_LIGHT_TREE, R_CLAMP, R_ENERGY, R_COUNT };
+    enum { R_W, R_H, R_SPP, R_LS, R_DEPTH, R_THREADS, R_SEED, R_ACCEL, R_FRESNEL, R_INTEGRATOR, R_REGULARIZE, R_LIGHT_TREE, R_CLAMP, R_ENERGY, R_FILTER, R_COUNT };
     static const char *const keys[R_COUNT] = {"width",   "height", "spp",   "light_samples", "max_depth",
                                               "threads", "seed",   "accel", "fresnel",       "integrator",
-                                              "regularize", "light_tree", "clamp_indirect", "energy_compensation"};
+                                              "regularize", "light_tree", "clamp_indirect", "energy_compensation",
+                                              "filter"};
     const cJSON *f[R_COUNT];
     pk_status st = object_fields(p, it, "render", keys, R_COUNT, f);
     if (st) return st;
@@ -923,6 +983,7 @@ static pk_status parse_render(jp *p, const cJSON *it)
             return jfail(p, PK_ERR_PARSE, f[R_CLAMP], "render.clamp_indirect", "must be 0 (off) or more");
         if ((st = scene_render_clamp(p->ctx, p->s, clamp))) return st;
     }
+    if (f[R_FILTER] && (st = parse_filter(p, f[R_FILTER]))) return st;
     return parse_size(p, f[R_W], f[R_H], it, "render");
 }
 

@@ -2663,6 +2663,57 @@ static pk_status d_sampler(pp *p, const char *type)
     return PK_OK;
 }
 
+/* PixelFilter: pbrt-v4's filters and their defaults ("sinc" is the lanczos
+ * filter); an unknown one is warned about and the default gaussian kept. */
+static pk_status d_pixel_filter(pp *p, const char *type)
+{
+    static const struct {
+        const char *name;
+        pk_filter_type t;
+    } names[] = {{"box", PK_FILTER_BOX},
+                 {"triangle", PK_FILTER_TRIANGLE},
+                 {"gaussian", PK_FILTER_GAUSSIAN},
+                 {"mitchell", PK_FILTER_MITCHELL},
+                 {"sinc", PK_FILTER_LANCZOS}};
+    int k = -1;
+    for (int i = 0; i < (int)(sizeof names / sizeof names[0]); i++)
+        if (strcmp(type, names[i].name) == 0) k = i;
+    if (k < 0) {
+        pd_mark_all(&p->pd);
+        pwarn(p, p->line, "PixelFilter \"%.40s\" is not known; using \"gaussian\"", type);
+        return PK_OK;
+    }
+    pk_filter f;
+    pk_filter_init(&f, names[k].t);
+    pk_status st;
+    if ((st = pb_float(&p->pd, "xradius", &f.radius_x)) || (st = pb_float(&p->pd, "yradius", &f.radius_y))) return st;
+    if (f.type == PK_FILTER_GAUSSIAN && (st = pb_float(&p->pd, "sigma", &f.sigma))) return st;
+    if (f.type == PK_FILTER_MITCHELL && ((st = pb_float(&p->pd, "B", &f.b)) || (st = pb_float(&p->pd, "C", &f.c))))
+        return st;
+    if (f.type == PK_FILTER_LANCZOS && (st = pb_float(&p->pd, "tau", &f.tau))) return st;
+    warn_unused(p, "PixelFilter");
+    float *r[2] = {&f.radius_x, &f.radius_y};
+    for (int i = 0; i < 2; i++) {
+        if (!(*r[i] > 0.0f))
+            return pfail(p, p->line, PK_ERR_PARSE, "PixelFilter \"%s\": %s %g must be positive", type,
+                         i ? "yradius" : "xradius", (double)*r[i]);
+        if (*r[i] > PK_FILTER_MAX_RADIUS) {
+            pwarn(p, p->line, "PixelFilter \"%s\": %s %g is more than %g pixels; using %g", type,
+                  i ? "yradius" : "xradius", (double)*r[i], (double)PK_FILTER_MAX_RADIUS,
+                  (double)PK_FILTER_MAX_RADIUS);
+            *r[i] = PK_FILTER_MAX_RADIUS;
+        }
+    }
+    if (f.type == PK_FILTER_GAUSSIAN && !(f.sigma > 0.0f && isfinite(f.sigma)))
+        return pfail(p, p->line, PK_ERR_PARSE, "PixelFilter \"gaussian\": sigma %g must be positive", (double)f.sigma);
+    if (f.type == PK_FILTER_MITCHELL && !(fabsf(f.b) <= 16.0f && fabsf(f.c) <= 16.0f))
+        return pfail(p, p->line, PK_ERR_PARSE, "PixelFilter \"mitchell\": B %g and C %g must be in [-16, 16]",
+                     (double)f.b, (double)f.c);
+    if (f.type == PK_FILTER_LANCZOS && !(f.tau > 0.0f && f.tau <= 1024.0f))
+        return pfail(p, p->line, PK_ERR_PARSE, "PixelFilter \"sinc\": tau %g must be in (0, 1024]", (double)f.tau);
+    return scene_render_filter(p->ctx, p->s, &f);
+}
+
 static pk_status d_integrator(pp *p, const char *type)
 {
     static const char *const pathlike[] = {"path", "volpath", "bdpt", "mlt", "sppm", "lightpath", "simplepath",
@@ -3623,9 +3674,10 @@ static pk_status directive(pp *p, const pbrt_token *tk)
     case 4: return d_film(p, a);
     case 5: return d_sampler(p, a);
     case 6: return d_integrator(p, a);
+    case 7: return d_pixel_filter(p, a);
     default:
         pd_mark_all(&p->pd);
-        return PK_OK; /* Paprsek's pixel filter is a box; its accelerator its own */
+        return PK_OK; /* Paprsek's accelerator is its own */
     }
 }
 
@@ -3688,6 +3740,11 @@ pk_status scene_pbrt_parse(pk_context *ctx, pk_scene *s, const char *data, size_
     /* pbrt's defaults: the material "diffuse" 0.5 (material 0 is that grey),
      * 16 samples are the sampler's own (not set), depth 5 */
     if (st == PK_OK) st = scene_render_int(ctx, s, "max_depth", 5);
+    if (st == PK_OK) { /* and its pixel filter, when the file names none */
+        pk_filter gauss;
+        pk_filter_init(&gauss, PK_FILTER_GAUSSIAN);
+        st = scene_render_filter(ctx, s, &gauss);
+    }
     if (st == PK_OK) st = parse_file(p, data, size, name, dir, key);
     p->top.name = name, p->top.dir = dir;
     p->f = &p->top;

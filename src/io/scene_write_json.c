@@ -422,6 +422,30 @@ static pk_status write_render(jw *w)
         pk_status st = jw_floats(w, &o->clamp_indirect, 1, "render.clamp_indirect");
         if (st) return st;
     }
+    if (r->has_filter) {
+        const pk_filter *fl = &o->filter;
+        jw_key(w, &first, "filter");
+        fputs("{\"type\": ", w->f);
+        jw_string(w->f, pk_filter_name(fl->type));
+        fputs(", \"radius\": ", w->f);
+        const float rad[2] = {fl->radius_x, fl->radius_y};
+        pk_status st = jw_floats(w, rad, 2, "render.filter.radius");
+        const struct {
+            pk_filter_type type;
+            const char *key;
+            const float *v;
+        } params[] = {{PK_FILTER_GAUSSIAN, "sigma", &fl->sigma},
+                      {PK_FILTER_MITCHELL, "b", &fl->b},
+                      {PK_FILTER_MITCHELL, "c", &fl->c},
+                      {PK_FILTER_LANCZOS, "tau", &fl->tau}};
+        for (size_t i = 0; i < sizeof params / sizeof params[0] && st == PK_OK; i++)
+            if (params[i].type == fl->type) {
+                fprintf(w->f, ", \"%s\": ", params[i].key);
+                st = jw_floats(w, params[i].v, 1, "render.filter");
+            }
+        if (st) return st;
+        fputc('}', w->f);
+    }
     fputc('}', w->f);
     return PK_OK;
 }

@@ -2575,6 +2575,68 @@ static pk_status parse_emitter(xp *p, xnode *e)
 
 /* ---- sensor, film, sampler, integrator ------------------------------------------------------- */
 
+/* A film's <rfilter>: Mitsuba's filters (0.6 and 3 alike) and their
+ * parameters. gaussian: stddev (0.5), radius 4 stddev; box: radius 0.5;
+ * tent: radius 1; mitchell and catmullrom: B and C (1/3, 1/3 and 0, 0.5),
+ * radius 2; lanczos: lobes (3), the window sinc(x / lobes) over radius
+ * lobes. A radius property, where given, is taken as well. */
+static pk_status parse_rfilter(xp *p, xnode *rf)
+{
+    pk_status st = PK_OK;
+    const char *type = attr_st(p, rf, "type", &st);
+    if (st) return st;
+    if (!type) type = "";
+    pdict d;
+    if ((st = xml_props(p, rf, &d))) return st;
+    pk_filter f;
+    if (strcmp(type, "box") == 0) {
+        pk_filter_init(&f, PK_FILTER_BOX);
+    } else if (strcmp(type, "tent") == 0) {
+        pk_filter_init(&f, PK_FILTER_TRIANGLE);
+        f.radius_x = f.radius_y = 1.0f;
+    } else if (strcmp(type, "gaussian") == 0) {
+        pk_filter_init(&f, PK_FILTER_GAUSSIAN);
+        if ((st = get_float(p, &d, "stddev", &f.sigma))) return st;
+        if (!(f.sigma > 0.0f && f.sigma <= 0.25f * PK_FILTER_MAX_RADIUS))
+            return xfail(p, PK_ERR_PARSE, rf, "rfilter gaussian: stddev %g must be in (0, %g]", (double)f.sigma,
+                         0.25 * (double)PK_FILTER_MAX_RADIUS);
+        f.radius_x = f.radius_y = 4.0f * f.sigma;
+    } else if (strcmp(type, "mitchell") == 0 || strcmp(type, "catmullrom") == 0) {
+        pk_filter_init(&f, PK_FILTER_MITCHELL);
+        if (type[0] == 'c') {
+            f.b = 0.0f, f.c = 0.5f;
+        } else if ((st = get_float(p, &d, "b", &f.b)) || (st = get_float(p, &d, "c", &f.c))) {
+            return st;
+        }
+        if (!(fabsf(f.b) <= 16.0f && fabsf(f.c) <= 16.0f))
+            return xfail(p, PK_ERR_PARSE, rf, "rfilter mitchell: B %g and C %g must be in [-16, 16]", (double)f.b,
+                         (double)f.c);
+    } else if (strcmp(type, "lanczos") == 0) {
+        pk_filter_init(&f, PK_FILTER_LANCZOS);
+        int64_t lobes = 3;
+        bool found;
+        if ((st = get_int(p, &d, "lobes", &lobes, &found))) return st;
+        if (lobes < 1 || lobes > (int64_t)PK_FILTER_MAX_RADIUS)
+            return xfail(p, PK_ERR_PARSE, rf, "rfilter lanczos: lobes %lld must be in 1..%d", (long long)lobes,
+                         (int)PK_FILTER_MAX_RADIUS);
+        f.radius_x = f.radius_y = f.tau = (float)lobes;
+    } else {
+        props_all_read(&d);
+        xwarn(p, rf, "rfilter \"%s\" is not supported; using \"gaussian\"", type);
+        return PK_OK;
+    }
+    float r = -1.0f;
+    if ((st = get_float(p, &d, "radius", &r))) return st;
+    if (r != -1.0f) {
+        if (!(r > 0.0f && r <= PK_FILTER_MAX_RADIUS))
+            return xfail(p, PK_ERR_PARSE, rf, "rfilter %s: radius %g must be in (0, %g]", type, (double)r,
+                         (double)PK_FILTER_MAX_RADIUS);
+        f.radius_x = f.radius_y = r;
+    }
+    warn_unused(&d, "rfilter", NULL);
+    return scene_render_filter(p->ctx, p->s, &f);
+}
+
 static pk_status parse_film(xp *p, xnode *f)
 {
     pk_status st;
@@ -2597,6 +2659,8 @@ static pk_status parse_film(xp *p, xnode *f)
     xnode *crop = prop(&d, "crop_width");
     if (crop) xwarn(p, crop, "film: crop windows are not supported; the whole image is rendered");
     prop(&d, "crop_height"), prop(&d, "crop_offset_x"), prop(&d, "crop_offset_y");
+    for (xnode *c = f->child; c; c = c->next)
+        if (strcmp(c->tag, "rfilter") == 0 && (st = parse_rfilter(p, c))) return st;
     static const char *const quiet[] = {"file_format", "pixel_format", "component_format", "banner", "gamma",
                                         "high_quality_edges", "attach_log", "exposure", "tonemap_method",
                                         "rfilter", "label", "key", "burn", NULL};
@@ -2968,7 +3032,12 @@ pk_status scene_xml_parse(pk_context *ctx, pk_scene *s, const char *data, size_t
             if (strcmp(root->attrs[i].name, "version") == 0) version = root->attrs[i].value;
         if (!version) xwarn(p, root, "<scene> has no version; read as Mitsuba 3");
         p->version_major = version ? atoi(version) : 3;
-        st = parse_scene(p, root, 0);
+        /* the film's pixel filter when it names none: Mitsuba's gaussian */
+        pk_filter gauss;
+        pk_filter_init(&gauss, PK_FILTER_GAUSSIAN);
+        gauss.radius_x = gauss.radius_y = 4.0f * gauss.sigma;
+        st = scene_render_filter(ctx, s, &gauss);
+        if (st == PK_OK) st = parse_scene(p, root, 0);
     }
     if (st == PK_OK) st = finish_camera(p);
     arena_free(p);

@@ -28,11 +28,15 @@ typedef struct camera_frame {
 } camera_frame;
 
 /* Where a camera sample lies: film_x, film_y in pixels ((0, 0) the top-left
- * corner of the image, pixel (px, py) covers px..px+1, py..py+1), and
- * lens_u, lens_v in [0, 1)^2 on the lens (unused without one). */
+ * corner of the image, pixel (px, py) covers px..px+1, py..py+1; with a
+ * pixel filter wider than the pixel a sample may lie outside it), and
+ * lens_u, lens_v in [0, 1)^2 on the lens (unused without one); weight: what
+ * its radiance is multiplied by in its pixel's sum (the pixel filter's,
+ * filter.h: 1 but for filters with negative lobes). */
 typedef struct camera_sample {
     float film_x, film_y;
     float lens_u, lens_v;
+    float weight;
 } camera_sample;
 
 /* Whether the camera of f has a lens: its camera samples then use the

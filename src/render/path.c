@@ -24,10 +24,11 @@ pk_status path_init(pk_context *ctx, path_tracer *pt, const frame *f, const pk_r
     pt->energy = opt->energy_compensation;
     pt->clamp_indirect = opt->clamp_indirect > 0.0f && isfinite(opt->clamp_indirect) ? opt->clamp_indirect : 0.0f;
     pt->seed = (uint32_t)opt->seed;
+    const pk_status st = filter_build(ctx, &opt->filter, &pt->filter);
+    if (st != PK_OK) return st;
     pt->lights = f->lights;
     const size_t placed = f->lights.tree ? (f->lights.ntree + 1) / 2 : 0;
     pt->lights.use_tree = f->lights.tree && (opt->light_tree == 1 || (opt->light_tree < 0 && placed >= LIGHT_TREE_MIN));
-    (void)ctx;
     return PK_OK;
 }
 

@@ -9,6 +9,7 @@
 #define PK_PATH_H
 
 #include "camera.h"
+#include "filter.h"
 #include "frame.h"
 #include "sampler.h"
 
@@ -32,6 +33,7 @@ typedef struct path_tracer {
     int regularize;      /* pk_render_options.regularize */
     float clamp_indirect; /* pk_render_options.clamp_indirect (0: off) */
     int energy;          /* pk_render_options.energy_compensation */
+    pixel_filter filter;  /* pk_render_options.filter: where camera samples lie, their weights */
     const void *gpu_nodes, *gpu_tris;  /* in the GPU's copy only: the device BVH (bvh_gpu.h) */
 } path_tracer;
 

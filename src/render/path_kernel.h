@@ -387,14 +387,16 @@ static inline PK_HD bool path_step(const path_tracer *pt, path_thread *t, path_s
 /* ---- camera samples -------------------------------------------------------------- */
 
 /* Where sample index of pixel (px, py) lies: the sampler's film dimensions
- * place it in the pixel, its lens dimensions on the lens (when the camera
- * has one). */
+ * place it about the pixel by the pixel filter (filter.h; the box of radius
+ * 0.5: in the pixel, uniformly), its lens dimensions on the lens (when the
+ * camera has one). */
 static inline PK_HD camera_sample path_camera_place(const path_tracer *pt, int px, int py, uint32_t index)
 {
     sampler sm = sampler_start((uint32_t)px, (uint32_t)py, index, pt->seed);
-    float jx, jy;
+    float jx, jy, ox, oy, w;
     sampler_2d(&sm, &jx, &jy); /* SAMPLER_DIM_FILM */
-    camera_sample cs = {(float)px + jx, (float)py + jy, 0.5f, 0.5f};
+    filter_sample(&pt->filter, jx, jy, &ox, &oy, &w);
+    camera_sample cs = {(float)px + ox, (float)py + oy, 0.5f, 0.5f, w};
     if (pt->lens) sampler_2d(&sm, &cs.lens_u, &cs.lens_v); /* SAMPLER_DIM_LENS */
     return cs;
 }

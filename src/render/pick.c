@@ -22,7 +22,7 @@ pk_status renderer_pick(const pk_renderer *r, const pk_camera *cam_in, double x,
     if (camera_check(&cam) != CAMERA_OK) return PK_ERR_INVALID_ARGUMENT;
     cam.lens_radius = 0.0f; /* the ray through the lens's centre: the one every lens sample focuses on */
     const camera_frame cf = camera_setup(&cam, o->width, o->height);
-    const camera_sample cs = {(float)x, (float)y, 0.5f, 0.5f};
+    const camera_sample cs = {(float)x, (float)y, 0.5f, 0.5f, 1.0f};
     ray ry = camera_ray(&cf, &cs);
     const frame *fr = renderer_frame(r);
     hit h;

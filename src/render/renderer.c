@@ -272,12 +272,14 @@ static pk_status check_regions(pk_context *ctx, const pk_region *reg, size_t n, 
 }
 
 /* The camera ray of sample smp (0..spp-1 of the current pass) of pixel
- * (px, py), placed on the film by the integrator. */
-static inline ray sample_camera_ray(const pk_renderer *r, const camera_frame *cf, int px, int py, int smp)
+ * (px, py), placed on the film by the integrator; *w its weight in the
+ * pixel (the pixel filter's). */
+static inline ray sample_camera_ray(const pk_renderer *r, const camera_frame *cf, int px, int py, int smp, float *w)
 {
     const int spp = r->opt.spp;
     const uint64_t index = (uint64_t)r->pass * (uint64_t)spp + (uint64_t)smp;
     const camera_sample cs = r->ig->camera_sample(r->self, px, py, index, smp, spp);
+    *w = cs.weight;
     return camera_ray(cf, &cs);
 }
 
@@ -305,12 +307,14 @@ static bool render_tile(const pk_renderer *r, int tid, const camera_frame *cf, c
     const bool want_aov = (aov_mask & (PK_AOV_ALBEDO | PK_AOV_NORMAL | PK_AOV_DEPTH)) != 0;
     ray rays[BATCH];
     hit hits[BATCH];
+    float wts[BATCH];
     memset(acc, 0, sizeof(float) * 3 * (size_t)n);
     if (aov_mask) memset(aovs, 0, sizeof(float) * FILM_AOVS * BATCH * 3);
     for (int smp = 0; smp < spp; smp++) {
         /* also between samples: a tile at many samples may take long */
         if (smp > 0 && ((cancel && *cancel) || atomic_load_explicit(stop, memory_order_relaxed))) return false;
-        for (int i = 0; i < n; i++) rays[i] = sample_camera_ray(r, cf, tl->x + i % tw, tl->y + i / tw, smp);
+        for (int i = 0; i < n; i++)
+            rays[i] = sample_camera_ray(r, cf, tl->x + i % tw, tl->y + i / tw, smp, &wts[i]);
         wk->rays_camera += (uint64_t)n;
         accel_intersect_many(r->fr.a, rays, hits, (size_t)n, false, wk->cp);
         for (int i = 0; i < n; i++) {
@@ -324,16 +328,18 @@ static bool render_tile(const pk_renderer *r, int tid, const camera_frame *cf, c
             }
             const bool kept = r->ig->sample(r->self, ts, px, py, first + (uint64_t)smp, &rays[i],
                                             hits[i].prim == PK_NO_HIT ? NULL : &hits[i], &c, want_aov ? &av : NULL);
+            /* weighted by the pixel filter (1 but where a filter with negative lobes is negative) */
+            const float w = wts[i];
             if (want_aov) {
                 const float *v[3] = {&av.albedo.x, &av.normal.x, NULL};
                 for (int k = 0; k < 2; k++)
-                    for (int j = 0; j < 3; j++) aovs[k][3 * i + j] += v[k][j];
-                for (int j = 0; j < 3; j++) aovs[2][3 * i + j] += av.depth;
+                    for (int j = 0; j < 3; j++) aovs[k][3 * i + j] += w * v[k][j];
+                for (int j = 0; j < 3; j++) aovs[2][3 * i + j] += w * av.depth;
             }
             if (!kept) continue; /* a lost sample, not a poisoned pixel */
-            acc[3 * i] += c.x;
-            acc[3 * i + 1] += c.y;
-            acc[3 * i + 2] += c.z;
+            acc[3 * i] += w * c.x;
+            acc[3 * i + 1] += w * c.y;
+            acc[3 * i + 2] += w * c.z;
         }
     }
     return true;
@@ -363,7 +369,8 @@ static void render_tile_aovs_cpu(const pk_renderer *r, const camera_frame *cf, c
     const float spread = cf->spread, cone0 = cf->cone0;
     for (int smp = 0; smp < r->opt.spp; smp++)
         for (int i = 0; i < n; i++) {
-            ray cr = sample_camera_ray(r, cf, tl->x + i % tw, tl->y + i / tw, smp);
+            float w;
+            ray cr = sample_camera_ray(r, cf, tl->x + i % tw, tl->y + i / tw, smp, &w);
             accel_counters c = {0, 0};
             hit h;
             const bool got = r->fr.a->ops->intersect(r->fr.a, &cr, &h, (film->aovs & PK_AOV_HEATMAP) ? &c : NULL);
@@ -377,9 +384,9 @@ static void render_tile_aovs_cpu(const pk_renderer *r, const camera_frame *cf, c
                 sf = surface_texture(s, &cr, &h, cone0 + spread * h.t * v3_len(cr.d), sf, &textured);
             aov_sample av;
             aov_from_surface(&sf, &cr, &h, &av);
-            a[0] += av.albedo.x, a[1] += av.albedo.y, a[2] += av.albedo.z;
-            nn[0] += av.normal.x, nn[1] += av.normal.y, nn[2] += av.normal.z;
-            d[0] += av.depth, d[1] += av.depth, d[2] += av.depth;
+            a[0] += w * av.albedo.x, a[1] += w * av.albedo.y, a[2] += w * av.albedo.z;
+            nn[0] += w * av.normal.x, nn[1] += w * av.normal.y, nn[2] += w * av.normal.z;
+            d[0] += w * av.depth, d[1] += w * av.depth, d[2] += w * av.depth;
         }
     film_add_aovs(film, tl, v);
 }

@@ -166,16 +166,19 @@ pk_status wavefront_render(wavefront *w, const camera_frame *cf, const gpu_tile 
             const wf_sample *o = &w->p.out[k - c0];
             if (samples) samples[k] = *o;
             const size_t i = slot[k % npix];
+            /* the pixel filter's weight, as the loop's (path_camera_place: 1 but in negative lobes) */
+            const float wt =
+                path_camera_place(w->pt, px[k % npix], py[k % npix], (uint32_t)(first + k / npix)).weight;
             if (aov) {
                 float *a = &aov[3 * i], *nn = &aov[slots * 3 + 3 * i], *d = &aov[slots * 6 + 3 * i];
-                a[0] += o->aov.albedo.x, a[1] += o->aov.albedo.y, a[2] += o->aov.albedo.z;
-                nn[0] += o->aov.normal.x, nn[1] += o->aov.normal.y, nn[2] += o->aov.normal.z;
-                d[0] += o->aov.depth, d[1] += o->aov.depth, d[2] += o->aov.depth;
+                a[0] += wt * o->aov.albedo.x, a[1] += wt * o->aov.albedo.y, a[2] += wt * o->aov.albedo.z;
+                nn[0] += wt * o->aov.normal.x, nn[1] += wt * o->aov.normal.y, nn[2] += wt * o->aov.normal.z;
+                d[0] += wt * o->aov.depth, d[1] += wt * o->aov.depth, d[2] += wt * o->aov.depth;
             }
             if (!o->kept) continue;
-            acc[3 * i] += o->L.x;
-            acc[3 * i + 1] += o->L.y;
-            acc[3 * i + 2] += o->L.z;
+            acc[3 * i] += wt * o->L.x;
+            acc[3 * i + 1] += wt * o->L.y;
+            acc[3 * i + 2] += wt * o->L.z;
         }
     }
     if (rays)

@@ -224,6 +224,8 @@ static pk_status ig_init(pk_context *ctx, void *self, const frame *f, const pk_r
     whitted *w = self;
     *w = (whitted){.f = f, .light_samples = opt->light_samples, .max_depth = pk_render_options_max_depth(opt),
                    .fresnel = opt->fresnel != 0};
+    const pk_status st = filter_build(ctx, &opt->filter, &w->filter);
+    if (st != PK_OK) return st;
     const light_set *set = &f->lights;
     if (set->n == 0) return PK_OK;
     w->sampled = mem_realloc_array(&ctx->alloc, NULL, set->n, sizeof *w->sampled);
@@ -268,19 +270,25 @@ static void ig_set_camera(void *self, const camera_frame *cf)
     w->lens = camera_has_lens(cf);
 }
 
-/* Through the pixel centre at 1 sample per pixel, above that jittered in
- * sx x sy strata of the pixel (a PCG stream seeded by pixel and sample);
- * on the lens, when the camera has one, uniform from the same stream. */
+/* Through the pixel centre at 1 sample per pixel (weight 1, whatever the
+ * filter), above that jittered in sx x sy strata of [0, 1)^2 (a PCG stream
+ * seeded by pixel and sample), which the pixel filter maps about the pixel
+ * (the box of radius 0.5: the strata of the pixel); on the lens, when the
+ * camera has one, uniform from the same stream. */
 static camera_sample ig_camera_sample(const void *self, int px, int py, uint64_t index, int smp, int spp)
 {
     const whitted *w = self;
-    camera_sample cs = {(float)px + 0.5f, (float)py + 0.5f, 0.5f, 0.5f};
+    camera_sample cs = {(float)px + 0.5f, (float)py + 0.5f, 0.5f, 0.5f, 1.0f};
     if (spp <= 1 && !w->lens) return cs; /* the pixel centre: no stream to seed */
     rng jr = rng_seed(((uint64_t)py << 32) | (uint32_t)px, index * 2 + 1);
     if (spp > 1) {
         const int sx = (int)ceilf(sqrtf((float)spp)), sy = (spp + sx - 1) / sx;
-        cs.film_x = (float)px + ((float)(smp % sx) + rng_float(&jr)) / (float)sx;
-        cs.film_y = (float)py + ((float)(smp / sx) + rng_float(&jr)) / (float)sy;
+        const float u = ((float)(smp % sx) + rng_float(&jr)) / (float)sx;
+        const float v = ((float)(smp / sx) + rng_float(&jr)) / (float)sy;
+        float ox, oy;
+        filter_sample(&w->filter, u, v, &ox, &oy, &cs.weight);
+        cs.film_x = (float)px + ox;
+        cs.film_y = (float)py + oy;
     }
     if (w->lens) {
         cs.lens_u = rng_float(&jr);

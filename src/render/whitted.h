@@ -7,6 +7,7 @@
 #ifndef PK_WHITTED_H
 #define PK_WHITTED_H
 
+#include "filter.h"
 #include "frame.h"
 #include "integrator.h"
 #include "sampling.h"
@@ -29,6 +30,7 @@ typedef struct whitted {
     float spread;        /* ray cone spread angle: the camera's pixel angle (textures) */
     float cone0;         /* the ray cone's width where camera rays start (camera_frame) */
     bool lens;           /* the camera has a lens (camera_has_lens) */
+    pixel_filter filter; /* pk_render_options.filter (above 1 sample per pixel) */
     /* The lights it samples: those of the frame's light set that are not
      * point lights or the sun (each gets a shadow ray of its own) or
      * emissive spheres (not lights for this integrator), with the set's

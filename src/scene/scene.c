@@ -460,6 +460,14 @@ pk_status scene_render_clamp(pk_context *ctx, pk_scene *s, float clamp_indirect)
     return PK_OK;
 }
 
+pk_status scene_render_filter(pk_context *ctx, pk_scene *s, const pk_filter *f)
+{
+    const pk_status st = options_check_filter(ctx, f);
+    if (st != PK_OK) return st;
+    s->render.opt.filter = *f, s->render.has_filter = true;
+    return PK_OK;
+}
+
 void scene_scale_emission(pk_scene *s, float k)
 {
     for (size_t i = 0; i < s->nmaterials; i++) s->materials[i].ke = v3_scale(s->materials[i].ke, k);

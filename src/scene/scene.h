@@ -148,7 +148,7 @@ typedef struct scene_render_settings {
     pk_render_options opt;
     bool has_width, has_height, has_spp, has_light_samples, has_max_depth, has_threads,
         has_accel, has_fresnel, has_seed, has_integrator, has_regularize, has_light_tree, has_clamp_indirect,
-        has_energy_compensation;
+        has_energy_compensation, has_filter;
 } scene_render_settings;
 
 /* Invariants (scene_check tests them after commit):
@@ -328,6 +328,8 @@ PK_HIDDEN void scene_render_fresnel(pk_scene *s, bool on);
 /* Energy compensation of rough microfacet lobes on or off (pk_render_options.energy_compensation). */
 PK_HIDDEN void scene_render_energy_compensation(pk_scene *s, bool on);
 PK_HIDDEN pk_status scene_render_clamp(pk_context *ctx, pk_scene *s, float clamp_indirect);
+/* The pixel filter (options_check_filter's refusals, latched). */
+PK_HIDDEN pk_status scene_render_filter(pk_context *ctx, pk_scene *s, const pk_filter *f);
 /* Adds a material initialised like MTL's defaults (kd 0.8, ks 0, ns 1, ni 1, d 1,
  * illum 2) named name; *index receives its number. A later material of the same
  * name replaces the earlier one for scene_find_material. */

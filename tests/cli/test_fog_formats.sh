@@ -3,6 +3,7 @@
 # pbrt-v4's (fog.pbrt) renders to the very image of its JSON version
 # (fog.json), float for float: the same media (fog, milk in a glass sphere,
 # a smoke grid inside an index-matched box), surfaces, camera and settings
+# (the pixel filter too: each file names its format's lanczos of radius 3)
 # make the same samples.
 # usage: test_fog_formats.sh PAPRSEK SHARED_DIR DATA_DIR
 set -u

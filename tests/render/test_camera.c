@@ -173,7 +173,7 @@ static void test_rays(void)
         CHECK(f.spread == 2.0f * f.half_h / (float)f.height && f.cone0 == 0.0f && !camera_has_lens(&f));
         for (int i = 0; i < 256; i++) {
             const camera_sample cs = {rng_float(&r) * (float)f.width, rng_float(&r) * (float)f.height,
-                                      rng_float(&r), rng_float(&r)};
+                                      rng_float(&r), rng_float(&r), 1.0f};
             const ray a = camera_ray(&f, &cs), b = old_pinhole(&f, &cs);
             if (memcmp(&a.o, &b.o, sizeof a.o) || memcmp(&a.d, &b.d, sizeof a.d) || a.tmin != b.tmin ||
                 a.tmax != b.tmax)
@@ -191,7 +191,7 @@ static void test_rays(void)
     CHECK(camera_has_lens(&f) && f.focus == 4.0f);
     double worst_focus = 0.0, worst_lens = 0.0;
     for (int i = 0; i < 1000; i++) {
-        const camera_sample cs = {rng_float(&r) * 64, rng_float(&r) * 48, rng_float(&r), rng_float(&r)};
+        const camera_sample cs = {rng_float(&r) * 64, rng_float(&r) * 48, rng_float(&r), rng_float(&r), 1.0f};
         const ray a = camera_ray(&f, &cs), b = old_pinhole(&f, &cs);
         const vec3 off = v3_sub(a.o, f.origin);
         worst_lens = fmax(worst_lens, fabs((double)v3_dot(off, f.w)));
@@ -217,7 +217,7 @@ static void test_rays(void)
     o.ortho_width = 3.0f;
     f = camera_setup(&o, 60, 20);
     CHECK(f.ortho && f.half_w == 1.5f && f.half_h == 0.5f && f.spread == 0.0f && f.cone0 == 3.0f / 60.0f);
-    const camera_sample corners[3] = {{0, 0, 0.5f, 0.5f}, {60, 20, 0.1f, 0.9f}, {30, 10, 0.5f, 0.5f}};
+    const camera_sample corners[3] = {{0, 0, 0.5f, 0.5f, 1.0f}, {60, 20, 0.1f, 0.9f, 1.0f}, {30, 10, 0.5f, 0.5f, 1.0f}};
     const float want[3][2] = {{-1.5f, 0.5f}, {1.5f, -0.5f}, {0.0f, 0.0f}};
     for (int k = 0; k < 3; k++) {
         const ray a = camera_ray(&f, &corners[k]);

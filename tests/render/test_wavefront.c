@@ -6,7 +6,8 @@
  * tiles add them, bit for bit. Each scene at pool sizes smaller than, equal
  * to and larger than its pixel count, at 1 and 2 threads.
  *
- * Scenes: the built-in Cornell box; tests/data's textured scene (texture
+ * Scenes: the built-in Cornell box (also with the mitchell pixel filter,
+ * whose negative lobes weight samples); tests/data's textured scene (texture
  * maps, map_d holes, bump and normal maps), its JSON scene (mirror and
  * glass spheres, point lights) and its room (a glossy and a mirror
  * material); CornellBox-Sphere and -Original of ../shared when present.
@@ -29,6 +30,7 @@
 #include <time.h>
 
 static pk_context *ctx;
+static const pk_filter *case_filter; /* the pixel filter of the next setup_init (NULL: the default box) */
 
 /* What the renderer would render: frame, path tracer, camera. */
 typedef struct setup {
@@ -48,6 +50,7 @@ static void setup_init(setup *su, const pk_scene *s, int width, int height, floa
     o.seed = 7;
     o.clamp_indirect = clamp;
     o.regularize = regularize;
+    if (case_filter) o.filter = *case_filter;
     REQUIRE(integrator_path.init(ctx, &su->pt, &su->f, &o) == PK_OK);
     pk_camera cam;
     pk_scene_get_camera(s, &cam);
@@ -72,10 +75,12 @@ static size_t make_tiles(int width, int height, gpu_tile *tiles)
     return n;
 }
 
-/* Sample index of pixel (px, py) by the loop, as the renderer takes it. */
-static bool loop_sample(const setup *su, void *ts, int px, int py, uint64_t index, vec3 *L, aov_sample *aov)
+/* Sample index of pixel (px, py) by the loop, as the renderer takes it;
+ * *w its pixel filter weight. */
+static bool loop_sample(const setup *su, void *ts, int px, int py, uint64_t index, vec3 *L, aov_sample *aov, float *w)
 {
     const camera_sample cs = integrator_path.camera_sample(&su->pt, px, py, index, 0, 1);
+    *w = cs.weight;
     const ray r = camera_ray(&su->cf, &cs);
     hit h;
     const bool got = su->f.a->ops->intersect(su->f.a, &r, &h, NULL);
@@ -106,18 +111,19 @@ static void compare(const char *name, const setup *su, uint64_t first, int spp)
             for (int i = 0; i < tiles[j].w * tiles[j].h; i++, q++) {
                 const int px = tiles[j].x + i % tiles[j].w, py = tiles[j].y + i / tiles[j].w;
                 wf_sample *o = &ref[(size_t)s * npix + q];
-                o->kept = loop_sample(su, &ts, px, py, first + (uint64_t)s, &o->L, &o->aov);
+                float wt;
+                o->kept = loop_sample(su, &ts, px, py, first + (uint64_t)s, &o->L, &o->aov, &wt);
                 const size_t k = j * 256 + (size_t)i;
                 float *a = &ref_aov[3 * k], *nn = &ref_aov[slots * 3 + 3 * k], *d = &ref_aov[slots * 6 + 3 * k];
-                a[0] += o->aov.albedo.x, a[1] += o->aov.albedo.y, a[2] += o->aov.albedo.z;
-                nn[0] += o->aov.normal.x, nn[1] += o->aov.normal.y, nn[2] += o->aov.normal.z;
-                d[0] += o->aov.depth, d[1] += o->aov.depth, d[2] += o->aov.depth;
+                a[0] += wt * o->aov.albedo.x, a[1] += wt * o->aov.albedo.y, a[2] += wt * o->aov.albedo.z;
+                nn[0] += wt * o->aov.normal.x, nn[1] += wt * o->aov.normal.y, nn[2] += wt * o->aov.normal.z;
+                d[0] += wt * o->aov.depth, d[1] += wt * o->aov.depth, d[2] += wt * o->aov.depth;
                 if (!o->kept) {
                     lost++;
                     o->L = v3s(0.0f);
                     continue;
                 }
-                ref_acc[3 * k] += o->L.x, ref_acc[3 * k + 1] += o->L.y, ref_acc[3 * k + 2] += o->L.z;
+                ref_acc[3 * k] += wt * o->L.x, ref_acc[3 * k + 1] += wt * o->L.y, ref_acc[3 * k + 2] += wt * o->L.z;
             }
     }
 
@@ -280,6 +286,12 @@ int main(int argc, char **argv)
     REQUIRE(pk_scene_create_cornell_box(ctx, &s) == PK_OK);
     scene_case("built-in Cornell box", s, 40, 36, 3, 0.0f, 0);
     scene_case("built-in Cornell box, clamped and regularised", s, 24, 20, 2, 0.5f, 1);
+    /* a pixel filter with negative lobes: weighted sums, the same placement */
+    pk_filter mitchell;
+    pk_filter_init(&mitchell, PK_FILTER_MITCHELL);
+    case_filter = &mitchell;
+    scene_case("built-in Cornell box, mitchell filter", s, 24, 20, 2, 0.0f, 0);
+    case_filter = NULL;
     pk_scene_destroy(s);
 
     const char *data[] = {"tex_scene.obj", "json_example.json", "mpi_room.obj"};

@@ -85,7 +85,8 @@ static __device__ __forceinline__ void path_render(const path_tracer *__restrict
             const bool got = path_gpu_trace(pt, &r, &h, false);
             t.rays_camera++;
             vec3 c;
-            if (path_camera_sample(pt, &t, px, py, index, &r, got ? &h : NULL, &c)) sum = v3_add(sum, c);
+            if (path_camera_sample(pt, &t, px, py, index, &r, got ? &h : NULL, &c))
+                sum = v3_add(sum, v3_scale(c, cs.weight)); /* the pixel filter's weight (1 but in negative lobes) */
         }
     }
     float *a = &acc[3 * (size_t)i];
