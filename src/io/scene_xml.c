@@ -1368,7 +1368,7 @@ static pk_status bsdf_diffuse(xp *p, const bsdf_in *in, material *m)
     if (in->type[0] == 'r') { /* Oren-Nayar: alpha (default 0.2) is the facets' RMS slope, sigma = alpha / sqrt(2) */
         float alpha = 0.2f;
         bool fast = false;
-        if ((st = get_scalar(p, in->d, "alpha", &alpha)) || (st = get_bool(p, in->d, "useFastApprox", &fast)))
+        if ((st = get_scalar(p, in->d, "alpha", &alpha)) || (st = get_bool(p, in->d, "use_fast_approx", &fast)))
             return st;
         material_rough_diffuse(m, clamp01v(r), alpha);
         return PK_OK;
@@ -1455,7 +1455,7 @@ static pk_status bsdf_mixture(xp *p, const bsdf_in *in, material *m)
     xnode *at = NULL;
     bool ensure = true;
     pk_status st;
-    if ((st = get_string(p, in->d, "weights", &ws, &at)) || (st = get_bool(p, in->d, "ensureEnergyConservation", &ensure)))
+    if ((st = get_string(p, in->d, "weights", &ws, &at)) || (st = get_bool(p, in->d, "ensure_energy_conservation", &ensure)))
         return st;
     float w[XML_MIXTURE_MAX + 1];
     int nw = 0;
