@@ -27,7 +27,8 @@ convert_same "$bin" "$tmp" \
   "$data/conformance/box_mr.json" "$data/conformance/box_nomtl.obj" "$data/pbrt/include_main.pbrt" \
   "$data/fuzz_seed_full.json" "$data/fuzz_seed_full.xml" "$data/tex_scene.obj" "$data/obj_mat.obj" \
   "$data/convert/lights.xml" "$data/convert/lights.pbrt" "$data/convert/lights.json" "$data/convert/spot.gltf" \
-  "$data/../../bench/scenes/materials.json" "$data/../../bench/scenes/materials.xml" || fail=1
+  "$data/../../bench/scenes/materials.json" "$data/../../bench/scenes/materials.xml" \
+  "$data/sheets/box.pbrt" "$data/sheets/box.xml" "$data/sheets/box.json" || fail=1
 
 # names: a material named as the default one, and two of one name (renamed NAME#N)
 printf '{"materials": [{"name": "default", "kd": [0.9, 0.1, 0.1]}, {"name": "twice", "kd": [0.1, 0.9, 0.1]},
