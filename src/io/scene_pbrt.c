@@ -667,8 +667,7 @@ static pk_status build_material(pp *p, const char *type, material *m, bool *inte
             return st;
         /* pbrt-v4 clamps scale * reflectance and scale * transmittance to 0..1 */
         const vec3 r = v3_scale(kd, sc), t = v3_scale(tr, sc);
-        material_diffuse_transmission(m, v3(fminf(fmaxf(r.x, 0.0f), 1.0f), fminf(fmaxf(r.y, 0.0f), 1.0f), fminf(fmaxf(r.z, 0.0f), 1.0f)),
-                                      v3(fminf(fmaxf(t.x, 0.0f), 1.0f), fminf(fmaxf(t.y, 0.0f), 1.0f), fminf(fmaxf(t.z, 0.0f), 1.0f)));
+        material_diffuse_transmission(m, v3_min(v3_max(r, v3s(0.0f)), v3s(1.0f)), v3_min(v3_max(t, v3s(0.0f)), v3s(1.0f)));
         m->map_kd = tkd;
     } else if (strcmp(type, "mix") == 0) {
         pparam *q;
