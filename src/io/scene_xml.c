@@ -1205,6 +1205,10 @@ static pk_status bsdf_bump(xp *p, const bsdf_in *in, material *m)
         return PK_OK;
     }
     if ((st = bsdf_resolve(p, inner, m))) return st;
+    if (m->type == MAT_MIX) { /* each hit shades one of the mix's materials, which have no bump map */
+        xwarn(p, b, "bsdf \"%s\" over a mix of bsdfs is not supported; the mix is not bumped", ty);
+        return PK_OK;
+    }
     /* the height: the first texture child (or a reference to one), through scale textures */
     xnode *t = NULL;
     for (xnode *c = b->child; c && !t; c = c->next) {
@@ -1312,6 +1316,10 @@ static pk_status bsdf_mask(xp *p, const bsdf_in *in, material *m)
     if (st) return st;
     if (inner && (st = bsdf_resolve(p, inner, m))) return st;
     if (!inner) material_diffuse(m, v3s(0.5f));
+    if (m->type == MAT_MIX) { /* each hit shades one of the mix's materials, which have no mask */
+        xwarn(p, in->b, "bsdf \"mask\" over a mix of bsdfs is not supported; the mix is opaque");
+        return PK_OK;
+    }
     if (m->type != MAT_DIELECTRIC) m->d = clamp01(opacity);
     return PK_OK;
 }

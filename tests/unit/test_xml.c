@@ -580,6 +580,8 @@ static void test_bsdfs(void)
                   bs->materials[m2->mix_b].type == MAT_DIFFUSE && near3(bs->materials[m2->mix_b].kd, v3s(0.0f), 0));
         }
         pk_scene_destroy(bs);
+        m = bsdf("<bsdf type=\"mask\"><bsdf type=\"blendbsdf\"><bsdf type=\"plastic\"/><bsdf type=\"diffuse\"/></bsdf></bsdf>");
+        CHECK(m.type == MAT_MIX && m.d == 1.0f && warned("bsdf \"mask\" over a mix of bsdfs is not supported"));
         m = bsdf("<bsdf type=\"blendbsdf\"><bsdf type=\"plastic\"/></bsdf>");
         CHECK(m.type == MAT_PLASTIC && warned("scene.xml:3: bsdf \"blendbsdf\" needs two nested bsdfs, not 1"));
         load_fails("<shape type=\"rectangle\"><bsdf type=\"mixturebsdf\"><string name=\"weights\" value=\"0.5\"/>"
