@@ -137,6 +137,74 @@ static pk_status create_metallic_roughness(pdict *d, const mat_row *row, const m
     return PK_OK;
 }
 
+static pk_status create_thin_dielectric(pdict *d, const mat_row *row, const mat_common *c, material *m)
+{
+    (void)d, (void)row;
+    material_thin_dielectric(m, c->ior, c->transmittance);
+    return PK_OK;
+}
+
+/* pbrt-v4's defaults: reflectance and transmittance 0.25 */
+static pk_status create_diffuse_transmission(pdict *d, const mat_row *row, const mat_common *c, material *m)
+{
+    const vec3 r = param(d, row, "albedo") ? c->albedo : v3s(0.25f);
+    const vec3 t = param(d, row, "transmittance") ? c->transmittance : v3s(0.25f);
+    material_diffuse_transmission(m, r, t);
+    return PK_OK;
+}
+
+/* Oren-Nayar: "alpha" as Mitsuba's roughdiffuse (0.2 by default) */
+static pk_status create_rough_diffuse(pdict *d, const mat_row *row, const mat_common *c, material *m)
+{
+    material_rough_diffuse(m, c->albedo, param(d, row, "alpha") ? c->alpha : 0.2f);
+    return PK_OK;
+}
+
+/* Mitsuba's phong and its defaults: albedo (diffuse) 0.5, specular 0.2, exponent 30 */
+static pk_status create_phong(pdict *d, const mat_row *row, const mat_common *c, material *m)
+{
+    vec3 ks = v3s(0.2f);
+    float n = 30.0f;
+    const pd_entry *spec = param(d, row, "specular");
+    pk_status st;
+    if (c->tex_specular.x >= 0.0f) ks = c->tex_specular;
+    else if (spec && (st = pd_vec3(d, "specular", ks, PD_V_REFLECTANCE, &ks))) return st;
+    if ((st = pd_float(d, "exponent", n, PD_NONNEG, &n))) return st;
+    material_phong(m, c->albedo, ks, n);
+    return PK_OK;
+}
+
+/* mix: "materials", two names of materials defined before it, and
+ * "amount" (0.5 by default), the probability of the second: a number in
+ * 0..1 or a texture */
+static pk_status create_mix(pdict *d, const mat_row *row, const mat_common *c, material *m)
+{
+    (void)c;
+    const pd_entry *e = param(d, row, "materials"), *am = param(d, row, "amount");
+    if (!e) return pd_fail(d, NULL, -1, PK_ERR_PARSE, "a mix needs \"materials\": the names of two materials");
+    if (!d->src || !d->src->material)
+        return pd_fail(d, e, -1, PK_ERR_PARSE, "a mix names materials of a scene file, which are not at hand here");
+    if (e->kind != PD_OTHER && e->kind != PD_NUMBERS)
+        return pd_fail(d, e, -1, PK_ERR_PARSE, "must be a list of two material names");
+    uint32_t ab[2];
+    pk_status st;
+    for (long k = 0; k < 2; k++)
+        if ((st = d->src->material(d->self, d, e, k, &ab[k]))) return st;
+    float amount = 0.5f;
+    tex_ref map;
+    tex_ref_init(&map);
+    if (is_obj(am)) {
+        bool loaded;
+        if ((st = pd_texture(d, am, false, &map, &loaded))) return st;
+        amount = loaded ? 1.0f : 0.5f;
+    } else if ((st = pd_float(d, "amount", amount, PD_UNIT, &amount))) {
+        return st;
+    }
+    material_mix(m, (int)ab[0], (int)ab[1], amount);
+    m->map_alpha = map;
+    return PK_OK;
+}
+
 /* emitter: black diffuse, or the surface its "bsdf" describes */
 static pk_status create_emitter(pdict *d, const mat_row *row, const mat_common *c, material *m)
 {
@@ -217,6 +285,11 @@ static const mat_row mat_rows[] = {
     {MD_PAPRSEK, "emitter", {"radiance", "bsdf"}, create_emitter},
     {MD_PAPRSEK, "two_sided", {"bsdf"}, create_two_sided},
     {MD_PAPRSEK, "interface", {NULL}, NULL},
+    {MD_PAPRSEK, "thin_dielectric", {"ior", "transmittance"}, create_thin_dielectric},
+    {MD_PAPRSEK, "diffuse_transmission", {"albedo", "transmittance"}, create_diffuse_transmission},
+    {MD_PAPRSEK, "mix", {"materials", "amount"}, create_mix},
+    {MD_PAPRSEK, "rough_diffuse", {"albedo", "alpha"}, create_rough_diffuse},
+    {MD_PAPRSEK, "phong", {"albedo", "specular", "exponent"}, create_phong},
 };
 #define N_MAT_ROWS (sizeof mat_rows / sizeof mat_rows[0])
 
@@ -327,7 +400,8 @@ static pk_status create_typed(pdict *d, const pd_entry *type_entry, material *m)
     if (!str || t == N_MAT_ROWS)
         return pd_fail(d, type_entry, -1, PK_ERR_PARSE,
                        "must be one of \"diffuse\", \"conductor\", \"dielectric\", \"plastic\", "
-                       "\"metallic_roughness\", \"emitter\", \"two_sided\", \"interface\"");
+                       "\"metallic_roughness\", \"emitter\", \"two_sided\", \"interface\", \"thin_dielectric\", "
+                       "\"diffuse_transmission\", \"mix\", \"rough_diffuse\", \"phong\"");
     const mat_row *row = &mat_rows[t];
     /* the known keys: "type", "two_sided", the maps, the type's parameters
      * and the media (read by the caller) */

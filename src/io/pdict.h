@@ -67,6 +67,10 @@ typedef struct pd_source {
     pk_status (*texture)(void *self, const pdict *d, const pd_entry *e, bool colour, tex_ref *ref, bool *loaded);
     /* Fills sub (pd_init'ed by the caller) from the object e. */
     pk_status (*nested)(void *self, const pdict *d, const pd_entry *e, pdict *sub);
+    /* The scene material that element elem of e's list names (a mix's
+     * "materials"), defined before the one being read; NULL: materials
+     * cannot be named here. */
+    pk_status (*material)(void *self, const pdict *d, const pd_entry *e, long elem, uint32_t *index);
 } pd_source;
 
 /* Invariants: n <= cap; e[0..n) in the order the front end gave them;

@@ -702,7 +702,26 @@ static pk_status pd_json_nested(void *self, const pdict *d, const pd_entry *e, p
     return pd_from_cjson(sub, e->node, fp);
 }
 
-static const pd_source pd_json = {pd_json_fail, pd_json_warn, pd_json_texture, pd_json_nested};
+/* A mix's material by name: an element of a list of names, defined before. */
+static pk_status pd_json_material(void *self, const pdict *d, const pd_entry *e, long elem, uint32_t *index)
+{
+    jp *p = self;
+    char fp[JP_PATH_MAX], ep[JP_PATH_MAX];
+    path_key(fp, d->path, e->name);
+    snprintf(ep, sizeof ep, "%.*s[%ld]", JP_PATH_MAX - 24, fp, elem);
+    const cJSON *it = cJSON_IsArray((const cJSON *)e->node) ? cJSON_GetArrayItem(e->node, (int)elem) : NULL;
+    if (!cJSON_IsString(it) || !it->valuestring[0])
+        return jfail(p, PK_ERR_PARSE, it ? it : e->node, it ? ep : fp, "must be a material's name");
+    const int64_t i = scene_find_material(p->s, it->valuestring);
+    if (i < 0)
+        return jfail(p, PK_ERR_PARSE, it, ep, "no material named \"%.60s\" before this one", it->valuestring);
+    if (scene_mix_depth(p->s, (uint32_t)i) >= MATERIAL_MIX_DEPTH)
+        return jfail(p, PK_ERR_LIMIT, it, ep, "mixes nested more than %d deep", MATERIAL_MIX_DEPTH);
+    *index = (uint32_t)i;
+    return PK_OK;
+}
+
+static const pd_source pd_json = {pd_json_fail, pd_json_warn, pd_json_texture, pd_json_nested, pd_json_material};
 
 /* Reads a material object into *m (name not set): the creators of
  * create_material.c through the cJSON adapter, then the media on its sides.
@@ -1491,8 +1510,11 @@ static pk_status parse_material_record(jp *p, const cJSON *e, const char *path)
     material m;
     material_init(&m);
     if ((st = rec_read(p, f[1], fp, rec_material, rec_nmaterial, extra, &m))) return st;
-    if (m.type < MAT_MTL || m.type > MAT_INTERFACE)
-        return jfail(p, PK_ERR_PARSE, f[1], fp, "type must be in %d..%d", (int)MAT_MTL, (int)MAT_INTERFACE);
+    if (m.type < MAT_MTL || m.type > MAT_LAST)
+        return jfail(p, PK_ERR_PARSE, f[1], fp, "type must be in %d..%d", (int)MAT_MTL, (int)MAT_LAST);
+    if (m.type == MAT_MIX && (m.mix_a < 0 || m.mix_b < 0 || (size_t)m.mix_a >= p->s->nmaterials ||
+                              (size_t)m.mix_b >= p->s->nmaterials))
+        return jfail(p, PK_ERR_PARSE, f[1], fp, "mix_a and mix_b must be numbers of materials before this one");
     if (m.illum < 0 || m.illum > 10) return jfail(p, PK_ERR_PARSE, f[1], fp, "illum must be in 0..10");
     for (int k = 0; k < REC_NMAPS; k++) {
         const cJSON *it = cJSON_GetObjectItemCaseSensitive(f[1], rec_map_names[k]);

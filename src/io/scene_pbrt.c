@@ -733,14 +733,15 @@ static pk_status build_material(pp *p, const char *type, material *m, bool *inte
             return st;
         pwarn(p, p->line, "coatedconductor is approximated by its conductor under the coat's roughness (no clear "
                           "coat layer)");
-    } else if (strcmp(type, "dielectric") == 0 || strcmp(type, "thindielectric") == 0) {
+    } else if (strcmp(type, "dielectric") == 0) {
         tex_ref ta;
         tex_ref_init(&ta);
         if ((st = get_eta(p, "eta", 1.5f, &eta)) || (st = get_roughness(p, "", &alpha, &ta))) return st;
-        if (type[0] == 't')
-            pwarn(p, p->line, "thindielectric is rendered as a solid dielectric of the same index (no thin sheet)");
         material_dielectric(m, eta, alpha, v3s(1.0f));
         m->map_alpha = ta;
+    } else if (strcmp(type, "thindielectric") == 0) {
+        if ((st = get_eta(p, "eta", 1.5f, &eta))) return st;
+        material_thin_dielectric(m, eta, v3s(1.0f));
     } else if (strcmp(type, "diffusetransmission") == 0) {
         vec3 tr = v3s(0.25f);
         float sc = 1.0f;
@@ -748,25 +749,46 @@ static pk_status build_material(pp *p, const char *type, material *m, bool *inte
         if ((st = get_colour(p, "reflectance", &kd, &tkd, NULL)) ||
             (st = get_colour(p, "transmittance", &tr, NULL, NULL)) || (st = pb_float(&p->pd, "scale", &sc)))
             return st;
-        pwarn(p, p->line, "diffusetransmission: the transmitted part is not rendered; a diffuse reflector of the "
-                          "reflectance");
-        material_diffuse(m, v3_scale(kd, sc));
+        /* pbrt-v4 clamps scale * reflectance and scale * transmittance to 0..1 */
+        const vec3 r = v3_scale(kd, sc), t = v3_scale(tr, sc);
+        material_diffuse_transmission(m, v3_min(v3_max(r, v3s(0.0f)), v3s(1.0f)), v3_min(v3_max(t, v3s(0.0f)), v3s(1.0f)));
         m->map_kd = tkd;
     } else if (strcmp(type, "mix") == 0) {
         pparam *q;
         if ((st = pb_typed(&p->pd, "materials", TB(PT_STRING), "two material names", &q))) return st;
         if (!q || q->nstr != 2) return pfail(p, p->line, PK_ERR_PARSE, "mix needs 'string materials' with two names");
+        int64_t idx[2];
+        for (int k = 0; k < 2; k++) {
+            idx[k] = scene_find_material(p->s, q->str[k]);
+            if (idx[k] < 0) return pfail(p, q->line, PK_ERR_PARSE, "mix: no material named \"%.60s\"", q->str[k]);
+            if (scene_mix_depth(p->s, (uint32_t)idx[k]) >= MATERIAL_MIX_DEPTH)
+                return pfail(p, q->line, PK_ERR_PARSE, "mix: mixes nested more than %d deep", MATERIAL_MIX_DEPTH);
+        }
+        /* amount: a float or a float texture (the probability of the second) */
         float amount = 0.5f;
-        if ((st = get_float_tex(p, "amount", &amount, NULL))) return st;
-        const char *pick = amount > 0.5f ? q->str[1] : q->str[0];
-        int64_t idx = scene_find_material(p->s, pick);
-        if (idx < 0 || depth > 8)
-            return pfail(p, q->line, PK_ERR_PARSE, "mix: no material named \"%.60s\"", pick);
-        pwarn(p, p->line, "mix is rendered as its dominant material \"%.60s\" (amount %g)", pick, (double)amount);
-        char *nm = m->name;
-        *m = p->s->materials[idx];
-        m->name = nm;
-        *interface = mat_is_interface(p, (uint32_t)idx);
+        tex_ref tam;
+        tex_ref_init(&tam);
+        pparam *qa;
+        if ((st = pb_typed(&p->pd, "amount", TB(PT_FLOAT) | TB(PT_TEXTURE), "a float or a float texture", &qa)))
+            return st;
+        if (qa && qa->type == PT_FLOAT) {
+            if (qa->nnum != 1) return pfail(p, qa->line, PK_ERR_PARSE, "'float amount' takes one value, not %zu", qa->nnum);
+            amount = (float)qa->num[0];
+        } else if (qa) {
+            if (qa->nstr != 1) return pfail(p, qa->line, PK_ERR_PARSE, "'texture amount' takes one name");
+            named_tex *t = find_tex(p, qa->str[0]);
+            if (!t) return pfail(p, qa->line, PK_ERR_PARSE, "'texture amount': no texture named \"%.60s\"", qa->str[0]);
+            amount = t->value.x; /* a constant, or the factor on an image's values */
+            if (t->cls == TC_EXPR) { /* a procedural texture: its values themselves */
+                if ((st = tex_add_expr(p, t, &tam))) return st;
+                amount = 1.0f;
+            } else if (t->cls != TC_CONST) {
+                tam = t->ref;
+            }
+        }
+        material_mix(m, (int)idx[0], (int)idx[1], amount);
+        m->map_alpha = tam;
+        (void)depth;
     } else if (strcmp(type, "interface") == 0 || strcmp(type, "") == 0 || strcmp(type, "none") == 0) {
         material_interface(m);
         *interface = true;

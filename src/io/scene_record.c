@@ -18,6 +18,8 @@ const rec_field rec_material[] = {
     F(material, metallic, REC_FLOAT),   F(material, roughness, REC_FLOAT),
     F(material, transmission, REC_FLOAT), F(material, clearcoat, REC_FLOAT),
     F(material, clearcoat_roughness, REC_FLOAT), F(material, tint, REC_VEC3),
+    F(material, mix_a, REC_INT),        F(material, mix_b, REC_INT),
+    F(material, amount, REC_FLOAT),
 };
 const size_t rec_nmaterial = sizeof rec_material / sizeof rec_material[0];
 

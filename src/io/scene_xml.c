@@ -1184,6 +1184,7 @@ static xnode *nested_bsdf(xp *p, xnode *b)
 }
 
 static pk_status bsdf_resolve(xp *p, xnode *b, material *m);
+static pk_status material_of(xp *p, xnode *b, uint32_t *index);
 
 /* Mitsuba's bump map (bumpmap, Mitsuba 0.x's bump): the nested bsdf with its
  * shading normal bent by a height texture, displaced along the normal in
@@ -1204,6 +1205,10 @@ static pk_status bsdf_bump(xp *p, const bsdf_in *in, material *m)
         return PK_OK;
     }
     if ((st = bsdf_resolve(p, inner, m))) return st;
+    if (m->type == MAT_MIX) { /* each hit shades one of the mix's materials, which have no bump map */
+        xwarn(p, b, "bsdf \"%s\" over a mix of bsdfs is not supported; the mix is not bumped", ty);
+        return PK_OK;
+    }
     /* the height: the first texture child (or a reference to one), through scale textures */
     xnode *t = NULL;
     for (xnode *c = b->child; c && !t; c = c->next) {
@@ -1311,6 +1316,10 @@ static pk_status bsdf_mask(xp *p, const bsdf_in *in, material *m)
     if (st) return st;
     if (inner && (st = bsdf_resolve(p, inner, m))) return st;
     if (!inner) material_diffuse(m, v3s(0.5f));
+    if (m->type == MAT_MIX) { /* each hit shades one of the mix's materials, which have no mask */
+        xwarn(p, in->b, "bsdf \"mask\" over a mix of bsdfs is not supported; the mix is opaque");
+        return PK_OK;
+    }
     if (m->type != MAT_DIELECTRIC) m->d = clamp01(opacity);
     return PK_OK;
 }
@@ -1346,7 +1355,7 @@ static pk_status bsdf_coating(xp *p, const bsdf_in *in, material *m)
     return PK_OK;
 }
 
-/* normalmap, blendbsdf, ...: the nested bsdf alone */
+/* normalmap, polarizer, measured: the nested bsdf alone */
 static pk_status bsdf_nested_only(xp *p, const bsdf_in *in, material *m)
 {
     xnode *inner = nested_bsdf(p, in->b);
@@ -1364,13 +1373,154 @@ static pk_status bsdf_diffuse(xp *p, const bsdf_in *in, material *m)
     vec3 r = v3s(0.5f);
     pk_status st = get_color_tex(p, in->d, "reflectance", &r, &m->map_kd);
     if (st) return st;
-    if (in->type[0] == 'r') {
-        prop(in->d, "alpha");
-        if (first_time(p, "roughdiffuse"))
-            xwarn(p, in->b, "roughdiffuse is rendered as diffuse (Lambert), without the Oren-Nayar roughness");
+    if (in->type[0] == 'r') { /* Oren-Nayar: alpha (default 0.2) is the facets' RMS slope, sigma = alpha / sqrt(2) */
+        float alpha = 0.2f;
+        bool fast = false;
+        if ((st = get_scalar(p, in->d, "alpha", &alpha)) || (st = get_bool(p, in->d, "use_fast_approx", &fast)))
+            return st;
+        material_rough_diffuse(m, clamp01v(r), alpha);
+        return PK_OK;
     }
     material_diffuse(m, clamp01v(r));
     return PK_OK;
+}
+
+/* Mitsuba 0.6's phong: diffuse_reflectance (0.5), specular_reflectance
+ * (0.2), exponent (30). */
+static pk_status bsdf_phong(xp *p, const bsdf_in *in, material *m)
+{
+    vec3 kd = v3s(0.5f), ks = v3s(0.2f);
+    float n = 30.0f;
+    pk_status st;
+    if ((st = get_color_tex(p, in->d, "diffuse_reflectance", &kd, &m->map_kd)) ||
+        (st = get_color_tex(p, in->d, "specular_reflectance", &ks, &m->map_ks)) ||
+        (st = get_scalar(p, in->d, "exponent", &n)))
+        return st;
+    material_phong(m, clamp01v(kd), clamp01v(ks), n);
+    return PK_OK;
+}
+
+/* The nested bsdfs of b (at most max), in order. */
+static int nested_bsdfs(xp *p, xnode *b, xnode **out, int max)
+{
+    int n = 0;
+    for (xnode *c = b->child; c; c = c->next)
+        if (strcmp(c->tag, "bsdf") == 0 || (strcmp(c->tag, "ref") == 0 && !attr_st(p, c, "name", &(pk_status){0}))) {
+            if (n < max) out[n] = c;
+            n++;
+        }
+    return n;
+}
+
+/* The scene material of the nested bsdf c, which a mix may name. */
+static pk_status mix_part(xp *p, xnode *c, uint32_t *idx)
+{
+    pk_status st = material_of(p, c, idx);
+    if (st == PK_OK && scene_mix_depth(p->s, *idx) >= MATERIAL_MIX_DEPTH)
+        return xfail(p, PK_ERR_LIMIT, c, "mixes of bsdfs nested more than %d deep", MATERIAL_MIX_DEPTH);
+    return st;
+}
+
+/* blendbsdf: the second nested bsdf with probability weight (a float or a
+ * texture, 0.5 by default), the first otherwise, chosen per hit. */
+static pk_status bsdf_blend(xp *p, const bsdf_in *in, material *m)
+{
+    xnode *kid[2];
+    const int n = nested_bsdfs(p, in->b, kid, 2);
+    if (n != 2) {
+        xwarn(p, in->b, "bsdf \"blendbsdf\" needs two nested bsdfs, not %d; using %s", n,
+              n ? "the first alone" : "a grey diffuse material");
+        if (n) return bsdf_resolve(p, kid[0], m);
+        material_diffuse(m, v3s(0.5f));
+        return PK_OK;
+    }
+    vec3 w = v3s(0.5f);
+    tex_ref map;
+    tex_ref_init(&map);
+    uint32_t a, b;
+    pk_status st;
+    if ((st = get_color_tex(p, in->d, "weight", &w, &map)) || (st = mix_part(p, kid[0], &a)) ||
+        (st = mix_part(p, kid[1], &b)))
+        return st;
+    material_mix(m, (int)a, (int)b, (w.x + w.y + w.z) / 3.0f);
+    m->map_alpha = map;
+    return PK_OK;
+}
+
+/* mixturebsdf: nested bsdf i with probability weights[i] (a list of
+ * numbers, "0.3, 0.7"), by a chain of two-way mixes: the first against the
+ * rest with weight w0 / (w0 + w1 + ...), and so on. Weights that add up to
+ * more than 1 are normalised (Mitsuba's ensureEnergyConservation); to less,
+ * the rest goes to a black material (light absorbed, as Mitsuba's sum). */
+#define XML_MIXTURE_MAX 16
+static pk_status bsdf_mixture(xp *p, const bsdf_in *in, material *m)
+{
+    xnode *kid[XML_MIXTURE_MAX];
+    const int n = nested_bsdfs(p, in->b, kid, XML_MIXTURE_MAX);
+    if (n > XML_MIXTURE_MAX)
+        return xfail(p, PK_ERR_LIMIT, in->b, "bsdf \"mixturebsdf\": more than %d nested bsdfs", XML_MIXTURE_MAX);
+    const char *ws = NULL;
+    xnode *at = NULL;
+    bool ensure = true;
+    pk_status st;
+    if ((st = get_string(p, in->d, "weights", &ws, &at)) || (st = get_bool(p, in->d, "ensure_energy_conservation", &ensure)))
+        return st;
+    float w[XML_MIXTURE_MAX + 1];
+    int nw = 0;
+    if (ws) {
+        const char *c = ws, *e = ws + strlen(ws);
+        while (c < e) {
+            while (c < e && (io_is_blank(*c) || *c == ',')) c++;
+            if (c == e) break;
+            float v;
+            const char *next = io_parse_float(c, e, &v);
+            if (!next || next == c || !(v >= 0.0f) || !isfinite(v))
+                return xfail(p, PK_ERR_PARSE, at, "bsdf \"mixturebsdf\": weights must be numbers >= 0");
+            if (nw < XML_MIXTURE_MAX) w[nw] = v;
+            nw++;
+            c = next;
+        }
+    }
+    if (n == 0 || nw != n)
+        return xfail(p, PK_ERR_PARSE, at ? at : in->b,
+                     "bsdf \"mixturebsdf\" needs as many weights (%d) as nested bsdfs (%d)", nw, n);
+    float sum = 0.0f;
+    for (int i = 0; i < n; i++) sum += w[i];
+    if (!(sum > 0.0f)) return xfail(p, PK_ERR_PARSE, at, "bsdf \"mixturebsdf\": the weights add up to 0");
+    if (sum > 1.0f && !ensure)
+        xwarn(p, in->b, "bsdf \"mixturebsdf\": weights adding up to %g > 1 are normalised (energy is conserved)",
+              (double)sum);
+    uint32_t idx[XML_MIXTURE_MAX + 1];
+    for (int i = 0; i < n; i++)
+        if ((st = mix_part(p, kid[i], &idx[i]))) return st;
+    int parts = n;
+    if (sum < 1.0f) { /* the absorbed rest */
+        char name[96];
+        snprintf(name, sizeof name, "mixturebsdf@%s:%lu:black", in->b->file->shown, in->b->line);
+        if ((st = scene_add_material(p->ctx, p->s, name, &idx[n]))) return st;
+        material_diffuse(&p->s->materials[idx[n]], v3s(0.0f));
+        w[n] = 1.0f - sum;
+        parts = n + 1;
+    }
+    /* from the end: rest = mix(part i, rest) with the rest's probability */
+    uint32_t rest = idx[parts - 1];
+    float wrest = w[parts - 1];
+    for (int i = parts - 2; i >= 0; i--) {
+        const float total = w[i] + wrest, amount = total > 0.0f ? wrest / total : 0.0f;
+        if (i == 0) {
+            material_mix(m, (int)idx[0], (int)rest, amount);
+            return PK_OK;
+        }
+        char name[96];
+        snprintf(name, sizeof name, "mixturebsdf@%s:%lu:%d", in->b->file->shown, in->b->line, i);
+        uint32_t mi;
+        if ((st = scene_add_material(p->ctx, p->s, name, &mi))) return st;
+        material_mix(&p->s->materials[mi], (int)idx[i], (int)rest, amount);
+        if (scene_mix_depth(p->s, mi) > MATERIAL_MIX_DEPTH)
+            return xfail(p, PK_ERR_LIMIT, in->b, "mixes of bsdfs nested more than %d deep", MATERIAL_MIX_DEPTH);
+        rest = mi, wrest = total;
+    }
+    return bsdf_resolve(p, kid[0], m); /* one bsdf of weight 1 */
 }
 
 static pk_status bsdf_conductor(xp *p, const bsdf_in *in, material *m)
@@ -1429,11 +1579,9 @@ static pk_status bsdf_dielectric(xp *p, const bsdf_in *in, material *m)
     float ior = in->ior, alpha = in->alpha;
     pk_status st;
     if ((st = get_color(p, in->d, "specular_transmittance", &tr)) || (st = specular_one(p, in))) return st;
-    if (in->type[0] == 't') {
-        /* a thin sheet: light goes through unbent; its reflection is lost */
-        xwarn(p, in->b, "thindielectric is rendered as a clear sheet that lets light through unbent, without its "
-                        "reflection");
-        ior = 1.0f;
+    if (in->type[0] == 't') { /* a thin sheet: reflects by R' and lets the rest through unbent */
+        material_thin_dielectric(m, ior, clamp01v(tr));
+        return PK_OK;
     }
     if (ior == 1.0f && alpha > 0.0f) alpha = 0.0f;
     material_dielectric(m, ior, alpha, clamp01v(tr));
@@ -1495,12 +1643,13 @@ static const bsdf_row bsdf_rows[] = {
     {"bumpmap", bsdf_bump, false, 0.0f, NULL},
     {"bump", bsdf_bump, false, 0.0f, NULL},
     {"normalmap", bsdf_nested_only, false, 0.0f, NULL},
-    {"blendbsdf", bsdf_nested_only, false, 0.0f, NULL},
-    {"mixturebsdf", bsdf_nested_only, false, 0.0f, NULL},
+    {"blendbsdf", bsdf_blend, false, 0.0f, ""},
+    {"mixturebsdf", bsdf_mixture, false, 0.0f, ""},
     {"polarizer", bsdf_nested_only, false, 0.0f, NULL},
     {"measured", bsdf_nested_only, false, 0.0f, NULL},
     {"diffuse", bsdf_diffuse, false, 0.0f, ""},
     {"roughdiffuse", bsdf_diffuse, false, 0.0f, ""},
+    {"phong", bsdf_phong, false, 0.0f, ""},
     {"conductor", bsdf_conductor, false, 0.0f, ""},
     {"roughconductor", bsdf_conductor, true, 0.0f, ""},
     {"dielectric", bsdf_dielectric, false, 1.5046f, ""},

@@ -2,7 +2,8 @@
  * pbsdf.h - physically based BSDFs for the path tracer: Lambert, GGX
  * (or Beckmann) conductors, smooth and rough dielectrics (Walter et al. 2007), plastic (a
  * diffuse base under a dielectric coating), the MTL "glossy over diffuse"
- * model and glTF 2.0's metallic-roughness material. Plain static inline PK_HD C over one plain struct: no context, no
+ * model, glTF 2.0's metallic-roughness material, and (last) a thin dielectric
+ * sheet, diffuse transmission, Oren-Nayar and the modified Phong model. Plain static inline PK_HD C over one plain struct: no context, no
  * allocation, no function pointers, so that nvcc can compile the same code.
  * docs/materials.md describes the models, their parameters and conventions.
  *
@@ -17,6 +18,9 @@
  *    the caller's business (flip the frame so that wo.z > 0). The
  *    metallic-roughness type is a thin sheet: wo.z > 0 as for those, and wi
  *    below (wi.z < 0) where it transmits.
+ *  - The thin dielectric and diffuse transmission are two-sided sheets: wo on
+ *    either side, wi on its side (reflection) or the other (transmission).
+ *    Oren-Nayar and Phong are one-sided reflectors like diffuse.
  *  - Dielectrics are two-sided: wo.z < 0 means wo is inside (the side with
  *    index `ior`), and wi may lie on either side.
  *  - Transmitted light is not scaled by 1/eta^2 (the radiance compression at
@@ -41,6 +45,10 @@ typedef enum pbsdf_type {
     PBSDF_PLASTIC,      /* diffuse albedo under a dielectric coating: ior, alpha */
     PBSDF_GLOSSY,       /* MTL Kd + Ks + Ns: albedo (kd) + specular (ks), alpha; no Fresnel */
     PBSDF_METALLIC_ROUGHNESS, /* glTF 2.0: albedo (base colour), metallic, alpha, transmission, ior */
+    PBSDF_THIN_DIELECTRIC,    /* a smooth thin sheet: ior, transmittance (tint of what goes through) */
+    PBSDF_DIFFUSE_TRANSMISSION, /* Lambert reflection (albedo) and transmission (transmittance) */
+    PBSDF_OREN_NAYAR,         /* rough diffuse (Oren-Nayar's qualitative model): albedo, on_a, on_b */
+    PBSDF_PHONG,              /* modified Phong: albedo (diffuse) + specular, exponent */
     PBSDF_TYPE_COUNT
 } pbsdf_type;
 
@@ -77,7 +85,9 @@ typedef enum pbsdf_type {
  *                                          base that is transmitted rather than diffuse
  *   coat          [0, 1]                   metallic-roughness: the clearcoat's weight
  *   coat_alpha    [0, 1]                   metallic-roughness: the clearcoat's GGX alpha
- *   ms, ms_albedo                          set by pbsdf_compensate (the multiple-scattering lobe) */
+ *   ms, ms_albedo                          set by pbsdf_compensate (the multiple-scattering lobe)
+ *   on_a, on_b    A, B >= 0                Oren-Nayar: the model's A and B (pbsdf_oren_nayar)
+ *   exponent      >= 0                     Phong: the lobe's exponent */
 typedef struct pbsdf {
     int type;            /* pbsdf_type */
     unsigned flags;      /* PBSDF_SCHLICK, PBSDF_BECKMANN, PBSDF_ENERGY */
@@ -92,6 +102,7 @@ typedef struct pbsdf {
     float coat, coat_alpha;
     vec3 ms;             /* F_ms / (pi (1 - E_avg)) per channel, with PBSDF_ENERGY */
     float ms_albedo;     /* the mean of F_ms: the lobe's albedo is ms_albedo (1 - E(wo.z)) */
+    float on_a, on_b, exponent;
 } pbsdf;
 
 /* ---- constructors ------------------------------------------------------- */
@@ -111,6 +122,7 @@ static inline PK_HD pbsdf pbsdf__blank(int type)
     b.coat = b.coat_alpha = 0.0f;
     b.ms = v3s(0.0f);
     b.ms_albedo = 0.0f;
+    b.on_a = 1.0f, b.on_b = b.exponent = 0.0f;
     return b;
 }
 static inline PK_HD pbsdf pbsdf_diffuse(vec3 albedo)
@@ -765,6 +777,211 @@ static inline PK_HD bool pbsdf__refract(vec3 w, vec3 m, float ior, vec3 *out)
     return true;
 }
 
+/* ---- thin dielectric, diffuse transmission, Oren-Nayar, modified Phong ---- */
+
+/* These four are two-sided where they transmit (the thin dielectric and the
+ * diffuse transmitter: wo on either side, mirrored to +z and back) and
+ * one-sided reflectors otherwise (Oren-Nayar, Phong: wo.z > 0, wi.z > 0).
+ * docs/materials.md describes the models. */
+
+/* A smooth thin sheet of relative index ior (pbrt-v4's ThinDielectricBxDF,
+ * Mitsuba's thindielectric): light reflects off it by the sheet's
+ * reflectance R' (pbsdf_thin_reflectance) and passes straight through,
+ * undeviated, with T' = 1 - R', tinted by transmittance. Both lobes are
+ * delta lobes. */
+static inline PK_HD pbsdf pbsdf_thin_dielectric(float ior, vec3 transmittance)
+{
+    pbsdf b = pbsdf__blank(PBSDF_THIN_DIELECTRIC);
+    b.ior = ior;
+    b.transmittance = transmittance;
+    return b;
+}
+/* Lambertian reflection of albedo r on the side of wo and Lambertian
+ * transmission of t to the other side (pbrt-v4's DiffuseTransmissionBxDF);
+ * r + t <= 1 per channel conserves energy. */
+static inline PK_HD pbsdf pbsdf_diffuse_transmission(vec3 r, vec3 t)
+{
+    pbsdf b = pbsdf__blank(PBSDF_DIFFUSE_TRANSMISSION);
+    b.albedo = r;
+    b.transmittance = t;
+    return b;
+}
+/* Oren-Nayar's qualitative model of a rough diffuse surface of albedo and
+ * facet-slope deviation sigma (radians): f = albedo / pi (A + B
+ * max(0, cos(phi_i - phi_o)) sin(alpha) tan(beta)), alpha the larger polar
+ * angle, beta the smaller, A = 1 - sigma^2 / (2 (sigma^2 + 0.33)),
+ * B = 0.45 sigma^2 / (sigma^2 + 0.09). sigma = 0 is Lambert. */
+static inline PK_HD pbsdf pbsdf_oren_nayar(vec3 albedo, float sigma)
+{
+    pbsdf b = pbsdf__blank(PBSDF_OREN_NAYAR);
+    const float s2 = sigma * sigma;
+    b.albedo = albedo;
+    b.on_a = 1.0f - 0.5f * s2 / (s2 + 0.33f);
+    b.on_b = 0.45f * s2 / (s2 + 0.09f);
+    return b;
+}
+/* The modified (energy-normalised) Phong model, as Mitsuba's phong:
+ * f = kd / pi + ks (n + 2) / (2 pi) max(0, wi . mirror(wo))^n. */
+static inline PK_HD pbsdf pbsdf_phong(vec3 kd, vec3 ks, float exponent)
+{
+    pbsdf b = pbsdf__blank(PBSDF_PHONG);
+    b.albedo = kd;
+    b.specular = ks;
+    b.exponent = exponent;
+    return b;
+}
+
+/* The thin sheet's reflectance toward cos_o (either side): with R the
+ * Fresnel reflectance of one face and T = 1 - R, light bounces between the
+ * faces, R' = R + T^2 R / (1 - R^2). */
+static inline PK_HD float pbsdf_thin_reflectance(float cos_o, float ior)
+{
+    float r = pbsdf_fresnel_dielectric(fabsf(cos_o), ior);
+    if (r < 1.0f) {
+        const float t = 1.0f - r;
+        r += t * t * r / (1.0f - r * r);
+    }
+    return r;
+}
+
+/* The probability of sampling the diffuse transmitter's reflection. */
+static inline PK_HD float pbsdf__dt_prob(const pbsdf *b)
+{
+    const float r = pbsdf__mean(b->albedo), t = pbsdf__mean(b->transmittance);
+    return r + t > 0.0f ? r / (r + t) : 0.5f;
+}
+/* The Phong lobe's sampling probability (Mitsuba's specular sampling
+ * weight: the mean specular over the mean of both). */
+static inline PK_HD float pbsdf__phong_prob(const pbsdf *b)
+{
+    const float d = pbsdf__mean(b->albedo), s = pbsdf__mean(b->specular);
+    return d + s > 0.0f ? s / (d + s) : 0.5f;
+}
+/* Oren-Nayar's factor A + B max(0, cos(dphi)) sin(alpha) tan(beta) for
+ * wo.z > 0, wi.z > 0. */
+static inline PK_HD float pbsdf__on_factor(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    const float so = sqrtf(fmaxf(0.0f, 1.0f - wo.z * wo.z)), si = sqrtf(fmaxf(0.0f, 1.0f - wi.z * wi.z));
+    float cphi = 0.0f;
+    if (so > 1e-4f && si > 1e-4f) cphi = fmaxf(0.0f, (wi.x * wo.x + wi.y * wo.y) / (so * si));
+    /* alpha = max(theta_i, theta_o), beta = min: the larger cosine is beta's */
+    const float sin_a = wi.z > wo.z ? so : si, tan_b = wi.z > wo.z ? si / wi.z : so / wo.z;
+    return b->on_a + b->on_b * cphi * sin_a * tan_b;
+}
+/* The Phong lobe's density about the mirror direction of wo (per solid
+ * angle of wi): (n + 1) / (2 pi) cos^n. */
+static inline PK_HD float pbsdf__phong_lobe_pdf(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    const float c = v3_dot(wi, pbsdf__mirror(wo));
+    return c > 0.0f ? (b->exponent + 1.0f) * (0.5f / PK_PI) * powf(c, b->exponent) : 0.0f;
+}
+
+static inline PK_HD vec3 pbsdf__ext_eval(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    if (b->type == PBSDF_DIFFUSE_TRANSMISSION) {
+        if (wo.z < 0.0f) wo = pbsdf__mirror_z(wo), wi = pbsdf__mirror_z(wi);
+        if (!(wo.z > 0.0f) || wi.z == 0.0f) return v3s(0.0f);
+        return wi.z > 0.0f ? v3_scale(b->albedo, wi.z / PK_PI) : v3_scale(b->transmittance, -wi.z / PK_PI);
+    }
+    if (!(wo.z > 0.0f && wi.z > 0.0f)) return v3s(0.0f);
+    if (b->type == PBSDF_OREN_NAYAR) return v3_scale(b->albedo, pbsdf__on_factor(b, wo, wi) * wi.z / PK_PI);
+    if (b->type == PBSDF_PHONG) {
+        vec3 r = v3_scale(b->albedo, wi.z / PK_PI);
+        const float c = v3_dot(wi, pbsdf__mirror(wo));
+        if (c > 0.0f)
+            r = v3_add(r, v3_scale(b->specular, (b->exponent + 2.0f) * (0.5f / PK_PI) * powf(c, b->exponent) * wi.z));
+        return r;
+    }
+    return v3s(0.0f); /* the thin dielectric: delta lobes only */
+}
+
+static inline PK_HD float pbsdf__ext_pdf(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    if (b->type == PBSDF_DIFFUSE_TRANSMISSION) {
+        if (wo.z < 0.0f) wo = pbsdf__mirror_z(wo), wi = pbsdf__mirror_z(wi);
+        if (!(wo.z > 0.0f) || wi.z == 0.0f) return 0.0f;
+        const float pr = pbsdf__dt_prob(b);
+        return wi.z > 0.0f ? pr * wi.z / PK_PI : (1.0f - pr) * -wi.z / PK_PI;
+    }
+    if (!(wo.z > 0.0f && wi.z > 0.0f)) return 0.0f;
+    if (b->type == PBSDF_OREN_NAYAR) return wi.z / PK_PI;
+    if (b->type == PBSDF_PHONG) {
+        const float ps = pbsdf__phong_prob(b);
+        return ps * pbsdf__phong_lobe_pdf(b, wo, wi) + (1.0f - ps) * wi.z / PK_PI;
+    }
+    return 0.0f;
+}
+
+/* A cosine-weighted direction about +z. */
+static inline PK_HD vec3 pbsdf__cosine_dir(float u1, float u2)
+{
+    const float r = sqrtf(u1), phi = 2.0f * PK_PI * u2;
+    return v3(r * cosf(phi), r * sinf(phi), sqrtf(fmaxf(0.0f, 1.0f - u1)));
+}
+
+static inline PK_HD bool pbsdf__ext_sample(const pbsdf *b, vec3 wo, const float u[3], vec3 *wi, vec3 *weight,
+                                           float *pdf, bool *is_delta)
+{
+    *is_delta = false;
+    if (b->type == PBSDF_THIN_DIELECTRIC) {
+        if (wo.z == 0.0f) return false;
+        const float r = pbsdf_thin_reflectance(wo.z, b->ior);
+        *is_delta = true;
+        if (u[0] < r) {
+            *wi = pbsdf__mirror(wo);
+            *weight = v3s(1.0f);
+            *pdf = r;
+        } else {
+            *wi = v3_neg(wo);
+            *weight = b->transmittance;
+            *pdf = 1.0f - r;
+        }
+        return true;
+    }
+    if (b->type == PBSDF_DIFFUSE_TRANSMISSION) {
+        const bool flip = wo.z < 0.0f;
+        if (wo.z == 0.0f || !(pbsdf__mean(b->albedo) + pbsdf__mean(b->transmittance) > 0.0f)) return false;
+        const float pr = pbsdf__dt_prob(b);
+        vec3 w = pbsdf__cosine_dir(u[1], u[2]);
+        if (!(w.z > 0.0f)) return false;
+        if (u[0] < pr) {
+            *weight = v3_scale(b->albedo, 1.0f / pr);
+            *pdf = pr * w.z / PK_PI;
+        } else {
+            *weight = v3_scale(b->transmittance, 1.0f / (1.0f - pr));
+            *pdf = (1.0f - pr) * w.z / PK_PI;
+            w = pbsdf__mirror_z(w);
+        }
+        *wi = flip ? pbsdf__mirror_z(w) : w;
+        return true;
+    }
+    if (!(wo.z > 0.0f)) return false;
+    vec3 w;
+    if (b->type == PBSDF_PHONG && u[0] < pbsdf__phong_prob(b)) {
+        /* cos^n about the mirror direction, in a basis around it */
+        const vec3 n = pbsdf__mirror(wo);
+        const float sg = n.z >= 0.0f ? 1.0f : -1.0f, a = -1.0f / (sg + n.z), c = n.x * n.y * a;
+        const vec3 t = v3(1.0f + sg * n.x * n.x * a, sg * c, -sg * n.x), bt = v3(c, sg + n.y * n.y * a, -n.y);
+        const float ca = powf(u[1], 1.0f / (b->exponent + 1.0f)), sa = sqrtf(fmaxf(0.0f, 1.0f - ca * ca));
+        const float phi = 2.0f * PK_PI * u[2];
+        w = v3_norm(v3_add(v3_add(v3_scale(t, sa * cosf(phi)), v3_scale(bt, sa * sinf(phi))), v3_scale(n, ca)));
+    } else {
+        w = pbsdf__cosine_dir(u[1], u[2]);
+    }
+    if (!(w.z > 0.0f)) return false;
+    *wi = w;
+    if (b->type == PBSDF_OREN_NAYAR) { /* f cos / pdf = albedo (A + B ...): Lambert's weight at sigma 0 */
+        *pdf = w.z / PK_PI;
+        *weight = v3_scale(b->albedo, pbsdf__on_factor(b, wo, w));
+        return true;
+    }
+    const float p = pbsdf__ext_pdf(b, wo, w);
+    if (!(p > 0.0f)) return false;
+    *pdf = p;
+    *weight = v3_scale(pbsdf__ext_eval(b, wo, w), 1.0f / p);
+    return true;
+}
+
 /* ---- the interface --------------------------------------------------------- */
 
 /* True if the BSDF has a non-delta part, i.e. light sampling and MIS can
@@ -780,6 +997,7 @@ static inline PK_HD void pbsdf_regularize(pbsdf *b)
 
 static inline PK_HD bool pbsdf_has_nondelta(const pbsdf *b)
 {
+    if (b->type >= PBSDF_THIN_DIELECTRIC) return b->type != PBSDF_THIN_DIELECTRIC;
     switch (b->type) {
     case PBSDF_DIFFUSE: case PBSDF_PLASTIC: case PBSDF_GLOSSY: return true;
     case PBSDF_METALLIC_ROUGHNESS:
@@ -792,6 +1010,7 @@ static inline PK_HD bool pbsdf_has_nondelta(const pbsdf *b)
 /* f(wo, wi) * |wi.z| of the non-delta part. Local frame, unit vectors. */
 static inline PK_HD vec3 pbsdf_eval(const pbsdf *b, vec3 wo, vec3 wi)
 {
+    if (b->type >= PBSDF_THIN_DIELECTRIC) return pbsdf__ext_eval(b, wo, wi);
     if (b->type == PBSDF_DIELECTRIC) return pbsdf__dielectric_eval(b, wo, wi);
     if (b->type == PBSDF_METALLIC_ROUGHNESS) return pbsdf__mr_eval(b, wo, wi);
     if (!(wo.z > 0.0f && wi.z > 0.0f)) return v3s(0.0f);
@@ -835,6 +1054,7 @@ static inline PK_HD vec3 pbsdf_eval(const pbsdf *b, vec3 wo, vec3 wi)
  * sample (the lobe choice included). */
 static inline PK_HD float pbsdf_pdf(const pbsdf *b, vec3 wo, vec3 wi)
 {
+    if (b->type >= PBSDF_THIN_DIELECTRIC) return pbsdf__ext_pdf(b, wo, wi);
     if (b->type == PBSDF_DIELECTRIC) return pbsdf__dielectric_pdf(b, wo, wi);
     if (b->type == PBSDF_METALLIC_ROUGHNESS) return pbsdf__mr_pdf(b, wo, wi);
     if (!(wo.z > 0.0f && wi.z > 0.0f)) return 0.0f;
@@ -871,6 +1091,7 @@ static inline PK_HD float pbsdf_pdf(const pbsdf *b, vec3 wo, vec3 wi)
 static inline PK_HD bool pbsdf_sample(const pbsdf *b, vec3 wo, const float u[3], vec3 *wi, vec3 *weight, float *pdf,
                                 bool *is_delta)
 {
+    if (b->type >= PBSDF_THIN_DIELECTRIC) return pbsdf__ext_sample(b, wo, u, wi, weight, pdf, is_delta);
     *is_delta = false;
     if (b->type == PBSDF_DIELECTRIC) {
         if (wo.z == 0.0f) return false;

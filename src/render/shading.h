@@ -7,8 +7,9 @@
  * weighted by Ks over the diffuse part, illum 5 a mirror with Fresnel;
  * illum 4, 6, 7 smooth dielectrics (Ni, Tf) with exact Fresnel; dissolve
  * d < 1 lets a fraction of the light pass straight through. The physically
- * based types (diffuse, conductor, dielectric, plastic, metallic-roughness)
- * map to their pbsdf directly. Directions are world space, unit, pointing
+ * based types (diffuse, conductor, dielectric, plastic, metallic-roughness,
+ * thin dielectric, diffuse transmission, rough diffuse, Phong) map to their
+ * pbsdf directly; a mix was resolved to one of its materials by surface_at. Directions are world space, unit, pointing
  * away from the surface.
  */
 #ifndef PK_SHADING_H
@@ -58,6 +59,10 @@ static inline PK_HD shading shading_at(const surface *sf)
             }
             break;
         }
+        case MAT_THIN_DIELECTRIC: sh.b = pbsdf_thin_dielectric(m->eta.x, m->tf); break;
+        case MAT_DIFFUSE_TRANSMISSION: sh.b = pbsdf_diffuse_transmission(m->kd, m->tf); break;
+        case MAT_ROUGH_DIFFUSE: sh.b = pbsdf_oren_nayar(m->kd, m->alpha * 0.70710678f); break; /* Mitsuba's sigma */
+        case MAT_PHONG: sh.b = pbsdf_phong(m->kd, m->ks, m->ns); break;
         default: sh.b = pbsdf_diffuse(m->kd); break;
         }
         if (m->beckmann && (m->type == MAT_CONDUCTOR || m->type == MAT_DIELECTRIC || m->type == MAT_PLASTIC))
@@ -136,7 +141,8 @@ static inline PK_HD vec3 shading_eval(const surface *sf, const shading *sh, vec3
 {
     *pdf = 0.0f;
     const float side = v3_dot(wi, sf->ng), shade = v3_dot(wi, sf->ns);
-    if (sh->b.type == PBSDF_METALLIC_ROUGHNESS) { /* reflects and transmits: both normals must agree */
+    if (sh->b.type == PBSDF_METALLIC_ROUGHNESS || sh->b.type == PBSDF_DIFFUSE_TRANSMISSION) {
+        /* reflects and transmits: both normals must agree */
         if (!(side * shade > 0.0f)) return v3s(0.0f);
     } else if (sh->b.type != PBSDF_DIELECTRIC && (side <= 0.0f || shade <= 0.0f)) {
         return v3s(0.0f);

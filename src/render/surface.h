@@ -25,9 +25,65 @@ static inline PK_HD bool surface_is_tri(const scene_view *s, uint32_t prim)
     return prim < s->ntris || (size_t)prim - s->ntris >= s->nspheres;
 }
 
+/* Texture coordinates at a hit (surface_uv_at, below). */
+typedef struct surface_uv {
+    float u, v;
+    vec3 dpdu, dpdv;
+    float uv_per_len;
+} surface_uv;
+static inline PK_HD surface_uv surface_uv_at(const scene_view *s, const ray *r, const hit *h);
+
+/* A number in [0, 1) from the bits of a hit point p, the direction wo and
+ * the level of a mix among nested mixes (MurmurHash3's mixing steps): the
+ * same arguments give the same number on the CPU and the GPU, and a scene
+ * gives the same choices whatever order its file defines the materials in. */
+static inline PK_HD float surface_mix_hash(vec3 p, vec3 wo, int level)
+{
+    union {
+        float f[6];
+        uint32_t u[6];
+    } w;
+    w.f[0] = p.x, w.f[1] = p.y, w.f[2] = p.z, w.f[3] = wo.x, w.f[4] = wo.y, w.f[5] = wo.z;
+    uint32_t h = 0x9747b28cu ^ ((uint32_t)level * 0x85ebca6bu);
+    for (int i = 0; i < 6; i++) {
+        uint32_t k = w.u[i] * 0xcc9e2d51u;
+        k = (k << 15) | (k >> 17);
+        h ^= k * 0x1b873593u;
+        h = ((h << 13) | (h >> 19)) * 5u + 0xe6546b64u;
+    }
+    h ^= h >> 16, h *= 0x85ebca6bu, h ^= h >> 13, h *= 0xc2b2ae35u, h ^= h >> 16;
+    return (float)(h >> 8) * (1.0f / 16777216.0f);
+}
+
+/* The material a mix (MAT_MIX) stands for at a hit, as pbrt-v4 chooses it:
+ * mix_b where the hash of the hit point p and the direction wo toward the
+ * viewer (and the level, for mixes of mixes) falls below the amount, mix_a
+ * elsewhere; a mix of mixes is
+ * followed down (at most MATERIAL_MIX_DEPTH levels, as readers ensure). No
+ * random number is drawn, so the sampler's dimensions stay as they were. */
+static inline PK_HD const material *surface_mix_choose(const scene_view *s, const ray *r, const hit *h, vec3 p,
+                                                       const material *m)
+{
+    const vec3 wo = v3_neg(v3_norm(r->d));
+    for (int k = 0; k < MATERIAL_MIX_DEPTH && m->type == MAT_MIX; k++) {
+        float amount = m->amount;
+        if (m->map_alpha.kind) {
+            const surface_uv uv = surface_uv_at(s, r, h);
+            const tex_query q = {uv.u, uv.v, 0.0f, p, v3s(0.0f), s->tex_nodes};
+            amount *= fminf(fmaxf(tex_eval_scalar(s->textures, &m->map_alpha, q), 0.0f), 1.0f);
+        }
+        int pick = m->mix_a;
+        if (amount >= 1.0f) pick = m->mix_b;
+        else if (amount > 0.0f && surface_mix_hash(p, wo, k) < amount) pick = m->mix_b;
+        m = &s->materials[pick];
+    }
+    return m;
+}
+
 /* The surface that ray r hit at h (h->prim is a triangle, a sphere or a
  * kept instance's triangle of s: view_tri_get gives every triangle in
- * world space, so this is the one place a hit becomes a surface). */
+ * world space, so this is the one place a hit becomes a surface). A mix is
+ * resolved here to the material it stands for at the hit. */
 static inline PK_HD surface surface_at(const scene_view *s, const ray *r, const hit *h)
 {
     surface sf;
@@ -57,6 +113,7 @@ static inline PK_HD surface surface_at(const scene_view *s, const ray *r, const 
         ns = ng;
         sf.m = &s->materials[sp->material];
     }
+    if (sf.m->type == MAT_MIX) sf.m = surface_mix_choose(s, r, h, sf.p, sf.m);
     sf.front = v3_dot(ng, r->d) < 0.0f;
     if (!sf.front) {
         ng = v3_neg(ng);
@@ -73,11 +130,6 @@ static inline PK_HD surface surface_at(const scene_view *s, const ray *r, const 
  * the position's derivatives (unnormalised tangents); uv_per_len: the uv
  * length of a unit of scene length on the surface (the square root of the
  * area ratio), which turns a world footprint into a uv one. */
-typedef struct surface_uv {
-    float u, v;
-    vec3 dpdu, dpdv;
-    float uv_per_len;
-} surface_uv;
 #define SURFACE_MIN_COS 0.05f    /* footprints of grazing hits stop growing here */
 static inline PK_HD surface_uv surface_uv_at(const scene_view *s, const ray *r, const hit *h)
 {

@@ -124,3 +124,53 @@ void material_metallic_roughness(material *m, vec3 base_color, float metallic, f
     m->illum = 2;
     whitted_gloss(m, m->alpha);
 }
+
+void material_thin_dielectric(material *m, float ior, vec3 transmittance)
+{
+    m->type = MAT_THIN_DIELECTRIC;
+    m->eta = v3s(ior), m->tf = transmittance, m->alpha = 0.0f;
+    /* Whitted: a clear sheet (glass of index 1, weights Ks and Tf when
+     * Fresnel is off: the sheet's reflectance at normal incidence) */
+    const float r = material_f0_dielectric(ior);
+    m->ni = 1.0f;
+    m->kd = v3s(0.0f), m->ks = v3s(r < 1.0f ? r + (1.0f - r) * (1.0f - r) * r / (1.0f - r * r) : 1.0f);
+    m->illum = 7;
+}
+
+void material_diffuse_transmission(material *m, vec3 reflectance, vec3 transmittance)
+{
+    m->type = MAT_DIFFUSE_TRANSMISSION;
+    m->kd = reflectance, m->tf = transmittance;
+    m->ks = v3s(0.0f);
+    m->illum = 2;
+}
+
+void material_mix(material *m, int a, int b, float amount)
+{
+    m->type = MAT_MIX;
+    m->mix_a = a, m->mix_b = b;
+    m->amount = fminf(fmaxf(amount, 0.0f), 1.0f);
+    /* never shaded itself (shading meets one of the two); Whitted likewise */
+    m->kd = v3s(0.5f), m->ks = v3s(0.0f);
+    m->illum = 2;
+}
+
+void material_rough_diffuse(material *m, vec3 albedo, float alpha)
+{
+    m->type = MAT_ROUGH_DIFFUSE;
+    m->kd = albedo, m->alpha = fmaxf(alpha, 0.0f);
+    m->ks = v3s(0.0f);
+    m->illum = 2;
+}
+
+void material_phong(material *m, vec3 kd, vec3 ks, float exponent)
+{
+    float *d[3] = {&kd.x, &kd.y, &kd.z}, *s[3] = {&ks.x, &ks.y, &ks.z};
+    for (int c = 0; c < 3; c++) {
+        const float sum = *d[c] + *s[c];
+        if (sum > 1.0f) *d[c] /= sum, *s[c] /= sum;
+    }
+    m->type = MAT_PHONG;
+    m->kd = kd, m->ks = ks, m->ns = fmaxf(exponent, 0.0f);
+    m->illum = 2;
+}

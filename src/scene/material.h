@@ -11,7 +11,9 @@
  * set field by field by the MTL reader), diffuse, conductor (a complex
  * index or a normal-incidence reflectance), dielectric, plastic (a diffuse
  * base under a dielectric coat), metallic-roughness (glTF 2.0's BRDF: a
- * metal and a dielectric mixed by metalness). Emission (ke) and
+ * metal and a dielectric mixed by metalness), thin dielectric, diffuse
+ * transmission, mix (one of two materials per hit), rough diffuse
+ * (Oren-Nayar) and Phong. Emission (ke) and
  * two-sidedness go with any kind; texture maps (texture.h) scale the
  * constants.
  */
@@ -30,8 +32,17 @@ typedef enum material_type {
     MAT_DIELECTRIC,
     MAT_PLASTIC,
     MAT_METALLIC_ROUGHNESS,
-    MAT_INTERFACE   /* no surface: the boundary of a medium, which rays pass straight through */
+    MAT_INTERFACE,  /* no surface: the boundary of a medium, which rays pass straight through */
+    MAT_THIN_DIELECTRIC,      /* a smooth thin sheet (a window pane) */
+    MAT_DIFFUSE_TRANSMISSION, /* Lambertian reflection and transmission */
+    MAT_MIX,                  /* one of two materials, chosen per hit */
+    MAT_ROUGH_DIFFUSE,        /* Oren-Nayar */
+    MAT_PHONG,                /* the modified Phong model */
+    MAT_LAST = MAT_PHONG
 } material_type;
+
+/* The deepest nesting of mixes (a mix of mixes ...) that readers accept. */
+#define MATERIAL_MIX_DEPTH 16
 
 /* Colours are linear RGB. illum follows the MTL convention: 3/5 add mirror
  * reflection weighted by ks, 4/6/7 make the surface a dielectric of index
@@ -81,6 +92,11 @@ typedef struct material {
     /* conductor, dielectric, plastic: alpha is the roughness of the Beckmann
      * distribution instead of GGX (Mitsuba's default microfacet model) */
     bool beckmann;
+    /* MAT_MIX: the materials mix_a and mix_b (indices into the scene's
+     * materials, both below the mix's own index), and amount in [0, 1], the
+     * probability of mix_b at a hit (map_alpha, when set, multiplies it). */
+    int mix_a, mix_b;
+    float amount;
     float metallic, roughness, transmission, clearcoat, clearcoat_roughness;
     /* Texture maps (docs/materials.md), kind TEX_NONE when absent. A map's
      * value multiplies its constant: map_kd kd, map_ks ks, map_ns ns,
@@ -128,6 +144,30 @@ PK_HIDDEN void material_dielectric(material *m, float ior, float alpha, vec3 tra
 PK_HIDDEN void material_interface(material *m);
 /* A diffuse base of albedo under a dielectric coat of index ior. */
 PK_HIDDEN void material_plastic(material *m, vec3 albedo, float ior, float alpha);
+
+/* A smooth thin sheet of relative index ior (both faces): it reflects by the
+ * sheet's reflectance, light bouncing between its faces, and lets the rest
+ * through undeviated, tinted by transmittance. The index is kept in eta
+ * (every channel); ni is 1 and illum 7: the Whitted integrator sees a clear
+ * sheet of glass of index 1 (straight through, its reflection lost). */
+PK_HIDDEN void material_thin_dielectric(material *m, float ior, vec3 transmittance);
+/* Lambertian reflection of reflectance (kd) on the side light arrives from
+ * and Lambertian transmission of transmittance (tf) to the other side. The
+ * Whitted integrator renders the reflection alone. */
+PK_HIDDEN void material_diffuse_transmission(material *m, vec3 reflectance, vec3 transmittance);
+/* One of the materials a and b (indices into the scene's materials, below
+ * the mix's own), chosen per hit with probability amount for b (clamped to
+ * 0..1) by a hash of the hit point and the direction to the viewer. */
+PK_HIDDEN void material_mix(material *m, int a, int b, float amount);
+/* Oren-Nayar's rough diffuse reflection of albedo and roughness alpha, the
+ * RMS slope of its facets as Mitsuba gives it (sigma = alpha / sqrt(2));
+ * the Whitted integrator renders it as Lambert. */
+PK_HIDDEN void material_rough_diffuse(material *m, vec3 albedo, float alpha);
+/* The modified Phong model: diffuse kd, a lobe of ks and exponent about the
+ * mirror direction, normalised ((exponent + 2) / (2 pi)); where kd + ks > 1
+ * in a channel both are scaled down in it. The Whitted integrator's own
+ * Lambert + Phong is the same model (illum 2). */
+PK_HIDDEN void material_phong(material *m, vec3 kd, vec3 ks, float exponent);
 
 /* glTF 2.0's metallic-roughness material: base colour (linear), metallic and
  * perceptual roughness in 0..1; transmission 0, ior 1.5 and no clearcoat

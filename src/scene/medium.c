@@ -220,11 +220,19 @@ pk_status scene_material_with_media(pk_context *ctx, pk_scene *s, uint32_t mat, 
         *out = (uint32_t)found;
         return PK_OK;
     }
-    uint32_t idx;
-    pk_status st = scene_material_copy(ctx, s, mat, name, &idx);
+    uint32_t idx, parts[2];
+    pk_status st;
+    const bool mix = m->type == MAT_MIX;
+    if (mix) { /* both materials of a mix bound the media */
+        const int ab[2] = {m->mix_a, m->mix_b};
+        for (int k = 0; k < 2; k++)
+            if ((st = scene_material_with_media(ctx, s, (uint32_t)ab[k], med_in, med_out, &parts[k])) != PK_OK) return st;
+    }
+    st = scene_material_copy(ctx, s, mat, name, &idx);
     if (st != PK_OK) return st;
     material *c = &s->materials[idx];
     c->medium_in = med_in, c->medium_out = med_out;
+    if (mix) c->mix_a = (int)parts[0], c->mix_b = (int)parts[1];
     *out = idx;
     return PK_OK;
 }

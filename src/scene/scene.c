@@ -544,14 +544,36 @@ pk_status scene_material_copy(pk_context *ctx, pk_scene *s, uint32_t mat, const 
     return PK_OK;
 }
 
+int scene_mix_depth(const pk_scene *s, uint32_t mat)
+{
+    if (mat >= s->nmaterials || s->materials[mat].type != MAT_MIX) return 0;
+    const material *m = &s->materials[mat];
+    if (m->mix_a < 0 || m->mix_b < 0 || (uint32_t)m->mix_a >= mat || (uint32_t)m->mix_b >= mat)
+        return MATERIAL_MIX_DEPTH + 1; /* not a mix of earlier materials */
+    const int a = scene_mix_depth(s, (uint32_t)m->mix_a);
+    if (a >= MATERIAL_MIX_DEPTH) return a + 1;
+    const int b = scene_mix_depth(s, (uint32_t)m->mix_b);
+    return 1 + (a > b ? a : b);
+}
+
 pk_status scene_material_with_emission(pk_context *ctx, pk_scene *s, uint32_t mat, const char *name, vec3 ke,
                                        bool two_sided, uint32_t *index)
 {
     if (!v3_finite(ke) || !(v3_min_comp(ke) >= 0.0f))
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: emission must be finite and not negative", name);
-    pk_status st = scene_material_copy(ctx, s, mat, name, index);
+    pk_status st;
+    uint32_t parts[2];
+    const bool mix = mat < s->nmaterials && s->materials[mat].type == MAT_MIX;
+    if (mix) { /* a mix emits through whichever material a hit meets: both emit */
+        const int ab[2] = {s->materials[mat].mix_a, s->materials[mat].mix_b};
+        for (int k = 0; k < 2; k++)
+            if ((st = scene_material_with_emission(ctx, s, (uint32_t)ab[k], name, ke, two_sided, &parts[k])) != PK_OK)
+                return st;
+    }
+    st = scene_material_copy(ctx, s, mat, name, index);
     if (st != PK_OK) return st;
     material *c = &s->materials[*index];
+    if (mix) c->mix_a = (int)parts[0], c->mix_b = (int)parts[1];
     c->ke = ke;
     c->two_sided = two_sided;
     return PK_OK;
@@ -922,9 +944,9 @@ bool scene_check(const pk_scene *s, char *why, size_t n)
     if (tex_bytes != s->texture_bytes) FAIL("texture bytes do not add up");
     for (size_t i = 0; i < s->nmaterials; i++) {
         const material *m = &s->materials[i];
-        const tex_ref *maps[8] = {&m->map_kd, &m->map_ks,   &m->map_ns,   &m->map_d,
-                                  &m->map_alpha, &m->map_bump, &m->map_norm, &m->map_mr};
-        for (int j = 0; j < 8; j++)
+        const tex_ref *maps[9] = {&m->map_kd,    &m->map_ks,   &m->map_ns,   &m->map_d, &m->map_alpha,
+                                  &m->map_bump, &m->map_norm, &m->map_mr, &m->map_ke};
+        for (int j = 0; j < 9; j++)
         {
             if (maps[j]->kind == TEX_IMAGE && (maps[j]->tex < 0 || (size_t)maps[j]->tex >= s->ntextures))
                 FAIL("material %zu: texture index out of range", i);
@@ -934,6 +956,9 @@ bool scene_check(const pk_scene *s, char *why, size_t n)
                  !tex_nodes_valid(s->tex_nodes + maps[j]->node, maps[j]->nnodes, s->ntextures)))
                 FAIL("material %zu: texture expression out of range", i);
         }
+        if (m->type == MAT_MIX && scene_mix_depth(s, (uint32_t)i) > MATERIAL_MIX_DEPTH)
+            FAIL("material %zu: a mix of materials that do not come before it, or nested more than %d deep", i,
+                 MATERIAL_MIX_DEPTH);
     }
     for (size_t k = 0; k < s->ntris; k++) {
         const triangle *t = &s->tris[k];

@@ -341,6 +341,13 @@ PK_HIDDEN pk_status scene_material_copy(pk_context *ctx, pk_scene *s, uint32_t m
  * radiance ke, from its front only unless two_sided. */
 PK_HIDDEN pk_status scene_material_with_emission(pk_context *ctx, pk_scene *s, uint32_t mat, const char *name, vec3 ke,
                                                  bool two_sided, uint32_t *index);
+/* How deep the mixes (MAT_MIX) under material mat nest: 0 for a material
+ * that is not a mix, 1 for a mix of two others, ...; more than
+ * MATERIAL_MIX_DEPTH where a mix names a material that does not come
+ * before it. (scene_material_with_emission and scene_material_with_media
+ * copy a mix with copies of its materials, so that whichever a hit meets
+ * emits, or bounds the media.) */
+PK_HIDDEN int scene_mix_depth(const pk_scene *s, uint32_t mat);
 /* Number of the newest material named name; -1 when absent. Constant time
  * (a hash index), so that files with many materials and usemtl statements
  * do not take quadratic time. */

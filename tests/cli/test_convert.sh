@@ -27,7 +27,8 @@ convert_same "$bin" "$tmp" \
   "$data/conformance/box_mr.json" "$data/conformance/box_nomtl.obj" "$data/pbrt/include_main.pbrt" \
   "$data/fuzz_seed_full.json" "$data/fuzz_seed_full.xml" "$data/tex_scene.obj" "$data/obj_mat.obj" \
   "$data/convert/lights.xml" "$data/convert/lights.pbrt" "$data/convert/lights.json" "$data/convert/spot.gltf" \
-  "$data/../../bench/scenes/materials.json" "$data/../../bench/scenes/materials.xml" || fail=1
+  "$data/../../bench/scenes/materials.json" "$data/../../bench/scenes/materials.xml" \
+  "$data/sheets/box.pbrt" "$data/sheets/box.xml" "$data/sheets/box.json" || fail=1
 
 # names: a material named as the default one, and two of one name (renamed NAME#N)
 printf '{"materials": [{"name": "default", "kd": [0.9, 0.1, 0.1]}, {"name": "twice", "kd": [0.1, 0.9, 0.1]},
@@ -91,7 +92,10 @@ else
 fi
 # the record forms refuse what no reader makes
 printf '{"materials": [{"name": "m", "record": {"type": 99}}], "spheres": [{"center": [0, 0, 0], "radius": 1}]}' >"$tmp/badtype.json"
-expect record-type 1 "badtype.json:1: materials\[0\].record: type must be in 0..6" "$bin" render "$tmp/badtype.json" -o "$tmp/e/x.pfm"
+expect record-type 1 "badtype.json:1: materials\[0\].record: type must be in 0..11" "$bin" render "$tmp/badtype.json" -o "$tmp/e/x.pfm"
+# a mix (type 9) of a material that does not come before it
+printf '{"materials": [{"name": "m", "record": {"type": 9, "mix_a": 0, "mix_b": 1}}], "spheres": [{"center": [0, 0, 0], "radius": 1}]}' >"$tmp/badmix.json"
+expect record-mix 1 "badmix.json:1: materials\[0\].record: mix_a and mix_b must be numbers of materials before this one" "$bin" render "$tmp/badmix.json" -o "$tmp/e/x.pfm"
 printf '{"lights": [{"record": {"spot_falloff": 5}}], "spheres": [{"center": [0, 0, 0], "radius": 1}]}' >"$tmp/badlight.json"
 expect record-light 1 "lights\[0\].record: spot_falloff must be 0, 1 or 2" "$bin" render "$tmp/badlight.json" -o "$tmp/e/x.pfm"
 printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nproperty int material\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2 4\n' >"$tmp/tri.ply"

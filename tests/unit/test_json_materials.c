@@ -227,10 +227,21 @@ static void test_errors(void)
 {
     const char *types =
         "must be one of \"diffuse\", \"conductor\", \"dielectric\", \"plastic\", \"metallic_roughness\", "
-        "\"emitter\", \"two_sided\", \"interface\"";
+        "\"emitter\", \"two_sided\", \"interface\", \"thin_dielectric\", \"diffuse_transmission\", \"mix\", "
+        "\"rough_diffuse\", \"phong\"";
     char want[512];
     snprintf(want, sizeof want, "scene.json:1: materials.gold.type: %s", types);
     EXPECT_ERROR(MAT("{\"type\": \"metal\"}"), want);
+    EXPECT_ERROR(MAT("{\"type\": \"mix\", \"materials\": [\"gold\", \"x\"]}"),
+                 "scene.json:1: materials.gold.materials[0]: no material named \"gold\" before this one");
+    EXPECT_ERROR(MAT("{\"type\": \"mix\"}"), "scene.json:1: materials.gold: a mix needs \"materials\": the names of two materials");
+    EXPECT_ERROR(MAT("{\"type\": \"mix\", \"materials\": \"a\"}"), "scene.json:1: materials.gold.materials: must be a list of two material names");
+    EXPECT_ERROR("{\"materials\": {\"a\": {\"type\": \"diffuse\"}, \"gold\": {\"type\": \"mix\", \"materials\": [\"a\", 3]}}}",
+                 "scene.json:1: materials.gold.materials[1]: must be a material's name");
+    EXPECT_ERROR("{\"materials\": {\"a\": {\"type\": \"diffuse\"}, \"gold\": {\"type\": \"mix\", \"materials\": [\"a\", \"a\"], "
+                 "\"amount\": 1.5}}}",
+                 "scene.json:1: materials.gold.amount: must be in 0..1");
+    EXPECT_ERROR(MAT("{\"type\": \"phong\", \"exponent\": -1}"), "scene.json:1: materials.gold.exponent: must not be negative");
     EXPECT_ERROR(MAT("{\"type\": 3}"), want);
     snprintf(want, sizeof want, "scene.json:2: spheres[0].material.type: %s", types);
     EXPECT_ERROR("{\"spheres\": [{\"center\": [0, 0, 0], \"radius\": 1,\n \"material\": {\"type\": \"Diffuse\"}}]}",
@@ -330,8 +341,49 @@ static void test_errors(void)
     EXPECT_ERROR("{\"materials\": {\"gold\": [1]}}", "scene.json:1: materials.gold: must be an object");
 }
 
+/* The thin dielectric, diffuse transmission, mix, rough diffuse and Phong
+ * types: defaults, values and the mix's references. */
+static void test_sheets(void)
+{
+    material m = one("{\"type\": \"thin_dielectric\"}");
+    CHECK(m.type == MAT_THIN_DIELECTRIC && near3(m.eta, 1.5f, 1.5f, 1.5f, 0) && near3(m.tf, 1, 1, 1, 0) && m.ni == 1.0f);
+    m = one("{\"type\": \"thin_dielectric\", \"ior\": 1.33, \"transmittance\": [0.9, 0.8, 0.7]}");
+    CHECK(m.eta.x == 1.33f && near3(m.tf, 0.9f, 0.8f, 0.7f, 0));
+    m = one("{\"type\": \"diffuse_transmission\"}"); /* pbrt-v4's defaults */
+    CHECK(m.type == MAT_DIFFUSE_TRANSMISSION && near3(m.kd, 0.25f, 0.25f, 0.25f, 0) && near3(m.tf, 0.25f, 0.25f, 0.25f, 0));
+    m = one("{\"type\": \"diffuse_transmission\", \"albedo\": [0.5, 0.4, 0.3], \"transmittance\": [0.1, 0.2, 0.3]}");
+    CHECK(near3(m.kd, 0.5f, 0.4f, 0.3f, 0) && near3(m.tf, 0.1f, 0.2f, 0.3f, 0));
+    m = one("{\"type\": \"rough_diffuse\"}");
+    CHECK(m.type == MAT_ROUGH_DIFFUSE && near3(m.kd, 0.5f, 0.5f, 0.5f, 0) && m.alpha == 0.2f);
+    m = one("{\"type\": \"rough_diffuse\", \"alpha\": 0.6, \"albedo\": [0.2, 0.3, 0.4]}");
+    CHECK(m.alpha == 0.6f && near3(m.kd, 0.2f, 0.3f, 0.4f, 0));
+    m = one("{\"type\": \"phong\"}"); /* Mitsuba's defaults */
+    CHECK(m.type == MAT_PHONG && near3(m.kd, 0.5f, 0.5f, 0.5f, 0) && near3(m.ks, 0.2f, 0.2f, 0.2f, 0) && m.ns == 30.0f);
+    m = one("{\"type\": \"phong\", \"albedo\": [0.8, 0.8, 0.8], \"specular\": [0.4, 0.2, 0.2], \"exponent\": 7}");
+    CHECK(near3(m.kd, 0.8f / 1.2f, 0.8f, 0.8f, 1e-6f) && near3(m.ks, 0.4f / 1.2f, 0.2f, 0.2f, 1e-6f) && m.ns == 7.0f);
+    /* a mix names materials before it; a mix of mixes */
+    pk_context *ctx = new_ctx();
+    pk_scene *s = NULL;
+    pk_status st = parse(ctx,
+                         "{\"materials\": {\"a\": {\"type\": \"diffuse\"}, \"b\": {\"type\": \"phong\"},"
+                         " \"ab\": {\"type\": \"mix\", \"materials\": [\"a\", \"b\"], \"amount\": 0.25},"
+                         " \"abb\": {\"type\": \"mix\", \"materials\": [\"ab\", \"b\"]}}}",
+                         &s);
+    CHECKF(st == PK_OK, "%s", pk_context_error(ctx));
+    if (st == PK_OK) {
+        const material *ab = &s->materials[scene_find_material(s, "ab")], *abb = &s->materials[scene_find_material(s, "abb")];
+        CHECK(ab->type == MAT_MIX && ab->amount == 0.25f && ab->mix_a == scene_find_material(s, "a") &&
+              ab->mix_b == scene_find_material(s, "b"));
+        CHECK(abb->type == MAT_MIX && abb->amount == 0.5f && abb->mix_a == scene_find_material(s, "ab"));
+        CHECK(scene_mix_depth(s, (uint32_t)scene_find_material(s, "abb")) == 2 && wl.count == 0);
+        scene_destroy(s);
+    }
+    pk_context_destroy(ctx);
+}
+
 int main(void)
 {
+    test_sheets();
     test_defaults();
     test_explicit();
     test_foreign_keys();

@@ -504,7 +504,17 @@ static void test_bsdfs(void)
     }
     pk_scene_destroy(bb);
     m = bsdf("<bsdf type=\"roughdiffuse\"><rgb name=\"reflectance\" value=\"0.2\"/></bsdf>");
-    CHECK(m.type == MAT_DIFFUSE && near3(m.kd, v3s(0.2f), 1e-6f) && warned("roughdiffuse"));
+    CHECK(m.type == MAT_ROUGH_DIFFUSE && near3(m.kd, v3s(0.2f), 1e-6f) && m.alpha == 0.2f && wl.count == 0);
+    m = bsdf("<bsdf type=\"roughdiffuse\"><float name=\"alpha\" value=\"0.7\"/>"
+             "<boolean name=\"useFastApprox\" value=\"true\"/></bsdf>");
+    CHECK(m.type == MAT_ROUGH_DIFFUSE && near3(m.kd, v3s(0.5f), 0) && fabsf(m.alpha - 0.7f) < 1e-7f && wl.count == 0);
+    /* phong: Mitsuba's defaults (0.5, 0.2, 30), and kd + ks above 1 scaled down */
+    m = bsdf("<bsdf type=\"phong\"/>");
+    CHECK(m.type == MAT_PHONG && near3(m.kd, v3s(0.5f), 0) && near3(m.ks, v3s(0.2f), 0) && m.ns == 30.0f &&
+          m.illum == 2 && wl.count == 0);
+    m = bsdf("<bsdf type=\"phong\"><rgb name=\"diffuseReflectance\" value=\"0.9\"/>"
+             "<rgb name=\"specularReflectance\" value=\"0.3\"/><float name=\"exponent\" value=\"5\"/></bsdf>");
+    CHECK(m.type == MAT_PHONG && near3(m.kd, v3s(0.75f), 1e-6f) && near3(m.ks, v3s(0.25f), 1e-6f) && m.ns == 5.0f);
     m = bsdf("<bsdf type=\"conductor\"><string name=\"material\" value=\"Au\"/></bsdf>");
     CHECK(m.type == MAT_CONDUCTOR && !m.schlick && m.alpha == 0.0f);
     CHECK(m.eta.x < 0.2f && m.k.x > 3.9f && m.k.z < 1.7f); /* gold: red reflects most */
@@ -543,8 +553,48 @@ static void test_bsdfs(void)
              "<float name=\"alpha\" value=\"0.2\"/><rgb name=\"specular_transmittance\" value=\"0.9 0.8 0.7\"/></bsdf>");
     CHECK(m.type == MAT_DIELECTRIC && fabsf(m.ni - 1.333f) < 1e-6f && fabsf(m.alpha - 0.2f) < 1e-6f);
     CHECK(near3(m.tf, v3(0.9f, 0.8f, 0.7f), 1e-6f));
+    /* blendbsdf and mixturebsdf: mixes chosen per hit (the second with
+     * probability weight); mixturebsdf by a chain of two-way mixes, weights
+     * short of 1 leaving the rest to a black material */
+    {
+        pk_scene *bs = load_ok("<shape type=\"rectangle\"><bsdf type=\"blendbsdf\"><float name=\"weight\" value=\"0.25\"/>"
+                               "<bsdf type=\"diffuse\"/><bsdf type=\"conductor\"/></bsdf></shape>");
+        if (bs) {
+            const material *mx = &bs->materials[bs->tris[0].material];
+            CHECK(mx->type == MAT_MIX && mx->amount == 0.25f && wl.count == 0);
+            CHECK(bs->materials[mx->mix_a].type == MAT_DIFFUSE && bs->materials[mx->mix_b].type == MAT_CONDUCTOR);
+        }
+        pk_scene_destroy(bs);
+        bs = load_ok("<shape type=\"rectangle\"><bsdf type=\"mixturebsdf\"><string name=\"weights\" value=\"0.2, 0.3 0.25\"/>"
+                     "<bsdf type=\"diffuse\"/><bsdf type=\"conductor\"/><bsdf type=\"plastic\"/></bsdf></shape>");
+        if (bs) {
+            /* 0.2 diffuse, 0.3 conductor, 0.25 plastic, 0.25 black */
+            const material *m0 = &bs->materials[bs->tris[0].material];
+            CHECK(m0->type == MAT_MIX && fabsf(m0->amount - 0.8f) < 1e-6f && wl.count == 0);
+            CHECK(bs->materials[m0->mix_a].type == MAT_DIFFUSE);
+            const material *m1 = &bs->materials[m0->mix_b];
+            CHECK(m1->type == MAT_MIX && fabsf(m1->amount - 0.5f / 0.8f) < 1e-6f &&
+                  bs->materials[m1->mix_a].type == MAT_CONDUCTOR);
+            const material *m2 = &bs->materials[m1->mix_b];
+            CHECK(m2->type == MAT_MIX && fabsf(m2->amount - 0.5f) < 1e-6f && bs->materials[m2->mix_a].type == MAT_PLASTIC &&
+                  bs->materials[m2->mix_b].type == MAT_DIFFUSE && near3(bs->materials[m2->mix_b].kd, v3s(0.0f), 0));
+        }
+        pk_scene_destroy(bs);
+        m = bsdf("<bsdf type=\"mask\"><bsdf type=\"blendbsdf\"><bsdf type=\"plastic\"/><bsdf type=\"diffuse\"/></bsdf></bsdf>");
+        CHECK(m.type == MAT_MIX && m.d == 1.0f && warned("bsdf \"mask\" over a mix of bsdfs is not supported"));
+        m = bsdf("<bsdf type=\"blendbsdf\"><bsdf type=\"plastic\"/></bsdf>");
+        CHECK(m.type == MAT_PLASTIC && warned("scene.xml:3: bsdf \"blendbsdf\" needs two nested bsdfs, not 1"));
+        load_fails("<shape type=\"rectangle\"><bsdf type=\"mixturebsdf\"><string name=\"weights\" value=\"0.5\"/>"
+                   "<bsdf type=\"diffuse\"/><bsdf type=\"diffuse\"/></bsdf></shape>",
+                   true, "needs as many weights (1) as nested bsdfs (2)");
+    }
     m = bsdf("<bsdf type=\"thindielectric\"/>");
-    CHECK(m.type == MAT_DIELECTRIC && m.ni == 1.0f && warned("thindielectric"));
+    CHECK(m.type == MAT_THIN_DIELECTRIC && fabsf(m.eta.x - 1.5046f / 1.000277f) < 1e-5f && wl.count == 0);
+    /* the Whitted integrator's clear sheet: glass of index 1 */
+    CHECK(m.ni == 1.0f && m.illum == 7);
+    m = bsdf("<bsdf type=\"thindielectric\"><float name=\"intIOR\" value=\"1.33\"/><float name=\"extIOR\" value=\"1\"/>"
+             "<rgb name=\"specularTransmittance\" value=\"0.5 0.6 0.7\"/></bsdf>");
+    CHECK(m.type == MAT_THIN_DIELECTRIC && m.eta.x == 1.33f && near3(m.tf, v3(0.5f, 0.6f, 0.7f), 1e-6f));
     m = bsdf("<bsdf type=\"roughplastic\"><rgb name=\"diffuseReflectance\" value=\"0.1 0.2 0.3\"/>"
              "<float name=\"alpha\" value=\"0.05\"/><boolean name=\"nonlinear\" value=\"true\"/></bsdf>");
     CHECK(m.type == MAT_PLASTIC && near3(m.kd, v3(0.1f, 0.2f, 0.3f), 1e-6f) && fabsf(m.ni - 1.49f / 1.000277f) < 1e-5f);
