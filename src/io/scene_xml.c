@@ -1186,6 +1186,79 @@ static xnode *nested_bsdf(xp *p, xnode *b)
 static pk_status bsdf_resolve(xp *p, xnode *b, material *m);
 static pk_status material_of(xp *p, xnode *b, uint32_t *index);
 
+/* The first texture child of b other than skip, or the texture a <ref>
+ * child names; *t NULL for none. */
+static pk_status first_texture(xp *p, xnode *b, const xnode *skip, xnode **t)
+{
+    pk_status st;
+    *t = NULL;
+    for (xnode *c = b->child; c && !*t; c = c->next) {
+        if (c == skip) continue;
+        if (strcmp(c->tag, "texture") == 0) *t = c;
+        else if (strcmp(c->tag, "ref") == 0) {
+            const char *id = attr_st(p, c, "id", &st);
+            if (st) return st;
+            xnode *r = id ? id_find(p, id) : NULL;
+            if (r && strcmp(r->tag, "texture") == 0) *t = r;
+        }
+    }
+    return PK_OK;
+}
+
+/* Mitsuba's normal map (normalmap): the nested bsdf with its shading normal
+ * taken from a bitmap of tangent-space normals, RGB -> 2 RGB - 1 in the
+ * frame of dp/du and the normal, as the material's map_norm
+ * (docs/materials.md). The bitmap is read as its "raw" property says (true,
+ * as normal maps are written: the stored values; false, Mitsuba's default:
+ * an 8-bit image decoded from sRGB). */
+static pk_status bsdf_normalmap(xp *p, const bsdf_in *in, material *m)
+{
+    xnode *b = in->b, *inner = nested_bsdf(p, b);
+    pk_status st;
+    if (!inner) {
+        xwarn(p, b, "bsdf \"%s\" without a nested bsdf; using a grey diffuse material", in->ty);
+        material_diffuse(m, v3s(0.5f));
+        return PK_OK;
+    }
+    if ((st = bsdf_resolve(p, inner, m))) return st;
+    if (m->type == MAT_MIX) {
+        xwarn(p, b, "bsdf \"%s\" over a mix of bsdfs is not supported; the mix keeps its normals", in->ty);
+        return PK_OK;
+    }
+    xnode *t;
+    if ((st = first_texture(p, b, inner, &t))) return st;
+    const char *tt = t ? attr_st(p, t, "type", &st) : NULL;
+    if (st) return st;
+    if (!t || !tt || strcmp(tt, "bitmap") != 0) {
+        xwarn(p, b, "bsdf \"%s\": only a bitmap of normals is supported; using its nested bsdf alone", in->ty);
+        return PK_OK;
+    }
+    pdict d;
+    const char *fn = NULL;
+    xnode *at;
+    bool raw = false;
+    if ((st = xml_props(p, t, &d)) || (st = get_string(p, &d, "filename", &fn, &at)) ||
+        (st = get_bool(p, &d, "raw", &raw)))
+        return st;
+    if (!fn) return xfail(p, PK_ERR_PARSE, t, "bitmap texture needs a filename");
+    char *full = path_join(&p->ctx->alloc, t->file->dir, fn);
+    if (!full) return ctx_nomem(p->ctx);
+    int32_t idx;
+    const bool was_ok = p->ctx->status == PK_OK;
+    st = texture_load(p->ctx, p->s, full, !raw, &idx);
+    mem_free(&p->ctx->alloc, full);
+    if (st != PK_OK) {
+        char why[PK_ERRMSG_MAX];
+        if (!io_demote_error(p->ctx, st, was_ok, why, sizeof why)) return st;
+        xwarn(p, t, "normal map not used (%s); the normals are the surface's", why);
+        return PK_OK;
+    }
+    tex_ref_init(&m->map_norm);
+    m->map_norm.kind = TEX_IMAGE;
+    m->map_norm.tex = idx;
+    return PK_OK;
+}
+
 /* Mitsuba's bump map (bumpmap, Mitsuba 0.x's bump): the nested bsdf with its
  * shading normal bent by a height texture, displaced along the normal in
  * scene units, as the material's map_bump with bm the product of the scale
@@ -1210,17 +1283,8 @@ static pk_status bsdf_bump(xp *p, const bsdf_in *in, material *m)
         return PK_OK;
     }
     /* the height: the first texture child (or a reference to one), through scale textures */
-    xnode *t = NULL;
-    for (xnode *c = b->child; c && !t; c = c->next) {
-        if (c == inner) continue;
-        if (strcmp(c->tag, "texture") == 0) t = c;
-        else if (strcmp(c->tag, "ref") == 0) {
-            const char *id = attr_st(p, c, "id", &st);
-            if (st) return st;
-            xnode *r = id ? id_find(p, id) : NULL;
-            if (r && strcmp(r->tag, "texture") == 0) t = r;
-        }
-    }
+    xnode *t;
+    if ((st = first_texture(p, b, inner, &t))) return st;
     for (int depth = 0; t && depth <= XML_MAX_BSDF_DEPTH; depth++) {
         const char *tt = attr_st(p, t, "type", &st);
         if (st) return st;
@@ -1355,7 +1419,7 @@ static pk_status bsdf_coating(xp *p, const bsdf_in *in, material *m)
     return PK_OK;
 }
 
-/* normalmap, polarizer, measured: the nested bsdf alone */
+/* polarizer, measured: the nested bsdf alone */
 static pk_status bsdf_nested_only(xp *p, const bsdf_in *in, material *m)
 {
     xnode *inner = nested_bsdf(p, in->b);
@@ -1642,7 +1706,7 @@ static const bsdf_row bsdf_rows[] = {
     {"roughcoating", bsdf_coating, false, 0.0f, NULL},
     {"bumpmap", bsdf_bump, false, 0.0f, NULL},
     {"bump", bsdf_bump, false, 0.0f, NULL},
-    {"normalmap", bsdf_nested_only, false, 0.0f, NULL},
+    {"normalmap", bsdf_normalmap, false, 0.0f, NULL},
     {"blendbsdf", bsdf_blend, false, 0.0f, ""},
     {"mixturebsdf", bsdf_mixture, false, 0.0f, ""},
     {"polarizer", bsdf_nested_only, false, 0.0f, NULL},

@@ -653,6 +653,13 @@ static void test_bsdfs(void)
     m = bsdf("<bsdf type=\"bumpmap\"><float name=\"scale\" value=\"0.25\"/><texture type=\"bitmap\">"
              "<string name=\"filename\" value=\"t.pfm\"/></texture><bsdf type=\"diffuse\"/></bsdf>");
     CHECK(m.type == MAT_DIFFUSE && m.map_bump.kind == TEX_IMAGE && m.map_bump.bm == 0.25f && wl.count == 0);
+    /* normal maps: the bitmap (raw, as normal maps are given) becomes the nested bsdf's map_norm */
+    m = bsdf("<bsdf type=\"normalmap\"><texture name=\"normalmap\" type=\"bitmap\"><boolean name=\"raw\" value=\"true\"/>"
+             "<string name=\"filename\" value=\"t.pfm\"/></texture><bsdf type=\"roughplastic\"/></bsdf>");
+    CHECK(m.type == MAT_PLASTIC && m.map_norm.kind == TEX_IMAGE && m.map_bump.kind == TEX_NONE && wl.count == 0);
+    m = bsdf("<bsdf type=\"normalmap\"><texture type=\"checkerboard\"/><bsdf type=\"diffuse\"/></bsdf>");
+    CHECK(m.type == MAT_DIFFUSE && m.map_norm.kind == TEX_NONE &&
+          warned("bsdf \"normalmap\": only a bitmap of normals is supported; using its nested bsdf alone"));
     m = bsdf("<bsdf type=\"roughplastic\"><texture name=\"diffuse_reflectance\" type=\"bitmap\"><string name=\"filename\" "
              "value=\"t.pfm\"/></texture></bsdf>");
     CHECK(m.type == MAT_PLASTIC && near3(m.kd, v3s(1.0f), 0) && m.map_kd.kind == TEX_IMAGE);
