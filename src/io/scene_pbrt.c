@@ -695,6 +695,29 @@ static pk_status coat_layer(pp *p, float *thick, vec3 *albedo)
     return pb_int(&p->pd, "nsamples", 0, 1 << 20, &ns);
 }
 
+/* An image file named in the scene (relative to the current file), loaded
+ * once as a texture: *idx its index, or -1 when it cannot be used, with the
+ * reason in why (a warning for the caller to give); other failures return. */
+static pk_status load_image(pp *p, const char *fn, bool colour, int32_t *idx, char *why, size_t nwhy)
+{
+    *idx = -1;
+    char *path = path_join(A(p), p->f->dir, fn);
+    if (!path) return ctx_nomem(p->ctx);
+    const bool was_ok = p->ctx->status == PK_OK;
+    pk_status st = texture_load(p->ctx, p->s, path, colour, idx);
+    mem_free(A(p), path);
+    if (st == PK_OK) return PK_OK;
+    *idx = -1;
+    return io_demote_error(p->ctx, st, was_ok, why, nwhy) ? PK_OK : st;
+}
+
+/* pbrt-v4 decodes PNG files from sRGB and reads the others as linear. */
+static bool png_name(const char *fn)
+{
+    const size_t fl = strlen(fn);
+    return fl >= 4 && (strcmp(fn + fl - 4, ".png") == 0 || strcmp(fn + fl - 4, ".PNG") == 0);
+}
+
 /* Fills m from a material's type and the current parameters. */
 static pk_status build_material(pp *p, const char *type, material *m, bool *interface, int depth)
 {
@@ -803,15 +826,10 @@ static pk_status build_material(pp *p, const char *type, material *m, bool *inte
     pparam *q;
     if ((st = pb_typed(&p->pd, "normalmap", TB(PT_STRING), "a file name", &q))) return st;
     if (q && q->nstr == 1) {
-        char *path = path_join(A(p), p->f->dir, q->str[0]);
-        if (!path) return ctx_nomem(p->ctx);
         int32_t idx;
-        const bool was_ok = p->ctx->status == PK_OK;
-        st = texture_load(p->ctx, p->s, path, false, &idx);
-        mem_free(A(p), path);
-        if (st != PK_OK) {
-            char why[PK_ERRMSG_MAX];
-            if (!io_demote_error(p->ctx, st, was_ok, why, sizeof why)) return st;
+        char why[PK_ERRMSG_MAX];
+        if ((st = load_image(p, q->str[0], false, &idx, why, sizeof why))) return st;
+        if (idx < 0) {
             pwarn(p, q->line, "normal map not used (%s)", why);
         } else {
             tex_ref_init(&m->map_norm);
@@ -1849,17 +1867,10 @@ static pk_status mapped_light(pp *p, bool gonio, const xform *w, float scale)
     }
     if (!gonio && !(fov > 0.0f && fov < 180.0f))
         return pfail(p, p->line, PK_ERR_PARSE, "projection: fov %g must be between 0 and 180 degrees", (double)fov);
-    const size_t fl = strlen(fn);
-    const bool colour = fl >= 4 && (strcmp(fn + fl - 4, ".png") == 0 || strcmp(fn + fl - 4, ".PNG") == 0);
-    char *path = path_join(A(p), p->f->dir, fn);
-    if (!path) return ctx_nomem(p->ctx);
     int32_t idx;
-    const bool was_ok = p->ctx->status == PK_OK;
-    st = texture_load(p->ctx, p->s, path, colour, &idx);
-    mem_free(A(p), path);
-    if (st != PK_OK) {
-        char why[PK_ERRMSG_MAX];
-        if (!io_demote_error(p->ctx, st, was_ok, why, sizeof why)) return st;
+    char why[PK_ERRMSG_MAX];
+    if ((st = load_image(p, fn, png_name(fn), &idx, why, sizeof why))) return st;
+    if (idx < 0) {
         pwarn(p, p->line, "%s: the image is not used (%s); the light is skipped", what, why);
         return PK_OK;
     }
@@ -2097,17 +2108,10 @@ static pk_status d_area_light(pp *p, const char *type)
     if (fn) { /* the image's linear RGB is the radiance (times scale), looked up by the shape's uv */
         if (pb_param(&p->pd, "L"))
             return pfail(p, p->line, PK_ERR_PARSE, "AreaLightSource: give either 'L' or 'filename', not both");
-        size_t fl = strlen(fn);
-        const bool colour = fl >= 4 && (strcmp(fn + fl - 4, ".png") == 0 || strcmp(fn + fl - 4, ".PNG") == 0);
-        char *path = path_join(A(p), p->f->dir, fn);
-        if (!path) return ctx_nomem(p->ctx);
         int32_t idx;
-        const bool was_ok = p->ctx->status == PK_OK;
-        st = texture_load(p->ctx, p->s, path, colour, &idx);
-        mem_free(A(p), path);
-        if (st != PK_OK) {
-            char why[PK_ERRMSG_MAX];
-            if (!io_demote_error(p->ctx, st, was_ok, why, sizeof why)) return st;
+        char why[PK_ERRMSG_MAX];
+        if ((st = load_image(p, fn, png_name(fn), &idx, why, sizeof why))) return st;
+        if (idx < 0) {
             pwarn(p, p->line, "AreaLightSource: the emission image is not used (%s); a uniform radiance %g is",
                   why, (double)scale);
         } else {
@@ -2344,21 +2348,15 @@ static pk_status d_texture(pp *p, const char *name, const char *kind, const char
         pb_param(&p->pd, "maxanisotropy");
         if (!fn) return pfail(p, p->line, PK_ERR_PARSE, "imagemap \"%.60s\" needs 'string filename'", name);
         /* pbrt-v4's default: sRGB for PNG files, linear for the others */
-        size_t fl = strlen(fn);
-        bool colour = fl >= 4 && (strcmp(fn + fl - 4, ".png") == 0 || strcmp(fn + fl - 4, ".PNG") == 0);
+        bool colour = png_name(fn);
         if (enc && strcmp(enc, "linear") == 0) colour = false;
         else if (enc && strcmp(enc, "sRGB") == 0) colour = true;
         else if (enc) pwarn(p, p->line, "imagemap: encoding \"%.20s\" is read as sRGB", enc);
         if (invert) pwarn(p, p->line, "imagemap: 'invert' is not supported; the image is used as it is");
-        char *path = path_join(A(p), p->f->dir, fn);
-        if (!path) return ctx_nomem(p->ctx);
         int32_t idx;
-        const bool was_ok = p->ctx->status == PK_OK;
-        st = texture_load(p->ctx, p->s, path, colour, &idx);
-        mem_free(A(p), path);
-        if (st != PK_OK) {
-            char why[PK_ERRMSG_MAX];
-            if (!io_demote_error(p->ctx, st, was_ok, why, sizeof why)) return st;
+        char why[PK_ERRMSG_MAX];
+        if ((st = load_image(p, fn, colour, &idx, why, sizeof why))) return st;
+        if (idx < 0) {
             pwarn(p, p->line, "texture \"%.60s\" not used (%s); the constant %g stands in", name, why, (double)sc);
             t.value = v3s(sc);
         } else {
