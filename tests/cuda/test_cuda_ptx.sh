@@ -11,11 +11,13 @@
 # (The path tracer, src/render/cuda/path.cu, is not checked: its shading
 # calls sinf, expf and friends, whose library code uses fma on purpose; its
 # traversal is the same code compiled with the same flags.)
-# Usage: test_cuda_ptx.sh NVCC SOURCE_DIR FLAGS...
+# Usage: test_cuda_ptx.sh NVCC SOURCE_DIR REPORT_DIR FLAGS...
+# (REPORT_DIR: the build's cuda/, where the build keeps ptxas's reports)
 set -u
 nvcc=$1
 src=$2
-shift 2
+reports=$3
+shift 3
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 fails=0
@@ -57,23 +59,24 @@ n_fused=$(grep -c 'fma\.' "$tmp/fused.ptx")
 [ "$n_fused" -gt "$n_fma" ] || fail "no more fma with -fmad=true: the check proves nothing"
 echo "PTX: $n_rn rounded float operations, $n_fma fma (box tests), $n_approx approximate (with -fmad=true: $n_fused fma)"
 
-# Resources per kernel as ptxas reports them for sm_90 (the H100), with the
-# build's flags: registers, stack frame, spills. Written to
-# cuda_resources.txt in the working directory (the build's tests/), the
-# table docs/gpu.md reads; the traversal kernels must not spill, and the
-# ordered traversal's stack frame must be its 64 entries, half the sorted
-# one's.
-resources() { # SOURCE -> lines "kernel registers stack spill_stores spill_loads"
-    "$nvcc" -cubin -arch=sm_90 "${flags[@]}" -Xptxas -v -I"$src/src" -I"$src/include" -o "$tmp/r.cubin" "$1" 2>&1 |
-        awk '/Compiling entry function/ { k = $0; sub(/.*function .?/, "", k); sub(/.? for .*/, "", k) }
-             /bytes stack frame/ && k != "" { st = $1; ss = $5; sl = $9 }
-             /Used [0-9]+ registers/ && k != "" { r = $0; sub(/.*Used /, "", r); sub(/ registers.*/, "", r);
-                                                  print k, r, st + 0, ss + 0, sl + 0; k = "" }'
+# Resources per kernel as ptxas reported them for sm_90 (the H100) when the
+# build compiled the kernels (cmake/nvcc_report.sh keeps the report in
+# REPORT_DIR/NAME.ptxas.txt; compiling path.cu again here took minutes):
+# registers, stack frame, spills. Written to cuda_resources.txt in the
+# working directory (the build's tests/), the table docs/gpu.md reads; the
+# traversal kernels must not spill, and the ordered traversal's stack frame
+# must be its 64 entries, half the sorted one's.
+resources() { # REPORT -> lines "kernel registers stack spill_stores spill_loads" (sm_90)
+    [ -r "$1" ] || { echo "FAIL: no ptxas report $1 (is the build complete?)" >&2; return 1; }
+    awk '/Compiling entry function/ { k = ""; if ($0 ~ /for .sm_90.$/) { k = $0; sub(/.*function .?/, "", k); sub(/.? for .*/, "", k) } }
+         /bytes stack frame/ && k != "" { st = $1; ss = $5; sl = $9 }
+         /Used [0-9]+ registers/ && k != "" { r = $0; sub(/.*Used /, "", r); sub(/ registers.*/, "", r);
+                                              print k, r, st + 0, ss + 0, sl + 0; k = "" }' "$1"
 }
 flags=("$@")
 {
-    resources "$src/src/accel/cuda/trace.cu"
-    resources "$src/src/render/cuda/path.cu"
+    resources "$reports/trace.ptxas.txt" || fails=$((fails + 1))
+    resources "$reports/path.ptxas.txt" || fails=$((fails + 1))
 } > "$tmp/res.txt"
 {
     echo "# kernel registers stack_bytes spill_store_bytes spill_load_bytes (ptxas, sm_90, flags: ${flags[*]})"
