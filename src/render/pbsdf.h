@@ -246,6 +246,7 @@ static inline PK_HD float pbsdf__fresnel_conductor1(float cos_i, float eta, floa
     float t1 = a2b2 + cos2;
     float a = sqrtf(fmaxf(0.0f, 0.5f * (a2b2 + t0)));
     float t2 = 2.0f * cos_i * a;
+    if (!(t1 + t2 > 0.0f)) return 1.0f; /* grazing on an index-matched surface (eta 1, k 0): the limit */
     float rs = (t1 - t2) / (t1 + t2);
     float t3 = cos2 * a2b2 + sin2 * sin2;
     float t4 = t2 * sin2;
