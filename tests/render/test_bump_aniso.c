@@ -4,13 +4,16 @@
  * (surface_at, surface_texture, shading_at): a height that is a linear
  * function of u tilts the shading normal by the closed-form angle; a
  * constant displacement changes nothing; the shading frame's x axis follows
- * dp/du of the uv parameterisation (or, without uvs, pbrt's default uvs).
+ * dp/du of the uv parameterisation (or, without uvs, pbrt's default uvs);
+ * the readers give two roughnesses where their formats do (pbrt, Mitsuba,
+ * JSON) and average them, with a warning, where they do not.
  */
 #include "test.h"
 
 #include "paprsek.h"
 #include "render/shading.h"
 #include "scene/scene.h"
+#include "warnings.h"
 
 static pk_context *ctx;
 
@@ -145,11 +148,86 @@ static void test_tangent_frame(void)
     pk_scene_destroy(s);
 }
 
+/* The material of scene text in format fmt, with its warnings. */
+static material first_material(const char *fmt, const char *text, warning_log *w)
+{
+    warning_log_clear(w);
+    warning_log_attach(ctx, w);
+    pk_scene *s = NULL;
+    pk_status st = pk_scene_load_memory(ctx, fmt, text, strlen(text), "m", ".", &s);
+    pk_context_set_warning_handler(ctx, NULL, NULL);
+    CHECKF(st == PK_OK, "%s", pk_context_error(ctx));
+    REQUIRE(st == PK_OK && s->nmaterials >= 1);
+    /* the scene's one conductor, dielectric or plastic (a default material may come first) */
+    material m = s->materials[0];
+    for (size_t i = 0; i < s->nmaterials; i++)
+        if (s->materials[i].type == MAT_CONDUCTOR || s->materials[i].type == MAT_DIELECTRIC ||
+            s->materials[i].type == MAT_PLASTIC)
+            m = s->materials[i];
+    m.name = NULL;
+    pk_scene_destroy(s);
+    return m;
+}
+
+static void test_readers(void)
+{
+    static warning_log w;
+    material m;
+    /* Mitsuba: alpha_u along dp/du on roughconductor and roughdielectric */
+    m = first_material("xml",
+                       "<scene version=\"0.6.0\"><bsdf type=\"roughconductor\" id=\"a\"><float name=\"alpha_u\" "
+                       "value=\"0.05\"/><float name=\"alpha_v\" value=\"0.3\"/></bsdf>"
+                       "<shape type=\"sphere\"><ref id=\"a\"/></shape></scene>",
+                       &w);
+    CHECKF(m.type == MAT_CONDUCTOR && m.alpha == 0.05f && m.alpha_v == 0.3f && m.beckmann && w.count == 0,
+           "roughconductor: alpha %g alpha_v %g, %d warnings: %s", (double)m.alpha, (double)m.alpha_v, w.count, w.all);
+    m = first_material("xml",
+                       "<scene version=\"0.6.0\"><bsdf type=\"roughdielectric\" id=\"a\"><string name=\"distribution\" "
+                       "value=\"ggx\"/><float name=\"alpha_u\" value=\"0.2\"/><float name=\"alpha_v\" value=\"0.1\"/>"
+                       "</bsdf><shape type=\"sphere\"><ref id=\"a\"/></shape></scene>",
+                       &w);
+    CHECK(m.type == MAT_DIELECTRIC && m.alpha == 0.2f && m.alpha_v == 0.1f && !m.beckmann && w.count == 0);
+    /* roughplastic has no alpha_u/alpha_v in Mitsuba: their mean, warned */
+    m = first_material("xml",
+                       "<scene version=\"0.6.0\"><bsdf type=\"roughplastic\" id=\"a\"><float name=\"alpha_u\" "
+                       "value=\"0.1\"/><float name=\"alpha_v\" value=\"0.3\"/></bsdf>"
+                       "<shape type=\"sphere\"><ref id=\"a\"/></shape></scene>",
+                       &w);
+    CHECKF(m.type == MAT_PLASTIC && fabsf(m.alpha - 0.2f) < 1e-6f && m.alpha_v < 0.0f &&
+               strstr(w.all, "anisotropic roughness is not supported here"),
+           "roughplastic: alpha %g alpha_v %g: %s", (double)m.alpha, (double)m.alpha_v, w.all);
+    /* JSON */
+    m = first_material("json",
+                       "{\"materials\": {\"m\": {\"type\": \"conductor\", \"alpha_u\": 0.05, \"alpha_v\": 0.3}},"
+                       " \"spheres\": [{\"center\": [0, 0, 0], \"radius\": 1, \"material\": \"m\"}]}",
+                       &w);
+    CHECK(m.type == MAT_CONDUCTOR && m.alpha == 0.05f && m.alpha_v == 0.3f && w.count == 0);
+    m = first_material("json",
+                       "{\"materials\": {\"m\": {\"type\": \"dielectric\", \"roughness\": 0.5, \"alpha_v\": 0.1}},"
+                       " \"spheres\": [{\"center\": [0, 0, 0], \"radius\": 1, \"material\": \"m\"}]}",
+                       &w);
+    CHECK(m.type == MAT_DIELECTRIC && m.alpha == 0.25f && m.alpha_v == 0.1f);
+    /* pbrt: the coated materials keep the mean (and say so) */
+    m = first_material("pbrt",
+                       "WorldBegin\nMaterial \"coateddiffuse\" \"float uroughness\" 0.04 \"float vroughness\" 0.16\n"
+                       "Shape \"sphere\"\n",
+                       &w);
+    CHECKF(m.type == MAT_PLASTIC && fabsf(m.alpha - 0.3f) < 1e-6f && m.alpha_v < 0.0f &&
+               strstr(w.all, "is rendered isotropic"),
+           "coateddiffuse: alpha %g alpha_v %g: %s", (double)m.alpha, (double)m.alpha_v, w.all);
+    m = first_material("pbrt",
+                       "WorldBegin\nMaterial \"dielectric\" \"float uroughness\" 0.04 \"float vroughness\" 0.16 "
+                       "\"bool remaproughness\" false\nShape \"sphere\"\n",
+                       &w);
+    CHECK(m.type == MAT_DIELECTRIC && m.alpha == 0.04f && m.alpha_v == 0.16f && w.count == 0);
+}
+
 int main(void)
 {
     REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
     test_displacement();
     test_tangent_frame();
+    test_readers();
     pk_context_destroy(ctx);
     if (test_failures) fprintf(stderr, "%d check(s) failed\n", test_failures);
     return test_failures ? 1 : 0;
