@@ -2624,7 +2624,10 @@ static pk_status parse_shape(xp *p, xnode *sh)
         float tol = 1e-4f * lx;
         bool similar = fabsf(lx - ly) <= tol && fabsf(lx - lz) <= tol && fabsf(v3_dot(cx, cy)) <= tol * lx &&
                        fabsf(v3_dot(cx, cz)) <= tol * lx && fabsf(v3_dot(cy, cz)) <= tol * lx;
-        if (similar && !flip && !p->sb.in_object) { /* (a shapegroup's spheres are meshes) */
+        /* anisotropic roughness follows Mitsuba's dp/du (phi about the sphere's
+         * own z axis), which only the mesh keeps */
+        const bool aniso = material_anisotropic(&p->s->materials[mat]);
+        if (similar && !flip && !p->sb.in_object && !aniso) { /* (a shapegroup's spheres are meshes) */
             sphere sp = {xform_point(&full, v3s(0.0f)), lx, mat};
             if (!v3_finite(sp.center) || !(sp.radius > 0.0f) || !isfinite(sp.radius))
                 return xfail(p, PK_ERR_PARSE, sh, "sphere: the transformed sphere is not finite");
