@@ -26,7 +26,8 @@ typedef pk_status (*mat_create_fn)(pdict *d, const mat_row *row, const mat_commo
 struct mat_row {
     mat_dialect dialect;
     const char *type;
-    const char *params[16];
+#define MAT_MAX_PARAMS 16
+    const char *params[MAT_MAX_PARAMS];
     mat_create_fn create; /* NULL: the interface (no surface) */
 };
 
@@ -34,7 +35,7 @@ struct mat_row {
  * parameter of the row (an unknown key, reported already). */
 static const pd_entry *param(pdict *d, const mat_row *row, const char *name)
 {
-    for (int i = 0; i < 8 && row->params[i]; i++)
+    for (int i = 0; i < MAT_MAX_PARAMS && row->params[i]; i++)
         if (strcmp(row->params[i], name) == 0) return pd_get(d, name);
     return NULL;
 }
@@ -208,7 +209,7 @@ static pk_status create_coated(pdict *d, const mat_row *row, const mat_common *c
         (st = pd_vec3(d, "layer_albedo", l.albedo, PD_V_REFLECTANCE, &l.albedo)) ||
         (st = pd_float(d, "g", l.g, PD_ANY, &l.g)))
         return st;
-    if (!(l.g > -1.0f && l.g < 1.0f)) return pd_fail(d, param(d, row, "g"), -1, PK_ERR_PARSE, "must be in (-1, 1)");
+    if (!(l.g > -1.0f && l.g < 1.0f)) return pd_fail(d, pd_get(d, "g"), -1, PK_ERR_PARSE, "must be in (-1, 1)");
     if ((st = pd_int(d, "maxdepth", l.maxdepth, 1, 65536, &l.maxdepth)) ||
         (st = pd_int(d, "nsamples", l.nsamples, 1, 65536, &l.nsamples)))
         return st;
@@ -466,7 +467,7 @@ static pk_status create_typed(pdict *d, const pd_entry *type_entry, material *m)
     static const char *const common[] = {"type", "two_sided", "opacity", "bump", "normal_map", "interior", "exterior"};
     pd_declare(d, common, sizeof common / sizeof common[0]);
     size_t np = 0;
-    while (np < 8 && row->params[np]) np++;
+    while (np < MAT_MAX_PARAMS && row->params[np]) np++;
     pd_declare(d, row->params, np);
     pk_status st = pd_report_unused(d);
     if (st) return st;

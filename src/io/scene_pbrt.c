@@ -641,8 +641,9 @@ static pk_status coat_layer(pp *p, material_layer *l)
     int64_t md = 10, ns = 1;
     *l = material_layer_default();
     pk_status st;
-    if ((st = get_float_tex(p, "thickness", &l->thickness, NULL)) || (st = get_colour(p, "albedo", &l->albedo, NULL, NULL)) ||
-        (st = get_float_tex(p, "g", &l->g, NULL)) || (st = pb_int(&p->pd, "maxdepth", 1, 1 << 16, &md)) ||
+    if ((st = get_float_tex(p, "thickness", &l->thickness, NULL)) ||
+        (st = get_colour(p, "albedo", &l->albedo, NULL, NULL)) || (st = get_float_tex(p, "g", &l->g, NULL)) ||
+        (st = pb_int(&p->pd, "maxdepth", 1, 1 << 16, &md)) ||
         (st = pb_int(&p->pd, "nsamples", 1, 1 << 16, &ns)))
         return st;
     if (!(l->thickness > 0.0f) || !isfinite(l->thickness)) {
@@ -720,13 +721,15 @@ static pk_status build_material(pp *p, const char *type, material *m, bool *inte
         tex_ref_init(&tr);
         spectra_named_metal("Cu", &ce, &ck);
         if ((st = get_roughness(p, "interface.", &alpha, &ta)) || (st = get_eta(p, "interface.eta", 1.5f, &eta)) ||
-            (st = get_roughness(p, "conductor.", &ba, NULL)) || (st = get_colour(p, "reflectance", &refl, &tr, &has_refl)) ||
-            (st = get_colour(p, "conductor.eta", &ce, NULL, &fe)) || (st = get_colour(p, "conductor.k", &ck, NULL, &fk)) ||
-            (st = coat_layer(p, &layer)))
+            (st = get_roughness(p, "conductor.", &ba, NULL)) ||
+            (st = get_colour(p, "reflectance", &refl, &tr, &has_refl)) ||
+            (st = get_colour(p, "conductor.eta", &ce, NULL, &fe)) ||
+            (st = get_colour(p, "conductor.k", &ck, NULL, &fk)) || (st = coat_layer(p, &layer)))
             return st;
         if (has_refl) {
             if (fe || fk)
-                pwarn(p, p->line, "coatedconductor: both reflectance and conductor.eta/k are given; reflectance is used");
+                pwarn(p, p->line,
+                      "coatedconductor: both reflectance and conductor.eta/k are given; reflectance is used");
             material_coated_conductor_f0(m, refl, ba, eta, alpha, layer);
             m->map_ks = tr;
         } else {

@@ -280,11 +280,11 @@ static void bsdf_est(const pbsdf *b, vec3 wo, long n, est *alb_s, est bins[NB], 
         const float u[3] = {rng_float(&r), rng_float(&r), rng_float(&r)};
         vec3 wi, wt;
         float pdf;
-        bool delta;
+        bool is_delta;
         double w = 0;
-        if (pbsdf_sample(b, wo, u, &wi, &wt, &pdf, &delta)) {
+        if (pbsdf_sample(b, wo, u, &wi, &wt, &pdf, &is_delta)) {
             w = wt.x;
-            if (delta) dl += w, dl2 += w * w;
+            if (is_delta) dl += w, dl2 += w * w;
         }
         s += w, s2 += w * w;
     }
@@ -294,9 +294,9 @@ static void bsdf_est(const pbsdf *b, vec3 wo, long n, est *alb_s, est bins[NB], 
         double e = 0, e2 = 0;
         for (long i = 0; i < n / NB; i++) {
             /* uniform in solid angle within the bin: cos uniform in [k, k+1) / NB */
-            double c = (k + rng_float(&r)) / NB, ph = 2.0 * M_PI * rng_float(&r), sn = sqrt(1.0 - c * c);
+            double c = (k + (double)rng_float(&r)) / NB, ph = 2.0 * M_PI * (double)rng_float(&r), sn = sqrt(1.0 - c * c);
             vec3 wi = v3((float)(sn * cos(ph)), (float)(sn * sin(ph)), (float)c);
-            double v = pbsdf_eval(b, wo, wi).x * (2.0 * M_PI / NB); /* f cos / (pdf = NB / 2 pi) */
+            double v = (double)pbsdf_eval(b, wo, wi).x * (2.0 * M_PI / NB); /* f cos / (pdf = NB / 2 pi) */
             e += v, e2 += v * v;
         }
         bins[k] = finish(e, e2, n / NB);
@@ -430,10 +430,10 @@ static void test_sampling(void)
         double s = 0, s2 = 0;
         const int t = c / NP, p = c % NP;
         for (long i = 0; i < m; i++) {
-            double c2 = (t + rng_float(&r)) / NT, ph = ((p + rng_float(&r)) / NP - 0.5) * 2.0 * M_PI;
+            double c2 = (t + (double)rng_float(&r)) / NT, ph = ((p + (double)rng_float(&r)) / NP - 0.5) * 2.0 * M_PI;
             double cz = sqrt(c2), sn = sqrt(1.0 - c2);
             vec3 wi = v3((float)(sn * cos(ph)), (float)(sn * sin(ph)), (float)cz);
-            double v = pbsdf_eval(&b, wo, wi).x / cz * (M_PI / NC); /* f cos / (cos / (pi / NC)) */
+            double v = (double)pbsdf_eval(&b, wo, wi).x / cz * (M_PI / NC); /* f cos / (cos / (pi / NC)) */
             s += v, s2 += v * v;
         }
         e[c] = s / m;
