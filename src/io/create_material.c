@@ -26,7 +26,8 @@ typedef pk_status (*mat_create_fn)(pdict *d, const mat_row *row, const mat_commo
 struct mat_row {
     mat_dialect dialect;
     const char *type;
-    const char *params[8];
+#define MAT_MAX_PARAMS 16
+    const char *params[MAT_MAX_PARAMS];
     mat_create_fn create; /* NULL: the interface (no surface) */
 };
 
@@ -34,7 +35,7 @@ struct mat_row {
  * parameter of the row (an unknown key, reported already). */
 static const pd_entry *param(pdict *d, const mat_row *row, const char *name)
 {
-    for (int i = 0; i < 8 && row->params[i]; i++)
+    for (int i = 0; i < MAT_MAX_PARAMS && row->params[i]; i++)
         if (strcmp(row->params[i], name) == 0) return pd_get(d, name);
     return NULL;
 }
@@ -199,6 +200,59 @@ static pk_status create_phong(pdict *d, const mat_row *row, const mat_common *c,
     return PK_OK;
 }
 
+/* pbrt-v4's layered material: a coat ("ior", "roughness" or "alpha") over a
+ * Lambertian base ("albedo", 0.5) or, where "eta"/"k" or "specular" is
+ * given, a conductor of that index (relative to vacuum) or normal-incidence
+ * reflectance with "base_roughness" or "base_alpha"; the layer between:
+ * "thickness" 0.01, "layer_albedo" 0, "g" 0, "maxdepth" 10, "nsamples" 1
+ * (pbrt-v4's defaults) */
+static pk_status create_coated(pdict *d, const mat_row *row, const mat_common *c, material *m)
+{
+    material_layer l = material_layer_default();
+    const pd_entry *spec = param(d, row, "specular"), *pe = param(d, row, "eta"), *pk = param(d, row, "k");
+    const pd_entry *alb = param(d, row, "albedo"), *br = param(d, row, "base_roughness"),
+                   *ba = param(d, row, "base_alpha");
+    const bool metal = spec || pe || pk;
+    pk_status st;
+    if (metal && alb)
+        return pd_fail(d, alb, -1, PK_ERR_PARSE,
+                       "a coated conductor (\"eta\", \"k\" or \"specular\") has no diffuse \"albedo\"");
+    if (!metal && (br || ba))
+        return pd_fail(d, br ? br : ba, -1, PK_ERR_PARSE,
+                       "is the conductor base's roughness: give \"eta\" and \"k\" or \"specular\"");
+    if (spec && (pe || pk))
+        return pd_fail(d, pe ? pe : pk, -1, PK_ERR_PARSE, "give \"eta\" and \"k\" or \"specular\", not both");
+    if (br && ba) return pd_fail(d, ba, -1, PK_ERR_PARSE, "give \"base_roughness\" or \"base_alpha\", not both");
+    float balpha = 0.0f;
+    if (br) {
+        if ((st = pd_float(d, "base_roughness", 0.0f, PD_UNIT, &balpha))) return st;
+        balpha *= balpha;
+    } else if (ba && (st = pd_float(d, "base_alpha", 0.0f, PD_UNIT, &balpha))) {
+        return st;
+    }
+    if ((st = pd_float(d, "thickness", l.thickness, PD_POSITIVE, &l.thickness)) ||
+        (st = pd_vec3(d, "layer_albedo", l.albedo, PD_V_REFLECTANCE, &l.albedo)) ||
+        (st = pd_float(d, "g", l.g, PD_ANY, &l.g)))
+        return st;
+    if (!(l.g > -1.0f && l.g < 1.0f)) return pd_fail(d, pd_get(d, "g"), -1, PK_ERR_PARSE, "must be in (-1, 1)");
+    if ((st = pd_int(d, "maxdepth", l.maxdepth, 1, 65536, &l.maxdepth)) ||
+        (st = pd_int(d, "nsamples", l.nsamples, 1, 65536, &l.nsamples)))
+        return st;
+    if (!metal) {
+        material_coated_diffuse(m, c->albedo, c->ior, c->alpha, l);
+        return PK_OK;
+    }
+    vec3 eta = v3(0.2f, 0.92f, 1.1f), k = v3(3.9f, 2.45f, 2.14f); /* copper, as pbrt */
+    vec3 f0 = v3s(-1.0f);
+    if (c->tex_specular.x >= 0.0f) f0 = c->tex_specular;
+    else if (spec && (st = pd_vec3(d, "specular", f0, PD_V_REFLECTANCE, &f0))) return st;
+    if (pe && (st = pd_vec3(d, "eta", eta, PD_V_POSITIVE, &eta))) return st;
+    if (pk && (st = pd_vec3(d, "k", k, PD_V_NONNEG, &k))) return st;
+    if (f0.x >= 0.0f) material_coated_conductor_f0(m, f0, balpha, c->ior, c->alpha, l);
+    else material_coated_conductor(m, eta, k, balpha, c->ior, c->alpha, l);
+    return PK_OK;
+}
+
 /* mix: "materials", two names of materials defined before it, and
  * "amount" (0.5 by default), the probability of the second: a number in
  * 0..1 or a texture */
@@ -315,6 +369,11 @@ static const mat_row mat_rows[] = {
     {MD_PAPRSEK, "mix", {"materials", "amount"}, create_mix},
     {MD_PAPRSEK, "rough_diffuse", {"albedo", "alpha"}, create_rough_diffuse},
     {MD_PAPRSEK, "phong", {"albedo", "specular", "exponent"}, create_phong},
+    {MD_PAPRSEK,
+     "coated",
+     {"albedo", "ior", "roughness", "alpha", "eta", "k", "specular", "base_roughness", "base_alpha", "thickness",
+      "layer_albedo", "g", "maxdepth", "nsamples"},
+     create_coated},
 };
 #define N_MAT_ROWS (sizeof mat_rows / sizeof mat_rows[0])
 
@@ -426,14 +485,14 @@ static pk_status create_typed(pdict *d, const pd_entry *type_entry, material *m)
         return pd_fail(d, type_entry, -1, PK_ERR_PARSE,
                        "must be one of \"diffuse\", \"conductor\", \"dielectric\", \"plastic\", "
                        "\"metallic_roughness\", \"emitter\", \"two_sided\", \"interface\", \"thin_dielectric\", "
-                       "\"diffuse_transmission\", \"mix\", \"rough_diffuse\", \"phong\"");
+                       "\"diffuse_transmission\", \"mix\", \"rough_diffuse\", \"phong\", \"coated\"");
     const mat_row *row = &mat_rows[t];
     /* the known keys: "type", "two_sided", the maps, the type's parameters
      * and the media (read by the caller) */
     static const char *const common[] = {"type", "two_sided", "opacity", "bump", "normal_map", "interior", "exterior"};
     pd_declare(d, common, sizeof common / sizeof common[0]);
     size_t np = 0;
-    while (np < 8 && row->params[np]) np++;
+    while (np < MAT_MAX_PARAMS && row->params[np]) np++;
     pd_declare(d, row->params, np);
     pk_status st = pd_report_unused(d);
     if (st) return st;

@@ -1516,6 +1516,12 @@ static pk_status parse_material_record(jp *p, const cJSON *e, const char *path)
                               (size_t)m.mix_b >= p->s->nmaterials))
         return jfail(p, PK_ERR_PARSE, f[1], fp, "mix_a and mix_b must be numbers of materials before this one");
     if (m.illum < 0 || m.illum > 10) return jfail(p, PK_ERR_PARSE, f[1], fp, "illum must be in 0..10");
+    if (m.type == MAT_COATED &&
+        (!(m.layer.thickness > 0.0f) || !(m.layer.g > -1.0f && m.layer.g < 1.0f) || m.layer.maxdepth < 1 ||
+         m.layer.nsamples < 1 || (m.coat_base != MATERIAL_BASE_DIFFUSE && m.coat_base != MATERIAL_BASE_CONDUCTOR)))
+        return jfail(p, PK_ERR_PARSE, f[1], fp,
+                     "a coated material needs coat_base 0 or 1, coat_thickness > 0, coat_g in (-1, 1), "
+                     "coat_maxdepth and coat_nsamples >= 1");
     for (int k = 0; k < REC_NMAPS; k++) {
         const cJSON *it = cJSON_GetObjectItemCaseSensitive(f[1], rec_map_names[k]);
         if (!it) continue;

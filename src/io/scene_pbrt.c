@@ -653,65 +653,30 @@ static pk_status make_conductor(pp *p, material *m, const char *prefix, float mi
     return PK_OK;
 }
 
-/* Unpolarised Fresnel reflectance of a smooth interface of relative index
- * eta for light arriving at cos_i (1 under total internal reflection). */
-static double fresnel(double cos_i, double eta)
+/* The coat's layer (both coated materials): thickness, albedo, g, maxdepth
+ * and nsamples, pbrt-v4's defaults where absent. */
+static pk_status coat_layer(pp *p, material_layer *l)
 {
-    double s2 = (1.0 - cos_i * cos_i) / (eta * eta);
-    if (s2 >= 1.0) return 1.0;
-    double ct = sqrt(1.0 - s2);
-    double rs = (cos_i - eta * ct) / (cos_i + eta * ct), rp = (eta * cos_i - ct) / (eta * cos_i + ct);
-    return 0.5 * (rs * rs + rp * rp);
-}
-
-/* The albedo Paprsek's plastic needs to render pbrt-v4's coateddiffuse.
- * pbrt's layer (a smooth coat over a Lambertian base, nothing in between)
- * returns, of the light that enters, rho (1 - Fi) / (1 - rho Fi): light
- * bounces between the base and the coat's underside, whose diffuse
- * reflectance is Fi = 1 - (1 - Fe) / eta^2 (Fe the coat's outside diffuse
- * reflectance, 2 * integral of F(mu) mu dmu). The plastic returns
- * kd (1 - Fe) with the same dependence on both directions (the coat's
- * transmittance each way), so kd = rho (1 - Fi) / ((1 - Fe) (1 - rho Fi))
- * makes them equal. pbrt's layer also has a thickness that light crosses
- * with transmittance exp(-thickness / cos): rho is first multiplied by the
- * square of its mean over diffuse directions, Td = 2 * integral of
- * exp(-thickness / mu) mu dmu (one crossing down and one up per bounce,
- * Td^2 = 0.96 for the default 0.01). kd is kept at most 1 (bases whiter than about
- * 0.96 for eta 1.5 lose up to 9 %). A texture can only be scaled: its scale
- * is the ratio at rho = 0.5. */
-static vec3 coated_albedo(vec3 rho, float eta, float thickness, bool textured)
-{
-    double fe = 0.0, td = 0.0;
-    const int n = 2048;
-    for (int i = 0; i < n; i++) {
-        double mu = ((double)i + 0.5) / n;
-        fe += 2.0 * fresnel(mu, (double)eta) * mu / n;
-        td += 2.0 * exp(-(double)thickness / mu) * mu / n;
-    }
-    double fi = 1.0 - (1.0 - fe) / ((double)eta * (double)eta);
-    float c[3] = {rho.x, rho.y, rho.z};
-    for (int k = 0; k < 3; k++) {
-        c[k] = (float)((double)c[k] * td * td);
-        double r = textured ? 0.5 * td * td : (double)c[k];
-        double f = (1.0 - fi) / ((1.0 - fe) * (1.0 - r * fi));
-        double v = (double)c[k] * f;
-        c[k] = (float)(v > 1.0 ? 1.0 : v);
-    }
-    return v3(c[0], c[1], c[2]);
-}
-
-/* The coat's layer (both coated materials): *thick, and an albedo, g,
- * maxdepth and nsamples that are read (checked) but not rendered. */
-static pk_status coat_layer(pp *p, float *thick, vec3 *albedo)
-{
-    float g = 0.0f;
     int64_t md = 10, ns = 1;
-    *thick = 0.01f, *albedo = v3s(0.0f);
+    *l = material_layer_default();
     pk_status st;
-    if ((st = get_float_tex(p, "thickness", thick, NULL)) || (st = get_colour(p, "albedo", albedo, NULL, NULL)) ||
-        (st = get_float_tex(p, "g", &g, NULL)) || (st = pb_int(&p->pd, "maxdepth", 0, 1 << 20, &md)))
+    if ((st = get_float_tex(p, "thickness", &l->thickness, NULL)) ||
+        (st = get_colour(p, "albedo", &l->albedo, NULL, NULL)) || (st = get_float_tex(p, "g", &l->g, NULL)) ||
+        (st = pb_int(&p->pd, "maxdepth", 1, 1 << 16, &md)) ||
+        (st = pb_int(&p->pd, "nsamples", 1, 1 << 16, &ns)))
         return st;
-    return pb_int(&p->pd, "nsamples", 0, 1 << 20, &ns);
+    if (!(l->thickness > 0.0f) || !isfinite(l->thickness)) {
+        pwarn(p, p->line, "'thickness' %g is not positive; using 0.01", (double)l->thickness);
+        l->thickness = 0.01f;
+    }
+    if (!(l->g > -1.0f && l->g < 1.0f)) {
+        pwarn(p, p->line, "'g' %g is outside (-1, 1); clamped", (double)l->g);
+        l->g = isnan(l->g) ? 0.0f : fminf(fmaxf(l->g, -0.99f), 0.99f);
+    }
+    if (v3_min_comp(l->albedo) < 0.0f || v3_max_comp(l->albedo) > 1.0f)
+        pwarn(p, p->line, "'albedo' is outside 0..1; clamped");
+    l->maxdepth = (int)md, l->nsamples = (int)ns;
+    return PK_OK;
 }
 
 /* An image file named in the scene (relative to the current file), loaded
@@ -751,30 +716,45 @@ static pk_status build_material(pp *p, const char *type, material *m, bool *inte
         material_diffuse(m, kd);
         m->map_kd = tkd;
     } else if (strcmp(type, "coateddiffuse") == 0) {
-        float thick;
-        vec3 albedo;
+        material_layer layer;
         tex_ref ta;
         tex_ref_init(&ta);
         if ((st = get_colour(p, "reflectance", &kd, &tkd, NULL)) || (st = get_roughness(p, "", &alpha, &ta)) ||
-            (st = get_eta(p, "eta", 1.5f, &eta)) || (st = coat_layer(p, &thick, &albedo)))
+            (st = get_eta(p, "eta", 1.5f, &eta)) || (st = coat_layer(p, &layer)))
             return st;
-        if (v3_max_comp(albedo) > 0.0f)
-            pwarn(p, p->line, "coateddiffuse: a scattering layer (albedo) is not rendered; the coat is clear");
-        if (!(thick >= 0.0f) || !isfinite(thick)) thick = 0.01f;
-        material_plastic(m, coated_albedo(kd, eta, thick, tkd.kind != TEX_NONE), eta, alpha);
+        material_coated_diffuse(m, kd, eta, alpha, layer);
         m->map_kd = tkd;
         m->map_alpha = ta;
     } else if (strcmp(type, "conductor") == 0) {
         if ((st = make_conductor(p, m, "", 0.0f, true))) return st;
     } else if (strcmp(type, "coatedconductor") == 0) {
-        /* the base conductor alone, roughened by the coat (docs: an approximation) */
-        float ia, thick;
-        vec3 albedo;
-        if ((st = get_roughness(p, "interface.", &ia, NULL)) || (st = get_eta(p, "interface.eta", 1.5f, &eta)) ||
-            (st = make_conductor(p, m, "conductor.", ia, false)) || (st = coat_layer(p, &thick, &albedo)))
+        /* a coat of interface.eta and interface.roughness over a conductor of
+         * conductor.eta/k (or reflectance) and conductor.roughness */
+        material_layer layer;
+        float ba;
+        tex_ref ta;
+        tex_ref_init(&ta);
+        vec3 refl, ce, ck;
+        bool has_refl, fe, fk;
+        tex_ref tr;
+        tex_ref_init(&tr);
+        spectra_named_metal("Cu", &ce, &ck);
+        if ((st = get_roughness(p, "interface.", &alpha, &ta)) || (st = get_eta(p, "interface.eta", 1.5f, &eta)) ||
+            (st = get_roughness(p, "conductor.", &ba, NULL)) ||
+            (st = get_colour(p, "reflectance", &refl, &tr, &has_refl)) ||
+            (st = get_colour(p, "conductor.eta", &ce, NULL, &fe)) ||
+            (st = get_colour(p, "conductor.k", &ck, NULL, &fk)) || (st = coat_layer(p, &layer)))
             return st;
-        pwarn(p, p->line, "coatedconductor is approximated by its conductor under the coat's roughness (no clear "
-                          "coat layer)");
+        if (has_refl) {
+            if (fe || fk)
+                pwarn(p, p->line,
+                      "coatedconductor: both reflectance and conductor.eta/k are given; reflectance is used");
+            material_coated_conductor_f0(m, refl, ba, eta, alpha, layer);
+            m->map_ks = tr;
+        } else {
+            material_coated_conductor(m, ce, ck, ba, eta, alpha, layer);
+        }
+        m->map_alpha = ta;
     } else if (strcmp(type, "dielectric") == 0) {
         tex_ref ta;
         tex_ref_init(&ta);

@@ -21,6 +21,12 @@ const rec_field rec_material[] = {
     F(material, clearcoat_roughness, REC_FLOAT), F(material, tint, REC_VEC3),
     F(material, mix_a, REC_INT),        F(material, mix_b, REC_INT),
     F(material, amount, REC_FLOAT),
+    F(material, coat_base, REC_INT),    F(material, base_alpha, REC_FLOAT),
+    {"coat_thickness", REC_FLOAT, offsetof(material, layer.thickness)},
+    {"coat_albedo", REC_VEC3, offsetof(material, layer.albedo)},
+    {"coat_g", REC_FLOAT, offsetof(material, layer.g)},
+    {"coat_maxdepth", REC_INT, offsetof(material, layer.maxdepth)},
+    {"coat_nsamples", REC_INT, offsetof(material, layer.nsamples)},
 };
 const size_t rec_nmaterial = sizeof rec_material / sizeof rec_material[0];
 

@@ -147,12 +147,15 @@ static inline PK_HD bool path_aov_specular(const shading *sh)
  * base) surfaces; a rough conductor's Fresnel reflectance at normal
  * incidence (F0: its tint, the same from every view); a rough dielectric's
  * transmittance (white for clear glass, the tint of what enters
- * otherwise). A surface partly dissolved (d < 1) counts as opaque here. */
+ * otherwise); a coated conductor's base at normal incidence. A surface
+ * partly dissolved (d < 1) counts as opaque here. */
 static inline PK_HD vec3 path_aov_albedo(const surface *sf, const shading *sh)
 {
     switch (sh->b.type) {
     case PBSDF_CONDUCTOR: return pbsdf__fresnel_conductor(&sh->b, 1.0f);
     case PBSDF_DIELECTRIC: return sh->b.transmittance;
+    case PBSDF_COATED:
+        return (sh->b.flags & PBSDF_COATED_METAL) ? pbsdf__base_fresnel(&sh->b, 1.0f) : sf->m->kd;
     default: return sf->m->kd;
     }
 }

@@ -3,7 +3,9 @@
  * (or Beckmann) conductors, smooth and rough dielectrics (Walter et al. 2007), plastic (a
  * diffuse base under a dielectric coating), the MTL "glossy over diffuse"
  * model, glTF 2.0's metallic-roughness material, and (last) a thin dielectric
- * sheet, diffuse transmission, Oren-Nayar and the modified Phong model. Plain static inline PK_HD C over one plain struct: no context, no
+ * sheet, diffuse transmission, Oren-Nayar, the modified Phong model and
+ * pbrt-v4's stochastic layered BSDF (coated: a dielectric coat over a
+ * diffuse or conductor base, a scattering slab between). Plain static inline PK_HD C over one plain struct: no context, no
  * allocation, no function pointers, so that nvcc can compile the same code.
  * docs/materials.md describes the models, their parameters and conventions.
  *
@@ -21,6 +23,10 @@
  *  - The thin dielectric and diffuse transmission are two-sided sheets: wo on
  *    either side, wi on its side (reflection) or the other (transmission).
  *    Oren-Nayar and Phong are one-sided reflectors like diffuse.
+ *  - Coated is a two-sided reflector: wo below is mirrored to +z with wi.
+ *    Its eval, pdf and sample weight are estimates (random walks seeded by
+ *    the directions and the hit), so for it pbsdf_sample's weight is not
+ *    pbsdf_eval / pbsdf_pdf but an estimate of the same mean.
  *  - Dielectrics are two-sided: wo.z < 0 means wo is inside (the side with
  *    index `ior`), and wi may lie on either side.
  *  - Transmitted light is not scaled by 1/eta^2 (the radiance compression at
@@ -35,6 +41,7 @@
 #include "../math/vec3.h"
 #include "energy.h"
 #include "optics.h"
+#include "sampling.h"
 
 #include <stdbool.h>
 
@@ -49,6 +56,9 @@ typedef enum pbsdf_type {
     PBSDF_DIFFUSE_TRANSMISSION, /* Lambert reflection (albedo) and transmission (transmittance) */
     PBSDF_OREN_NAYAR,         /* rough diffuse (Oren-Nayar's qualitative model): albedo, on_a, on_b */
     PBSDF_PHONG,              /* modified Phong: albedo (diffuse) + specular, exponent */
+    PBSDF_COATED,             /* pbrt-v4's layered BSDF: a dielectric coat (ior, alpha) over a Lambertian
+                                 (albedo) or conductor (PBSDF_COATED_METAL: eta, k, base_alpha) base, a slab
+                                 (thickness, medium, g) between them, maxdepth, nsamples, seed */
     PBSDF_TYPE_COUNT
 } pbsdf_type;
 
@@ -63,6 +73,8 @@ typedef enum pbsdf_type {
  * local x axis (the surface's tangent, dp/du) and alpha_v along y
  * (pbsdf_anisotropic sets it) */
 #define PBSDF_ANISO 8u
+/* coated: the base is a conductor (eta, k relative to the coat, base_alpha), not Lambert */
+#define PBSDF_COATED_METAL 16u
 
 /* Below this roughness a microfacet lobe is treated as perfectly smooth (a
  * delta lobe): the GGX density would exceed float range long before 0. */
@@ -93,7 +105,14 @@ typedef enum pbsdf_type {
  *   coat_alpha    [0, 1]                   metallic-roughness: the clearcoat's GGX alpha
  *   ms, ms_albedo                          set by pbsdf_compensate (the multiple-scattering lobe)
  *   on_a, on_b    A, B >= 0                Oren-Nayar: the model's A and B (pbsdf_oren_nayar)
- *   exponent      >= 0                     Phong: the lobe's exponent */
+ *   exponent      >= 0                     Phong: the lobe's exponent
+ *   thickness     > 0                      coated: the slab's optical thickness (unit extinction)
+ *   medium        [0, 1] per channel       coated: the slab medium's single-scattering albedo (0 = clear)
+ *   g             (-1, 1)                  coated: the medium's Henyey-Greenstein asymmetry
+ *   base_alpha    [0, 1]                   coated: the conductor base's GGX alpha
+ *   maxdepth      >= 1                     coated: the longest random walk in the slab
+ *   nsamples      >= 1                     coated: walks averaged per estimate
+ *   seed                                   coated: a hash of the hit, mixed into the walks' seeds */
 typedef struct pbsdf {
     int type;            /* pbsdf_type */
     unsigned flags;      /* PBSDF_SCHLICK, PBSDF_BECKMANN, PBSDF_ENERGY */
@@ -110,6 +129,10 @@ typedef struct pbsdf {
     vec3 ms;             /* F_ms / (pi (1 - E_avg)) per channel, with PBSDF_ENERGY */
     float ms_albedo;     /* the mean of F_ms: the lobe's albedo is ms_albedo (1 - E(wo.z)) */
     float on_a, on_b, exponent;
+    vec3 medium;
+    float thickness, g, base_alpha;
+    int maxdepth, nsamples;
+    unsigned seed;
 } pbsdf;
 
 /* ---- constructors ------------------------------------------------------- */
@@ -130,6 +153,10 @@ static inline PK_HD pbsdf pbsdf__blank(int type)
     b.ms = v3s(0.0f);
     b.ms_albedo = 0.0f;
     b.on_a = 1.0f, b.on_b = b.exponent = 0.0f;
+    b.medium = v3s(0.0f);
+    b.thickness = 0.01f, b.g = 0.0f, b.base_alpha = 0.0f;
+    b.maxdepth = 10, b.nsamples = 1;
+    b.seed = 0u;
     return b;
 }
 static inline PK_HD pbsdf pbsdf_diffuse(vec3 albedo)
@@ -1095,6 +1122,449 @@ static inline PK_HD bool pbsdf__ext_sample(const pbsdf *b, vec3 wo, const float 
     return true;
 }
 
+/* ---- coated: pbrt-v4's stochastic layered BSDF ------------------------------ */
+
+/* A dielectric coat of relative index ior (GGX alpha, smooth below
+ * PBSDF_ALPHA_SMOOTH) over a base (Lambert of albedo, or with
+ * PBSDF_COATED_METAL a conductor of eta + i k relative to the coat and GGX
+ * base_alpha), with a slab of `thickness` between them that holds a
+ * homogeneous medium of unit extinction, single-scattering albedo `medium`
+ * and Henyey-Greenstein asymmetry g (medium 0: clear, light crossing it
+ * attenuated by exp(-thickness / |cos|)). eval, pdf and sample are pbrt-v4's
+ * LayeredBxDF estimators (docs/materials.md): random walks between the two
+ * interfaces, at most maxdepth scattering events each, nsamples of them
+ * averaged, with next-event connections through the coat combined by the
+ * power heuristic (each weight from the two densities of the same inside
+ * direction: where pbrt-v4 weighs the walk's exit by the density of wi
+ * given the inside direction, the reverse of what the connection from wi
+ * samples, this uses the forward one, so the weights sum to 1:
+ * test_layered checks eval against an independent walk); the pdf is
+ * estimated from one bounce off the base and
+ * mixed with a uniform density (0.1 / (4 pi)). The walks draw their numbers
+ * from a PCG32 seeded by a hash of the directions and `seed` (the hit), so
+ * no sampler dimension is used and the same (wo, wi, seed) gives the same
+ * value. The material is two-sided: wo below is mirrored to +z with wi.
+ * The transmitted light's 1 / eta^2 is applied here as pbrt applies it in
+ * radiance mode (only the product of the factors through the coat matters,
+ * and it is 1: a white base under a clear coat reflects all of the light). */
+static inline PK_HD pbsdf pbsdf_coated(vec3 albedo, float ior, float alpha, float thickness, vec3 slab_albedo,
+                                       float g, int maxdepth, int nsamples)
+{
+    pbsdf b = pbsdf__blank(PBSDF_COATED);
+    b.albedo = albedo;
+    b.ior = ior;
+    b.alpha = alpha;
+    b.transmittance = v3s(1.0f); /* the coat's dielectric lobes are clear */
+    b.thickness = thickness;
+    b.medium = slab_albedo;
+    b.g = g;
+    b.maxdepth = maxdepth;
+    b.nsamples = nsamples;
+    return b;
+}
+/* The same over a conductor of eta + i k (relative to the coat) and GGX
+ * base_alpha. */
+static inline PK_HD pbsdf pbsdf_coated_conductor(vec3 eta, vec3 k, float base_alpha, float ior, float alpha,
+                                                 float thickness, vec3 slab_albedo, float g, int maxdepth,
+                                                 int nsamples)
+{
+    pbsdf b = pbsdf_coated(v3s(0.0f), ior, alpha, thickness, slab_albedo, g, maxdepth, nsamples);
+    b.flags |= PBSDF_COATED_METAL;
+    b.eta = eta;
+    b.k = k;
+    b.base_alpha = base_alpha;
+    return b;
+}
+
+/* One sampled direction of an interface: wi, f (without the cosine), pdf
+ * and whether it came from a delta lobe. */
+typedef struct pbsdf__lsample {
+    vec3 wi, f;
+    float pdf;
+    bool spec;
+} pbsdf__lsample;
+
+#define PBSDF__LREFL 1
+#define PBSDF__LTRANS 2
+
+static inline PK_HD float pbsdf__power(float a, float b)
+{
+    const float a2 = a * a, b2 = b * b;
+    if (!(a2 < INFINITY)) return 1.0f;
+    return a2 + b2 > 0.0f ? a2 / (a2 + b2) : 0.0f;
+}
+/* exp(-|dz / cos|): the slab's transmittance over a height dz along w */
+static inline PK_HD float pbsdf__lay_tr(float dz, vec3 w)
+{
+    if (fabsf(dz) <= 1e-30f) return 1.0f;
+    return expf(-fabsf(dz / w.z));
+}
+/* Henyey-Greenstein for a walk travelling along d turning to wi. */
+static inline PK_HD float pbsdf__hg(float g, vec3 d, vec3 wi)
+{
+    const float c = v3_dot(d, wi), den = 1.0f + g * g - 2.0f * g * c;
+    return (1.0f - g * g) / (4.0f * PK_PI * den * sqrtf(fmaxf(den, 1e-12f)));
+}
+static inline PK_HD vec3 pbsdf__hg_sample(float g, vec3 d, float u1, float u2)
+{
+    float c;
+    if (fabsf(g) < 1e-3f) c = 1.0f - 2.0f * u1;
+    else {
+        const float s = (1.0f - g * g) / (1.0f - g + 2.0f * g * u1);
+        c = (1.0f + g * g - s * s) / (2.0f * g);
+    }
+    c = fminf(1.0f, fmaxf(-1.0f, c));
+    const float sn = sqrtf(fmaxf(0.0f, 1.0f - c * c)), phi = 2.0f * PK_PI * u2;
+    const float sg = d.z >= 0.0f ? 1.0f : -1.0f, a = -1.0f / (sg + d.z), bb = d.x * d.y * a;
+    const vec3 t = v3(1.0f + sg * d.x * d.x * a, sg * bb, -sg * d.x), bt = v3(bb, sg + d.y * d.y * a, -d.y);
+    return v3_norm(v3_add(v3_add(v3_scale(t, sn * cosf(phi)), v3_scale(bt, sn * sinf(phi))), v3_scale(d, c)));
+}
+
+/* The coat (a dielectric, wo on either side: below is inside). f is without
+ * the cosine; rad applies the radiance-mode 1 / eta'^2 to transmission. */
+static inline PK_HD float pbsdf__coat_f(const pbsdf *b, vec3 wo, vec3 wi, bool rad)
+{
+    if (pbsdf__smooth(b) || wi.z == 0.0f) return 0.0f;
+    float f = pbsdf__dielectric_eval(b, wo, wi).x / fabsf(wi.z);
+    if (rad && wo.z * wi.z < 0.0f) f *= wo.z > 0.0f ? 1.0f / (b->ior * b->ior) : b->ior * b->ior;
+    return f;
+}
+static inline PK_HD float pbsdf__coat_pdf(const pbsdf *b, vec3 wo, vec3 wi, int want)
+{
+    vec3 m;
+    float e;
+    if (pbsdf__smooth(b) || !pbsdf__dielectric_half(b, wo, wi, &m, &e)) return 0.0f;
+    const bool refl = wo.z * wi.z > 0.0f;
+    if (!(want & (refl ? PBSDF__LREFL : PBSDF__LTRANS))) return 0.0f;
+    const float r = pbsdf_fresnel_dielectric(v3_dot(wo, m), b->ior);
+    const float pr = (want & PBSDF__LREFL) ? r : 0.0f, pt = (want & PBSDF__LTRANS) ? 1.0f - r : 0.0f;
+    if (!(pr + pt > 0.0f)) return 0.0f;
+    return pbsdf__dielectric_pdf(b, wo, wi) / (pr + pt);
+}
+static inline PK_HD bool pbsdf__coat_sample(const pbsdf *b, vec3 wo, float uc, float u1, float u2, int want, bool rad,
+                                            pbsdf__lsample *s)
+{
+    if (wo.z == 0.0f) return false;
+    if (pbsdf__smooth(b)) {
+        const float r = pbsdf_fresnel_dielectric(wo.z, b->ior);
+        const float pr = (want & PBSDF__LREFL) ? r : 0.0f, pt = (want & PBSDF__LTRANS) ? 1.0f - r : 0.0f;
+        if (!(pr + pt > 0.0f)) return false;
+        s->spec = true;
+        if (uc < pr / (pr + pt)) {
+            s->wi = pbsdf__mirror(wo);
+            s->f = v3s(r / fabsf(s->wi.z));
+            s->pdf = pr / (pr + pt);
+            return s->wi.z != 0.0f;
+        }
+        if (!pbsdf__refract(wo, v3(0.0f, 0.0f, 1.0f), b->ior, &s->wi) || s->wi.z == 0.0f) return false;
+        float t = (1.0f - r) / fabsf(s->wi.z);
+        if (rad) t *= wo.z > 0.0f ? 1.0f / (b->ior * b->ior) : b->ior * b->ior;
+        s->f = v3s(t);
+        s->pdf = pt / (pr + pt);
+        return true;
+    }
+    const vec3 m = pbsdf_ggx_vndf_sample(b->alpha, wo, u1, u2);
+    const float om = v3_dot(wo, m);
+    if (!(om * wo.z > 0.0f)) return false;
+    const float r = pbsdf_fresnel_dielectric(om, b->ior);
+    const float pr = (want & PBSDF__LREFL) ? r : 0.0f, pt = (want & PBSDF__LTRANS) ? 1.0f - r : 0.0f;
+    if (!(pr + pt > 0.0f)) return false;
+    vec3 w;
+    if (uc < pr / (pr + pt)) {
+        w = v3_sub(v3_scale(m, 2.0f * om), wo);
+        if (!(w.z * wo.z > 0.0f)) return false;
+    } else if (!pbsdf__refract(wo, m, b->ior, &w) || !(w.z * wo.z < 0.0f)) {
+        return false;
+    }
+    s->spec = false;
+    s->wi = w;
+    s->pdf = pbsdf__coat_pdf(b, wo, w, want);
+    s->f = v3s(pbsdf__coat_f(b, wo, w, rad));
+    return s->pdf > 0.0f;
+}
+
+/* The base (wo.z > 0 from inside the slab; reflection only). */
+static inline PK_HD bool pbsdf__base_smooth(const pbsdf *b)
+{
+    return (b->flags & PBSDF_COATED_METAL) && b->base_alpha < PBSDF_ALPHA_SMOOTH;
+}
+static inline PK_HD vec3 pbsdf__base_fresnel(const pbsdf *b, float c)
+{
+    return v3(pbsdf__fresnel_conductor1(c, b->eta.x, b->k.x), pbsdf__fresnel_conductor1(c, b->eta.y, b->k.y),
+              pbsdf__fresnel_conductor1(c, b->eta.z, b->k.z));
+}
+static inline PK_HD vec3 pbsdf__base_f(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    if (!(wo.z > 0.0f && wi.z > 0.0f)) return v3s(0.0f);
+    if (!(b->flags & PBSDF_COATED_METAL)) return v3_scale(b->albedo, 1.0f / PK_PI);
+    if (pbsdf__base_smooth(b)) return v3s(0.0f);
+    vec3 h;
+    const float s = pbsdf__ggx_refl_cos(b->base_alpha, wo, wi, &h);
+    if (!(s > 0.0f)) return v3s(0.0f);
+    return v3_scale(pbsdf__base_fresnel(b, fabsf(v3_dot(wo, h))), s / wi.z);
+}
+static inline PK_HD float pbsdf__base_pdf(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    if (!(wo.z > 0.0f && wi.z > 0.0f)) return 0.0f;
+    if (!(b->flags & PBSDF_COATED_METAL)) return wi.z / PK_PI;
+    if (pbsdf__base_smooth(b)) return 0.0f;
+    return pbsdf__ggx_refl_pdf(b->base_alpha, wo, wi);
+}
+static inline PK_HD bool pbsdf__base_sample(const pbsdf *b, vec3 wo, float u1, float u2, pbsdf__lsample *s)
+{
+    if (!(wo.z > 0.0f)) return false;
+    s->spec = false;
+    if (!(b->flags & PBSDF_COATED_METAL)) {
+        s->wi = pbsdf__cosine_dir(u1, u2);
+        if (!(s->wi.z > 0.0f)) return false;
+        s->pdf = s->wi.z / PK_PI;
+        s->f = v3_scale(b->albedo, 1.0f / PK_PI);
+        return true;
+    }
+    if (pbsdf__base_smooth(b)) {
+        s->wi = pbsdf__mirror(wo);
+        s->f = v3_scale(pbsdf__base_fresnel(b, wo.z), 1.0f / wo.z);
+        s->pdf = 1.0f;
+        s->spec = true;
+        return true;
+    }
+    const vec3 m = pbsdf_ggx_vndf_sample(b->base_alpha, wo, u1, u2);
+    const float om = v3_dot(wo, m);
+    s->wi = v3_sub(v3_scale(m, 2.0f * om), wo);
+    if (!(om > 0.0f) || !(s->wi.z > 0.0f)) return false;
+    s->pdf = pbsdf__ggx_refl_pdf(b->base_alpha, wo, s->wi);
+    s->f = pbsdf__base_f(b, wo, s->wi);
+    return s->pdf > 0.0f;
+}
+
+/* The walks' generator, seeded by two hashes of the directions and the hit. */
+static inline PK_HD uint64_t pbsdf__hash3(vec3 w, unsigned seed)
+{
+    union {
+        float f;
+        uint32_t u;
+    } x, y, z;
+    x.f = w.x, y.f = w.y, z.f = w.z;
+    uint64_t h = mix64(((uint64_t)x.u << 32) ^ y.u ^ ((uint64_t)seed << 17));
+    return mix64(h ^ ((uint64_t)z.u * 0x9e3779b97f4a7c15ull));
+}
+static inline PK_HD float pbsdf__r(rng *r) { return rng_float(r); }
+static inline PK_HD bool pbsdf__clear(const pbsdf *b) { return !(v3_max_comp(b->medium) > 0.0f); }
+
+/* f cos of the layered BSDF (pbrt-v4's LayeredBxDF::f, reflection only:
+ * the bases are opaque). */
+static inline PK_HD vec3 pbsdf__coated_eval(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    if (wo.z < 0.0f) wo = v3_neg(wo), wi = v3_neg(wi);
+    if (!(wo.z > 0.0f && wi.z > 0.0f)) return v3s(0.0f);
+    const int ns = b->nsamples > 0 ? b->nsamples : 1;
+    const float th = b->thickness, ez = th; /* the coat is the exit: z = thickness */
+    const bool top_spec = pbsdf__smooth(b), base_spec = pbsdf__base_smooth(b), clear = pbsdf__clear(b);
+    vec3 f = v3s((float)ns * pbsdf__coat_f(b, wo, wi, true));
+    rng r = rng_seed(pbsdf__hash3(wo, b->seed), pbsdf__hash3(wi, ~b->seed));
+    for (int s = 0; s < ns; s++) {
+        pbsdf__lsample wos, wis;
+        if (!pbsdf__coat_sample(b, wo, pbsdf__r(&r), pbsdf__r(&r), pbsdf__r(&r), PBSDF__LTRANS, true, &wos) ||
+            !(wos.pdf > 0.0f) || wos.wi.z == 0.0f)
+            continue;
+        if (!pbsdf__coat_sample(b, wi, pbsdf__r(&r), pbsdf__r(&r), pbsdf__r(&r), PBSDF__LTRANS, false, &wis) ||
+            !(wis.pdf > 0.0f) || wis.wi.z == 0.0f)
+            continue;
+        vec3 beta = v3_scale(wos.f, fabsf(wos.wi.z) / wos.pdf);
+        const vec3 wisw = v3_scale(wis.f, 1.0f / wis.pdf); /* wis.f / wis.pdf */
+        float z = th;
+        vec3 w = wos.wi;
+        for (int depth = 0; depth < b->maxdepth; depth++) {
+            const float bm = v3_max_comp(beta);
+            if (depth > 3 && bm < 0.25f) {
+                const float q = fmaxf(0.0f, 1.0f - bm);
+                if (pbsdf__r(&r) < q) break;
+                beta = v3_scale(beta, 1.0f / (1.0f - q));
+            }
+            if (clear) {
+                z = z == th ? 0.0f : th;
+                beta = v3_scale(beta, pbsdf__lay_tr(th, w));
+            } else {
+                const float dz = -logf(1.0f - pbsdf__r(&r)) * fabsf(w.z);
+                const float zp = w.z > 0.0f ? z + dz : z - dz;
+                if (zp == z) continue;
+                if (0.0f < zp && zp < th) { /* scattered in the slab */
+                    const vec3 din = v3_neg(wis.wi);
+                    float wt = 1.0f;
+                    if (!top_spec) wt = pbsdf__power(wis.pdf, pbsdf__hg(b->g, w, din));
+                    f = v3_add(f, v3_scale(v3_mul(v3_mul(beta, b->medium), wisw),
+                                           pbsdf__hg(b->g, w, din) * wt * pbsdf__lay_tr(zp - ez, wis.wi)));
+                    const vec3 nw = pbsdf__hg_sample(b->g, w, pbsdf__r(&r), pbsdf__r(&r));
+                    if (nw.z == 0.0f) continue;
+                    const float pp = pbsdf__hg(b->g, w, nw);
+                    beta = v3_mul(beta, b->medium); /* p / pdf = 1 */
+                    w = nw;
+                    z = zp;
+                    if (!top_spec && ((z < ez && w.z > 0.0f) || (z > ez && w.z < 0.0f))) {
+                        const float fe = pbsdf__coat_f(b, v3_neg(w), wi, true);
+                        if (fe > 0.0f) {
+                            const float pe = pbsdf__coat_pdf(b, wi, v3_neg(w), PBSDF__LTRANS);
+                            f = v3_add(f, v3_scale(beta, pbsdf__lay_tr(zp - ez, w) * fe * pbsdf__power(pp, pe)));
+                        }
+                    }
+                    continue;
+                }
+                z = fminf(fmaxf(zp, 0.0f), th);
+            }
+            pbsdf__lsample bs;
+            if (z == ez) { /* back down off the coat's underside */
+                if (!pbsdf__coat_sample(b, v3_neg(w), pbsdf__r(&r), pbsdf__r(&r), pbsdf__r(&r), PBSDF__LREFL, true, &bs))
+                    break;
+                beta = v3_mul(beta, v3_scale(bs.f, fabsf(bs.wi.z) / bs.pdf));
+                w = bs.wi;
+                continue;
+            }
+            /* at the base: connect to wi through the coat, then bounce */
+            if (!base_spec) {
+                float wt = 1.0f;
+                if (!top_spec) wt = pbsdf__power(wis.pdf, pbsdf__base_pdf(b, v3_neg(w), v3_neg(wis.wi)));
+                const vec3 fb = pbsdf__base_f(b, v3_neg(w), v3_neg(wis.wi));
+                f = v3_add(f, v3_scale(v3_mul(v3_mul(beta, fb), wisw),
+                                       fabsf(wis.wi.z) * wt * pbsdf__lay_tr(th, wis.wi)));
+            }
+            (void)pbsdf__r(&r); /* pbrt's lobe choice: one number, unused by one-lobe bases */
+            if (!pbsdf__base_sample(b, v3_neg(w), pbsdf__r(&r), pbsdf__r(&r), &bs)) break;
+            beta = v3_mul(beta, v3_scale(bs.f, fabsf(bs.wi.z) / bs.pdf));
+            w = bs.wi;
+            if (!top_spec) {
+                const float fe = pbsdf__coat_f(b, v3_neg(w), wi, true);
+                if (fe > 0.0f) {
+                    float wt = 1.0f;
+                    if (!base_spec) wt = pbsdf__power(bs.pdf, pbsdf__coat_pdf(b, wi, v3_neg(w), PBSDF__LTRANS));
+                    f = v3_add(f, v3_scale(beta, pbsdf__lay_tr(th, bs.wi) * fe * wt));
+                }
+            }
+        }
+    }
+    return v3_scale(f, wi.z / (float)ns);
+}
+
+/* The estimated density of pbsdf__coated_sample (pbrt-v4's LayeredBxDF::PDF):
+ * the coat's reflection and one bounce off the base through the coat, mixed
+ * with a uniform density. */
+static inline PK_HD float pbsdf__coated_pdf(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    if (wo.z < 0.0f) wo = v3_neg(wo), wi = v3_neg(wi);
+    if (!(wo.z > 0.0f && wi.z > 0.0f)) return 0.0f;
+    const int ns = b->nsamples > 0 ? b->nsamples : 1;
+    const bool top_spec = pbsdf__smooth(b), base_spec = pbsdf__base_smooth(b);
+    float sum = (float)ns * pbsdf__coat_pdf(b, wo, wi, PBSDF__LREFL | PBSDF__LTRANS);
+    rng r = rng_seed(pbsdf__hash3(wi, b->seed ^ 0x5bd1e995u), pbsdf__hash3(wo, ~b->seed));
+    for (int s = 0; s < ns; s++) {
+        pbsdf__lsample wos, wis, rs;
+        if (!pbsdf__coat_sample(b, wo, pbsdf__r(&r), pbsdf__r(&r), pbsdf__r(&r), PBSDF__LTRANS, true, &wos) ||
+            !(wos.pdf > 0.0f))
+            continue;
+        if (!pbsdf__coat_sample(b, wi, pbsdf__r(&r), pbsdf__r(&r), pbsdf__r(&r), PBSDF__LTRANS, false, &wis) ||
+            !(wis.pdf > 0.0f))
+            continue;
+        if (top_spec) {
+            sum += pbsdf__base_pdf(b, v3_neg(wos.wi), v3_neg(wis.wi));
+            continue;
+        }
+        (void)pbsdf__r(&r);
+        if (!pbsdf__base_sample(b, v3_neg(wos.wi), pbsdf__r(&r), pbsdf__r(&r), &rs) || !(rs.pdf > 0.0f)) continue;
+        if (base_spec) {
+            sum += pbsdf__coat_pdf(b, v3_neg(rs.wi), wi, PBSDF__LREFL | PBSDF__LTRANS);
+        } else {
+            const float rp = pbsdf__base_pdf(b, v3_neg(wos.wi), v3_neg(wis.wi));
+            sum += pbsdf__power(wis.pdf, rp) * rp;
+            const float tp = pbsdf__coat_pdf(b, v3_neg(rs.wi), wi, PBSDF__LREFL | PBSDF__LTRANS);
+            sum += pbsdf__power(rs.pdf, tp) * tp;
+        }
+    }
+    return 0.1f / (4.0f * PK_PI) + 0.9f * sum / (float)ns;
+}
+
+/* Samples by one random walk (pbrt-v4's LayeredBxDF::Sample_f): the weight
+ * is the walk's f cos / pdf, an unbiased estimate of the BSDF's; *pdf is
+ * pbsdf_pdf's estimate (for MIS), or for an all-delta walk the product of
+ * its lobes' probabilities. */
+static inline PK_HD bool pbsdf__coated_sample(const pbsdf *b, vec3 wo, const float u[3], vec3 *wi, vec3 *weight,
+                                              float *pdf, bool *is_delta)
+{
+    *is_delta = false;
+    const bool flip = wo.z < 0.0f;
+    if (flip) wo = v3_neg(wo);
+    if (!(wo.z > 0.0f)) return false;
+    pbsdf__lsample bs;
+    if (!pbsdf__coat_sample(b, wo, u[0], u[1], u[2], PBSDF__LREFL | PBSDF__LTRANS, true, &bs) || !(bs.pdf > 0.0f))
+        return false;
+    if (bs.wi.z > 0.0f) { /* reflected by the coat */
+        *wi = flip ? v3_neg(bs.wi) : bs.wi;
+        *weight = v3_scale(bs.f, bs.wi.z / bs.pdf);
+        *is_delta = bs.spec;
+        *pdf = bs.spec ? bs.pdf : pbsdf__coated_pdf(b, wo, bs.wi);
+        return true;
+    }
+    vec3 w = bs.wi, f = v3_scale(bs.f, fabsf(bs.wi.z));
+    float p = bs.pdf, z = b->thickness;
+    const float th = b->thickness;
+    bool spec = bs.spec;
+    const bool clear = pbsdf__clear(b);
+    union {
+        float f;
+        uint32_t u;
+    } a, c, d;
+    a.f = u[0], c.f = u[1], d.f = u[2];
+    rng r = rng_seed(pbsdf__hash3(wo, b->seed), mix64(((uint64_t)a.u << 32 | c.u) ^ mix64(d.u)));
+    for (int depth = 0; depth < b->maxdepth; depth++) {
+        const float rb = v3_max_comp(f) / p;
+        if (depth > 3 && rb < 0.25f) {
+            const float q = fmaxf(0.0f, 1.0f - rb);
+            if (pbsdf__r(&r) < q) return false;
+            p *= 1.0f - q;
+        }
+        if (w.z == 0.0f) return false;
+        if (!clear) {
+            const float dz = -logf(1.0f - pbsdf__r(&r)) * fabsf(w.z);
+            const float zp = w.z > 0.0f ? z + dz : z - dz;
+            if (zp == z) return false;
+            if (0.0f < zp && zp < th) {
+                const vec3 nw = pbsdf__hg_sample(b->g, w, pbsdf__r(&r), pbsdf__r(&r));
+                const float pp = pbsdf__hg(b->g, w, nw);
+                if (!(pp > 0.0f) || nw.z == 0.0f) return false;
+                f = v3_scale(v3_mul(f, b->medium), pp);
+                p *= pp;
+                spec = false;
+                w = nw;
+                z = zp;
+                continue;
+            }
+            z = fminf(fmaxf(zp, 0.0f), th);
+        } else {
+            z = z == th ? 0.0f : th;
+            f = v3_scale(f, pbsdf__lay_tr(th, w));
+        }
+        if (z == 0.0f) {
+            (void)pbsdf__r(&r);
+            if (!pbsdf__base_sample(b, v3_neg(w), pbsdf__r(&r), pbsdf__r(&r), &bs)) return false;
+        } else if (!pbsdf__coat_sample(b, v3_neg(w), pbsdf__r(&r), pbsdf__r(&r), pbsdf__r(&r),
+                                       PBSDF__LREFL | PBSDF__LTRANS, true, &bs)) {
+            return false;
+        }
+        if (!(bs.pdf > 0.0f)) return false;
+        f = v3_mul(f, bs.f);
+        p *= bs.pdf;
+        spec = spec && bs.spec;
+        w = bs.wi;
+        if (z == th && w.z > 0.0f) { /* out through the coat */
+            *wi = flip ? v3_neg(w) : w;
+            *weight = v3_scale(f, w.z / p);
+            *is_delta = spec;
+            *pdf = spec ? p : pbsdf__coated_pdf(b, wo, w);
+            return true;
+        }
+        f = v3_scale(f, fabsf(w.z));
+    }
+    return false;
+}
+
 /* ---- the interface --------------------------------------------------------- */
 
 /* True if the BSDF has a non-delta part, i.e. light sampling and MIS can
@@ -1106,11 +1576,14 @@ static inline PK_HD void pbsdf_regularize(pbsdf *b)
 {
     if (b->type != PBSDF_DIFFUSE && b->alpha < 0.3f) b->alpha = fminf(fmaxf(2.0f * b->alpha, 0.1f), 0.3f);
     if (pbsdf__an(b) && b->alpha_v < 0.3f) b->alpha_v = fminf(fmaxf(2.0f * b->alpha_v, 0.1f), 0.3f);
+    if (b->type == PBSDF_COATED && (b->flags & PBSDF_COATED_METAL) && b->base_alpha < 0.3f)
+        b->base_alpha = fminf(fmaxf(2.0f * b->base_alpha, 0.1f), 0.3f);
     if (b->coat > 0.0f && b->coat_alpha < 0.3f) b->coat_alpha = fminf(fmaxf(2.0f * b->coat_alpha, 0.1f), 0.3f);
 }
 
 static inline PK_HD bool pbsdf_has_nondelta(const pbsdf *b)
 {
+    if (b->type == PBSDF_COATED) return !pbsdf__smooth(b) || !pbsdf__base_smooth(b) || !pbsdf__clear(b);
     if (b->type >= PBSDF_THIN_DIELECTRIC) return b->type != PBSDF_THIN_DIELECTRIC;
     switch (b->type) {
     case PBSDF_DIFFUSE: case PBSDF_PLASTIC: case PBSDF_GLOSSY: return true;
@@ -1124,6 +1597,7 @@ static inline PK_HD bool pbsdf_has_nondelta(const pbsdf *b)
 /* f(wo, wi) * |wi.z| of the non-delta part. Local frame, unit vectors. */
 static inline PK_HD vec3 pbsdf_eval(const pbsdf *b, vec3 wo, vec3 wi)
 {
+    if (b->type == PBSDF_COATED) return pbsdf__coated_eval(b, wo, wi);
     if (b->type >= PBSDF_THIN_DIELECTRIC) return pbsdf__ext_eval(b, wo, wi);
     if (b->type == PBSDF_DIELECTRIC) return pbsdf__dielectric_eval(b, wo, wi);
     if (b->type == PBSDF_METALLIC_ROUGHNESS) return pbsdf__mr_eval(b, wo, wi);
@@ -1168,6 +1642,7 @@ static inline PK_HD vec3 pbsdf_eval(const pbsdf *b, vec3 wo, vec3 wi)
  * sample (the lobe choice included). */
 static inline PK_HD float pbsdf_pdf(const pbsdf *b, vec3 wo, vec3 wi)
 {
+    if (b->type == PBSDF_COATED) return pbsdf__coated_pdf(b, wo, wi);
     if (b->type >= PBSDF_THIN_DIELECTRIC) return pbsdf__ext_pdf(b, wo, wi);
     if (b->type == PBSDF_DIELECTRIC) return pbsdf__dielectric_pdf(b, wo, wi);
     if (b->type == PBSDF_METALLIC_ROUGHNESS) return pbsdf__mr_pdf(b, wo, wi);
@@ -1205,6 +1680,7 @@ static inline PK_HD float pbsdf_pdf(const pbsdf *b, vec3 wo, vec3 wi)
 static inline PK_HD bool pbsdf_sample(const pbsdf *b, vec3 wo, const float u[3], vec3 *wi, vec3 *weight, float *pdf,
                                 bool *is_delta)
 {
+    if (b->type == PBSDF_COATED) return pbsdf__coated_sample(b, wo, u, wi, weight, pdf, is_delta);
     if (b->type >= PBSDF_THIN_DIELECTRIC) return pbsdf__ext_sample(b, wo, u, wi, weight, pdf, is_delta);
     *is_delta = false;
     if (b->type == PBSDF_DIELECTRIC) {

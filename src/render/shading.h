@@ -46,6 +46,33 @@ static inline PK_HD onb shading_frame(vec3 n, vec3 dpdu)
     return f;
 }
 
+/* A coated material's layered BSDF; the hit point seeds its random walks
+ * (pbsdf.h). A conductor base's index is relative to the coat (pbrt-v4
+ * divides it by the coat's), a reflectance r becomes eta 1, k 2 sqrt(r) /
+ * sqrt(1 - r) as pbrt-v4 does. */
+static inline PK_HD pbsdf shading__coated(const material *m, vec3 p)
+{
+    const material_layer *l = &m->layer;
+    if (m->coat_base != MATERIAL_BASE_CONDUCTOR) {
+        pbsdf b = pbsdf_coated(surface_clamp_rgb(m->kd), m->ni, m->alpha, l->thickness, l->albedo, l->g, l->maxdepth,
+                               l->nsamples);
+        b.seed = (unsigned)pbsdf__hash3(p, 0x2545f491u);
+        return b;
+    }
+    vec3 eta = m->eta, k = m->k;
+    if (m->schlick) {
+        const vec3 r = v3_min(surface_clamp_rgb(m->ks), v3s(0.9999f));
+        eta = v3s(1.0f);
+        k = v3(2.0f * sqrtf(r.x) / sqrtf(1.0f - r.x), 2.0f * sqrtf(r.y) / sqrtf(1.0f - r.y),
+               2.0f * sqrtf(r.z) / sqrtf(1.0f - r.z));
+    }
+    const float ie = 1.0f / m->ni;
+    pbsdf b = pbsdf_coated_conductor(v3_scale(eta, ie), v3_scale(k, ie), m->base_alpha, m->ni, m->alpha, l->thickness,
+                                     l->albedo, l->g, l->maxdepth, l->nsamples);
+    b.seed = (unsigned)pbsdf__hash3(p, 0x2545f491u);
+    return b;
+}
+
 static inline PK_HD shading shading_at(const surface *sf)
 {
     const material *m = sf->m;
@@ -79,6 +106,7 @@ static inline PK_HD shading shading_at(const surface *sf)
         case MAT_DIFFUSE_TRANSMISSION: sh.b = pbsdf_diffuse_transmission(m->kd, m->tf); break;
         case MAT_ROUGH_DIFFUSE: sh.b = pbsdf_oren_nayar(m->kd, m->alpha * 0.70710678f); break; /* Mitsuba's sigma */
         case MAT_PHONG: sh.b = pbsdf_phong(m->kd, m->ks, m->ns); break;
+        case MAT_COATED: sh.b = shading__coated(m, sf->p); break;
         default: sh.b = pbsdf_diffuse(m->kd); break;
         }
         if (m->beckmann && (m->type == MAT_CONDUCTOR || m->type == MAT_DIELECTRIC || m->type == MAT_PLASTIC))

@@ -3,6 +3,7 @@
  */
 #include "material.h"
 
+#include <math.h>
 #include <string.h>
 
 void material_init(material *m)
@@ -174,4 +175,55 @@ void material_phong(material *m, vec3 kd, vec3 ks, float exponent)
     m->type = MAT_PHONG;
     m->kd = kd, m->ks = ks, m->ns = fmaxf(exponent, 0.0f);
     m->illum = 2;
+}
+
+material_layer material_layer_default(void)
+{
+    material_layer l;
+    l.thickness = 0.01f, l.albedo = v3s(0.0f), l.g = 0.0f, l.maxdepth = 10, l.nsamples = 1;
+    return l;
+}
+
+static void coated(material *m, int base, float ior, float alpha, material_layer layer)
+{
+    m->type = MAT_COATED;
+    m->coat_base = base;
+    m->ni = ior, m->alpha = fminf(fmaxf(alpha, 0.0f), 1.0f);
+    if (!(layer.thickness > 0.0f) || !isfinite(layer.thickness)) layer.thickness = 1e-6f;
+    layer.albedo = v3_min(v3_max(layer.albedo, v3s(0.0f)), v3s(1.0f));
+    layer.g = fminf(fmaxf(layer.g, -0.99f), 0.99f);
+    if (layer.maxdepth < 1) layer.maxdepth = 1;
+    if (layer.nsamples < 1) layer.nsamples = 1;
+    m->layer = layer;
+}
+
+void material_coated_diffuse(material *m, vec3 reflectance, float ior, float alpha, material_layer layer)
+{
+    coated(m, MATERIAL_BASE_DIFFUSE, ior, alpha, layer);
+    m->kd = reflectance;
+    m->schlick = false;
+    m->base_alpha = 0.0f;
+    m->ks = v3s(material_f0_dielectric(ior));
+    whitted_gloss(m, m->alpha);
+}
+
+void material_coated_conductor(material *m, vec3 eta, vec3 k, float base_alpha, float ior, float alpha,
+                               material_layer layer)
+{
+    coated(m, MATERIAL_BASE_CONDUCTOR, ior, alpha, layer);
+    m->schlick = false;
+    m->eta = eta, m->k = k;
+    m->base_alpha = fminf(fmaxf(base_alpha, 0.0f), 1.0f);
+    m->kd = v3s(0.0f), m->ks = material_f0_conductor(v3_scale(eta, 1.0f / ior), v3_scale(k, 1.0f / ior));
+    whitted_gloss(m, fmaxf(m->alpha, m->base_alpha));
+}
+
+void material_coated_conductor_f0(material *m, vec3 reflectance, float base_alpha, float ior, float alpha,
+                                  material_layer layer)
+{
+    coated(m, MATERIAL_BASE_CONDUCTOR, ior, alpha, layer);
+    m->schlick = true;
+    m->base_alpha = fminf(fmaxf(base_alpha, 0.0f), 1.0f);
+    m->kd = v3s(0.0f), m->ks = reflectance;
+    whitted_gloss(m, fmaxf(m->alpha, m->base_alpha));
 }

@@ -13,7 +13,8 @@
  * base under a dielectric coat), metallic-roughness (glTF 2.0's BRDF: a
  * metal and a dielectric mixed by metalness), thin dielectric, diffuse
  * transmission, mix (one of two materials per hit), rough diffuse
- * (Oren-Nayar) and Phong. Emission (ke) and
+ * (Oren-Nayar), Phong and coated (pbrt-v4's layered coateddiffuse and
+ * coatedconductor). Emission (ke) and
  * two-sidedness go with any kind; texture maps (texture.h) scale the
  * constants.
  */
@@ -38,11 +39,21 @@ typedef enum material_type {
     MAT_MIX,                  /* one of two materials, chosen per hit */
     MAT_ROUGH_DIFFUSE,        /* Oren-Nayar */
     MAT_PHONG,                /* the modified Phong model */
-    MAT_LAST = MAT_PHONG
+    MAT_COATED,               /* pbrt-v4's layered BSDF: a dielectric coat over a diffuse or conductor base */
+    MAT_LAST = MAT_COATED
 } material_type;
 
 /* The deepest nesting of mixes (a mix of mixes ...) that readers accept. */
 #define MATERIAL_MIX_DEPTH 16
+
+/* The slab between a coated material's coat and its base (MAT_COATED). */
+typedef struct material_layer {
+    float thickness; /* > 0 */
+    vec3 albedo;     /* the medium's single-scattering albedo, 0..1; 0 = clear */
+    float g;         /* its Henyey-Greenstein asymmetry, -1..1 */
+    int maxdepth;    /* >= 1: the longest random walk */
+    int nsamples;    /* >= 1: walks averaged per estimate */
+} material_layer;
 
 /* Colours are linear RGB. illum follows the MTL convention: 3/5 add mirror
  * reflection weighted by ks, 4/6/7 make the surface a dielectric of index
@@ -103,6 +114,14 @@ typedef struct material {
     int mix_a, mix_b;
     float amount;
     float metallic, roughness, transmission, clearcoat, clearcoat_roughness;
+    /* MAT_COATED: a dielectric coat of index ni and GGX alpha over a base,
+     * MATERIAL_BASE_DIFFUSE (Lambert of kd) or MATERIAL_BASE_CONDUCTOR (a
+     * metal of complex index eta + i k as a file gives it, relative to
+     * vacuum, or with schlick of normal-incidence reflectance ks; GGX
+     * base_alpha), and between them the layer (material_layer). */
+    int coat_base;
+    float base_alpha;
+    material_layer layer;
     /* Texture maps (docs/materials.md), kind TEX_NONE when absent. A map's
      * value multiplies its constant: map_kd kd, map_ks ks, map_ns ns,
      * map_alpha alpha; map_mr is glTF's metallic-roughness texture (data,
@@ -176,6 +195,26 @@ PK_HIDDEN void material_rough_diffuse(material *m, vec3 albedo, float alpha);
  * in a channel both are scaled down in it. The Whitted integrator's own
  * Lambert + Phong is the same model (illum 2). */
 PK_HIDDEN void material_phong(material *m, vec3 kd, vec3 ks, float exponent);
+
+/* pbrt-v4's coated materials (MAT_COATED). The layer's defaults are pbrt's:
+ * material_layer_default gives thickness 0.01, albedo 0, g 0, maxdepth 10,
+ * nsamples 1; constructors clamp it into range. The Whitted integrator sees
+ * the coat's Fresnel reflection (a mirror or a Phong lobe of its
+ * roughness) over the base's diffuse (coateddiffuse) or the base's
+ * reflectance (coatedconductor). */
+enum { MATERIAL_BASE_DIFFUSE = 0, MATERIAL_BASE_CONDUCTOR = 1 };
+PK_HIDDEN material_layer material_layer_default(void);
+/* A Lambertian base of reflectance under a coat of index ior and alpha. */
+PK_HIDDEN void material_coated_diffuse(material *m, vec3 reflectance, float ior, float alpha, material_layer layer);
+/* A conductor base of eta + i k (relative to vacuum; the coat's index
+ * divides them at shading, as pbrt-v4 does) and GGX base_alpha. */
+PK_HIDDEN void material_coated_conductor(material *m, vec3 eta, vec3 k, float base_alpha, float ior, float alpha,
+                                         material_layer layer);
+/* The same by the conductor's normal-incidence reflectance (in ks: a map_ks
+ * scales it), turned into eta = 1, k = 2 sqrt(r) / sqrt(1 - r) at shading as
+ * pbrt-v4 does. */
+PK_HIDDEN void material_coated_conductor_f0(material *m, vec3 reflectance, float base_alpha, float ior, float alpha,
+                                            material_layer layer);
 
 /* glTF 2.0's metallic-roughness material: base colour (linear), metallic and
  * perceptual roughness in 0..1; transmission 0, ior 1.5 and no clearcoat

@@ -173,7 +173,7 @@ int main(void)
         const d3 n = d3norm(d3cross(d3v(0, 0, 1), d3v(pl->m00, pl->m10, 0)));
         REQUIRE(n.y > 0.0);
         const d3 wo = d3norm(d3sub(cam, p));
-        surface sf;
+        surface sf = {0};
         sf.p = v3((float)p.x, (float)p.y, (float)p.z);
         sf.ng = sf.ns = v3((float)n.x, (float)n.y, (float)n.z);
         sf.front = true;

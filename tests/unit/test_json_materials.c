@@ -228,7 +228,7 @@ static void test_errors(void)
     const char *types =
         "must be one of \"diffuse\", \"conductor\", \"dielectric\", \"plastic\", \"metallic_roughness\", "
         "\"emitter\", \"two_sided\", \"interface\", \"thin_dielectric\", \"diffuse_transmission\", \"mix\", "
-        "\"rough_diffuse\", \"phong\"";
+        "\"rough_diffuse\", \"phong\", \"coated\"";
     char want[512];
     snprintf(want, sizeof want, "scene.json:1: materials.gold.type: %s", types);
     EXPECT_ERROR(MAT("{\"type\": \"metal\"}"), want);
@@ -242,6 +242,11 @@ static void test_errors(void)
                  "\"amount\": 1.5}}}",
                  "scene.json:1: materials.gold.amount: must be in 0..1");
     EXPECT_ERROR(MAT("{\"type\": \"phong\", \"exponent\": -1}"), "scene.json:1: materials.gold.exponent: must not be negative");
+    EXPECT_ERROR(MAT("{\"type\": \"coated\", \"g\": 1}"), "scene.json:1: materials.gold.g: must be in (-1, 1)");
+    EXPECT_ERROR(MAT("{\"type\": \"coated\", \"albedo\": [1, 1, 1], \"specular\": [1, 1, 1]}"),
+                 "scene.json:1: materials.gold.albedo: a coated conductor (\"eta\", \"k\" or \"specular\") has no "
+                 "diffuse \"albedo\"");
+    EXPECT_ERROR(MAT("{\"type\": \"coated\", \"maxdepth\": 0}"), "scene.json:1: materials.gold.maxdepth: must be an integer in 1..65536");
     EXPECT_ERROR(MAT("{\"type\": 3}"), want);
     snprintf(want, sizeof want, "scene.json:2: spheres[0].material.type: %s", types);
     EXPECT_ERROR("{\"spheres\": [{\"center\": [0, 0, 0], \"radius\": 1,\n \"material\": {\"type\": \"Diffuse\"}}]}",
@@ -361,6 +366,20 @@ static void test_sheets(void)
     CHECK(m.type == MAT_PHONG && near3(m.kd, 0.5f, 0.5f, 0.5f, 0) && near3(m.ks, 0.2f, 0.2f, 0.2f, 0) && m.ns == 30.0f);
     m = one("{\"type\": \"phong\", \"albedo\": [0.8, 0.8, 0.8], \"specular\": [0.4, 0.2, 0.2], \"exponent\": 7}");
     CHECK(near3(m.kd, 0.8f / 1.2f, 0.8f, 0.8f, 1e-6f) && near3(m.ks, 0.4f / 1.2f, 0.2f, 0.2f, 1e-6f) && m.ns == 7.0f);
+    m = one("{\"type\": \"coated\"}"); /* pbrt-v4's coateddiffuse defaults */
+    CHECK(m.type == MAT_COATED && m.coat_base == MATERIAL_BASE_DIFFUSE && near3(m.kd, 0.5f, 0.5f, 0.5f, 0) &&
+          m.ni == 1.5f && m.alpha == 0.0f && m.layer.thickness == 0.01f && m.layer.maxdepth == 10 &&
+          m.layer.nsamples == 1 && m.layer.g == 0.0f && near3(m.layer.albedo, 0, 0, 0, 0));
+    m = one("{\"type\": \"coated\", \"eta\": [0.2, 0.9, 1.1], \"k\": [3.9, 2.4, 2.1], \"base_roughness\": 0.5, "
+            "\"roughness\": 0.2, \"thickness\": 0.1, \"layer_albedo\": [0.5, 0.6, 0.7], \"g\": -0.3, "
+            "\"maxdepth\": 20, \"nsamples\": 3}");
+    CHECK(m.type == MAT_COATED && m.coat_base == MATERIAL_BASE_CONDUCTOR && !m.schlick && near3(m.eta, 0.2f, 0.9f, 1.1f, 0) &&
+          m.base_alpha == 0.25f && fabsf(m.alpha - 0.04f) < 1e-7f && m.layer.thickness == 0.1f &&
+          near3(m.layer.albedo, 0.5f, 0.6f, 0.7f, 0) && m.layer.g == -0.3f && m.layer.maxdepth == 20 &&
+          m.layer.nsamples == 3);
+    m = one("{\"type\": \"coated\", \"specular\": [0.9, 0.6, 0.4], \"base_alpha\": 0.1}");
+    CHECK(m.type == MAT_COATED && m.coat_base == MATERIAL_BASE_CONDUCTOR && m.schlick && near3(m.ks, 0.9f, 0.6f, 0.4f, 0) &&
+          m.base_alpha == 0.1f);
     /* a mix names materials before it; a mix of mixes */
     pk_context *ctx = new_ctx();
     pk_scene *s = NULL;
