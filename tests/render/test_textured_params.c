@@ -13,6 +13,7 @@
 #include "paprsek.h"
 
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
 

@@ -392,9 +392,9 @@ static void test_pbrt_metals(void)
          * written from this rule with six digits */
         const double rel = i < 4 ? 5e-4 : 1e-5;
         for (int c = 0; c < 3; c++) {
-            CHECKF(fabs(ge[c] - re[c]) <= rel * re[c] + 1e-6, "%s eta[%d] %.6g, recomputed %.6g", m[i].sym, c,
+            CHECKF(fabs((double)ge[c] - re[c]) <= rel * re[c] + 1e-6, "%s eta[%d] %.6g, recomputed %.6g", m[i].sym, c,
                    (double)ge[c], re[c]);
-            CHECKF(fabs(gk[c] - rk[c]) <= rel * rk[c] + 1e-6, "%s k[%d] %.6g, recomputed %.6g", m[i].sym, c,
+            CHECKF(fabs((double)gk[c] - rk[c]) <= rel * rk[c] + 1e-6, "%s k[%d] %.6g, recomputed %.6g", m[i].sym, c,
                    (double)gk[c], rk[c]);
         }
         char name[32];
@@ -434,9 +434,10 @@ static void test_pbrt_glasses(void)
 /* XYZ of linear sRGB (the inverse of the library's matrix, IEC 61966-2-1). */
 static void xyz_of_srgb(vec3 c, double xyz[3])
 {
-    xyz[0] = 0.4124564 * c.x + 0.3575761 * c.y + 0.1804375 * c.z;
-    xyz[1] = 0.2126729 * c.x + 0.7151522 * c.y + 0.0721750 * c.z;
-    xyz[2] = 0.0193339 * c.x + 0.1191920 * c.y + 0.9503041 * c.z;
+    const double r = c.x, g = c.y, b = c.z;
+    xyz[0] = 0.4124564 * r + 0.3575761 * g + 0.1804375 * b;
+    xyz[1] = 0.2126729 * r + 0.7151522 * g + 0.0721750 * b;
+    xyz[2] = 0.0193339 * r + 0.1191920 * g + 0.9503041 * b;
 }
 
 static void test_pbrt_illuminants(void)
@@ -444,7 +445,7 @@ static void test_pbrt_illuminants(void)
     vec3 c;
     /* D65 is the sRGB white */
     REQUIRE(spectra_pbrt_named("stdillum-D65", &c) == SPECTRA_PBRT_KNOWN);
-    CHECKF(fabs(c.x - 1.0) < 1e-3 && fabs(c.y - 1.0) < 1e-3 && fabs(c.z - 1.0) < 1e-3, "D65 %.5f %.5f %.5f",
+    CHECKF(fabsf(c.x - 1.0f) < 1e-3f && fabsf(c.y - 1.0f) < 1e-3f && fabsf(c.z - 1.0f) < 1e-3f, "D65 %.5f %.5f %.5f",
            (double)c.x, (double)c.y, (double)c.z);
     /* A is Planck's law of 2848 K with c2 = 1.435e-2 m K: 2856 K with today's c2 */
     vec3 bb = spectra_pbrt_blackbody(2848.0f * 1.4388f / 1.435f);
