@@ -409,12 +409,13 @@ static void test_reader(void)
 {
     pk_scene *s = load_text(PLAIN
                             "Texture \"k\" \"spectrum\" \"checkerboard\" \"float uscale\" 2 \"rgb tex1\" [1 0 0]\n"
-                            "Texture \"f\" \"float\" \"fbm\"\n"
+                            "Texture \"f\" \"float\" \"fbm\" Texture \"g\" \"float\" \"mix\" \"float tex1\" 1.4 "
+                            "\"float tex2\" 1.6 \"texture amount\" \"f\"\n"
                             "Texture \"m\" \"spectrum\" \"mix\" \"texture tex1\" \"k\" \"texture amount\" \"f\"\n"
                             "MakeNamedMaterial \"a\" \"string type\" \"diffuse\" \"texture reflectance\" \"k\"\n"
                             "MakeNamedMaterial \"b\" \"string type\" \"diffuse\" \"texture reflectance\" \"m\"\n"
                             "MakeNamedMaterial \"c\" \"string type\" \"dielectric\" \"texture roughness\" \"f\"\n"
-                            "MakeNamedMaterial \"d\" \"string type\" \"dielectric\" \"texture eta\" \"f\"\n"
+                            "MakeNamedMaterial \"d\" \"string type\" \"dielectric\" \"texture eta\" \"g\"\n"
                             "MakeNamedMaterial \"e\" \"string type\" \"conductor\" \"texture eta\" \"k\" \"texture k\" \"f\"\n"
                             "Shape \"sphere\"\n");
     REQUIRE(s != NULL);
