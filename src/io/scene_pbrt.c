@@ -360,7 +360,6 @@ static pk_status spectrum_rgb(pp *p, const pparam *q, bool illuminant, vec3 *out
     }
     const char *nmn = q->str[0];
     const int known = spectra_pbrt_named(nmn, out);
-    if (known == SPECTRA_PBRT_APPROX) pwarn(p, q->line, "spectrum \"%s\" is not in the table; copper's is used", nmn);
     if (known == SPECTRA_PBRT_UNKNOWN) return spectrum_file(p, q, nmn, illuminant, out);
     return PK_OK;
 }
@@ -640,13 +639,18 @@ static pk_status make_conductor(pp *p, material *m, const char *prefix, float mi
     vec3 eta, k;
     spectra_named_metal("Cu", &eta, &k);
     bool fe, fk;
-    if ((st = get_colour(p, ne, &eta, NULL, &fe)) || (st = get_colour(p, nk, &k, NULL, &fk))) return st;
+    tex_ref te, tk; /* spectrum textures on eta and k (pbrt evaluates them per hit) */
+    tex_ref_init(&te);
+    tex_ref_init(&tk);
+    if ((st = get_colour(p, ne, &eta, maps ? &te : NULL, &fe)) || (st = get_colour(p, nk, &k, maps ? &tk : NULL, &fk)))
+        return st;
     if (has_refl) {
         if (fe || fk) pwarn(p, p->line, "conductor: both reflectance and eta/k are given; reflectance is used");
         material_conductor_f0(m, refl, alpha);
         m->map_ks = tr;
     } else {
         material_conductor(m, eta, k, alpha);
+        m->map_eta = te, m->map_k = tk;
     }
     m->alpha_v = alpha_v;
     m->map_alpha = ta;
@@ -770,13 +774,16 @@ static pk_status build_material(pp *p, const char *type, material *m, bool *inte
         vec3 tr = v3s(0.25f);
         float sc = 1.0f;
         kd = v3s(0.25f);
+        tex_ref ttr;
+        tex_ref_init(&ttr);
         if ((st = get_colour(p, "reflectance", &kd, &tkd, NULL)) ||
-            (st = get_colour(p, "transmittance", &tr, NULL, NULL)) || (st = pb_float(&p->pd, "scale", &sc)))
+            (st = get_colour(p, "transmittance", &tr, &ttr, NULL)) || (st = pb_float(&p->pd, "scale", &sc)))
             return st;
         /* pbrt-v4 clamps scale * reflectance and scale * transmittance to 0..1 */
         const vec3 r = v3_scale(kd, sc), t = v3_scale(tr, sc);
         material_diffuse_transmission(m, v3_min(v3_max(r, v3s(0.0f)), v3s(1.0f)), v3_min(v3_max(t, v3s(0.0f)), v3s(1.0f)));
         m->map_kd = tkd;
+        m->map_tf = ttr;
     } else if (strcmp(type, "mix") == 0) {
         pparam *q;
         if ((st = pb_typed(&p->pd, "materials", TB(PT_STRING), "two material names", &q))) return st;
@@ -1048,8 +1055,8 @@ static bool needs_uv(pp *p, int32_t alpha_tex)
 {
     const material *m = &p->s->materials[GS(p)->material];
     return alpha_tex >= 0 || m->map_kd.kind || m->map_ks.kind || m->map_ns.kind || m->map_d.kind ||
-           m->map_alpha.kind || m->map_bump.kind || m->map_norm.kind || m->map_mr.kind ||
-           material_anisotropic(m); /* the roughness follows pbrt's dp/du */
+           m->map_alpha.kind || m->map_bump.kind || m->map_norm.kind || m->map_mr.kind || m->map_eta.kind ||
+           m->map_k.kind || m->map_tf.kind || material_anisotropic(m); /* the roughness follows pbrt's dp/du */
 }
 
 /* A copy of m in which every face (per_face corners of faces[]) has
@@ -2676,9 +2683,22 @@ static pk_status d_film(pp *p, const char *type)
     if ((st = pb_float(&p->pd, "iso", &iso)) || (st = pb_string(&p->pd, "sensor", &sensor))) return st;
     if (!(iso > 0.0f)) return pfail(p, p->line, PK_ERR_PARSE, "Film: 'iso' %g must be positive", (double)iso);
     p->film_iso = iso;
-    if (strcmp(sensor, "cie1931") != 0)
-        pwarn(p, p->line, "Film: the sensor \"%.40s\" is not simulated (colours as the CIE 1931 observer sees them)",
-              sensor);
+    if (strcmp(sensor, "cie1931") != 0) {
+        /* pbrt-v4's measured cameras (Jiang et al., "What is the space of
+         * spectral sensitivity functions for digital color cameras?", 2013) */
+        static const char *const cameras[] = {
+            "canon_eos_100d",  "canon_eos_1dx_mkii", "canon_eos_200d",  "canon_eos_200d_mkii", "canon_eos_5d",
+            "canon_eos_5d_mkii", "canon_eos_5d_mkiii", "canon_eos_5d_mkiv", "canon_eos_5ds",   "canon_eos_m",
+            "hasselblad_l1d_20c", "nikon_d810",       "nikon_d850",      "sony_ilce_6400",      "sony_ilce_7m3",
+            "sony_ilce_7rm3",  "sony_ilce_9"};
+        bool camera = false;
+        for (size_t i = 0; i < sizeof cameras / sizeof cameras[0]; i++) camera = camera || strcmp(sensor, cameras[i]) == 0;
+        if (camera)
+            pwarn(p, p->line,
+                  "Film: the camera sensor \"%s\" is not simulated (colours as the CIE 1931 observer sees them)", sensor);
+        else
+            pwarn(p, p->line, "Film: unknown sensor \"%.40s\" (colours as the CIE 1931 observer sees them)", sensor);
+    }
     if (pb_param(&p->pd, "whitebalance")) pwarn(p, p->line, "Film: white balance is not applied");
     /* the output file is named on the command line; the rest is the film's look */
     static const char *const quiet[] = {"filename", "diagonal", "maxcomponentvalue", "savefp16", "writefp16"};

@@ -1616,8 +1616,9 @@ static pk_status bsdf_conductor(xp *p, const bsdf_in *in, material *m)
             xwarn(p, mat_at, "conductor material \"%s\" is not in the table (Cu, Au, Ag, Al, Cr, none); using Cu", sm);
         }
     }
-    if ((st = get_color(p, in->d, "eta", &eta))) return st;
-    if ((st = get_color(p, in->d, "k", &k))) return st;
+    /* a texture on eta or k multiplies it per hit */
+    if ((st = get_color_tex(p, in->d, "eta", &eta, &m->map_eta))) return st;
+    if ((st = get_color_tex(p, in->d, "k", &k, &m->map_k))) return st;
     if ((st = get_ior(p, in->d, "ext_eta", &ext))) return st;
     if ((st = get_color(p, in->d, "specular_reflectance", &spec))) return st;
     eta = v3_scale(eta, 1.0f / ext), k = v3_scale(k, 1.0f / ext);
@@ -1653,7 +1654,8 @@ static pk_status bsdf_dielectric(xp *p, const bsdf_in *in, material *m)
     vec3 tr = v3s(1.0f);
     float ior = in->ior, alpha = in->alpha;
     pk_status st;
-    if ((st = get_color(p, in->d, "specular_transmittance", &tr)) || (st = specular_one(p, in))) return st;
+    if ((st = get_color_tex(p, in->d, "specular_transmittance", &tr, &m->map_tf)) || (st = specular_one(p, in)))
+        return st;
     if (in->type[0] == 't') { /* a thin sheet: reflects by R' and lets the rest through unbent */
         material_thin_dielectric(m, ior, clamp01v(tr));
         return PK_OK;

@@ -223,6 +223,15 @@ static inline PK_HD void surface_texture_at(const scene_view *s, const ray *r, c
         tm->roughness = fminf(fmaxf(m->roughness * rg, 0.0f), 1.0f);
         tm->alpha = tm->roughness * tm->roughness;
     }
+    if (m->map_eta.kind) { /* a conductor's complex index: not clamped above */
+        const vec3 e = tex_eval_rgb(s->textures, &m->map_eta, q);
+        tm->eta = v3_mul(m->eta, v3(fmaxf(e.x, 0.0f), fmaxf(e.y, 0.0f), fmaxf(e.z, 0.0f)));
+    }
+    if (m->map_k.kind) {
+        const vec3 k = tex_eval_rgb(s->textures, &m->map_k, q);
+        tm->k = v3_mul(m->k, v3(fmaxf(k.x, 0.0f), fmaxf(k.y, 0.0f), fmaxf(k.z, 0.0f)));
+    }
+    if (m->map_tf.kind) tm->tf = v3_mul(m->tf, surface_clamp_rgb(tex_eval_rgb(s->textures, &m->map_tf, q)));
     if (m->map_ke.kind) { /* the finest level, as light sampling sees it (lights.h), so that both agree */
         const tex_query qe = {uv.u, uv.v, 0.0f, sf->p, sf->ng, s->tex_nodes};
         const vec3 e = tex_eval_rgb(s->textures, &m->map_ke, qe);

@@ -27,6 +27,9 @@ void material_init(material *m)
     tex_ref_init(&m->map_norm);
     tex_ref_init(&m->map_mr);
     tex_ref_init(&m->map_ke);
+    tex_ref_init(&m->map_eta);
+    tex_ref_init(&m->map_k);
+    tex_ref_init(&m->map_tf);
 }
 
 float material_f0_dielectric(float ior)

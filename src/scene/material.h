@@ -130,8 +130,12 @@ typedef struct material {
      * surface is not there for any ray (the constant d still dissolves the
      * rest). map_bump is a height field (heights times bm, in scene units);
      * map_norm a tangent-space normal map. map_ke multiplies the emission ke
-     * (linear colour, values above 1 allowed): a textured emitter. */
-    tex_ref map_kd, map_ks, map_ns, map_d, map_alpha, map_bump, map_norm, map_mr, map_ke;
+     * (linear colour, values above 1 allowed): a textured emitter. map_eta
+     * and map_k multiply a conductor's eta and k (not clamped above: pbrt's
+     * spectrum textures on conductor.eta and .k); map_tf multiplies the
+     * transmittance tf of a dielectric, thin dielectric or diffuse
+     * transmitter (clamped to 0..1). */
+    tex_ref map_kd, map_ks, map_ns, map_d, map_alpha, map_bump, map_norm, map_mr, map_ke, map_eta, map_k, map_tf;
     /* The media on either side (medium.h): medium_out on the side the
      * geometric normal points to, medium_in on the other; an index into the
      * scene's media, MEDIUM_NONE (vacuum) or MEDIUM_INHERIT (the surface

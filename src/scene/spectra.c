@@ -477,6 +477,173 @@ vec3 spectra_pbrt_emitter(const float *nm, const float *val, size_t n)
     return pbrt_emitter_unit(sampled_at, &sp);
 }
 
+/* pbrt-v4's metals and oxides that Mitsuba's table does not name: measured
+ * complex indices from the refractiveindex.info database (public domain,
+ * CC0 1.0): brass "other/alloys/Cu-Zn/Querry-Cu70Zn30" (M. R. Querry, 1987),
+ * MgO and TiO2 in the samples pbrt-v4 tabulates. Reduced to RGB as the
+ * metals above are (Bitterli's table, which these rules reproduce to 4e-5):
+ * XYZ over 360..830 nm against the 1 nm CIE 1931 functions, the samples
+ * linear between them and held beyond the last, divided by the integral of
+ * y, then Mitsuba's sRGB matrix, negative channels set to 0. The samples are
+ * in tests/unit/spectra_metals.inc, where test_spectra recomputes every row. */
+static const metal pbrt_metals[] = {
+    {"CuZn", {0.51977f, 0.488506f, 1.04201f}, {4.33059f, 2.5481f, 1.59189f}},
+    {"MgO", {2.08965f, 1.65071f, 1.59488f}, {0.0f, 0.0f, 0.0f}},
+    {"TiO2", {3.45663f, 2.80171f, 2.90516f}, {0.000102587f, 0.0f, 0.000635063f}},
+};
+
+/* pbrt-v4's named glasses: Schott's Sellmeier coefficients (n^2 = 1 + sum of
+ * B_i l^2 / (l^2 - C_i), l in micrometres, C_i in square micrometres; the
+ * Schott catalogue as the refractiveindex.info database lists it, CC0) and
+ * the index at 550 nm they give, which is what a glass's name stands for
+ * (test_spectra recomputes it). pbrt-v4's glass-F5, -F10 and -F11 are its
+ * tables of N-SF5, N-SF10 and N-SF11; the SF names are accepted too. */
+static const struct spectra_glass {
+    const char *name, *schott;
+    float eta550;
+    double b[3], c[3];
+} pbrt_glasses[] = {
+    {"glass-BK7", "N-BK7", 1.51852f, {1.03961212, 0.231792344, 1.01046945}, {0.00600069867, 0.0200179144, 103.560653}},
+    {"glass-BAF10", "N-BAF10", 1.67306f, {1.5851495, 0.143559385, 1.08521269}, {0.00926681282, 0.0424489805, 105.613573}},
+    {"glass-FK51A", "N-FK51A", 1.48779f, {0.971247817, 0.216901417, 0.904651666}, {0.00472301995, 0.0153575612, 168.68133}},
+    {"glass-LASF9", "N-LASF9", 1.85584f, {2.00029547, 0.298926886, 1.80691843}, {0.0121426017, 0.0538736236, 156.530829}},
+    {"glass-F5", "N-SF5", 1.67711f, {1.52481889, 0.187085527, 1.42729015}, {0.011254756, 0.0588995392, 129.141675}},
+    {"glass-SF5", "N-SF5", 1.67711f, {1.52481889, 0.187085527, 1.42729015}, {0.011254756, 0.0588995392, 129.141675}},
+    {"glass-F10", "N-SF10", 1.73366f, {1.62153902, 0.256287842, 1.64447552}, {0.0122241457, 0.0595736775, 147.468793}},
+    {"glass-SF10", "N-SF10", 1.73366f, {1.62153902, 0.256287842, 1.64447552}, {0.0122241457, 0.0595736775, 147.468793}},
+    {"glass-F11", "N-SF11", 1.79115f, {1.73759695, 0.313747346, 1.89878101}, {0.013188707, 0.0623068142, 155.23629}},
+    {"glass-SF11", "N-SF11", 1.79115f, {1.73759695, 0.313747346, 1.89878101}, {0.013188707, 0.0623068142, 155.23629}},
+};
+
+bool spectra_pbrt_glass(size_t i, const char **name, float *eta550, double b[3], double c[3])
+{
+    if (i >= sizeof pbrt_glasses / sizeof pbrt_glasses[0]) return false;
+    *name = pbrt_glasses[i].name, *eta550 = pbrt_glasses[i].eta550;
+    for (int j = 0; j < 3; j++) b[j] = pbrt_glasses[i].b[j], c[j] = pbrt_glasses[i].c[j];
+    return true;
+}
+
+bool spectra_pbrt_metal(const char *sym, vec3 *eta, vec3 *k)
+{
+    if (spectra_named_metal(sym, eta, k)) return true;
+    for (size_t i = 0; i < sizeof pbrt_metals / sizeof pbrt_metals[0]; i++)
+        if (strcmp(pbrt_metals[i].name, sym) == 0) {
+            *eta = v3(pbrt_metals[i].eta[0], pbrt_metals[i].eta[1], pbrt_metals[i].eta[2]);
+            *k = v3(pbrt_metals[i].k[0], pbrt_metals[i].k[1], pbrt_metals[i].k[2]);
+            return true;
+        }
+    return false;
+}
+
+/* ---- CIE illuminants ---------------------------------------------------------------------- */
+
+#include "spectra_illum.inc"
+
+/* CIE illuminant A (CIE 15:2004, eq. 2.1): Planck's law with c2 = 1.435e7
+ * nm K at 2848 K, 100 at 560 nm; the same as a blackbody of 2856 K with
+ * today's c2 = 1.4388e7 nm K. */
+static double illum_a(const void *user, double nm)
+{
+    (void)user;
+    const double c2 = 1.435e7, t = 2848.0;
+    return 100.0 * pow(560.0 / nm, 5.0) * expm1(c2 / (t * 560.0)) / expm1(c2 / (t * nm));
+}
+
+typedef struct dseries {
+    double m1, m2;
+} dseries;
+
+/* A D-series illuminant: S0 + M1 S1 + M2 S2, linear between the 5 nm rows
+ * (300..830 nm), zero outside. */
+static double illum_d(const void *user, double nm)
+{
+    const dseries *d = user;
+    if (!(nm >= 300.0 && nm <= 830.0)) return 0.0;
+    double t = (nm - 300.0) / 5.0;
+    int i = (int)t;
+    if (i > 105) i = 105;
+    double f = t - i, s[3];
+    for (int j = 0; j < 3; j++) s[j] = (1.0 - f) * (double)cie_daylight_s[j][i] + f * (double)cie_daylight_s[j][i + 1];
+    return s[0] + d->m1 * s[1] + d->m2 * s[2];
+}
+
+void spectra_cie_daylight_m(double cct, bool round3, double *m1, double *m2)
+{
+    /* CIE 15:2004, eqs. 3.3 - 3.6: the chromaticity of daylight of the
+     * correlated colour temperature, then the weights of S1 and S2 */
+    const double t = cct;
+    double x = t <= 7000.0 ? -4.6070e9 / (t * t * t) + 2.9678e6 / (t * t) + 0.09911e3 / t + 0.244063
+                           : -2.0064e9 / (t * t * t) + 1.9018e6 / (t * t) + 0.24748e3 / t + 0.237040;
+    double y = -3.0 * x * x + 2.870 * x - 0.275;
+    double m = 0.0241 + 0.2562 * x - 0.7341 * y;
+    *m1 = (-1.3515 - 1.7703 * x + 5.9114 * y) / m;
+    *m2 = (0.0300 - 31.4424 * x + 30.0717 * y) / m;
+    if (round3) *m1 = round(*m1 * 1000.0) / 1000.0, *m2 = round(*m2 * 1000.0) / 1000.0;
+}
+
+double spectra_cie_daylight(double cct, bool round3, double nm)
+{
+    dseries d;
+    spectra_cie_daylight_m(cct, round3, &d.m1, &d.m2);
+    return illum_d(&d, nm);
+}
+
+typedef struct fseries {
+    int i;
+} fseries;
+
+static double illum_f(const void *user, double nm)
+{
+    const int i = ((const fseries *)user)->i;
+    if (!(nm >= 380.0 && nm <= 780.0)) return 0.0;
+    double t = (nm - 380.0) / 5.0;
+    int j = (int)t;
+    if (j > 79) j = 79;
+    double f = t - j;
+    return (1.0 - f) * (double)cie_illum_f[i][j] + f * (double)cie_illum_f[i][j + 1];
+}
+
+double spectra_cie_illum_f(int i, double nm)
+{
+    const fseries f = {i - 1};
+    return i >= 1 && i <= 12 ? illum_f(&f, nm) : 0.0;
+}
+
+/* The named illuminants as lights: luminance 1, linear sRGB (pbrt_emitter_unit). */
+static bool pbrt_illuminant(const char *name, vec3 *out)
+{
+    if (strcmp(name, "stdillum-A") == 0) {
+        *out = pbrt_emitter_unit(illum_a, NULL);
+        return true;
+    }
+    /* D50 and D65 as CIE tabulates them (the correlated colour temperatures
+     * 5000 and 6500 K times 1.4388 / 1.4380, M1 and M2 rounded to three
+     * decimals); ACES's D60 as the Academy computes it (6000 K, not rounded) */
+    double cct = 0.0;
+    bool round3 = true;
+    if (strcmp(name, "stdillum-D50") == 0) cct = 5000.0 * 1.4388 / 1.4380;
+    else if (strcmp(name, "stdillum-D65") == 0) cct = 6500.0 * 1.4388 / 1.4380;
+    else if (strcmp(name, "illum-acesD60") == 0) cct = 6000.0, round3 = false;
+    if (cct > 0.0) {
+        dseries d;
+        spectra_cie_daylight_m(cct, round3, &d.m1, &d.m2);
+        *out = pbrt_emitter_unit(illum_d, &d);
+        return true;
+    }
+    if (strncmp(name, "stdillum-F", 10) == 0) {
+        const char *n = name + 10;
+        int i = 0;
+        if (n[0] >= '1' && n[0] <= '9' && n[1] == '\0') i = n[0] - '0';
+        else if (n[0] == '1' && n[1] >= '0' && n[1] <= '2' && n[2] == '\0') i = 10 + n[1] - '0';
+        if (i) {
+            const fseries f = {i - 1};
+            *out = pbrt_emitter_unit(illum_f, &f);
+            return true;
+        }
+    }
+    return false;
+}
+
 int spectra_pbrt_named(const char *name, vec3 *out)
 {
     if (strncmp(name, "metal-", 6) == 0) {
@@ -486,40 +653,21 @@ int spectra_pbrt_named(const char *name, vec3 *out)
         else if (ok && strcmp(dash, "-eta") != 0) ok = false;
         char sym[16];
         const size_t n = ok ? (size_t)(dash - el) : 0;
+        vec3 eta, k;
         if (ok && n < sizeof sym) {
             memcpy(sym, el, n);
             sym[n] = '\0';
-            vec3 eta, k;
-            int known = SPECTRA_PBRT_KNOWN;
-            if (!spectra_named_metal(sym, &eta, &k)) {
-                if (strcmp(sym, "CuZn") && strcmp(sym, "MgO") && strcmp(sym, "TiO2")) goto glass;
-                spectra_named_metal("Cu", &eta, &k); /* brass and the oxides: not in the table */
-                known = SPECTRA_PBRT_APPROX;
+            if (spectra_pbrt_metal(sym, &eta, &k)) {
+                *out = is_k ? k : eta;
+                return SPECTRA_PBRT_KNOWN;
             }
-            *out = is_k ? k : eta;
-            return known;
         }
     }
-glass:;
-    /* the named glasses, reduced to their index at 550 nm (Schott's dispersion formulas) */
-    static const struct {
-        const char *name;
-        float eta;
-    } g[] = {{"glass-BK7", 1.5185f},  {"glass-BAF10", 1.6734f}, {"glass-FK51A", 1.4875f}, {"glass-LASF9", 1.8555f},
-             {"glass-F5", 1.6076f},   {"glass-SF5", 1.6776f},   {"glass-F10", 1.6289f},   {"glass-SF10", 1.7343f},
-             {"glass-F11", 1.6235f},  {"glass-SF11", 1.7919f}};
-    for (size_t i = 0; i < sizeof g / sizeof g[0]; i++)
-        if (strcmp(g[i].name, name) == 0) {
-            *out = v3s(g[i].eta);
+    for (size_t i = 0; i < sizeof pbrt_glasses / sizeof pbrt_glasses[0]; i++)
+        if (strcmp(pbrt_glasses[i].name, name) == 0) {
+            *out = v3s(pbrt_glasses[i].eta550);
             return SPECTRA_PBRT_KNOWN;
         }
-    if (strcmp(name, "stdillum-D65") == 0 || strcmp(name, "illum-acesD60") == 0) {
-        *out = v3s(1.0f);
-        return SPECTRA_PBRT_KNOWN;
-    }
-    if (strcmp(name, "stdillum-D50") == 0 || strcmp(name, "stdillum-A") == 0) {
-        *out = spectra_pbrt_blackbody(name[9] == 'D' ? 5003.0f : 2856.0f);
-        return SPECTRA_PBRT_KNOWN;
-    }
+    if (pbrt_illuminant(name, out)) return SPECTRA_PBRT_KNOWN;
     return SPECTRA_PBRT_UNKNOWN;
 }

@@ -97,14 +97,32 @@ PK_HIDDEN vec3 spectra_pbrt_blackbody(float kelvin);
  * luminance: spectra_pbrt_blackbody times that spectrum's luminance (media's
  * "temperature" emission). */
 PK_HIDDEN vec3 spectra_pbrt_blackbody_peak(double kelvin);
-enum { SPECTRA_PBRT_UNKNOWN = 0, SPECTRA_PBRT_KNOWN = 1, SPECTRA_PBRT_APPROX = 2 };
+enum { SPECTRA_PBRT_UNKNOWN = 0, SPECTRA_PBRT_KNOWN = 1 };
 /* A named spectrum of pbrt-v4 as RGB: "metal-XX-eta" / "metal-XX-k" (the
- * metals of spectra_named_metal; brass, MgO and TiO2 get copper's values
- * and SPECTRA_PBRT_APPROX), "glass-XX" (the index at 550 nm), and the
- * illuminants stdillum-D65, illum-acesD60 (white), stdillum-D50 and
- * stdillum-A (blackbodies of 5003 and 2856 K). SPECTRA_PBRT_UNKNOWN,
- * nothing written, for another name. */
+ * metals of spectra_pbrt_metal), "glass-XX" (the index at 550 nm of
+ * spectra_pbrt_glass), and the illuminants stdillum-A (CIE's formula),
+ * stdillum-D50, stdillum-D65, illum-acesD60 (CIE daylight of 5003, 6504
+ * and 6000 K), stdillum-F1 ... F12 (CIE's tables) as lights: luminance 1,
+ * reduced as spectra_pbrt_emitter reduces a spectrum (D65 is white to
+ * 1e-3). SPECTRA_PBRT_UNKNOWN, nothing written, for another name. */
 PK_HIDDEN int spectra_pbrt_named(const char *name, vec3 *out);
+
+/* The complex index (eta, k) at the red, green and blue primaries of a
+ * metal pbrt-v4 names ("Ag", "Al", "Au", "Cu", "CuZn", "MgO", "TiO2"; also
+ * "Cr"). False, nothing written, for another symbol. */
+PK_HIDDEN bool spectra_pbrt_metal(const char *sym, vec3 *eta, vec3 *k);
+/* The i-th named glass of pbrt-v4 (false past the last): its name, its
+ * index at 550 nm and its Sellmeier coefficients (n^2 = 1 + sum of b_j l^2 /
+ * (l^2 - c_j), l in micrometres), kept for spectral rendering. */
+PK_HIDDEN bool spectra_pbrt_glass(size_t i, const char **name, float *eta550, double b[3], double c[3]);
+/* CIE daylight (the D series) of correlated colour temperature cct
+ * (4000..25000 K): M1 and M2 (rounded to three decimals, as CIE's tables,
+ * when round3), and the relative spectral power at nm (300..830 nm, zero
+ * outside). */
+PK_HIDDEN void spectra_cie_daylight_m(double cct, bool round3, double *m1, double *m2);
+PK_HIDDEN double spectra_cie_daylight(double cct, bool round3, double nm);
+/* CIE illuminant Fi (1..12) at nm (380..780 nm, zero outside). */
+PK_HIDDEN double spectra_cie_illum_f(int i, double nm);
 
 /* The complex index of refraction (eta, k) of a named metal at the red,
  * green and blue primaries: "Cu", "Au", "Ag", "Al", "Cr" (the names of

@@ -409,21 +409,27 @@ static void test_reader(void)
 {
     pk_scene *s = load_text(PLAIN
                             "Texture \"k\" \"spectrum\" \"checkerboard\" \"float uscale\" 2 \"rgb tex1\" [1 0 0]\n"
-                            "Texture \"f\" \"float\" \"fbm\"\n"
+                            "Texture \"f\" \"float\" \"fbm\" Texture \"g\" \"float\" \"mix\" \"float tex1\" 1.4 "
+                            "\"float tex2\" 1.6 \"texture amount\" \"f\"\n"
                             "Texture \"m\" \"spectrum\" \"mix\" \"texture tex1\" \"k\" \"texture amount\" \"f\"\n"
                             "MakeNamedMaterial \"a\" \"string type\" \"diffuse\" \"texture reflectance\" \"k\"\n"
                             "MakeNamedMaterial \"b\" \"string type\" \"diffuse\" \"texture reflectance\" \"m\"\n"
                             "MakeNamedMaterial \"c\" \"string type\" \"dielectric\" \"texture roughness\" \"f\"\n"
-                            "MakeNamedMaterial \"d\" \"string type\" \"conductor\" \"texture eta\" \"f\"\n"
+                            "MakeNamedMaterial \"d\" \"string type\" \"dielectric\" \"texture eta\" \"g\"\n"
+                            "MakeNamedMaterial \"e\" \"string type\" \"conductor\" \"texture eta\" \"k\" \"texture k\" \"f\"\n"
                             "Shape \"sphere\"\n");
     REQUIRE(s != NULL);
     const material *a = &s->materials[scene_find_material(s, "a")];
     const material *b = &s->materials[scene_find_material(s, "b")];
     const material *c = &s->materials[scene_find_material(s, "c")];
+    const material *e = &s->materials[scene_find_material(s, "e")];
     CHECK(a->map_kd.kind == TEX_CHECKER && a->map_kd.s[0] == 2.0f); /* the scene's own checker, as before */
     CHECK(b->map_kd.kind == TEX_EXPR && b->map_kd.nnodes == 6); /* tex1 (2 consts, checker), tex2, fbm, mix */
     CHECK(c->map_alpha.kind == TEX_EXPR && c->alpha == 1.0f);
     CHECK(s->tex_nodes[c->map_alpha.node + c->map_alpha.nnodes - 1].op == TN_SQRT); /* remaproughness */
+    /* a conductor's eta and k take their textures (the checker as the scene's own, the fbm as an expression) */
+    CHECK(e->type == MAT_CONDUCTOR && e->map_eta.kind == TEX_CHECKER && e->map_k.kind == TEX_EXPR);
+    CHECK(e->eta.x == 1.0f && e->k.x == 1.0f);
     CHECKF(warnings.count == 1 && strstr(warnings.all, "t.pbrt:10: a texture for 'eta' is not supported (the material "
                                                         "has no texture map for it); using its mean"),
            "%s", warnings.all);
