@@ -1744,6 +1744,8 @@ static pk_status parse_environment_record(jp *p, const cJSON *it)
         float c[12];
         if ((st = get_floats(p, portal, "environment.record.portal", c, 12))) return st;
         for (int k = 0; k < 4; k++) env->portal[k] = v3(c[3 * k], c[3 * k + 1], c[3 * k + 2]);
+        if (!io_portal_is_rectangle(env->portal))
+            return jfail(p, PK_ERR_PARSE, portal, "environment.record.portal", "must be four corners of a rectangle");
         env->has_portal = true;
     }
     const cJSON *map = cJSON_GetObjectItemCaseSensitive(f[0], "map");

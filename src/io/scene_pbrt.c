@@ -2020,25 +2020,7 @@ static pk_status portal_points(pp *p, vec3 out[4], bool *ok)
         return PK_OK;
     }
     for (int k = 0; k < 4; k++) out[k] = v3((float)q->num[3 * k], (float)q->num[3 * k + 1], (float)q->num[3 * k + 2]);
-    double e[4][3]; /* p0 -> p1, p1 -> p2, p3 -> p2, p0 -> p3, unit */
-    const int from[4] = {0, 1, 3, 0}, to[4] = {1, 2, 2, 3};
-    bool good = true;
-    for (int k = 0; k < 4; k++) {
-        double len = 0.0;
-        for (int c = 0; c < 3; c++) {
-            e[k][c] = q->num[3 * to[k] + c] - q->num[3 * from[k] + c];
-            len += e[k][c] * e[k][c];
-        }
-        len = sqrt(len);
-        if (!(len > 0.0) || !isfinite(len)) good = false;
-        for (int c = 0; c < 3 && good; c++) e[k][c] /= len;
-    }
-#define DOT3(a, b) ((a)[0] * (b)[0] + (a)[1] * (b)[1] + (a)[2] * (b)[2])
-    if (good && (fabs(DOT3(e[0], e[2]) - 1.0) > 1e-3 || fabs(DOT3(e[1], e[3]) - 1.0) > 1e-3)) good = false;
-    if (good && (fabs(DOT3(e[0], e[1])) > 1e-3 || fabs(DOT3(e[1], e[2])) > 1e-3 || fabs(DOT3(e[2], e[3])) > 1e-3 ||
-                 fabs(DOT3(e[3], e[0])) > 1e-3))
-        good = false;
-#undef DOT3
+    const bool good = io_portal_is_rectangle(out);
     if (!good) {
         pwarn(p, q->line, "infinite: the 'portal' is not a planar rectangle; the whole environment is used");
         return PK_OK;
