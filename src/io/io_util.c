@@ -427,3 +427,22 @@ pk_status io_gunzip(pk_context *ctx, const char *name, const char *data, size_t 
     *out_size = len;
     return PK_OK;
 }
+
+bool io_portal_is_rectangle(const vec3 p[4])
+{
+    double e[4][3]; /* p0 -> p1, p1 -> p2, p3 -> p2, p0 -> p3, unit */
+    const int from[4] = {0, 1, 3, 0}, to[4] = {1, 2, 2, 3};
+    for (int k = 0; k < 4; k++) {
+        const double d[3] = {(double)p[to[k]].x - (double)p[from[k]].x, (double)p[to[k]].y - (double)p[from[k]].y,
+                             (double)p[to[k]].z - (double)p[from[k]].z};
+        const double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        if (!(len > 0.0) || !isfinite(len)) return false;
+        for (int c = 0; c < 3; c++) e[k][c] = d[c] / len;
+    }
+#define DOT3(a, b) ((a)[0] * (b)[0] + (a)[1] * (b)[1] + (a)[2] * (b)[2])
+    const bool parallel = fabs(DOT3(e[0], e[2]) - 1.0) <= 1e-3 && fabs(DOT3(e[1], e[3]) - 1.0) <= 1e-3;
+    const bool square = fabs(DOT3(e[0], e[1])) <= 1e-3 && fabs(DOT3(e[1], e[2])) <= 1e-3 &&
+                        fabs(DOT3(e[2], e[3])) <= 1e-3 && fabs(DOT3(e[3], e[0])) <= 1e-3;
+#undef DOT3
+    return parallel && square;
+}

@@ -8,6 +8,7 @@
 #define PK_IO_UTIL_H
 
 #include "../paprsek_internal.h"
+#include "../math/vec3.h"
 
 #define IO_WARN_KINDS 16     /* distinct unknown statement kinds remembered */
 #define IO_WARN_KIND_LEN 24  /* bytes of a kind that are compared */
@@ -136,5 +137,10 @@ static inline int io_tok_len(const char *s, const char *e)
     size_t n = (size_t)(e - s);
     return n > 40 ? 40 : (int)n;
 }
+
+/* Whether four points make a planar rectangle, as pbrt-v4 checks a portal:
+ * opposite edges parallel and adjacent ones perpendicular, within 0.001 in
+ * the cosine of their unit directions (finite, no edge of length zero). */
+PK_HIDDEN bool io_portal_is_rectangle(const vec3 p[4]);
 
 #endif

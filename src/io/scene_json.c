@@ -1730,11 +1730,12 @@ static pk_status parse_light_record(jp *p, const cJSON *it, const char *path)
 }
 
 /* {"record": {...}} as "environment": the surroundings as the scene holds
- * them, the map as raw linear RGB floats ("map": {"file", "size"}). */
+ * them, the map as raw linear RGB floats ("map": {"file", "size"}), a
+ * portal as its four corners ("portal": 12 numbers; absent: none). */
 static pk_status parse_environment_record(jp *p, const cJSON *it)
 {
     static const char *const outer[] = {"record"};
-    static const char *const extra[] = {"map", NULL};
+    static const char *const extra[] = {"map", "portal", NULL};
     const cJSON *f[1];
     scene_environment *env = &p->s->env;
     pk_status st = object_fields(p, it, "environment", outer, 1, f);
@@ -1745,6 +1746,15 @@ static pk_status parse_environment_record(jp *p, const cJSON *it)
         env->sun_radiance.y < 0.0f || env->sun_radiance.z < 0.0f)
         return jfail(p, PK_ERR_PARSE, f[0], "environment.record",
                      "sun_angle must be in (0, 90], scales and radiances not negative");
+    const cJSON *portal = cJSON_GetObjectItemCaseSensitive(f[0], "portal");
+    if (portal) {
+        float c[12];
+        if ((st = get_floats(p, portal, "environment.record.portal", c, 12))) return st;
+        for (int k = 0; k < 4; k++) env->portal[k] = v3(c[3 * k], c[3 * k + 1], c[3 * k + 2]);
+        if (!io_portal_is_rectangle(env->portal))
+            return jfail(p, PK_ERR_PARSE, portal, "environment.record.portal", "must be four corners of a rectangle");
+        env->has_portal = true;
+    }
     const cJSON *map = cJSON_GetObjectItemCaseSensitive(f[0], "map");
     if (!map) return PK_OK;
     int wh[2];

@@ -1872,6 +1872,7 @@ static pk_status light_spectrum(pp *p, const char *name, vec3 *c)
     return spectrum_rgb(p, q, true, c);
 }
 
+static pk_status portal_points(pp *p, vec3 out[4], bool *ok);
 static pk_status equal_area_env(pp *p, const char *file, size_t line, const xform *light_to_world, float scale,
                                 float illuminance);
 
@@ -1997,9 +1998,15 @@ static pk_status d_light(pp *p, const char *type)
         if ((st = light_spectrum(p, "L", &L)) || (st = pb_string(&p->pd, "filename", &fn))) return st;
         float illum = -1.0f;
         if ((st = pb_float(&p->pd, "illuminance", &illum))) return st;
-        if (pb_param(&p->pd, "portal"))
-            pwarn(p, p->line, "infinite: portals are not used (the light is sampled as a whole)");
+        vec3 portal[4];
+        bool has_portal = false;
+        if ((st = portal_points(p, portal, &has_portal))) return st;
         if (has_L && fn) return pfail(p, p->line, PK_ERR_PARSE, "infinite: give either 'L' or 'filename', not both");
+        const scene_environment *env = &p->s->env;
+        const bool had_env = env->has_portal || env->map || env->map_rgb || v3_max_comp(env->radiance) > 0.0f ||
+                             env->has_sky;
+        if (had_env && (has_portal || env->has_portal))
+            pwarn(p, p->line, "infinite: a portal applies to every infinite light of the scene (the scene has two)");
         if (fn) {
             if ((st = equal_area_env(p, fn, p->line, &w, scale, illum))) return st;
         } else {
@@ -2007,12 +2014,49 @@ static pk_status d_light(pp *p, const char *type)
             if (illum > 0.0f) scale *= illum / PK_PI;
             scene_env_add_radiance(p->s, v3_scale(L, scale));
         }
+        if (has_portal) {
+            /* into the (possibly mirrored, see the top) world; a mirror turns
+             * the rectangle's normal inward, which walking its corners the
+             * other way round turns back */
+            const float *mm = p->mirror.m;
+            const float det = mm[0] * (mm[5] * mm[10] - mm[6] * mm[9]) - mm[1] * (mm[4] * mm[10] - mm[6] * mm[8]) +
+                              mm[2] * (mm[4] * mm[9] - mm[5] * mm[8]);
+            vec3 *pq = p->s->env.portal;
+            for (int k = 0; k < 4; k++) pq[k] = xform_point(&p->mirror, portal[det < 0.0f ? (4 - k) % 4 : k]);
+            p->s->env.has_portal = true;
+        }
     } else if (strcmp(type, "goniometric") == 0 || strcmp(type, "projection") == 0) {
         if ((st = mapped_light(p, type[0] == 'g', &w, scale))) return st;
     } else {
         return pfail(p, p->line, PK_ERR_PARSE, "unknown light \"%.40s\"", type);
     }
     warn_unused(p, "LightSource \"%.40s\"", type);
+    return PK_OK;
+}
+
+/* An infinite light's "point3 portal": four points in the world (pbrt-v4
+ * does not apply the current transform to them) that must make a planar
+ * rectangle, checked as pbrt-v4 does (opposite edges parallel, adjacent
+ * ones perpendicular, within 0.001 in cosine); otherwise a warning and no
+ * portal (the whole environment shines). */
+static pk_status portal_points(pp *p, vec3 out[4], bool *ok)
+{
+    pparam *q;
+    pk_status st = pb_typed(&p->pd, "portal", TB(PT_POINT3), "point3 values", &q);
+    *ok = false;
+    if (st || !q) return st;
+    if (q->nnum != 12) {
+        pwarn(p, q->line,
+              "infinite: 'portal' takes 4 points (12 numbers), not %zu numbers; the whole environment is used", q->nnum);
+        return PK_OK;
+    }
+    for (int k = 0; k < 4; k++) out[k] = v3((float)q->num[3 * k], (float)q->num[3 * k + 1], (float)q->num[3 * k + 2]);
+    const bool good = io_portal_is_rectangle(out);
+    if (!good) {
+        pwarn(p, q->line, "infinite: the 'portal' is not a planar rectangle; the whole environment is used");
+        return PK_OK;
+    }
+    *ok = true;
     return PK_OK;
 }
 

@@ -676,6 +676,15 @@ static pk_status write_environment(jw *w)
     fputs(",\n\"environment\": {\"record\": {", w->f);
     pk_status st = jw_fields(w, &first, rec_env, rec_nenv, env, "environment");
     if (st) return st;
+    if (env->has_portal) {
+        float c[12];
+        for (int k = 0; k < 4; k++) {
+            c[3 * k] = env->portal[k].x, c[3 * k + 1] = env->portal[k].y;
+            c[3 * k + 2] = env->portal[k].z;
+        }
+        jw_key(w, &first, "portal");
+        if ((st = jw_floats(w, c, 12, "environment.portal"))) return st;
+    }
     if (env->map_rgb && env->map_w > 0 && env->map_h > 0) {
         char rel[PATH_MAX];
         const size_t n = 3 * (size_t)env->map_w * (size_t)env->map_h;

@@ -2654,6 +2654,82 @@ static pk_status parse_shape(xp *p, xnode *sh)
 
 /* ---- emitters ------------------------------------------------------------------------------------- */
 
+/* Mitsuba 3's projector: a pinhole at the origin of to_world that projects
+ * the irradiance texture along +z through a field of view (fov, fov_axis as
+ * a perspective sensor's; without fov, focal_length, 50mm by default, over
+ * the 36 x 24 mm diagonal). Mitsuba scales the texture by pi * scale /
+ * cos^3 of the angle from the axis, so that a plane facing the projector at
+ * z = 1 receives pi * scale times the texture (a white diffuse plane there
+ * shows the texture times scale): a projection light of intensity
+ * pi * scale with the projector's 1 / cos^3 (LIGHT_MAP_PROJECTOR). The image
+ * runs as a Mitsuba camera's: u along -x, v along -y (row 0 on top). A
+ * constant irradiance is a one-texel image. Texels are taken nearest, where
+ * Mitsuba's bitmap filters them bilinearly. */
+static pk_status parse_projector(xp *p, xnode *e, pdict *d)
+{
+    pk_status st;
+    xform m;
+    float scale = 1.0f, fov = -1.0f;
+    vec3 irr = v3s(1.0f);
+    tex_ref tex;
+    tex_ref_init(&tex);
+    if ((st = get_to_world(p, d, &m, NULL)) || (st = get_float(p, d, "scale", &scale))) return st;
+    if ((st = get_color_tex(p, d, "irradiance", &irr, &tex))) return st;
+    xnode *fn = prop(d, "fov"), *an = NULL, *fl = NULL;
+    const char *axis = "x", *focal = NULL;
+    if (fn && (st = node_float(p, fn, &fov))) return st;
+    if ((st = get_string(p, d, "fov_axis", &axis, &an)) || (st = get_string(p, d, "focal_length", &focal, &fl)))
+        return st;
+    if (fn && focal) return xfail(p, PK_ERR_PARSE, e, "projector: give either fov or focal_length, not both");
+    if (!fn) {
+        double f = 50.0;
+        if (focal) {
+            char *end;
+            f = strtod(focal, &end);
+            if (end == focal || (*end && strcmp(end, "mm") != 0) || !(f > 0.0) || !isfinite(f))
+                return xfail(p, PK_ERR_PARSE, fl, "projector: focal_length must be a length in mm (\"50mm\")");
+        }
+        fov = (float)(2.0 * atan(sqrt(36.0 * 36.0 + 24.0 * 24.0) / (2.0 * f)) * 180.0 / (double)PK_PI);
+        axis = "diagonal";
+    }
+    if (!(fov > 0.0f && fov < 180.0f))
+        return xfail(p, PK_ERR_PARSE, fn ? fn : e, "projector: fov must be in (0, 180) degrees");
+    if (!(scale >= 0.0f && isfinite(scale)))
+        return xfail(p, PK_ERR_PARSE, e, "projector: scale must be finite, not negative");
+    if (!v3_finite(irr) || !(v3_min_comp(irr) >= 0.0f))
+        return xfail(p, PK_ERR_PARSE, e, "projector: the irradiance must be finite and not negative");
+    int32_t idx = tex.kind == TEX_IMAGE ? tex.tex : -1;
+    if (idx < 0) { /* a constant: one white texel, the colour in the intensity */
+        const float one[3] = {1.0f, 1.0f, 1.0f};
+        st = texture_add_pixels(p->ctx, p->s, "<projector: constant>", 1, 1, 3, NULL, one, false, &idx);
+        if (st) return st;
+    } else if (tex.s[0] != 1.0f || tex.s[1] != 1.0f) {
+        xwarn(p, e, "projector: the bitmap's uscale and vscale are not used");
+    }
+    const tex_level *lv = &p->s->textures[idx].lv[0];
+    const double aspect = (double)lv->w / (double)lv->h;
+    /* the horizontal field of view, as Mitsuba's sensors compute it */
+    double t = tan(0.5 * (double)fov * (double)PK_PI / 180.0);
+    if (strcmp(axis, "smaller") == 0) axis = aspect > 1.0 ? "y" : "x";
+    else if (strcmp(axis, "larger") == 0) axis = aspect > 1.0 ? "x" : "y";
+    if (strcmp(axis, "y") == 0) t *= aspect;
+    else if (strcmp(axis, "diagonal") == 0) t = t / sqrt(1.0 + 1.0 / (aspect * aspect));
+    else if (strcmp(axis, "x") != 0)
+        return xfail(p, PK_ERR_PARSE, an, "fov_axis must be x, y, diagonal, smaller or larger");
+    if (!(t > 0.0) || !isfinite(t)) return xfail(p, PK_ERR_PARSE, e, "projector: the field of view is degenerate");
+    xform inv;
+    if (!xform_invert(&m, &inv)) return xfail(p, PK_ERR_PARSE, e, "projector: to_world is singular");
+    float tl[9]; /* world -> the light's frame, x and y turned to the image's u and v */
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++) tl[3 * r + c] = (r < 2 ? -1.0f : 1.0f) * inv.m[4 * r + c];
+    const vec3 position = xform_point(&m, v3s(0.0f));
+    const vec3 intensity = v3_scale(irr, PK_PI * scale);
+    if (!v3_finite(position) || !v3_finite(intensity))
+        return xfail(p, PK_ERR_PARSE, e, "projector: the position or intensity is not finite");
+    return scene_light_mapped(p->ctx, p->s, position, intensity, LIGHT_MAP_PROJECTOR, idx, tl, (float)t, 1.0f,
+                              (float)(1.0 / aspect), -1.0f);
+}
+
 static pk_status parse_emitter(xp *p, xnode *e)
 {
     pk_status st;
@@ -2706,6 +2782,8 @@ static pk_status parse_emitter(xp *p, xnode *e)
         st = type[0] == 's' ? scene_light_spot(p->ctx, p->s, position, axis, cos_inner, cos_outer, SPOT_FALLOFF_ANGLE, intensity)
                             : scene_light_point(p->ctx, p->s, position, intensity);
         if (st) return st;
+    } else if (strcmp(type, "projector") == 0) {
+        if ((st = parse_projector(p, e, &d))) return st;
     } else if (strcmp(type, "constant") == 0) {
         vec3 r = v3s(1.0f);
         if ((st = get_color(p, &d, "radiance", &r))) return st;

@@ -117,6 +117,8 @@ void env_free(const pk_allocator *al, env_light *e)
     mem_free(al, e->marginal);
     mem_free(al, e->conditional);
     mem_free(al, e->weight);
+    mem_free(al, e->portal_f);
+    mem_free(al, e->portal_sat);
     memset(e, 0, sizeof *e);
 }
 
@@ -165,6 +167,76 @@ static pk_status build_tables(pk_context *ctx, env_light *e)
     e->active = total > 0.0;
     e->power_env = lum_solid; /* times pi R^2 by the caller */
     e->bytes += (size_t)h * sizeof(float) + 2 * n * sizeof(float);
+    return PK_OK;
+}
+
+/* The portal's frame from its corners: false unless they make a rectangle. */
+static bool portal_frame(const vec3 p[4], float m[9])
+{
+    const vec3 e03 = v3_sub(p[3], p[0]), e01 = v3_sub(p[1], p[0]);
+    if (!(v3_len2(e03) > 0.0f) || !(v3_len2(e01) > 0.0f)) return false;
+    const vec3 x = v3_norm(e03), y = v3_norm(e01), z = v3_norm(v3_cross(x, y));
+    if (!v3_finite(z) || fabsf(v3_dot(x, y)) > 1e-3f) return false;
+    const float r[9] = {x.x, x.y, x.z, y.x, y.y, y.z, z.x, z.y, z.z};
+    memcpy(m, r, sizeof r);
+    return true;
+}
+
+#define PORTAL_MIN 32 /* the density grid's cells a side: the map's rows, within these */
+#define PORTAL_MAX 1024
+
+/* The portal's density grid and summed-area table (e's radiance is built):
+ * per cell the luminance toward its centre times d(omega)/d(u, v) there,
+ * plus a floor of 1% of the mean, so that every direction through the
+ * portal can be drawn. */
+static pk_status build_portal(pk_context *ctx, const scene_environment *env, env_light *e)
+{
+    if (!portal_frame(env->portal, e->portal_to_local)) return PK_OK; /* the readers check; whole environment */
+    const int n = e->uniform ? 64 : (e->h < PORTAL_MIN ? PORTAL_MIN : e->h > PORTAL_MAX ? PORTAL_MAX : e->h);
+    e->pw = e->ph = n;
+    const size_t cells = (size_t)n * (size_t)n, W = (size_t)n + 1;
+    e->portal_f = mem_realloc_array(&ctx->alloc, NULL, cells, sizeof(float));
+    e->portal_sat = mem_calloc(&ctx->alloc, W * W, sizeof(double));
+    if (!e->portal_f || !e->portal_sat) return ctx_nomem(ctx);
+    e->bytes += cells * sizeof(float) + W * W * sizeof(double);
+    double sum = 0.0, flux = 0.0;
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++) {
+            float jac;
+            const vec3 d = portal_dir(e, ((float)i + 0.5f) / (float)n, ((float)j + 0.5f) / (float)n, &jac);
+            const double lum = (double)v3_luminance(env_eval(e, d));
+            e->portal_f[(size_t)j * (size_t)n + (size_t)i] = (float)(lum * (double)jac);
+            sum += lum * (double)jac;
+            flux += lum * (double)jac * (double)v3_dot(d, v3(e->portal_to_local[6], e->portal_to_local[7],
+                                                             e->portal_to_local[8]));
+        }
+    /* the floor: 1% of the mean over the grid (of d(omega)/d(u, v) alone for a black one) */
+    double floor_k = 0.01 * sum / (double)cells, total = 0.0;
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++) {
+            float jac;
+            (void)portal_dir(e, ((float)i + 0.5f) / (float)n, ((float)j + 0.5f) / (float)n, &jac);
+            float *f = &e->portal_f[(size_t)j * (size_t)n + (size_t)i];
+            *f = (float)((double)*f + (sum > 0.0 ? floor_k : (double)jac));
+            total += (double)*f;
+        }
+    /* density: integral 1 over the unit square; the table of its integrals */
+    for (size_t k = 0; k < cells; k++) e->portal_f[k] = (float)((double)e->portal_f[k] * (double)cells / total);
+    for (int j = 0; j < n; j++) {
+        double row = 0.0;
+        for (int i = 0; i < n; i++) {
+            row += (double)e->portal_f[(size_t)j * (size_t)n + (size_t)i] / (double)cells;
+            e->portal_sat[(size_t)(j + 1) * W + (size_t)(i + 1)] = e->portal_sat[(size_t)j * W + (size_t)(i + 1)] + row;
+        }
+    }
+    e->portal = true;
+    e->portal_p0 = env->portal[0];
+    e->portal_p2 = env->portal[2];
+    /* the power through the portal: its area times the irradiance of the
+     * hemisphere it looks at (the sum of luminance times the cosine) */
+    const double area = (double)v3_len(v3_sub(env->portal[3], env->portal[0])) *
+                        (double)v3_len(v3_sub(env->portal[1], env->portal[0]));
+    e->power_env = area * flux / (double)cells;
     return PK_OK;
 }
 
@@ -232,6 +304,13 @@ pk_status env_build(pk_context *ctx, const scene_environment *env, const float *
         e->sun_frame = onb_from_normal(sun);
         const double solid = 2.0 * (double)PK_PI * (double)e->sun_omc;
         e->power_sun = (double)v3_luminance(e->sun_le) * solid * area;
+    }
+    if (env->has_portal && e->active) {
+        pk_status st = build_portal(ctx, env, e);
+        if (st != PK_OK) {
+            env_free(&ctx->alloc, e);
+            return st;
+        }
     }
     return PK_OK;
 }

@@ -322,7 +322,8 @@ static inline PK_HD vec3 point_light_map(const scene_view *s, const point_light 
     tex_fetch(t, l, ix, iy, c);
     if (t->nc < 3) c[1] = c[2] = c[0];
     if (pl->map_kind == LIGHT_MAP_GONIOMETRIC) return v3s(fmaxf((c[0] + c[1] + c[2]) * (1.0f / 3.0f), 0.0f));
-    return v3(fmaxf(c[0], 0.0f), fmaxf(c[1], 0.0f), fmaxf(c[2], 0.0f));
+    const float k = pl->map_kind == LIGHT_MAP_PROJECTOR ? 1.0f / (d.z * d.z * d.z) : 1.0f; /* d.z >= 1e-3 */
+    return v3(fmaxf(c[0], 0.0f) * k, fmaxf(c[1], 0.0f) * k, fmaxf(c[2], 0.0f) * k);
 }
 
 /* The radiance that emitter l (a triangle or sphere) sends from its point q
@@ -365,7 +366,7 @@ static inline PK_HD bool light_sample_one_with(const light_set *set, const scene
     if (l->kind == LIGHT_ENV || l->kind == LIGHT_SUN) { /* a direction toward the surroundings */
         vec3 d;
         if (l->kind == LIGHT_ENV) {
-            if (!env_sample(e, u1, u2, &d, &le, &pdf)) return false;
+            if (!env_sample_from(e, o, u1, u2, &d, &le, &pdf)) return false;
         } else {
             d = sun_sample(e, u1, u2);
             le = e->sun_le, pdf = sun_pdf(e);

@@ -177,6 +177,10 @@ pk_status path_gpu_create(pk_context *ctx, const path_tracer *pt, path_gpu **out
     UPE(marginal, e->uniform ? 0 : (size_t)e->h)
     UPE(conditional, npix)
     UPE(weight, npix)
+    const size_t ncell = e->portal ? (size_t)e->pw * (size_t)e->ph : 0;
+    const size_t nsat = e->portal ? ((size_t)e->pw + 1) * ((size_t)e->ph + 1) : 0;
+    UPE(portal_f, ncell)
+    UPE(portal_sat, nsat)
 #undef UPE
     uint64_t d_frame = 0;
     if (st == PK_OK) st = upload(g, &df, 1, sizeof df, &d_frame);

@@ -71,10 +71,10 @@ static inline PK_HD vec3 emitted(const surface *sf) { return sf->front || sf->m-
 
 /* ---- lights ------------------------------------------------------------------- */
 
-/* What a path leaving the scene toward d (unit) gathers from the
+/* What a path leaving the scene from o toward d (unit) gathers from the
  * environment and the sun, each weighted by MIS against its light
  * sampling when the last bounce was not a delta one. */
-static inline PK_HD vec3 leaving(const path_tracer *pt, vec3 d, bool prev_delta, float prev_pdf)
+static inline PK_HD vec3 leaving(const path_tracer *pt, vec3 o, vec3 d, bool prev_delta, float prev_pdf)
 {
     const env_light *e = &pt->f->env;
     const light_set *ls = &pt->lights;
@@ -85,8 +85,8 @@ static inline PK_HD vec3 leaving(const path_tracer *pt, vec3 d, bool prev_delta,
         vec3 le;
         float pl;
         if (k == 0) {
-            le = env_eval(e, d);
-            pl = prev_delta ? 0.0f : env_pdf(e, d);
+            le = env_eval_from(e, o, d);
+            pl = prev_delta ? 0.0f : env_pdf_from(e, o, d);
         } else {
             if (!sun_covers(e, d)) continue;
             le = e->sun_le;
@@ -190,13 +190,13 @@ static inline PK_HD void path_aov_vertex(path_aov *pa, const surface *sf, const 
     pa->open = false;
 }
 
-/* The AOVs of a path that leaves the scene toward d (unit) while they are
+/* The AOVs of a path that leaves the scene from o toward d (unit) while they are
  * open (the camera ray, or a chain of specular bounces of throughput beta):
  * what it sees there (env_background: environment and sun) normalised,
  * times beta; the normal stays zero. */
-static inline PK_HD void path_aov_miss(const path_tracer *pt, path_aov *pa, vec3 d, vec3 beta)
+static inline PK_HD void path_aov_miss(const path_tracer *pt, path_aov *pa, vec3 o, vec3 d, vec3 beta)
 {
-    pa->out->albedo = v3_mul(beta, aov_normalised(env_background(&pt->f->env, d)));
+    pa->out->albedo = v3_mul(beta, aov_normalised(env_background(&pt->f->env, o, d)));
     pa->open = false;
 }
 
@@ -265,8 +265,8 @@ enum { PATH_NEXT_SHADOW = 1, PATH_NEXT_BOUNCE = 2 };
  * are still open. */
 static inline PK_HD void path_miss(const path_tracer *pt, path_state *ps, path_aov *aov, vec3 d, bool indirect)
 {
-    if (aov && aov->open) path_aov_miss(pt, aov, d, ps->beta);
-    path_add(pt, ps, v3_mul(ps->beta, leaving(pt, d, ps->prev_delta, ps->prev_pdf)), indirect);
+    if (aov && aov->open) path_aov_miss(pt, aov, ps->r.o, d, ps->beta);
+    path_add(pt, ps, v3_mul(ps->beta, leaving(pt, ps->r.o, d, ps->prev_delta, ps->prev_pdf)), indirect);
 }
 
 /* The vertex at ps's hit, which is not a hole: its emission, its light
@@ -411,7 +411,7 @@ static inline PK_HD bool path_start(const path_tracer *pt, int px, int py, uint3
                                     path_state *ps, vec3 *bg)
 {
     if (!h) {
-        *bg = env_background(&pt->f->env, v3_norm(r->d));
+        *bg = env_background(&pt->f->env, r->o, v3_norm(r->d));
         return false;
     }
     sampler sm = sampler_start((uint32_t)px, (uint32_t)py, index, pt->seed);

@@ -342,8 +342,9 @@ static inline PK_HD bool vol_step(const path_tracer *pt, path_thread *t, vol_sta
     }
     if (!vs->has_hit) { /* out of the scene */
         const vec3 d = v3_norm(ps->r.d);
-        if (aov && aov->open) path_aov_miss(pt, aov, d, v3_scale(ps->beta, vol_mis(vs)));
-        path_add(pt, ps, v3_scale(v3_mul(ps->beta, leaving(pt, d, ps->prev_delta, ps->prev_pdf)), vol_mis(vs)),
+        if (aov && aov->open) path_aov_miss(pt, aov, ps->r.o, d, v3_scale(ps->beta, vol_mis(vs)));
+        path_add(pt, ps,
+                 v3_scale(v3_mul(ps->beta, leaving(pt, ps->r.o, d, ps->prev_delta, ps->prev_pdf)), vol_mis(vs)),
                  ps->depth >= 1);
         return false;
     }

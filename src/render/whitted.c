@@ -51,7 +51,7 @@ static vec3 trace(const whitted *w, whitted_thread *ts, const ray *r, int depth,
     ts->ray_budget--;
     ts->rays[kind]++;
     hit h;
-    if (!accel_intersect(w->f->a, r, &h, ts->cp)) return env_background(&w->f->env, v3_norm(r->d));
+    if (!accel_intersect(w->f->a, r, &h, ts->cp)) return env_background(&w->f->env, r->o, v3_norm(r->d));
     return whitted_shade(w, ts, r, &h, depth, NULL);
 }
 
@@ -211,7 +211,7 @@ static vec3 whitted_shade(const whitted *w, whitted_thread *ts, const ray *r, co
     if (s->has_cutout && surface_is_hole(s, r, h)) { /* map_d holes: what lies behind */
         ray rr = *r;
         hit hh = *h;
-        if (!trace_past_holes(w->f->a, s, &rr, &hh, ts->cp)) return env_background(&w->f->env, v3_norm(rr.d));
+        if (!trace_past_holes(w->f->a, s, &rr, &hh, ts->cp)) return env_background(&w->f->env, rr.o, v3_norm(rr.d));
         return shade_opaque(w, ts, &rr, &hh, depth, aov);
     }
     return shade_opaque(w, ts, r, h, depth, aov);
@@ -303,7 +303,7 @@ static bool ig_sample(const void *self, void *t, int px, int py, uint64_t index,
     const whitted *w = self;
     whitted_thread *ts = t;
     if (!h) {
-        *L = env_background(&w->f->env, v3_norm(r->d));
+        *L = env_background(&w->f->env, r->o, v3_norm(r->d));
         return true;
     }
     ts->rng = rng_seed(((uint64_t)py << 32) | (uint32_t)px, index * 2);

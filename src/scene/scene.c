@@ -240,7 +240,8 @@ pk_status scene_light_mapped(pk_context *ctx, pk_scene *s, vec3 position, vec3 i
     pk_status st = light_check(ctx, "mapped point", intensity);
     if (st) return st;
     if (!v3_finite(position)) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "point light: the position is not finite");
-    if (kind != LIGHT_MAP_GONIOMETRIC && kind != LIGHT_MAP_PROJECTION)
+    const bool proj = kind == LIGHT_MAP_PROJECTION || kind == LIGHT_MAP_PROJECTOR;
+    if (kind != LIGHT_MAP_GONIOMETRIC && !proj)
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "point light: unknown map kind %d", kind);
     if (map_tex < 0 || (size_t)map_tex >= s->ntextures)
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "point light: no texture %d", (int)map_tex);
@@ -250,7 +251,7 @@ pk_status scene_light_mapped(pk_context *ctx, pk_scene *s, vec3 position, vec3 i
                        tm[2] * (tm[3] * tm[7] - tm[4] * tm[6]);
     if (!(fabs(det) > 1e-20) || !isfinite(det))
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "point light: the map's frame is singular");
-    if (kind == LIGHT_MAP_PROJECTION && !(tan_half_fov > 0.0f && isfinite(tan_half_fov) && sx > 0.0f && sy > 0.0f))
+    if (proj && !(tan_half_fov > 0.0f && isfinite(tan_half_fov) && sx > 0.0f && sy > 0.0f))
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "projection light: the field of view must be in (0, 180)");
     point_light l;
     memset(&l, 0, sizeof l);
@@ -266,11 +267,12 @@ pk_status scene_light_mapped(pk_context *ctx, pk_scene *s, vec3 position, vec3 i
         for (int x = 0; x < lv->w; x++) {
             float c[4] = {0.0f, 0.0f, 0.0f, 1.0f};
             tex_fetch(t, lv, x, y, c);
-            const double g = t->nc >= 3 ? kind == LIGHT_MAP_PROJECTION ? (double)v3_luminance(v3(c[0], c[1], c[2]))
+            const double g = t->nc >= 3 ? proj ? (double)v3_luminance(v3(c[0], c[1], c[2]))
                                                                          : ((double)c[0] + (double)c[1] + (double)c[2]) / 3.0
                                         : (double)c[0];
             double wt = 1.0; /* goniometric: texels of equal solid angle */
-            if (kind == LIGHT_MAP_PROJECTION) { /* solid angle per screen area: cos^3 / t^2 */
+            /* solid angle per screen area: cos^3 / t^2 (which a projector's 1 / cos^3 cancels) */
+            if (kind == LIGHT_MAP_PROJECTION) {
                 const double px = (2.0 * (x + 0.5) / lv->w - 1.0) * (double)sx * (double)tan_half_fov;
                 const double py = (2.0 * (y + 0.5) / lv->h - 1.0) * (double)sy * (double)tan_half_fov;
                 wt = pow(1.0 + px * px + py * py, -1.5);
@@ -278,7 +280,7 @@ pk_status scene_light_mapped(pk_context *ctx, pk_scene *s, vec3 position, vec3 i
             sum += fmax(g, 0.0) * wt, wsum += wt;
         }
     l.map_mean = wsum > 0.0 ? (float)(sum / wsum) : 0.0f;
-    if (kind == LIGHT_MAP_PROJECTION) {
+    if (proj) {
         l.proj_tan = tan_half_fov, l.proj_sx = sx, l.proj_sy = sy;
         /* the cone around the frame's +z through the window's corners bounds it (a spot with one cone) */
         const vec3 axis = v3_norm_scaled(frame_to_world(to_light, v3(0.0f, 0.0f, 1.0f)));
@@ -298,7 +300,7 @@ pk_status scene_light_mapped(pk_context *ctx, pk_scene *s, vec3 position, vec3 i
         l.map_mean = (float)((double)l.map_mean * omega * (wsum > 0.0 ? wsum / ((double)lv->w * lv->h) : 0.0) / cone);
     }
     if (power > 0.0f) {
-        const double flux = (kind == LIGHT_MAP_PROJECTION ? 2.0 * (double)PK_PI * (1.0 - (double)l.cos_outer)
+        const double flux = (proj ? 2.0 * (double)PK_PI * (1.0 - (double)l.cos_outer)
                                                           : 4.0 * (double)PK_PI) *
                             (double)l.map_mean;
         if (flux > 0.0) l.intensity = v3_scale(l.intensity, (float)((double)power / flux));

@@ -64,7 +64,10 @@ typedef struct point_light {
      * the texel's channels (grey); a projection map covers the screen window
      * [-proj_sx, proj_sx] x [-proj_sy, proj_sy] of the perspective
      * projection x/(z t), y/(z t) (t = proj_tan = tan(fov/2)) along +z, its
-     * value the texel's colour, nothing outside it (row 0 at -proj_sy).
+     * value the texel's colour, nothing outside it (row 0 at -proj_sy). A
+     * projector map (Mitsuba's projector) is a projection map divided by
+     * cos^3 of the angle from +z, so that it gives a plane facing the light
+     * at z = 1 an irradiance of the texel's colour times the intensity.
      * map_mean is the map's mean over the directions it covers (the spot
      * cone bounds a projection's), for the light's share of samples. */
     int map_kind;
@@ -77,6 +80,7 @@ typedef struct point_light {
 #define LIGHT_MAP_NONE 0
 #define LIGHT_MAP_GONIOMETRIC 1
 #define LIGHT_MAP_PROJECTION 2
+#define LIGHT_MAP_PROJECTOR 3
 
 /* Light from the surroundings (docs/scene-format.md, "environment"): what a
  * ray that leaves the scene sees. Every part is optional and they add up.
@@ -101,6 +105,9 @@ typedef struct scene_environment {
     float sky_scale;      /* multiplies the sky (1) */
     bool sky_hosek;       /* the sky is Hosek-Wilkie's (Mitsuba scenes), not Preetham's */
     vec3 sky_albedo;      /* Hosek-Wilkie: the ground albedo per channel (0.2) */
+    bool has_portal;      /* the environment shines only through a rectangle (pbrt-v4's portal) */
+    vec3 portal[4];       /* its corners in order, world space: a planar rectangle whose normal
+                           * (p3 - p0) x (p1 - p0) points away from the scene, toward the light */
 } scene_environment;
 
 /* An object-space mesh: ranges of the scene's mesh_* arrays. Its triangles'

@@ -748,13 +748,13 @@ static void test_emitters(void)
         CHECK(near3(s->lights[0].position, v3(0, 1, 0), 1e-6f) && near3(s->lights[0].intensity, v3(2, 2, 2), 0.0f));
     }
     pk_scene_destroy(s);
-    s = load_ok("<shape type=\"cube\"/>\n<emitter type=\"spot\"/>\n<emitter type=\"projector\"/>");
+    s = load_ok("<shape type=\"cube\"/>\n<emitter type=\"spot\"/>\n<emitter type=\"collimated\"/>");
     /* Mitsuba's defaults: along +z, cutoff 20 degrees, beam width 3/4 of it, linear in the angle */
     CHECK(s && s->nlights == 1 && near3(s->lights[0].spot_dir, v3(0, 0, 1), 1e-6f) &&
           fabs(acos((double)s->lights[0].cos_outer) * 180.0 / M_PI - 20.0) < 1e-4 &&
           fabs(acos((double)s->lights[0].cos_inner) * 180.0 / M_PI - 15.0) < 1e-4 &&
           s->lights[0].spot_falloff == SPOT_FALLOFF_ANGLE && !warned("scene.xml:3") &&
-          warned("scene.xml:4: emitter \"projector\" is not supported; ignored"));
+          warned("scene.xml:4: emitter \"collimated\" is not supported; ignored"));
     pk_scene_destroy(s);
 }
 
