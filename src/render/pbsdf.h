@@ -49,6 +49,7 @@ typedef enum pbsdf_type {
     PBSDF_DIFFUSE_TRANSMISSION, /* Lambert reflection (albedo) and transmission (transmittance) */
     PBSDF_OREN_NAYAR,         /* rough diffuse (Oren-Nayar's qualitative model): albedo, on_a, on_b */
     PBSDF_PHONG,              /* modified Phong: albedo (diffuse) + specular, exponent */
+    PBSDF_PRINCIPLED,         /* Mitsuba 3's principled: base colour (albedo), metallic, ... (pbsdf_principled) */
     PBSDF_TYPE_COUNT
 } pbsdf_type;
 
@@ -103,6 +104,11 @@ typedef struct pbsdf {
     vec3 ms;             /* F_ms / (pi (1 - E_avg)) per channel, with PBSDF_ENERGY */
     float ms_albedo;     /* the mean of F_ms: the lobe's albedo is ms_albedo (1 - E(wo.z)) */
     float on_a, on_b, exponent;
+    /* principled (pbsdf_principled): the perceptual roughness (the diffuse
+     * lobe's), spec_tint, sheen, sheen_tint, flatness in [0, 1], and the
+     * sampling rates of the main specular, clearcoat and diffuse lobes */
+    float roughness, pr_spec_tint, pr_sheen, pr_sheen_tint, pr_flatness;
+    float pr_srate_spec, pr_srate_cc, pr_srate_diff;
 } pbsdf;
 
 /* ---- constructors ------------------------------------------------------- */
@@ -123,6 +129,8 @@ static inline PK_HD pbsdf pbsdf__blank(int type)
     b.ms = v3s(0.0f);
     b.ms_albedo = 0.0f;
     b.on_a = 1.0f, b.on_b = b.exponent = 0.0f;
+    b.roughness = b.pr_spec_tint = b.pr_sheen = b.pr_sheen_tint = b.pr_flatness = 0.0f;
+    b.pr_srate_spec = b.pr_srate_cc = b.pr_srate_diff = 1.0f;
     return b;
 }
 static inline PK_HD pbsdf pbsdf_diffuse(vec3 albedo)
@@ -982,6 +990,234 @@ static inline PK_HD bool pbsdf__ext_sample(const pbsdf *b, vec3 wo, const float 
     return true;
 }
 
+/* ---- Mitsuba 3's principled BSDF ------------------------------------------- */
+
+/* Mitsuba 3's "principled" (its reading of Burley's Disney BSDF, 2012/2015),
+ * lobe by lobe as Mitsuba defines it (docs/materials.md): a Disney diffuse
+ * with retro-reflection and the flatness blend, sheen, an isotropic GGX
+ * specular lobe whose Fresnel blends the dielectric's, a metal's (Schlick,
+ * F0 = base colour) and a tinted Schlick one, a rough dielectric
+ * transmission tinted by sqrt(base colour), and a GTR1 clearcoat. Fields:
+ * albedo = base colour, metallic, transmission = spec_trans, ior = eta,
+ * alpha = GGX alpha, roughness (the diffuse's), coat = clearcoat, coat_alpha
+ * = the GTR1 alpha, and pr_* below. wo.z < 0 is the inside (the frame is the
+ * outward normal as for the dielectric); there only the specular reflection
+ * and transmission scatter, as in Mitsuba. */
+static inline PK_HD pbsdf pbsdf_principled(vec3 base_color, float metallic, float roughness, float alpha,
+                                           float spec_trans, float eta)
+{
+    pbsdf b = pbsdf__blank(PBSDF_PRINCIPLED);
+    b.albedo = base_color;
+    b.metallic = metallic;
+    b.roughness = roughness;
+    b.alpha = alpha;
+    b.transmission = spec_trans;
+    b.ior = eta;
+    return b;
+}
+
+static inline PK_HD float pbsdf__pr_lum(vec3 c) { return 0.212671f * c.x + 0.715160f * c.y + 0.072169f * c.z; }
+/* Schlick's Fresnel as Mitsuba's principled has it: the cosine on the
+ * optically thinner side (cos_i's own side when light enters the denser). */
+static inline PK_HD float pbsdf__pr_schlick_w(float cos_i, float eta)
+{
+    const float eta_it = cos_i >= 0.0f ? eta : 1.0f / eta;
+    if (eta_it > 1.0f) return pbsdf__schlick_w(fabsf(cos_i));
+    const float ct2 = 1.0f - (1.0f - cos_i * cos_i) / (eta_it * eta_it);
+    return pbsdf__schlick_w(sqrtf(fmaxf(0.0f, ct2)));
+}
+static inline PK_HD vec3 pbsdf__pr_schlick(vec3 r0, float w)
+{
+    return v3(r0.x + (1.0f - r0.x) * w, r0.y + (1.0f - r0.y) * w, r0.z + (1.0f - r0.z) * w);
+}
+/* GTR1 (Berry) of alpha a: D(m) and the sampling of m by D(m) m.z */
+static inline PK_HD float pbsdf__gtr1_d(float a, vec3 m)
+{
+    const float a2 = a * a;
+    const float d = (a2 - 1.0f) / (PK_PI * logf(a2) * (1.0f + (a2 - 1.0f) * m.z * m.z));
+    return d * m.z > 1e-20f ? d : 0.0f;
+}
+static inline PK_HD vec3 pbsdf__gtr1_sample(float a, float u1, float u2)
+{
+    const float a2 = a * a, phi = 2.0f * PK_PI * u1;
+    const float c2 = (1.0f - powf(a2, 1.0f - u2)) / (1.0f - a2);
+    const float s = sqrtf(fmaxf(0.0f, 1.0f - c2)), c = sqrtf(fmaxf(0.0f, c2));
+    return v3(cosf(phi) * s, sinf(phi) * s, c);
+}
+/* Smith's G1 of GGX with alpha a, 0 for a microfacet m seen from behind */
+static inline PK_HD float pbsdf__pr_g1(float a, vec3 v, vec3 m)
+{
+    if (v3_dot(v, m) * v.z <= 0.0f) return 0.0f;
+    return v.z == 1.0f ? 1.0f : pbsdf_ggx_g1(a, v);
+}
+/* The half vector of wo, wi (+z side), the relative index along the path,
+ * whether it reflects, and the macro/micro compatibility of the pair. */
+typedef struct pbsdf__pr_geo {
+    vec3 h;
+    float eta_path, f;
+    bool reflect, refl_ok, refr_ok;
+} pbsdf__pr_geo;
+static inline PK_HD pbsdf__pr_geo pbsdf__pr_geometry(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    pbsdf__pr_geo g;
+    g.reflect = wo.z * wi.z > 0.0f;
+    g.eta_path = wo.z > 0.0f ? b->ior : 1.0f / b->ior;
+    vec3 h = v3_add(wo, v3_scale(wi, g.reflect ? 1.0f : g.eta_path));
+    const float l2 = v3_len2(h);
+    h = l2 > 0.0f ? v3_scale(h, 1.0f / sqrtf(l2)) : v3(0.0f, 0.0f, 1.0f);
+    if (h.z < 0.0f) h = v3_neg(h);
+    g.h = h;
+    const vec3 hs = wo.z > 0.0f ? h : v3_neg(h);
+    g.refl_ok = v3_dot(wo, hs) > 0.0f && v3_dot(wi, hs) > 0.0f;
+    g.refr_ok = v3_dot(wo, hs) > 0.0f && v3_dot(wi, hs) < 0.0f;
+    g.f = pbsdf_fresnel_dielectric(v3_dot(wo, h), b->ior);
+    return g;
+}
+/* The probabilities of the lobes (diffuse, clearcoat, transmission,
+ * reflection) for a dielectric Fresnel f, Mitsuba's sampling rates included. */
+static inline PK_HD void pbsdf__pr_probs(const pbsdf *b, bool front, float f, float p[4])
+{
+    const float brdf = (1.0f - b->metallic) * (1.0f - b->transmission);
+    const float bsdf = (1.0f - b->metallic) * b->transmission;
+    if (front) {
+        p[0] = brdf * b->pr_srate_diff;
+        p[1] = 0.25f * b->coat * b->pr_srate_cc;
+        p[2] = b->pr_srate_spec * bsdf * (1.0f - f);
+        p[3] = b->pr_srate_spec * (1.0f - bsdf * (1.0f - f));
+    } else {
+        p[0] = p[1] = 0.0f;
+        p[2] = bsdf > 0.0f ? 1.0f - f : 0.0f;
+        p[3] = f;
+    }
+    const float t = p[0] + p[1] + p[2] + p[3];
+    const float r = t > 0.0f ? 1.0f / t : 0.0f;
+    for (int k = 0; k < 4; k++) p[k] *= r;
+}
+
+static inline PK_HD vec3 pbsdf__pr_eval(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    vec3 v = v3s(0.0f);
+    if (wo.z == 0.0f || wi.z == 0.0f) return v;
+    const float brdf = (1.0f - b->metallic) * (1.0f - b->transmission);
+    const float bsdf = (1.0f - b->metallic) * b->transmission;
+    const bool front = wo.z > 0.0f;
+    const pbsdf__pr_geo g = pbsdf__pr_geometry(b, wo, wi);
+    const vec3 h = g.h, base = b->albedo;
+    const float d = pbsdf_ggx_d(b->alpha, h);
+    const float gg = pbsdf__pr_g1(b->alpha, wo, h) * pbsdf__pr_g1(b->alpha, wi, h);
+    const float oh = v3_dot(wo, h), ih = v3_dot(wi, h);
+    if (g.reflect && g.refl_ok && g.f > 0.0f) {
+        vec3 fr;
+        if (front) {
+            const float lum = pbsdf__pr_lum(base), eta_it = oh >= 0.0f ? b->ior : 1.0f / b->ior;
+            const vec3 ctint = lum > 0.0f ? v3_scale(base, 1.0f / lum) : v3s(1.0f);
+            const float r0 = (eta_it - 1.0f) / (eta_it + 1.0f), w = pbsdf__pr_schlick_w(oh, b->ior);
+            fr = v3s((1.0f - b->metallic) * (1.0f - b->pr_spec_tint) * g.f);
+            fr = v3_add(fr, v3_scale(pbsdf__pr_schlick(base, w), b->metallic));
+            fr = v3_add(fr, v3_scale(pbsdf__pr_schlick(v3_scale(ctint, r0 * r0), w),
+                                     (1.0f - b->metallic) * b->pr_spec_tint));
+        } else {
+            fr = v3s(bsdf * g.f);
+        }
+        v = v3_add(v, v3_scale(fr, d * gg / (4.0f * fabsf(wo.z))));
+    }
+    if (!g.reflect && g.refr_ok && bsdf > 0.0f && g.f < 1.0f) {
+        /* no 1/eta^2 radiance compression (the file's convention) */
+        const float den = oh + g.eta_path * ih;
+        const float t = bsdf * fabsf((1.0f - g.f) * d * gg * g.eta_path * g.eta_path * oh * ih / (wo.z * den * den));
+        v = v3_add(v, v3_scale(v3(sqrtf(base.x), sqrtf(base.y), sqrtf(base.z)), t));
+    }
+    if (!front || !g.reflect) return v;
+    if (b->coat > 0.0f && g.refl_ok) {
+        /* Mitsuba's clearcoat: 0.25 clearcoat F D G (Schlick F0 0.04, GTR1, Smith G of GGX 0.25) */
+        const float fcc = 0.04f + 0.96f * pbsdf__pr_schlick_w(oh, b->ior);
+        const float gcc = pbsdf__pr_g1(0.25f, wo, h) * pbsdf__pr_g1(0.25f, wi, h);
+        v = v3_add(v, v3s(0.25f * b->coat * fcc * pbsdf__gtr1_d(b->coat_alpha, h) * gcc * fabsf(wi.z)));
+    }
+    if (brdf > 0.0f) {
+        const float fo = pbsdf__schlick_w(fabsf(wi.z)), fi = pbsdf__schlick_w(fabsf(wo.z));
+        const float f_diff = (1.0f - 0.5f * fi) * (1.0f - 0.5f * fo);
+        const float cd = v3_dot(h, wi), rr = 2.0f * b->roughness * cd * cd;
+        const float f_retro = rr * (fo + fi + fo * fi * (rr - 1.0f));
+        float f = f_diff + f_retro;
+        if (b->pr_flatness != 0.0f) {
+            const float fss90 = 0.5f * rr;
+            const float fss = (1.0f + (fss90 - 1.0f) * fo) * (1.0f + (fss90 - 1.0f) * fi);
+            const float f_ss = 1.25f * (fss * (1.0f / (fabsf(wi.z) + fabsf(wo.z)) - 0.5f) + 0.5f);
+            f += (f_ss - f) * b->pr_flatness;
+        }
+        v = v3_add(v, v3_scale(base, brdf * fabsf(wi.z) * f / PK_PI));
+        if (b->pr_sheen > 0.0f && b->metallic < 1.0f) {
+            const float lum = pbsdf__pr_lum(base);
+            const vec3 ctint = lum > 0.0f ? v3_scale(base, 1.0f / lum) : v3s(1.0f);
+            const vec3 cs = v3_add(v3s(1.0f - b->pr_sheen_tint), v3_scale(ctint, b->pr_sheen_tint));
+            v = v3_add(v, v3_scale(cs, b->pr_sheen * (1.0f - b->metallic) * pbsdf__schlick_w(fabsf(cd)) * fabsf(wi.z)));
+        }
+    }
+    return v;
+}
+
+static inline PK_HD float pbsdf__pr_pdf(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    if (wo.z == 0.0f || wi.z == 0.0f) return 0.0f;
+    const bool front = wo.z > 0.0f;
+    const pbsdf__pr_geo g = pbsdf__pr_geometry(b, wo, wi);
+    float p[4];
+    pbsdf__pr_probs(b, front, g.f, p);
+    const float oh = v3_dot(wo, g.h), ih = v3_dot(wi, g.h);
+    float jac;
+    if (g.reflect) {
+        jac = fabsf(1.0f / (4.0f * ih));
+    } else {
+        const float den = oh + g.eta_path * ih;
+        jac = fabsf(g.eta_path * g.eta_path * ih / (den * den));
+    }
+    if (!isfinite(jac)) return 0.0f;
+    const float vn = pbsdf_ggx_vndf_pdf(b->alpha, wo, g.h);
+    float pdf = 0.0f;
+    if (g.reflect) {
+        if (g.refl_ok) {
+            pdf += p[3] * vn * jac;
+            if (p[1] > 0.0f) pdf += p[1] * pbsdf__gtr1_d(b->coat_alpha, g.h) * g.h.z * jac;
+        }
+        pdf += p[0] * fmaxf(0.0f, wi.z) / PK_PI;
+    } else if (g.refr_ok) {
+        pdf += p[2] * vn * jac;
+    }
+    return pdf;
+}
+
+static inline PK_HD bool pbsdf__pr_sample(const pbsdf *b, vec3 wo, const float u[3], vec3 *wi, vec3 *weight,
+                                          float *pdf)
+{
+    if (wo.z == 0.0f) return false;
+    const bool front = wo.z > 0.0f;
+    if (!front && !((1.0f - b->metallic) * b->transmission > 0.0f)) return false;
+    const vec3 m = pbsdf_ggx_vndf_sample(b->alpha, wo, u[1], u[2]);
+    float p[4];
+    pbsdf__pr_probs(b, front, pbsdf_fresnel_dielectric(v3_dot(wo, m), b->ior), p);
+    vec3 w;
+    if (u[0] < p[0]) {
+        w = pbsdf__cosine_dir(u[1], u[2]);
+    } else if (u[0] < p[0] + p[1]) {
+        const vec3 mc = pbsdf__gtr1_sample(b->coat_alpha, u[1], u[2]);
+        w = v3_sub(v3_scale(mc, 2.0f * v3_dot(wo, mc)), wo);
+        if (!(w.z * wo.z > 0.0f)) return false; /* through the surface: lost (the pdf would read a transmission) */
+    } else if (u[0] < p[0] + p[1] + p[2]) {
+        if (!pbsdf__refract(wo, m, b->ior, &w)) return false;
+        if (!(w.z * wo.z < 0.0f)) return false;
+    } else {
+        w = v3_sub(v3_scale(m, 2.0f * v3_dot(wo, m)), wo);
+        if (!(w.z * wo.z > 0.0f)) return false; /* as the clearcoat's */
+    }
+    const float pd = pbsdf__pr_pdf(b, wo, w);
+    if (!(pd > 0.0f)) return false;
+    *wi = w;
+    *pdf = pd;
+    *weight = v3_scale(pbsdf__pr_eval(b, wo, w), 1.0f / pd);
+    return true;
+}
+
 /* ---- the interface --------------------------------------------------------- */
 
 /* True if the BSDF has a non-delta part, i.e. light sampling and MIS can
@@ -1010,6 +1246,7 @@ static inline PK_HD bool pbsdf_has_nondelta(const pbsdf *b)
 /* f(wo, wi) * |wi.z| of the non-delta part. Local frame, unit vectors. */
 static inline PK_HD vec3 pbsdf_eval(const pbsdf *b, vec3 wo, vec3 wi)
 {
+    if (b->type == PBSDF_PRINCIPLED) return pbsdf__pr_eval(b, wo, wi);
     if (b->type >= PBSDF_THIN_DIELECTRIC) return pbsdf__ext_eval(b, wo, wi);
     if (b->type == PBSDF_DIELECTRIC) return pbsdf__dielectric_eval(b, wo, wi);
     if (b->type == PBSDF_METALLIC_ROUGHNESS) return pbsdf__mr_eval(b, wo, wi);
@@ -1054,6 +1291,7 @@ static inline PK_HD vec3 pbsdf_eval(const pbsdf *b, vec3 wo, vec3 wi)
  * sample (the lobe choice included). */
 static inline PK_HD float pbsdf_pdf(const pbsdf *b, vec3 wo, vec3 wi)
 {
+    if (b->type == PBSDF_PRINCIPLED) return pbsdf__pr_pdf(b, wo, wi);
     if (b->type >= PBSDF_THIN_DIELECTRIC) return pbsdf__ext_pdf(b, wo, wi);
     if (b->type == PBSDF_DIELECTRIC) return pbsdf__dielectric_pdf(b, wo, wi);
     if (b->type == PBSDF_METALLIC_ROUGHNESS) return pbsdf__mr_pdf(b, wo, wi);
@@ -1091,6 +1329,10 @@ static inline PK_HD float pbsdf_pdf(const pbsdf *b, vec3 wo, vec3 wi)
 static inline PK_HD bool pbsdf_sample(const pbsdf *b, vec3 wo, const float u[3], vec3 *wi, vec3 *weight, float *pdf,
                                 bool *is_delta)
 {
+    if (b->type == PBSDF_PRINCIPLED) {
+        *is_delta = false;
+        return pbsdf__pr_sample(b, wo, u, wi, weight, pdf);
+    }
     if (b->type >= PBSDF_THIN_DIELECTRIC) return pbsdf__ext_sample(b, wo, u, wi, weight, pdf, is_delta);
     *is_delta = false;
     if (b->type == PBSDF_DIELECTRIC) {

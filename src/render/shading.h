@@ -63,6 +63,20 @@ static inline PK_HD shading shading_at(const surface *sf)
         case MAT_DIFFUSE_TRANSMISSION: sh.b = pbsdf_diffuse_transmission(m->kd, m->tf); break;
         case MAT_ROUGH_DIFFUSE: sh.b = pbsdf_oren_nayar(m->kd, m->alpha * 0.70710678f); break; /* Mitsuba's sigma */
         case MAT_PHONG: sh.b = pbsdf_phong(m->kd, m->ks, m->ns); break;
+        case MAT_PRINCIPLED: { /* the frame is the outward normal where it transmits (wo.z < 0 inside) */
+            const float r = fminf(fmaxf(m->roughness, 0.0f), 1.0f), r2 = r * r;
+            const float asp = sqrtf(1.0f - 0.9f * fminf(fmaxf(m->anisotropic, 0.0f), 1.0f));
+            /* anisotropy: the isotropic GGX of the same sqrt(ax ay) for now */
+            const float alpha = sqrtf(fmaxf(1e-3f, r2 / asp) * fmaxf(1e-3f, r2 * asp));
+            sh.b = pbsdf_principled(surface_clamp_rgb(m->kd), m->metallic, r, alpha, m->transmission, m->ni);
+            sh.b.coat = m->clearcoat;
+            sh.b.coat_alpha = 0.1f + (0.001f - 0.1f) * m->clearcoat_gloss;
+            sh.b.pr_spec_tint = m->spec_tint, sh.b.pr_sheen = m->sheen, sh.b.pr_sheen_tint = m->sheen_tint;
+            sh.b.pr_flatness = m->flatness;
+            sh.b.pr_srate_spec = m->srate_spec, sh.b.pr_srate_cc = m->srate_cc, sh.b.pr_srate_diff = m->srate_diff;
+            if (m->transmission > 0.0f && m->metallic < 1.0f && !sf->front) n = v3_neg(n);
+            break;
+        }
         default: sh.b = pbsdf_diffuse(m->kd); break;
         }
         if (m->beckmann && (m->type == MAT_CONDUCTOR || m->type == MAT_DIELECTRIC || m->type == MAT_PLASTIC))
@@ -144,7 +158,8 @@ static inline PK_HD vec3 shading_eval(const surface *sf, const shading *sh, vec3
     if (sh->b.type == PBSDF_METALLIC_ROUGHNESS || sh->b.type == PBSDF_DIFFUSE_TRANSMISSION) {
         /* reflects and transmits: both normals must agree */
         if (!(side * shade > 0.0f)) return v3s(0.0f);
-    } else if (sh->b.type != PBSDF_DIELECTRIC && (side <= 0.0f || shade <= 0.0f)) {
+    } else if (sh->b.type != PBSDF_DIELECTRIC && !(sh->b.type == PBSDF_PRINCIPLED && sh->b.transmission > 0.0f) &&
+               (side <= 0.0f || shade <= 0.0f)) {
         return v3s(0.0f);
     }
     vec3 lo = onb_to_local(sh->frame, wo), li = onb_to_local(sh->frame, wi);

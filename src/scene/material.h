@@ -38,7 +38,8 @@ typedef enum material_type {
     MAT_MIX,                  /* one of two materials, chosen per hit */
     MAT_ROUGH_DIFFUSE,        /* Oren-Nayar */
     MAT_PHONG,                /* the modified Phong model */
-    MAT_LAST = MAT_PHONG
+    MAT_PRINCIPLED,           /* Mitsuba 3's principled BSDF */
+    MAT_LAST = MAT_PRINCIPLED
 } material_type;
 
 /* The deepest nesting of mixes (a mix of mixes ...) that readers accept. */
@@ -98,6 +99,17 @@ typedef struct material {
     int mix_a, mix_b;
     float amount;
     float metallic, roughness, transmission, clearcoat, clearcoat_roughness;
+    /* MAT_PRINCIPLED (Mitsuba 3's principled, material_principled): base
+     * colour kd, metallic, roughness (GGX alpha = max(0.001, roughness^2)),
+     * transmission (spec_trans), clearcoat, the index ni (eta, or Mitsuba's
+     * specular mapped to it), and these, all in [0, 1]: anisotropic (kept
+     * with the anisotropic alphas ax, ay Mitsuba would use; rendered with
+     * the isotropic alpha sqrt(ax ay) for now), spec_tint, sheen,
+     * sheen_tint, flatness, clearcoat_gloss; and the sampling rates of the
+     * main specular, clearcoat and diffuse lobes (>= 0, 1 by default).
+     * map_kd multiplies the base colour and map_alpha the roughness. */
+    float anisotropic, ax, ay, spec_tint, sheen, sheen_tint, flatness, clearcoat_gloss;
+    float srate_spec, srate_cc, srate_diff;
     /* Texture maps (docs/materials.md), kind TEX_NONE when absent. A map's
      * value multiplies its constant: map_kd kd, map_ks ks, map_ns ns,
      * map_alpha alpha; map_mr is glTF's metallic-roughness texture (data,
@@ -176,12 +188,18 @@ PK_HIDDEN void material_phong(material *m, vec3 kd, vec3 ks, float exponent);
  * material_whitted_kd reads transmission where it is used; the Whitted
  * approximation has no clearcoat). */
 PK_HIDDEN void material_metallic_roughness(material *m, vec3 base_color, float metallic, float roughness);
+/* Mitsuba 3's principled with its defaults but for these (see the fields
+ * above; set the others after it, then call material_principled_update). */
+PK_HIDDEN void material_principled(material *m, vec3 base_color, float metallic, float roughness);
+/* Derives alpha, ax, ay and the Whitted fields from the principled fields. */
+PK_HIDDEN void material_principled_update(material *m);
 
 /* The diffuse reflectance that the MTL model and the Whitted integrator use:
  * kd, but for metallic-roughness the base colour's diffuse share
  * kd (1 - metallic) (1 - transmission). */
 static inline PK_HD vec3 material_whitted_kd(const material *m)
 {
+    if (m->type == MAT_PRINCIPLED) return v3_scale(m->kd, (1.0f - m->metallic) * (1.0f - m->transmission));
     if (m->type != MAT_METALLIC_ROUGHNESS) return m->kd;
     return v3_scale(m->kd, (1.0f - m->metallic) * (1.0f - m->transmission));
 }
