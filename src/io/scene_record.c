@@ -20,6 +20,12 @@ const rec_field rec_material[] = {
     F(material, clearcoat_roughness, REC_FLOAT), F(material, tint, REC_VEC3),
     F(material, mix_a, REC_INT),        F(material, mix_b, REC_INT),
     F(material, amount, REC_FLOAT),
+    F(material, anisotropic, REC_FLOAT), F(material, ax, REC_FLOAT),
+    F(material, ay, REC_FLOAT),         F(material, spec_tint, REC_FLOAT),
+    F(material, sheen, REC_FLOAT),      F(material, sheen_tint, REC_FLOAT),
+    F(material, flatness, REC_FLOAT),   F(material, clearcoat_gloss, REC_FLOAT),
+    F(material, srate_spec, REC_FLOAT), F(material, srate_cc, REC_FLOAT),
+    F(material, srate_diff, REC_FLOAT),
 };
 const size_t rec_nmaterial = sizeof rec_material / sizeof rec_material[0];
 
