@@ -85,6 +85,23 @@ static pk_status create_diffuse(pdict *d, const mat_row *row, const mat_common *
     return PK_OK;
 }
 
+/* "alpha_u" and "alpha_v" (conductor, dielectric): anisotropic roughness,
+ * alpha_u along the surface's dp/du; either one left out is the isotropic
+ * alpha. *alpha_v is -1 where the two are equal (isotropic). */
+static pk_status read_alpha_uv(pdict *d, const mat_row *row, const mat_common *c, float *alpha, float *alpha_v)
+{
+    const pd_entry *eu = param(d, row, "alpha_u"), *ev = param(d, row, "alpha_v");
+    *alpha = c->alpha, *alpha_v = -1.0f;
+    if (!eu && !ev) return PK_OK;
+    float au = c->alpha, av = c->alpha;
+    pk_status st;
+    if (eu && (st = pd_float(d, "alpha_u", au, PD_UNIT, &au))) return st;
+    if (ev && (st = pd_float(d, "alpha_v", av, PD_UNIT, &av))) return st;
+    *alpha = au;
+    if (av != au) *alpha_v = av;
+    return PK_OK;
+}
+
 static pk_status create_conductor(pdict *d, const mat_row *row, const mat_common *c, material *m)
 {
     vec3 eta = v3(0.2f, 0.92f, 1.1f), k = v3(3.9f, 2.45f, 2.14f); /* copper, as pbrt */
@@ -101,15 +118,23 @@ static pk_status create_conductor(pdict *d, const mat_row *row, const mat_common
         if (pe && (st = pd_vec3(d, "eta", eta, PD_V_POSITIVE, &eta))) return st;
         if (pk && (st = pd_vec3(d, "k", k, PD_V_NONNEG, &k))) return st;
     }
-    if (f0.x >= 0.0f) material_conductor_f0(m, f0, c->alpha);
-    else material_conductor(m, eta, k, c->alpha);
+    float alpha, alpha_v;
+    if ((st = read_alpha_uv(d, row, c, &alpha, &alpha_v))) return st;
+    if (f0.x >= 0.0f) material_conductor_f0(m, f0, alpha);
+    else material_conductor(m, eta, k, alpha);
+    m->alpha_v = alpha_v;
     return PK_OK;
 }
 
 static pk_status create_dielectric(pdict *d, const mat_row *row, const mat_common *c, material *m)
 {
-    (void)d, (void)row;
-    material_dielectric(m, c->ior, c->alpha, c->transmittance);
+    float alpha, alpha_v;
+    pk_status st = read_alpha_uv(d, row, c, &alpha, &alpha_v);
+    if (st) return st;
+    if (c->ior == 1.0f && (alpha > 0.0f || alpha_v > 0.0f))
+        return pd_fail(d, pd_get(d, "ior"), -1, PK_ERR_PARSE, "must not be 1 on a rough surface (roughness > 0)");
+    material_dielectric(m, c->ior, alpha, c->transmittance);
+    m->alpha_v = alpha_v;
     return PK_OK;
 }
 
@@ -325,8 +350,8 @@ static pk_status create_two_sided(pdict *d, const mat_row *row, const mat_common
  * name; the pbrt, Mitsuba and glTF names will be rows of their dialects. */
 static const mat_row mat_rows[] = {
     {MD_PAPRSEK, "diffuse", {"albedo"}, create_diffuse},
-    {MD_PAPRSEK, "conductor", {"eta", "k", "specular", "roughness", "alpha"}, create_conductor},
-    {MD_PAPRSEK, "dielectric", {"ior", "roughness", "transmittance"}, create_dielectric},
+    {MD_PAPRSEK, "conductor", {"eta", "k", "specular", "roughness", "alpha", "alpha_u", "alpha_v"}, create_conductor},
+    {MD_PAPRSEK, "dielectric", {"ior", "roughness", "transmittance", "alpha_u", "alpha_v"}, create_dielectric},
     {MD_PAPRSEK, "plastic", {"albedo", "ior", "roughness"}, create_plastic},
     {MD_PAPRSEK, "metallic_roughness",
      {"base_color", "metallic", "roughness", "transmission", "ior", "metallic_roughness_map", "clearcoat",

@@ -538,11 +538,18 @@ static pk_status roughness_map(pp *p, const named_tex *t, bool remap, tex_ref *m
     return st;
 }
 
+static float clamp_alpha(float a) { return !isfinite(a) || a < 0.0f ? 0.0f : a > 1.0f ? 1.0f : a; }
+
 /* roughness / uroughness / vroughness and remaproughness (prefix: "" or
  * "interface." / "conductor."). map: where a roughness texture goes (the
- * material's map_alpha; its alpha is then 1), NULL where there is none. */
-static pk_status get_roughness(pp *p, const char *prefix, float *alpha, tex_ref *map)
+ * material's map_alpha; its alpha is then 1), NULL where there is none.
+ * alpha_v NULL: anisotropic roughness is warned about and rendered as the
+ * mean of the two alphas. alpha_v non-NULL: *alpha is the alpha along u
+ * (the surface's dp/du) and *alpha_v the one along v where the two differ
+ * (material's alpha_v), -1 where the roughness is isotropic. */
+static pk_status get_roughness_uv(pp *p, const char *prefix, float *alpha, float *alpha_v, tex_ref *map)
 {
+    if (alpha_v) *alpha_v = -1.0f;
     char n1[64], n2[64], n3[64], n4[64];
     snprintf(n1, sizeof n1, "%sroughness", prefix);
     snprintf(n2, sizeof n2, "%suroughness", prefix);
@@ -574,6 +581,12 @@ static pk_status get_roughness(pp *p, const char *prefix, float *alpha, tex_ref 
     if (fu || fv) {
         if (!fu) u = r;
         if (!fv) v = r;
+        if (u != v && alpha_v) {
+            *alpha = clamp_alpha(rough_alpha(u, remap));
+            *alpha_v = clamp_alpha(rough_alpha(v, remap));
+            if (*alpha_v == *alpha) *alpha_v = -1.0f;
+            return PK_OK;
+        }
         if (u != v)
             pwarn(p, p->line, "anisotropic roughness %g x %g is rendered isotropic (the mean of the two alphas)",
                   (double)u, (double)v);
@@ -585,6 +598,10 @@ static pk_status get_roughness(pp *p, const char *prefix, float *alpha, tex_ref 
     if (!isfinite(*alpha) || *alpha < 0.0f) *alpha = 0.0f;
     if (*alpha > 1.0f) *alpha = 1.0f;
     return PK_OK;
+}
+static pk_status get_roughness(pp *p, const char *prefix, float *alpha, tex_ref *map)
+{
+    return get_roughness_uv(p, prefix, alpha, NULL, map);
 }
 
 static pk_status get_eta(pp *p, const char *name, float def, float *eta)
@@ -608,10 +625,11 @@ static pk_status make_conductor(pp *p, material *m, const char *prefix, float mi
     snprintf(ne, sizeof ne, "%seta", prefix);
     snprintf(nk, sizeof nk, "%sk", prefix);
     snprintf(nr, sizeof nr, "%sroughness", prefix);
-    float alpha;
+    float alpha, alpha_v = -1.0f;
     tex_ref ta;
     tex_ref_init(&ta);
-    pk_status st = get_roughness(p, prefix, &alpha, maps ? &ta : NULL);
+    /* anisotropic where the conductor stands alone (maps); a coated one's is averaged */
+    pk_status st = get_roughness_uv(p, prefix, &alpha, maps ? &alpha_v : NULL, maps ? &ta : NULL);
     if (st) return st;
     if (min_alpha > alpha) alpha = min_alpha;
     vec3 refl;
@@ -630,6 +648,7 @@ static pk_status make_conductor(pp *p, material *m, const char *prefix, float mi
     } else {
         material_conductor(m, eta, k, alpha);
     }
+    m->alpha_v = alpha_v;
     m->map_alpha = ta;
     return PK_OK;
 }
@@ -759,8 +778,10 @@ static pk_status build_material(pp *p, const char *type, material *m, bool *inte
     } else if (strcmp(type, "dielectric") == 0) {
         tex_ref ta;
         tex_ref_init(&ta);
-        if ((st = get_eta(p, "eta", 1.5f, &eta)) || (st = get_roughness(p, "", &alpha, &ta))) return st;
+        float alpha_v;
+        if ((st = get_eta(p, "eta", 1.5f, &eta)) || (st = get_roughness_uv(p, "", &alpha, &alpha_v, &ta))) return st;
         material_dielectric(m, eta, alpha, v3s(1.0f));
+        m->alpha_v = alpha_v;
         m->map_alpha = ta;
     } else if (strcmp(type, "thindielectric") == 0) {
         if ((st = get_eta(p, "eta", 1.5f, &eta))) return st;
@@ -837,7 +858,29 @@ static pk_status build_material(pp *p, const char *type, material *m, bool *inte
             m->map_norm.tex = idx;
         }
     }
-    if (pb_param(&p->pd, "displacement")) pwarn(p, p->line, "bump mapping by 'displacement' is not supported; ignored");
+    /* displacement: pbrt bump-maps with it (heights along the normal, in
+     * scene units): the material's bump map. A constant moves the surface
+     * without tilting it, so it changes nothing. */
+    if ((st = pb_typed(&p->pd, "displacement", TB(PT_FLOAT) | TB(PT_TEXTURE), "a float or a float texture", &q)))
+        return st;
+    if (q && q->type == PT_TEXTURE) {
+        if (q->nstr != 1) return pfail(p, q->line, PK_ERR_PARSE, "'texture displacement' takes one name");
+        named_tex *t = find_tex(p, q->str[0]);
+        if (!t) return pfail(p, q->line, PK_ERR_PARSE, "'texture displacement': no texture named \"%.60s\"", q->str[0]);
+        tex_ref r;
+        tex_ref_init(&r);
+        if (t->cls == TC_EXPR) {
+            if ((st = tex_add_expr(p, t, &r))) return st;
+            r.bm = 1.0f;
+        } else if (t->cls != TC_CONST) {
+            r = t->ref;
+            r.bm = t->value.x; /* the factor on the image's values */
+        }
+        if (r.kind != TEX_NONE && m->map_norm.kind != TEX_NONE)
+            pwarn(p, q->line, "'displacement' with a normal map: the normal map is used, as pbrt does");
+        else if (r.kind != TEX_NONE)
+            m->map_bump = r;
+    }
     return PK_OK;
 }
 
@@ -1025,7 +1068,8 @@ static bool needs_uv(pp *p, int32_t alpha_tex)
 {
     const material *m = &p->s->materials[GS(p)->material];
     return alpha_tex >= 0 || m->map_kd.kind || m->map_ks.kind || m->map_ns.kind || m->map_d.kind ||
-           m->map_alpha.kind || m->map_bump.kind || m->map_norm.kind || m->map_mr.kind;
+           m->map_alpha.kind || m->map_bump.kind || m->map_norm.kind || m->map_mr.kind ||
+           material_anisotropic(m); /* the roughness follows pbrt's dp/du */
 }
 
 /* A copy of m in which every face (per_face corners of faces[]) has

@@ -13,6 +13,7 @@ const rec_field rec_material[] = {
     F(material, ni, REC_FLOAT),         F(material, d, REC_FLOAT),
     F(material, illum, REC_INT),        F(material, two_sided, REC_BOOL),
     F(material, type, REC_INT),         F(material, alpha, REC_FLOAT),
+    F(material, alpha_v, REC_FLOAT),
     F(material, eta, REC_VEC3),         F(material, k, REC_VEC3),
     F(material, schlick, REC_BOOL),     F(material, beckmann, REC_BOOL),
     F(material, metallic, REC_FLOAT),   F(material, roughness, REC_FLOAT),

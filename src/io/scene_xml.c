@@ -1123,12 +1123,15 @@ static pk_status get_rel_ior(xp *p, pdict *d, float in, float *ior)
 static float clamp01(float x) { return x > 0.0f ? (x < 1.0f ? x : 1.0f) : 0.0f; }
 static vec3 clamp01v(vec3 c) { return v3(clamp01(c.x), clamp01(c.y), clamp01(c.z)); }
 
-/* roughness of the rough* plugins: alpha, or alpha_u/alpha_v (averaged),
- * and the microfacet distribution (*beckmann: Mitsuba's default "beckmann",
+/* roughness of the rough* plugins: alpha, or alpha_u/alpha_v (alpha_v
+ * NULL: averaged, with a warning; else *alpha is alpha_u, along the
+ * surface's dp/du, and *alpha_v alpha_v where the two differ, -1 where
+ * they do not), and the microfacet distribution (*beckmann: Mitsuba's default "beckmann",
  * and "phong" by Mitsuba's own equivalence of the two for one alpha; false
  * for "ggx"). */
-static pk_status get_alpha(xp *p, pdict *d, float def, float *alpha, bool *beckmann)
+static pk_status get_alpha(xp *p, pdict *d, float def, float *alpha, float *alpha_v, bool *beckmann)
 {
+    if (alpha_v) *alpha_v = -1.0f;
     const xnode *b = d->node;
     pk_status st;
     float a = def, au = -1.0f, av = -1.0f;
@@ -1138,8 +1141,13 @@ static pk_status get_alpha(xp *p, pdict *d, float def, float *alpha, bool *beckm
         au = av = a;
         if ((st = get_scalar(p, d, "alpha_u", &au))) return st;
         if ((st = get_scalar(p, d, "alpha_v", &av))) return st;
-        if (au != av) xwarn(p, b, "anisotropic roughness is not supported; using alpha %g", (double)(0.5f * (au + av)));
-        a = 0.5f * (au + av);
+        if (au != av && alpha_v) {
+            a = au;
+            *alpha_v = clamp01(av);
+        } else {
+            if (au != av) xwarn(p, b, "anisotropic roughness is not supported here; using alpha %g", (double)(0.5f * (au + av)));
+            a = 0.5f * (au + av);
+        }
     }
     const char *dist = NULL;
     xnode *dist_at = NULL;
@@ -1156,6 +1164,7 @@ static pk_status get_alpha(xp *p, pdict *d, float def, float *alpha, bool *beckm
         xwarn(p, dist_at, "microfacet distribution \"%s\" is unknown; using beckmann", sd);
     }
     *alpha = clamp01(a);
+    if (alpha_v && *alpha_v == *alpha) *alpha_v = -1.0f;
     return PK_OK;
 }
 
@@ -1171,6 +1180,7 @@ typedef struct bsdf_in {
     pdict *d;
     const char *type, *ty;
     float alpha, ior;
+    float alpha_v; /* rough conductor and dielectric: anisotropic roughness (get_alpha) */
     bool beckmann;
 } bsdf_in;
 
@@ -1395,7 +1405,7 @@ static pk_status bsdf_coating(xp *p, const bsdf_in *in, material *m)
     float alpha = 0.0f, ior;
     bool bk = false, rough = in->type[0] == 'r';
     pk_status st;
-    if (rough && (st = get_alpha(p, in->d, 0.1f, &alpha, &bk))) return st;
+    if (rough && (st = get_alpha(p, in->d, 0.1f, &alpha, NULL, &bk))) return st;
     if ((st = get_rel_ior(p, in->d, 1.5046f, &ior))) return st;
     if (inner && (st = bsdf_resolve(p, inner, m))) return st;
     if (inner && m->type == MAT_DIFFUSE && ior > 0.0f && ior != 1.0f) {
@@ -1622,6 +1632,7 @@ static pk_status bsdf_conductor(xp *p, const bsdf_in *in, material *m)
      * to 1 (tests/render/test_veach_plates.c) */
     if (none) material_conductor_f0(m, v3s(1.0f), in->alpha);
     else material_conductor(m, eta, k, in->alpha);
+    m->alpha_v = in->alpha_v;
     if (spec.x != 1.0f || spec.y != 1.0f || spec.z != 1.0f) material_conductor_tint(m, spec);
     m->beckmann = in->beckmann;
     return PK_OK;
@@ -1647,8 +1658,10 @@ static pk_status bsdf_dielectric(xp *p, const bsdf_in *in, material *m)
         material_thin_dielectric(m, ior, clamp01v(tr));
         return PK_OK;
     }
-    if (ior == 1.0f && alpha > 0.0f) alpha = 0.0f;
+    float alpha_v = in->alpha_v;
+    if (ior == 1.0f && (alpha > 0.0f || alpha_v > 0.0f)) alpha = 0.0f, alpha_v = -1.0f;
     material_dielectric(m, ior, alpha, clamp01v(tr));
+    m->alpha_v = alpha_v;
     m->beckmann = in->beckmann;
     return PK_OK;
 }
@@ -1814,8 +1827,10 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
         return PK_OK;
     }
     const bsdf_row *row = &bsdf_rows[r];
-    bsdf_in in = {.b = b, .d = &d, .type = type, .ty = ty};
-    if (row->rough && (st = get_alpha(p, &d, 0.1f, &in.alpha, &in.beckmann))) return st;
+    bsdf_in in = {.b = b, .d = &d, .type = type, .ty = ty, .alpha_v = -1.0f};
+    /* Mitsuba's rough conductor and dielectric take alpha_u and alpha_v; its rough plastic does not */
+    const bool aniso = row->create == bsdf_conductor || row->create == bsdf_dielectric;
+    if (row->rough && (st = get_alpha(p, &d, 0.1f, &in.alpha, aniso ? &in.alpha_v : NULL, &in.beckmann))) return st;
     if (row->int_ior > 0.0f && (st = get_rel_ior(p, &d, row->int_ior, &in.ior))) return st;
     if (!row->create) material_interface(m);
     else if ((st = row->create(p, &in, m)) || !row->kind) return st;
@@ -2675,7 +2690,10 @@ static pk_status parse_shape(xp *p, xnode *sh)
         float tol = 1e-4f * lx;
         bool similar = fabsf(lx - ly) <= tol && fabsf(lx - lz) <= tol && fabsf(v3_dot(cx, cy)) <= tol * lx &&
                        fabsf(v3_dot(cx, cz)) <= tol * lx && fabsf(v3_dot(cy, cz)) <= tol * lx;
-        if (similar && !flip && !p->sb.in_object) { /* (a shapegroup's spheres are meshes) */
+        /* anisotropic roughness follows Mitsuba's dp/du (phi about the sphere's
+         * own z axis), which only the mesh keeps */
+        const bool aniso = material_anisotropic(&p->s->materials[mat]);
+        if (similar && !flip && !p->sb.in_object && !aniso) { /* (a shapegroup's spheres are meshes) */
             sphere sp = {xform_point(&full, v3s(0.0f)), lx, mat};
             if (!v3_finite(sp.center) || !(sp.radius > 0.0f) || !isfinite(sp.radius))
                 return xfail(p, PK_ERR_PARSE, sh, "sphere: the transformed sphere is not finite");

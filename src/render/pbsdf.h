@@ -60,6 +60,10 @@ typedef enum pbsdf_type {
 #define PBSDF_BECKMANN 2u
 /* energy compensation of the rough lobes (pbsdf_compensate sets it) */
 #define PBSDF_ENERGY 4u
+/* conductor, dielectric, plastic: anisotropic roughness, alpha along the
+ * local x axis (the surface's tangent, dp/du) and alpha_v along y
+ * (pbsdf_anisotropic sets it) */
+#define PBSDF_ANISO 8u
 
 /* Below this roughness a microfacet lobe is treated as perfectly smooth (a
  * delta lobe): the GGX density would exceed float range long before 0. */
@@ -78,6 +82,8 @@ typedef enum pbsdf_type {
  *   transmittance [0, 1] per channel       dielectric: tint of refracted light (MTL Tf)
  *   alpha         [0, 1]                   GGX roughness (alpha = perceptual roughness^2);
  *                                          < PBSDF_ALPHA_SMOOTH: smooth (delta lobes)
+ *   alpha_v       [0, 1]                   with PBSDF_ANISO: the roughness along local y
+ *                                          (alpha is then the one along x)
  *   ior           > 0, != 1 for dielectric dielectric, plastic: inside / outside index;
  *                                          metallic-roughness: the dielectric's Fresnel
  *                                          (Schlick, F0 = ((ior - 1) / (ior + 1))^2)
@@ -98,6 +104,7 @@ typedef struct pbsdf {
     vec3 eta, k;
     vec3 transmittance;
     float alpha;
+    float alpha_v;       /* with PBSDF_ANISO */
     float ior;
     float metallic, transmission;
     float coat, coat_alpha;
@@ -122,7 +129,7 @@ static inline PK_HD pbsdf pbsdf__blank(int type)
     b.tint = v3s(1.0f);
     b.eta = v3s(1.0f);
     b.k = v3s(0.0f);
-    b.alpha = 0.0f;
+    b.alpha = b.alpha_v = 0.0f;
     b.ior = 1.5f;
     b.metallic = b.transmission = 0.0f;
     b.coat = b.coat_alpha = 0.0f;
@@ -202,6 +209,21 @@ static inline PK_HD pbsdf pbsdf_with_clearcoat(pbsdf b, float coat, float coat_a
     b.coat_alpha = coat_alpha;
     return b;
 }
+/* Anisotropic roughness for a conductor, dielectric or plastic b made with
+ * alpha (the roughness along the local x axis, the surface's tangent):
+ * alpha_v along y. alpha_v < 0 or equal to alpha leaves b isotropic. A lobe
+ * rough in one direction is at least PBSDF_ALPHA_SMOOTH in the other (the
+ * density would overflow as one roughness goes to 0). */
+static inline PK_HD void pbsdf_anisotropic(pbsdf *b, float alpha_v)
+{
+    if (!(alpha_v >= 0.0f) || alpha_v == b->alpha) return;
+    b->alpha_v = alpha_v;
+    b->flags |= PBSDF_ANISO;
+    if (fmaxf(b->alpha, alpha_v) >= PBSDF_ALPHA_SMOOTH) {
+        b->alpha = fmaxf(b->alpha, PBSDF_ALPHA_SMOOTH);
+        b->alpha_v = fmaxf(b->alpha_v, PBSDF_ALPHA_SMOOTH);
+    }
+}
 /* GGX roughness for an MTL Phong exponent: alpha = sqrt(2 / (Ns + 2)). */
 static inline PK_HD float pbsdf_alpha_from_ns(float ns)
 {
@@ -254,6 +276,7 @@ static inline PK_HD float pbsdf__fresnel_conductor1(float cos_i, float eta, floa
     float t1 = a2b2 + cos2;
     float a = sqrtf(fmaxf(0.0f, 0.5f * (a2b2 + t0)));
     float t2 = 2.0f * cos_i * a;
+    if (!(t1 + t2 > 0.0f)) return 1.0f; /* grazing on an index-matched surface (eta 1, k 0): the limit */
     float rs = (t1 - t2) / (t1 + t2);
     float t3 = cos2 * a2b2 + sin2 * sin2;
     float t4 = t2 * sin2;
@@ -364,15 +387,91 @@ static inline PK_HD vec3 pbsdf_beckmann_sample(float alpha, float u1, float u2)
     return v3(sn * cosf(phi), sn * sinf(phi), c);
 }
 
+/* ---- anisotropic GGX and Beckmann, local frame ------------------------------ */
+
+/* The same distributions stretched: roughness ax along x, ay along y (the
+ * isotropic functions above are these with ax = ay, written for speed and
+ * kept as they were). m and w are unit vectors. */
+static inline PK_HD float pbsdf_ggx_d_aniso(float ax, float ay, vec3 m)
+{
+    if (m.z <= 0.0f) return 0.0f;
+    const float x = m.x / ax, y = m.y / ay, t = x * x + y * y + m.z * m.z;
+    return 1.0f / (PK_PI * ax * ay * t * t);
+}
+static inline PK_HD float pbsdf_ggx_lambda_aniso(float ax, float ay, vec3 w)
+{
+    float z2 = w.z * w.z;
+    if (z2 <= 0.0f) return INFINITY;
+    float t2 = (ax * ax * w.x * w.x + ay * ay * w.y * w.y) / z2;
+    return 0.5f * (sqrtf(1.0f + t2) - 1.0f);
+}
+static inline PK_HD float pbsdf_ggx_vndf_pdf_aniso(float ax, float ay, vec3 w, vec3 m)
+{
+    if (w.z < 0.0f) w = v3_neg(w);
+    float wm = v3_dot(w, m);
+    if (wm <= 0.0f || w.z <= 0.0f) return 0.0f;
+    return wm * pbsdf_ggx_d_aniso(ax, ay, m) / ((1.0f + pbsdf_ggx_lambda_aniso(ax, ay, w)) * w.z);
+}
+/* Heitz 2018 with the view stretched by (ax, ay) and the normal back. */
+static inline PK_HD vec3 pbsdf_ggx_vndf_sample_aniso(float ax, float ay, vec3 w, float u1, float u2)
+{
+    if (w.z < 0.0f) w = v3_neg(w);
+    vec3 vh = v3_norm(v3(ax * w.x, ay * w.y, w.z));
+    float lensq = vh.x * vh.x + vh.y * vh.y;
+    vec3 t1 = lensq > 0.0f ? v3_scale(v3(-vh.y, vh.x, 0.0f), 1.0f / sqrtf(lensq)) : v3(1.0f, 0.0f, 0.0f);
+    vec3 t2 = v3_cross(vh, t1);
+    float r = sqrtf(u1), phi = 2.0f * PK_PI * u2;
+    float p1 = r * cosf(phi), p2 = r * sinf(phi);
+    float s = 0.5f * (1.0f + vh.z);
+    p2 = (1.0f - s) * sqrtf(fmaxf(0.0f, 1.0f - p1 * p1)) + s * p2;
+    vec3 nh = v3_add(v3_add(v3_scale(t1, p1), v3_scale(t2, p2)),
+                     v3_scale(vh, sqrtf(fmaxf(0.0f, 1.0f - p1 * p1 - p2 * p2))));
+    return v3_norm(v3(ax * nh.x, ay * nh.y, fmaxf(1e-7f, nh.z)));
+}
+/* D(m) = exp(-(x^2 / ax^2 + y^2 / ay^2) / z^2) / (pi ax ay z^4). */
+static inline PK_HD float pbsdf_beckmann_d_aniso(float ax, float ay, vec3 m)
+{
+    if (m.z <= 0.0f) return 0.0f;
+    float c2 = m.z * m.z;
+    float e = (m.x * m.x / (ax * ax) + m.y * m.y / (ay * ay)) / c2;
+    if (e > 80.0f) return 0.0f;
+    return expf(-e) / (PK_PI * ax * ay * c2 * c2);
+}
+/* Lambda with a = 1 / (alpha tan theta) for the roughness alpha of w's
+ * azimuth: alpha tan theta = sqrt(ax^2 x^2 + ay^2 y^2) / |z|. */
+static inline PK_HD float pbsdf_beckmann_lambda_aniso(float ax, float ay, vec3 w)
+{
+    float z2 = w.z * w.z;
+    if (z2 <= 0.0f) return INFINITY;
+    float s2 = ax * ax * w.x * w.x + ay * ay * w.y * w.y;
+    if (s2 <= 0.0f) return 0.0f;
+    float a = sqrtf(z2 / s2);
+    if (a > 9.0f) return 0.0f;
+    return 0.5f * (expf(-a * a) / (a * 1.7724538509f) - erfcf(a));
+}
+/* m from D(m) cos theta_m: a Gaussian slope (ax r cos phi, ay r sin phi). */
+static inline PK_HD vec3 pbsdf_beckmann_sample_aniso(float ax, float ay, float u1, float u2)
+{
+    float r = sqrtf(-logf(fmaxf(1.0f - u1, 1e-30f))), phi = 2.0f * PK_PI * u2;
+    return v3_norm(v3(-ax * r * cosf(phi), -ay * r * sinf(phi), 1.0f));
+}
+
 /* ---- the distribution of a conductor, dielectric or plastic --------------- */
 
 static inline PK_HD bool pbsdf__bk(const pbsdf *b) { return (b->flags & PBSDF_BECKMANN) != 0u; }
+static inline PK_HD bool pbsdf__an(const pbsdf *b) { return (b->flags & PBSDF_ANISO) != 0u; }
 static inline PK_HD float pbsdf_mf_d(const pbsdf *b, vec3 m)
 {
+    if (pbsdf__an(b))
+        return pbsdf__bk(b) ? pbsdf_beckmann_d_aniso(b->alpha, b->alpha_v, m)
+                            : pbsdf_ggx_d_aniso(b->alpha, b->alpha_v, m);
     return pbsdf__bk(b) ? pbsdf_beckmann_d(b->alpha, m) : pbsdf_ggx_d(b->alpha, m);
 }
 static inline PK_HD float pbsdf_mf_lambda(const pbsdf *b, vec3 w)
 {
+    if (pbsdf__an(b))
+        return pbsdf__bk(b) ? pbsdf_beckmann_lambda_aniso(b->alpha, b->alpha_v, w)
+                            : pbsdf_ggx_lambda_aniso(b->alpha, b->alpha_v, w);
     return pbsdf__bk(b) ? pbsdf_beckmann_lambda(b->alpha, w) : pbsdf_ggx_lambda(b->alpha, w);
 }
 /* Height-correlated Smith masking-shadowing, as for GGX. */
@@ -384,20 +483,27 @@ static inline PK_HD float pbsdf_mf_g2(const pbsdf *b, vec3 wo, vec3 wi)
  * distribution. */
 static inline PK_HD vec3 pbsdf_mf_sample(const pbsdf *b, vec3 wo, float u1, float u2)
 {
+    if (pbsdf__an(b))
+        return pbsdf__bk(b) ? pbsdf_beckmann_sample_aniso(b->alpha, b->alpha_v, u1, u2)
+                            : pbsdf_ggx_vndf_sample_aniso(b->alpha, b->alpha_v, wo, u1, u2);
     return pbsdf__bk(b) ? pbsdf_beckmann_sample(b->alpha, u1, u2) : pbsdf_ggx_vndf_sample(b->alpha, wo, u1, u2);
 }
 /* Solid-angle density of pbsdf_mf_sample returning m (m.z > 0) for wo
  * (either hemisphere); 0 where m faces away from wo. */
 static inline PK_HD float pbsdf_mf_pdf(const pbsdf *b, vec3 wo, vec3 m)
 {
-    if (!pbsdf__bk(b)) return pbsdf_ggx_vndf_pdf(b->alpha, wo, m);
+    if (!pbsdf__bk(b))
+        return pbsdf__an(b) ? pbsdf_ggx_vndf_pdf_aniso(b->alpha, b->alpha_v, wo, m) : pbsdf_ggx_vndf_pdf(b->alpha, wo, m);
     if (v3_dot(wo, m) * wo.z <= 0.0f) return 0.0f;
-    return pbsdf_beckmann_d(b->alpha, m) * m.z;
+    return pbsdf_mf_d(b, m) * m.z;
 }
 
 /* ---- lobes (local frame, wo.z > 0 and wi.z > 0 checked by the caller) -- */
 
-static inline PK_HD bool pbsdf__smooth(const pbsdf *b) { return b->alpha < PBSDF_ALPHA_SMOOTH; }
+static inline PK_HD bool pbsdf__smooth(const pbsdf *b)
+{
+    return (pbsdf__an(b) ? fmaxf(b->alpha, b->alpha_v) : b->alpha) < PBSDF_ALPHA_SMOOTH;
+}
 static inline PK_HD float pbsdf__mean(vec3 c) { return (c.x + c.y + c.z) * (1.0f / 3.0f); }
 static inline PK_HD vec3 pbsdf__mirror(vec3 w) { return v3(-w.x, -w.y, w.z); }
 
@@ -424,7 +530,7 @@ static inline PK_HD float pbsdf__ggx_refl_pdf(float alpha, vec3 wo, vec3 wi)
 /* The same for the BSDF's own distribution (GGX or Beckmann). */
 static inline PK_HD float pbsdf__mf_refl_cos(const pbsdf *b, vec3 wo, vec3 wi, vec3 *h_out)
 {
-    if (!pbsdf__bk(b)) return pbsdf__ggx_refl_cos(b->alpha, wo, wi, h_out);
+    if (!pbsdf__bk(b) && !pbsdf__an(b)) return pbsdf__ggx_refl_cos(b->alpha, wo, wi, h_out);
     vec3 h = v3_add(wo, wi);
     if (v3_len2(h) <= 0.0f) return 0.0f;
     h = v3_norm(h);
@@ -433,7 +539,7 @@ static inline PK_HD float pbsdf__mf_refl_cos(const pbsdf *b, vec3 wo, vec3 wi, v
 }
 static inline PK_HD float pbsdf__mf_refl_pdf(const pbsdf *b, vec3 wo, vec3 wi)
 {
-    if (!pbsdf__bk(b)) return pbsdf__ggx_refl_pdf(b->alpha, wo, wi);
+    if (!pbsdf__bk(b) && !pbsdf__an(b)) return pbsdf__ggx_refl_pdf(b->alpha, wo, wi);
     vec3 h = v3_add(wo, wi);
     if (v3_len2(h) <= 0.0f) return 0.0f;
     h = v3_norm(h);
@@ -490,8 +596,15 @@ static inline PK_HD float pbsdf__fms(float favg, float eavg)
     return favg * favg * eavg / (1.0f - favg * (1.0f - eavg));
 }
 
+/* The roughness the (isotropic) tables are read at: alpha, or for an
+ * anisotropic lobe the isotropic equivalent sqrt(alpha alpha_v) (the
+ * geometric mean: the same area of the slope distribution's ellipse). */
+static inline PK_HD float pbsdf__ealpha(const pbsdf *b)
+{
+    return pbsdf__an(b) ? sqrtf(b->alpha * b->alpha_v) : b->alpha;
+}
 /* E(mu) of the BSDF's lobe (alpha, distribution). */
-static inline PK_HD float pbsdf__e(const pbsdf *b, float mu) { return energy_e(pbsdf__bk(b), b->alpha, mu); }
+static inline PK_HD float pbsdf__e(const pbsdf *b, float mu) { return energy_e(pbsdf__bk(b), pbsdf__ealpha(b), mu); }
 
 /* Turns energy compensation on for a rough conductor, dielectric, plastic
  * or metallic-roughness BSDF (others, and smooth lobes, stay as they are).
@@ -504,7 +617,7 @@ static inline PK_HD void pbsdf_compensate(pbsdf *b)
         return;
     }
     if (b->type != PBSDF_CONDUCTOR && b->type != PBSDF_PLASTIC && b->type != PBSDF_METALLIC_ROUGHNESS) return;
-    const float eavg = energy_eavg(pbsdf__bk(b), b->alpha);
+    const float eavg = energy_eavg(pbsdf__bk(b), pbsdf__ealpha(b));
     if (!(eavg < 0.99999f)) return;
     vec3 fms;
     if (b->type == PBSDF_CONDUCTOR) {
@@ -547,7 +660,7 @@ static inline PK_HD float pbsdf__ms_prob(const pbsdf *b, vec3 wo)
 /* Turquin's factor of the dielectric: 1 / E_d toward wo. */
 static inline PK_HD float pbsdf__dielectric_comp(const pbsdf *b, vec3 wo)
 {
-    const float e = energy_dielectric(pbsdf__bk(b), b->ior, b->alpha, wo.z);
+    const float e = energy_dielectric(pbsdf__bk(b), b->ior, pbsdf__ealpha(b), wo.z);
     return e > 0.05f ? 1.0f / e : 20.0f;
 }
 
@@ -1228,6 +1341,7 @@ static inline PK_HD bool pbsdf__pr_sample(const pbsdf *b, vec3 wo, const float u
 static inline PK_HD void pbsdf_regularize(pbsdf *b)
 {
     if (b->type != PBSDF_DIFFUSE && b->alpha < 0.3f) b->alpha = fminf(fmaxf(2.0f * b->alpha, 0.1f), 0.3f);
+    if (pbsdf__an(b) && b->alpha_v < 0.3f) b->alpha_v = fminf(fmaxf(2.0f * b->alpha_v, 0.1f), 0.3f);
     if (b->coat > 0.0f && b->coat_alpha < 0.3f) b->coat_alpha = fminf(fmaxf(2.0f * b->coat_alpha, 0.1f), 0.3f);
 }
 
@@ -1418,6 +1532,10 @@ static inline PK_HD bool pbsdf_sample(const pbsdf *b, vec3 wo, const float u[3],
             return true;
         }
         /* f cos / pdf = F D G2 / (4 cos_o) / (G1(wo) D / (4 cos_o)) = F G2 / G1(wo) */
+        if (pbsdf__an(b)) {
+            *weight = v3_scale(pbsdf__fresnel_conductor(b, om), pbsdf_mf_g2(b, wo, w) * (1.0f + pbsdf_mf_lambda(b, wo)));
+            return true;
+        }
         *weight = v3_scale(pbsdf__fresnel_conductor(b, om),
                            pbsdf_ggx_g2(b->alpha, wo, w) / pbsdf_ggx_g1(b->alpha, wo));
         return true;

@@ -30,6 +30,22 @@ typedef struct shading {
     bool nondelta;       /* the BSDF has a part that light sampling can reach */
 } shading;
 
+/* The shading frame about the unit normal n: its x axis along the tangent
+ * dpdu made perpendicular to n (where the roughness is anisotropic: the u
+ * roughness lies along dp/du, as pbrt and Mitsuba have it), or, where
+ * dpdu is zero or along n, onb_from_normal's. */
+static inline PK_HD onb shading_frame(vec3 n, vec3 dpdu)
+{
+    vec3 s = v3_sub(dpdu, v3_scale(n, v3_dot(n, dpdu)));
+    const float l2 = v3_len2(s);
+    if (!(l2 > 1e-12f * v3_len2(dpdu)) || !v3_finite(s)) return onb_from_normal(n);
+    onb f;
+    f.s = v3_scale(s, 1.0f / sqrtf(l2));
+    f.t = v3_cross(n, f.s);
+    f.n = n;
+    return f;
+}
+
 static inline PK_HD shading shading_at(const surface *sf)
 {
     const material *m = sf->m;
@@ -81,6 +97,7 @@ static inline PK_HD shading shading_at(const surface *sf)
         }
         if (m->beckmann && (m->type == MAT_CONDUCTOR || m->type == MAT_DIELECTRIC || m->type == MAT_PLASTIC))
             sh.b.flags |= PBSDF_BECKMANN;
+        if (material_anisotropic(m)) pbsdf_anisotropic(&sh.b, m->alpha_v);
     } else if (glass) {
         sh.b = pbsdf_dielectric(m->ni, 0.0f, sf->front ? material_mtl_tint(m) : v3s(1.0f));
         if (!sf->front) n = v3_neg(n); /* the outward normal: wo.z < 0 inside */
@@ -93,7 +110,7 @@ static inline PK_HD shading shading_at(const surface *sf)
     } else {
         sh.b = pbsdf_diffuse(m->kd);
     }
-    sh.frame = onb_from_normal(n);
+    sh.frame = sh.b.flags & PBSDF_ANISO ? shading_frame(n, sf->dpdu) : onb_from_normal(n);
     sh.nondelta = sh.opaque > 0.0f && pbsdf_has_nondelta(&sh.b) &&
                   (sh.b.type != PBSDF_DIFFUSE || !black(sh.b.albedo));
     return sh;

@@ -16,6 +16,7 @@ typedef struct surface {
     vec3 ns;       /* shading normal, same hemisphere as ng */
     bool front;    /* the ray hit the side the geometric normal points to */
     const material *m;
+    vec3 dpdu;     /* the tangent dp/du (unnormalised; zero unless the material is anisotropic) */
 } surface;
 
 /* Whether hit number prim is a triangle (of the world arrays or of a kept
@@ -121,6 +122,7 @@ static inline PK_HD surface surface_at(const scene_view *s, const ray *r, const 
     }
     sf.ng = ng;
     sf.ns = ns;
+    sf.dpdu = v3s(0.0f);
     return sf;
 }
 
@@ -184,10 +186,11 @@ static inline PK_HD vec3 surface_clamp_rgb(vec3 c)
     return v3(fminf(fmaxf(c.x, 0.0f), 1.0f), fminf(fmaxf(c.y, 0.0f), 1.0f), fminf(fmaxf(c.z, 0.0f), 1.0f));
 }
 
-/* Height of a bump map at (u, v), the fine level. */
-static inline PK_HD float surface_bump_height(const scene_view *s, const tex_ref *ref, float u, float v)
+/* Height of a bump map at (u, v) and the point p with normal n (which
+ * procedural textures read), the fine level. */
+static inline PK_HD float surface_bump_height(const scene_view *s, const tex_ref *ref, float u, float v, vec3 p, vec3 n)
 {
-    tex_query q = {u, v, 0.0f, v3s(0.0f), v3s(0.0f), s->tex_nodes};
+    tex_query q = {u, v, 0.0f, p, n, s->tex_nodes};
     return tex_eval_scalar(s->textures, ref, q);
 }
 
@@ -210,6 +213,7 @@ static inline PK_HD void surface_texture_at(const scene_view *s, const ray *r, c
     if (m->map_alpha.kind) {
         float a = fminf(fmaxf(tex_eval_scalar(s->textures, &m->map_alpha, q), 0.0f), 1.0f);
         tm->alpha = fminf(m->alpha * (m->map_alpha.squared ? a * a : a), 1.0f);
+        if (m->alpha_v >= 0.0f) tm->alpha_v = fminf(m->alpha_v * (m->map_alpha.squared ? a * a : a), 1.0f);
         if (m->type == MAT_PRINCIPLED) tm->roughness = fminf(m->roughness * a, 1.0f); /* its roughness map */
     }
     if (m->map_mr.kind) { /* glTF: blue metallic, green roughness (a grey map: both) */
@@ -226,6 +230,7 @@ static inline PK_HD void surface_texture_at(const scene_view *s, const ray *r, c
         tm->ke = v3_mul(m->ke, v3(fmaxf(e.x, 0.0f), fmaxf(e.y, 0.0f), fmaxf(e.z, 0.0f)));
     }
     sf->m = tm;
+    if (material_anisotropic(m)) sf->dpdu = uv.dpdu; /* the u roughness's direction */
     if (!m->map_bump.kind && !m->map_norm.kind) return;
     /* a frame on the surface, z = the shading normal as it faces the ray */
     const vec3 n = sf->ns;
@@ -247,14 +252,25 @@ static inline PK_HD void surface_texture_at(const scene_view *s, const ray *r, c
             const texture *tx = &s->textures[ref->tex];
             size = tx->lv[0].w > tx->lv[0].h ? tx->lv[0].w : tx->lv[0].h;
         }
-        const float du = 0.5f / (float)size, dv = du;
-        const float h0 = surface_bump_height(s, ref, uv.u, uv.v);
-        const float hu = (surface_bump_height(s, ref, uv.u + du, uv.v) - h0) / du * ref->bm;
-        const float hv = (surface_bump_height(s, ref, uv.u, uv.v + dv) - h0) / dv * ref->bm;
+        float du = 0.5f / (float)size;
+        /* a procedural texture (of the point, not only of uv): differences
+         * over the ray's footprint in uv (pbrt's BumpMap: du = (|du/dx| +
+         * |du/dy|) / 2, 0.0005 without one), read at the points moved
+         * along dp/du and dp/dv */
+        const bool expr = ref->kind == TEX_EXPR;
+        if (expr) du = q.width > 0.0f ? q.width : 0.0005f;
+        const float dv = du;
+        const vec3 pn = expr ? sf->p : v3s(0.0f), nn0 = expr ? sf->ng : v3s(0.0f);
+        const vec3 pu = expr ? v3_add(sf->p, v3_scale(uv.dpdu, du)) : pn;
+        const vec3 pv = expr ? v3_add(sf->p, v3_scale(uv.dpdv, dv)) : pn;
+        const float h0 = surface_bump_height(s, ref, uv.u, uv.v, pn, nn0);
+        const float hu = (surface_bump_height(s, ref, uv.u + du, uv.v, pu, nn0) - h0) / du * ref->bm;
+        const float hv = (surface_bump_height(s, ref, uv.u, uv.v + dv, pv, nn0) - h0) / dv * ref->bm;
         /* in the frame (t, b, n) with dp/du ~ |dpdu| t and dp/dv ~ |dpdv| b */
         const float lu = v3_len(uv.dpdu), lv = v3_len(uv.dpdv);
         if (!(lu > 0.0f) || !(lv > 0.0f)) return;
         nn = v3_sub(n, v3_add(v3_scale(t, hu / lu), v3_scale(b, hv / lv)));
+        if (material_anisotropic(m)) sf->dpdu = v3_add(uv.dpdu, v3_scale(n, hu)); /* the displaced surface's */
     }
     if (!v3_finite(nn) || !(v3_len2(nn) > 0.0f)) return;
     nn = v3_norm(nn);

@@ -17,6 +17,7 @@ void material_init(material *m)
     m->d = 1.0f;
     m->illum = 2;
     m->medium_in = m->medium_out = -2; /* MEDIUM_INHERIT */
+    m->alpha_v = -1.0f;                /* isotropic */
     tex_ref_init(&m->map_kd);
     tex_ref_init(&m->map_ks);
     tex_ref_init(&m->map_ns);

@@ -84,6 +84,11 @@ typedef struct material {
      * colour). */
     int type;
     float alpha;
+    /* conductor, dielectric, plastic: anisotropic roughness when >= 0 and
+     * not alpha (material_init: -1, isotropic): alpha is then the roughness
+     * along the surface's tangent dp/du (pbrt's uroughness, Mitsuba's
+     * alpha_u) and alpha_v the one across it. map_alpha scales both. */
+    float alpha_v;
     vec3 eta, k;
     bool schlick;
     /* conductor: a factor on its Fresnel reflectance, per channel in [0, 1]
@@ -125,7 +130,10 @@ typedef struct material {
      * scene's media, MEDIUM_NONE (vacuum) or MEDIUM_INHERIT (the surface
      * does not change the ray's medium; material_init's default). */
     int32_t medium_in, medium_out;
-    bool textured;   /* derived by scene_commit: a map other than map_d is set */
+    /* derived by scene_commit: a map other than map_d is set, or the
+     * roughness is anisotropic (the shading then needs the surface's
+     * tangent, which surface_texture finds with the texture coordinates) */
+    bool textured;
     bool cutout;     /* derived by scene_commit: map_d is set */
 } material;
 
@@ -224,6 +232,13 @@ static inline PK_HD vec3 material_mtl_tint(const material *m)
 {
     float tmax_c = v3_max_comp(m->tf);
     return tmax_c > 0.0f ? v3_scale(m->tf, 1.0f / tmax_c) : v3s(1.0f);
+}
+
+/* Whether the material's roughness is anisotropic (alpha_v, above). */
+static inline PK_HD bool material_anisotropic(const material *m)
+{
+    return (m->type == MAT_CONDUCTOR || m->type == MAT_DIELECTRIC || m->type == MAT_PLASTIC) && m->alpha_v >= 0.0f &&
+           m->alpha_v != m->alpha;
 }
 
 /* Fresnel reflectance at normal incidence of a dielectric of index ior,

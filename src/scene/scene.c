@@ -876,7 +876,7 @@ pk_status scene_commit(pk_context *ctx, pk_scene *s)
         m->cutout = m->map_d.kind != TEX_NONE;
         m->textured = m->map_kd.kind != TEX_NONE || m->map_ks.kind != TEX_NONE || m->map_ns.kind != TEX_NONE ||
                       m->map_alpha.kind != TEX_NONE || m->map_bump.kind != TEX_NONE || m->map_norm.kind != TEX_NONE ||
-                      m->map_mr.kind != TEX_NONE || m->map_ke.kind != TEX_NONE;
+                      m->map_mr.kind != TEX_NONE || m->map_ke.kind != TEX_NONE || material_anisotropic(m);
         s->has_cutout |= m->cutout;
         s->has_interfaces |= m->type == MAT_INTERFACE;
         s->has_textured |= m->textured;

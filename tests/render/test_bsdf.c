@@ -703,6 +703,10 @@ static void test_fresnel(void)
     /* conductor with k = 0 is a dielectric */
     for (float c = 0.05f; c < 1.0f; c += 0.1f)
         CHECK_NEAR(pbsdf__fresnel_conductor1(c, 1.5f, 0.0f), pbsdf_fresnel_dielectric(c, 1.5f), 1e-5);
+    /* at grazing incidence every interface reflects all (eta 1, k 0 was 0 / 0) */
+    CHECK_NEAR(pbsdf__fresnel_conductor1(0.0f, 1.0f, 0.0f), 1.0, 1e-6);
+    CHECK_NEAR(pbsdf__fresnel_conductor1(0.0f, 0.2f, 3.0f), 1.0, 1e-5);
+    CHECK_NEAR(pbsdf__fresnel_conductor1(0.0f, 1.5f, 0.0f), 1.0, 1e-5);
     CHECK_NEAR(pbsdf_alpha_from_ns(0.0f), 1.0, 1e-6);
     CHECK_NEAR(pbsdf_alpha_from_ns(98.0f), sqrt(0.02), 1e-6);
 }
