@@ -1738,8 +1738,6 @@ static pk_status bsdf_principled(xp *p, const bsdf_in *in, material *m)
     m->srate_spec = rate[0], m->srate_cc = rate[1], m->srate_diff = rate[2];
     m->ni = eta;
     material_principled_update(m);
-    if (v[2] > 0.0f && first_time(p, "principled anisotropic"))
-        xwarn(p, in->b, "principled: anisotropic is rendered isotropically (GGX alpha sqrt(ax ay))");
     return PK_OK;
 }
 

@@ -1107,23 +1107,27 @@ static inline PK_HD bool pbsdf__ext_sample(const pbsdf *b, vec3 wo, const float 
 
 /* Mitsuba 3's "principled" (its reading of Burley's Disney BSDF, 2012/2015),
  * lobe by lobe as Mitsuba defines it (docs/materials.md): a Disney diffuse
- * with retro-reflection and the flatness blend, sheen, an isotropic GGX
- * specular lobe whose Fresnel blends the dielectric's, a metal's (Schlick,
+ * with retro-reflection and the flatness blend, sheen, a GGX specular lobe
+ * (anisotropic: PBSDF_ANISO, alpha along x, alpha_v along y) whose Fresnel blends the dielectric's, a metal's (Schlick,
  * F0 = base colour) and a tinted Schlick one, a rough dielectric
  * transmission tinted by sqrt(base colour), and a GTR1 clearcoat. Fields:
  * albedo = base colour, metallic, transmission = spec_trans, ior = eta,
- * alpha = GGX alpha, roughness (the diffuse's), coat = clearcoat, coat_alpha
+ * alpha (, alpha_v) = GGX alphas, roughness (the diffuse's), coat = clearcoat, coat_alpha
  * = the GTR1 alpha, and pr_* below. wo.z < 0 is the inside (the frame is the
  * outward normal as for the dielectric); there only the specular reflection
  * and transmission scatter, as in Mitsuba. */
-static inline PK_HD pbsdf pbsdf_principled(vec3 base_color, float metallic, float roughness, float alpha,
+static inline PK_HD pbsdf pbsdf_principled(vec3 base_color, float metallic, float roughness, float ax, float ay,
                                            float spec_trans, float eta)
 {
     pbsdf b = pbsdf__blank(PBSDF_PRINCIPLED);
     b.albedo = base_color;
     b.metallic = metallic;
     b.roughness = roughness;
-    b.alpha = alpha;
+    b.alpha = ax; /* GGX along the local x axis (dp/du) and, where they differ, alpha_v = ay along y */
+    if (ay != ax) {
+        b.alpha_v = ay;
+        b.flags |= PBSDF_ANISO;
+    }
     b.transmission = spec_trans;
     b.ior = eta;
     return b;
@@ -1157,11 +1161,17 @@ static inline PK_HD vec3 pbsdf__gtr1_sample(float a, float u1, float u2)
     const float s = sqrtf(fmaxf(0.0f, 1.0f - c2)), c = sqrtf(fmaxf(0.0f, c2));
     return v3(cosf(phi) * s, sinf(phi) * s, c);
 }
-/* Smith's G1 of GGX with alpha a, 0 for a microfacet m seen from behind */
+/* Smith's G1 of GGX with alpha a, 0 for a microfacet m seen from behind
+ * (the clearcoat's), and the same of the main lobe (anisotropic or not) */
 static inline PK_HD float pbsdf__pr_g1(float a, vec3 v, vec3 m)
 {
     if (v3_dot(v, m) * v.z <= 0.0f) return 0.0f;
     return v.z == 1.0f ? 1.0f : pbsdf_ggx_g1(a, v);
+}
+static inline PK_HD float pbsdf__pr_g1m(const pbsdf *b, vec3 v, vec3 m)
+{
+    if (v3_dot(v, m) * v.z <= 0.0f) return 0.0f;
+    return v.z == 1.0f ? 1.0f : 1.0f / (1.0f + pbsdf_mf_lambda(b, v));
 }
 /* The half vector of wo, wi (+z side), the relative index along the path,
  * whether it reflects, and the macro/micro compatibility of the pair. */
@@ -1216,8 +1226,8 @@ static inline PK_HD vec3 pbsdf__pr_eval(const pbsdf *b, vec3 wo, vec3 wi)
     const bool front = wo.z > 0.0f;
     const pbsdf__pr_geo g = pbsdf__pr_geometry(b, wo, wi);
     const vec3 h = g.h, base = b->albedo;
-    const float d = pbsdf_ggx_d(b->alpha, h);
-    const float gg = pbsdf__pr_g1(b->alpha, wo, h) * pbsdf__pr_g1(b->alpha, wi, h);
+    const float d = pbsdf_mf_d(b, h);
+    const float gg = pbsdf__pr_g1m(b, wo, h) * pbsdf__pr_g1m(b, wi, h);
     const float oh = v3_dot(wo, h), ih = v3_dot(wi, h);
     if (g.reflect && g.refl_ok && g.f > 0.0f) {
         vec3 fr;
@@ -1286,7 +1296,7 @@ static inline PK_HD float pbsdf__pr_pdf(const pbsdf *b, vec3 wo, vec3 wi)
         jac = fabsf(g.eta_path * g.eta_path * ih / (den * den));
     }
     if (!isfinite(jac)) return 0.0f;
-    const float vn = pbsdf_ggx_vndf_pdf(b->alpha, wo, g.h);
+    const float vn = pbsdf_mf_pdf(b, wo, g.h);
     float pdf = 0.0f;
     if (g.reflect) {
         if (g.refl_ok) {
@@ -1306,7 +1316,7 @@ static inline PK_HD bool pbsdf__pr_sample(const pbsdf *b, vec3 wo, const float u
     if (wo.z == 0.0f) return false;
     const bool front = wo.z > 0.0f;
     if (!front && !((1.0f - b->metallic) * b->transmission > 0.0f)) return false;
-    const vec3 m = pbsdf_ggx_vndf_sample(b->alpha, wo, u[1], u[2]);
+    const vec3 m = pbsdf_mf_sample(b, wo, u[1], u[2]);
     float p[4];
     pbsdf__pr_probs(b, front, pbsdf_fresnel_dielectric(v3_dot(wo, m), b->ior), p);
     vec3 w;
@@ -1445,6 +1455,7 @@ static inline PK_HD bool pbsdf_sample(const pbsdf *b, vec3 wo, const float u[3],
 {
     if (b->type == PBSDF_PRINCIPLED) {
         *is_delta = false;
+        *weight = v3s(0.0f); /* (gcc cannot see that a true return sets it) */
         return pbsdf__pr_sample(b, wo, u, wi, weight, pdf);
     }
     if (b->type >= PBSDF_THIN_DIELECTRIC) return pbsdf__ext_sample(b, wo, u, wi, weight, pdf, is_delta);

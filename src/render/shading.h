@@ -80,11 +80,11 @@ static inline PK_HD shading shading_at(const surface *sf)
         case MAT_ROUGH_DIFFUSE: sh.b = pbsdf_oren_nayar(m->kd, m->alpha * 0.70710678f); break; /* Mitsuba's sigma */
         case MAT_PHONG: sh.b = pbsdf_phong(m->kd, m->ks, m->ns); break;
         case MAT_PRINCIPLED: { /* the frame is the outward normal where it transmits (wo.z < 0 inside) */
+            /* Mitsuba's calc_dist_params: ax along dp/du (the frame's x, below) */
             const float r = fminf(fmaxf(m->roughness, 0.0f), 1.0f), r2 = r * r;
             const float asp = sqrtf(1.0f - 0.9f * fminf(fmaxf(m->anisotropic, 0.0f), 1.0f));
-            /* anisotropy: the isotropic GGX of the same sqrt(ax ay) for now */
-            const float alpha = sqrtf(fmaxf(1e-3f, r2 / asp) * fmaxf(1e-3f, r2 * asp));
-            sh.b = pbsdf_principled(surface_clamp_rgb(m->kd), m->metallic, r, alpha, m->transmission, m->ni);
+            const float ax = fmaxf(1e-3f, r2 / asp), ay = fmaxf(1e-3f, r2 * asp);
+            sh.b = pbsdf_principled(surface_clamp_rgb(m->kd), m->metallic, r, ax, ay, m->transmission, m->ni);
             sh.b.coat = m->clearcoat;
             sh.b.coat_alpha = 0.1f + (0.001f - 0.1f) * m->clearcoat_gloss;
             sh.b.pr_spec_tint = m->spec_tint, sh.b.pr_sheen = m->sheen, sh.b.pr_sheen_tint = m->sheen_tint;

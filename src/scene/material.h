@@ -107,9 +107,9 @@ typedef struct material {
     /* MAT_PRINCIPLED (Mitsuba 3's principled, material_principled): base
      * colour kd, metallic, roughness (GGX alpha = max(0.001, roughness^2)),
      * transmission (spec_trans), clearcoat, the index ni (eta, or Mitsuba's
-     * specular mapped to it), and these, all in [0, 1]: anisotropic (kept
-     * with the anisotropic alphas ax, ay Mitsuba would use; rendered with
-     * the isotropic alpha sqrt(ax ay) for now), spec_tint, sheen,
+     * specular mapped to it), and these, all in [0, 1]: anisotropic (GGX
+     * alphas ax along dp/du and ay across it, Mitsuba's calc_dist_params;
+     * alpha = sqrt(ax ay) for the Whitted integrator), spec_tint, sheen,
      * sheen_tint, flatness, clearcoat_gloss; and the sampling rates of the
      * main specular, clearcoat and diffuse lobes (>= 0, 1 by default).
      * map_kd multiplies the base colour and map_alpha the roughness. */
@@ -234,9 +234,11 @@ static inline PK_HD vec3 material_mtl_tint(const material *m)
     return tmax_c > 0.0f ? v3_scale(m->tf, 1.0f / tmax_c) : v3s(1.0f);
 }
 
-/* Whether the material's roughness is anisotropic (alpha_v, above). */
+/* Whether the material's roughness is anisotropic (alpha_v, above; for
+ * principled its anisotropic > 0). */
 static inline PK_HD bool material_anisotropic(const material *m)
 {
+    if (m->type == MAT_PRINCIPLED) return m->anisotropic > 0.0f;
     return (m->type == MAT_CONDUCTOR || m->type == MAT_DIELECTRIC || m->type == MAT_PLASTIC) && m->alpha_v >= 0.0f &&
            m->alpha_v != m->alpha;
 }

@@ -169,7 +169,7 @@ static pbsdf to_pbsdf(const rparams *q)
     double ax, ay;
     r_alphas(q, &ax, &ay);
     pbsdf b = pbsdf_principled(v3((float)q->base[0], (float)q->base[1], (float)q->base[2]), (float)q->metallic,
-                               (float)q->roughness, (float)sqrt(ax * ay), (float)q->spec_trans, (float)q->eta);
+                               (float)q->roughness, (float)ax, (float)ay, (float)q->spec_trans, (float)q->eta);
     b.coat = (float)q->clearcoat;
     b.coat_alpha = (float)(0.1 + (0.001 - 0.1) * q->clearcoat_gloss);
     b.pr_spec_tint = (float)q->spec_tint, b.pr_sheen = (float)q->sheen, b.pr_sheen_tint = (float)q->sheen_tint;
@@ -233,6 +233,7 @@ static rparams random_params(void)
     for (int c = 0; c < 3; c++) q.base[c] = rnd();
     q.metallic = rnd() < 0.3 ? 0 : rnd();
     q.roughness = 0.2 + 0.8 * rnd();
+    q.anisotropic = rnd() < 0.5 ? 0 : rnd();
     q.spec_trans = rnd() < 0.4 ? 0 : rnd();
     q.eta = 1.1 + rnd();
     if (rnd() < 0.2) q.eta = 1 / q.eta;
@@ -354,28 +355,34 @@ static void test_chi2(void)
 {
     struct {
         const char *name;
-        double metallic, spec_trans, clearcoat, sheen, roughness, eta, wz;
+        double metallic, spec_trans, clearcoat, sheen, roughness, eta, wz, anisotropic;
     } cases[] = {
-        {"diffuse only", 0, 0, 0, 0, 0.6, 1.5, 0.7},
-        {"metallic", 1, 0, 0, 0, 0.5, 1.5, 0.6},
-        {"spec_trans 1", 0, 1, 0, 0, 0.5, 1.5, 0.6},
-        {"spec_trans 0.5", 0.2, 0.5, 0.8, 0, 0.6, 1.33, 0.7},
-        {"clearcoat", 0.4, 0, 1, 0, 0.6, 1.33, 0.7},
-        {"sheen", 0, 0, 0, 1, 0.7, 1.5, 0.4},
-        {"from inside", 0, 0.7, 0.8, 0, 0.5, 1.5, -0.7},
-        {"eta < 1", 0.2, 0.5, 1, 0, 0.8, 0.5, 0.7},
+        {"diffuse only", 0, 0, 0, 0, 0.6, 1.5, 0.7, 0},
+        {"metallic", 1, 0, 0, 0, 0.5, 1.5, 0.6, 0},
+        {"spec_trans 1", 0, 1, 0, 0, 0.5, 1.5, 0.6, 0},
+        {"spec_trans 0.5", 0.2, 0.5, 0.8, 0, 0.6, 1.33, 0.7, 0},
+        {"clearcoat", 0.4, 0, 1, 0, 0.6, 1.33, 0.7, 0},
+        {"sheen", 0, 0, 0, 1, 0.7, 1.5, 0.4, 0},
+        {"from inside", 0, 0.7, 0.8, 0, 0.5, 1.5, -0.7, 0},
+        {"eta < 1", 0.2, 0.5, 1, 0, 0.8, 0.5, 0.7, 0},
+        /* anisotropic (ax != ay), wo at an azimuth off both axes */
+        {"aniso metal", 1, 0, 0, 0, 0.6, 1.5, 0.6, 0.9},
+        {"aniso mixed", 0.3, 0.4, 0.5, 0.5, 0.7, 1.5, 0.5, 0.6},
+        {"aniso inside", 0, 0.8, 0, 0, 0.6, 1.4, -0.6, 0.8},
     };
     const int nc = (int)(sizeof cases / sizeof cases[0]);
-    /* 8 tests at once: each at a significance of 0.01 / 8 (Sidak) */
+    /* nc tests at once: each at a significance of about 0.01 / nc (Sidak) */
     const double alpha = 1 - pow(1 - 0.01, 1.0 / nc);
     for (int i = 0; i < nc; i++) {
         rparams q = rdefault();
         q.base[0] = 0.8, q.base[1] = 0.5, q.base[2] = 0.3;
         q.metallic = cases[i].metallic, q.spec_trans = cases[i].spec_trans, q.clearcoat = cases[i].clearcoat;
         q.sheen = cases[i].sheen, q.roughness = cases[i].roughness, q.eta = cases[i].eta;
+        q.anisotropic = cases[i].anisotropic;
         pbsdf b = to_pbsdf(&q);
-        double wz = cases[i].wz, s = sqrt(1 - wz * wz);
-        vec3 wo = v3((float)s, 0.0f, (float)wz);
+        CHECK(((b.flags & PBSDF_ANISO) != 0) == (q.anisotropic > 0));
+        double wz = cases[i].wz, s = sqrt(1 - wz * wz), phi = q.anisotropic > 0 ? 0.6 : 0.0;
+        vec3 wo = v3((float)(s * cos(phi)), (float)(s * sin(phi)), (float)wz);
         double total;
         int badw = 0;
         double pv = chi2_run(&b, wo, 400000, &total, &badw);
@@ -391,14 +398,16 @@ static void test_chi2(void)
  * dielectric's is reported (the model adds specular on top of diffuse) */
 static void test_albedo(void)
 {
-    struct { const char *name; double metallic, spec_trans, roughness; int bounded; } cases[] = {
-        {"metal r0.2", 1, 0, 0.2, 1}, {"metal r0.8", 1, 0, 0.8, 1}, {"glass r0.3", 0, 1, 0.3, 1},
-        {"glass r0.8", 0, 1, 0.8, 1}, {"dielectric r0.5", 0, 0, 0.5, 0},
+    struct { const char *name; double metallic, spec_trans, roughness, anisotropic; int bounded; } cases[] = {
+        {"metal r0.2", 1, 0, 0.2, 0, 1},      {"metal r0.8", 1, 0, 0.8, 0, 1},     {"glass r0.3", 0, 1, 0.3, 0, 1},
+        {"glass r0.8", 0, 1, 0.8, 0, 1},      {"dielectric r0.5", 0, 0, 0.5, 0, 0}, {"aniso metal", 1, 0, 0.5, 0.9, 1},
+        {"aniso glass", 0, 1, 0.5, 0.9, 1},
     };
-    for (int i = 0; i < 5; i++) {
+    for (int i = 0; i < (int)(sizeof cases / sizeof cases[0]); i++) {
         rparams q = rdefault();
         q.base[0] = q.base[1] = q.base[2] = 1;
         q.metallic = cases[i].metallic, q.spec_trans = cases[i].spec_trans, q.roughness = cases[i].roughness;
+        q.anisotropic = cases[i].anisotropic;
         pbsdf b = to_pbsdf(&q);
         double worst = 0, worst_err = 0, worst_z = 0;
         bool first = true;
