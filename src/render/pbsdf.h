@@ -50,6 +50,7 @@ typedef enum pbsdf_type {
     PBSDF_OREN_NAYAR,         /* rough diffuse (Oren-Nayar's qualitative model): albedo, on_a, on_b */
     PBSDF_PHONG,              /* modified Phong: albedo (diffuse) + specular, exponent */
     PBSDF_PRINCIPLED,         /* Mitsuba 3's principled: base colour (albedo), metallic, ... (pbsdf_principled) */
+    PBSDF_PRINCIPLED_THIN,    /* Mitsuba 3's principledthin: a thin sheet (pbsdf_principled_thin) */
     PBSDF_TYPE_COUNT
 } pbsdf_type;
 
@@ -116,6 +117,10 @@ typedef struct pbsdf {
      * sampling rates of the main specular, clearcoat and diffuse lobes */
     float roughness, pr_spec_tint, pr_sheen, pr_sheen_tint, pr_flatness;
     float pr_srate_spec, pr_srate_cc, pr_srate_diff;
+    /* principledthin: diff_trans in [0, 1] (Mitsuba's / 2), the GGX alphas
+     * of the transmission lobe (of the roughness scaled by 0.65 eta - 0.35)
+     * and the sampling rates of the specular and diffuse transmission */
+    float pr_diff_trans, pr_tax, pr_tay, pr_srate_st, pr_srate_dt;
 } pbsdf;
 
 /* ---- constructors ------------------------------------------------------- */
@@ -138,6 +143,8 @@ static inline PK_HD pbsdf pbsdf__blank(int type)
     b.on_a = 1.0f, b.on_b = b.exponent = 0.0f;
     b.roughness = b.pr_spec_tint = b.pr_sheen = b.pr_sheen_tint = b.pr_flatness = 0.0f;
     b.pr_srate_spec = b.pr_srate_cc = b.pr_srate_diff = 1.0f;
+    b.pr_diff_trans = b.pr_tax = b.pr_tay = 0.0f;
+    b.pr_srate_st = b.pr_srate_dt = 1.0f;
     return b;
 }
 static inline PK_HD pbsdf pbsdf_diffuse(vec3 albedo)
@@ -1341,6 +1348,165 @@ static inline PK_HD bool pbsdf__pr_sample(const pbsdf *b, vec3 wo, const float u
     return true;
 }
 
+/* ---- Mitsuba 3's principledthin ------------------------------------------- */
+
+/* Mitsuba 3's "principledthin": a thin sheet, the same from both sides (wo
+ * and wi are mirrored so that wo.z > 0). Lobes: the specular reflection
+ * spec_trans F_thin D G / (4 cos_o) (GGX alpha, alpha_v as principled's;
+ * F_thin = lerp(F, the tinted Schlick, spec_tint), F the dielectric Fresnel
+ * of eta), the specular transmission spec_trans base (1 - F) D_t G_t /
+ * (4 cos_o) about the mirror image of the reflection (alphas pr_tax,
+ * pr_tay), the principled diffuse (with flatness) and sheen scaled by
+ * (1 - spec_trans)(1 - diff_trans), and a Lambertian transmission
+ * (1 - spec_trans) diff_trans base / pi. Fields as pbsdf_principled's with
+ * transmission = spec_trans, ior = eta, pr_diff_trans, pr_tax, pr_tay and
+ * the rates pr_srate_spec (specular reflection), pr_srate_st, pr_srate_diff,
+ * pr_srate_dt. */
+static inline PK_HD pbsdf pbsdf_principled_thin(vec3 base_color, float roughness, float ax, float ay, float tax,
+                                                float tay, float spec_trans, float diff_trans, float eta)
+{
+    pbsdf b = pbsdf_principled(base_color, 0.0f, roughness, ax, ay, spec_trans, eta);
+    b.type = PBSDF_PRINCIPLED_THIN;
+    b.pr_diff_trans = diff_trans;
+    b.pr_tax = tax, b.pr_tay = tay;
+    return b;
+}
+/* the lobes' probabilities: specular reflection, specular transmission,
+ * diffuse reflection, diffuse transmission */
+static inline PK_HD void pbsdf__th_probs(const pbsdf *b, float p[4])
+{
+    const float st = b->transmission, dt = b->pr_diff_trans;
+    p[0] = st * b->pr_srate_spec * 0.5f;
+    p[1] = st * b->pr_srate_st * 0.5f;
+    p[2] = b->pr_srate_diff * (1.0f - st) * (1.0f - dt);
+    p[3] = b->pr_srate_dt * (1.0f - st) * dt;
+    const float t = p[0] + p[1] + p[2] + p[3];
+    const float r = t > 0.0f ? 1.0f / t : 0.0f;
+    for (int k = 0; k < 4; k++) p[k] *= r;
+}
+/* the transmission lobe's distribution: b with its alphas */
+static inline PK_HD pbsdf pbsdf__th_trans_lobe(const pbsdf *b)
+{
+    pbsdf t = *b;
+    t.alpha = b->pr_tax;
+    t.alpha_v = b->pr_tay;
+    if (b->pr_tax != b->pr_tay) t.flags |= PBSDF_ANISO;
+    else t.flags &= ~PBSDF_ANISO;
+    return t;
+}
+/* mirrors wo, wi so that wo.z > 0; the half vector of wo and wi's mirror
+ * image above the sheet */
+static inline PK_HD vec3 pbsdf__th_half(vec3 *wo, vec3 *wi)
+{
+    if (wo->z < 0.0f) *wo = v3_neg(*wo), *wi = v3_neg(*wi);
+    vec3 h = v3_add(*wo, v3(wi->x, wi->y, fabsf(wi->z)));
+    const float l2 = v3_len2(h);
+    return l2 > 0.0f ? v3_scale(h, 1.0f / sqrtf(l2)) : v3(0.0f, 0.0f, 1.0f);
+}
+static inline PK_HD vec3 pbsdf__th_eval(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    vec3 v = v3s(0.0f);
+    if (wo.z == 0.0f) return v;
+    const vec3 h = pbsdf__th_half(&wo, &wi);
+    const bool reflect = wi.z > 0.0f, refract = wi.z < 0.0f;
+    const float st = b->transmission, dt = b->pr_diff_trans, oh = v3_dot(wo, h), ih = v3_dot(wi, h);
+    const vec3 base = b->albedo;
+    if (st > 0.0f) {
+        const float f = pbsdf_fresnel_dielectric(oh, b->ior);
+        if (reflect && oh > 0.0f && ih > 0.0f) {
+            const float lum = pbsdf__pr_lum(base), eta_it = oh >= 0.0f ? b->ior : 1.0f / b->ior;
+            const vec3 ctint = lum > 0.0f ? v3_scale(base, 1.0f / lum) : v3s(1.0f);
+            const float r0 = (eta_it - 1.0f) / (eta_it + 1.0f);
+            const vec3 fs = pbsdf__pr_schlick(v3_scale(ctint, r0 * r0), pbsdf__pr_schlick_w(oh, b->ior));
+            const vec3 ft = v3_add(v3s((1.0f - b->pr_spec_tint) * f), v3_scale(fs, b->pr_spec_tint));
+            const float dg = pbsdf_mf_d(b, h) * pbsdf__pr_g1m(b, wo, h) * pbsdf__pr_g1m(b, wi, h);
+            v = v3_add(v, v3_scale(ft, st * dg / (4.0f * wo.z)));
+        }
+        if (refract && oh > 0.0f && ih < 0.0f) {
+            const pbsdf t = pbsdf__th_trans_lobe(b);
+            const float dg = pbsdf_mf_d(&t, h) * pbsdf__pr_g1m(&t, wo, h) * pbsdf__pr_g1m(&t, wi, h);
+            v = v3_add(v, v3_scale(base, st * (1.0f - f) * dg / (4.0f * wo.z)));
+        }
+    }
+    if (reflect && st < 1.0f && dt < 1.0f) {
+        const float fo = pbsdf__schlick_w(wi.z), fi = pbsdf__schlick_w(wo.z);
+        const float f_diff = (1.0f - 0.5f * fi) * (1.0f - 0.5f * fo);
+        const float rr = 2.0f * b->roughness * ih * ih;
+        float f = f_diff + rr * (fo + fi + fo * fi * (rr - 1.0f));
+        if (b->pr_flatness != 0.0f) {
+            const float fss90 = 0.5f * rr;
+            const float fss = (1.0f + (fss90 - 1.0f) * fo) * (1.0f + (fss90 - 1.0f) * fi);
+            const float f_ss = 1.25f * (fss * (1.0f / (wi.z + wo.z) - 0.5f) + 0.5f);
+            f += (f_ss - f) * b->pr_flatness;
+        }
+        const float w = (1.0f - st) * (1.0f - dt);
+        v = v3_add(v, v3_scale(base, w * wi.z * f / PK_PI));
+        if (b->pr_sheen > 0.0f) {
+            const float lum = pbsdf__pr_lum(base);
+            const vec3 ctint = lum > 0.0f ? v3_scale(base, 1.0f / lum) : v3s(1.0f);
+            const vec3 cs = v3_add(v3s(1.0f - b->pr_sheen_tint), v3_scale(ctint, b->pr_sheen_tint));
+            v = v3_add(v, v3_scale(cs, b->pr_sheen * w * pbsdf__schlick_w(fabsf(ih)) * wi.z));
+        }
+    }
+    if (refract && st < 1.0f && dt > 0.0f) v = v3_add(v, v3_scale(base, (1.0f - st) * dt * -wi.z / PK_PI));
+    return v;
+}
+static inline PK_HD float pbsdf__th_pdf(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    if (wo.z == 0.0f) return 0.0f;
+    const vec3 h = pbsdf__th_half(&wo, &wi);
+    float p[4];
+    pbsdf__th_probs(b, p);
+    const float oh = v3_dot(wo, h), ih = v3_dot(wi, h);
+    /* the mirror image of wi above the sheet reflects wo about h */
+    const float jac = fabsf(1.0f / (4.0f * v3_dot(v3(wi.x, wi.y, fabsf(wi.z)), h)));
+    float pdf = 0.0f;
+    if (wi.z > 0.0f) {
+        if (oh > 0.0f && ih > 0.0f && p[0] > 0.0f) pdf += p[0] * pbsdf_mf_pdf(b, wo, h) * jac;
+        pdf += p[2] * wi.z / PK_PI;
+    } else if (wi.z < 0.0f) {
+        if (oh > 0.0f && ih < 0.0f && p[1] > 0.0f) {
+            const pbsdf t = pbsdf__th_trans_lobe(b);
+            pdf += p[1] * pbsdf_mf_pdf(&t, wo, h) * jac;
+        }
+        pdf += p[3] * -wi.z / PK_PI;
+    }
+    return isfinite(pdf) ? pdf : 0.0f;
+}
+static inline PK_HD bool pbsdf__th_sample(const pbsdf *b, vec3 wo, const float u[3], vec3 *wi, vec3 *weight,
+                                          float *pdf)
+{
+    if (wo.z == 0.0f) return false;
+    const float s = wo.z < 0.0f ? -1.0f : 1.0f;
+    const vec3 v = v3_scale(wo, s);
+    float p[4];
+    pbsdf__th_probs(b, p);
+    vec3 w;
+    if (u[0] < p[0]) {
+        const vec3 m = pbsdf_mf_sample(b, v, u[1], u[2]);
+        w = v3_sub(v3_scale(m, 2.0f * v3_dot(v, m)), v);
+        if (!(w.z > 0.0f) || !(v3_dot(w, m) > 0.0f)) return false;
+    } else if (u[0] < p[0] + p[1]) {
+        const pbsdf t = pbsdf__th_trans_lobe(b);
+        const vec3 m = pbsdf_mf_sample(&t, v, u[1], u[2]);
+        w = v3_sub(v3_scale(m, 2.0f * v3_dot(v, m)), v);
+        w.z = -w.z;
+        if (!(w.z < 0.0f) || !(v3_dot(w, m) < 0.0f)) return false;
+    } else if (u[0] < p[0] + p[1] + p[2]) {
+        w = pbsdf__cosine_dir(u[1], u[2]);
+    } else {
+        w = v3_neg(pbsdf__cosine_dir(u[1], u[2]));
+    }
+    if (w.z == 0.0f) return false;
+    w = v3_scale(w, s);
+    const float pd = pbsdf__th_pdf(b, wo, w);
+    if (!(pd > 0.0f)) return false;
+    *wi = w;
+    *pdf = pd;
+    *weight = v3_scale(pbsdf__th_eval(b, wo, w), 1.0f / pd);
+    return true;
+}
+
 /* ---- the interface --------------------------------------------------------- */
 
 /* True if the BSDF has a non-delta part, i.e. light sampling and MIS can
@@ -1371,6 +1537,7 @@ static inline PK_HD bool pbsdf_has_nondelta(const pbsdf *b)
 static inline PK_HD vec3 pbsdf_eval(const pbsdf *b, vec3 wo, vec3 wi)
 {
     if (b->type == PBSDF_PRINCIPLED) return pbsdf__pr_eval(b, wo, wi);
+    if (b->type == PBSDF_PRINCIPLED_THIN) return pbsdf__th_eval(b, wo, wi);
     if (b->type >= PBSDF_THIN_DIELECTRIC) return pbsdf__ext_eval(b, wo, wi);
     if (b->type == PBSDF_DIELECTRIC) return pbsdf__dielectric_eval(b, wo, wi);
     if (b->type == PBSDF_METALLIC_ROUGHNESS) return pbsdf__mr_eval(b, wo, wi);
@@ -1416,6 +1583,7 @@ static inline PK_HD vec3 pbsdf_eval(const pbsdf *b, vec3 wo, vec3 wi)
 static inline PK_HD float pbsdf_pdf(const pbsdf *b, vec3 wo, vec3 wi)
 {
     if (b->type == PBSDF_PRINCIPLED) return pbsdf__pr_pdf(b, wo, wi);
+    if (b->type == PBSDF_PRINCIPLED_THIN) return pbsdf__th_pdf(b, wo, wi);
     if (b->type >= PBSDF_THIN_DIELECTRIC) return pbsdf__ext_pdf(b, wo, wi);
     if (b->type == PBSDF_DIELECTRIC) return pbsdf__dielectric_pdf(b, wo, wi);
     if (b->type == PBSDF_METALLIC_ROUGHNESS) return pbsdf__mr_pdf(b, wo, wi);
@@ -1457,6 +1625,11 @@ static inline PK_HD bool pbsdf_sample(const pbsdf *b, vec3 wo, const float u[3],
         *is_delta = false;
         *weight = v3s(0.0f); /* (gcc cannot see that a true return sets it) */
         return pbsdf__pr_sample(b, wo, u, wi, weight, pdf);
+    }
+    if (b->type == PBSDF_PRINCIPLED_THIN) {
+        *is_delta = false;
+        *weight = v3s(0.0f);
+        return pbsdf__th_sample(b, wo, u, wi, weight, pdf);
     }
     if (b->type >= PBSDF_THIN_DIELECTRIC) return pbsdf__ext_sample(b, wo, u, wi, weight, pdf, is_delta);
     *is_delta = false;

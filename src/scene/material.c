@@ -135,6 +135,9 @@ void material_principled(material *m, vec3 base_color, float metallic, float rou
     m->transmission = m->clearcoat = m->clearcoat_roughness = 0.0f;
     m->anisotropic = m->spec_tint = m->sheen = m->sheen_tint = m->flatness = m->clearcoat_gloss = 0.0f;
     m->srate_spec = m->srate_cc = m->srate_diff = 1.0f;
+    m->thin = false;
+    m->diff_trans = 0.0f;
+    m->srate_st = m->srate_dt = 1.0f;
     m->ni = 2.0f / (1.0f - sqrtf(0.08f * 0.5f)) - 1.0f; /* Mitsuba's specular 0.5 */
     material_principled_update(m);
 }

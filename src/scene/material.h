@@ -115,6 +115,12 @@ typedef struct material {
      * map_kd multiplies the base colour and map_alpha the roughness. */
     float anisotropic, ax, ay, spec_tint, sheen, sheen_tint, flatness, clearcoat_gloss;
     float srate_spec, srate_cc, srate_diff;
+    /* thin: Mitsuba's principledthin instead (a two-sided sheet of index ni,
+     * no metallic or clearcoat; srate_spec is its specular reflection's
+     * rate) with diff_trans in [0, 1] (Mitsuba's 0 ... 2 halved) and the
+     * sampling rates of its specular and diffuse transmission */
+    bool thin;
+    float diff_trans, srate_st, srate_dt;
     /* Texture maps (docs/materials.md), kind TEX_NONE when absent. A map's
      * value multiplies its constant: map_kd kd, map_ks ks, map_ns ns,
      * map_alpha alpha; map_mr is glTF's metallic-roughness texture (data,
