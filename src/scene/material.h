@@ -209,11 +209,13 @@ PK_HIDDEN void material_principled(material *m, vec3 base_color, float metallic,
 PK_HIDDEN void material_principled_update(material *m);
 
 /* The diffuse reflectance that the MTL model and the Whitted integrator use:
- * kd, but for metallic-roughness the base colour's diffuse share
- * kd (1 - metallic) (1 - transmission). */
+ * kd, but for metallic-roughness and principled the base colour's diffuse
+ * share kd (1 - metallic) (1 - transmission) (principledthin: also
+ * (1 - diff_trans)). */
 static inline PK_HD vec3 material_whitted_kd(const material *m)
 {
-    if (m->type == MAT_PRINCIPLED) return v3_scale(m->kd, (1.0f - m->metallic) * (1.0f - m->transmission));
+    if (m->type == MAT_PRINCIPLED) /* principledthin: less its diffuse transmission */
+        return v3_scale(m->kd, (1.0f - m->metallic) * (1.0f - m->transmission) * (1.0f - m->diff_trans));
     if (m->type != MAT_METALLIC_ROUGHNESS) return m->kd;
     return v3_scale(m->kd, (1.0f - m->metallic) * (1.0f - m->transmission));
 }
