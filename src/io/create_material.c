@@ -10,6 +10,7 @@
  */
 #include "create_material.h"
 
+#include <math.h>
 #include <string.h>
 
 typedef enum mat_dialect { MD_PAPRSEK } mat_dialect;
@@ -160,6 +161,55 @@ static pk_status create_metallic_roughness(pdict *d, const mat_row *row, const m
     m->ni = c->ior;
     m->clearcoat = clearcoat;
     m->clearcoat_roughness = clearcoat_roughness;
+    return PK_OK;
+}
+
+/* Mitsuba 3's principled BSDF (Mitsuba's parameter names; "eta", the
+ * index, or Mitsuba's "specular" that maps to it) */
+static pk_status create_principled(pdict *d, const mat_row *row, const mat_common *c, material *m)
+{
+    static const char *const names[] = {"metallic",   "spec_trans", "anisotropic", "spec_tint",      "sheen",
+                                        "sheen_tint", "flatness",   "clearcoat",   "clearcoat_gloss"};
+    static const char *const rates[] = {"main_specular_sampling_rate", "clearcoat_sampling_rate",
+                                        "diffuse_reflectance_sampling_rate"};
+    float v[9] = {0}, rate[3] = {1.0f, 1.0f, 1.0f};
+    pk_status st;
+    const pd_entry *e;
+    vec3 base = v3s(0.5f);
+    bool loaded;
+    if (is_obj(e = param(d, row, "base_color"))) {
+        if ((st = pd_texture(d, e, true, &m->map_kd, &loaded))) return st;
+        base = loaded ? v3s(1.0f) : v3s(0.5f);
+    } else if ((st = pd_vec3(d, "base_color", base, PD_V_REFLECTANCE, &base))) {
+        return st;
+    }
+    float roughness = param(d, row, "roughness") ? c->roughness : 0.5f;
+    if (c->tex_alpha >= 0.0f) roughness = c->tex_alpha > 0.0f ? 1.0f : 0.5f;
+    for (int k = 0; k < 9; k++) {
+        if (is_obj(e = param(d, row, names[k]))) return pd_fail(d, e, -1, PK_ERR_PARSE, "must be a number in 0..1");
+        if ((st = pd_float(d, names[k], 0.0f, PD_UNIT, &v[k]))) return st;
+    }
+    for (int k = 0; k < 3; k++)
+        if ((st = pd_float(d, rates[k], 1.0f, PD_NONNEG, &rate[k]))) return st;
+    const pd_entry *ee = param(d, row, "eta"), *se = param(d, row, "specular");
+    if (ee && se) return pd_fail(d, se, -1, PK_ERR_PARSE, "give \"eta\" or \"specular\", not both");
+    float eta = 0.0f, specular = 0.5f;
+    if (ee) {
+        if ((st = pd_float(d, "eta", 1.5f, PD_POSITIVE, &eta))) return st;
+        if (v[1] > 0.0f && eta == 1.0f) eta = 1.001f; /* as Mitsuba: an index of 1 cannot refract */
+    } else {
+        if ((st = pd_float(d, "specular", 0.5f, PD_NONNEG, &specular))) return st;
+        if (!(specular < 12.5f)) return pd_fail(d, se, -1, PK_ERR_PARSE, "must be below 12.5");
+        if (v[1] > 0.0f && specular == 0.0f) specular = 1e-3f;
+        eta = 2.0f / (1.0f - sqrtf(0.08f * specular)) - 1.0f;
+    }
+    material_principled(m, base, v[0], roughness);
+    m->transmission = v[1], m->anisotropic = v[2], m->spec_tint = v[3], m->sheen = v[4], m->sheen_tint = v[5];
+    m->flatness = v[6], m->clearcoat = v[7], m->clearcoat_gloss = v[8];
+    m->srate_spec = rate[0], m->srate_cc = rate[1], m->srate_diff = rate[2];
+    m->ni = eta;
+    m->map_alpha.squared = false; /* the map multiplies the roughness */
+    material_principled_update(m);
     return PK_OK;
 }
 
@@ -374,6 +424,11 @@ static const mat_row mat_rows[] = {
      {"albedo", "ior", "roughness", "alpha", "eta", "k", "specular", "base_roughness", "base_alpha", "thickness",
       "layer_albedo", "g", "maxdepth", "nsamples"},
      create_coated},
+    {MD_PAPRSEK, "principled",
+     {"base_color", "roughness", "metallic", "spec_trans", "anisotropic", "spec_tint", "sheen", "sheen_tint",
+      "flatness", "clearcoat", "clearcoat_gloss", "eta", "specular", "main_specular_sampling_rate",
+      "clearcoat_sampling_rate", "diffuse_reflectance_sampling_rate"},
+     create_principled},
 };
 #define N_MAT_ROWS (sizeof mat_rows / sizeof mat_rows[0])
 
@@ -485,7 +540,7 @@ static pk_status create_typed(pdict *d, const pd_entry *type_entry, material *m)
         return pd_fail(d, type_entry, -1, PK_ERR_PARSE,
                        "must be one of \"diffuse\", \"conductor\", \"dielectric\", \"plastic\", "
                        "\"metallic_roughness\", \"emitter\", \"two_sided\", \"interface\", \"thin_dielectric\", "
-                       "\"diffuse_transmission\", \"mix\", \"rough_diffuse\", \"phong\", \"coated\"");
+                       "\"diffuse_transmission\", \"mix\", \"rough_diffuse\", \"phong\", \"coated\", \"principled\"");
     const mat_row *row = &mat_rows[t];
     /* the known keys: "type", "two_sided", the maps, the type's parameters
      * and the media (read by the caller) */

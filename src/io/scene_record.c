@@ -27,6 +27,14 @@ const rec_field rec_material[] = {
     {"coat_g", REC_FLOAT, offsetof(material, layer.g)},
     {"coat_maxdepth", REC_INT, offsetof(material, layer.maxdepth)},
     {"coat_nsamples", REC_INT, offsetof(material, layer.nsamples)},
+    F(material, anisotropic, REC_FLOAT), F(material, ax, REC_FLOAT),
+    F(material, ay, REC_FLOAT),         F(material, spec_tint, REC_FLOAT),
+    F(material, sheen, REC_FLOAT),      F(material, sheen_tint, REC_FLOAT),
+    F(material, flatness, REC_FLOAT),   F(material, clearcoat_gloss, REC_FLOAT),
+    F(material, srate_spec, REC_FLOAT), F(material, srate_cc, REC_FLOAT),
+    F(material, srate_diff, REC_FLOAT), F(material, thin, REC_BOOL),
+    F(material, diff_trans, REC_FLOAT), F(material, srate_st, REC_FLOAT),
+    F(material, srate_dt, REC_FLOAT),
 };
 const size_t rec_nmaterial = sizeof rec_material / sizeof rec_material[0];
 

@@ -1679,23 +1679,122 @@ static pk_status bsdf_plastic(xp *p, const bsdf_in *in, material *m)
     return PK_OK;
 }
 
-/* Disney's model by its main parameters: a metal (Schlick, F0 = base_color)
- * when metallic > 0.5, else a plastic of base_color; the rest is read
- * without a warning */
+/* Mitsuba 3's principled BSDF with all its parameters (MAT_PRINCIPLED):
+ * base_color and roughness may be textures (map_kd, map_alpha), the other
+ * parameters are constants (a texture stands in as one, with a warning).
+ * eta and specular are two ways to give the index (eta = 2 / (1 - sqrt(0.08
+ * specular)) - 1); Mitsuba refuses both at once, here eta wins. */
 static pk_status bsdf_principled(xp *p, const bsdf_in *in, material *m)
 {
+    static const char *const names[] = {"metallic",  "spec_trans", "anisotropic", "spec_tint",      "sheen",
+                                        "sheen_tint", "flatness",   "clearcoat",   "clearcoat_gloss"};
+    float v[9] = {0};
     vec3 base = v3s(0.5f);
-    float metallic = 0.0f, roughness = 0.5f, eta = 1.5f;
+    float roughness = 0.5f, eta = 1.5f, specular = 0.5f;
+    float rate[3] = {1.0f, 1.0f, 1.0f};
+    static const char *const rates[] = {"main_specular_sampling_rate", "clearcoat_sampling_rate",
+                                        "diffuse_reflectance_sampling_rate"};
+    material_principled(m, base, 0.0f, roughness);
     pk_status st;
-    if ((st = get_color(p, in->d, "base_color", &base)) || (st = get_scalar(p, in->d, "metallic", &metallic)) ||
-        (st = get_scalar(p, in->d, "roughness", &roughness)) || (st = get_float(p, in->d, "eta", &eta)))
-        return st;
-    if (first_time(p, "principled"))
-        xwarn(p, in->b, "principled is approximated by a %s of its base_color and roughness",
-              metallic > 0.5f ? "metal" : "plastic");
-    const float alpha = clamp01(roughness) * clamp01(roughness);
-    if (metallic > 0.5f) material_conductor_f0(m, clamp01v(base), alpha);
-    else material_plastic(m, clamp01v(base), eta > 1.0f ? eta : 1.5f, alpha);
+    if ((st = get_color_tex(p, in->d, "base_color", &base, &m->map_kd))) return st;
+    p->want_tex = &m->map_alpha;
+    st = get_scalar(p, in->d, "roughness", &roughness);
+    p->want_tex = NULL;
+    if (st) return st;
+    for (int k = 0; k < 9; k++)
+        if ((st = get_scalar(p, in->d, names[k], &v[k]))) return st;
+    for (int k = 0; k < 3; k++) {
+        if ((st = get_float(p, in->d, rates[k], &rate[k]))) return st;
+        if (!(rate[k] >= 0.0f)) {
+            xwarn(p, in->b, "%s must be >= 0, not %g; using 1", rates[k], (double)rate[k]);
+            rate[k] = 1.0f;
+        }
+    }
+    const bool has_eta = pd_has(in->d, "eta"), has_spec = pd_has(in->d, "specular");
+    if ((st = get_float(p, in->d, "eta", &eta)) || (st = get_float(p, in->d, "specular", &specular))) return st;
+    const bool has_trans = pd_has(in->d, "spec_trans") && v[1] != 0.0f;
+    if (has_eta && has_spec) xwarn(p, in->b, "principled takes eta or specular, not both; using eta %g", (double)eta);
+    if (has_eta) {
+        if (!(eta > 0.0f)) {
+            xwarn(p, in->b, "eta must be > 0, not %g; using 1.5", (double)eta);
+            eta = 1.5f;
+        }
+        if (has_trans && eta == 1.0f) eta = 1.001f; /* as Mitsuba: an index of 1 cannot refract */
+    } else {
+        if (!(specular >= 0.0f && specular < 12.5f)) {
+            xwarn(p, in->b, "specular must be in [0, 12.5), not %g; using 0.5", (double)specular);
+            specular = 0.5f;
+        }
+        if (has_trans && specular == 0.0f) specular = 1e-3f;
+        eta = 2.0f / (1.0f - sqrtf(0.08f * specular)) - 1.0f;
+    }
+    for (int k = 0; k < 9; k++)
+        if (!(v[k] >= 0.0f && v[k] <= 1.0f)) {
+            xwarn(p, in->b, "%s must be in [0, 1], not %g; clamped", names[k], (double)v[k]);
+            v[k] = clamp01(v[k]);
+        }
+    m->kd = clamp01v(base);
+    m->roughness = clamp01(roughness);
+    m->metallic = v[0], m->transmission = v[1], m->anisotropic = v[2], m->spec_tint = v[3];
+    m->sheen = v[4], m->sheen_tint = v[5], m->flatness = v[6], m->clearcoat = v[7], m->clearcoat_gloss = v[8];
+    m->srate_spec = rate[0], m->srate_cc = rate[1], m->srate_diff = rate[2];
+    m->ni = eta;
+    material_principled_update(m);
+    return PK_OK;
+}
+
+/* Mitsuba 3's principledthin (MAT_PRINCIPLED with thin): a two-sided sheet
+ * with base_color and roughness (textures allowed, as principled's),
+ * anisotropic, spec_trans, spec_tint, sheen, sheen_tint, flatness (0 ... 1),
+ * diff_trans (0 ... 2, halved as Mitsuba does), eta (1.5) and the four
+ * sampling rates. */
+static pk_status bsdf_principled_thin(xp *p, const bsdf_in *in, material *m)
+{
+    static const char *const names[] = {"spec_trans", "anisotropic", "spec_tint", "sheen", "sheen_tint", "flatness"};
+    static const char *const rates[] = {"specular_reflectance_sampling_rate", "specular_transmittance_sampling_rate",
+                                        "diffuse_reflectance_sampling_rate", "diffuse_transmittance_sampling_rate"};
+    float v[6] = {0}, rate[4] = {1.0f, 1.0f, 1.0f, 1.0f};
+    vec3 base = v3s(0.5f);
+    float roughness = 0.5f, eta = 1.5f, diff_trans = 0.0f;
+    material_principled(m, base, 0.0f, roughness);
+    pk_status st;
+    if ((st = get_color_tex(p, in->d, "base_color", &base, &m->map_kd))) return st;
+    p->want_tex = &m->map_alpha;
+    st = get_scalar(p, in->d, "roughness", &roughness);
+    p->want_tex = NULL;
+    if (st) return st;
+    for (int k = 0; k < 6; k++)
+        if ((st = get_scalar(p, in->d, names[k], &v[k]))) return st;
+    if ((st = get_scalar(p, in->d, "diff_trans", &diff_trans)) || (st = get_float(p, in->d, "eta", &eta))) return st;
+    for (int k = 0; k < 4; k++) {
+        if ((st = get_float(p, in->d, rates[k], &rate[k]))) return st;
+        if (!(rate[k] >= 0.0f)) {
+            xwarn(p, in->b, "%s must be >= 0, not %g; using 1", rates[k], (double)rate[k]);
+            rate[k] = 1.0f;
+        }
+    }
+    for (int k = 0; k < 6; k++)
+        if (!(v[k] >= 0.0f && v[k] <= 1.0f)) {
+            xwarn(p, in->b, "%s must be in [0, 1], not %g; clamped", names[k], (double)v[k]);
+            v[k] = clamp01(v[k]);
+        }
+    if (!(diff_trans >= 0.0f && diff_trans <= 2.0f)) {
+        xwarn(p, in->b, "diff_trans must be in [0, 2], not %g; clamped", (double)diff_trans);
+        diff_trans = diff_trans > 2.0f ? 2.0f : 0.0f;
+    }
+    if (!(eta > 0.0f)) {
+        xwarn(p, in->b, "eta must be > 0, not %g; using 1.5", (double)eta);
+        eta = 1.5f;
+    }
+    m->kd = clamp01v(base);
+    m->roughness = clamp01(roughness);
+    m->thin = true;
+    m->transmission = v[0], m->anisotropic = v[1], m->spec_tint = v[2];
+    m->sheen = v[3], m->sheen_tint = v[4], m->flatness = v[5];
+    m->diff_trans = 0.5f * diff_trans;
+    m->srate_spec = rate[0], m->srate_st = rate[1], m->srate_diff = rate[2], m->srate_dt = rate[3];
+    m->ni = eta;
+    material_principled_update(m);
     return PK_OK;
 }
 
@@ -1736,8 +1835,8 @@ static const bsdf_row bsdf_rows[] = {
     {"thindielectric", bsdf_dielectric, false, 1.5046f, ""},
     {"plastic", bsdf_plastic, false, 1.49f, ""},
     {"roughplastic", bsdf_plastic, true, 1.49f, ""},
-    {"principled", bsdf_principled, false, 0.0f, NULL},
-    {"principledthin", bsdf_principled, false, 0.0f, NULL},
+    {"principled", bsdf_principled, false, 0.0f, ""},
+    {"principledthin", bsdf_principled_thin, false, 0.0f, ""},
     {"null", NULL, false, 0.0f, ""}, /* no surface: light passes straight through; it may bound media */
 };
 

@@ -59,6 +59,8 @@ typedef enum pbsdf_type {
     PBSDF_COATED,             /* pbrt-v4's layered BSDF: a dielectric coat (ior, alpha) over a Lambertian
                                  (albedo) or conductor (PBSDF_COATED_METAL: eta, k, base_alpha) base, a slab
                                  (thickness, medium, g) between them, maxdepth, nsamples, seed */
+    PBSDF_PRINCIPLED,         /* Mitsuba 3's principled: base colour (albedo), metallic, ... (pbsdf_principled) */
+    PBSDF_PRINCIPLED_THIN,    /* Mitsuba 3's principledthin: a thin sheet (pbsdf_principled_thin) */
     PBSDF_TYPE_COUNT
 } pbsdf_type;
 
@@ -133,6 +135,15 @@ typedef struct pbsdf {
     float thickness, g, base_alpha;
     int maxdepth, nsamples;
     unsigned seed;
+    /* principled (pbsdf_principled): the perceptual roughness (the diffuse
+     * lobe's), spec_tint, sheen, sheen_tint, flatness in [0, 1], and the
+     * sampling rates of the main specular, clearcoat and diffuse lobes */
+    float roughness, pr_spec_tint, pr_sheen, pr_sheen_tint, pr_flatness;
+    float pr_srate_spec, pr_srate_cc, pr_srate_diff;
+    /* principledthin: diff_trans in [0, 1] (Mitsuba's / 2), the GGX alphas
+     * of the transmission lobe (of the roughness scaled by 0.65 eta - 0.35)
+     * and the sampling rates of the specular and diffuse transmission */
+    float pr_diff_trans, pr_tax, pr_tay, pr_srate_st, pr_srate_dt;
 } pbsdf;
 
 /* ---- constructors ------------------------------------------------------- */
@@ -157,6 +168,10 @@ static inline PK_HD pbsdf pbsdf__blank(int type)
     b.thickness = 0.01f, b.g = 0.0f, b.base_alpha = 0.0f;
     b.maxdepth = 10, b.nsamples = 1;
     b.seed = 0u;
+    b.roughness = b.pr_spec_tint = b.pr_sheen = b.pr_sheen_tint = b.pr_flatness = 0.0f;
+    b.pr_srate_spec = b.pr_srate_cc = b.pr_srate_diff = 1.0f;
+    b.pr_diff_trans = b.pr_tax = b.pr_tay = 0.0f;
+    b.pr_srate_st = b.pr_srate_dt = 1.0f;
     return b;
 }
 static inline PK_HD pbsdf pbsdf_diffuse(vec3 albedo)
@@ -1565,6 +1580,403 @@ static inline PK_HD bool pbsdf__coated_sample(const pbsdf *b, vec3 wo, const flo
     return false;
 }
 
+/* ---- Mitsuba 3's principled BSDF ------------------------------------------- */
+
+/* Mitsuba 3's "principled" (its reading of Burley's Disney BSDF, 2012/2015),
+ * lobe by lobe as Mitsuba defines it (docs/materials.md): a Disney diffuse
+ * with retro-reflection and the flatness blend, sheen, a GGX specular lobe
+ * (anisotropic: PBSDF_ANISO, alpha along x, alpha_v along y) whose Fresnel blends the dielectric's, a metal's (Schlick,
+ * F0 = base colour) and a tinted Schlick one, a rough dielectric
+ * transmission tinted by sqrt(base colour), and a GTR1 clearcoat. Fields:
+ * albedo = base colour, metallic, transmission = spec_trans, ior = eta,
+ * alpha (, alpha_v) = GGX alphas, roughness (the diffuse's), coat = clearcoat, coat_alpha
+ * = the GTR1 alpha, and pr_* below. wo.z < 0 is the inside (the frame is the
+ * outward normal as for the dielectric); there only the specular reflection
+ * and transmission scatter, as in Mitsuba. */
+static inline PK_HD pbsdf pbsdf_principled(vec3 base_color, float metallic, float roughness, float ax, float ay,
+                                           float spec_trans, float eta)
+{
+    pbsdf b = pbsdf__blank(PBSDF_PRINCIPLED);
+    b.albedo = base_color;
+    b.metallic = metallic;
+    b.roughness = roughness;
+    b.alpha = ax; /* GGX along the local x axis (dp/du) and, where they differ, alpha_v = ay along y */
+    if (ay != ax) {
+        b.alpha_v = ay;
+        b.flags |= PBSDF_ANISO;
+    }
+    b.transmission = spec_trans;
+    b.ior = eta;
+    return b;
+}
+
+static inline PK_HD float pbsdf__pr_lum(vec3 c) { return 0.212671f * c.x + 0.715160f * c.y + 0.072169f * c.z; }
+/* Schlick's Fresnel as Mitsuba's principled has it: the cosine on the
+ * optically thinner side (cos_i's own side when light enters the denser). */
+static inline PK_HD float pbsdf__pr_schlick_w(float cos_i, float eta)
+{
+    const float eta_it = cos_i >= 0.0f ? eta : 1.0f / eta;
+    if (eta_it > 1.0f) return pbsdf__schlick_w(fabsf(cos_i));
+    const float ct2 = 1.0f - (1.0f - cos_i * cos_i) / (eta_it * eta_it);
+    return pbsdf__schlick_w(sqrtf(fmaxf(0.0f, ct2)));
+}
+static inline PK_HD vec3 pbsdf__pr_schlick(vec3 r0, float w)
+{
+    return v3(r0.x + (1.0f - r0.x) * w, r0.y + (1.0f - r0.y) * w, r0.z + (1.0f - r0.z) * w);
+}
+/* GTR1 (Berry) of alpha a: D(m) and the sampling of m by D(m) m.z */
+static inline PK_HD float pbsdf__gtr1_d(float a, vec3 m)
+{
+    const float a2 = a * a;
+    const float d = (a2 - 1.0f) / (PK_PI * logf(a2) * (1.0f + (a2 - 1.0f) * m.z * m.z));
+    return d * m.z > 1e-20f ? d : 0.0f;
+}
+static inline PK_HD vec3 pbsdf__gtr1_sample(float a, float u1, float u2)
+{
+    const float a2 = a * a, phi = 2.0f * PK_PI * u1;
+    const float c2 = (1.0f - powf(a2, 1.0f - u2)) / (1.0f - a2);
+    const float s = sqrtf(fmaxf(0.0f, 1.0f - c2)), c = sqrtf(fmaxf(0.0f, c2));
+    return v3(cosf(phi) * s, sinf(phi) * s, c);
+}
+/* Smith's G1 of GGX with alpha a, 0 for a microfacet m seen from behind
+ * (the clearcoat's), and the same of the main lobe (anisotropic or not) */
+static inline PK_HD float pbsdf__pr_g1(float a, vec3 v, vec3 m)
+{
+    if (v3_dot(v, m) * v.z <= 0.0f) return 0.0f;
+    return v.z == 1.0f ? 1.0f : pbsdf_ggx_g1(a, v);
+}
+static inline PK_HD float pbsdf__pr_g1m(const pbsdf *b, vec3 v, vec3 m)
+{
+    if (v3_dot(v, m) * v.z <= 0.0f) return 0.0f;
+    return v.z == 1.0f ? 1.0f : 1.0f / (1.0f + pbsdf_mf_lambda(b, v));
+}
+/* The half vector of wo, wi (+z side), the relative index along the path,
+ * whether it reflects, and the macro/micro compatibility of the pair. */
+typedef struct pbsdf__pr_geo {
+    vec3 h;
+    float eta_path, f;
+    bool reflect, refl_ok, refr_ok;
+} pbsdf__pr_geo;
+static inline PK_HD pbsdf__pr_geo pbsdf__pr_geometry(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    pbsdf__pr_geo g;
+    g.reflect = wo.z * wi.z > 0.0f;
+    g.eta_path = wo.z > 0.0f ? b->ior : 1.0f / b->ior;
+    vec3 h = v3_add(wo, v3_scale(wi, g.reflect ? 1.0f : g.eta_path));
+    const float l2 = v3_len2(h);
+    h = l2 > 0.0f ? v3_scale(h, 1.0f / sqrtf(l2)) : v3(0.0f, 0.0f, 1.0f);
+    if (h.z < 0.0f) h = v3_neg(h);
+    g.h = h;
+    const vec3 hs = wo.z > 0.0f ? h : v3_neg(h);
+    g.refl_ok = v3_dot(wo, hs) > 0.0f && v3_dot(wi, hs) > 0.0f;
+    g.refr_ok = v3_dot(wo, hs) > 0.0f && v3_dot(wi, hs) < 0.0f;
+    g.f = pbsdf_fresnel_dielectric(v3_dot(wo, h), b->ior);
+    return g;
+}
+/* The probabilities of the lobes (diffuse, clearcoat, transmission,
+ * reflection) for a dielectric Fresnel f, Mitsuba's sampling rates included. */
+static inline PK_HD void pbsdf__pr_probs(const pbsdf *b, bool front, float f, float p[4])
+{
+    const float brdf = (1.0f - b->metallic) * (1.0f - b->transmission);
+    const float bsdf = (1.0f - b->metallic) * b->transmission;
+    if (front) {
+        p[0] = brdf * b->pr_srate_diff;
+        p[1] = 0.25f * b->coat * b->pr_srate_cc;
+        p[2] = b->pr_srate_spec * bsdf * (1.0f - f);
+        p[3] = b->pr_srate_spec * (1.0f - bsdf * (1.0f - f));
+    } else {
+        p[0] = p[1] = 0.0f;
+        p[2] = bsdf > 0.0f ? 1.0f - f : 0.0f;
+        p[3] = f;
+    }
+    const float t = p[0] + p[1] + p[2] + p[3];
+    const float r = t > 0.0f ? 1.0f / t : 0.0f;
+    for (int k = 0; k < 4; k++) p[k] *= r;
+}
+
+static inline PK_HD vec3 pbsdf__pr_eval(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    vec3 v = v3s(0.0f);
+    if (wo.z == 0.0f || wi.z == 0.0f) return v;
+    const float brdf = (1.0f - b->metallic) * (1.0f - b->transmission);
+    const float bsdf = (1.0f - b->metallic) * b->transmission;
+    const bool front = wo.z > 0.0f;
+    const pbsdf__pr_geo g = pbsdf__pr_geometry(b, wo, wi);
+    const vec3 h = g.h, base = b->albedo;
+    const float d = pbsdf_mf_d(b, h);
+    const float gg = pbsdf__pr_g1m(b, wo, h) * pbsdf__pr_g1m(b, wi, h);
+    const float oh = v3_dot(wo, h), ih = v3_dot(wi, h);
+    if (g.reflect && g.refl_ok && g.f > 0.0f) {
+        vec3 fr;
+        if (front) {
+            const float lum = pbsdf__pr_lum(base), eta_it = oh >= 0.0f ? b->ior : 1.0f / b->ior;
+            const vec3 ctint = lum > 0.0f ? v3_scale(base, 1.0f / lum) : v3s(1.0f);
+            const float r0 = (eta_it - 1.0f) / (eta_it + 1.0f), w = pbsdf__pr_schlick_w(oh, b->ior);
+            fr = v3s((1.0f - b->metallic) * (1.0f - b->pr_spec_tint) * g.f);
+            fr = v3_add(fr, v3_scale(pbsdf__pr_schlick(base, w), b->metallic));
+            fr = v3_add(fr, v3_scale(pbsdf__pr_schlick(v3_scale(ctint, r0 * r0), w),
+                                     (1.0f - b->metallic) * b->pr_spec_tint));
+        } else {
+            fr = v3s(bsdf * g.f);
+        }
+        v = v3_add(v, v3_scale(fr, d * gg / (4.0f * fabsf(wo.z))));
+    }
+    if (!g.reflect && g.refr_ok && bsdf > 0.0f && g.f < 1.0f) {
+        /* no 1/eta^2 radiance compression (the file's convention) */
+        const float den = oh + g.eta_path * ih;
+        const float t = bsdf * fabsf((1.0f - g.f) * d * gg * g.eta_path * g.eta_path * oh * ih / (wo.z * den * den));
+        v = v3_add(v, v3_scale(v3(sqrtf(base.x), sqrtf(base.y), sqrtf(base.z)), t));
+    }
+    if (!front || !g.reflect) return v;
+    if (b->coat > 0.0f && g.refl_ok) {
+        /* Mitsuba's clearcoat: 0.25 clearcoat F D G (Schlick F0 0.04, GTR1, Smith G of GGX 0.25) */
+        const float fcc = 0.04f + 0.96f * pbsdf__pr_schlick_w(oh, b->ior);
+        const float gcc = pbsdf__pr_g1(0.25f, wo, h) * pbsdf__pr_g1(0.25f, wi, h);
+        v = v3_add(v, v3s(0.25f * b->coat * fcc * pbsdf__gtr1_d(b->coat_alpha, h) * gcc * fabsf(wi.z)));
+    }
+    if (brdf > 0.0f) {
+        const float fo = pbsdf__schlick_w(fabsf(wi.z)), fi = pbsdf__schlick_w(fabsf(wo.z));
+        const float f_diff = (1.0f - 0.5f * fi) * (1.0f - 0.5f * fo);
+        const float cd = v3_dot(h, wi), rr = 2.0f * b->roughness * cd * cd;
+        const float f_retro = rr * (fo + fi + fo * fi * (rr - 1.0f));
+        float f = f_diff + f_retro;
+        if (b->pr_flatness != 0.0f) {
+            const float fss90 = 0.5f * rr;
+            const float fss = (1.0f + (fss90 - 1.0f) * fo) * (1.0f + (fss90 - 1.0f) * fi);
+            const float f_ss = 1.25f * (fss * (1.0f / (fabsf(wi.z) + fabsf(wo.z)) - 0.5f) + 0.5f);
+            f += (f_ss - f) * b->pr_flatness;
+        }
+        v = v3_add(v, v3_scale(base, brdf * fabsf(wi.z) * f / PK_PI));
+        if (b->pr_sheen > 0.0f && b->metallic < 1.0f) {
+            const float lum = pbsdf__pr_lum(base);
+            const vec3 ctint = lum > 0.0f ? v3_scale(base, 1.0f / lum) : v3s(1.0f);
+            const vec3 cs = v3_add(v3s(1.0f - b->pr_sheen_tint), v3_scale(ctint, b->pr_sheen_tint));
+            v = v3_add(v, v3_scale(cs, b->pr_sheen * (1.0f - b->metallic) * pbsdf__schlick_w(fabsf(cd)) * fabsf(wi.z)));
+        }
+    }
+    return v;
+}
+
+static inline PK_HD float pbsdf__pr_pdf(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    if (wo.z == 0.0f || wi.z == 0.0f) return 0.0f;
+    const bool front = wo.z > 0.0f;
+    const pbsdf__pr_geo g = pbsdf__pr_geometry(b, wo, wi);
+    float p[4];
+    pbsdf__pr_probs(b, front, g.f, p);
+    const float oh = v3_dot(wo, g.h), ih = v3_dot(wi, g.h);
+    float jac;
+    if (g.reflect) {
+        jac = fabsf(1.0f / (4.0f * ih));
+    } else {
+        const float den = oh + g.eta_path * ih;
+        jac = fabsf(g.eta_path * g.eta_path * ih / (den * den));
+    }
+    if (!isfinite(jac)) return 0.0f;
+    const float vn = pbsdf_mf_pdf(b, wo, g.h);
+    float pdf = 0.0f;
+    if (g.reflect) {
+        if (g.refl_ok) {
+            pdf += p[3] * vn * jac;
+            if (p[1] > 0.0f) pdf += p[1] * pbsdf__gtr1_d(b->coat_alpha, g.h) * g.h.z * jac;
+        }
+        pdf += p[0] * fmaxf(0.0f, wi.z) / PK_PI;
+    } else if (g.refr_ok) {
+        pdf += p[2] * vn * jac;
+    }
+    return pdf;
+}
+
+static inline PK_HD bool pbsdf__pr_sample(const pbsdf *b, vec3 wo, const float u[3], vec3 *wi, vec3 *weight,
+                                          float *pdf)
+{
+    if (wo.z == 0.0f) return false;
+    const bool front = wo.z > 0.0f;
+    if (!front && !((1.0f - b->metallic) * b->transmission > 0.0f)) return false;
+    const vec3 m = pbsdf_mf_sample(b, wo, u[1], u[2]);
+    float p[4];
+    pbsdf__pr_probs(b, front, pbsdf_fresnel_dielectric(v3_dot(wo, m), b->ior), p);
+    vec3 w;
+    if (u[0] < p[0]) {
+        w = pbsdf__cosine_dir(u[1], u[2]);
+    } else if (u[0] < p[0] + p[1]) {
+        const vec3 mc = pbsdf__gtr1_sample(b->coat_alpha, u[1], u[2]);
+        w = v3_sub(v3_scale(mc, 2.0f * v3_dot(wo, mc)), wo);
+        if (!(w.z * wo.z > 0.0f)) return false; /* through the surface: lost (the pdf would read a transmission) */
+    } else if (u[0] < p[0] + p[1] + p[2]) {
+        if (!pbsdf__refract(wo, m, b->ior, &w)) return false;
+        if (!(w.z * wo.z < 0.0f)) return false;
+    } else {
+        w = v3_sub(v3_scale(m, 2.0f * v3_dot(wo, m)), wo);
+        if (!(w.z * wo.z > 0.0f)) return false; /* as the clearcoat's */
+    }
+    const float pd = pbsdf__pr_pdf(b, wo, w);
+    if (!(pd > 0.0f)) return false;
+    *wi = w;
+    *pdf = pd;
+    *weight = v3_scale(pbsdf__pr_eval(b, wo, w), 1.0f / pd);
+    return true;
+}
+
+/* ---- Mitsuba 3's principledthin ------------------------------------------- */
+
+/* Mitsuba 3's "principledthin": a thin sheet, the same from both sides (wo
+ * and wi are mirrored so that wo.z > 0). Lobes: the specular reflection
+ * spec_trans F_thin D G / (4 cos_o) (GGX alpha, alpha_v as principled's;
+ * F_thin = lerp(F, the tinted Schlick, spec_tint), F the dielectric Fresnel
+ * of eta), the specular transmission spec_trans base (1 - F) D_t G_t /
+ * (4 cos_o) about the mirror image of the reflection (alphas pr_tax,
+ * pr_tay), the principled diffuse (with flatness) and sheen scaled by
+ * (1 - spec_trans)(1 - diff_trans), and a Lambertian transmission
+ * (1 - spec_trans) diff_trans base / pi. Fields as pbsdf_principled's with
+ * transmission = spec_trans, ior = eta, pr_diff_trans, pr_tax, pr_tay and
+ * the rates pr_srate_spec (specular reflection), pr_srate_st, pr_srate_diff,
+ * pr_srate_dt. */
+static inline PK_HD pbsdf pbsdf_principled_thin(vec3 base_color, float roughness, float ax, float ay, float tax,
+                                                float tay, float spec_trans, float diff_trans, float eta)
+{
+    pbsdf b = pbsdf_principled(base_color, 0.0f, roughness, ax, ay, spec_trans, eta);
+    b.type = PBSDF_PRINCIPLED_THIN;
+    b.pr_diff_trans = diff_trans;
+    b.pr_tax = tax, b.pr_tay = tay;
+    return b;
+}
+/* the lobes' probabilities: specular reflection, specular transmission,
+ * diffuse reflection, diffuse transmission */
+static inline PK_HD void pbsdf__th_probs(const pbsdf *b, float p[4])
+{
+    const float st = b->transmission, dt = b->pr_diff_trans;
+    p[0] = st * b->pr_srate_spec * 0.5f;
+    p[1] = st * b->pr_srate_st * 0.5f;
+    p[2] = b->pr_srate_diff * (1.0f - st) * (1.0f - dt);
+    p[3] = b->pr_srate_dt * (1.0f - st) * dt;
+    const float t = p[0] + p[1] + p[2] + p[3];
+    const float r = t > 0.0f ? 1.0f / t : 0.0f;
+    for (int k = 0; k < 4; k++) p[k] *= r;
+}
+/* the transmission lobe's distribution: b with its alphas */
+static inline PK_HD pbsdf pbsdf__th_trans_lobe(const pbsdf *b)
+{
+    pbsdf t = *b;
+    t.alpha = b->pr_tax;
+    t.alpha_v = b->pr_tay;
+    if (b->pr_tax != b->pr_tay) t.flags |= PBSDF_ANISO;
+    else t.flags &= ~PBSDF_ANISO;
+    return t;
+}
+/* mirrors wo, wi so that wo.z > 0; the half vector of wo and wi's mirror
+ * image above the sheet */
+static inline PK_HD vec3 pbsdf__th_half(vec3 *wo, vec3 *wi)
+{
+    if (wo->z < 0.0f) *wo = v3_neg(*wo), *wi = v3_neg(*wi);
+    vec3 h = v3_add(*wo, v3(wi->x, wi->y, fabsf(wi->z)));
+    const float l2 = v3_len2(h);
+    return l2 > 0.0f ? v3_scale(h, 1.0f / sqrtf(l2)) : v3(0.0f, 0.0f, 1.0f);
+}
+static inline PK_HD vec3 pbsdf__th_eval(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    vec3 v = v3s(0.0f);
+    if (wo.z == 0.0f) return v;
+    const vec3 h = pbsdf__th_half(&wo, &wi);
+    const bool reflect = wi.z > 0.0f, refract = wi.z < 0.0f;
+    const float st = b->transmission, dt = b->pr_diff_trans, oh = v3_dot(wo, h), ih = v3_dot(wi, h);
+    const vec3 base = b->albedo;
+    if (st > 0.0f) {
+        const float f = pbsdf_fresnel_dielectric(oh, b->ior);
+        if (reflect && oh > 0.0f && ih > 0.0f) {
+            const float lum = pbsdf__pr_lum(base), eta_it = oh >= 0.0f ? b->ior : 1.0f / b->ior;
+            const vec3 ctint = lum > 0.0f ? v3_scale(base, 1.0f / lum) : v3s(1.0f);
+            const float r0 = (eta_it - 1.0f) / (eta_it + 1.0f);
+            const vec3 fs = pbsdf__pr_schlick(v3_scale(ctint, r0 * r0), pbsdf__pr_schlick_w(oh, b->ior));
+            const vec3 ft = v3_add(v3s((1.0f - b->pr_spec_tint) * f), v3_scale(fs, b->pr_spec_tint));
+            const float dg = pbsdf_mf_d(b, h) * pbsdf__pr_g1m(b, wo, h) * pbsdf__pr_g1m(b, wi, h);
+            v = v3_add(v, v3_scale(ft, st * dg / (4.0f * wo.z)));
+        }
+        if (refract && oh > 0.0f && ih < 0.0f) {
+            const pbsdf t = pbsdf__th_trans_lobe(b);
+            const float dg = pbsdf_mf_d(&t, h) * pbsdf__pr_g1m(&t, wo, h) * pbsdf__pr_g1m(&t, wi, h);
+            v = v3_add(v, v3_scale(base, st * (1.0f - f) * dg / (4.0f * wo.z)));
+        }
+    }
+    if (reflect && st < 1.0f && dt < 1.0f) {
+        const float fo = pbsdf__schlick_w(wi.z), fi = pbsdf__schlick_w(wo.z);
+        const float f_diff = (1.0f - 0.5f * fi) * (1.0f - 0.5f * fo);
+        const float rr = 2.0f * b->roughness * ih * ih;
+        float f = f_diff + rr * (fo + fi + fo * fi * (rr - 1.0f));
+        if (b->pr_flatness != 0.0f) {
+            const float fss90 = 0.5f * rr;
+            const float fss = (1.0f + (fss90 - 1.0f) * fo) * (1.0f + (fss90 - 1.0f) * fi);
+            const float f_ss = 1.25f * (fss * (1.0f / (wi.z + wo.z) - 0.5f) + 0.5f);
+            f += (f_ss - f) * b->pr_flatness;
+        }
+        const float w = (1.0f - st) * (1.0f - dt);
+        v = v3_add(v, v3_scale(base, w * wi.z * f / PK_PI));
+        if (b->pr_sheen > 0.0f) {
+            const float lum = pbsdf__pr_lum(base);
+            const vec3 ctint = lum > 0.0f ? v3_scale(base, 1.0f / lum) : v3s(1.0f);
+            const vec3 cs = v3_add(v3s(1.0f - b->pr_sheen_tint), v3_scale(ctint, b->pr_sheen_tint));
+            v = v3_add(v, v3_scale(cs, b->pr_sheen * w * pbsdf__schlick_w(fabsf(ih)) * wi.z));
+        }
+    }
+    if (refract && st < 1.0f && dt > 0.0f) v = v3_add(v, v3_scale(base, (1.0f - st) * dt * -wi.z / PK_PI));
+    return v;
+}
+static inline PK_HD float pbsdf__th_pdf(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    if (wo.z == 0.0f) return 0.0f;
+    const vec3 h = pbsdf__th_half(&wo, &wi);
+    float p[4];
+    pbsdf__th_probs(b, p);
+    const float oh = v3_dot(wo, h), ih = v3_dot(wi, h);
+    /* the mirror image of wi above the sheet reflects wo about h */
+    const float jac = fabsf(1.0f / (4.0f * v3_dot(v3(wi.x, wi.y, fabsf(wi.z)), h)));
+    float pdf = 0.0f;
+    if (wi.z > 0.0f) {
+        if (oh > 0.0f && ih > 0.0f && p[0] > 0.0f) pdf += p[0] * pbsdf_mf_pdf(b, wo, h) * jac;
+        pdf += p[2] * wi.z / PK_PI;
+    } else if (wi.z < 0.0f) {
+        if (oh > 0.0f && ih < 0.0f && p[1] > 0.0f) {
+            const pbsdf t = pbsdf__th_trans_lobe(b);
+            pdf += p[1] * pbsdf_mf_pdf(&t, wo, h) * jac;
+        }
+        pdf += p[3] * -wi.z / PK_PI;
+    }
+    return isfinite(pdf) ? pdf : 0.0f;
+}
+static inline PK_HD bool pbsdf__th_sample(const pbsdf *b, vec3 wo, const float u[3], vec3 *wi, vec3 *weight,
+                                          float *pdf)
+{
+    if (wo.z == 0.0f) return false;
+    const float s = wo.z < 0.0f ? -1.0f : 1.0f;
+    const vec3 v = v3_scale(wo, s);
+    float p[4];
+    pbsdf__th_probs(b, p);
+    vec3 w;
+    if (u[0] < p[0]) {
+        const vec3 m = pbsdf_mf_sample(b, v, u[1], u[2]);
+        w = v3_sub(v3_scale(m, 2.0f * v3_dot(v, m)), v);
+        if (!(w.z > 0.0f) || !(v3_dot(w, m) > 0.0f)) return false;
+    } else if (u[0] < p[0] + p[1]) {
+        const pbsdf t = pbsdf__th_trans_lobe(b);
+        const vec3 m = pbsdf_mf_sample(&t, v, u[1], u[2]);
+        w = v3_sub(v3_scale(m, 2.0f * v3_dot(v, m)), v);
+        w.z = -w.z;
+        if (!(w.z < 0.0f) || !(v3_dot(w, m) < 0.0f)) return false;
+    } else if (u[0] < p[0] + p[1] + p[2]) {
+        w = pbsdf__cosine_dir(u[1], u[2]);
+    } else {
+        w = v3_neg(pbsdf__cosine_dir(u[1], u[2]));
+    }
+    if (w.z == 0.0f) return false;
+    w = v3_scale(w, s);
+    const float pd = pbsdf__th_pdf(b, wo, w);
+    if (!(pd > 0.0f)) return false;
+    *wi = w;
+    *pdf = pd;
+    *weight = v3_scale(pbsdf__th_eval(b, wo, w), 1.0f / pd);
+    return true;
+}
+
 /* ---- the interface --------------------------------------------------------- */
 
 /* True if the BSDF has a non-delta part, i.e. light sampling and MIS can
@@ -1598,6 +2010,8 @@ static inline PK_HD bool pbsdf_has_nondelta(const pbsdf *b)
 static inline PK_HD vec3 pbsdf_eval(const pbsdf *b, vec3 wo, vec3 wi)
 {
     if (b->type == PBSDF_COATED) return pbsdf__coated_eval(b, wo, wi);
+    if (b->type == PBSDF_PRINCIPLED) return pbsdf__pr_eval(b, wo, wi);
+    if (b->type == PBSDF_PRINCIPLED_THIN) return pbsdf__th_eval(b, wo, wi);
     if (b->type >= PBSDF_THIN_DIELECTRIC) return pbsdf__ext_eval(b, wo, wi);
     if (b->type == PBSDF_DIELECTRIC) return pbsdf__dielectric_eval(b, wo, wi);
     if (b->type == PBSDF_METALLIC_ROUGHNESS) return pbsdf__mr_eval(b, wo, wi);
@@ -1643,6 +2057,8 @@ static inline PK_HD vec3 pbsdf_eval(const pbsdf *b, vec3 wo, vec3 wi)
 static inline PK_HD float pbsdf_pdf(const pbsdf *b, vec3 wo, vec3 wi)
 {
     if (b->type == PBSDF_COATED) return pbsdf__coated_pdf(b, wo, wi);
+    if (b->type == PBSDF_PRINCIPLED) return pbsdf__pr_pdf(b, wo, wi);
+    if (b->type == PBSDF_PRINCIPLED_THIN) return pbsdf__th_pdf(b, wo, wi);
     if (b->type >= PBSDF_THIN_DIELECTRIC) return pbsdf__ext_pdf(b, wo, wi);
     if (b->type == PBSDF_DIELECTRIC) return pbsdf__dielectric_pdf(b, wo, wi);
     if (b->type == PBSDF_METALLIC_ROUGHNESS) return pbsdf__mr_pdf(b, wo, wi);
@@ -1681,6 +2097,16 @@ static inline PK_HD bool pbsdf_sample(const pbsdf *b, vec3 wo, const float u[3],
                                 bool *is_delta)
 {
     if (b->type == PBSDF_COATED) return pbsdf__coated_sample(b, wo, u, wi, weight, pdf, is_delta);
+    if (b->type == PBSDF_PRINCIPLED) {
+        *is_delta = false;
+        *weight = v3s(0.0f); /* (gcc cannot see that a true return sets it) */
+        return pbsdf__pr_sample(b, wo, u, wi, weight, pdf);
+    }
+    if (b->type == PBSDF_PRINCIPLED_THIN) {
+        *is_delta = false;
+        *weight = v3s(0.0f);
+        return pbsdf__th_sample(b, wo, u, wi, weight, pdf);
+    }
     if (b->type >= PBSDF_THIN_DIELECTRIC) return pbsdf__ext_sample(b, wo, u, wi, weight, pdf, is_delta);
     *is_delta = false;
     if (b->type == PBSDF_DIELECTRIC) {

@@ -107,6 +107,30 @@ static inline PK_HD shading shading_at(const surface *sf)
         case MAT_ROUGH_DIFFUSE: sh.b = pbsdf_oren_nayar(m->kd, m->alpha * 0.70710678f); break; /* Mitsuba's sigma */
         case MAT_PHONG: sh.b = pbsdf_phong(m->kd, m->ks, m->ns); break;
         case MAT_COATED: sh.b = shading__coated(m, sf->p); break;
+        case MAT_PRINCIPLED: { /* the frame is the outward normal where it transmits (wo.z < 0 inside) */
+            /* Mitsuba's calc_dist_params: ax along dp/du (the frame's x, below) */
+            const float r = fminf(fmaxf(m->roughness, 0.0f), 1.0f), r2 = r * r;
+            const float asp = sqrtf(1.0f - 0.9f * fminf(fmaxf(m->anisotropic, 0.0f), 1.0f));
+            const float ax = fmaxf(1e-3f, r2 / asp), ay = fmaxf(1e-3f, r2 * asp);
+            if (m->thin) { /* principledthin: its transmission's roughness scaled by 0.65 eta - 0.35 */
+                const float rt = (0.65f * m->ni - 0.35f) * r, rt2 = rt * rt;
+                sh.b = pbsdf_principled_thin(surface_clamp_rgb(m->kd), r, ax, ay, fmaxf(1e-3f, rt2 / asp),
+                                             fmaxf(1e-3f, rt2 * asp), m->transmission, m->diff_trans, m->ni);
+                sh.b.pr_spec_tint = m->spec_tint, sh.b.pr_sheen = m->sheen, sh.b.pr_sheen_tint = m->sheen_tint;
+                sh.b.pr_flatness = m->flatness;
+                sh.b.pr_srate_spec = m->srate_spec, sh.b.pr_srate_diff = m->srate_diff;
+                sh.b.pr_srate_st = m->srate_st, sh.b.pr_srate_dt = m->srate_dt;
+                break;
+            }
+            sh.b = pbsdf_principled(surface_clamp_rgb(m->kd), m->metallic, r, ax, ay, m->transmission, m->ni);
+            sh.b.coat = m->clearcoat;
+            sh.b.coat_alpha = 0.1f + (0.001f - 0.1f) * m->clearcoat_gloss;
+            sh.b.pr_spec_tint = m->spec_tint, sh.b.pr_sheen = m->sheen, sh.b.pr_sheen_tint = m->sheen_tint;
+            sh.b.pr_flatness = m->flatness;
+            sh.b.pr_srate_spec = m->srate_spec, sh.b.pr_srate_cc = m->srate_cc, sh.b.pr_srate_diff = m->srate_diff;
+            if (m->transmission > 0.0f && m->metallic < 1.0f && !sf->front) n = v3_neg(n);
+            break;
+        }
         default: sh.b = pbsdf_diffuse(m->kd); break;
         }
         if (m->beckmann && (m->type == MAT_CONDUCTOR || m->type == MAT_DIELECTRIC || m->type == MAT_PLASTIC))
@@ -186,10 +210,12 @@ static inline PK_HD vec3 shading_eval(const surface *sf, const shading *sh, vec3
 {
     *pdf = 0.0f;
     const float side = v3_dot(wi, sf->ng), shade = v3_dot(wi, sf->ns);
-    if (sh->b.type == PBSDF_METALLIC_ROUGHNESS || sh->b.type == PBSDF_DIFFUSE_TRANSMISSION) {
+    if (sh->b.type == PBSDF_METALLIC_ROUGHNESS || sh->b.type == PBSDF_DIFFUSE_TRANSMISSION ||
+        sh->b.type == PBSDF_PRINCIPLED_THIN) {
         /* reflects and transmits: both normals must agree */
         if (!(side * shade > 0.0f)) return v3s(0.0f);
-    } else if (sh->b.type != PBSDF_DIELECTRIC && (side <= 0.0f || shade <= 0.0f)) {
+    } else if (sh->b.type != PBSDF_DIELECTRIC && !(sh->b.type == PBSDF_PRINCIPLED && sh->b.transmission > 0.0f) &&
+               (side <= 0.0f || shade <= 0.0f)) {
         return v3s(0.0f);
     }
     vec3 lo = onb_to_local(sh->frame, wo), li = onb_to_local(sh->frame, wi);

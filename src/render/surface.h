@@ -214,6 +214,7 @@ static inline PK_HD void surface_texture_at(const scene_view *s, const ray *r, c
         float a = fminf(fmaxf(tex_eval_scalar(s->textures, &m->map_alpha, q), 0.0f), 1.0f);
         tm->alpha = fminf(m->alpha * (m->map_alpha.squared ? a * a : a), 1.0f);
         if (m->alpha_v >= 0.0f) tm->alpha_v = fminf(m->alpha_v * (m->map_alpha.squared ? a * a : a), 1.0f);
+        if (m->type == MAT_PRINCIPLED) tm->roughness = fminf(m->roughness * a, 1.0f); /* its roughness map */
     }
     if (m->map_mr.kind) { /* glTF: blue metallic, green roughness (a grey map: both) */
         float c[4];

@@ -130,6 +130,36 @@ void material_metallic_roughness(material *m, vec3 base_color, float metallic, f
     whitted_gloss(m, m->alpha);
 }
 
+void material_principled(material *m, vec3 base_color, float metallic, float roughness)
+{
+    m->type = MAT_PRINCIPLED;
+    m->kd = base_color;
+    m->metallic = metallic, m->roughness = roughness;
+    m->transmission = m->clearcoat = m->clearcoat_roughness = 0.0f;
+    m->anisotropic = m->spec_tint = m->sheen = m->sheen_tint = m->flatness = m->clearcoat_gloss = 0.0f;
+    m->srate_spec = m->srate_cc = m->srate_diff = 1.0f;
+    m->thin = false;
+    m->diff_trans = 0.0f;
+    m->srate_st = m->srate_dt = 1.0f;
+    m->ni = 2.0f / (1.0f - sqrtf(0.08f * 0.5f)) - 1.0f; /* Mitsuba's specular 0.5 */
+    material_principled_update(m);
+}
+
+void material_principled_update(material *m)
+{
+    /* Mitsuba's calc_dist_params */
+    const float r2 = m->roughness * m->roughness;
+    const float aspect = sqrtf(1.0f - 0.9f * m->anisotropic);
+    m->ax = fmaxf(1e-3f, r2 / aspect), m->ay = fmaxf(1e-3f, r2 * aspect);
+    m->alpha = sqrtf(m->ax * m->ay);
+    /* Whitted: the diffuse share of kd (material_whitted_kd) and a glossy
+     * lobe of the Fresnel reflectance at normal incidence */
+    const float f0 = material_f0_dielectric(m->ni);
+    m->ks = v3_add(v3s((1.0f - m->metallic) * f0), v3_scale(m->kd, m->metallic));
+    m->illum = 2;
+    whitted_gloss(m, m->alpha);
+}
+
 void material_thin_dielectric(material *m, float ior, vec3 transmittance)
 {
     m->type = MAT_THIN_DIELECTRIC;

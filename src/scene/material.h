@@ -40,7 +40,8 @@ typedef enum material_type {
     MAT_ROUGH_DIFFUSE,        /* Oren-Nayar */
     MAT_PHONG,                /* the modified Phong model */
     MAT_COATED,               /* pbrt-v4's layered BSDF: a dielectric coat over a diffuse or conductor base */
-    MAT_LAST = MAT_COATED
+    MAT_PRINCIPLED,           /* Mitsuba 3's principled BSDF */
+    MAT_LAST = MAT_PRINCIPLED
 } material_type;
 
 /* The deepest nesting of mixes (a mix of mixes ...) that readers accept. */
@@ -122,6 +123,23 @@ typedef struct material {
     int coat_base;
     float base_alpha;
     material_layer layer;
+    /* MAT_PRINCIPLED (Mitsuba 3's principled, material_principled): base
+     * colour kd, metallic, roughness (GGX alpha = max(0.001, roughness^2)),
+     * transmission (spec_trans), clearcoat, the index ni (eta, or Mitsuba's
+     * specular mapped to it), and these, all in [0, 1]: anisotropic (GGX
+     * alphas ax along dp/du and ay across it, Mitsuba's calc_dist_params;
+     * alpha = sqrt(ax ay) for the Whitted integrator), spec_tint, sheen,
+     * sheen_tint, flatness, clearcoat_gloss; and the sampling rates of the
+     * main specular, clearcoat and diffuse lobes (>= 0, 1 by default).
+     * map_kd multiplies the base colour and map_alpha the roughness. */
+    float anisotropic, ax, ay, spec_tint, sheen, sheen_tint, flatness, clearcoat_gloss;
+    float srate_spec, srate_cc, srate_diff;
+    /* thin: Mitsuba's principledthin instead (a two-sided sheet of index ni,
+     * no metallic or clearcoat; srate_spec is its specular reflection's
+     * rate) with diff_trans in [0, 1] (Mitsuba's 0 ... 2 halved) and the
+     * sampling rates of its specular and diffuse transmission */
+    bool thin;
+    float diff_trans, srate_st, srate_dt;
     /* Texture maps (docs/materials.md), kind TEX_NONE when absent. A map's
      * value multiplies its constant: map_kd kd, map_ks ks, map_ns ns,
      * map_alpha alpha; map_mr is glTF's metallic-roughness texture (data,
@@ -227,12 +245,20 @@ PK_HIDDEN void material_coated_conductor_f0(material *m, vec3 reflectance, float
  * material_whitted_kd reads transmission where it is used; the Whitted
  * approximation has no clearcoat). */
 PK_HIDDEN void material_metallic_roughness(material *m, vec3 base_color, float metallic, float roughness);
+/* Mitsuba 3's principled with its defaults but for these (see the fields
+ * above; set the others after it, then call material_principled_update). */
+PK_HIDDEN void material_principled(material *m, vec3 base_color, float metallic, float roughness);
+/* Derives alpha, ax, ay and the Whitted fields from the principled fields. */
+PK_HIDDEN void material_principled_update(material *m);
 
 /* The diffuse reflectance that the MTL model and the Whitted integrator use:
- * kd, but for metallic-roughness the base colour's diffuse share
- * kd (1 - metallic) (1 - transmission). */
+ * kd, but for metallic-roughness and principled the base colour's diffuse
+ * share kd (1 - metallic) (1 - transmission) (principledthin: also
+ * (1 - diff_trans)). */
 static inline PK_HD vec3 material_whitted_kd(const material *m)
 {
+    if (m->type == MAT_PRINCIPLED) /* principledthin: less its diffuse transmission */
+        return v3_scale(m->kd, (1.0f - m->metallic) * (1.0f - m->transmission) * (1.0f - m->diff_trans));
     if (m->type != MAT_METALLIC_ROUGHNESS) return m->kd;
     return v3_scale(m->kd, (1.0f - m->metallic) * (1.0f - m->transmission));
 }
@@ -259,9 +285,11 @@ static inline PK_HD vec3 material_mtl_tint(const material *m)
     return tmax_c > 0.0f ? v3_scale(m->tf, 1.0f / tmax_c) : v3s(1.0f);
 }
 
-/* Whether the material's roughness is anisotropic (alpha_v, above). */
+/* Whether the material's roughness is anisotropic (alpha_v, above; for
+ * principled its anisotropic > 0). */
 static inline PK_HD bool material_anisotropic(const material *m)
 {
+    if (m->type == MAT_PRINCIPLED) return m->anisotropic > 0.0f;
     return (m->type == MAT_CONDUCTOR || m->type == MAT_DIELECTRIC || m->type == MAT_PLASTIC) && m->alpha_v >= 0.0f &&
            m->alpha_v != m->alpha;
 }

@@ -129,7 +129,7 @@ int main(void)
     CHECK(pk_scene_add_material(ctx, s, "x", "velvet", NULL, &m) == PK_ERR_PARSE && m == 99);
     CHECK_MSG(ctx, "t: material \"x\": type: must be one of \"diffuse\", \"conductor\", \"dielectric\", \"plastic\", "
                    "\"metallic_roughness\", \"emitter\", \"two_sided\", \"interface\", \"thin_dielectric\", "
-                   "\"diffuse_transmission\", \"mix\", \"rough_diffuse\", \"phong\"");
+                   "\"diffuse_transmission\", \"mix\", \"rough_diffuse\", \"phong\", \"coated\", \"principled\"");
     REQUIRE(pk_params_set_rgb(p, "albedo", 0.5f, 0.5f, 0.5f) == PK_OK);
     REQUIRE(pk_params_set_float(p, "albedoo", 1.0f) == PK_OK);
     warning_log_clear(&w);

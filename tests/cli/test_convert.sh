@@ -92,7 +92,7 @@ else
 fi
 # the record forms refuse what no reader makes
 printf '{"materials": [{"name": "m", "record": {"type": 99}}], "spheres": [{"center": [0, 0, 0], "radius": 1}]}' >"$tmp/badtype.json"
-expect record-type 1 "badtype.json:1: materials\[0\].record: type must be in 0..11" "$bin" render "$tmp/badtype.json" -o "$tmp/e/x.pfm"
+expect record-type 1 "badtype.json:1: materials\[0\].record: type must be in 0..13" "$bin" render "$tmp/badtype.json" -o "$tmp/e/x.pfm"
 # a mix (type 9) of a material that does not come before it
 printf '{"materials": [{"name": "m", "record": {"type": 9, "mix_a": 0, "mix_b": 1}}], "spheres": [{"center": [0, 0, 0], "radius": 1}]}' >"$tmp/badmix.json"
 expect record-mix 1 "badmix.json:1: materials\[0\].record: mix_a and mix_b must be numbers of materials before this one" "$bin" render "$tmp/badmix.json" -o "$tmp/e/x.pfm"

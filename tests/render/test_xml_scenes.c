@@ -4,7 +4,9 @@
  * with the triangle counts their sources list and render small images without
  * NaN or negative values; the Cornell box has its red wall on the left, its
  * green wall on the right and its lamp at the top centre. Skipped when
- * ../shared is absent.
+ * ../shared is absent. First the principled scenes of tests/data/xml (which
+ * need no ../shared): they load without warnings and render finite values;
+ * the leaf of principledthin lit from behind glows green.
  */
 #include "test.h"
 #include "warnings.h"
@@ -66,8 +68,56 @@ static void region(const pk_image *img, int x0, int x1, int y0, int y1, double c
     for (int k = 0; k < 3; k++) c[k] /= (double)((x1 - x0) * (y1 - y0));
 }
 
+/* tests/data/xml's principled and principledthin scenes */
+static void test_principled_scenes(void)
+{
+    pk_context *ctx = NULL;
+    REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
+    warning_log_attach(ctx, &warnings);
+    warnings.echo = true;
+    static const char *const files[] = {"xml/principled_spheres.xml", "xml/principledthin_sheets.xml"};
+    for (int i = 0; i < 2; i++) {
+        char path[1024];
+        snprintf(path, sizeof path, "%s/%s", PK_TEST_DATA, files[i]);
+        pk_scene *s = NULL;
+        warning_log_clear(&warnings);
+        if (pk_scene_load_file(ctx, path, &s) != PK_OK) {
+            fprintf(stderr, "%s: %s\n", files[i], pk_context_error(ctx));
+            test_failures++;
+            continue;
+        }
+        pk_scene_info info;
+        pk_scene_get_info(s, &info);
+        printf("%s: %d spheres, %d triangles, %d warnings\n", files[i], (int)info.spheres, (int)info.triangles,
+               warnings.count);
+        CHECK(warnings.count == 0);
+        /* the anisotropic sphere is tessellated (its tangents follow Mitsuba's uv) */
+        if (i == 0) CHECK(info.spheres == 4 && info.triangles > 1000);
+        pk_render_options o;
+        pk_scene_get_render_options(s, &o);
+        o.width = 80, o.height = 50, o.spp = 32, o.threads = 0;
+        pk_image *img = NULL;
+        if (pk_render(ctx, s, &o, &img, NULL) != PK_OK) {
+            fprintf(stderr, "%s: %s\n", files[i], pk_context_error(ctx));
+            test_failures++;
+        } else {
+            CHECK(check_values(img, files[i]) > 0.01);
+            if (i == 1) { /* the left sheet, seen from the side away from the lamp */
+                double leaf[3];
+                region(img, 8, 30, 14, 34, leaf);
+                printf("principledthin leaf: %.3f %.3f %.3f\n", leaf[0], leaf[1], leaf[2]);
+                CHECKF(leaf[1] > 1.5 * leaf[0] && leaf[1] > 1.5 * leaf[2], "leaf %g %g %g", leaf[0], leaf[1], leaf[2]);
+            }
+            pk_image_destroy(img);
+        }
+        pk_scene_destroy(s);
+    }
+    pk_context_destroy(ctx);
+}
+
 int main(void)
 {
+    test_principled_scenes();
     char buf[1024];
     shared_path(buf, sizeof buf, "scenes/bitterli/cornell-box/scene_v3.xml");
     pk_context *ctx = NULL;

@@ -228,7 +228,7 @@ static void test_errors(void)
     const char *types =
         "must be one of \"diffuse\", \"conductor\", \"dielectric\", \"plastic\", \"metallic_roughness\", "
         "\"emitter\", \"two_sided\", \"interface\", \"thin_dielectric\", \"diffuse_transmission\", \"mix\", "
-        "\"rough_diffuse\", \"phong\", \"coated\"";
+        "\"rough_diffuse\", \"phong\", \"coated\", \"principled\"";
     char want[512];
     snprintf(want, sizeof want, "scene.json:1: materials.gold.type: %s", types);
     EXPECT_ERROR(MAT("{\"type\": \"metal\"}"), want);
@@ -247,6 +247,11 @@ static void test_errors(void)
                  "scene.json:1: materials.gold.albedo: a coated conductor (\"eta\", \"k\" or \"specular\") has no "
                  "diffuse \"albedo\"");
     EXPECT_ERROR(MAT("{\"type\": \"coated\", \"maxdepth\": 0}"), "scene.json:1: materials.gold.maxdepth: must be an integer in 1..65536");
+    EXPECT_ERROR(MAT("{\"type\": \"principled\", \"eta\": 1.4, \"specular\": 0.3}"),
+                 "scene.json:1: materials.gold.specular: give \"eta\" or \"specular\", not both");
+    EXPECT_ERROR(MAT("{\"type\": \"principled\", \"metallic\": 1.5}"), "scene.json:1: materials.gold.metallic: must be in 0..1");
+    EXPECT_ERROR(MAT("{\"type\": \"principled\", \"sheen\": {\"image\": \"x.png\"}}"),
+                 "scene.json:1: materials.gold.sheen: must be a number in 0..1");
     EXPECT_ERROR(MAT("{\"type\": 3}"), want);
     snprintf(want, sizeof want, "scene.json:2: spheres[0].material.type: %s", types);
     EXPECT_ERROR("{\"spheres\": [{\"center\": [0, 0, 0], \"radius\": 1,\n \"material\": {\"type\": \"Diffuse\"}}]}",
@@ -380,6 +385,22 @@ static void test_sheets(void)
     m = one("{\"type\": \"coated\", \"specular\": [0.9, 0.6, 0.4], \"base_alpha\": 0.1}");
     CHECK(m.type == MAT_COATED && m.coat_base == MATERIAL_BASE_CONDUCTOR && m.schlick && near3(m.ks, 0.9f, 0.6f, 0.4f, 0) &&
           m.base_alpha == 0.1f);
+    /* Mitsuba's principled: its defaults (specular 0.5 is eta 1.5), every parameter, specular for eta */
+    m = one("{\"type\": \"principled\"}");
+    CHECK(m.type == MAT_PRINCIPLED && near3(m.kd, 0.5f, 0.5f, 0.5f, 0) && m.roughness == 0.5f && m.metallic == 0.0f &&
+          fabsf(m.ni - 1.5f) < 1e-5f && m.anisotropic == 0.0f && m.srate_spec == 1.0f && !material_anisotropic(&m));
+    m = one("{\"type\": \"principled\", \"base_color\": [0.9, 0.6, 0.2], \"roughness\": 0.3, \"metallic\": 0.7, "
+            "\"spec_trans\": 0.2, \"anisotropic\": 0.5, \"spec_tint\": 0.1, \"sheen\": 0.4, \"sheen_tint\": 0.6, "
+            "\"flatness\": 0.25, \"clearcoat\": 0.8, \"clearcoat_gloss\": 0.9, \"eta\": 1.33, "
+            "\"clearcoat_sampling_rate\": 2}");
+    CHECK(m.type == MAT_PRINCIPLED && near3(m.kd, 0.9f, 0.6f, 0.2f, 0) && m.roughness == 0.3f && m.metallic == 0.7f &&
+          m.transmission == 0.2f && m.anisotropic == 0.5f && m.spec_tint == 0.1f && m.sheen == 0.4f &&
+          m.sheen_tint == 0.6f && m.flatness == 0.25f && m.clearcoat == 0.8f && m.clearcoat_gloss == 0.9f &&
+          m.ni == 1.33f && m.srate_cc == 2.0f && m.srate_diff == 1.0f && material_anisotropic(&m));
+    /* calc_dist_params: ax = r^2 / sqrt(1 - 0.9 anisotropic), ay = r^2 sqrt(...) */
+    CHECK(fabsf(m.ax - 0.09f / sqrtf(0.55f)) < 1e-6f && fabsf(m.ay - 0.09f * sqrtf(0.55f)) < 1e-6f && wl.count == 0);
+    m = one("{\"type\": \"principled\", \"specular\": 0.3}");
+    CHECK(fabsf(m.ni - (2.0f / (1.0f - sqrtf(0.024f)) - 1.0f)) < 1e-5f);
     /* a mix names materials before it; a mix of mixes */
     pk_context *ctx = new_ctx();
     pk_scene *s = NULL;

@@ -611,10 +611,33 @@ static void test_bsdfs(void)
           warned("scene.xml:3: bsdf \"bumpmap\": only a bitmap height (scaled or not) bends the normal"));
     m = bsdf("<bsdf type=\"principled\"><rgb name=\"base_color\" value=\"0.9 0.6 0.2\"/><float name=\"metallic\" value=\"1\"/>"
              "<float name=\"roughness\" value=\"0.2\"/><float name=\"sheen\" value=\"0.3\"/></bsdf>");
-    CHECK(m.type == MAT_CONDUCTOR && m.schlick && near3(m.ks, v3(0.9f, 0.6f, 0.2f), 1e-6f) && fabsf(m.alpha - 0.04f) < 1e-6f);
-    CHECK(warned("principled is approximated by a metal"));
+    CHECK(m.type == MAT_PRINCIPLED && near3(m.kd, v3(0.9f, 0.6f, 0.2f), 1e-6f) && m.metallic == 1.0f &&
+          fabsf(m.roughness - 0.2f) < 1e-6f && fabsf(m.alpha - 0.04f) < 1e-6f && fabsf(m.sheen - 0.3f) < 1e-6f);
+    CHECK(!warned("principled is approximated"));
+    /* the defaults: base colour 0.5, roughness 0.5, specular 0.5 (eta = 2 / (1 - sqrt(0.04)) - 1 = 1.5) */
     m = bsdf("<bsdf type=\"principled\"><rgb name=\"base_color\" value=\"0.1 0.2 0.3\"/></bsdf>");
-    CHECK(m.type == MAT_PLASTIC && near3(m.kd, v3(0.1f, 0.2f, 0.3f), 1e-6f) && fabsf(m.alpha - 0.25f) < 1e-6f);
+    CHECK(m.type == MAT_PRINCIPLED && near3(m.kd, v3(0.1f, 0.2f, 0.3f), 1e-6f) && fabsf(m.alpha - 0.25f) < 1e-6f &&
+          fabsf(m.ni - 1.5f) < 1e-5f && m.transmission == 0.0f && m.srate_spec == 1.0f);
+    /* eta and specular together: eta wins, with a warning; anisotropic: Mitsuba's ax, ay (no warning) */
+    m = bsdf("<bsdf type=\"principled\"><float name=\"eta\" value=\"1.33\"/><float name=\"specular\" value=\"0.2\"/>"
+             "<float name=\"anisotropic\" value=\"0.5\"/><float name=\"roughness\" value=\"0.6\"/>"
+             "<float name=\"spec_trans\" value=\"0.7\"/><float name=\"clearcoat_sampling_rate\" value=\"2\"/></bsdf>");
+    CHECK(m.type == MAT_PRINCIPLED && fabsf(m.ni - 1.33f) < 1e-6f && warned("eta or specular, not both") &&
+          !warned("anisotropic") && material_anisotropic(&m) && fabsf(m.transmission - 0.7f) < 1e-6f &&
+          fabsf(m.ax - 0.36f / sqrtf(0.55f)) < 1e-5f && fabsf(m.ay - 0.36f * sqrtf(0.55f)) < 1e-5f &&
+          m.srate_cc == 2.0f);
+    m = bsdf("<bsdf type=\"principled\"><float name=\"metallic\" value=\"1.5\"/></bsdf>");
+    CHECK(m.type == MAT_PRINCIPLED && m.metallic == 1.0f && warned("scene.xml:3: metallic must be in [0, 1], not 1.5"));
+    /* principledthin: its own lobes (thin), diff_trans halved, its four rates */
+    m = bsdf("<bsdf type=\"principledthin\"><rgb name=\"base_color\" value=\"0.1 0.2 0.3\"/>"
+             "<float name=\"diff_trans\" value=\"0.6\"/><float name=\"spec_trans\" value=\"0.4\"/>"
+             "<float name=\"eta\" value=\"1.33\"/><float name=\"specular_transmittance_sampling_rate\" value=\"3\"/></bsdf>");
+    CHECK(m.type == MAT_PRINCIPLED && m.thin && near3(m.kd, v3(0.1f, 0.2f, 0.3f), 1e-6f) && fabsf(m.diff_trans - 0.3f) < 1e-6f &&
+          fabsf(m.transmission - 0.4f) < 1e-6f && m.ni == 1.33f && m.srate_st == 3.0f && m.srate_dt == 1.0f &&
+          !warned("principledthin"));
+    m = bsdf("<bsdf type=\"principledthin\"><float name=\"diff_trans\" value=\"2.5\"/><float name=\"metallic\" value=\"1\"/></bsdf>");
+    CHECK(m.type == MAT_PRINCIPLED && m.thin && m.diff_trans == 1.0f && warned("scene.xml:3: diff_trans must be in [0, 2], not 2.5") &&
+          warned("metallic"));
     m = bsdf("<bsdf type=\"coating\"><float name=\"intIOR\" value=\"1.2\"/><bsdf type=\"diffuse\"><rgb name=\"reflectance\" "
              "value=\"0.3 0.4 0.5\"/></bsdf></bsdf>");
     CHECK(m.type == MAT_PLASTIC && near3(m.kd, v3(0.3f, 0.4f, 0.5f), 1e-6f) && fabsf(m.ni - 1.2f / 1.000277f) < 1e-5f);
