@@ -1679,6 +1679,41 @@ static pk_status bsdf_plastic(xp *p, const bsdf_in *in, material *m)
     return PK_OK;
 }
 
+/* What principled and principledthin read alike: base_color and roughness
+ * (textures allowed: map_kd, map_alpha), the n parameters names[] in [0, 1]
+ * (clamped with a warning) into v[], and the nr sampling rates rates[]
+ * (>= 0, 1 by default) into rate[]. */
+static pk_status principled_common(xp *p, const bsdf_in *in, material *m, const char *const *names, int n, float *v,
+                                   const char *const *rates, int nr, float *rate)
+{
+    vec3 base = v3s(0.5f);
+    float roughness = 0.5f;
+    material_principled(m, base, 0.0f, roughness);
+    pk_status st;
+    if ((st = get_color_tex(p, in->d, "base_color", &base, &m->map_kd))) return st;
+    p->want_tex = &m->map_alpha;
+    st = get_scalar(p, in->d, "roughness", &roughness);
+    p->want_tex = NULL;
+    if (st) return st;
+    for (int k = 0; k < n; k++) {
+        if ((st = get_scalar(p, in->d, names[k], &v[k]))) return st;
+        if (!(v[k] >= 0.0f && v[k] <= 1.0f)) {
+            xwarn(p, in->b, "%s must be in [0, 1], not %g; clamped", names[k], (double)v[k]);
+            v[k] = clamp01(v[k]);
+        }
+    }
+    for (int k = 0; k < nr; k++) {
+        if ((st = get_float(p, in->d, rates[k], &rate[k]))) return st;
+        if (!(rate[k] >= 0.0f)) {
+            xwarn(p, in->b, "%s must be >= 0, not %g; using 1", rates[k], (double)rate[k]);
+            rate[k] = 1.0f;
+        }
+    }
+    m->kd = clamp01v(base);
+    m->roughness = clamp01(roughness);
+    return PK_OK;
+}
+
 /* Mitsuba 3's principled BSDF with all its parameters (MAT_PRINCIPLED):
  * base_color and roughness may be textures (map_kd, map_alpha), the other
  * parameters are constants (a texture stands in as one, with a warning).
@@ -1689,27 +1724,12 @@ static pk_status bsdf_principled(xp *p, const bsdf_in *in, material *m)
     static const char *const names[] = {"metallic",  "spec_trans", "anisotropic", "spec_tint",      "sheen",
                                         "sheen_tint", "flatness",   "clearcoat",   "clearcoat_gloss"};
     float v[9] = {0};
-    vec3 base = v3s(0.5f);
-    float roughness = 0.5f, eta = 1.5f, specular = 0.5f;
+    float eta = 1.5f, specular = 0.5f;
     float rate[3] = {1.0f, 1.0f, 1.0f};
     static const char *const rates[] = {"main_specular_sampling_rate", "clearcoat_sampling_rate",
                                         "diffuse_reflectance_sampling_rate"};
-    material_principled(m, base, 0.0f, roughness);
-    pk_status st;
-    if ((st = get_color_tex(p, in->d, "base_color", &base, &m->map_kd))) return st;
-    p->want_tex = &m->map_alpha;
-    st = get_scalar(p, in->d, "roughness", &roughness);
-    p->want_tex = NULL;
+    pk_status st = principled_common(p, in, m, names, 9, v, rates, 3, rate);
     if (st) return st;
-    for (int k = 0; k < 9; k++)
-        if ((st = get_scalar(p, in->d, names[k], &v[k]))) return st;
-    for (int k = 0; k < 3; k++) {
-        if ((st = get_float(p, in->d, rates[k], &rate[k]))) return st;
-        if (!(rate[k] >= 0.0f)) {
-            xwarn(p, in->b, "%s must be >= 0, not %g; using 1", rates[k], (double)rate[k]);
-            rate[k] = 1.0f;
-        }
-    }
     const bool has_eta = pd_has(in->d, "eta"), has_spec = pd_has(in->d, "specular");
     if ((st = get_float(p, in->d, "eta", &eta)) || (st = get_float(p, in->d, "specular", &specular))) return st;
     const bool has_trans = pd_has(in->d, "spec_trans") && v[1] != 0.0f;
@@ -1728,13 +1748,6 @@ static pk_status bsdf_principled(xp *p, const bsdf_in *in, material *m)
         if (has_trans && specular == 0.0f) specular = 1e-3f;
         eta = 2.0f / (1.0f - sqrtf(0.08f * specular)) - 1.0f;
     }
-    for (int k = 0; k < 9; k++)
-        if (!(v[k] >= 0.0f && v[k] <= 1.0f)) {
-            xwarn(p, in->b, "%s must be in [0, 1], not %g; clamped", names[k], (double)v[k]);
-            v[k] = clamp01(v[k]);
-        }
-    m->kd = clamp01v(base);
-    m->roughness = clamp01(roughness);
     m->metallic = v[0], m->transmission = v[1], m->anisotropic = v[2], m->spec_tint = v[3];
     m->sheen = v[4], m->sheen_tint = v[5], m->flatness = v[6], m->clearcoat = v[7], m->clearcoat_gloss = v[8];
     m->srate_spec = rate[0], m->srate_cc = rate[1], m->srate_diff = rate[2];
@@ -1754,30 +1767,10 @@ static pk_status bsdf_principled_thin(xp *p, const bsdf_in *in, material *m)
     static const char *const rates[] = {"specular_reflectance_sampling_rate", "specular_transmittance_sampling_rate",
                                         "diffuse_reflectance_sampling_rate", "diffuse_transmittance_sampling_rate"};
     float v[6] = {0}, rate[4] = {1.0f, 1.0f, 1.0f, 1.0f};
-    vec3 base = v3s(0.5f);
-    float roughness = 0.5f, eta = 1.5f, diff_trans = 0.0f;
-    material_principled(m, base, 0.0f, roughness);
-    pk_status st;
-    if ((st = get_color_tex(p, in->d, "base_color", &base, &m->map_kd))) return st;
-    p->want_tex = &m->map_alpha;
-    st = get_scalar(p, in->d, "roughness", &roughness);
-    p->want_tex = NULL;
+    float eta = 1.5f, diff_trans = 0.0f;
+    pk_status st = principled_common(p, in, m, names, 6, v, rates, 4, rate);
     if (st) return st;
-    for (int k = 0; k < 6; k++)
-        if ((st = get_scalar(p, in->d, names[k], &v[k]))) return st;
     if ((st = get_scalar(p, in->d, "diff_trans", &diff_trans)) || (st = get_float(p, in->d, "eta", &eta))) return st;
-    for (int k = 0; k < 4; k++) {
-        if ((st = get_float(p, in->d, rates[k], &rate[k]))) return st;
-        if (!(rate[k] >= 0.0f)) {
-            xwarn(p, in->b, "%s must be >= 0, not %g; using 1", rates[k], (double)rate[k]);
-            rate[k] = 1.0f;
-        }
-    }
-    for (int k = 0; k < 6; k++)
-        if (!(v[k] >= 0.0f && v[k] <= 1.0f)) {
-            xwarn(p, in->b, "%s must be in [0, 1], not %g; clamped", names[k], (double)v[k]);
-            v[k] = clamp01(v[k]);
-        }
     if (!(diff_trans >= 0.0f && diff_trans <= 2.0f)) {
         xwarn(p, in->b, "diff_trans must be in [0, 2], not %g; clamped", (double)diff_trans);
         diff_trans = diff_trans > 2.0f ? 2.0f : 0.0f;
@@ -1786,8 +1779,6 @@ static pk_status bsdf_principled_thin(xp *p, const bsdf_in *in, material *m)
         xwarn(p, in->b, "eta must be > 0, not %g; using 1.5", (double)eta);
         eta = 1.5f;
     }
-    m->kd = clamp01v(base);
-    m->roughness = clamp01(roughness);
     m->thin = true;
     m->transmission = v[0], m->anisotropic = v[1], m->spec_tint = v[2];
     m->sheen = v[3], m->sheen_tint = v[4], m->flatness = v[5];
