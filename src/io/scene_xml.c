@@ -1128,16 +1128,25 @@ static vec3 clamp01v(vec3 c) { return v3(clamp01(c.x), clamp01(c.y), clamp01(c.z
  * surface's dp/du, and *alpha_v alpha_v where the two differ, -1 where
  * they do not), and the microfacet distribution (*beckmann: Mitsuba's default "beckmann",
  * and "phong" by Mitsuba's own equivalence of the two for one alpha; false
- * for "ggx"). */
-static pk_status get_alpha(xp *p, pdict *d, float def, float *alpha, float *alpha_v, bool *beckmann)
+ * for "ggx"). A texture on alpha goes to *tex (tex NULL: its mean), *alpha
+ * becomes 1 and the texture's value is the roughness; textures on alpha_u
+ * and alpha_v stand in as their means (warning). */
+static pk_status get_alpha(xp *p, pdict *d, float def, float *alpha, float *alpha_v, bool *beckmann, tex_ref *tex)
 {
     if (alpha_v) *alpha_v = -1.0f;
     const xnode *b = d->node;
     pk_status st;
     float a = def, au = -1.0f, av = -1.0f;
-    if ((st = get_scalar(p, d, "alpha", &a))) return st;
+    p->want_tex = tex;
+    st = get_scalar(p, d, "alpha", &a);
+    p->want_tex = NULL;
+    if (st) return st;
     xnode *cu = prop(d, "alpha_u"), *cv = prop(d, "alpha_v");
     if (cu || cv) {
+        if (tex && tex->kind) { /* alpha_u and alpha_v, as Mitsuba reads them, win */
+            tex_ref_init(tex);
+            a = def;
+        }
         au = av = a;
         if ((st = get_scalar(p, d, "alpha_u", &au))) return st;
         if ((st = get_scalar(p, d, "alpha_v", &av))) return st;
@@ -1182,6 +1191,7 @@ typedef struct bsdf_in {
     float alpha, ior;
     float alpha_v; /* rough conductor and dielectric: anisotropic roughness (get_alpha) */
     bool beckmann;
+    tex_ref alpha_tex; /* a texture on alpha (get_alpha), TEX_NONE if none */
 } bsdf_in;
 
 /* The nested bsdf of a wrapper (its first <bsdf> or <ref> child). */
@@ -1405,7 +1415,7 @@ static pk_status bsdf_coating(xp *p, const bsdf_in *in, material *m)
     float alpha = 0.0f, ior;
     bool bk = false, rough = in->type[0] == 'r';
     pk_status st;
-    if (rough && (st = get_alpha(p, in->d, 0.1f, &alpha, NULL, &bk))) return st;
+    if (rough && (st = get_alpha(p, in->d, 0.1f, &alpha, NULL, &bk, NULL))) return st;
     if ((st = get_rel_ior(p, in->d, 1.5046f, &ior))) return st;
     if (inner && (st = bsdf_resolve(p, inner, m))) return st;
     if (inner && m->type == MAT_DIFFUSE && ior > 0.0f && ior != 1.0f) {
@@ -1856,10 +1866,14 @@ static pk_status bsdf_material(xp *p, xnode *b, material *m)
     bsdf_in in = {.b = b, .d = &d, .type = type, .ty = ty, .alpha_v = -1.0f};
     /* Mitsuba's rough conductor and dielectric take alpha_u and alpha_v; its rough plastic does not */
     const bool aniso = row->create == bsdf_conductor || row->create == bsdf_dielectric;
-    if (row->rough && (st = get_alpha(p, &d, 0.1f, &in.alpha, aniso ? &in.alpha_v : NULL, &in.beckmann))) return st;
+    tex_ref_init(&in.alpha_tex);
+    if (row->rough &&
+        (st = get_alpha(p, &d, 0.1f, &in.alpha, aniso ? &in.alpha_v : NULL, &in.beckmann, &in.alpha_tex)))
+        return st;
     if (row->int_ior > 0.0f && (st = get_rel_ior(p, &d, row->int_ior, &in.ior))) return st;
     if (!row->create) material_interface(m);
     else if ((st = row->create(p, &in, m)) || !row->kind) return st;
+    if (in.alpha_tex.kind) m->map_alpha = in.alpha_tex; /* the roughness is the texture's value (alpha 1) */
     static const char *const quiet[] = {"ext_ior", "ext_eta", "nonlinear", "distribution", "sample_visible", NULL};
     char kind[64];
     snprintf(kind, sizeof kind, "bsdf \"%s\"", ty);

@@ -692,6 +692,23 @@ static void test_bsdfs(void)
           near3(m.map_kd.odd, v3(0.2f, 0.4f, 0.6f), 1e-6f) && m.map_kd.checker_scale == 2.0f);
     m = bsdf("<bsdf type=\"roughconductor\">\n<texture name=\"specular_reflectance\" type=\"checkerboard\"/></bsdf>");
     CHECK(m.map_kd.kind == TEX_NONE && warned("scene.xml:4: a texture for specular_reflectance is not supported; using the constant"));
+    /* a texture on a rough bsdf's alpha is the roughness at each hit (alpha 1 times the texture's value), on
+     * the conductor, dielectric and plastic; alpha_u and alpha_v win over it, as in Mitsuba */
+    static const char *const rough[] = {"roughconductor", "roughdielectric", "roughplastic"};
+    for (int i = 0; i < 3; i++) {
+        char x[400];
+        snprintf(x, sizeof x,
+                 "<bsdf type=\"%s\"><texture name=\"alpha\" type=\"checkerboard\"><rgb name=\"color0\" "
+                 "value=\"0.05\"/><rgb name=\"color1\" value=\"0.4\"/></texture></bsdf>",
+                 rough[i]);
+        m = bsdf(x);
+        CHECKF(m.alpha == 1.0f && m.map_alpha.kind == TEX_CHECKER && fabsf(m.map_alpha.even.x - 0.05f) < 1e-7f &&
+                   fabsf(m.map_alpha.odd.x - 0.4f) < 1e-7f && !m.map_alpha.squared && wl.count == 0,
+               "%s: alpha %g, texture kind %d, %d warnings", rough[i], (double)m.alpha, (int)m.map_alpha.kind, wl.count);
+    }
+    m = bsdf("<bsdf type=\"roughconductor\"><texture name=\"alpha\" type=\"checkerboard\"/>"
+             "<float name=\"alpha_u\" value=\"0.2\"/><float name=\"alpha_v\" value=\"0.3\"/></bsdf>");
+    CHECK(m.map_alpha.kind == TEX_NONE && fabsf(m.alpha - 0.2f) < 1e-6f && fabsf(m.alpha_v - 0.3f) < 1e-6f);
     /* unknown properties: a warning naming the bsdf and the property */
     m = bsdf("<bsdf type=\"diffuse\"><float name=\"sheen\" value=\"1\"/></bsdf>");
     CHECK(warned("scene.xml:3: bsdf \"diffuse\": property \"sheen\" is not supported; ignored"));
