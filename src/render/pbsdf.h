@@ -146,6 +146,15 @@ typedef struct pbsdf {
     float pr_diff_trans, pr_tax, pr_tay, pr_srate_st, pr_srate_dt;
 } pbsdf;
 
+/* The layered and principled BSDFs are large: on the GPU they are called,
+ * not inlined into every kernel that shades (inlined, ptxas spent tens of
+ * minutes on the path kernels); on the CPU the compiler decides. */
+#ifdef __CUDA_ARCH__
+#define PBSDF_CALLED __noinline__
+#else
+#define PBSDF_CALLED
+#endif
+
 /* ---- constructors ------------------------------------------------------- */
 
 static inline PK_HD pbsdf pbsdf__blank(int type)
@@ -1368,7 +1377,7 @@ static inline PK_HD bool pbsdf__clear(const pbsdf *b) { return !(v3_max_comp(b->
 
 /* f cos of the layered BSDF (pbrt-v4's LayeredBxDF::f, reflection only:
  * the bases are opaque). */
-static inline PK_HD vec3 pbsdf__coated_eval(const pbsdf *b, vec3 wo, vec3 wi)
+static inline PBSDF_CALLED PK_HD vec3 pbsdf__coated_eval(const pbsdf *b, vec3 wo, vec3 wi)
 {
     if (wo.z < 0.0f) wo = v3_neg(wo), wi = v3_neg(wi);
     if (!(wo.z > 0.0f && wi.z > 0.0f)) return v3s(0.0f);
@@ -1462,7 +1471,7 @@ static inline PK_HD vec3 pbsdf__coated_eval(const pbsdf *b, vec3 wo, vec3 wi)
 /* The estimated density of pbsdf__coated_sample (pbrt-v4's LayeredBxDF::PDF):
  * the coat's reflection and one bounce off the base through the coat, mixed
  * with a uniform density. */
-static inline PK_HD float pbsdf__coated_pdf(const pbsdf *b, vec3 wo, vec3 wi)
+static inline PBSDF_CALLED PK_HD float pbsdf__coated_pdf(const pbsdf *b, vec3 wo, vec3 wi)
 {
     if (wo.z < 0.0f) wo = v3_neg(wo), wi = v3_neg(wi);
     if (!(wo.z > 0.0f && wi.z > 0.0f)) return 0.0f;
@@ -1500,7 +1509,7 @@ static inline PK_HD float pbsdf__coated_pdf(const pbsdf *b, vec3 wo, vec3 wi)
  * is the walk's f cos / pdf, an unbiased estimate of the BSDF's; *pdf is
  * pbsdf_pdf's estimate (for MIS), or for an all-delta walk the product of
  * its lobes' probabilities. */
-static inline PK_HD bool pbsdf__coated_sample(const pbsdf *b, vec3 wo, const float u[3], vec3 *wi, vec3 *weight,
+static inline PBSDF_CALLED PK_HD bool pbsdf__coated_sample(const pbsdf *b, vec3 wo, const float u[3], vec3 *wi, vec3 *weight,
                                               float *pdf, bool *is_delta)
 {
     *is_delta = false;
@@ -1694,7 +1703,7 @@ static inline PK_HD void pbsdf__pr_probs(const pbsdf *b, bool front, float f, fl
     for (int k = 0; k < 4; k++) p[k] *= r;
 }
 
-static inline PK_HD vec3 pbsdf__pr_eval(const pbsdf *b, vec3 wo, vec3 wi)
+static inline PBSDF_CALLED PK_HD vec3 pbsdf__pr_eval(const pbsdf *b, vec3 wo, vec3 wi)
 {
     vec3 v = v3s(0.0f);
     if (wo.z == 0.0f || wi.z == 0.0f) return v;
@@ -1757,7 +1766,7 @@ static inline PK_HD vec3 pbsdf__pr_eval(const pbsdf *b, vec3 wo, vec3 wi)
     return v;
 }
 
-static inline PK_HD float pbsdf__pr_pdf(const pbsdf *b, vec3 wo, vec3 wi)
+static inline PBSDF_CALLED PK_HD float pbsdf__pr_pdf(const pbsdf *b, vec3 wo, vec3 wi)
 {
     if (wo.z == 0.0f || wi.z == 0.0f) return 0.0f;
     const bool front = wo.z > 0.0f;
@@ -1787,7 +1796,7 @@ static inline PK_HD float pbsdf__pr_pdf(const pbsdf *b, vec3 wo, vec3 wi)
     return pdf;
 }
 
-static inline PK_HD bool pbsdf__pr_sample(const pbsdf *b, vec3 wo, const float u[3], vec3 *wi, vec3 *weight,
+static inline PBSDF_CALLED PK_HD bool pbsdf__pr_sample(const pbsdf *b, vec3 wo, const float u[3], vec3 *wi, vec3 *weight,
                                           float *pdf)
 {
     if (wo.z == 0.0f) return false;
@@ -1873,7 +1882,7 @@ static inline PK_HD vec3 pbsdf__th_half(vec3 *wo, vec3 *wi)
     const float l2 = v3_len2(h);
     return l2 > 0.0f ? v3_scale(h, 1.0f / sqrtf(l2)) : v3(0.0f, 0.0f, 1.0f);
 }
-static inline PK_HD vec3 pbsdf__th_eval(const pbsdf *b, vec3 wo, vec3 wi)
+static inline PBSDF_CALLED PK_HD vec3 pbsdf__th_eval(const pbsdf *b, vec3 wo, vec3 wi)
 {
     vec3 v = v3s(0.0f);
     if (wo.z == 0.0f) return v;
@@ -1921,7 +1930,7 @@ static inline PK_HD vec3 pbsdf__th_eval(const pbsdf *b, vec3 wo, vec3 wi)
     if (refract && st < 1.0f && dt > 0.0f) v = v3_add(v, v3_scale(base, (1.0f - st) * dt * -wi.z / PK_PI));
     return v;
 }
-static inline PK_HD float pbsdf__th_pdf(const pbsdf *b, vec3 wo, vec3 wi)
+static inline PBSDF_CALLED PK_HD float pbsdf__th_pdf(const pbsdf *b, vec3 wo, vec3 wi)
 {
     if (wo.z == 0.0f) return 0.0f;
     const vec3 h = pbsdf__th_half(&wo, &wi);
@@ -1943,7 +1952,7 @@ static inline PK_HD float pbsdf__th_pdf(const pbsdf *b, vec3 wo, vec3 wi)
     }
     return isfinite(pdf) ? pdf : 0.0f;
 }
-static inline PK_HD bool pbsdf__th_sample(const pbsdf *b, vec3 wo, const float u[3], vec3 *wi, vec3 *weight,
+static inline PBSDF_CALLED PK_HD bool pbsdf__th_sample(const pbsdf *b, vec3 wo, const float u[3], vec3 *wi, vec3 *weight,
                                           float *pdf)
 {
     if (wo.z == 0.0f) return false;
