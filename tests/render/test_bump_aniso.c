@@ -158,11 +158,11 @@ static material first_material(const char *fmt, const char *text, warning_log *w
     pk_context_set_warning_handler(ctx, NULL, NULL);
     CHECKF(st == PK_OK, "%s", pk_context_error(ctx));
     REQUIRE(st == PK_OK && s->nmaterials >= 1);
-    /* the scene's one conductor, dielectric or plastic (a default material may come first) */
+    /* the scene's one conductor, dielectric, plastic or coated material (a default material may come first) */
     material m = s->materials[0];
     for (size_t i = 0; i < s->nmaterials; i++)
         if (s->materials[i].type == MAT_CONDUCTOR || s->materials[i].type == MAT_DIELECTRIC ||
-            s->materials[i].type == MAT_PLASTIC)
+            s->materials[i].type == MAT_PLASTIC || s->materials[i].type == MAT_COATED)
             m = s->materials[i];
     m.name = NULL;
     pk_scene_destroy(s);
@@ -212,7 +212,7 @@ static void test_readers(void)
                        "WorldBegin\nMaterial \"coateddiffuse\" \"float uroughness\" 0.04 \"float vroughness\" 0.16\n"
                        "Shape \"sphere\"\n",
                        &w);
-    CHECKF(m.type == MAT_PLASTIC && fabsf(m.alpha - 0.3f) < 1e-6f && m.alpha_v < 0.0f &&
+    CHECKF(m.type == MAT_COATED && fabsf(m.alpha - 0.3f) < 1e-6f && m.alpha_v < 0.0f &&
                strstr(w.all, "is rendered isotropic"),
            "coateddiffuse: alpha %g alpha_v %g: %s", (double)m.alpha, (double)m.alpha_v, w.all);
     m = first_material("pbrt",
