@@ -54,6 +54,7 @@ static char *b64(const uint8_t *p, size_t n)
 
 static warning_log wlog;
 static char msg[1024];
+static const char *load_config; /* a context configuration for load (NULL: none) */
 
 /* Parses and commits json; *out the scene (NULL on failure). */
 static pk_status load(const char *json, pk_scene **out)
@@ -61,6 +62,7 @@ static pk_status load(const char *json, pk_scene **out)
     pk_context *ctx;
     REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
     warning_log_attach(ctx, &wlog);
+    if (load_config) REQUIRE(pk_context_set_config(ctx, load_config) == PK_OK);
     pk_scene *s;
     REQUIRE(scene_create(ctx, "t.gltf", &s) == PK_OK);
     pk_status st = scene_gltf_parse(ctx, s, json, strlen(json), "t.gltf", PK_TEST_DATA "/gltf");
@@ -618,6 +620,55 @@ static void test_tangents_cube(void)
     scene_destroy(s);
 }
 
+/* Instances kept rather than flattened give the same vertex colours and
+ * tangents at a hit (a mirroring instance's handedness turned). */
+static void test_kept(void)
+{
+    const float pos[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0}, nrm[12] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
+    const float uv[8] = {0, 1, 1, 1, 1, 0, 0, 0};
+    const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+    /* node 0 places the mesh and its child node 1 places it again, mirrored and turned */
+    const char *nodes = ",\"children\":[1]},{\"mesh\":0,\"scale\":[-1,1,1],\"rotation\":[0,0,0.38268343,0.92387953]";
+    char *j = mesh_doc(pos, nrm, uv, NULL, 4, idx, 6, nodes);
+    pk_scene *flat, *kept;
+    load_config = "scene.instances=flatten";
+    CHECKF(load(j, &flat) == PK_OK, "%s", msg);
+    load_config = "scene.instances=keep";
+    CHECKF(load(j, &kept) == PK_OK, "%s", msg);
+    load_config = NULL;
+    free(j);
+    REQUIRE(flat && kept && flat->ntris == 4 && kept->ntris == 0 && kept->nkept == 2 && flat->tangents && kept->mesh_tangents);
+    const scene_view vf = scene_view_of(flat), vk = scene_view_of(kept);
+    int bad = 0;
+    for (uint32_t k = 0; k < 4; k++) {
+        vec3 tf, tk;
+        float wf, wk;
+        REQUIRE(view_tri_tangent(&vf, k, 0.2f, 0.3f, &tf, &wf) && view_tri_tangent(&vk, k, 0.2f, 0.3f, &tk, &wk));
+        bad += !vnear(v3_norm(tf), v3_norm(tk), 1e-6f) || wf != wk;
+        if (k >= 2) CHECK(wf == -1.0f); /* the mirrored one */
+    }
+    CHECK(bad == 0);
+    scene_destroy(flat);
+    scene_destroy(kept);
+
+    /* colours */
+    j = color_doc(",\"material\":0", ",\"materials\":[{}]", "\"componentType\":5121,\"normalized\":true,\"type\":\"VEC4\"");
+    load_config = "scene.instances=flatten";
+    CHECKF(load(j, &flat) == PK_OK, "%s", msg);
+    load_config = "scene.instances=keep";
+    CHECKF(load(j, &kept) == PK_OK, "%s", msg);
+    load_config = NULL;
+    free(j);
+    REQUIRE(flat && kept && kept->nkept == 2 && kept->mesh_colors);
+    const scene_view cf = scene_view_of(flat), ck = scene_view_of(kept);
+    for (uint32_t k = 0; k < 2; k++) {
+        const rgba a = view_tri_color(&cf, k, 0.2f, 0.3f), b = view_tri_color(&ck, k, 0.2f, 0.3f);
+        CHECK(a.r == b.r && a.g == b.g && a.b == b.b && a.a == b.a && fabsf(a.r - 0.5f) < 1e-6f);
+    }
+    scene_destroy(flat);
+    scene_destroy(kept);
+}
+
 int main(void)
 {
     test_morph();
@@ -628,5 +679,6 @@ int main(void)
     test_tangents_plane();
     test_tangents_sphere();
     test_tangents_cube();
+    test_kept();
     return test_done("test_gltf_geom");
 }
