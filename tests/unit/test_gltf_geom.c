@@ -276,6 +276,27 @@ static void test_normal_scale(void)
     CHECKF(wlog.count == 0, "%s", wlog.last);
     const material *m = &s->materials[s->tris[0].material];
     CHECK(m->map_norm.kind == TEX_IMAGE && m->norm_scale == 0.25f);
+    /* at texel centres: the map's x and y times 0.25 in the frame t = +x (u), b = -y (the image's
+     * up: glTF's v runs down +y here), n = +z, then normalised */
+    const scene_view v = scene_view_of(s);
+    const float centres[3][2] = {{0.25f, 0.75f}, {0.75f, 0.75f}, {0.25f, 0.25f}};
+    int checked = 0;
+    for (int k = 0; k < 3; k++) {
+        const float uc = centres[k][0], vc = centres[k][1];
+        const tex_query q = {uc, vc, 0.0f, v3s(0.0f), v3s(0.0f), v.tex_nodes};
+        const vec3 c = tex_eval_rgb(v.textures, &m->map_norm, q);
+        const vec3 tl = v3(0.25f * (2.0f * c.x - 1.0f), 0.25f * (2.0f * c.y - 1.0f), 2.0f * c.z - 1.0f);
+        if (!(tl.z > 0.0f)) continue; /* a normal facing away is not used */
+        const vec3 want = v3_norm(v3(tl.x, -tl.y, tl.z));
+        ray r = {{uc, 1.0f - vc, 1.0f}, 0.0f, {0.0f, 0.0f, -1.0f}, INFINITY};
+        hit h = {1.0f, 0, uc, 1.0f - vc};
+        material tm;
+        const surface sf = surface_texture(&v, &r, &h, 0.0f, surface_at(&v, &r, &h), &tm);
+        CHECKF(vnear(sf.ns, want, 1e-5f), "texel %d: (%g %g %g), want (%g %g %g)", k, (double)sf.ns.x, (double)sf.ns.y,
+               (double)sf.ns.z, (double)want.x, (double)want.y, (double)want.z);
+        checked++;
+    }
+    CHECK(checked >= 1); /* (tex_rgbw: red and green texels point into the surface) */
     scene_destroy(s);
 }
 
