@@ -71,6 +71,16 @@ typedef struct gltf {
     unsigned warned;
     int camera_pick;       /* /cameras/N asked for, -1: the first placed */
     bool camera_done;
+    /* the node being placed: its morph weights (NULL: the mesh's own) and,
+     * for a skinned node, its joint matrices (joint's world transform times
+     * its inverse bind matrix, nskin of them; NULL: not skinned) */
+    const float *node_weights;
+    size_t nnode_weights;
+    xform *skin;
+    size_t nskin;
+    int64_t skin_index;
+    int64_t *parent;       /* per node: its parent, -1 for a root */
+    uint32_t vc_default;   /* the default material's copy for vertex colours (0: not made) */
 } gltf;
 
 /* warned bits */
@@ -132,6 +142,9 @@ PK_HIDDEN pk_status gltf_accessor_get(gltf *g, int64_t i, gltf_accessor *a);
 /* Reads accessor i as floats, ncomp a vertex (normalized integers as the
  * specification maps them; others as their values). *out allocated. */
 PK_HIDDEN pk_status gltf_read_floats(gltf *g, int64_t i, const gltf_accessor *a, float **out);
+/* Reads a MAT4 accessor of floats as affine transforms (column-major in
+ * the file; a last row other than 0 0 0 1 is refused). *out allocated. */
+PK_HIDDEN pk_status gltf_read_mat4(gltf *g, int64_t i, const gltf_accessor *a, xform **out);
 /* Reads a SCALAR accessor of unsigned integers. *out allocated. */
 PK_HIDDEN pk_status gltf_read_uints(gltf *g, int64_t i, const gltf_accessor *a, uint32_t **out);
 PK_HIDDEN void gltf_buffers_free(gltf *g);

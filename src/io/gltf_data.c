@@ -448,6 +448,29 @@ pk_status gltf_read_floats(gltf *g, int64_t i, const gltf_accessor *a, float **o
     return PK_OK;
 }
 
+pk_status gltf_read_mat4(gltf *g, int64_t i, const gltf_accessor *a, xform **out)
+{
+    *out = NULL;
+    if (!a->matrix || a->ncomp != 16 || a->ctype != 5126)
+        return gltf_fail(g, PK_ERR_PARSE, "/accessors/%lld: must be a MAT4 of floats", (long long)i);
+    xform *x = mem_calloc(&g->ctx->alloc, a->count, sizeof *x);
+    if (!x) return ctx_nomem(g->ctx);
+    for (size_t k = 0; k < a->count; k++) {
+        float m[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+        if (a->base)
+            for (int c = 0; c < 16; c++) m[c] = (float)comp_raw(a->base + k * a->stride + (size_t)c * 4, 5126);
+        if (m[3] != 0.0f || m[7] != 0.0f || m[11] != 0.0f || m[15] != 1.0f) {
+            mem_free(&g->ctx->alloc, x);
+            return gltf_fail(g, PK_ERR_PARSE, "/accessors/%lld: matrix %zu is not affine (its last row is not 0 0 0 1)",
+                             (long long)i, k);
+        }
+        for (int row = 0; row < 4; row++)
+            for (int col = 0; col < 4; col++) x[k].m[4 * row + col] = m[4 * col + row];
+    }
+    *out = x;
+    return PK_OK;
+}
+
 pk_status gltf_read_uints(gltf *g, int64_t i, const gltf_accessor *a, uint32_t **out)
 {
     *out = NULL;

@@ -470,9 +470,7 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
     if ((st = make_ref(g, &t_base, true, bake, path, &m.map_kd))) goto fail;
     if ((st = make_ref(g, &t_mr, false, bake, path, &m.map_mr))) goto fail;
     if ((st = make_ref(g, &t_norm, false, bake, path, &m.map_norm))) goto fail;
-    if (m.map_norm.kind && t_norm.scale != 1.0f)
-        gltf_warn_once(g, GW_NORMAL_SCALE, "%s/normalTexture: scale %g is drawn as 1 (further ones not reported)",
-                       path, (double)t_norm.scale);
+    if (m.map_norm.kind) m.norm_scale = t_norm.scale;
     if (t_emit.present && v3_max_comp(m.ke) > 0.0f) {
         tex_ref er;
         if ((st = make_ref(g, &t_emit, true, bake, path, &er))) goto fail;
@@ -481,22 +479,19 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
     if (amode == 1 || amode == 2) {
         const bool tex_alpha =
             m.map_kd.kind == TEX_IMAGE && (g->s->textures[m.map_kd.tex].nc == 2 || g->s->textures[m.map_kd.tex].nc == 4);
-        if (amode == 1 || tex_alpha) {
-            /* MASK: the cut-out alpha * factor >= cutoff; BLEND with a texture's alpha: its
-             * cut-out at one half, the constant factor dissolving the rest */
-            float factor = amode == 1 ? base[3] : 1.0f, cut = amode == 1 ? cutoff : 0.5f;
+        if (amode == 1) {
+            /* MASK: the cut-out alpha * factor >= cutoff */
             int32_t mask;
-            if ((st = make_mask(g, mi, tex_alpha ? m.map_kd.tex : -1, factor, cut, &mask))) goto fail;
+            if ((st = make_mask(g, mi, tex_alpha ? m.map_kd.tex : -1, base[3], cutoff, &mask))) goto fail;
             tex_ref_init(&m.map_d);
             m.map_d = m.map_kd; /* the same uv transform and wrap */
             m.map_d.tex = mask;
-            if (amode == 2)
-                gltf_warn_once(g, GW_BLEND,
-                               "%s: alphaMode BLEND with a texture's alpha is drawn as a cut-out at alpha 0.5 "
-                               "(further ones not reported)",
-                               path);
+        } else {
+            /* BLEND: there with probability factor x the base colour texture's alpha, for every ray */
+            m.blend = true;
+            m.blend_alpha = base[3];
+            if (tex_alpha) m.map_d = m.map_kd; /* its alpha channel (linear), the same uv transform and wrap */
         }
-        if (amode == 2) m.d = base[3]; /* stochastic opacity */
     }
     if (transmission > 0.0f && thickness > 0.0f && (st = make_volume(g, path, &m, transmission, thickness, att_dist,
                                                                       att_col, t_base.present || t_mr.present)))

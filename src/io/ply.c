@@ -151,6 +151,8 @@ void ply_mesh_free(pk_context *ctx, ply_mesh *m)
     mem_free(&ctx->alloc, m->positions);
     mem_free(&ctx->alloc, m->normals);
     mem_free(&ctx->alloc, m->uvs);
+    mem_free(&ctx->alloc, m->colors);
+    mem_free(&ctx->alloc, m->tangents);
     mem_free(&ctx->alloc, m->indices);
     mem_free(&ctx->alloc, m->face_material);
     memset(m, 0, sizeof *m);
@@ -275,6 +277,9 @@ pk_status ply_parse(pk_context *ctx, const char *data, size_t size, const char *
         }
         bool is_vertex = strcmp(el->name, "vertex") == 0, is_face = strcmp(el->name, "face") == 0;
         int px = -1, py = -1, pz = -1, pnx = -1, pny = -1, pnz = -1, pu = -1, pv = -1, pidx = -1, pmat = -1;
+        int pc[4] = {-1, -1, -1, -1}, pt[4] = {-1, -1, -1, -1};
+        static const char *const cnames[4] = {"color_r", "color_g", "color_b", "color_a"};
+        static const char *const tnames[4] = {"tangent_x", "tangent_y", "tangent_z", "tangent_w"};
         for (int k = 0; k < el->nprops; k++) {
             const char *pn = el->props[k].name;
             bool list = el->props[k].count_type != T_NONE;
@@ -289,6 +294,10 @@ pk_status ply_parse(pk_context *ctx, const char *data, size_t size, const char *
                     pu = k;
                 else if (!strcmp(pn, "v") || !strcmp(pn, "t") || !strcmp(pn, "texture_v") || !strcmp(pn, "texture_t"))
                     pv = k;
+                for (int q = 0; q < 4; q++) {
+                    if (!strcmp(pn, cnames[q])) pc[q] = k;
+                    if (!strcmp(pn, tnames[q])) pt[q] = k;
+                }
             }
             if (is_face && list && (!strcmp(pn, "vertex_indices") || !strcmp(pn, "vertex_index"))) pidx = k;
             if (is_face && !list && !strcmp(pn, "material")) pmat = k;
@@ -312,6 +321,13 @@ pk_status ply_parse(pk_context *ctx, const char *data, size_t size, const char *
             out->positions = mem_calloc(&ctx->alloc, ncap, sizeof *out->positions);
             if (pnx >= 0 && pny >= 0 && pnz >= 0) out->normals = mem_calloc(&ctx->alloc, ncap, sizeof *out->normals);
             if (pu >= 0 && pv >= 0) out->uvs = mem_calloc(&ctx->alloc, 2 * ncap, sizeof *out->uvs);
+            const bool hc = pc[0] >= 0 && pc[1] >= 0 && pc[2] >= 0 && pc[3] >= 0;
+            const bool ht = pt[0] >= 0 && pt[1] >= 0 && pt[2] >= 0 && pt[3] >= 0;
+            if ((hc && !(out->colors = mem_calloc(&ctx->alloc, 4 * ncap, sizeof *out->colors))) ||
+                (ht && !(out->tangents = mem_calloc(&ctx->alloc, 4 * ncap, sizeof *out->tangents)))) {
+                st = ctx_nomem(ctx);
+                goto out;
+            }
             if (!out->positions || (pnx >= 0 && pny >= 0 && pnz >= 0 && !out->normals) ||
                 (pu >= 0 && pv >= 0 && !out->uvs)) {
                 st = ctx_nomem(ctx);
@@ -375,6 +391,12 @@ pk_status ply_parse(pk_context *ctx, const char *data, size_t size, const char *
                 if (out->uvs) {
                     out->uvs[2 * it] = isfinite((float)vals[pu]) ? (float)vals[pu] : 0.0f;
                     out->uvs[2 * it + 1] = isfinite((float)vals[pv]) ? (float)vals[pv] : 0.0f;
+                }
+                for (int ch = 0; ch < 4; ch++) {
+                    if (out->colors)
+                        out->colors[4 * it + (uint64_t)ch] = isfinite((float)vals[pc[ch]]) ? (float)vals[pc[ch]] : 0.0f;
+                    if (out->tangents)
+                        out->tangents[4 * it + (uint64_t)ch] = isfinite((float)vals[pt[ch]]) ? (float)vals[pt[ch]] : 0.0f;
                 }
             }
         }

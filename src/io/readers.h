@@ -96,6 +96,10 @@ typedef struct ply_mesh {
     vec3 *positions;      /* nvertices */
     vec3 *normals;        /* nvertices, or NULL when the file has none */
     float *uvs;           /* 2 * nvertices, or NULL when the file has none */
+    /* 4 * nvertices each, or NULL: Paprsek's converter's vertex colours
+     * (color_r, color_g, color_b, color_a) and tangents (tangent_x, _y, _z,
+     * _w: scene.h's vtangent), all four properties or none */
+    float *colors, *tangents;
     size_t nvertices;
     uint32_t *indices;    /* 3 * ntriangles, each < nvertices */
     size_t ntriangles;

@@ -198,7 +198,7 @@ static pk_status check_document(gltf *g)
         if (strcmp(e->valuestring, "KHR_texture_transform") == 0) g->ext_texture_transform = true;
     }
     static const char *const arrays[] = {"buffers", "bufferViews", "accessors", "meshes", "nodes", "scenes",
-                                         "materials", "textures", "images", "samplers", "cameras", NULL};
+                                         "materials", "textures", "images", "samplers", "cameras", "skins", NULL};
     for (int i = 0; arrays[i]; i++) {
         const cJSON *a = cJSON_GetObjectItemCaseSensitive(g->root, arrays[i]);
         if (a && !cJSON_IsArray(a)) return gltf_fail(g, PK_ERR_PARSE, "/%s: must be an array", arrays[i]);
@@ -279,21 +279,23 @@ static pk_status triangulate(gltf *g, const char *path, int mode, const uint32_t
     return PK_OK;
 }
 
-/* One vertex attribute of a primitive as floats (*out NULL when absent). */
-static pk_status attribute(gltf *g, const cJSON *attrs, const char *path, const char *key, int ncomp, bool required,
-                           size_t *count, float **out)
+/* One vertex attribute of a primitive as floats (*out NULL when absent);
+ * ap: the JSON pointer of attrs. Integers that are not normalized are read
+ * as their values (warned unless ints: joint numbers). */
+static pk_status attribute_in(gltf *g, const cJSON *attrs, const char *ap, const char *key, int ncomp, bool required,
+                              bool ints, size_t *count, float **out)
 {
     *out = NULL;
     int64_t ai;
-    char ap[128];
-    snprintf(ap, sizeof ap, "%s/attributes", path);
     pk_status st = gltf_index(g, attrs, ap, key, gltf_count(g, "accessors"), required, &ai);
     if (st || ai < 0) return st;
     gltf_accessor a;
     if ((st = gltf_accessor_get(g, ai, &a))) return st;
     if (a.ncomp != ncomp || a.matrix)
         return gltf_fail(g, PK_ERR_PARSE, "/accessors/%lld: %s must have %d components", (long long)ai, key, ncomp);
-    if (a.ctype != 5126 && !g->ext_quantization && !a.normalized)
+    if (ints && (a.ctype == 5126 || a.normalized))
+        return gltf_fail(g, PK_ERR_PARSE, "/accessors/%lld: %s must be unsigned bytes or shorts", (long long)ai, key);
+    if (!ints && a.ctype != 5126 && !g->ext_quantization && !a.normalized)
         gltf_warn(g, "/accessors/%lld: integer %s without KHR_mesh_quantization declared; read as its values",
                   (long long)ai, key);
     if (*count && a.count != *count)
@@ -303,8 +305,265 @@ static pk_status attribute(gltf *g, const cJSON *attrs, const char *path, const 
     return gltf_read_floats(g, ai, &a, out);
 }
 
-/* Adds primitive p of mesh mi through the builder's current transform. */
-static pk_status add_primitive(gltf *g, int64_t mi, int pi, const cJSON *p, bool flip)
+static pk_status attribute(gltf *g, const cJSON *attrs, const char *path, const char *key, int ncomp, bool required,
+                           size_t *count, float **out)
+{
+    char ap[128];
+    snprintf(ap, sizeof ap, "%s/attributes", path);
+    return attribute_in(g, attrs, ap, key, ncomp, required, false, count, out);
+}
+
+/* COLOR_0 (VEC3 or VEC4 of floats or normalized unsigned bytes or shorts)
+ * as RGBA (alpha 1 for VEC3), *out NULL when absent. */
+static pk_status read_colors(gltf *g, const cJSON *attrs, const char *path, size_t *count, float **out)
+{
+    *out = NULL;
+    char ap[128];
+    snprintf(ap, sizeof ap, "%s/attributes", path);
+    int64_t ai;
+    pk_status st = gltf_index(g, attrs, ap, "COLOR_0", gltf_count(g, "accessors"), false, &ai);
+    if (st || ai < 0) return st;
+    gltf_accessor a;
+    if ((st = gltf_accessor_get(g, ai, &a))) return st;
+    if (a.matrix || (a.ncomp != 3 && a.ncomp != 4) ||
+        !(a.ctype == 5126 || (a.normalized && (a.ctype == 5121 || a.ctype == 5123))))
+        return gltf_fail(g, PK_ERR_PARSE,
+                         "/accessors/%lld: COLOR_0 must be a VEC3 or VEC4 of floats or normalized unsigned bytes or shorts",
+                         (long long)ai);
+    float *c = NULL;
+    if ((st = attribute_in(g, attrs, ap, "COLOR_0", a.ncomp, false, false, count, &c))) return st;
+    if (a.ncomp == 4) {
+        *out = c;
+        return PK_OK;
+    }
+    float *c4 = mem_calloc(&g->ctx->alloc, *count, 4 * sizeof *c4);
+    if (!c4) {
+        mem_free(&g->ctx->alloc, c);
+        return ctx_nomem(g->ctx);
+    }
+    for (size_t k = 0; k < *count; k++) {
+        c4[4 * k] = c[3 * k], c4[4 * k + 1] = c[3 * k + 1], c4[4 * k + 2] = c[3 * k + 2];
+        c4[4 * k + 3] = 1.0f;
+    }
+    mem_free(&g->ctx->alloc, c);
+    *out = c4;
+    return PK_OK;
+}
+
+/* Applies the morph targets of primitive p (at path) with weights w[0..nw)
+ * to its n positions and normals (nrm may be NULL): each target's
+ * POSITION and NORMAL displacements times its weight are added. */
+static pk_status apply_morph(gltf *g, const cJSON *p, const char *path, const float *w, size_t nw, size_t n,
+                             float *pos, float *nrm)
+{
+    const cJSON *targets = cJSON_GetObjectItemCaseSensitive(p, "targets");
+    if (!targets) return PK_OK;
+    if (!cJSON_IsArray(targets)) return gltf_fail(g, PK_ERR_PARSE, "%s/targets: must be an array", path);
+    size_t nt = (size_t)cJSON_GetArraySize(targets);
+    if (nw && nw != nt)
+        gltf_warn_once(g, GW_MORPH, "%s/targets: %zu targets and %zu weights; the missing weights are 0", path, nt, nw);
+    size_t k = 0;
+    for (const cJSON *t = targets->child; t; t = t->next, k++) {
+        char tp[128];
+        snprintf(tp, sizeof tp, "%s/targets/%zu", path, k);
+        if (!cJSON_IsObject(t)) return gltf_fail(g, PK_ERR_PARSE, "%s: must be an object", tp);
+        const float wk = k < nw ? w[k] : 0.0f;
+        if (wk == 0.0f) continue;
+        for (int a = 0; a < 2; a++) {
+            float *dst = a ? nrm : pos, *d = NULL;
+            if (!dst) continue;
+            size_t cnt = n;
+            pk_status st = attribute_in(g, t, tp, a ? "NORMAL" : "POSITION", 3, false, false, &cnt, &d);
+            if (st) return st;
+            if (!d) continue;
+            for (size_t i = 0; i < 3 * n; i++) dst[i] += wk * d[i];
+            mem_free(&g->ctx->alloc, d);
+        }
+    }
+    return PK_OK;
+}
+
+/* Linear blend skinning with the node's joint matrices (g->skin): each
+ * vertex moves by the sum of its four joints' matrices times their weights
+ * (the weights divided by their sum); normals by the inverse transpose of
+ * that sum. */
+static pk_status apply_skin(gltf *g, const cJSON *attrs, const char *path, size_t n, float *pos, float *nrm)
+{
+    float *jn = NULL, *wt = NULL;
+    size_t cnt = n;
+    char ap[128];
+    snprintf(ap, sizeof ap, "%s/attributes", path);
+    pk_status st = attribute_in(g, attrs, ap, "JOINTS_0", 4, false, true, &cnt, &jn);
+    if (!st) st = attribute_in(g, attrs, ap, "WEIGHTS_0", 4, false, false, &cnt, &wt);
+    if (st) goto out;
+    if (!jn || !wt) {
+        gltf_warn_once(g, GW_SKIN, "%s: a skinned node's mesh without JOINTS_0 and WEIGHTS_0 is drawn as it stands", path);
+        goto out;
+    }
+    if (cJSON_GetObjectItemCaseSensitive(attrs, "JOINTS_1"))
+        gltf_warn_once(g, GW_SKIN, "%s/attributes/JOINTS_1: only the first four joints of a vertex move it", path);
+    for (size_t i = 0; i < n; i++) {
+        xform m;
+        memset(&m, 0, sizeof m);
+        float sum = 0.0f;
+        for (int c = 0; c < 4; c++) {
+            const float w = wt[4 * i + c], j = jn[4 * i + c];
+            if (w == 0.0f) continue;
+            if (!(j >= 0.0f) || j >= (float)g->nskin) {
+                st = gltf_fail(g, PK_ERR_PARSE, "%s/attributes/JOINTS_0: joint %.0f of vertex %zu is not one of the skin's %zu",
+                               path, (double)j, i, g->nskin);
+                goto out;
+            }
+            const xform *J = &g->skin[(size_t)j];
+            for (int e = 0; e < 12; e++) m.m[e] += w * J->m[e];
+            sum += w;
+        }
+        if (!(sum > 0.0f)) continue; /* no weight: left where it is */
+        for (int e = 0; e < 12; e++) m.m[e] /= sum;
+        m.m[15] = 1.0f;
+        vec3 *q = (vec3 *)(pos + 3 * i);
+        *q = xform_point(&m, *q);
+        if (nrm) {
+            float nm[9];
+            xform_normal_cofactors(&m, nm);
+            vec3 *nq = (vec3 *)(nrm + 3 * i);
+            *nq = xform_apply3(nm, *nq);
+        }
+    }
+out:
+    mem_free(&g->ctx->alloc, jn);
+    mem_free(&g->ctx->alloc, wt);
+    return st;
+}
+
+
+/* ---- tangents --------------------------------------------------------------------------- */
+
+/* A vertex's key for welding: its position, normal and uv bits. */
+typedef struct weld_key {
+    float f[8];
+    uint32_t i;
+} weld_key;
+
+static int weld_cmp(const void *a, const void *b)
+{
+    const int c = memcmp(((const weld_key *)a)->f, ((const weld_key *)b)->f, sizeof ((const weld_key *)a)->f);
+    if (c) return c;
+    const uint32_t x = ((const weld_key *)a)->i, y = ((const weld_key *)b)->i;
+    return x < y ? -1 : x > y;
+}
+
+/* Tangents for n vertices (pos, unit nrm, uv in the scene's convention: v
+ * up) of triangles tris, after Mikkelsen's "Simulation of wrinkled surfaces
+ * revisited" (the MikkTSpace of other tools): each triangle's dp/du from its
+ * uv derivatives, projected on the tangent plane of each corner's normal
+ * and weighted by the corner's angle there, summed over the corners of
+ * vertices equal in position, normal and uv (welded, whatever their
+ * indices) and of the same uv orientation (the sign of the uv area), then
+ * made perpendicular to the normal; the handedness is that orientation.
+ * Triangles without uv area add nothing (their vertices take their
+ * neighbours' tangents); a vertex left without any gets one perpendicular
+ * to its normal. Where one vertex index has corners of both orientations,
+ * the heavier one is kept. *out: 4 floats a vertex. */
+static pk_status gen_tangents(gltf *g, const float *pos, const float *nrm, const float *uv, size_t n,
+                              const uint32_t *tris, size_t ntris, float **out)
+{
+    *out = NULL;
+    const pk_allocator *al = &g->ctx->alloc;
+    weld_key *keys = mem_calloc(al, n ? n : 1, sizeof *keys);
+    uint32_t *weld = mem_calloc(al, n ? n : 1, sizeof *weld);
+    float *acc = mem_calloc(al, n ? n : 1, 8 * sizeof *acc); /* per weld id and orientation: x y z weight */
+    float *t = mem_calloc(al, n ? n : 1, 4 * sizeof *t);
+    if (!keys || !weld || !acc || !t) {
+        mem_free(al, keys), mem_free(al, weld), mem_free(al, acc), mem_free(al, t);
+        return ctx_nomem(g->ctx);
+    }
+    for (size_t i = 0; i < n; i++) {
+        memcpy(keys[i].f, pos + 3 * i, 3 * sizeof(float));
+        memcpy(keys[i].f + 3, nrm + 3 * i, 3 * sizeof(float));
+        memcpy(keys[i].f + 6, uv + 2 * i, 2 * sizeof(float));
+        for (int c = 0; c < 8; c++)
+            if (keys[i].f[c] == 0.0f) keys[i].f[c] = 0.0f; /* -0 welds with 0 */
+        keys[i].i = (uint32_t)i;
+    }
+    qsort(keys, n, sizeof *keys, weld_cmp);
+    for (size_t k = 0; k < n; k++) /* a weld id: the first index of its run */
+        weld[keys[k].i] = k && memcmp(keys[k].f, keys[k - 1].f, sizeof keys[k].f) == 0 ? weld[keys[k - 1].i] : keys[k].i;
+    for (size_t f = 0; f < ntris; f++) {
+        const uint32_t *v = tris + 3 * f;
+        const vec3 p0 = v3(pos[3 * v[0]], pos[3 * v[0] + 1], pos[3 * v[0] + 2]);
+        const vec3 e1 = v3_sub(v3(pos[3 * v[1]], pos[3 * v[1] + 1], pos[3 * v[1] + 2]), p0);
+        const vec3 e2 = v3_sub(v3(pos[3 * v[2]], pos[3 * v[2] + 1], pos[3 * v[2] + 2]), p0);
+        const float du1 = uv[2 * v[1]] - uv[2 * v[0]], dv1 = uv[2 * v[1] + 1] - uv[2 * v[0] + 1];
+        const float du2 = uv[2 * v[2]] - uv[2 * v[0]], dv2 = uv[2 * v[2] + 1] - uv[2 * v[0] + 1];
+        const float det = du1 * dv2 - dv1 * du2;
+        if (!(fabsf(det) > 0.0f) || !isfinite(1.0f / det)) continue; /* no uv area */
+        const vec3 dpdu = v3_norm_scaled(v3_scale(v3_sub(v3_scale(e1, dv2), v3_scale(e2, dv1)), det > 0.0f ? 1.0f : -1.0f));
+        if (!v3_finite(dpdu) || !(v3_len2(dpdu) > 0.0f)) continue;
+        const int o = det > 0.0f ? 0 : 1;
+        for (int j = 0; j < 3; j++) {
+            const uint32_t i = v[j];
+            const vec3 nn = v3(nrm[3 * i], nrm[3 * i + 1], nrm[3 * i + 2]);
+            const vec3 pi = v3(pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]);
+            const uint32_t a = v[(j + 1) % 3], b = v[(j + 2) % 3];
+            /* the corner's edges in the normal's tangent plane, and the angle between them */
+            vec3 ea = v3_sub(v3(pos[3 * a], pos[3 * a + 1], pos[3 * a + 2]), pi);
+            vec3 eb = v3_sub(v3(pos[3 * b], pos[3 * b + 1], pos[3 * b + 2]), pi);
+            ea = v3_norm_scaled(v3_sub(ea, v3_scale(nn, v3_dot(nn, ea))));
+            eb = v3_norm_scaled(v3_sub(eb, v3_scale(nn, v3_dot(nn, eb))));
+            float ang = acosf(fminf(fmaxf(v3_dot(ea, eb), -1.0f), 1.0f));
+            if (!isfinite(ang)) ang = 0.0f;
+            const vec3 tp = v3_norm_scaled(v3_sub(dpdu, v3_scale(nn, v3_dot(nn, dpdu))));
+            if (!v3_finite(tp)) continue;
+            float *s = acc + 8 * (size_t)weld[i] + 4 * o;
+            s[0] += ang * tp.x, s[1] += ang * tp.y, s[2] += ang * tp.z, s[3] += ang;
+        }
+    }
+    for (size_t i = 0; i < n; i++) {
+        const float *s = acc + 8 * (size_t)weld[i];
+        /* the heavier orientation (the corners' total angle) */
+        const int o = s[7] > s[3] ? 1 : 0;
+        const vec3 nn = v3(nrm[3 * i], nrm[3 * i + 1], nrm[3 * i + 2]);
+        vec3 x = v3(s[4 * o], s[4 * o + 1], s[4 * o + 2]);
+        x = v3_norm_scaled(v3_sub(x, v3_scale(nn, v3_dot(nn, x))));
+        if (!v3_finite(x) || !(v3_len2(x) > 0.5f)) { /* nothing to go by: any direction across the normal */
+            const vec3 ax = fabsf(nn.x) < 0.9f ? v3(1.0f, 0.0f, 0.0f) : v3(0.0f, 1.0f, 0.0f);
+            x = v3_norm_scaled(v3_sub(ax, v3_scale(nn, v3_dot(nn, ax))));
+            if (!v3_finite(x)) x = v3(1.0f, 0.0f, 0.0f);
+        }
+        t[4 * i] = x.x, t[4 * i + 1] = x.y, t[4 * i + 2] = x.z;
+        t[4 * i + 3] = o ? -1.0f : 1.0f;
+    }
+    mem_free(al, keys), mem_free(al, weld), mem_free(al, acc);
+    *out = t;
+    return PK_OK;
+}
+
+/* TANGENT (VEC4 of floats or normalized signed bytes or shorts) with unit
+ * xyz and w = +1 or -1; *out NULL when absent. */
+static pk_status read_tangents(gltf *g, const cJSON *attrs, const char *path, size_t *count, float **out)
+{
+    *out = NULL;
+    char ap[128];
+    snprintf(ap, sizeof ap, "%s/attributes", path);
+    int64_t ai;
+    pk_status st = gltf_index(g, attrs, ap, "TANGENT", gltf_count(g, "accessors"), false, &ai);
+    if (st || ai < 0) return st;
+    float *t = NULL;
+    if ((st = attribute_in(g, attrs, ap, "TANGENT", 4, false, false, count, &t))) return st;
+    for (size_t k = 0; k < *count; k++) {
+        vec3 x = v3_norm_scaled(v3(t[4 * k], t[4 * k + 1], t[4 * k + 2]));
+        if (!v3_finite(x)) x = v3s(0.0f);
+        t[4 * k] = x.x, t[4 * k + 1] = x.y, t[4 * k + 2] = x.z;
+        t[4 * k + 3] = t[4 * k + 3] < 0.0f ? -1.0f : 1.0f;
+    }
+    *out = t;
+    return PK_OK;
+}
+
+/* Adds primitive p of mesh mi through the builder's current transform,
+ * morphed by weights w[0..nw) and skinned by g->skin when set. */
+static pk_status add_primitive(gltf *g, int64_t mi, int pi, const cJSON *p, bool flip, const float *w, size_t nw)
 {
     char path[96];
     snprintf(path, sizeof path, "/meshes/%lld/primitives/%d", (long long)mi, pi);
@@ -318,8 +577,6 @@ static pk_status add_primitive(gltf *g, int64_t mi, int pi, const cJSON *p, bool
     }
     if (gltf_ext(p, "KHR_draco_mesh_compression"))
         gltf_warn_once(g, GW_EXT, "%s: Draco-compressed data ignored; the uncompressed fallback is read", path);
-    if (cJSON_GetObjectItemCaseSensitive(p, "targets"))
-        gltf_warn_once(g, GW_MORPH, "%s: morph targets are not applied (further ones not reported)", path);
     const cJSON *attrs = cJSON_GetObjectItemCaseSensitive(p, "attributes");
     if (!cJSON_IsObject(attrs)) return gltf_fail(g, PK_ERR_PARSE, "%s/attributes: required, and must be an object", path);
     if ((st = gltf_index(g, p, path, "indices", gltf_count(g, "accessors"), false, &ii))) return st;
@@ -328,19 +585,22 @@ static pk_status add_primitive(gltf *g, int64_t mi, int pi, const cJSON *p, bool
     int uvset;
     if ((st = gltf_material(g, mat, &smat, &uvset))) return st;
 
-    float *pos = NULL, *nrm = NULL, *uv = NULL, *tmp = NULL;
+    float *pos = NULL, *nrm = NULL, *uv = NULL, *tmp = NULL, *col = NULL, *tan = NULL;
     uint32_t *idx = NULL, *tris = NULL;
     size_t n = 0, ntris = 0;
     if ((st = attribute(g, attrs, path, "POSITION", 3, true, &n, &pos))) goto out;
     if ((st = attribute(g, attrs, path, "NORMAL", 3, false, &n, &nrm))) goto out;
     if ((st = attribute(g, attrs, path, uvset ? "TEXCOORD_1" : "TEXCOORD_0", 2, false, &n, &uv))) goto out;
-    if (cJSON_GetObjectItemCaseSensitive(attrs, "COLOR_0"))
-        gltf_warn_once(g, GW_COLOR, "%s/attributes/COLOR_0: vertex colours are not drawn (further ones not reported)",
-                       path);
+    if ((st = read_colors(g, attrs, path, &n, &col))) goto out;
     if (!uvset && cJSON_GetObjectItemCaseSensitive(attrs, "TEXCOORD_1"))
         gltf_warn_once(g, GW_UV1, "%s/attributes/TEXCOORD_1: no texture of the material reads it; ignored", path);
-    if (cJSON_GetObjectItemCaseSensitive(attrs, "JOINTS_0"))
-        gltf_warn_once(g, GW_SKIN, "%s: skinning is not applied; drawn in the bind pose", path);
+    /* the vertex tangents, for the frame of a normal map or of anisotropic roughness */
+    const bool want_tan = g->s->materials[smat].map_norm.kind != TEX_NONE || material_anisotropic(&g->s->materials[smat]);
+    bool posed = g->skin != NULL;
+    for (size_t k = 0; k < nw; k++) posed |= w[k] != 0.0f && cJSON_GetObjectItemCaseSensitive(p, "targets");
+    if (want_tan && !posed && (st = read_tangents(g, attrs, path, &n, &tan))) goto out;
+    if ((st = apply_morph(g, p, path, w, nw, n, pos, nrm))) goto out;
+    if (g->skin && (st = apply_skin(g, attrs, path, n, pos, nrm))) goto out;
     size_t nidx = n;
     if (ii >= 0) {
         gltf_accessor a;
@@ -367,10 +627,37 @@ static pk_status add_primitive(gltf *g, int64_t mi, int pi, const cJSON *p, bool
             *q = v3_norm_scaled(*q);
             if (!v3_finite(*q)) *q = v3s(0.0f);
         }
+    if (want_tan && !tan && nrm && uv && (st = gen_tangents(g, pos, nrm, uv, n, tris, ntris, &tan))) goto out;
+    if (col && smat == 0) { /* the default material with the colours: a copy of its own */
+        if (!g->vc_default) {
+            uint32_t c;
+            if ((st = scene_material_copy(g->ctx, g->s, 0, "default+COLOR_0", &c))) goto out;
+            g->vc_default = c;
+        }
+        smat = g->vc_default;
+    }
+    if (col) g->s->materials[smat].vertex_color = true;
     sb_set_material(&g->b, smat);
+    const size_t pbase = g->s->npositions;
     sb_mesh m = {(const vec3 *)pos, (const vec3 *)nrm, uv, n, tris, ntris, flip};
     st = sb_add_mesh(&g->b, &m);
+    for (size_t k = 0; col && st == PK_OK && k < n; k++) {
+        const float *c = col + 4 * k;
+        st = scene_set_color(g->ctx, g->s, pbase + k, (rgba){c[0], c[1], c[2], c[3]});
+    }
+    if (tan && st == PK_OK) { /* through the transform; a mirroring one turns the handedness */
+        const xform *x = sb_transform(&g->b);
+        const float hand = xform_det3(x) < 0.0 ? -1.0f : 1.0f;
+        for (size_t k = 0; st == PK_OK && k < n; k++) {
+            const float *c = tan + 4 * k;
+            vtangent vt = {v3_norm_scaled(xform_vector(x, v3(c[0], c[1], c[2]))), c[3] * hand};
+            if (!v3_finite(vt.t) || !(v3_len2(vt.t) > 0.0f)) vt = (vtangent){{0.0f, 0.0f, 0.0f}, 0.0f};
+            st = scene_set_tangent(g->ctx, g->s, pbase + k, vt);
+        }
+    }
 out:
+    mem_free(&g->ctx->alloc, col);
+    mem_free(&g->ctx->alloc, tan);
     mem_free(&g->ctx->alloc, pos);
     mem_free(&g->ctx->alloc, nrm);
     mem_free(&g->ctx->alloc, uv);
@@ -378,6 +665,30 @@ out:
     mem_free(&g->ctx->alloc, idx);
     mem_free(&g->ctx->alloc, tris);
     return st;
+}
+
+#define GLTF_MAX_WEIGHTS 256   /* morph targets of a mesh applied */
+
+/* obj's weights array (none: *n = 0) into w. */
+static pk_status weights(gltf *g, const cJSON *obj, const char *path, float *w, size_t *n)
+{
+    *n = 0;
+    const cJSON *a = cJSON_GetObjectItemCaseSensitive(obj, "weights");
+    if (!a) return PK_OK;
+    if (!cJSON_IsArray(a)) return gltf_fail(g, PK_ERR_PARSE, "%s/weights: must be an array of numbers", path);
+    size_t k = 0;
+    for (const cJSON *e = a->child; e; e = e->next, k++) {
+        if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble) || !isfinite((float)e->valuedouble))
+            return gltf_fail(g, PK_ERR_PARSE, "%s/weights/%zu: must be a finite number", path, k);
+        if (k >= GLTF_MAX_WEIGHTS) {
+            gltf_warn_once(g, GW_MORPH, "%s/weights: morph targets past the first %d are not applied", path,
+                           GLTF_MAX_WEIGHTS);
+            break;
+        }
+        w[k] = (float)e->valuedouble;
+    }
+    *n = k;
+    return PK_OK;
 }
 
 static pk_status add_mesh(gltf *g, int64_t mi, bool flip)
@@ -388,11 +699,16 @@ static pk_status add_mesh(gltf *g, int64_t mi, bool flip)
     if (!cJSON_IsObject(m)) return gltf_fail(g, PK_ERR_PARSE, "%s: must be an object", path);
     const cJSON *prims = cJSON_GetObjectItemCaseSensitive(m, "primitives");
     if (!cJSON_IsArray(prims)) return gltf_fail(g, PK_ERR_PARSE, "%s/primitives: required, and must be an array", path);
+    /* the node's morph weights, else the mesh's own, else none */
+    float mw[GLTF_MAX_WEIGHTS];
+    const float *w = g->node_weights;
+    size_t nw = g->nnode_weights;
+    pk_status st;
+    if (!w && (st = weights(g, m, path, mw, &nw))) return st;
+    if (!w) w = mw;
     int k = 0;
-    for (const cJSON *p = prims->child; p; p = p->next, k++) {
-        pk_status st = add_primitive(g, mi, k, p, flip);
-        if (st) return st;
-    }
+    for (const cJSON *p = prims->child; p; p = p->next, k++)
+        if ((st = add_primitive(g, mi, k, p, flip, w, nw))) return st;
     return PK_OK;
 }
 
@@ -505,6 +821,73 @@ static pk_status place_light(gltf *g, int64_t li, const xform *x)
 
 /* ---- the node tree ------------------------------------------------------------------------- */
 
+/* Node ni's transform in the world: its local transforms and its
+ * ancestors' (g->parent). */
+static pk_status node_world(gltf *g, int64_t ni, xform *out)
+{
+    *out = xform_identity();
+    const cJSON *nodes = gltf_array(g, "nodes");
+    for (int depth = 0; ni >= 0; depth++) {
+        char path[48];
+        snprintf(path, sizeof path, "/nodes/%lld", (long long)ni);
+        if (depth >= GLTF_MAX_NODE_DEPTH)
+            return gltf_fail(g, PK_ERR_LIMIT, "%s: nodes nested deeper than %d", path, GLTF_MAX_NODE_DEPTH);
+        const cJSON *n = cJSON_GetArrayItem(nodes, (int)ni);
+        if (!cJSON_IsObject(n)) return gltf_fail(g, PK_ERR_PARSE, "%s: must be an object", path);
+        xform local;
+        pk_status st = node_local(g, n, path, &local);
+        if (st) return st;
+        *out = xform_mul(&local, out);
+        ni = g->parent[ni];
+    }
+    if (!xform_finite(out)) return gltf_fail(g, PK_ERR_PARSE, "/nodes/%lld: the transform is not finite", (long long)ni);
+    return PK_OK;
+}
+
+/* The joint matrices of skin si into g->skin: each joint's world transform
+ * times its inverse bind matrix (the identity when there are none). */
+static pk_status skin_matrices(gltf *g, int64_t si)
+{
+    char path[48];
+    snprintf(path, sizeof path, "/skins/%lld", (long long)si);
+    const cJSON *sk = cJSON_GetArrayItem(gltf_array(g, "skins"), (int)si);
+    if (!cJSON_IsObject(sk)) return gltf_fail(g, PK_ERR_PARSE, "%s: must be an object", path);
+    const cJSON *joints = cJSON_GetObjectItemCaseSensitive(sk, "joints");
+    if (!cJSON_IsArray(joints) || !cJSON_GetArraySize(joints))
+        return gltf_fail(g, PK_ERR_PARSE, "%s/joints: required, and must be an array of node indices", path);
+    const size_t nj = (size_t)cJSON_GetArraySize(joints), nn = gltf_count(g, "nodes");
+    pk_status st;
+    int64_t ibi;
+    if ((st = gltf_index(g, sk, path, "inverseBindMatrices", gltf_count(g, "accessors"), false, &ibi))) return st;
+    xform *ib = NULL;
+    if (ibi >= 0) {
+        gltf_accessor a;
+        if ((st = gltf_accessor_get(g, ibi, &a))) return st;
+        if (a.count < nj)
+            return gltf_fail(g, PK_ERR_PARSE, "%s/inverseBindMatrices: %zu matrices for %zu joints", path, a.count, nj);
+        if ((st = gltf_read_mat4(g, ibi, &a, &ib))) return st;
+    }
+    g->skin = mem_calloc(&g->ctx->alloc, nj, sizeof *g->skin);
+    if (!g->skin) {
+        mem_free(&g->ctx->alloc, ib);
+        return ctx_nomem(g->ctx);
+    }
+    g->nskin = nj;
+    size_t k = 0;
+    st = PK_OK;
+    for (const cJSON *j = joints->child; j && !st; j = j->next, k++) {
+        if (!is_integer(j) || j->valuedouble < 0 || j->valuedouble >= (double)nn) {
+            st = gltf_fail(g, PK_ERR_PARSE, "%s/joints/%zu: not a node index", path, k);
+            break;
+        }
+        xform jw;
+        if ((st = node_world(g, (int64_t)j->valuedouble, &jw))) break;
+        g->skin[k] = ib ? xform_mul(&jw, &ib[k]) : jw;
+    }
+    mem_free(&g->ctx->alloc, ib);
+    return st;
+}
+
 typedef struct walk {
     uint8_t *state;       /* per node: 0 not seen, 1 on the path, 2 done */
     uint32_t *mesh_uses;  /* per mesh: nodes that place it */
@@ -541,13 +924,41 @@ static pk_status visit(gltf *g, walk *w, int64_t ni, const xform *parent, int de
         size_t nl = cJSON_IsArray(lights) ? (size_t)cJSON_GetArraySize(lights) : 0;
         if ((st = gltf_index(g, le, lp, "light", nl, true, &li))) return st;
     }
+    int64_t ski;
+    if ((st = gltf_index(g, n, path, "skin", gltf_count(g, "skins"), false, &ski))) return st;
+    /* a skinned or morphed node's mesh is its own, not an instance */
+    const bool own = mi >= 0 && (ski >= 0 || cJSON_GetObjectItemCaseSensitive(n, "weights"));
     if (w->count_only) {
-        if (mi >= 0 && w->mesh_uses[mi] < UINT32_MAX) w->mesh_uses[mi]++;
+        if (mi >= 0 && !own && w->mesh_uses[mi] < UINT32_MAX) w->mesh_uses[mi]++;
     } else {
-        if (cJSON_GetObjectItemCaseSensitive(n, "skin"))
-            gltf_warn_once(g, GW_SKIN, "%s: skinning is not applied; drawn in the bind pose", path);
         double det = xform_det3(&x);
-        if (mi >= 0 && w->mesh_uses[mi] > 1) {
+        if (own) {
+            float *nw = mem_calloc(&g->ctx->alloc, GLTF_MAX_WEIGHTS, sizeof *nw); /* (visit recurses: not on the stack) */
+            if (!nw) return ctx_nomem(g->ctx);
+            size_t nnw = 0;
+            if ((st = weights(g, n, path, nw, &nnw))) {
+                mem_free(&g->ctx->alloc, nw);
+                return st;
+            }
+            g->node_weights = cJSON_GetObjectItemCaseSensitive(n, "weights") ? nw : NULL;
+            g->nnode_weights = nnw;
+            if (ski >= 0) {
+                /* the joints place the vertices; the node's own transform is not applied */
+                xform id = xform_identity();
+                sb_set_transform(&g->b, &id);
+                if ((st = skin_matrices(g, ski)) == PK_OK) st = add_mesh(g, mi, false);
+            } else {
+                sb_set_transform(&g->b, &x);
+                st = add_mesh(g, mi, det < 0.0);
+            }
+            g->node_weights = NULL;
+            g->nnode_weights = 0;
+            mem_free(&g->ctx->alloc, nw);
+            mem_free(&g->ctx->alloc, g->skin);
+            g->skin = NULL;
+            g->nskin = 0;
+            if (st) return st;
+        } else if (mi >= 0 && w->mesh_uses[mi] > 1) {
             if (w->mesh_obj[mi] < 0) {
                 /* the mesh in its own space, once */
                 xform id = xform_identity();
@@ -716,6 +1127,21 @@ pk_status scene_gltf_parse_params(pk_context *ctx, pk_scene *s, const char *data
         goto out;
     }
     for (size_t i = 0; i < nm; i++) w.mesh_obj[i] = -1;
+    g->parent = mem_calloc(&ctx->alloc, nn + 1, sizeof *g->parent);
+    if (!g->parent) {
+        st = ctx_nomem(ctx);
+        goto out;
+    }
+    for (size_t i = 0; i < nn; i++) g->parent[i] = -1;
+    {
+        size_t i = 0;
+        for (const cJSON *n = gltf_array(g, "nodes") ? gltf_array(g, "nodes")->child : NULL; n; n = n->next, i++) {
+            const cJSON *ch = cJSON_GetObjectItemCaseSensitive(n, "children");
+            for (const cJSON *c = cJSON_IsArray(ch) ? ch->child : NULL; c; c = c->next)
+                if (is_integer(c) && c->valuedouble >= 0 && c->valuedouble < (double)nn && g->parent[(size_t)c->valuedouble] < 0)
+                    g->parent[(size_t)c->valuedouble] = (int64_t)i;
+        }
+    }
     if (g->camera_pick >= 0 && (size_t)g->camera_pick >= gltf_count(g, "cameras")) {
         st = gltf_fail(g, PK_ERR_INVALID_ARGUMENT, "camera %d: the asset has %zu camera%s", g->camera_pick,
                        gltf_count(g, "cameras"), gltf_count(g, "cameras") == 1 ? "" : "s");
@@ -737,6 +1163,8 @@ out:
     if (w.state) mem_free(&ctx->alloc, w.state);
     mem_free(&ctx->alloc, w.mesh_uses);
     mem_free(&ctx->alloc, w.mesh_obj);
+    mem_free(&ctx->alloc, g->parent);
+    mem_free(&ctx->alloc, g->skin);
     gltf_materials_free(g);
     gltf_buffers_free(g);
     if (g->root) cJSON_Delete(g->root);

@@ -1554,6 +1554,14 @@ static pk_status load_ply_file(jp *p, const cJSON *file, const char *fp, const u
         if (st == PK_OK && m.normals) st = scene_add_normal(p->ctx, s, m.normals[v]);
         if (st == PK_OK && m.uvs) st = scene_add_uv(p->ctx, s, (uv2){m.uvs[2 * v], m.uvs[2 * v + 1]});
     }
+    for (size_t v = 0; m.colors && v < m.nvertices && st == PK_OK; v++) {
+        const float *c = m.colors + 4 * v;
+        st = scene_set_color(p->ctx, s, pos0 + v, (rgba){c[0], c[1], c[2], c[3]});
+    }
+    for (size_t v = 0; m.tangents && v < m.nvertices && st == PK_OK; v++) {
+        const float *c = m.tangents + 4 * v;
+        st = scene_set_tangent(p->ctx, s, pos0 + v, (vtangent){{c[0], c[1], c[2]}, c[3]});
+    }
     for (size_t t = 0; t < m.ntriangles && st == PK_OK; t++) {
         triangle tri;
         tri.material = 0;

@@ -35,6 +35,8 @@ const rec_field rec_material[] = {
     F(material, srate_diff, REC_FLOAT), F(material, thin, REC_BOOL),
     F(material, diff_trans, REC_FLOAT), F(material, srate_st, REC_FLOAT),
     F(material, srate_dt, REC_FLOAT),
+    F(material, norm_scale, REC_FLOAT), F(material, blend, REC_BOOL),
+    F(material, blend_alpha, REC_FLOAT), F(material, vertex_color, REC_BOOL),
 };
 const size_t rec_nmaterial = sizeof rec_material / sizeof rec_material[0];
 

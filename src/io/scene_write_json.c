@@ -457,6 +457,8 @@ typedef struct tri_src {
     size_t ntris;
     const vec3 *pos, *nrm;
     const uv2 *uv;
+    const rgba *col;        /* by position, NULL: none */
+    const vtangent *tan;    /* by position, NULL: none */
 } tri_src;
 
 static bool tri_has_n(const triangle *t) { return t->n[0] >= 0 && t->n[1] >= 0 && t->n[2] >= 0; }
@@ -496,11 +498,14 @@ static pk_status write_run(jw *w, const tri_src *src, size_t t0, size_t t1, mat_
             *(const uint8_t *)&one ? "little" : "big", 3 * ntri);
     if (has_n) fputs("property float nx\nproperty float ny\nproperty float nz\n", f);
     if (has_t) fputs("property float u\nproperty float v\n", f);
+    if (src->col) fputs("property float color_r\nproperty float color_g\nproperty float color_b\nproperty float color_a\n", f);
+    if (src->tan)
+        fputs("property float tangent_x\nproperty float tangent_y\nproperty float tangent_z\nproperty float tangent_w\n", f);
     fprintf(f, "element face %zu\nproperty list uchar uint vertex_indices\nproperty uint material\nend_header\n", ntri);
     for (size_t t = t0; t < t1; t++) {
         const triangle *tr = &src->tris[t];
         for (int j = 0; j < 3; j++) {
-            float v[8];
+            float v[16];
             int n = 0;
             const vec3 p = src->pos[tr->v[j]];
             v[n++] = p.x, v[n++] = p.y, v[n++] = p.z;
@@ -511,6 +516,14 @@ static pk_status write_run(jw *w, const tri_src *src, size_t t0, size_t t1, mat_
             if (has_t) {
                 const uv2 q = src->uv[tr->t[j]];
                 v[n++] = q.u, v[n++] = q.v;
+            }
+            if (src->col) {
+                const rgba c = src->col[tr->v[j]];
+                v[n++] = c.r, v[n++] = c.g, v[n++] = c.b, v[n++] = c.a;
+            }
+            if (src->tan) {
+                const vtangent c = src->tan[tr->v[j]];
+                v[n++] = c.t.x, v[n++] = c.t.y, v[n++] = c.t.z, v[n++] = c.w;
             }
             fwrite(v, sizeof(float), (size_t)n, f);
         }
@@ -577,7 +590,7 @@ static pk_status write_meshes(jw *w)
     }
     fputs(",\n\"meshes\": [", w->f);
     /* the world's triangles, a file (and an entry) per run */
-    const tri_src world = {s->tris, s->ntris, s->positions, s->normals, s->uvs};
+    const tri_src world = {s->tris, s->ntris, s->positions, s->normals, s->uvs, s->colors, s->tangents};
     bool first = true;
     for (size_t t0 = 0; t0 < s->ntris && st == PK_OK;) {
         const size_t t1 = run_end(&world, t0);
@@ -598,7 +611,9 @@ static pk_status write_meshes(jw *w)
         mesh_no[mi] = ++nmesh;
         const scene_mesh *m = &s->meshes[mi];
         const tri_src src = {s->mesh_tris + m->first_tri, m->ntris, s->mesh_positions + m->first_pos,
-                             s->mesh_normals + m->first_nrm, s->mesh_uvs + m->first_uv};
+                             s->mesh_normals + m->first_nrm, s->mesh_uvs + m->first_uv,
+                             s->mesh_colors ? s->mesh_colors + m->first_pos : NULL,
+                             s->mesh_tangents ? s->mesh_tangents + m->first_pos : NULL};
         fprintf(w->f, "%s\n  {\"ply\": [", first ? "" : ",");
         first = false;
         for (size_t t0 = 0; t0 < src.ntris && st == PK_OK;) {

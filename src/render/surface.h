@@ -208,6 +208,10 @@ static inline PK_HD void surface_texture_at(const scene_view *s, const ray *r, c
 #endif
     /* texture values: colours and alpha in 0..1 (HDR images may hold more), Ns >= 0 */
     if (m->map_kd.kind) tm->kd = v3_mul(m->kd, surface_clamp_rgb(tex_eval_rgb(s->textures, &m->map_kd, q)));
+    if (m->vertex_color && surface_is_tri(s, h->prim)) {
+        const rgba c = view_tri_color(s, h->prim, h->u, h->v);
+        tm->kd = v3_mul(tm->kd, surface_clamp_rgb(v3(c.r, c.g, c.b)));
+    }
     if (m->map_ks.kind) tm->ks = v3_mul(m->ks, surface_clamp_rgb(tex_eval_rgb(s->textures, &m->map_ks, q)));
     if (m->map_ns.kind) tm->ns = m->ns * fmaxf(tex_eval_scalar(s->textures, &m->map_ns, q), 0.0f);
     if (m->map_alpha.kind) {
@@ -239,19 +243,29 @@ static inline PK_HD void surface_texture_at(const scene_view *s, const ray *r, c
         tm->ke = v3_mul(m->ke, v3(fmaxf(e.x, 0.0f), fmaxf(e.y, 0.0f), fmaxf(e.z, 0.0f)));
     }
     sf->m = tm;
-    if (material_anisotropic(m)) sf->dpdu = uv.dpdu; /* the u roughness's direction */
+    /* the vertex tangents where the mesh has them (glTF's TANGENT, given or generated) */
+    vec3 vt = uv.dpdu;
+    float vw = 0.0f;
+    const bool has_vt = surface_is_tri(s, h->prim) && view_tri_tangent(s, h->prim, h->u, h->v, &vt, &vw);
+    if (material_anisotropic(m)) sf->dpdu = vt; /* the u roughness's direction */
     if (!m->map_bump.kind && !m->map_norm.kind) return;
     /* a frame on the surface, z = the shading normal as it faces the ray */
     const vec3 n = sf->ns;
-    vec3 t = v3_sub(uv.dpdu, v3_scale(n, v3_dot(n, uv.dpdu)));
+    vec3 t = v3_sub(vt, v3_scale(n, v3_dot(n, vt)));
     if (!(v3_len2(t) > 0.0f) || !v3_finite(t)) return;
     t = v3_norm(t);
     vec3 b = v3_cross(n, t);
-    if (v3_dot(b, uv.dpdv) < 0.0f) b = v3_neg(b);
+    if (has_vt) { /* the bitangent w (n x t), n the normal on the side the vertex normals give */
+        if (!sf->front) b = v3_neg(b);
+        if (vw < 0.0f) b = v3_neg(b);
+    } else if (v3_dot(b, uv.dpdv) < 0.0f) {
+        b = v3_neg(b);
+    }
     vec3 nn = n;
     if (m->map_norm.kind) {
         vec3 c = tex_eval_rgb(s->textures, &m->map_norm, q);
         vec3 tl = v3(2.0f * c.x - 1.0f, 2.0f * c.y - 1.0f, 2.0f * c.z - 1.0f);
+        if (m->norm_scale != 1.0f) tl.x *= m->norm_scale, tl.y *= m->norm_scale;
         nn = v3_add(v3_add(v3_scale(t, tl.x), v3_scale(b, tl.y)), v3_scale(n, tl.z));
     } else {
         /* heights times bm displace along n: n' = (dp/du + dh/du n) x (dp/dv + dh/dv n) */
@@ -300,18 +314,38 @@ static inline PK_HD surface surface_texture(const scene_view *s, const ray *r, c
 
 #define HOLE_STEPS 256   /* holes passed along one ray at most; then the surface counts */
 
-/* True when the hit lies in a hole of its material's map_d (opacity < 0.5). */
+/* Whether a ray r that hits a surface of coverage a (0 ... 1) at h passes
+ * through it: with probability 1 - a, by a hash of the hit point and the
+ * ray's direction, so that the choice is the same for the same ray
+ * whatever the thread or the device, and differs between the rays of a
+ * pixel's samples, the bounces of a path and the layers one ray passes. */
+static inline PK_HD bool surface_blend_pass(const ray *r, const hit *h, float a)
+{
+    if (a >= 1.0f) return false;
+    if (!(a > 0.0f)) return true;
+    const vec3 p = v3_add(r->o, v3_scale(r->d, h->t));
+    return surface_mix_hash(p, r->d, 0x51ed) >= a;
+}
+
+/* True when the hit lies in a hole of its material's map_d (opacity < 0.5),
+ * or passes through a stochastically transparent surface (material.blend). */
 static inline PK_HD bool surface_is_hole(const scene_view *s, const ray *r, const hit *h)
 {
     const material *m = &s->materials[view_prim_material(s, h->prim)];
     if (!m->cutout) return false;
+    float ca = 1.0f; /* the vertex colours' alpha */
+    if (m->vertex_color && surface_is_tri(s, h->prim))
+        ca = fminf(fmaxf(view_tri_color(s, h->prim, h->u, h->v).a, 0.0f), 1.0f);
+    if (m->blend && !m->map_d.kind) return surface_blend_pass(r, h, m->blend_alpha * ca);
     const surface_uv uv = surface_uv_at(s, r, h);
     tex_query q = {uv.u, uv.v, 0.0f, v3s(0.0f), v3s(0.0f), s->tex_nodes};
     if (m->map_d.kind == TEX_EXPR) {
         const surface sf = surface_at(s, r, h);
         q.p = sf.p, q.n = sf.ng;
     }
-    return tex_eval_alpha(s->textures, &m->map_d, q) < 0.5f;
+    const float a = tex_eval_alpha(s->textures, &m->map_d, q);
+    if (m->blend) return surface_blend_pass(r, h, m->blend_alpha * ca * fminf(fmaxf(a, 0.0f), 1.0f));
+    return a < 0.5f;
 }
 
 /* Steps past holes: while h (a hit of *r) is a hole, looks further along *r

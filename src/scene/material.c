@@ -18,6 +18,7 @@ void material_init(material *m)
     m->illum = 2;
     m->medium_in = m->medium_out = -2; /* MEDIUM_INHERIT */
     m->alpha_v = -1.0f;                /* isotropic */
+    m->norm_scale = 1.0f;
     tex_ref_init(&m->map_kd);
     tex_ref_init(&m->map_ks);
     tex_ref_init(&m->map_ns);

@@ -154,6 +154,18 @@ typedef struct material {
      * transmittance tf of a dielectric, thin dielectric or diffuse
      * transmitter (clamped to 0..1). */
     tex_ref map_kd, map_ks, map_ns, map_d, map_alpha, map_bump, map_norm, map_mr, map_ke, map_eta, map_k, map_tf;
+    /* map_norm's scale (glTF's normalTexture.scale): the map's x and y are
+     * multiplied by it before the normal is normalised; 1 by default */
+    float norm_scale;
+    /* glTF's alphaMode BLEND as stochastic transparency: the surface is
+     * there for a ray with probability blend_alpha times map_d's alpha
+     * (when map_d is set; then it is no cut-out), decided by a hash of the
+     * ray and the hit (surface_is_hole), for shadow rays as for the others */
+    bool blend;
+    float blend_alpha;
+    /* the triangles' vertex colours (glTF's COLOR_0; white where a vertex
+     * has none) multiply kd, and with blend their alpha blend_alpha */
+    bool vertex_color;
     /* The media on either side (medium.h): medium_out on the side the
      * geometric normal points to, medium_in on the other; an index into the
      * scene's media, MEDIUM_NONE (vacuum) or MEDIUM_INHERIT (the surface

@@ -89,6 +89,10 @@ void scene_destroy(pk_scene *s)
     mem_free(a, s->mesh_positions);
     mem_free(a, s->mesh_normals);
     mem_free(a, s->mesh_uvs);
+    mem_free(a, s->colors);
+    mem_free(a, s->mesh_colors);
+    mem_free(a, s->tangents);
+    mem_free(a, s->mesh_tangents);
     mem_free(a, s->mesh_tris);
     mem_free(a, s->meshes);
     mem_free(a, s->instances);
@@ -116,7 +120,52 @@ void scene_destroy(pk_scene *s)
 
 pk_status scene_add_position(pk_context *ctx, pk_scene *s, vec3 p)
 {
+    if (s->colors) { /* every position has a colour: white until set */
+        if (!mem_grow(&s->alloc, (void **)&s->colors, &s->cap_colors, s->npositions + 1, sizeof *s->colors))
+            return ctx_nomem(ctx);
+        s->colors[s->npositions] = (rgba){1.0f, 1.0f, 1.0f, 1.0f};
+    }
+    if (s->tangents) { /* every position has a tangent: none until set */
+        if (!mem_grow(&s->alloc, (void **)&s->tangents, &s->cap_tangents, s->npositions + 1, sizeof *s->tangents))
+            return ctx_nomem(ctx);
+        s->tangents[s->npositions] = (vtangent){{0.0f, 0.0f, 0.0f}, 0.0f};
+    }
     APPEND(ctx, s, positions, npositions, cap_positions, p, SCENE_MAX_PRIMS, "vertices");
+}
+
+/* Grows *arr (of *cap) to n colours, white from from on. */
+static bool colors_grow(const pk_allocator *a, rgba **arr, size_t *cap, size_t from, size_t n)
+{
+    if (!mem_grow(a, (void **)arr, cap, n ? n : 1, sizeof **arr)) return false;
+    for (size_t i = from; i < n; i++) (*arr)[i] = (rgba){1.0f, 1.0f, 1.0f, 1.0f};
+    return true;
+}
+
+pk_status scene_set_color(pk_context *ctx, pk_scene *s, size_t i, rgba c)
+{
+    if (i >= s->npositions) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: a colour for no vertex", s->name);
+    if (!s->colors && !colors_grow(&s->alloc, &s->colors, &s->cap_colors, 0, s->npositions)) return ctx_nomem(ctx);
+    s->colors[i] = c;
+    s->committed = false;
+    return PK_OK;
+}
+
+/* Grows *arr (of *cap) to n tangents, none from from on. */
+static bool tangents_grow(const pk_allocator *a, vtangent **arr, size_t *cap, size_t from, size_t n)
+{
+    if (!mem_grow(a, (void **)arr, cap, n ? n : 1, sizeof **arr)) return false;
+    for (size_t i = from; i < n; i++) (*arr)[i] = (vtangent){{0.0f, 0.0f, 0.0f}, 0.0f};
+    return true;
+}
+
+pk_status scene_set_tangent(pk_context *ctx, pk_scene *s, size_t i, vtangent t)
+{
+    if (i >= s->npositions) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: a tangent for no vertex", s->name);
+    if (!s->tangents && !tangents_grow(&s->alloc, &s->tangents, &s->cap_tangents, 0, s->npositions))
+        return ctx_nomem(ctx);
+    s->tangents[i] = t;
+    s->committed = false;
+    return PK_OK;
 }
 
 pk_status scene_add_normal(pk_context *ctx, pk_scene *s, vec3 n)
@@ -636,6 +685,22 @@ pk_status scene_capture_mesh(pk_context *ctx, pk_scene *s, size_t pos0, size_t n
         s->nmesh_positions = m.first_pos, s->nmesh_normals = m.first_nrm, s->nmesh_uvs = m.first_uv;
         return ctx_nomem(ctx);
     }
+    if (s->colors || s->mesh_colors) { /* the mesh's colours beside its positions */
+        const size_t had = s->mesh_colors ? m.first_pos : 0;
+        if (!colors_grow(a, &s->mesh_colors, &s->cap_mesh_colors, had, s->nmesh_positions)) {
+            s->nmesh_positions = m.first_pos, s->nmesh_normals = m.first_nrm, s->nmesh_uvs = m.first_uv;
+            return ctx_nomem(ctx);
+        }
+        if (s->colors) memcpy(s->mesh_colors + m.first_pos, s->colors + pos0, m.npos * sizeof *s->colors);
+    }
+    if (s->tangents || s->mesh_tangents) { /* the mesh's tangents beside its positions */
+        const size_t had = s->mesh_tangents ? m.first_pos : 0;
+        if (!tangents_grow(a, &s->mesh_tangents, &s->cap_mesh_tangents, had, s->nmesh_positions)) {
+            s->nmesh_positions = m.first_pos, s->nmesh_normals = m.first_nrm, s->nmesh_uvs = m.first_uv;
+            return ctx_nomem(ctx);
+        }
+        if (s->tangents) memcpy(s->mesh_tangents + m.first_pos, s->tangents + pos0, m.npos * sizeof *s->tangents);
+    }
     for (size_t k = tri0; k < s->ntris; k++) {
         triangle t = s->tris[k];
         for (int j = 0; j < 3; j++) {
@@ -680,6 +745,21 @@ static pk_status place_instance(pk_context *ctx, pk_scene *s, const scene_instan
         vec3 q = xform_point(&in->to_world, s->mesh_positions[m->first_pos + i]);
         if (!v3_finite(q)) return ctx_error(ctx, PK_ERR_PARSE, "%s: a transformed vertex is not finite", s->name);
         if ((st = scene_add_position(ctx, s, q))) return st;
+    }
+    if (s->mesh_colors) {
+        if (!s->colors && !colors_grow(&s->alloc, &s->colors, &s->cap_colors, 0, s->npositions)) return ctx_nomem(ctx);
+        memcpy(s->colors + pbase, s->mesh_colors + m->first_pos, m->npos * sizeof *s->colors);
+    }
+    if (s->mesh_tangents) { /* directions by to_world; a mirroring transform turns the handedness */
+        if (!s->tangents && !tangents_grow(&s->alloc, &s->tangents, &s->cap_tangents, 0, s->npositions))
+            return ctx_nomem(ctx);
+        const float hand = xform_det3(&in->to_world) < 0.0 ? -1.0f : 1.0f;
+        for (size_t i = 0; i < m->npos; i++) {
+            const vtangent t = s->mesh_tangents[m->first_pos + i];
+            vtangent tw = {v3_norm_scaled(xform_vector(&in->to_world, t.t)), t.w * hand};
+            if (!v3_finite(tw.t) || t.w == 0.0f) tw = (vtangent){{0.0f, 0.0f, 0.0f}, 0.0f};
+            s->tangents[pbase + i] = tw;
+        }
     }
     for (size_t i = 0; i < m->nnrm; i++) {
         vec3 n = v3_norm_scaled(xform_apply3(nm, s->mesh_normals[m->first_nrm + i]));
@@ -875,11 +955,12 @@ pk_status scene_commit(pk_context *ctx, pk_scene *s)
     s->has_cutout = s->has_textured = s->has_interfaces = s->has_emission_maps = false;
     for (size_t i = 0; i < s->nmaterials; i++) {
         material *m = &s->materials[i];
-        m->cutout = m->map_d.kind != TEX_NONE;
+        m->cutout = m->map_d.kind != TEX_NONE || m->blend;
         m->textured = m->map_kd.kind != TEX_NONE || m->map_ks.kind != TEX_NONE || m->map_ns.kind != TEX_NONE ||
                       m->map_alpha.kind != TEX_NONE || m->map_bump.kind != TEX_NONE || m->map_norm.kind != TEX_NONE ||
                       m->map_mr.kind != TEX_NONE || m->map_ke.kind != TEX_NONE || m->map_eta.kind != TEX_NONE ||
-                      m->map_k.kind != TEX_NONE || m->map_tf.kind != TEX_NONE || material_anisotropic(m);
+                      m->map_k.kind != TEX_NONE || m->map_tf.kind != TEX_NONE || material_anisotropic(m) ||
+                      m->vertex_color;
         s->has_cutout |= m->cutout;
         s->has_interfaces |= m->type == MAT_INTERFACE;
         s->has_textured |= m->textured;

@@ -25,6 +25,19 @@ typedef struct triangle {
     uint32_t material;
 } triangle;
 
+/* A vertex colour, linear RGB and alpha (glTF's COLOR_0). */
+typedef struct rgba {
+    float r, g, b, a;
+} rgba;
+
+/* A vertex tangent (glTF's TANGENT): the unit direction t of increasing u
+ * and the handedness w (+1 or -1): the bitangent, the direction of
+ * increasing v, is w (n x t) for the vertex normal n. w = 0: none. */
+typedef struct vtangent {
+    vec3 t;
+    float w;
+} vtangent;
+
 /* A texture coordinate (OBJ vt: u to the right, v up). */
 typedef struct uv2 {
     float u, v;
@@ -187,6 +200,12 @@ struct pk_scene {
     vec3 *normals;   size_t nnormals, cap_normals;
     uv2 *uvs;        size_t nuvs, cap_uvs;
     triangle *tris;  size_t ntris, cap_tris;
+    /* Vertex colours by position: NULL when no vertex has one, else one
+     * for each position (white where none was given; scene_set_color) */
+    rgba *colors;    size_t cap_colors;
+    /* Vertex tangents by position: NULL when no vertex has one, else one
+     * for each position (w = 0 where none was given; scene_set_tangent) */
+    vtangent *tangents; size_t cap_tangents;
     sphere *spheres; size_t nspheres, cap_spheres;
     material *materials; size_t nmaterials, cap_materials;
     /* Name index: open addressing, mat_slots (a power of two, > 2 * nmaterials)
@@ -235,6 +254,8 @@ struct pk_scene {
     vec3 *mesh_positions; size_t nmesh_positions, cap_mesh_positions;
     vec3 *mesh_normals;   size_t nmesh_normals, cap_mesh_normals;
     uv2 *mesh_uvs;        size_t nmesh_uvs, cap_mesh_uvs;
+    rgba *mesh_colors;    size_t cap_mesh_colors;  /* NULL, or one for each mesh position */
+    vtangent *mesh_tangents; size_t cap_mesh_tangents; /* NULL, or one for each mesh position (object space) */
     triangle *mesh_tris;  size_t nmesh_tris, cap_mesh_tris;
     scene_mesh *meshes;   size_t nmeshes, cap_meshes;
     scene_instance *instances; size_t ninstances, cap_instances;
@@ -252,6 +273,13 @@ PK_HIDDEN void scene_destroy(pk_scene *s);
 PK_HIDDEN pk_status scene_add_position(pk_context *ctx, pk_scene *s, vec3 p);
 PK_HIDDEN pk_status scene_add_normal(pk_context *ctx, pk_scene *s, vec3 n);
 PK_HIDDEN pk_status scene_add_uv(pk_context *ctx, pk_scene *s, uv2 t);
+/* Gives position i (< npositions) the vertex colour c: the first colour of
+ * a scene gives every other position white. */
+PK_HIDDEN pk_status scene_set_color(pk_context *ctx, pk_scene *s, size_t i, rgba c);
+/* Gives position i (< npositions) the tangent t (world space, as the
+ * position: t.t of unit length, t.w +1 or -1): the first tangent of a
+ * scene gives every other position none (w = 0). */
+PK_HIDDEN pk_status scene_set_tangent(pk_context *ctx, pk_scene *s, size_t i, vtangent t);
 PK_HIDDEN pk_status scene_add_triangle(pk_context *ctx, pk_scene *s, const triangle *t);
 PK_HIDDEN pk_status scene_add_sphere(pk_context *ctx, pk_scene *s, const sphere *sp);
 /* Appends an expression of n procedural nodes (1 <= n <= TEX_MAX_NODES,

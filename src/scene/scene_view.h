@@ -15,6 +15,8 @@ typedef struct scene_view {
     const vec3 *positions, *normals;
     const uv2 *uvs;
     const triangle *tris;     /* ntris, in hit numbering; spheres follow as prims ntris.. */
+    const rgba *colors;       /* vertex colours by position, NULL: none (pk_scene's) */
+    const vtangent *tangents; /* vertex tangents by position, NULL: none */
     const sphere *spheres;
     const material *materials;
     const point_light *lights;
@@ -33,6 +35,8 @@ typedef struct scene_view {
     const vec3 *mesh_positions, *mesh_normals;
     const uv2 *mesh_uvs;
     const triangle *mesh_tris;
+    const rgba *mesh_colors;  /* by mesh position, NULL: none */
+    const vtangent *mesh_tangents; /* by mesh position, object space, NULL: none */
     /* Participating media (medium.h): the volumetric path tracer's (the GPU
      * renders scenes without them). */
     const medium *media;
@@ -55,6 +59,8 @@ static inline scene_view scene_view_of(const pk_scene *s)
     v.kept = s->kept, v.nkept = s->nkept, v.meshes = s->meshes;
     v.mesh_positions = s->mesh_positions, v.mesh_normals = s->mesh_normals, v.mesh_uvs = s->mesh_uvs;
     v.mesh_tris = s->mesh_tris;
+    v.colors = s->colors, v.mesh_colors = s->mesh_colors;
+    v.tangents = s->tangents, v.mesh_tangents = s->mesh_tangents;
     v.media = s->media, v.nmedia = s->nmedia, v.camera_medium = s->camera_medium;
     v.has_interfaces = s->has_interfaces;
     return v;
@@ -125,6 +131,60 @@ static inline PK_HD uint32_t view_prim_material(const scene_view *s, uint32_t pr
     if (k->material != SCENE_MESH_MATERIAL) return k->material;
     const scene_mesh *m = &s->meshes[k->mesh];
     return s->mesh_tris[m->first_tri + (prim - k->prim0)].material;
+}
+
+/* The vertex colour at a hit on triangle prim (barycentric u, v of its
+ * second and third vertices): white where the scene has none. */
+static inline PK_HD rgba view_tri_color(const scene_view *s, uint32_t prim, float u, float v)
+{
+    rgba c[3], out = {1.0f, 1.0f, 1.0f, 1.0f};
+    if (prim < s->ntris) {
+        if (!s->colors) return out;
+        for (int j = 0; j < 3; j++) c[j] = s->colors[s->tris[prim].v[j]];
+    } else {
+        if (!s->mesh_colors || prim - s->ntris < s->nspheres) return out;
+        const scene_kept *k = &s->kept[view_kept_of(s, prim)];
+        const scene_mesh *m = &s->meshes[k->mesh];
+        const triangle *t = &s->mesh_tris[m->first_tri + (prim - k->prim0)];
+        for (int j = 0; j < 3; j++) c[j] = s->mesh_colors[m->first_pos + t->v[j]];
+    }
+    const float w = 1.0f - u - v;
+    out.r = c[0].r * w + c[1].r * u + c[2].r * v, out.g = c[0].g * w + c[1].g * u + c[2].g * v;
+    out.b = c[0].b * w + c[1].b * u + c[2].b * v, out.a = c[0].a * w + c[1].a * u + c[2].a * v;
+    return out;
+}
+
+/* The vertex tangent at a hit on triangle prim (barycentric u, v), world
+ * space, not normalised, and its handedness *w: false where any of its
+ * vertices has none. */
+static inline PK_HD bool view_tri_tangent(const scene_view *s, uint32_t prim, float u, float v, vec3 *t, float *w)
+{
+    vtangent c[3];
+    const scene_kept *k = NULL;
+    if (prim < s->ntris) {
+        if (!s->tangents) return false;
+        for (int j = 0; j < 3; j++) c[j] = s->tangents[s->tris[prim].v[j]];
+    } else {
+        if (!s->mesh_tangents || prim - s->ntris < s->nspheres) return false;
+        k = &s->kept[view_kept_of(s, prim)];
+        const scene_mesh *m = &s->meshes[k->mesh];
+        const triangle *tr = &s->mesh_tris[m->first_tri + (prim - k->prim0)];
+        for (int j = 0; j < 3; j++) c[j] = s->mesh_tangents[m->first_pos + tr->v[j]];
+    }
+    if (c[0].w == 0.0f || c[1].w == 0.0f || c[2].w == 0.0f) return false;
+    const float b = 1.0f - u - v;
+    vec3 x = v3_add(v3_add(v3_scale(c[0].t, b), v3_scale(c[1].t, u)), v3_scale(c[2].t, v));
+    float hand = c[0].w;
+    if (k) { /* as flattening places it */
+        x = xform_vector(&k->to_world, x);
+        const float *m = k->to_world.m;
+        const float det = m[0] * (m[5] * m[10] - m[6] * m[9]) - m[1] * (m[4] * m[10] - m[6] * m[8]) +
+                          m[2] * (m[4] * m[9] - m[5] * m[8]);
+        if (det < 0.0f) hand = -hand;
+    }
+    *t = x;
+    *w = hand;
+    return true;
 }
 
 /* Geometry of triangle k. */

@@ -529,9 +529,9 @@ static void test_materials(void)
     CHECK(m1->d == 1.0f && !m1->two_sided);
     /* an emission map: the factor times the texture, decoded from sRGB (the image m2's base colour uses) */
     CHECK(vnear(m1->ke, v3(1, 0.5f, 1), 0) && m1->map_ke.kind == TEX_IMAGE && m1->map_ke.tex == m2->map_kd.tex);
-    /* BLEND: the constant alpha as stochastic opacity; one transform for the
+    /* BLEND: the constant alpha as stochastic transparency; one transform for the
      * material's textures: baked into the uvs, the references plain */
-    CHECK(m2->d == 0.3f && m2->map_kd.kind == TEX_IMAGE && m2->map_mr.kind == TEX_IMAGE && m2->map_kd.clamp);
+    CHECK(m2->blend && m2->blend_alpha == 0.3f && m2->d == 1.0f && m2->map_kd.kind == TEX_IMAGE && m2->map_mr.kind == TEX_IMAGE && m2->map_kd.clamp);
     CHECK(m2->map_kd.s[0] == 1.0f && m2->map_kd.o[1] == 0.0f);
     CHECK(m2->map_mr.tex != m2->map_kd.tex); /* the same image, decoded as data */
     /* uv (1, 0) in glTF: scaled (2, 0), offset (2.5, 0.25), the scene's v = 1 - 0.25 */
