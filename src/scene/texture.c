@@ -214,6 +214,31 @@ static vec3 texel_rgb(const texture *t, const tex_level *l, int x, int y)
     return t->nc >= 3 ? v3(c[0], c[1], c[2]) : v3s(c[0]);
 }
 
+/* Adds to sum the integral over triangle p (texel units of level l) of the
+ * level's texels read as constant squares, repeat or clamp. */
+static void box_integral(const texture *t, const tex_level *l, const double p[6], bool clamp, double sum[3])
+{
+    const double ylo = fmin(p[1], fmin(p[3], p[5])), yhi = fmax(p[1], fmax(p[3], p[5]));
+    double row[2 * 16], tmp[2 * 16], cell[2 * 16]; /* clipping adds at most 2 points a side */
+    for (int64_t iy = (int64_t)floor(ylo); (double)iy <= yhi; iy++) {
+        int n = clip_half(p, 3, tmp, 1, (double)iy, true);
+        n = clip_half(tmp, n, row, 1, (double)(iy + 1), false);
+        if (n < 3) continue;
+        double rxlo = row[0], rxhi = row[0];
+        for (int i = 1; i < n; i++) rxlo = fmin(rxlo, row[2 * i]), rxhi = fmax(rxhi, row[2 * i]);
+        const int y = (int)wrap64(iy, l->h, clamp);
+        for (int64_t ix = (int64_t)floor(rxlo); (double)ix <= rxhi; ix++) {
+            int m = clip_half(row, n, tmp, 0, (double)ix, true);
+            m = clip_half(tmp, m, cell, 0, (double)(ix + 1), false);
+            if (m < 3) continue;
+            const double a = poly_area(cell, m);
+            if (!(a > 0.0)) continue;
+            const vec3 c = texel_rgb(t, l, (int)wrap64(ix, l->w, clamp), y);
+            sum[0] += a * (double)c.x, sum[1] += a * (double)c.y, sum[2] += a * (double)c.z;
+        }
+    }
+}
+
 vec3 texture_triangle_mean(const texture *t, const double u[3], const double v[3], bool clamp)
 {
     const tex_level *top = &t->lv[t->nlevels - 1];
@@ -247,23 +272,22 @@ vec3 texture_triangle_mean(const texture *t, const double u[3], const double v[3
         return texel_rgb(t, top, 0, 0);
     }
     double sum[3] = {0.0, 0.0, 0.0};
-    double row[2 * 16], tmp[2 * 16], cell[2 * 16]; /* clipping adds at most 2 points a side */
-    for (int64_t iy = (int64_t)floor(ylo); (double)iy <= yhi; iy++) {
-        int n = clip_half(p, 3, tmp, 1, (double)iy, true);
-        n = clip_half(tmp, n, row, 1, (double)(iy + 1), false);
-        if (n < 3) continue;
-        double rxlo = row[0], rxhi = row[0];
-        for (int i = 1; i < n; i++) rxlo = fmin(rxlo, row[2 * i]), rxhi = fmax(rxhi, row[2 * i]);
-        const int y = (int)wrap64(iy, l->h, clamp);
-        for (int64_t ix = (int64_t)floor(rxlo); (double)ix <= rxhi; ix++) {
-            int m = clip_half(row, n, tmp, 0, (double)ix, true);
-            m = clip_half(tmp, m, cell, 0, (double)(ix + 1), false);
-            if (m < 3) continue;
-            const double a = poly_area(cell, m);
-            if (!(a > 0.0)) continue;
-            const vec3 c = texel_rgb(t, l, (int)wrap64(ix, l->w, clamp), y);
-            sum[0] += a * (double)c.x, sum[1] += a * (double)c.y, sum[2] += a * (double)c.z;
+    if (k > 0) {
+        box_integral(t, l, p, clamp, sum);
+    } else {
+        /* on the finest level the lookups' bilinear filter, which spreads
+         * each texel over a texel's width around it (the box function
+         * convolved with a one-texel box), counts: the mean of the box
+         * integral over the triangle moved by (+-1/4, +-1/4) texel (the
+         * midpoint rule of that convolution), so that a triangle beside a
+         * bright texel gets the light that reaches it */
+        for (int j = 0; j < 4; j++) {
+            double q[6];
+            for (int i = 0; i < 3; i++)
+                q[2 * i] = p[2 * i] + ((j & 1) ? 0.25 : -0.25), q[2 * i + 1] = p[2 * i + 1] + ((j & 2) ? 0.25 : -0.25);
+            box_integral(t, l, q, clamp, sum);
         }
+        sum[0] *= 0.25, sum[1] *= 0.25, sum[2] *= 0.25;
     }
     return v3((float)(sum[0] / area), (float)(sum[1] / area), (float)(sum[2] / area));
 }
