@@ -239,6 +239,9 @@ static void box_integral(const texture *t, const tex_level *l, const double p[6]
     }
 }
 
+/* (texture.h) On the finest level the lookups' bilinear filter is counted
+ * too: the mean of the integrals over the triangle moved by (+-1/4, +-1/4)
+ * texel. */
 vec3 texture_triangle_mean(const texture *t, const double u[3], const double v[3], bool clamp)
 {
     const tex_level *top = &t->lv[t->nlevels - 1];
