@@ -2495,13 +2495,15 @@ static pk_status medium_of(xp *p, xnode *n, int32_t *index)
 
 /* ---- shapes --------------------------------------------------------------------------------- */
 
-static pk_status parse_emitter_area(xp *p, xnode *e, vec3 *radiance)
+/* An area emitter's radiance: a colour, or a texture (a bitmap or a
+ * checkerboard) into *tex with *radiance 1. */
+static pk_status parse_emitter_area(xp *p, xnode *e, vec3 *radiance, tex_ref *tex)
 {
     pk_status st;
     pdict d;
     if ((st = xml_props(p, e, &d))) return st;
     *radiance = v3s(1.0f);
-    if ((st = get_color(p, &d, "radiance", radiance))) return st;
+    if ((st = get_color_tex(p, &d, "radiance", radiance, tex))) return st;
     if (!(radiance->x >= 0.0f && radiance->y >= 0.0f && radiance->z >= 0.0f))
         return xfail(p, PK_ERR_PARSE, e, "radiance must not be negative");
     static const char *const quiet[] = {"sampling_weight", NULL};
@@ -2696,11 +2698,21 @@ static pk_status parse_shape(xp *p, xnode *sh)
             xwarn(p, emitter, "emitter \"%s\" on a shape is not supported (only \"area\"); ignored", se);
         } else {
             vec3 radiance;
-            if ((st = parse_emitter_area(p, emitter, &radiance))) return st;
+            tex_ref tex;
+            tex_ref_init(&tex);
+            if ((st = parse_emitter_area(p, emitter, &radiance, &tex))) return st;
             /* a copy of the material that also emits (one-sided, as Mitsuba's) */
             char name[96];
             snprintf(name, sizeof name, "%s+emitter@%lu", p->s->materials[mat].name, emitter->line);
             if ((st = scene_material_with_emission(p->ctx, p->s, mat, name, radiance, false, &mat))) return st;
+            if (tex.kind != TEX_NONE) { /* a textured radiance (on a mix's emitting copies too) */
+                material *em = &p->s->materials[mat];
+                em->map_ke = tex;
+                if (em->type == MAT_MIX) {
+                    p->s->materials[em->mix_a].map_ke = tex;
+                    p->s->materials[em->mix_b].map_ke = tex;
+                }
+            }
         }
     }
     /* Mitsuba orients an analytic shape's normal by the inverse transpose

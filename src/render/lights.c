@@ -8,13 +8,44 @@
 static bool emits(vec3 ke) { return ke.x > 0.0f || ke.y > 0.0f || ke.z > 0.0f; }
 
 /* The luminance that chooses among emitters: ke's, times the mean of an
- * emission map (over the whole image: a triangle's own part of it is not
- * looked at). */
+ * emission map over the whole image (spheres, and triangles that take it
+ * from emitted_luminance_tri), or of a checker's two colours. */
 static double emitted_luminance(const pk_scene *s, const material *m)
 {
     vec3 ke = m->ke;
     if (m->map_ke.kind == TEX_IMAGE) ke = v3_mul(ke, texture_mean_rgb(&s->textures[m->map_ke.tex]));
+    if (m->map_ke.kind == TEX_CHECKER) ke = v3_mul(ke, v3_scale(v3_add(m->map_ke.even, m->map_ke.odd), 0.5f));
     return (double)fmaxf(v3_luminance(ke), 1e-6f);
+}
+
+/* The share of the image's mean that a triangle's own mean never falls
+ * below: a triangle over black texels still emits where bilinear filtering
+ * reaches across its edges, so it keeps a chance of being sampled. */
+#define EMISSION_MAP_FLOOR 1e-3
+
+/* The same for emitting triangle t: with an image emission map, ke times
+ * the map's mean over the triangle's own texture coordinates (as shading
+ * finds them: the vertices' uvs, or (0,0), (1,0), (0,1), through the
+ * reference's scale and offset), so that the bright parts of an emitting
+ * texture draw the samples. */
+static double emitted_luminance_tri(const pk_scene *s, const scene_view *v, const material *m, uint32_t t)
+{
+    const tex_ref *r = &m->map_ke;
+    if (r->kind != TEX_IMAGE) return emitted_luminance(s, m);
+    view_tri vt;
+    view_tri_get(v, t, &vt);
+    static const uv2 plain[3] = {{0.0f, 0.0f}, {1.0f, 0.0f}, {0.0f, 1.0f}};
+    double tu[3], tv[3];
+    for (int k = 0; k < 3; k++) {
+        const uv2 q = vt.has_t ? vt.t[k] : plain[k];
+        tu[k] = (double)r->s[0] * (double)q.u + (double)r->o[0];
+        tv[k] = (double)r->s[1] * (double)q.v + (double)r->o[1];
+    }
+    const texture *tex = &s->textures[r->tex];
+    const double tri = (double)v3_luminance(v3_mul(m->ke, texture_triangle_mean(tex, tu, tv, r->clamp)));
+    const double all = (double)v3_luminance(v3_mul(m->ke, texture_mean_rgb(tex)));
+    const double lum = fmax(tri, EMISSION_MAP_FLOOR * all);
+    return isfinite(lum) && lum > 1e-6 ? lum : 1e-6;
 }
 
 /* The radius of a sphere about the centre of the scene's bounds that holds
@@ -301,6 +332,7 @@ pk_status light_set_build(pk_context *ctx, const pk_scene *s, const env_light *e
     }
     memset(ls->lights, 0, n * sizeof(light)); /* the fields a kind leaves unused are zero */
     size_t k = 0;
+    const scene_view view = scene_view_of(s);
     /* emitted flux (luminance): pi * L * area per emitting side; 4 pi I for points */
     for (size_t i = 0; i < s->nemissive; i++) {
         const uint32_t t = s->emissive[i];
@@ -309,7 +341,7 @@ pk_status light_set_build(pk_context *ctx, const pk_scene *s, const env_light *e
         const material *m = &s->materials[s->tris[t].material];
         light *l = &ls->lights[k];
         *l = light_of_triangle(t, a, b, c, m);
-        power[k] = emitted_luminance(s, m) * (double)l->area * (double)PK_PI * (m->two_sided ? 2.0 : 1.0);
+        power[k] = emitted_luminance_tri(s, &view, m, t) * (double)l->area * (double)PK_PI * (m->two_sided ? 2.0 : 1.0);
         ls->of_prim[t] = (int32_t)k;
         k++;
     }

@@ -167,3 +167,130 @@ vec3 texture_mean_rgb(const texture *t)
     tex_fetch(t, l, 0, 0, c);
     return t->nc >= 3 ? v3(c[0], c[1], c[2]) : v3s(c[0]);
 }
+
+/* ---- the mean over a triangle of uv ------------------------------------------------ */
+
+/* Clips polygon in[0..n) (x, y pairs) to the half-plane where coordinate
+ * axis (0 x, 1 y) is >= c (keep_ge) or <= c; the result (at most n + 1
+ * points) into out, its count returned. */
+static int clip_half(const double *in, int n, double *out, int axis, double c, bool keep_ge)
+{
+    int m = 0;
+    for (int i = 0; i < n; i++) {
+        const double *a = in + 2 * i, *b = in + 2 * ((i + 1) % n);
+        const double da = keep_ge ? a[axis] - c : c - a[axis], db = keep_ge ? b[axis] - c : c - b[axis];
+        if (da >= 0.0) out[2 * m] = a[0], out[2 * m + 1] = a[1], m++;
+        if ((da >= 0.0) != (db >= 0.0)) {
+            const double t = da / (da - db);
+            out[2 * m] = a[0] + t * (b[0] - a[0]), out[2 * m + 1] = a[1] + t * (b[1] - a[1]);
+            out[2 * m + axis] = c; /* exactly on the line */
+            m++;
+        }
+    }
+    return m;
+}
+
+static double poly_area(const double *p, int n)
+{
+    double a = 0.0;
+    for (int i = 0; i < n; i++) {
+        const double *q = p + 2 * i, *r = p + 2 * ((i + 1) % n);
+        a += q[0] * r[1] - r[0] * q[1];
+    }
+    return 0.5 * fabs(a);
+}
+
+static int64_t wrap64(int64_t i, int64_t n, bool clamp)
+{
+    if (clamp) return i < 0 ? 0 : i >= n ? n - 1 : i;
+    const int64_t m = i % n;
+    return m < 0 ? m + n : m;
+}
+
+static vec3 texel_rgb(const texture *t, const tex_level *l, int x, int y)
+{
+    float c[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+    tex_fetch(t, l, x, y, c);
+    return t->nc >= 3 ? v3(c[0], c[1], c[2]) : v3s(c[0]);
+}
+
+/* Adds to sum the integral over triangle p (texel units of level l) of the
+ * level's texels read as constant squares, repeat or clamp. */
+static void box_integral(const texture *t, const tex_level *l, const double p[6], bool clamp, double sum[3])
+{
+    const double ylo = fmin(p[1], fmin(p[3], p[5])), yhi = fmax(p[1], fmax(p[3], p[5]));
+    double row[2 * 16], tmp[2 * 16], cell[2 * 16]; /* clipping adds at most 2 points a side */
+    for (int64_t iy = (int64_t)floor(ylo); (double)iy <= yhi; iy++) {
+        int n = clip_half(p, 3, tmp, 1, (double)iy, true);
+        n = clip_half(tmp, n, row, 1, (double)(iy + 1), false);
+        if (n < 3) continue;
+        double rxlo = row[0], rxhi = row[0];
+        for (int i = 1; i < n; i++) rxlo = fmin(rxlo, row[2 * i]), rxhi = fmax(rxhi, row[2 * i]);
+        const int y = (int)wrap64(iy, l->h, clamp);
+        for (int64_t ix = (int64_t)floor(rxlo); (double)ix <= rxhi; ix++) {
+            int m = clip_half(row, n, tmp, 0, (double)ix, true);
+            m = clip_half(tmp, m, cell, 0, (double)(ix + 1), false);
+            if (m < 3) continue;
+            const double a = poly_area(cell, m);
+            if (!(a > 0.0)) continue;
+            const vec3 c = texel_rgb(t, l, (int)wrap64(ix, l->w, clamp), y);
+            sum[0] += a * (double)c.x, sum[1] += a * (double)c.y, sum[2] += a * (double)c.z;
+        }
+    }
+}
+
+/* (texture.h) On the finest level the lookups' bilinear filter is counted
+ * too: the mean of the integrals over the triangle moved by (+-1/4, +-1/4)
+ * texel. */
+vec3 texture_triangle_mean(const texture *t, const double u[3], const double v[3], bool clamp)
+{
+    const tex_level *top = &t->lv[t->nlevels - 1];
+    const double du = fmax(u[0], fmax(u[1], u[2])) - fmin(u[0], fmin(u[1], u[2]));
+    const double dv = fmax(v[0], fmax(v[1], v[2])) - fmin(v[0], fmin(v[1], v[2]));
+    const double area_uv = 0.5 * fabs((u[1] - u[0]) * (v[2] - v[0]) - (u[2] - u[0]) * (v[1] - v[0]));
+    if (!isfinite(du) || !isfinite(dv) || !isfinite(area_uv)) return texel_rgb(t, top, 0, 0);
+    /* the finest level whose texels are no smaller than 1 / TEX_TRI_CELLS of the footprint's box */
+    int k = 0;
+    while (k + 1 < t->nlevels &&
+           (du * (double)t->lv[k].w > TEX_TRI_CELLS || dv * (double)t->lv[k].h > TEX_TRI_CELLS))
+        k++;
+    const tex_level *l = &t->lv[k];
+    if (l->w == 1 && l->h == 1) return texel_rgb(t, l, 0, 0);
+    /* the triangle in the level's texel units: texel (x, y) is the square [x, x+1) x [y, y+1) */
+    double p[6];
+    for (int i = 0; i < 3; i++) p[2 * i] = u[i] * (double)l->w, p[2 * i + 1] = (1.0 - v[i]) * (double)l->h;
+    const double xlo = fmin(p[0], fmin(p[2], p[4])), xhi = fmax(p[0], fmax(p[2], p[4]));
+    const double ylo = fmin(p[1], fmin(p[3], p[5])), yhi = fmax(p[1], fmax(p[3], p[5]));
+    const double area = area_uv * (double)l->w * (double)l->h;
+    const double ncells = (floor(xhi) - floor(xlo) + 1.0) * (floor(yhi) - floor(ylo) + 1.0);
+    if (!(area > 1e-9) || !(ncells <= 4.0 * TEX_TRI_CELLS * TEX_TRI_CELLS + 64.0)) {
+        /* a sliver (no area: the texel at its centroid), or a box of more
+         * texels than the level's side allows (a level that stopped halving
+         * on one side under a footprint of many repeats): the image's mean */
+        if (!(area > 1e-9)) {
+            const int64_t x = wrap64((int64_t)floor((p[0] + p[2] + p[4]) / 3.0), l->w, clamp);
+            const int64_t y = wrap64((int64_t)floor((p[1] + p[3] + p[5]) / 3.0), l->h, clamp);
+            return texel_rgb(t, l, (int)x, (int)y);
+        }
+        return texel_rgb(t, top, 0, 0);
+    }
+    double sum[3] = {0.0, 0.0, 0.0};
+    if (k > 0) {
+        box_integral(t, l, p, clamp, sum);
+    } else {
+        /* on the finest level the lookups' bilinear filter, which spreads
+         * each texel over a texel's width around it (the box function
+         * convolved with a one-texel box), counts: the mean of the box
+         * integral over the triangle moved by (+-1/4, +-1/4) texel (the
+         * midpoint rule of that convolution), so that a triangle beside a
+         * bright texel gets the light that reaches it */
+        for (int j = 0; j < 4; j++) {
+            double q[6];
+            for (int i = 0; i < 3; i++)
+                q[2 * i] = p[2 * i] + ((j & 1) ? 0.25 : -0.25), q[2 * i + 1] = p[2 * i + 1] + ((j & 2) ? 0.25 : -0.25);
+            box_integral(t, l, q, clamp, sum);
+        }
+        sum[0] *= 0.25, sum[1] *= 0.25, sum[2] *= 0.25;
+    }
+    return v3((float)(sum[0] / area), (float)(sum[1] / area), (float)(sum[2] / area));
+}

@@ -99,6 +99,17 @@ PK_HIDDEN pk_status texture_add_pixels(pk_context *ctx, struct pk_scene *s, cons
 /* The mean linear colour of a texture (its coarsest mip level); grey for one channel. */
 PK_HIDDEN vec3 texture_mean_rgb(const texture *t);
 PK_HIDDEN int32_t texture_find(const struct pk_scene *s, const char *key, bool colour);
+/* The mean of a texture over the triangle of texture coordinates (u[k],
+ * v[k]) (a reference's transform applied), repeat or clamp, each texel read
+ * as a constant square: from the finest mip level on which the triangle's
+ * bounding box spans at most TEX_TRI_CELLS texels a side, every texel
+ * weighted by the exact area it shares with the triangle. Mip texels are
+ * means of the finer ones, so only texels on the triangle's edges are
+ * approximate (off by at most the share of the triangle in the band of
+ * such texels, times the image's contrast). A triangle of no uv area: the
+ * texel at its centroid; non-finite uv: the image's mean. */
+#define TEX_TRI_CELLS 8
+PK_HIDDEN vec3 texture_triangle_mean(const texture *t, const double u[3], const double v[3], bool clamp);
 
 
 
