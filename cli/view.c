@@ -47,7 +47,7 @@ void cli_view_help(FILE *f)
     const cli_option *opts = cli_render_options(&n);
     cli_option shown[64];
     size_t k = 0;
-    static const char *const skip[] = {"output", "time", "aov", "stats", "stats-json"};
+    static const char *const skip[] = {"output", "time", "aov", "stats", "stats-json", "transparent"};
     for (size_t i = 0; i < n && k < 64; i++) {
         int drop = 0;
         for (size_t j = 0; j < sizeof skip / sizeof skip[0]; j++) drop |= strcmp(opts[i].name, skip[j]) == 0;
@@ -60,6 +60,8 @@ void cli_view_help(FILE *f)
         }
         if (drop) continue;
         shown[k] = opts[i];
+        if (strcmp(opts[i].name, "tonemap") == 0)
+            shown[k].help = "the page's first tone curve of the PNG: clamp (default), agx, pbr-neutral, aces";
         if (strcmp(opts[i].name, "exposure") == 0)
             shown[k].help = "the page's first exposure: the linear values times 2^EV before the tone curve of the "
                             "PNG; a number in -20..20, default 0";
@@ -135,6 +137,8 @@ int cli_view(int argc, char **argv)
     if (o.time > 0.0) return cli_usage_error("view: --time does not apply (the view refines until --spp)");
     if (o.aovs) return cli_usage_error("view: --aov does not apply (the page chooses what is shown)");
     if (o.stats || o.stats_json) return cli_usage_error("view: --stats and --stats-json do not apply");
+    if (o.transparent)
+        return cli_usage_error("view: --transparent is not offered by the viewer yet (paprsek render has it)");
     int port = 0;
     if (o.extra[VIEW_PORT] && !cli_parse_int(o.extra[VIEW_PORT], 0, 65535, &port))
         return cli_usage_error("--port: '%s' must be a port number in 0..65535", o.extra[VIEW_PORT]);
@@ -213,6 +217,7 @@ int cli_view(int argc, char **argv)
     cfg.bind = bind;
     cfg.port = port;
     cfg.exposure = o.has_exposure ? o.exposure : 0.0f;
+    cfg.tonemap = o.tonemap;
     cfg.denoise = o.denoise == 1;
     cfg.dopt = have_denoiser ? &dopt : NULL;
     cfg.no_denoise_why = why;

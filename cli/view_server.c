@@ -116,6 +116,7 @@ typedef struct snap {
     pk_image *img;     /* width x height, linear: the colour (denoised or not) or the AOV's values */
     unsigned aov;
     float exposure;
+    int tonemap;       /* PK_TONEMAP_* of the PNG */
     pthread_mutex_t enc_mu; /* guards the encodings */
     unsigned char *png, *exr;
     size_t png_len, exr_len;
@@ -146,9 +147,10 @@ struct view_server {
     int integrator;        /* pk_integrator_kind, never DEFAULT */
     int max_depth;         /* -1: the integrator's default */
     float exposure;
+    int tonemap;           /* PK_TONEMAP_* */
     int denoise;
     unsigned aov;
-    int display_dirty;     /* exposure, aov or denoise changed: make the display again */
+    int display_dirty;     /* exposure, tone curve, aov or denoise changed: make the display again */
 
     /* what the render thread reports (under mu) */
     snap *cur;             /* the latest frame (NULL before the first) */
@@ -297,6 +299,7 @@ static int snap_encode(view_server *s, snap *p, int exr, char *why, size_t cap)
     if (!exr) {
         if (p->aov == AOV_COLOR) {
             wo.exposure_ev = p->exposure;
+            wo.tonemap = p->tonemap;
         } else {
             const int w = pk_image_width(p->img), h = pk_image_height(p->img);
             if (pk_image_create(ctx, w, h, &copy) != PK_OK) {
@@ -450,6 +453,7 @@ static char *status_json_locked(view_server *s)
     sb_camera(&b, &s->cam);
     sb_printf(&b, ",\"settings\":{\"exposure\":");
     sb_float(&b, s->exposure);
+    sb_printf(&b, ",\"tonemap\":\"%s\"", pk_tonemap_name(s->tonemap));
     sb_printf(&b, ",\"denoise\":%s,\"aov\":\"%s\",\"integrator\":\"%s\",\"max_depth\":%d}",
               s->denoise ? "true" : "false", aov_label(s->aov), integrator_label(s->integrator),
               pk_render_options_max_depth(&ro));
@@ -551,7 +555,7 @@ static pk_image *display_image(view_server *s, const pk_film *film, int preview,
 }
 
 /* Publishes img (taken) as the next frame. Under mu. */
-static void publish_locked(view_server *s, pk_image *img, unsigned aov, float exposure)
+static void publish_locked(view_server *s, pk_image *img, unsigned aov, float exposure, int tonemap)
 {
     snap *p = calloc(1, sizeof *p);
     if (!p) {
@@ -562,6 +566,7 @@ static void publish_locked(view_server *s, pk_image *img, unsigned aov, float ex
     p->img = img;
     p->aov = aov;
     p->exposure = exposure;
+    p->tonemap = tonemap;
     pthread_mutex_init(&p->enc_mu, NULL);
     p->frame = ++s->frame;
     snap_unref_locked(s->cur);
@@ -670,6 +675,7 @@ static void *render_main(void *arg)
         }
         const unsigned aov = s->aov;
         const float exposure = s->exposure;
+        const int tonemap = s->tonemap;
         const int denoise = s->denoise && s->cfg.dopt;
         int job;
         const int more = (uint64_t)passes * (uint64_t)s->cfg.ro.spp < (uint64_t)s->max_spp;
@@ -757,7 +763,7 @@ static void *render_main(void *arg)
             s->t_last = now_s();
             if (ps.render_s > render_s0) s->rays_per_s = (double)(rays_of(&ps) - rays0) / (ps.render_s - render_s0);
             if (img) {
-                publish_locked(s, img, aov, exposure);
+                publish_locked(s, img, aov, exposure, tonemap);
                 img = NULL;
             }
         }
@@ -977,6 +983,7 @@ static enum MHD_Result post_settings(view_server *s, struct MHD_Connection *c, r
     if (!root) return ret;
     pthread_mutex_lock(&s->mu);
     float exposure = s->exposure;
+    int tonemap = s->tonemap;
     int denoise = s->denoise, integrator = s->integrator, depth = s->max_depth;
     unsigned aov = s->aov;
     pthread_mutex_unlock(&s->mu);
@@ -992,6 +999,10 @@ static enum MHD_Result post_settings(view_server *s, struct MHD_Connection *c, r
             if (!(why = get_number(it, &x)) && !(x >= -PK_MAX_EXPOSURE_EV && x <= PK_MAX_EXPOSURE_EV))
                 why = "must be a number of stops in -20..20";
             exposure = (float)x;
+        } else if (strcmp(k, "tonemap") == 0) {
+            const char *v = cJSON_GetStringValue(it);
+            if (!v || pk_tonemap_parse(v) < 0) why = "must be one of clamp, agx, pbr-neutral, aces";
+            else tonemap = pk_tonemap_parse(v);
         } else if (strcmp(k, "denoise") == 0) {
             if (!cJSON_IsBool(it))
                 why = "must be true or false";
@@ -1028,7 +1039,7 @@ static enum MHD_Result post_settings(view_server *s, struct MHD_Connection *c, r
                 }
             }
         } else {
-            snprintf(msg, sizeof msg, "unknown field '%.64s' (exposure, denoise, aov, integrator, max_depth)", k);
+            snprintf(msg, sizeof msg, "unknown field '%.64s' (exposure, tonemap, denoise, aov, integrator, max_depth)", k);
         }
         if (why) snprintf(msg, sizeof msg, "%.64s: %s", k, why);
         if (msg[0]) break;
@@ -1036,8 +1047,10 @@ static enum MHD_Result post_settings(view_server *s, struct MHD_Connection *c, r
     cJSON_Delete(root);
     if (msg[0]) return send_error(c, MHD_HTTP_BAD_REQUEST, "%s", msg);
     pthread_mutex_lock(&s->mu);
-    if (exposure != s->exposure || aov != s->aov || denoise != s->denoise) s->display_dirty = 1;
+    if (exposure != s->exposure || tonemap != s->tonemap || aov != s->aov || denoise != s->denoise)
+        s->display_dirty = 1;
     s->exposure = exposure;
+    s->tonemap = tonemap;
     s->aov = aov;
     s->denoise = denoise;
     if (integrator != s->integrator || depth != s->max_depth) {
@@ -1394,6 +1407,7 @@ int view_server_start(const view_config *cfg, view_server **out, char *err, size
                                                                   : PK_INTEGRATOR_PATH;
     s->max_depth = cfg->ro.max_depth;
     s->exposure = cfg->exposure;
+    s->tonemap = cfg->tonemap;
     s->denoise_available = cfg->dopt != NULL;
     s->denoise = cfg->denoise && cfg->dopt;
     s->aov = AOV_COLOR;
