@@ -141,7 +141,9 @@ static void check_shape(int curve)
         const float v = exp2f((float)s / 16.0f);
         const float grey[3] = {v, v, v}, col[3] = {0.8f * v, 0.3f * v, 0.1f * v};
         image_tonemap(curve, grey, out);
-        bad_g += out[1] < prev_g || out[0] != out[1] || out[1] != out[2];
+        /* grey stays grey up to the matrices' rounding (ACES's output rows sum to 1 within 1e-5,
+         * AgX's within 1e-4) */
+        bad_g += out[1] < prev_g || fabsf(out[0] - out[1]) > 2e-4f || fabsf(out[2] - out[1]) > 2e-4f;
         prev_g = out[1];
         for (int i = 0; i < 3; i++) bad_g += !(out[i] >= 0.0f && out[i] <= 1.0f);
         image_tonemap(curve, col, out);
@@ -149,8 +151,7 @@ static void check_shape(int curve)
         bad_l += l < prev_l - 1e-7f;
         prev_l = l;
     }
-    /* (AgX's matrices keep grey grey only to about 1e-4: compared with a tolerance below) */
-    if (curve != PK_TONEMAP_AGX) CHECKF(bad_g == 0, "%s: grey ramp not monotonic and grey (%d)", pk_tonemap_name(curve), bad_g);
+    CHECKF(bad_g == 0, "%s: grey ramp not monotonic and grey (%d)", pk_tonemap_name(curve), bad_g);
     CHECKF(bad_l == 0, "%s: colour ramp's luminance not monotonic (%d)", pk_tonemap_name(curve), bad_l);
     const float nan3[3] = {NAN, -1.0f, INFINITY};
     image_tonemap(curve, nan3, out);
