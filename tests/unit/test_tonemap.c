@@ -219,12 +219,12 @@ static void test_names(void)
 int main(void)
 {
     test_names();
-    /* tolerances: float evaluation of a double reference, 1e-5; AgX 2e-3,
+    /* tolerances: float evaluation of a double reference, 1e-5; AgX 5e-4,
      * since its matrix product is taken here from the two published
-     * matrices (BT.2087 given to 7 digits) */
+     * matrices, whose entries differ from the stored product by up to 1e-4) */
     check_against(PK_TONEMAP_PBR_NEUTRAL, ref_pbr_neutral, 1e-5);
     check_against(PK_TONEMAP_ACES, ref_aces, 1e-5);
-    check_against(PK_TONEMAP_AGX, ref_agx, 2e-3);
+    check_against(PK_TONEMAP_AGX, ref_agx, 5e-4);
     for (int k = 0; k < PK_TONEMAP_COUNT; k++) check_shape(k);
     test_agx_grey();
     test_pbr_neutral_identity();
