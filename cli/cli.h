@@ -87,7 +87,7 @@ const char *cli_nearest(const char *word, size_t len, const char *const *names, 
 /* ---- the render options, checks and outputs (cli/render_common.c) --------
  * Shared by `paprsek render` and paprsek-mpi. */
 
-#define CLI_RENDER_MAX_OPTIONS 48
+#define CLI_RENDER_MAX_OPTIONS 64
 #define CLI_RENDER_MAX_EXTRA 8
 enum { CLI_RENDER_EXTRA = 100 }; /* ids of a program's own options: CLI_RENDER_EXTRA + k */
 
@@ -95,6 +95,10 @@ typedef struct cli_render_opts {
     const char *scene, *out, *stats_json;
     int has_exposure;
     float exposure;
+    int tonemap;         /* --tonemap: PK_TONEMAP_* (0, clamp, when not given) */
+    int transparent;     /* --transparent */
+    int has_orbit;       /* --camera-orbit THETA,PHI,RADIUS (RADIUS 0: auto) */
+    float orbit[3];
     int stats, quiet;
     int int_set[CLI_RENDER_MAX_OPTIONS]; /* per table entry: given on the command line */
     int int_value[CLI_RENDER_MAX_OPTIONS];

@@ -801,6 +801,8 @@ int main(int argc, char **argv)
     if (g_rank == 0) {
         rc = cli_render_parse(argc - 1, argv + 1, &o, mpi_help);
         if (rc == 0) rc = cli_render_check(&o, &wo);
+        if (rc == 0 && (o.transparent || (o.aovs & PK_AOV_ALPHA)))
+            rc = cli_usage_error("paprsek-mpi: --transparent and --aov alpha are for paprsek render only");
     }
     MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD);
     if (rc) {

@@ -113,7 +113,8 @@ int cli_render(int argc, char **argv)
     const int denoise = cli_render_wants_denoise(ctx, &o, scene, &dopt);
     if (denoise < 0) goto out;
     /* the denoiser takes the albedo and normal of the same render */
-    const unsigned aovs = o.aovs | (denoise ? PK_AOV_ALBEDO | PK_AOV_NORMAL : 0u);
+    const unsigned aovs =
+        o.aovs | (denoise ? PK_AOV_ALBEDO | PK_AOV_NORMAL : 0u) | (o.transparent ? PK_AOV_ALPHA : 0u);
 
     pk_stats stats;
     uint32_t passes = 1;

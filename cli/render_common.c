@@ -19,6 +19,9 @@
 enum {
     OPT_OUTPUT = 1,
     OPT_EXPOSURE,
+    OPT_TONEMAP,
+    OPT_TRANSPARENT,
+    OPT_CAMERA_ORBIT,
     OPT_INT, /* an integer render option of the library's table */
     OPT_ACCEL,
     OPT_DEVICE,
@@ -79,6 +82,14 @@ const cli_option *cli_render_options(size_t *n)
         add((cli_option){.name = "exposure", .id = OPT_EXPOSURE, .kind = CLI_STRING, .arg = "EV",
                          .help = "PNG only: multiply the linear values by 2^EV before the tone curve; a number "
                                  "in -20..20, default 0 (.pfm and .exr are written unscaled)"});
+        add((cli_option){.name = "tonemap", .id = OPT_TONEMAP, .kind = CLI_STRING, .arg = "CURVE",
+                         .help = "PNG only: the tone curve after the exposure: clamp (default: values above 1 "
+                                 "clipped), agx (Blender's AgX), pbr-neutral (Khronos PBR Neutral), aces (Hill's "
+                                 "fit of ACES); .pfm and .exr stay linear and untouched"});
+        add((cli_option){.name = "transparent", .id = OPT_TRANSPARENT, .kind = CLI_FLAG,
+                         .help = "transparent background: what the camera sees of the environment gets alpha 0 "
+                                 "(the environment still lights the scene); PNG becomes RGBA, .exr gets a "
+                                 "channel A (colour premultiplied); not with .pfm, nor on the GPU"});
         size_t count = 0;
         const pk_int_option *ints = pk_int_options(&count);
         for (size_t i = 0; i < count && g_nopts < MAX_RENDER_OPTIONS; i++) {
@@ -141,8 +152,15 @@ const cli_option *cli_render_options(size_t *n)
                                  "by a white one of radiance 1"});
         add((cli_option){.name = "aov", .id = OPT_AOV, .kind = CLI_STRING, .arg = "LIST",
                          .help = "also write these outputs, from the camera rays: albedo, normal, depth, "
-                                 "heatmap (nodes visited + primitives tested per camera ray), comma-separated; "
+                                 "heatmap (nodes visited + primitives tested per camera ray), alpha (coverage), comma-separated; "
                                  "layers NAME.R/G/B of an .exr OUT, else files beside OUT as NAME.AOV.EXT"});
+        add((cli_option){.name = "camera-orbit", .id = OPT_CAMERA_ORBIT, .kind = CLI_STRING,
+                         .arg = "THETA,PHI,RADIUS",
+                         .help = "place the camera on a sphere about the centre of the scene's bounds, looking "
+                                 "at it, as model-viewer's camera-orbit: THETA degrees around the y axis from +z, "
+                                 "PHI degrees down from +y (90: level), RADIUS a distance or auto (the bounding "
+                                 "sphere just fills the vertical field of view); --look-at moves the centre, "
+                                 "--look-from is then ignored"});
         add((cli_option){.name = "fov", .id = OPT_FOV, .kind = CLI_STRING, .arg = "DEG",
                          .help = "vertical field of view in degrees, between 0 and 180"});
         add((cli_option){.name = "lens-radius", .id = OPT_LENS_RADIUS, .kind = CLI_STRING, .arg = "R",
@@ -208,10 +226,13 @@ void cli_render_usage(FILE *f, const char *usage_line)
           "  .png  8-bit sRGB. Tone curve (clamp): each linear value v becomes\n"
           "        x = v * 2^EV (--exposure, default 0); x <= 0 gives 0, x >= 1 gives\n"
           "        255, else the sRGB curve s = 12.92 x (x <= 0.0031308) or\n"
-          "        1.055 x^(1/2.4) - 0.055, stored as floor(255 s + 0.5).\n"
-          "  .pfm  linear 32-bit float RGB, the rendered values unchanged.\n"
+          "        1.055 x^(1/2.4) - 0.055, stored as floor(255 s + 0.5). --tonemap agx,\n"
+          "        pbr-neutral or aces compress x instead of clipping it. With\n"
+          "        --transparent: RGBA, colour divided by alpha (the pixel's coverage).\n"
+          "  .pfm  linear 32-bit float RGB, the rendered values unchanged (no alpha).\n"
           "  .exr  OpenEXR, linear 32-bit float channels R, G, B, the rendered values\n"
-          "        unchanged (scanlines, lossless ZIP compression).\n"
+          "        unchanged (scanlines, lossless ZIP compression); with --transparent\n"
+          "        also A, and R, G, B premultiplied by it. Never tone-mapped.\n"
           "\n"
           "options (they override the scene's own \"render\" settings; --name VALUE and\n"
           "--name=VALUE are the same, and a unique beginning of a name is enough):\n",
@@ -321,6 +342,37 @@ int cli_render_parse(int argc, char **argv, cli_render_opts *o, void (*help)(FIL
                                        -PK_MAX_EXPOSURE_EV, PK_MAX_EXPOSURE_EV);
             o->exposure = (float)ev;
             o->has_exposure = 1;
+            break;
+        }
+        case OPT_TONEMAP:
+            if ((o->tonemap = pk_tonemap_parse(v)) < 0)
+                return cli_usage_error("--tonemap: '%s' is not a tone curve (clamp, agx, pbr-neutral, aces)", v);
+            break;
+        case OPT_TRANSPARENT: o->transparent = 1; break;
+        case OPT_CAMERA_ORBIT: {
+            float t[3] = {0.0f, 0.0f, 0.0f};
+            char buf[128];
+            snprintf(buf, sizeof buf, "%s", v);
+            char *comma = strrchr(buf, ',');
+            int ok = comma != NULL && strlen(v) < sizeof buf;
+            if (ok && strcmp(comma + 1, "auto") == 0) {
+                *comma = 0;
+                char *e1, *e2;
+                t[0] = strtof(buf, &e1);
+                ok = *e1 == ',' && e1 != buf;
+                if (ok) {
+                    t[1] = strtof(e1 + 1, &e2);
+                    ok = !*e2 && e2 != e1 + 1;
+                }
+                t[2] = 0.0f;
+            } else if (ok) {
+                ok = cli_parse_vec3(v, t) && t[2] > 0.0f;
+            }
+            if (!ok || !isfinite(t[0]) || !isfinite(t[1]))
+                return cli_usage_error("--camera-orbit: '%s' must be THETA,PHI,RADIUS (degrees, degrees, a distance "
+                                       "> 0 or auto)", v);
+            memcpy(o->orbit, t, sizeof t);
+            o->has_orbit = 1;
             break;
         }
         case OPT_INT:
@@ -447,10 +499,10 @@ int cli_render_parse(int argc, char **argv, cli_render_opts *o, void (*help)(FIL
             snprintf(buf, sizeof buf, "%s", v);
             for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
                 unsigned a = pk_aov_parse(tok);
-                if (!a) return cli_usage_error("--aov: unknown output '%s' (albedo, normal, depth, heatmap)", tok);
+                if (!a) return cli_usage_error("--aov: unknown output '%s' (albedo, normal, depth, heatmap, alpha)", tok);
                 o->aovs |= a;
             }
-            if (!o->aovs) return cli_usage_error("--aov: no output named (albedo, normal, depth, heatmap)");
+            if (!o->aovs) return cli_usage_error("--aov: no output named (albedo, normal, depth, heatmap, alpha)");
             break;
         }
         case OPT_STATS: o->stats = 1; break;
@@ -763,6 +815,11 @@ int cli_render_check(const cli_render_opts *o, pk_write_options *wo)
     if (o->has_exposure) wo->exposure_ev = o->exposure;
     if (o->has_exposure && o->exposure != 0.0f && !png && !o->quiet)
         cli_print_warning(NULL, "--exposure applies to PNG only; the HDR image is written unscaled");
+    wo->tonemap = o->tonemap;
+    if (o->tonemap != PK_TONEMAP_CLAMP && !png && !o->quiet)
+        cli_print_warning(NULL, "--tonemap applies to PNG only; the HDR image is written linear");
+    if (o->transparent && ends_with_ci(o->out, ".pfm"))
+        return cli_usage_error("--transparent: PFM has no alpha channel; write .png or .exr");
     if (o->has_camera_pick && (!o->scene || !pk_scene_format(o->scene) || strcmp(pk_scene_format(o->scene), "gltf") != 0))
         return cli_usage_error("--camera: picks a camera of a glTF asset (.gltf, .glb); %s%s%s is not one",
                                o->scene ? "'" : "", o->scene ? o->scene : "the built-in Cornell box",
@@ -822,6 +879,7 @@ pk_status cli_render_settings(pk_context *ctx, const cli_render_opts *o, pk_scen
         if (o->device == PK_DEVICE_CPU && ro->accel == PK_ACCEL_CUDA) ro->accel = PK_ACCEL_DEFAULT;
     }
     if (o->has_integrator) ro->integrator = o->integrator;
+    ro->transparent = o->transparent;
     if (cli_render_clean_default(o, scene)) ro->spp = CLI_CLEAN_SPP;
     ro->collect_stats = o->stats || o->stats_json;
     if (cli_configure(ctx, o->config) != 0) return PK_ERR_INVALID_ARGUMENT; /* (checked at parsing) */
@@ -844,11 +902,34 @@ pk_status cli_render_settings(pk_context *ctx, const cli_render_opts *o, pk_scen
         if (st != PK_OK) return st;
     }
     if (o->has_from || o->has_at || o->has_up || o->has_fov || o->has_lens_radius || o->has_focus_distance ||
-        o->projection) {
+        o->projection || o->has_orbit) {
         pk_camera cam;
         pk_scene_get_camera(scene, &cam);
         if (o->has_from) memcpy(cam.look_from, o->from, sizeof o->from);
         if (o->has_at) memcpy(cam.look_at, o->at, sizeof o->at);
+        if (o->has_fov) cam.fov_deg = o->fov;
+        if (o->has_orbit) {
+            pk_scene_info info;
+            pk_scene_get_info(scene, &info);
+            double c[3], rad = 0.0;
+            for (int k = 0; k < 3; k++) {
+                const double h = 0.5 * ((double)info.bounds_max[k] - info.bounds_min[k]);
+                c[k] = o->has_at ? o->at[k] : 0.5 * ((double)info.bounds_min[k] + info.bounds_max[k]);
+                rad += h * h;
+            }
+            rad = sqrt(rad);
+            const double th = o->orbit[0] * 3.14159265358979323846 / 180.0, ph = o->orbit[1] * 3.14159265358979323846 / 180.0;
+            const double fov = (o->has_fov ? o->fov : cam.fov_deg) * 3.14159265358979323846 / 180.0;
+            double r = o->orbit[2] > 0.0f ? o->orbit[2] : rad / sin(0.5 * fov);
+            if (!(r > 0.0)) r = 1.0;
+            double d[3] = {sin(ph) * sin(th), cos(ph), sin(ph) * cos(th)};
+            for (int k = 0; k < 3; k++) d[k] = fabs(d[k]) < 1e-12 ? 0.0 : d[k]; /* cos(90°) is 0 */
+            for (int k = 0; k < 3; k++) {
+                cam.look_at[k] = (float)c[k];
+                cam.look_from[k] = (float)(c[k] + r * d[k]);
+            }
+            if (!o->has_up) cam.up[0] = 0.0f, cam.up[1] = 1.0f, cam.up[2] = 0.0f;
+        }
         if (o->has_up) memcpy(cam.up, o->up, sizeof o->up);
         if (o->has_fov) cam.fov_deg = o->fov;
         if (o->has_lens_radius) cam.lens_radius = o->lens_radius;
@@ -860,17 +941,35 @@ pk_status cli_render_settings(pk_context *ctx, const cli_render_opts *o, pk_scen
     return st;
 }
 
+static pk_status cli_render_write_images(pk_context *ctx, const cli_render_opts *o, const pk_write_options *wo_in,
+                                         const pk_image *img, const pk_film *film);
+
 pk_status cli_render_write(pk_context *ctx, const cli_render_opts *o, const pk_write_options *wo_in,
                            const pk_image *img, const pk_film *film)
 {
     pk_write_options wo = *wo_in;
+    pk_image *alpha = NULL; /* --transparent: the coverage */
+    if (o->transparent) {
+        pk_status as = pk_film_resolve_aov(ctx, film, PK_AOV_ALPHA, &alpha);
+        if (as != PK_OK) return as;
+        wo.alpha = alpha;
+    }
+    pk_status ws0 = cli_render_write_images(ctx, o, &wo, img, film);
+    pk_image_destroy(alpha);
+    return ws0;
+}
+
+static pk_status cli_render_write_images(pk_context *ctx, const cli_render_opts *o, const pk_write_options *wo_in,
+                                         const pk_image *img, const pk_film *film)
+{
+    pk_write_options wo = *wo_in;
     if (o->aovs && ends_with_ci(o->out, ".exr")) {
         /* one file: the AOVs as layers */
-        pk_image *li[4] = {NULL, NULL, NULL, NULL};
-        const char *ln[4];
+        pk_image *li[5] = {NULL, NULL, NULL, NULL, NULL};
+        const char *ln[5];
         size_t nl = 0;
         pk_status ls = PK_OK;
-        for (unsigned a = 1; a <= PK_AOV_HEATMAP && ls == PK_OK; a <<= 1)
+        for (unsigned a = 1; a <= PK_AOV_ALPHA && ls == PK_OK; a <<= 1)
             if (o->aovs & a) {
                 ln[nl] = pk_aov_name(a);
                 ls = pk_film_resolve_aov(ctx, film, a, &li[nl++]);
@@ -881,13 +980,13 @@ pk_status cli_render_write(pk_context *ctx, const cli_render_opts *o, const pk_w
             wo.layer_names = ln;
             ls = pk_image_write_ex(ctx, img, o->out, &wo);
         }
-        for (size_t l = 0; l < 4; l++) pk_image_destroy(li[l]);
+        for (size_t l = 0; l < 5; l++) pk_image_destroy(li[l]);
         if (ls != PK_OK) return ls;
     } else {
         pk_status ws = pk_image_write_ex(ctx, img, o->out, &wo);
         if (ws != PK_OK) return ws;
     }
-    for (unsigned a = 1; a <= PK_AOV_HEATMAP; a <<= 1) {
+    for (unsigned a = 1; a <= PK_AOV_ALPHA; a <<= 1) {
         if (!(o->aovs & a) || ends_with_ci(o->out, ".exr")) continue;
         pk_image *ai = NULL;
         char *name = aov_name(o->out, pk_aov_name(a));

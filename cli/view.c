@@ -33,14 +33,16 @@ void cli_view_help(FILE *f)
           "it then waits for the next change. Any change starts again with a cheap pass\n"
           "(1 sample per pixel at a quarter of the size), then full-size passes.\n"
           "On the page: drag to orbit, shift-drag or right-drag to pan, the wheel to\n"
-          "dolly, a click with Ctrl (or Alt) held to focus there; exposure, denoising,\n"
-          "what is shown (colour, albedo, normal, depth, heat map), the integrator, and\n"
+          "dolly, a click with Ctrl (or Alt) held to focus there; exposure, the tone\n"
+          "curve, a transparent background (over a checkerboard), denoising, what is\n"
+          "shown (colour, albedo, normal, depth, heat map), the integrator, and\n"
           "saving the image as PNG or EXR (docs/viewer.md).\n"
           "\n"
           "SCENE is a Wavefront .obj, a .json scene, a Mitsuba .xml scene, a pbrt-v4 .pbrt\n"
           "scene or a glTF 2.0 asset (.gltf, .glb); without it the built-in Cornell box.\n"
           "\n"
-          "options (those of paprsek render that apply; --exposure and --denoise set the\n"
+          "options (those of paprsek render that apply; --exposure, --tonemap,\n"
+          "--transparent and --denoise set the\n"
           "page's first settings):\n",
           f);
     size_t n;
@@ -60,6 +62,11 @@ void cli_view_help(FILE *f)
         }
         if (drop) continue;
         shown[k] = opts[i];
+        if (strcmp(opts[i].name, "transparent") == 0)
+            shown[k].help = "start with a transparent background: the environment the camera sees has alpha 0, "
+                            "shown over a checkerboard (the page's checkbox turns it on and off)";
+        if (strcmp(opts[i].name, "tonemap") == 0)
+            shown[k].help = "the page's first tone curve of the PNG: clamp (default), agx, pbr-neutral, aces";
         if (strcmp(opts[i].name, "exposure") == 0)
             shown[k].help = "the page's first exposure: the linear values times 2^EV before the tone curve of the "
                             "PNG; a number in -20..20, default 0";
@@ -135,6 +142,7 @@ int cli_view(int argc, char **argv)
     if (o.time > 0.0) return cli_usage_error("view: --time does not apply (the view refines until --spp)");
     if (o.aovs) return cli_usage_error("view: --aov does not apply (the page chooses what is shown)");
     if (o.stats || o.stats_json) return cli_usage_error("view: --stats and --stats-json do not apply");
+
     int port = 0;
     if (o.extra[VIEW_PORT] && !cli_parse_int(o.extra[VIEW_PORT], 0, 65535, &port))
         return cli_usage_error("--port: '%s' must be a port number in 0..65535", o.extra[VIEW_PORT]);
@@ -213,6 +221,7 @@ int cli_view(int argc, char **argv)
     cfg.bind = bind;
     cfg.port = port;
     cfg.exposure = o.has_exposure ? o.exposure : 0.0f;
+    cfg.tonemap = o.tonemap;
     cfg.denoise = o.denoise == 1;
     cfg.dopt = have_denoiser ? &dopt : NULL;
     cfg.no_denoise_why = why;

@@ -116,6 +116,8 @@ typedef struct snap {
     pk_image *img;     /* width x height, linear: the colour (denoised or not) or the AOV's values */
     unsigned aov;
     float exposure;
+    int tonemap;       /* PK_TONEMAP_* of the PNG */
+    pk_image *alpha;   /* the coverage when the colour is premultiplied (transparent background), else NULL */
     pthread_mutex_t enc_mu; /* guards the encodings */
     unsigned char *png, *exr;
     size_t png_len, exr_len;
@@ -146,9 +148,11 @@ struct view_server {
     int integrator;        /* pk_integrator_kind, never DEFAULT */
     int max_depth;         /* -1: the integrator's default */
     float exposure;
+    int tonemap;           /* PK_TONEMAP_* */
+    int transparent;       /* the environment seen by the camera has alpha 0 */
     int denoise;
     unsigned aov;
-    int display_dirty;     /* exposure, aov or denoise changed: make the display again */
+    int display_dirty;     /* exposure, tone curve, aov or denoise changed: make the display again */
 
     /* what the render thread reports (under mu) */
     snap *cur;             /* the latest frame (NULL before the first) */
@@ -182,6 +186,7 @@ static void snap_unref_locked(snap *p)
 {
     if (!p || --p->refs > 0) return;
     pk_image_destroy(p->img);
+    pk_image_destroy(p->alpha);
     free(p->png);
     free(p->exr);
     pthread_mutex_destroy(&p->enc_mu);
@@ -294,9 +299,12 @@ static int snap_encode(view_server *s, snap *p, int exr, char *why, size_t cap)
     pk_write_options wo;
     pk_write_options_init(&wo);
     const pk_image *src = p->img;
+    if (exr && p->aov == AOV_COLOR) wo.alpha = p->alpha;
     if (!exr) {
         if (p->aov == AOV_COLOR) {
             wo.exposure_ev = p->exposure;
+            wo.tonemap = p->tonemap;
+            wo.alpha = p->alpha;
         } else {
             const int w = pk_image_width(p->img), h = pk_image_height(p->img);
             if (pk_image_create(ctx, w, h, &copy) != PK_OK) {
@@ -450,9 +458,11 @@ static char *status_json_locked(view_server *s)
     sb_camera(&b, &s->cam);
     sb_printf(&b, ",\"settings\":{\"exposure\":");
     sb_float(&b, s->exposure);
-    sb_printf(&b, ",\"denoise\":%s,\"aov\":\"%s\",\"integrator\":\"%s\",\"max_depth\":%d}",
+    sb_printf(&b, ",\"denoise\":%s,\"aov\":\"%s\",\"integrator\":\"%s\",\"max_depth\":%d",
               s->denoise ? "true" : "false", aov_label(s->aov), integrator_label(s->integrator),
               pk_render_options_max_depth(&ro));
+    sb_printf(&b, ",\"tonemap\":\"%s\",\"transparent\":%s}", pk_tonemap_name(s->tonemap),
+              s->transparent ? "true" : "false");
     sb_printf(&b, ",\"initial_camera\":");
     sb_camera(&b, &s->initial_cam);
     sb_printf(&b, ",\"denoise_available\":%s}", s->denoise_available ? "true" : "false");
@@ -472,13 +482,16 @@ typedef struct rstate {
     int den_failed;       /* the denoiser failed: denoising is turned off */
     double den_cost, den_end;
     pk_denoiser *denoiser;
+    int transparent;      /* the renderers' pk_render_options.transparent: the colour is premultiplied */
 } rstate;
 
 /* The renderers for the settings (integrator, max_depth); on failure the
  * old ones stay and the error is printed. */
-static pk_status make_renderers(view_server *s, int integrator, int max_depth, pk_renderer **full, pk_renderer **prev)
+static pk_status make_renderers(view_server *s, int integrator, int max_depth, int transparent, pk_renderer **full,
+                                pk_renderer **prev)
 {
     pk_render_options ro = s->cfg.ro;
+    ro.transparent = transparent;
     ro.integrator = integrator;
     ro.max_depth = max_depth;
     ro.cancel = &s->cancel;
@@ -531,6 +544,16 @@ static pk_image *copy_image(pk_context *ctx, const pk_image *src)
 
 /* The image to show from film (the preview's when preview), for aov;
  * the denoised colour when den is given. NULL on failure (printed). */
+static pk_image *display_image(view_server *s, const pk_film *film, int preview, unsigned aov, const pk_image *den);
+
+/* The coverage of film (scaled up from the preview's) when the colour is
+ * premultiplied (a transparent background) and shown; else NULL. */
+static pk_image *display_alpha(view_server *s, const pk_film *film, int preview, unsigned aov, int transparent)
+{
+    if (!transparent || aov != AOV_COLOR) return NULL;
+    return display_image(s, film, preview, PK_AOV_ALPHA, NULL);
+}
+
 static pk_image *display_image(view_server *s, const pk_film *film, int preview, unsigned aov, const pk_image *den)
 {
     pk_context *ctx = s->cfg.ctx;
@@ -551,17 +574,20 @@ static pk_image *display_image(view_server *s, const pk_film *film, int preview,
 }
 
 /* Publishes img (taken) as the next frame. Under mu. */
-static void publish_locked(view_server *s, pk_image *img, unsigned aov, float exposure)
+static void publish_locked(view_server *s, pk_image *img, pk_image *alpha, unsigned aov, float exposure, int tonemap)
 {
     snap *p = calloc(1, sizeof *p);
     if (!p) {
         pk_image_destroy(img);
+        pk_image_destroy(alpha);
         return;
     }
     p->refs = 1;
     p->img = img;
+    p->alpha = alpha;
     p->aov = aov;
     p->exposure = exposure;
+    p->tonemap = tonemap;
     pthread_mutex_init(&p->enc_mu, NULL);
     p->frame = ++s->frame;
     snap_unref_locked(s->cur);
@@ -610,7 +636,8 @@ static void *render_main(void *arg)
     view_server *s = arg;
     pk_context *ctx = s->cfg.ctx;
     rstate st = {0};
-    const unsigned all_aovs = PK_AOV_ALBEDO | PK_AOV_NORMAL | PK_AOV_DEPTH | PK_AOV_HEATMAP;
+    const unsigned all_aovs = PK_AOV_ALBEDO | PK_AOV_NORMAL | PK_AOV_DEPTH | PK_AOV_HEATMAP | PK_AOV_ALPHA;
+    st.transparent = s->transparent; /* what the renderers were made with */
     pk_render_options po;
     pk_renderer_get_options(s->r_prev, &po);
     if (pk_film_create_aovs(ctx, s->width, s->height, all_aovs, &st.film) != PK_OK ||
@@ -635,11 +662,11 @@ static void *render_main(void *arg)
         if (s->quit) break;
         if (s->rebuild_gen != rebuild_done) {
             rebuild_done = s->rebuild_gen;
-            const int integrator = s->integrator, depth = s->max_depth;
+            const int integrator = s->integrator, depth = s->max_depth, transparent = s->transparent;
             s->rendering = 1;
             pthread_mutex_unlock(&s->mu);
             pk_renderer *full, *prev;
-            if (make_renderers(s, integrator, depth, &full, &prev) != PK_OK) {
+            if (make_renderers(s, integrator, depth, transparent, &full, &prev) != PK_OK) {
                 fprintf(stderr, "paprsek: view: %s\n", pk_context_error(ctx));
                 pk_context_clear_error(ctx);
             } else {
@@ -648,6 +675,7 @@ static void *render_main(void *arg)
                 pk_renderer_destroy(s->r_prev);
                 s->r_full = full;
                 s->r_prev = prev;
+                st.transparent = transparent;
                 pthread_rwlock_unlock(&s->rlock);
             }
             pthread_mutex_lock(&s->mu);
@@ -670,6 +698,7 @@ static void *render_main(void *arg)
         }
         const unsigned aov = s->aov;
         const float exposure = s->exposure;
+        const int tonemap = s->tonemap;
         const int denoise = s->denoise && s->cfg.dopt;
         int job;
         const int more = (uint64_t)passes * (uint64_t)s->cfg.ro.spp < (uint64_t)s->max_spp;
@@ -695,7 +724,7 @@ static void *render_main(void *arg)
         pthread_mutex_unlock(&s->mu);
 
         pk_status rs = PK_OK;
-        pk_image *img = NULL;
+        pk_image *img = NULL, *alpha = NULL;
         int show = 1;
         if (job == JOB_PREVIEW) {
             pk_film_clear(st.pfilm);
@@ -707,6 +736,7 @@ static void *render_main(void *arg)
             if (rs == PK_OK) {
                 stage = 1;
                 img = display_image(s, st.pfilm, 1, aov, NULL);
+                alpha = display_alpha(s, st.pfilm, 1, aov, st.transparent);
             }
         } else if (job == JOB_PASS) {
             pk_renderer_set_pass(s->r_full, passes);
@@ -722,15 +752,24 @@ static void *render_main(void *arg)
                     else if (!dirty)
                         show = 0; /* the denoised image stays until the next denoising */
                 }
-                if (show) img = display_image(s, st.film, 0, aov, denoise ? st.den : NULL);
+                if (show) {
+                    img = display_image(s, st.film, 0, aov, denoise ? st.den : NULL);
+                    alpha = display_alpha(s, st.film, 0, aov, st.transparent);
+                }
             }
         } else if (job == JOB_DENOISE) {
-            if (run_denoise(s, &st, passes) == 0) img = display_image(s, st.film, 0, aov, st.den);
+            if (run_denoise(s, &st, passes) == 0) {
+                img = display_image(s, st.film, 0, aov, st.den);
+                alpha = display_alpha(s, st.film, 0, aov, st.transparent);
+            }
         } else { /* JOB_DISPLAY */
-            if (passes > 0)
+            if (passes > 0) {
                 img = display_image(s, st.film, 0, aov, denoise && st.den ? st.den : NULL);
-            else
+                alpha = display_alpha(s, st.film, 0, aov, st.transparent);
+            } else {
                 img = display_image(s, st.pfilm, 1, aov, NULL);
+                alpha = display_alpha(s, st.pfilm, 1, aov, st.transparent);
+            }
         }
         if (rs != PK_OK && rs != PK_ERR_CANCELLED) {
             fprintf(stderr, "paprsek: view: %s\n", pk_context_error(ctx));
@@ -757,11 +796,12 @@ static void *render_main(void *arg)
             s->t_last = now_s();
             if (ps.render_s > render_s0) s->rays_per_s = (double)(rays_of(&ps) - rays0) / (ps.render_s - render_s0);
             if (img) {
-                publish_locked(s, img, aov, exposure);
-                img = NULL;
+                publish_locked(s, img, alpha, aov, exposure, tonemap);
+                img = alpha = NULL;
             }
         }
         pk_image_destroy(img);
+        pk_image_destroy(alpha);
     }
     s->rendering = 0;
     s->thread_done = 1;
@@ -977,6 +1017,7 @@ static enum MHD_Result post_settings(view_server *s, struct MHD_Connection *c, r
     if (!root) return ret;
     pthread_mutex_lock(&s->mu);
     float exposure = s->exposure;
+    int tonemap = s->tonemap, transparent = s->transparent;
     int denoise = s->denoise, integrator = s->integrator, depth = s->max_depth;
     unsigned aov = s->aov;
     pthread_mutex_unlock(&s->mu);
@@ -992,6 +1033,17 @@ static enum MHD_Result post_settings(view_server *s, struct MHD_Connection *c, r
             if (!(why = get_number(it, &x)) && !(x >= -PK_MAX_EXPOSURE_EV && x <= PK_MAX_EXPOSURE_EV))
                 why = "must be a number of stops in -20..20";
             exposure = (float)x;
+        } else if (strcmp(k, "tonemap") == 0) {
+            const char *v = cJSON_GetStringValue(it);
+            if (!v || pk_tonemap_parse(v) < 0) why = "must be one of clamp, agx, pbr-neutral, aces";
+            else tonemap = pk_tonemap_parse(v);
+        } else if (strcmp(k, "transparent") == 0) {
+            if (!cJSON_IsBool(it))
+                why = "must be true or false";
+            else if (cJSON_IsTrue(it) && (s->cfg.ro.device == PK_DEVICE_CUDA || s->cfg.ro.accel == PK_ACCEL_CUDA))
+                snprintf(msg, sizeof msg, "transparent: a transparent background is rendered on the CPU only");
+            else
+                transparent = cJSON_IsTrue(it);
         } else if (strcmp(k, "denoise") == 0) {
             if (!cJSON_IsBool(it))
                 why = "must be true or false";
@@ -1028,7 +1080,7 @@ static enum MHD_Result post_settings(view_server *s, struct MHD_Connection *c, r
                 }
             }
         } else {
-            snprintf(msg, sizeof msg, "unknown field '%.64s' (exposure, denoise, aov, integrator, max_depth)", k);
+            snprintf(msg, sizeof msg, "unknown field '%.64s' (exposure, tonemap, transparent, denoise, aov, integrator, max_depth)", k);
         }
         if (why) snprintf(msg, sizeof msg, "%.64s: %s", k, why);
         if (msg[0]) break;
@@ -1036,13 +1088,16 @@ static enum MHD_Result post_settings(view_server *s, struct MHD_Connection *c, r
     cJSON_Delete(root);
     if (msg[0]) return send_error(c, MHD_HTTP_BAD_REQUEST, "%s", msg);
     pthread_mutex_lock(&s->mu);
-    if (exposure != s->exposure || aov != s->aov || denoise != s->denoise) s->display_dirty = 1;
+    if (exposure != s->exposure || tonemap != s->tonemap || aov != s->aov || denoise != s->denoise)
+        s->display_dirty = 1;
     s->exposure = exposure;
+    s->tonemap = tonemap;
     s->aov = aov;
     s->denoise = denoise;
-    if (integrator != s->integrator || depth != s->max_depth) {
+    if (integrator != s->integrator || depth != s->max_depth || transparent != s->transparent) {
         s->integrator = integrator;
         s->max_depth = depth;
+        s->transparent = transparent;
         s->rebuild_gen++;
         s->restart_gen++;
         s->cancel = 1;
@@ -1394,6 +1449,8 @@ int view_server_start(const view_config *cfg, view_server **out, char *err, size
                                                                   : PK_INTEGRATOR_PATH;
     s->max_depth = cfg->ro.max_depth;
     s->exposure = cfg->exposure;
+    s->tonemap = cfg->tonemap;
+    s->transparent = cfg->ro.transparent;
     s->denoise_available = cfg->dopt != NULL;
     s->denoise = cfg->denoise && cfg->dopt;
     s->aov = AOV_COLOR;
@@ -1409,7 +1466,7 @@ int view_server_start(const view_config *cfg, view_server **out, char *err, size
         free(s);
         return fail(err, cap, "cannot make a temporary folder in %s: %s", tmp && *tmp ? tmp : "/tmp", strerror(e));
     }
-    if (make_renderers(s, s->integrator, s->max_depth, &s->r_full, &s->r_prev) != PK_OK) {
+    if (make_renderers(s, s->integrator, s->max_depth, s->transparent, &s->r_full, &s->r_prev) != PK_OK) {
         fail(err, cap, "%s", pk_context_error(cfg->ctx));
         view_server_stop(s);
         return 1;

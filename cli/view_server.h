@@ -31,6 +31,7 @@ typedef struct view_config {
     int port;               /* 0: a free one */
     int require_token;      /* 1: a token on every request (always so for an address other than 127.x.x.x) */
     float exposure;         /* the initial exposure, stops */
+    int tonemap;            /* the initial tone curve, PK_TONEMAP_* */
     int denoise;            /* denoise from the start (needs dopt) */
     const pk_denoise_options *dopt; /* NULL: no denoiser here; denoise cannot be turned on */
     const char *no_denoise_why;     /* with dopt NULL: why (said in the 400) */

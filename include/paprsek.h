@@ -328,6 +328,13 @@ typedef struct pk_render_options {
      * with negative lobes (mitchell, lanczos) give samples negative weights
      * there, which makes them noisier than the others at equal samples. */
     pk_filter filter;
+    /* Transparent background: 1 makes what camera rays see of the
+     * surroundings black (their samples add nothing), so the image is
+     * colour premultiplied by the coverage (PK_AOV_ALPHA); the environment
+     * still lights the scene and is still seen in reflections and through
+     * glass. 0 (the default) shows it. CPU only: PK_ERR_UNSUPPORTED on the
+     * GPU. */
+    int transparent;
 } pk_render_options;
 
 /* Arbitrary output variables: what the camera ray of each sample found,
@@ -339,9 +346,12 @@ enum {
                           * denoiser wants); emitters and the sky their colour over its largest part */
     PK_AOV_NORMAL = 2u,  /* the shading normal, world space, facing the ray, at that same surface */
     PK_AOV_DEPTH = 4u,   /* distance from the camera to the hit (0 where nothing is hit) */
-    PK_AOV_HEATMAP = 8u  /* acceleration-structure nodes visited + primitives tested by the camera ray */
+    PK_AOV_HEATMAP = 8u, /* acceleration-structure nodes visited + primitives tested by the camera ray */
+    PK_AOV_ALPHA = 16u   /* coverage: the fraction of the pixel's samples whose camera ray hit a surface
+                          * (through map_d holes; glass and mirrors count as surfaces), in all three
+                          * channels (pk_write_options.alpha reads the first) */
 };
-/* "albedo", "normal", "depth", "heatmap" -> PK_AOV_*, 0 when unknown. */
+/* "albedo", "normal", "depth", "heatmap", "alpha" -> PK_AOV_*, 0 when unknown. */
 PK_API unsigned pk_aov_parse(const char *name);
 PK_API const char *pk_aov_name(unsigned aov);
 
@@ -629,8 +639,43 @@ PK_API pk_status pk_image_write(pk_context *ctx, const pk_image *img, const char
  * s = 12.92 x (x <= 0.0031308) or 1.055 x^(1/2.4) - 0.055, and the byte is
  * floor(255 s + 0.5). Values above 1 are clipped, not compressed. */
 #define PK_MAX_EXPOSURE_EV 20
+
+/* Tone curves of 8-bit outputs (pk_write_options.tonemap), applied to the
+ * linear values after the exposure and before the sRGB encoding:
+ *   PK_TONEMAP_CLAMP        values above 1 are clipped (the default);
+ *   PK_TONEMAP_AGX          Blender's AgX (its base look): the colour in
+ *                           Rec.2020 through AgX's inset matrix, log2 of
+ *                           x / 0.18 over [-10, +6.5] stops, AgX's sigmoid
+ *                           (slope 2.4 at middle grey, toe and shoulder
+ *                           powers 1.5), decoded by the 2.4 power, the
+ *                           outset matrix, back to Rec.709;
+ *   PK_TONEMAP_PBR_NEUTRAL  Khronos PBR Neutral: colours whose components
+ *                           lie in [0.08, 0.8] come out as they went in,
+ *                           less 0.04; brighter ones are compressed toward
+ *                           white;
+ *   PK_TONEMAP_ACES         Stephen Hill's fit of ACES's RRT and sRGB ODT
+ *                           (input matrix, rational curve, output matrix).
+ * Each maps 0 to 0 and is monotonic along the grey axis. */
+enum { PK_TONEMAP_CLAMP = 0, PK_TONEMAP_AGX, PK_TONEMAP_PBR_NEUTRAL, PK_TONEMAP_ACES, PK_TONEMAP_COUNT };
+/* "clamp", "agx", "pbr-neutral", "aces" -> PK_TONEMAP_*; -1 when unknown. */
+PK_API int pk_tonemap_parse(const char *name);
+/* The name of a PK_TONEMAP_* ("unknown" for any other number). */
+PK_API const char *pk_tonemap_name(int tonemap);
+
 typedef struct pk_write_options {
     float exposure_ev;
+    /* PNG only: PK_TONEMAP_* (default PK_TONEMAP_CLAMP). HDR outputs hold
+     * the linear values, untouched. */
+    int tonemap;
+    /* Coverage (NULL: opaque): an image of the same size whose first
+     * channel of each pixel is its alpha in [0, 1] (a render's
+     * PK_AOV_ALPHA). The image is then premultiplied colour, as a render with
+     * pk_render_options.transparent gives it. PNG becomes RGBA, its colour
+     * divided by alpha (PNG is not premultiplied; 0 where alpha is 0) before
+     * the exposure and the tone curve; OpenEXR gets a channel A beside R, G,
+     * B, which stay premultiplied (OpenEXR's convention); PFM has no alpha
+     * and refuses it. */
+    const pk_image *alpha;
     /* .exr only: more images of the same size written into the same file as
      * layers, channels "NAME.R", "NAME.G", "NAME.B" (the AOVs). Other formats
      * refuse layers. */

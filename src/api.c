@@ -456,14 +456,14 @@ pk_status pk_film_create_aovs(pk_context *ctx, int width, int height, unsigned a
 {
     if (!ctx || !out) return PK_ERR_INVALID_ARGUMENT;
     *out = NULL;
-    if (aovs & ~(PK_AOV_ALBEDO | PK_AOV_NORMAL | PK_AOV_DEPTH | PK_AOV_HEATMAP))
+    if (aovs & ~(PK_AOV_ALBEDO | PK_AOV_NORMAL | PK_AOV_DEPTH | PK_AOV_HEATMAP | PK_AOV_ALPHA))
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "unknown AOV bits 0x%x", aovs);
     return film_create(ctx, width, height, aovs, out);
 }
 
 unsigned pk_film_aovs(const pk_film *film) { return film ? film->aovs : 0; }
 
-static const char *const aov_names[FILM_AOVS] = {"albedo", "normal", "depth", "heatmap"};
+static const char *const aov_names[FILM_AOVS] = {"albedo", "normal", "depth", "heatmap", "alpha"};
 
 unsigned pk_aov_parse(const char *name)
 {

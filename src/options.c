@@ -96,6 +96,8 @@ pk_status options_check(pk_context *ctx, const pk_render_options *o)
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "unknown accelerator %d", (int)o->accel);
     if ((unsigned)o->integrator > PK_INTEGRATOR_VOLPATH)
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "unknown integrator %d", (int)o->integrator);
+    if ((unsigned)o->transparent > 1u)
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "transparent %d is not 0 or 1", o->transparent);
     if ((unsigned)o->energy_compensation > 1u)
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "energy compensation %d is not 0 or 1", o->energy_compensation);
     if ((unsigned)o->device > PK_DEVICE_CUDA)

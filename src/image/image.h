@@ -17,7 +17,7 @@ struct pk_image {
 
 /* Invariants: sums holds 3*width*height floats and counts width*height
  * sample counts, rows top first; a pixel with count 0 has zero sums. */
-#define FILM_AOVS 4 /* albedo, normal, depth, heatmap: bit k of the mask is aov[k] */
+#define FILM_AOVS 5 /* albedo, normal, depth, heatmap, alpha: bit k of the mask is aov[k] */
 
 struct pk_film {
     pk_allocator alloc;

@@ -14,6 +14,10 @@ PK_HIDDEN pk_status image_write(pk_context *ctx, const pk_image *img, const char
 /* The same with options (wo NULL: the defaults; see pk_write_options). */
 PK_HIDDEN pk_status image_write_ex(pk_context *ctx, const pk_image *img, const char *path,
                                    const pk_write_options *wo);
+/* The tone curve PK_TONEMAP_* on one linear colour (after the exposure):
+ * out (may be in) is linear display RGB in [0, 1], to be sRGB-encoded.
+ * Negative and NaN components count as 0. */
+PK_HIDDEN void image_tonemap(int tonemap, const float in[3], float out[3]);
 /* Linear [0,1] to 8-bit sRGB, clamped: the PNG tone curve after exposure. */
 PK_HIDDEN unsigned char srgb_encode(float linear);
 

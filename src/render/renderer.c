@@ -130,6 +130,10 @@ pk_status renderer_create(pk_context *ctx, const pk_scene *s, const pk_render_op
                           pk_renderer **out)
 {
     *out = NULL;
+    if (opt->transparent && (opt->accel == PK_ACCEL_CUDA || opt->device == PK_DEVICE_CUDA))
+        return ctx_error(ctx, PK_ERR_UNSUPPORTED,
+                         "device 'cuda': a transparent background is rendered on the CPU only (render without it "
+                         "on the GPU, or on the CPU)");
     if (s->nkept && (opt->accel == PK_ACCEL_CUDA || opt->device == PK_DEVICE_CUDA))
         return ctx_error(ctx, PK_ERR_UNSUPPORTED,
                          "device 'cuda': the GPU renders flattened triangles only (the scene keeps %zu instances; "
@@ -292,6 +296,17 @@ static float camera_ray_heat(const pk_renderer *r, const ray *cr)
     return (float)(c.nodes + c.tests);
 }
 
+/* Whether camera ray cr (closest hit *h, prim PK_NO_HIT for none) meets a
+ * surface: past the holes of map_d cut-outs, as the integrators go. */
+static bool camera_ray_covered(const pk_renderer *r, const ray *cr, const hit *h)
+{
+    if (h->prim == PK_NO_HIT) return false;
+    if (!r->fr.v.has_cutout) return true;
+    ray rr = *cr;
+    hit hh = *h;
+    return trace_past_holes(r->fr.a, &r->fr.v, &rr, &hh, NULL);
+}
+
 /* Renders the samples of tile tl into acc (3 floats a pixel) and, when the
  * film holds AOVs, their sums into aovs: camera rays traced as one batch,
  * then each sample shaded by the renderer's integrator. Returns false when
@@ -326,10 +341,16 @@ static bool render_tile(const pk_renderer *r, int tid, const camera_frame *cf, c
                 const float heat = camera_ray_heat(r, &rays[i]);
                 for (int k = 0; k < 3; k++) aovs[3][3 * i + k] += heat;
             }
-            const bool kept = r->ig->sample(r->self, ts, px, py, first + (uint64_t)smp, &rays[i],
-                                            hits[i].prim == PK_NO_HIT ? NULL : &hits[i], &c, want_aov ? &av : NULL);
             /* weighted by the pixel filter (1 but where a filter with negative lobes is negative) */
             const float w = wts[i];
+            if (aov_mask & PK_AOV_ALPHA || r->opt.transparent) {
+                const bool covered = camera_ray_covered(r, &rays[i], &hits[i]);
+                if (aov_mask & PK_AOV_ALPHA)
+                    for (int k = 0; k < 3; k++) aovs[4][3 * i + k] += covered ? w : 0.0f;
+                if (!covered && r->opt.transparent) continue; /* the background: nothing, AOVs 0 */
+            }
+            const bool kept = r->ig->sample(r->self, ts, px, py, first + (uint64_t)smp, &rays[i],
+                                            hits[i].prim == PK_NO_HIT ? NULL : &hits[i], &c, want_aov ? &av : NULL);
             if (want_aov) {
                 const float *v[3] = {&av.albedo.x, &av.normal.x, NULL};
                 for (int k = 0; k < 2; k++)
@@ -374,10 +395,11 @@ static void render_tile_aovs_cpu(const pk_renderer *r, const camera_frame *cf, c
             accel_counters c = {0, 0};
             hit h;
             const bool got = r->fr.a->ops->intersect(r->fr.a, &cr, &h, (film->aovs & PK_AOV_HEATMAP) ? &c : NULL);
-            float *a = &v[0][3 * i], *nn = &v[1][3 * i], *d = &v[2][3 * i], *hm = &v[3][3 * i];
+            float *a = &v[0][3 * i], *nn = &v[1][3 * i], *d = &v[2][3 * i], *hm = &v[3][3 * i], *al = &v[4][3 * i];
             const float heat = (float)(c.nodes + c.tests);
             hm[0] += heat, hm[1] += heat, hm[2] += heat;
             if (!got || (s->has_cutout && !trace_past_holes(r->fr.a, s, &cr, &h, NULL))) continue;
+            al[0] += w, al[1] += w, al[2] += w;
             surface sf = surface_at(s, &cr, &h);
             material textured;
             if (sf.m->textured)

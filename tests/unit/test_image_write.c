@@ -429,6 +429,72 @@ static void test_write_layers(void)
     pk_image_destroy(img), pk_image_destroy(lay), pk_image_destroy(small);
 }
 
+/* ---- alpha (coverage) --------------------------------------------------------- */
+
+/* A 4x1 premultiplied image with coverage 0, 0.25, 0.5, 1: the PNG is RGBA
+ * with alpha round(255 a) and colour un-premultiplied (c / a, sRGB-encoded);
+ * the EXR has A beside R, G, B, all bit for bit (colour still premultiplied);
+ * PFM refuses alpha and writes nothing; an alpha of another size is refused. */
+static void test_alpha(void)
+{
+    pk_image *img = NULL, *al = NULL, *small = NULL;
+    REQUIRE(pk_image_create(ctx, 4, 1, &img) == PK_OK && pk_image_create(ctx, 4, 1, &al) == PK_OK &&
+            pk_image_create(ctx, 3, 1, &small) == PK_OK);
+    const float a[4] = {0.0f, 0.25f, 0.5f, 1.0f}, c[4] = {0.0f, 0.1f, 0.2f, 0.3f}; /* c = straight 0.4 * a, 0.3 */
+    float *px = pk_image_pixels(img), *pa = pk_image_pixels(al);
+    for (int i = 0; i < 4; i++)
+        for (int k = 0; k < 3; k++) px[3 * i + k] = c[i], pa[3 * i + k] = a[i];
+    pk_write_options wo;
+    pk_write_options_init(&wo);
+    wo.alpha = al;
+    char path[256];
+    snprintf(path, sizeof path, "%s/a.png", dir);
+    REQUIRE(pk_image_write_ex(ctx, img, path, &wo) == PK_OK);
+    png_image pi;
+    memset(&pi, 0, sizeof pi);
+    pi.version = PNG_IMAGE_VERSION;
+    unsigned char buf[4 * 4];
+    REQUIRE(png_image_begin_read_from_file(&pi, path));
+    CHECK(pi.format & PNG_FORMAT_FLAG_ALPHA);
+    pi.format = PNG_FORMAT_RGBA;
+    REQUIRE(pi.width == 4 && pi.height == 1 && png_image_finish_read(&pi, NULL, buf, 0, NULL));
+    for (int i = 0; i < 4; i++) {
+        CHECKF(buf[4 * i + 3] == (int)floor(255.0 * a[i] + 0.5), "pixel %d alpha %d", i, buf[4 * i + 3]);
+        const double straight = a[i] > 0.0f ? (i == 3 ? 0.3 : 0.4) : 0.0;
+        const double s = straight <= 0.0031308 ? 12.92 * straight : 1.055 * pow(straight, 1.0 / 2.4) - 0.055;
+        CHECKF(buf[4 * i] == (int)floor(255.0 * s + 0.5), "pixel %d red %d, expected %.2f", i, buf[4 * i], 255.0 * s);
+    }
+    remove(path);
+    snprintf(path, sizeof path, "%s/a.exr", dir);
+    REQUIRE(pk_image_write_ex(ctx, img, path, &wo) == PK_OK);
+    exr_read r;
+    REQUIRE(read_exr(path, &r) == 0);
+    CHECK(r.nch == 4);
+    for (int ch = 0; ch < r.nch; ch++) {
+        const int is_a = strcmp(r.names[ch], "A") == 0;
+        CHECK(is_a || strlen(r.names[ch]) == 1);
+        for (int i = 0; i < 4; i++) CHECK(bits(r.planes[ch][i]) == bits(is_a ? a[i] : c[i]));
+    }
+    CHECK(strcmp(r.names[0], "A") == 0); /* sorted: A, B, G, R */
+    free_read(&r);
+    remove(path);
+    snprintf(path, sizeof path, "%s/a.pfm", dir);
+    CHECK(pk_image_write_ex(ctx, img, path, &wo) == PK_ERR_INVALID_ARGUMENT);
+    CHECK(strstr(pk_context_error(ctx), "alpha") != NULL);
+    CHECK(access(path, F_OK) != 0);
+    wo.alpha = small;
+    snprintf(path, sizeof path, "%s/b.png", dir);
+    CHECK(pk_image_write_ex(ctx, img, path, &wo) == PK_ERR_INVALID_ARGUMENT);
+    CHECK(access(path, F_OK) != 0);
+    wo.alpha = NULL;
+    wo.tonemap = PK_TONEMAP_COUNT;
+    CHECK(pk_image_write_ex(ctx, img, path, &wo) == PK_ERR_INVALID_ARGUMENT);
+    CHECK(access(path, F_OK) != 0);
+    pk_image_destroy(img);
+    pk_image_destroy(al);
+    pk_image_destroy(small);
+}
+
 int main(void)
 {
     REQUIRE(mkdtemp(dir));
@@ -438,6 +504,7 @@ int main(void)
     test_write_layers();
     test_exr_missing_folder();
     test_png_exposure();
+    test_alpha();
     pk_context_destroy(ctx);
     rmdir(dir);
     return test_done("test_image_write");

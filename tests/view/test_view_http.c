@@ -238,6 +238,24 @@ int main(void)
     CHECK(vc_json_number((char *)r.body, "passes") == 0);
     vc_free(&r);
     CHECK(vc_wait_status(port, 30, converged, NULL));
+    /* a tone curve and a transparent background: the background restarts
+     * (a renderer option), the frame becomes RGBA (PNG colour type 6), then back */
+    r = vc_post(port, "/api/settings", "{\"tonemap\":\"agx\",\"transparent\":true}");
+    CHECK(r.code == 200);
+    CHECK(r.body && strstr((char *)r.body, "\"tonemap\":\"agx\",\"transparent\":true"));
+    CHECK(vc_json_number((char *)r.body, "passes") == 0);
+    vc_free(&r);
+    CHECK(vc_wait_status(port, 30, converged, NULL));
+    r = vc_get(port, "/api/frame.png");
+    CHECK(r.code == 200 && r.len > 26 && r.body[25] == 6);
+    vc_free(&r);
+    r = vc_post(port, "/api/settings", "{\"tonemap\":\"clamp\",\"transparent\":false}");
+    CHECK(r.code == 200);
+    vc_free(&r);
+    CHECK(vc_wait_status(port, 30, converged, NULL));
+    r = vc_get(port, "/api/frame.png");
+    CHECK(r.code == 200 && r.len > 26 && r.body[25] == 2);
+    vc_free(&r);
 
     /* pick: the centre of the image hits the front face of the tall block
      * (x, z from 0.265, 0.296 to 0.423, 0.247), a row near the top the back
@@ -292,6 +310,8 @@ int main(void)
     expect_refused(port, "POST", "/api/settings", NULL, NULL, "{\"denoise\":\"yes\"}", 400, "denoise not a boolean");
     expect_refused(port, "POST", "/api/settings", NULL, NULL, "{\"denoise\":true}", 400, "no denoiser here");
     expect_refused(port, "POST", "/api/settings", NULL, NULL, "{\"gamma\":2.2}", 400, "unknown setting");
+    expect_refused(port, "POST", "/api/settings", NULL, NULL, "{\"tonemap\":\"filmic\"}", 400, "unknown tone curve");
+    expect_refused(port, "POST", "/api/settings", NULL, NULL, "{\"transparent\":1}", 400, "transparent not a boolean");
     expect_refused(port, "POST", "/api/settings", NULL, NULL, "", 400, "empty body");
     expect_refused(port, "GET", "/api/pick?x=10", NULL, NULL, NULL, 400, "pick without y");
     expect_refused(port, "GET", "/api/pick?x=10&y=abc", NULL, NULL, NULL, 400, "pick y not a number");
