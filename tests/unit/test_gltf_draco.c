@@ -16,6 +16,7 @@
 #include "io/readers.h"
 #include "scene/scene.h"
 
+#include <float.h>
 #include <stdint.h>
 
 #if PK_HAVE_DRACO
@@ -253,8 +254,10 @@ static void test_quantized(void)
     free(packed);
     if (st != PK_OK) return;
     /* Draco quantizes positions on a grid of 2^q - 1 steps over the largest
-     * extent of their box (here 2): each coordinate within half a step */
-    const float range = 2.0f, step = range / (float)((1 << qpos) - 1), tol = 0.5f * step * (1 + 1e-5f) + 1e-7f;
+     * extent of their box (here 2): each coordinate within half a step, and
+     * a few float roundings of the quantizer's and the dequantizer's
+     * arithmetic (coordinates at most 1 in magnitude: 4 FLT_EPSILON) */
+    const float range = 2.0f, step = range / (float)((1 << qpos) - 1), tol = 0.5f * step + 4 * FLT_EPSILON;
     CHECK(b->ntris == NT);
     static tri9 want[NT], got[NT];
     for (int t = 0; t < NT; t++) {

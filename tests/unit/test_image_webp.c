@@ -27,7 +27,9 @@
 static uint32_t rng = 7;
 static uint8_t rnd8(void) { return rng = rng * 1664525u + 1013904223u, (uint8_t)(rng >> 24); }
 
-/* A w x h picture of nc channels: smooth ramps plus a little noise. */
+/* A w x h picture of nc channels: smooth ramps plus a little noise; alpha
+ * never 0 (libwebp's lossless encoder may change the colour under a fully
+ * transparent pixel) nor everywhere 255 (it drops an opaque alpha channel). */
 static uint8_t *picture(int w, int h, int nc)
 {
     uint8_t *p = malloc((size_t)w * (size_t)h * (size_t)nc);
@@ -35,7 +37,7 @@ static uint8_t *picture(int w, int h, int nc)
         for (int x = 0; x < w; x++)
             for (int c = 0; c < nc; c++)
                 p[((size_t)y * (size_t)w + (size_t)x) * (size_t)nc + (size_t)c] =
-                    (uint8_t)(c == 3 ? 255 - x * 255 / (w > 1 ? w - 1 : 1) : (x * (c + 1) * 7 + y * 5 + (rnd8() & 7)) & 255);
+                    (uint8_t)(c == 3 ? 55 + (x * 7 + y * 3) % 200 : (x * (c + 1) * 7 + y * 5 + (rnd8() & 7)) & 255);
     return p;
 }
 
