@@ -156,8 +156,9 @@ PK_HIDDEN void gltf_buffers_free(gltf *g);
  * module, a primitive whose accessors have buffer views (the uncompressed
  * fallback) is read from those with one warning; one without is an error. */
 PK_HIDDEN pk_status gltf_draco_primitive(gltf *g, const cJSON *p, const char *path);
-/* Whether this build has the Draco module and it loads (for messages). */
-PK_HIDDEN bool gltf_have_draco(gltf *g);
+/* Whether this build has the Draco module and it loads; when not, why (n
+ * bytes) says why not. */
+PK_HIDDEN bool gltf_have_draco(gltf *g, char *why, size_t n);
 
 /* ---- materials (gltf_material.c) ---- */
 

@@ -55,11 +55,7 @@ static bool draco_loaded(const pk_context *ctx, char *why, size_t n)
     return false;
 }
 
-bool gltf_have_draco(gltf *g)
-{
-    char why[8];
-    return draco_loaded(g->ctx, why, sizeof why);
-}
+bool gltf_have_draco(gltf *g, char *why, size_t n) { return draco_loaded(g->ctx, why, n); }
 
 static void *host_alloc(void *user, size_t size) { return mem_alloc(&((gltf *)user)->ctx->alloc, size); }
 static void host_free(void *user, void *p) { mem_free(&((gltf *)user)->ctx->alloc, p); }

@@ -183,12 +183,12 @@ static pk_status check_document(gltf *g)
     int k = 0;
     for (const cJSON *e = req ? req->child : NULL; e; e = e->next, k++) {
         if (!cJSON_IsString(e)) return gltf_fail(g, PK_ERR_PARSE, "/extensionsRequired/%d: must be a string", k);
-        if (strcmp(e->valuestring, "KHR_draco_mesh_compression") == 0 && !gltf_have_draco(g))
+        char why[700];
+        if (strcmp(e->valuestring, "KHR_draco_mesh_compression") == 0 && !gltf_have_draco(g, why, sizeof why))
             return gltf_fail(g, PK_ERR_UNSUPPORTED,
                              "/extensionsRequired/%d: Draco-compressed meshes (KHR_draco_mesh_compression) are not "
-                             "read by this build (Draco, Debian libdraco-dev, and its module are needed); export the "
-                             "model without Draco compression",
-                             k);
+                             "read here (%.200s); export the model without Draco compression",
+                             k, why);
         if (strcmp(e->valuestring, "EXT_texture_webp") == 0 && !image_have_webp())
             return gltf_fail(g, PK_ERR_UNSUPPORTED,
                              "/extensionsRequired/%d: WebP textures (EXT_texture_webp) are not read by this build "

@@ -195,6 +195,19 @@ static void test_lossless(const uint8_t *stream, size_t slen, const int ids[4])
                sizeof pos + sizeof nrm + sizeof uv + sizeof col + sizeof idx16);
         scene_destroy(b);
     }
+    /* the same with the extension required */
+    const char *at = strstr(packed, "\"extensionsUsed\"");
+    REQUIRE(at);
+    size_t n = strlen(packed) + 64;
+    char *req = malloc(n);
+    snprintf(req, n, "%.*s\"extensionsRequired\":[\"KHR_draco_mesh_compression\"],%s", (int)(at - packed), packed, at);
+    st = load(req, module_config, &b);
+    CHECKF(st == PK_OK, "%s", msg);
+    if (st == PK_OK) {
+        CHECK(compare_exact(a, b) == 0);
+        scene_destroy(b);
+    }
+    free(req);
     scene_destroy(a);
     free(plain);
     free(packed);
