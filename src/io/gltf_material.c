@@ -198,7 +198,7 @@ static pk_status texture_ext_source(gltf *g, const cJSON *t, const char *path, i
         }
         gltf_warn_once(g, k ? GW_BASISU : GW_WEBP, "%s: %s; %s", xp,
                        k ? "KTX2 / Basis Universal images are not decoded (no decoder in this build)"
-                         : "WebP images are not decoded in this build (libwebp, Debian libwebp-dev, was missing)",
+                         : "WebP images are not decoded here (libwebp is needed: Debian libwebp-dev)",
                        *src >= 0 ? "the texture's fallback source image is read" : "and it has no fallback source");
     }
     return PK_OK;

@@ -191,8 +191,8 @@ static pk_status check_document(gltf *g)
                              k, why);
         if (strcmp(e->valuestring, "EXT_texture_webp") == 0 && !image_have_webp())
             return gltf_fail(g, PK_ERR_UNSUPPORTED,
-                             "/extensionsRequired/%d: WebP textures (EXT_texture_webp) are not read by this build "
-                             "(libwebp, Debian libwebp-dev, is needed)",
+                             "/extensionsRequired/%d: WebP textures (EXT_texture_webp) are not read here (libwebp is "
+                             "needed: Debian libwebp-dev)",
                              k);
         if (strcmp(e->valuestring, "KHR_texture_basisu") == 0)
             return gltf_fail(g, PK_ERR_UNSUPPORTED,
