@@ -10,7 +10,10 @@ DEMO_PKGS   = gcc make cmake pkg-config libpng-dev libjpeg62-turbo-dev libcjson-
 # bring): the OpenVDB module, which reads .vdb grids of participating media (optional: the build
 # goes on without them, and the library then refuses .vdb files saying so)
 # libmicrohttpd-dev: the HTTP server of `paprsek view` (optional: the command is left out without it)
-BUILD_PKGS  = $(DEMO_PKGS) libopenvdb-dev g++ libboost-dev libmicrohttpd-dev
+# libmeshoptimizer-dev, libdraco-dev, libwebp-dev: compressed glTF (EXT_meshopt_compression,
+# KHR_draco_mesh_compression: the Draco module, with g++) and WebP images (optional: without them
+# such files are refused, or their uncompressed fallback read, saying which package is missing)
+BUILD_PKGS  = $(DEMO_PKGS) libopenvdb-dev g++ libboost-dev libmicrohttpd-dev libmeshoptimizer-dev libdraco-dev libwebp-dev
 # g++: the install tests build a C++ program against the installed library;
 # Open MPI: paprsek-mpi and its tests (mpirun), iproute2: their two-host test
 # python3-numpy: the denoiser's oracle (tests/denoise/oracle.py)

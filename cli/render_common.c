@@ -108,7 +108,7 @@ const cli_option *cli_render_options(size_t *n)
         add((cli_option){.name = "config", .id = OPT_CONFIG, .kind = CLI_STRING, .arg = "KEY=VALUE,...",
                          .help = "settings of the library's back ends: cpu.isa=auto|avx2, bvh.quality=high|fast, "
                                  "embree.quality=low|medium|high, embree.library=FILE, cuda.library=FILE, "
-                                 "cuda.module=FILE, openvdb.module=FILE, "
+                                 "cuda.module=FILE, openvdb.module=FILE, draco.module=FILE, "
                                  "scene.instances=auto|flatten|keep (README, Configuration); they override the "
                                  "environment variables "
                                  "PAPRSEK_CPU_ISA, PAPRSEK_BVH_QUALITY, PAPRSEK_EMBREE_QUALITY, "

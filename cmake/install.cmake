@@ -1,7 +1,7 @@
 # install.cmake - what `cmake --install` puts under the prefix:
 #   bin/paprsek (and bin/paprsek-mpi when MPI was found), include/paprsek.h, lib/libpaprsek.so.0.1.0 (+ .so.0, .so),
 #   lib/libpaprsek.a, the library's modules where they were built (lib/paprsek/paprsek_openvdb.so,
-#   lib/paprsek/paprsek_cuda.so: src/device/module.h), lib/pkgconfig/paprsek.pc and lib/cmake/paprsek/
+#   lib/paprsek/paprsek_cuda.so, lib/paprsek/paprsek_draco.so: src/device/module.h), lib/pkgconfig/paprsek.pc and lib/cmake/paprsek/
 #   (paprsekConfig.cmake, its version file, the exported targets
 #   paprsek::paprsek and paprsek::paprsek_static).
 include(CMakePackageConfigHelpers)
@@ -20,7 +20,7 @@ install(TARGETS paprsek_shared paprsek_static EXPORT paprsekTargets
 install(FILES include/paprsek.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 # The modules, where the library looks for them (PK_MODULE_DIR, and
 # LIBDIR/paprsek beside libpaprsek.so.0 wherever the prefix is).
-foreach(module paprsek_openvdb paprsek_cuda)
+foreach(module paprsek_openvdb paprsek_cuda paprsek_draco)
   if(TARGET ${module})
     install(TARGETS ${module} LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/paprsek)
   endif()

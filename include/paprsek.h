@@ -112,6 +112,9 @@ PK_API void pk_context_set_file_reader(pk_context *ctx, pk_file_reader_fn fn, vo
  *                   installed, LIBDIR/paprsek, or beside it in the build tree)
  *   cuda.module     the library's CUDA kernels' module (a path; default:
  *                   paprsek_cuda.so, found as paprsek_openvdb.so is)
+ *   draco.module    the library's Draco module, which decodes glTF's
+ *                   KHR_draco_mesh_compression (a path; default:
+ *                   paprsek_draco.so, found as paprsek_openvdb.so is)
  * A library is loaded once per process: the first name that loads stays.
  * Keys not named keep their values (a new context has the defaults); an
  * empty value ("cpu.isa=") restores a key's default; blanks around keys and

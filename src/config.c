@@ -30,12 +30,13 @@ static int choose(const char *v, size_t n, const char *const *names, size_t coun
 
 typedef enum {
     KEY_ISA, KEY_BVH, KEY_EMBREE_QUALITY, KEY_EMBREE_LIBRARY, KEY_CUDA_LIBRARY, KEY_DNNL_LIBRARY, KEY_INSTANCES,
-    KEY_CUDA_TRAVERSAL, KEY_CUDA_LEAF, KEY_OPENVDB_MODULE, KEY_CUDA_MODULE, NKEYS
+    KEY_CUDA_TRAVERSAL, KEY_CUDA_LEAF, KEY_OPENVDB_MODULE, KEY_CUDA_MODULE, KEY_DRACO_MODULE, NKEYS
 } key_id;
 
 static const char *const key_names[NKEYS] = {"cpu.isa",      "bvh.quality",  "embree.quality",  "embree.library",
                                              "cuda.library", "dnnl.library", "scene.instances",
-                                             "cuda.traversal", "cuda.leaf",    "openvdb.module", "cuda.module"};
+                                             "cuda.traversal", "cuda.leaf",    "openvdb.module", "cuda.module",
+                                             "draco.module"};
 
 /* Sets key k of c from the value v[0..n-1] (n 0: the default); false with a
  * message in ctx when the value is not one the key takes. */
@@ -72,11 +73,13 @@ static bool set_key(pk_context *ctx, pk_config *c, key_id k, const char *v, size
     case KEY_CUDA_LIBRARY:
     case KEY_DNNL_LIBRARY:
     case KEY_OPENVDB_MODULE:
-    case KEY_CUDA_MODULE: {
+    case KEY_CUDA_MODULE:
+    case KEY_DRACO_MODULE: {
         char *dst = k == KEY_CUDA_LIBRARY     ? c->cuda_library
                     : k == KEY_DNNL_LIBRARY   ? c->dnnl_library
                     : k == KEY_OPENVDB_MODULE ? c->openvdb_module
                     : k == KEY_CUDA_MODULE    ? c->cuda_module
+                    : k == KEY_DRACO_MODULE   ? c->draco_module
                                               : c->embree_library;
         if (n >= PK_CONFIG_NAME_MAX) {
             ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "config: %s: a library name of %zu bytes (at most %d)",
@@ -124,7 +127,7 @@ pk_status pk_context_set_config(pk_context *ctx, const char *config)
         if (k < 0)
             return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT,
                              "config: unknown key '%.*s' (cpu.isa, bvh.quality, embree.quality, embree.library, "
-                             "cuda.library, dnnl.library, scene.instances, cuda.traversal, cuda.leaf, openvdb.module, cuda.module)", (int)(kend - a > 64 ? 64 : kend - a), a);
+                             "cuda.library, dnnl.library, scene.instances, cuda.traversal, cuda.leaf, openvdb.module, cuda.module, draco.module)", (int)(kend - a > 64 ? 64 : kend - a), a);
         if (!eq) return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "config: %s: expected %s=VALUE", key_names[k], key_names[k]);
         const char *v = eq + 1;
         while (v < b && blank(*v)) v++;
@@ -151,14 +154,15 @@ const char *config_dnnl_library(const pk_context *ctx)
 
 size_t pk_context_get_config(const pk_context *ctx, char *buf, size_t size)
 {
-    static const pk_config defaults = {false, false, 1, "", "", "", "", "", 0, 0, 0};
+    static const pk_config defaults = {false, false, 1, "", "", "", "", "", 0, 0, 0, ""};
     const pk_config *c = ctx ? &ctx->config : &defaults;
     int n = snprintf(buf, size, "cpu.isa=%s,bvh.quality=%s,embree.quality=%s,embree.library=%s,cuda.library=%s,"
-                     "dnnl.library=%s,scene.instances=%s,cuda.traversal=%s,cuda.leaf=%s,openvdb.module=%s,cuda.module=%s",
+                     "dnnl.library=%s,scene.instances=%s,cuda.traversal=%s,cuda.leaf=%s,openvdb.module=%s,cuda.module=%s,"
+                     "draco.module=%s",
                      isa_names[c->cpu_avx2], bvh_names[c->bvh_fast], embree_names[c->embree_quality],
                      config_embree_library(ctx), config_cuda_library(ctx), config_dnnl_library(ctx),
                      instance_names[c->instances >= 0 && c->instances < 3 ? c->instances : 0],
                      traversal_names[c->cuda_traversal == 1], leaf_names[c->cuda_leaf >= 0 && c->cuda_leaf < 3 ? c->cuda_leaf : 0],
-                     c->openvdb_module, c->cuda_module);
+                     c->openvdb_module, c->cuda_module, c->draco_module);
     return n < 0 ? 0 : (size_t)n;
 }

@@ -52,6 +52,7 @@ typedef struct pk_config {
     int instances;        /* scene.instances: 0 auto, 1 flatten every instance, 2 keep them (scene_commit) */
     int cuda_traversal;   /* cuda.traversal: 0 sorted (default), 1 ordered (bvh_gpu.h gpu_trace_ordered) */
     int cuda_leaf;        /* cuda.leaf: the GPU tree's largest leaf, 0: 16 (default), 1: 8, 2: 4 triangles */
+    char draco_module[PK_CONFIG_NAME_MAX];   /* draco.module: "" for the installed one (io/gltf_draco_module.h) */
 } pk_config;
 
 /* Invariants:

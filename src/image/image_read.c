@@ -2,7 +2,8 @@
  * image_read.c - the image readers (see image_read.h): PNG through libpng's
  * simplified API, JPEG through libjpeg (errors caught with setjmp/longjmp,
  * messages kept instead of printed), OpenEXR through OpenEXRCore reading
- * from memory, and Radiance .hdr and PFM parsed here.
+ * from memory, Radiance .hdr and PFM parsed here, and WebP through libwebp
+ * (loaded at run time, as Embree is, where the build found its header).
  */
 #include "image_read.h"
 
@@ -20,6 +21,11 @@
 #include <jpeglib.h>
 #include <openexr.h>
 #include <png.h>
+
+#include "device/dynlib.h"
+#if PK_HAVE_WEBP
+#include <webp/decode.h>
+#endif
 
 const float image_srgb_to_linear[256] = PK_SRGB_TO_LINEAR_INIT;
 
@@ -74,6 +80,7 @@ image_format image_sniff(const void *data, size_t size)
     if (size >= 2 && b[0] == '#' && b[1] == '?') return IMAGE_HDR;
     if (size >= 3 && b[0] == 'P' && (b[1] == 'F' || b[1] == 'f') && (b[2] == '\n' || b[2] == ' ' || b[2] == '\r' || b[2] == '\t'))
         return IMAGE_PFM;
+    if (size >= 12 && memcmp(b, "RIFF", 4) == 0 && memcmp(b + 8, "WEBP", 4) == 0) return IMAGE_WEBP;
     return IMAGE_UNKNOWN;
 }
 
@@ -86,9 +93,87 @@ pk_status image_decode(pk_context *ctx, const void *data, size_t size, const cha
     case IMAGE_EXR: return image_decode_exr(ctx, data, size, name, out);
     case IMAGE_HDR: return image_decode_hdr(ctx, data, size, name, out);
     case IMAGE_PFM: return image_decode_pfm(ctx, data, size, name, out);
+    case IMAGE_WEBP: return image_decode_webp(ctx, data, size, name, out);
     default: break;
     }
-    return ctx_error(ctx, PK_ERR_UNSUPPORTED, "%s: not a PNG, JPEG, OpenEXR, Radiance HDR or PFM image", name);
+    return ctx_error(ctx, PK_ERR_UNSUPPORTED, "%s: not a PNG, JPEG, OpenEXR, Radiance HDR, PFM or WebP image", name);
+}
+
+/* ---- WebP ------------------------------------------------------------------ */
+
+static dynlib webp_lib = DYNLIB_INIT;
+
+#if PK_HAVE_WEBP
+static struct {
+    VP8StatusCode (*features)(const uint8_t *, size_t, WebPBitstreamFeatures *, int);
+    uint8_t *(*rgba)(const uint8_t *, size_t, uint8_t *, size_t, int);
+    uint8_t *(*rgb)(const uint8_t *, size_t, uint8_t *, size_t, int);
+} webp;
+
+static bool webp_init(void *h, const char *name, char *why, size_t n)
+{
+    static const char *const names[3] = {"WebPGetFeaturesInternal", "WebPDecodeRGBAInto", "WebPDecodeRGBInto"};
+    void *sym[3];
+    for (int k = 0; k < 3; k++)
+        if (!(sym[k] = dynlib_symbol(h, names[k]))) {
+            snprintf(why, n, "%s has no %s", name, names[k]);
+            return false;
+        }
+    memcpy(&webp.features, &sym[0], sizeof sym[0]);
+    memcpy(&webp.rgba, &sym[1], sizeof sym[1]);
+    memcpy(&webp.rgb, &sym[2], sizeof sym[2]);
+    return true;
+}
+#endif
+
+bool image_have_webp(void)
+{
+#if PK_HAVE_WEBP
+    char why[8];
+    return dynlib_load(&webp_lib, PK_WEBP_SONAME, webp_init, why, sizeof why);
+#else
+    (void)webp_lib;
+    return false;
+#endif
+}
+
+pk_status image_decode_webp(pk_context *ctx, const void *data, size_t size, const char *name, image_buf *out)
+{
+    memset(out, 0, sizeof *out);
+#if PK_HAVE_WEBP
+    char why[400];
+    if (!dynlib_load(&webp_lib, PK_WEBP_SONAME, webp_init, why, sizeof why))
+        return ctx_error(ctx, PK_ERR_UNSUPPORTED, "%s: a WebP image, and libwebp does not load (%.300s; Debian: libwebp7)",
+                         name, why);
+    WebPBitstreamFeatures f;
+    memset(&f, 0, sizeof f);
+    VP8StatusCode vs = webp.features(data, size, &f, WEBP_DECODER_ABI_VERSION);
+    if (vs != VP8_STATUS_OK)
+        return ctx_error(ctx, vs == VP8_STATUS_UNSUPPORTED_FEATURE ? PK_ERR_UNSUPPORTED : PK_ERR_PARSE,
+                         "%s: bad WebP (%s)", name,
+                         vs == VP8_STATUS_NOT_ENOUGH_DATA ? "truncated" : vs == VP8_STATUS_UNSUPPORTED_FEATURE
+                                                                               ? "a feature libwebp does not decode"
+                                                                               : "corrupt header");
+    if (f.has_animation)
+        return ctx_error(ctx, PK_ERR_UNSUPPORTED, "%s: an animated WebP (only still images are read)", name);
+    pk_status st = check_size(ctx, name, f.width, f.height);
+    if (st != PK_OK) return st;
+    int nc = f.has_alpha ? 4 : 3;
+    if ((st = alloc_buf(ctx, out, f.width, f.height, nc, false)) != PK_OK) return st;
+    size_t row = (size_t)f.width * (size_t)nc, total = row * (size_t)f.height;
+    uint8_t *r = nc == 4 ? webp.rgba(data, size, out->px8, total, (int)row) : webp.rgb(data, size, out->px8, total, (int)row);
+    if (!r) {
+        image_buf_free(&ctx->alloc, out);
+        return ctx_error(ctx, PK_ERR_PARSE, "%s: bad WebP (corrupt or truncated image data)", name);
+    }
+    return PK_OK;
+#else
+    (void)data, (void)size, (void)webp_lib;
+    return ctx_error(ctx, PK_ERR_UNSUPPORTED,
+                     "%s: a WebP image, and this build does not read WebP (libwebp's header, Debian libwebp-dev, was "
+                     "missing when it was built)",
+                     name);
+#endif
 }
 
 /* ---- PNG ------------------------------------------------------------------ */

@@ -1,7 +1,8 @@
 /*
  * image_read.h - image readers for textures and environment maps: PNG
  * (libpng), JPEG (libjpeg-turbo: baseline, progressive, greyscale), OpenEXR
- * (OpenEXRCore), Radiance .hdr (RLE and flat) and PFM. Every reader decodes
+ * (OpenEXRCore), Radiance .hdr (RLE and flat), PFM and WebP (libwebp, loaded
+ * at run time). Every reader decodes
  * a (data, size) buffer, so that files are read only through file_read_all
  * and the fuzzers reach the decoders directly. The format is told by the
  * first bytes, not by the file name.
@@ -18,7 +19,7 @@
 
 /* A decoded image, rows top to bottom, samples interleaved. nc is 1 (grey),
  * 2 (grey, alpha), 3 (RGB) or 4 (RGBA). Exactly one of px8 and pxf is set:
- * px8 for the 8-bit formats (PNG, JPEG), the bytes as stored in the file
+ * px8 for the 8-bit formats (PNG, JPEG, WebP), the bytes as stored in the file
  * (sRGB-encoded for colour); pxf for the HDR formats (OpenEXR, .hdr, PFM),
  * linear floats, every sample finite and within +-IMAGE_MAX_SAMPLE (larger
  * ones are clamped, non-finite ones read as 0). */
@@ -30,7 +31,7 @@ typedef struct image_buf {
 } image_buf;
 
 typedef enum image_format {
-    IMAGE_UNKNOWN, IMAGE_PNG, IMAGE_JPEG, IMAGE_EXR, IMAGE_HDR, IMAGE_PFM
+    IMAGE_UNKNOWN, IMAGE_PNG, IMAGE_JPEG, IMAGE_EXR, IMAGE_HDR, IMAGE_PFM, IMAGE_WEBP
 } image_format;
 
 /* The format the first bytes of data announce (IMAGE_UNKNOWN when none). */
@@ -52,6 +53,11 @@ PK_HIDDEN pk_status image_decode_exr_layer(pk_context *ctx, const void *data, si
                                            const char *layer, image_buf *out);
 PK_HIDDEN pk_status image_decode_hdr(pk_context *ctx, const void *data, size_t size, const char *name, image_buf *out);
 PK_HIDDEN pk_status image_decode_pfm(pk_context *ctx, const void *data, size_t size, const char *name, image_buf *out);
+/* WebP (lossy or lossless, alpha; not animated) through libwebp, loaded at
+ * run time: PK_ERR_UNSUPPORTED naming the package where it is missing. */
+PK_HIDDEN pk_status image_decode_webp(pk_context *ctx, const void *data, size_t size, const char *name, image_buf *out);
+/* Whether WebP images are read here (libwebp built for and loadable). */
+PK_HIDDEN bool image_have_webp(void);
 PK_HIDDEN void image_buf_free(const pk_allocator *a, image_buf *img);
 
 /* Reads the file at path (through file_read_all) and decodes it. */

@@ -81,6 +81,15 @@ typedef struct gltf {
     int64_t skin_index;
     int64_t *parent;       /* per node: its parent, -1 for a root */
     uint32_t vc_default;   /* the default material's copy for vertex colours (0: not made) */
+    /* compressed data decoded (gltf_data.c, gltf_draco.c): buffer view i's
+     * EXT_meshopt_compression bytes (NULL: not decoded), and accessor i as a
+     * KHR_draco_mesh_compression primitive decoded it (acc_data[i] NULL: the
+     * accessor as the document describes it) */
+    uint8_t **view_dec;
+    size_t nview_dec;
+    gltf_accessor *acc_dec;
+    uint8_t **acc_data;
+    size_t nacc_dec;
 } gltf;
 
 /* warned bits */
@@ -89,7 +98,8 @@ enum {
     GW_BLEND = 1u << 6, GW_ROTATION = 1u << 7, GW_CLEARCOAT = 1u << 8,
     GW_EXT = 1u << 9, GW_MIRROR = 1u << 10, GW_NORMAL_SCALE = 1u << 11, GW_SKIN = 1u << 12, GW_WRAP = 1u << 13,
     GW_ANIM = 1u << 14, GW_RANGE = 1u << 15, GW_UV_SETS = 1u << 16, GW_SINGULAR = 1u << 17, GW_MORPH = 1u << 18,
-    GW_INSTANCE_MIRROR = 1u << 19
+    GW_INSTANCE_MIRROR = 1u << 19,
+    GW_MESHOPT = 1u << 27, GW_DRACO = 1u << 28, GW_WEBP = 1u << 29, GW_BASISU = 1u << 30
 };
 
 /* "name: " + fmt, latched; returns st. */
@@ -147,7 +157,21 @@ PK_HIDDEN pk_status gltf_read_floats(gltf *g, int64_t i, const gltf_accessor *a,
 PK_HIDDEN pk_status gltf_read_mat4(gltf *g, int64_t i, const gltf_accessor *a, xform **out);
 /* Reads a SCALAR accessor of unsigned integers. *out allocated. */
 PK_HIDDEN pk_status gltf_read_uints(gltf *g, int64_t i, const gltf_accessor *a, uint32_t **out);
+/* Frees the buffers and what was decoded from them (view_dec, acc_dec). */
 PK_HIDDEN void gltf_buffers_free(gltf *g);
+
+/* ---- KHR_draco_mesh_compression (gltf_draco.c) ---- */
+
+/* Primitive p (path: its JSON pointer) has the extension: decodes its
+ * Draco stream and substitutes the decoded data for the accessors its
+ * attributes and indices name (gltf_accessor_get then describes those),
+ * so that the primitive is read as an uncompressed one. Without the Draco
+ * module, a primitive whose accessors have buffer views (the uncompressed
+ * fallback) is read from those with one warning; one without is an error. */
+PK_HIDDEN pk_status gltf_draco_primitive(gltf *g, const cJSON *p, const char *path);
+/* Whether this build has the Draco module and it loads; when not, why (n
+ * bytes) says why not. */
+PK_HIDDEN bool gltf_have_draco(gltf *g, char *why, size_t n);
 
 /* ---- materials (gltf_material.c) ---- */
 

@@ -4,9 +4,17 @@
  * accessors (every component type, normalized integers, strides, sparse
  * substitutes). Every length, offset and count is checked against what
  * holds it before a byte is read, in arithmetic that cannot overflow.
+ *
+ * Buffer views with EXT_meshopt_compression are decoded by meshoptimizer
+ * (libmeshoptimizer, loaded at run time when the build found its header):
+ * the decoded bytes are kept for the rest of the read and stand for the
+ * view. Without the library a view whose own buffer holds the uncompressed
+ * data (not a fallback placeholder) is read from there, with one warning.
  */
 #include "gltf.h"
 #include "io_util.h"
+
+#include "device/dynlib.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -223,6 +231,167 @@ void gltf_buffers_free(gltf *g)
     mem_free(&g->ctx->alloc, g->buffers);
     g->buffers = NULL;
     g->nbuffers = 0;
+    for (size_t i = 0; i < g->nview_dec; i++) mem_free(&g->ctx->alloc, g->view_dec[i]);
+    mem_free(&g->ctx->alloc, g->view_dec);
+    g->view_dec = NULL;
+    g->nview_dec = 0;
+    for (size_t i = 0; i < g->nacc_dec; i++) mem_free(&g->ctx->alloc, g->acc_data[i]);
+    mem_free(&g->ctx->alloc, g->acc_data);
+    mem_free(&g->ctx->alloc, g->acc_dec);
+    g->acc_data = NULL;
+    g->acc_dec = NULL;
+    g->nacc_dec = 0;
+}
+
+/* ---- EXT_meshopt_compression ------------------------------------------------------ */
+
+/* meshoptimizer's decoders (meshoptimizer.h), loaded by soname */
+typedef int (*meshopt_decode_fn)(void *dst, size_t count, size_t size, const unsigned char *src, size_t src_size);
+typedef void (*meshopt_filter_fn)(void *buffer, size_t count, size_t stride);
+static struct {
+    meshopt_decode_fn vertex, index, sequence;
+    meshopt_filter_fn oct, quat, exp;
+} mo;
+static dynlib mo_lib = DYNLIB_INIT;
+
+#if PK_HAVE_MESHOPT
+static bool mo_init(void *h, const char *name, char *why, size_t n)
+{
+    static const char *const names[6] = {"meshopt_decodeVertexBuffer", "meshopt_decodeIndexBuffer",
+                                         "meshopt_decodeIndexSequence", "meshopt_decodeFilterOct",
+                                         "meshopt_decodeFilterQuat", "meshopt_decodeFilterExp"};
+    void *sym[6];
+    for (int k = 0; k < 6; k++)
+        if (!(sym[k] = dynlib_symbol(h, names[k]))) {
+            snprintf(why, n, "%s has no %s (meshoptimizer 0.18 or later is needed)", name, names[k]);
+            return false;
+        }
+    memcpy(&mo.vertex, &sym[0], sizeof sym[0]);
+    memcpy(&mo.index, &sym[1], sizeof sym[1]);
+    memcpy(&mo.sequence, &sym[2], sizeof sym[2]);
+    memcpy(&mo.oct, &sym[3], sizeof sym[3]);
+    memcpy(&mo.quat, &sym[4], sizeof sym[4]);
+    memcpy(&mo.exp, &sym[5], sizeof sym[5]);
+    return true;
+}
+#endif
+
+/* True when meshoptimizer's decoders are ready; else why says why not. */
+static bool mo_loaded(char *why, size_t n)
+{
+#if PK_HAVE_MESHOPT
+    char reason[400];
+    if (dynlib_load(&mo_lib, PK_MESHOPT_SONAME, mo_init, reason, sizeof reason)) return true;
+    snprintf(why, n, "meshoptimizer does not load (%.300s; Debian: libmeshoptimizer2d)", reason);
+#else
+    (void)mo_lib;
+    snprintf(why, n, "this build does not decode it (meshoptimizer's header, Debian libmeshoptimizer-dev, was "
+                     "missing when it was built)");
+#endif
+    return false;
+}
+
+/* Whether buffer b is a placeholder: no uri and not the GLB's BIN chunk, or
+ * marked as EXT_meshopt_compression's fallback. */
+static bool buffer_is_placeholder(gltf *g, int64_t b)
+{
+    const cJSON *o = cJSON_GetArrayItem(gltf_array(g, "buffers"), (int)b);
+    const cJSON *fb = cJSON_GetObjectItemCaseSensitive(gltf_ext(o, "EXT_meshopt_compression"), "fallback");
+    if (cJSON_IsTrue(fb)) return true;
+    return !cJSON_IsString(cJSON_GetObjectItemCaseSensitive(o, "uri")) && !(b == 0 && g->bin);
+}
+
+/* Buffer view i (path) carries ext: its bytes decoded into g->view_dec[i]
+ * (len bytes, the view's byteLength; vstride its byteStride or 0). *data
+ * NULL and PK_OK: not decoded (no meshoptimizer), read the view's own buffer. */
+static pk_status meshopt_view(gltf *g, int64_t i, const cJSON *ext, const char *path, int64_t buf, int64_t len,
+                              int64_t vstride, const uint8_t **data)
+{
+    *data = NULL;
+    char ep[96];
+    snprintf(ep, sizeof ep, "%s/extensions/EXT_meshopt_compression", path);
+    if (!cJSON_IsObject(ext)) return gltf_fail(g, PK_ERR_PARSE, "%s: must be an object", ep);
+    pk_status st;
+    int64_t cbuf, off, clen, stride, count;
+    const char *mode, *filter;
+    if ((st = gltf_index(g, ext, ep, "buffer", g->nbuffers, true, &cbuf))) return st;
+    if ((st = gltf_int(g, ext, ep, "byteOffset", 0, INT64_MAX, 0, &off))) return st;
+    if ((st = gltf_int(g, ext, ep, "byteLength", 1, INT64_MAX, -1, &clen))) return st;
+    if (clen < 0) return gltf_fail(g, PK_ERR_PARSE, "%s: byteLength is required", ep);
+    if ((st = gltf_int(g, ext, ep, "byteStride", 1, 256, -1, &stride))) return st;
+    if (stride < 0) return gltf_fail(g, PK_ERR_PARSE, "%s: byteStride is required", ep);
+    if ((st = gltf_int(g, ext, ep, "count", 1, INT64_MAX, -1, &count))) return st;
+    if (count < 0) return gltf_fail(g, PK_ERR_PARSE, "%s: count is required", ep);
+    if ((st = gltf_string(g, ext, ep, "mode", &mode))) return st;
+    if (!mode) return gltf_fail(g, PK_ERR_PARSE, "%s: mode is required", ep);
+    if ((st = gltf_string(g, ext, ep, "filter", &filter))) return st;
+    if (!filter) filter = "NONE";
+    int m = strcmp(mode, "ATTRIBUTES") == 0 ? 0 : strcmp(mode, "TRIANGLES") == 0 ? 1 : strcmp(mode, "INDICES") == 0 ? 2 : -1;
+    if (m < 0)
+        return gltf_fail(g, PK_ERR_PARSE, "%s/mode: '%.32s' is not ATTRIBUTES, TRIANGLES or INDICES", ep, mode);
+    int f = strcmp(filter, "NONE") == 0 ? 0 : strcmp(filter, "OCTAHEDRAL") == 0 ? 1 : strcmp(filter, "QUATERNION") == 0 ? 2
+            : strcmp(filter, "EXPONENTIAL") == 0 ? 3 : -1;
+    if (f < 0)
+        return gltf_fail(g, PK_ERR_PARSE, "%s/filter: '%.32s' is not NONE, OCTAHEDRAL, QUATERNION or EXPONENTIAL", ep,
+                         filter);
+    /* the extension's rules on strides, counts and filters */
+    if (vstride && vstride != stride)
+        return gltf_fail(g, PK_ERR_PARSE, "%s: byteStride %lld differs from the buffer view's %lld", ep,
+                         (long long)stride, (long long)vstride);
+    if ((uint64_t)count > (uint64_t)INT64_MAX / (uint64_t)stride || count * stride != len)
+        return gltf_fail(g, PK_ERR_PARSE, "%s: count %lld times byteStride %lld is not the buffer view's byteLength %lld",
+                         ep, (long long)count, (long long)stride, (long long)len);
+    if (m == 0 && stride % 4)
+        return gltf_fail(g, PK_ERR_PARSE, "%s: ATTRIBUTES with byteStride %lld, not a multiple of 4", ep, (long long)stride);
+    if (m != 0 && stride != 2 && stride != 4)
+        return gltf_fail(g, PK_ERR_PARSE, "%s: %s with byteStride %lld, not 2 or 4", ep, mode, (long long)stride);
+    if (m == 1 && count % 3)
+        return gltf_fail(g, PK_ERR_PARSE, "%s: TRIANGLES with count %lld, not a multiple of 3", ep, (long long)count);
+    if (m != 0 && f != 0) return gltf_fail(g, PK_ERR_PARSE, "%s: the filter of %s must be NONE", ep, mode);
+    if ((f == 1 && stride != 4 && stride != 8) || (f == 2 && stride != 8))
+        return gltf_fail(g, PK_ERR_PARSE, "%s: filter %s with byteStride %lld (%s)", ep, filter, (long long)stride,
+                         f == 1 ? "4 or 8 required" : "8 required");
+    /* The densest stream holds a byte of headers per element byte of a block
+     * of at most 256 elements (indices need more): a decoded length beyond
+     * 256 times the compressed one is a lie, refused before allocating it. */
+    if ((uint64_t)len / 256 > (uint64_t)clen)
+        return gltf_fail(g, PK_ERR_PARSE, "%s: %lld decoded bytes cannot come from %lld compressed bytes", ep,
+                         (long long)len, (long long)clen);
+    char why[400];
+    if (!mo_loaded(why, sizeof why)) {
+        if (buffer_is_placeholder(g, buf))
+            return gltf_fail(g, PK_ERR_UNSUPPORTED, "%s: meshopt-compressed data, and %s", ep, why);
+        gltf_warn_once(g, GW_MESHOPT, "%s: meshopt-compressed data not decoded (%s); the uncompressed fallback is read",
+                       ep, why);
+        return PK_OK;
+    }
+    const gltf_buffer *b;
+    if ((st = load_buffer(g, cbuf, &b))) return st;
+    if ((uint64_t)off > b->size || (uint64_t)clen > b->size - (uint64_t)off)
+        return gltf_fail(g, PK_ERR_PARSE, "%s: byteOffset %lld + byteLength %lld exceeds buffer %lld (%zu bytes)", ep,
+                         (long long)off, (long long)clen, (long long)cbuf, b->size);
+    if (!g->view_dec) {
+        size_t nv = gltf_count(g, "bufferViews");
+        g->view_dec = mem_calloc(&g->ctx->alloc, nv ? nv : 1, sizeof *g->view_dec);
+        if (!g->view_dec) return ctx_nomem(g->ctx);
+        g->nview_dec = nv;
+    }
+    uint8_t *out = mem_alloc(&g->ctx->alloc, (size_t)len);
+    if (!out) return ctx_nomem(g->ctx);
+    const uint8_t *src = b->data + off;
+    int rc = m == 0   ? mo.vertex(out, (size_t)count, (size_t)stride, src, (size_t)clen)
+             : m == 1 ? mo.index(out, (size_t)count, (size_t)stride, src, (size_t)clen)
+                      : mo.sequence(out, (size_t)count, (size_t)stride, src, (size_t)clen);
+    if (rc != 0) {
+        mem_free(&g->ctx->alloc, out);
+        return gltf_fail(g, PK_ERR_PARSE, "%s: corrupt %s stream (meshoptimizer's decoder says %d)", ep, mode, rc);
+    }
+    if (f == 1) mo.oct(out, (size_t)count, (size_t)stride);
+    else if (f == 2) mo.quat(out, (size_t)count, (size_t)stride);
+    else if (f == 3) mo.exp(out, (size_t)count, (size_t)stride);
+    g->view_dec[i] = out;
+    *data = out;
+    return PK_OK;
 }
 
 pk_status gltf_view(gltf *g, int64_t i, const uint8_t **data, size_t *size, size_t *stride)
@@ -239,6 +408,17 @@ pk_status gltf_view(gltf *g, int64_t i, const uint8_t **data, size_t *size, size
     if (len < 0) return gltf_fail(g, PK_ERR_PARSE, "%s: byteLength is required", path);
     if ((st = gltf_int(g, o, path, "byteStride", 4, 252, 0, &st_))) return st;
     if (st_ % 4) return gltf_fail(g, PK_ERR_PARSE, "%s: byteStride %lld is not a multiple of 4", path, (long long)st_);
+    const cJSON *mx = gltf_ext(o, "EXT_meshopt_compression");
+    if (mx) {
+        const uint8_t *dec = (size_t)i < g->nview_dec ? g->view_dec[i] : NULL;
+        if (!dec && (st = meshopt_view(g, i, mx, path, buf, len, st_, &dec))) return st;
+        if (dec) {
+            *data = dec;
+            *size = (size_t)len;
+            *stride = (size_t)st_;
+            return PK_OK;
+        }
+    }
     const gltf_buffer *b;
     if ((st = load_buffer(g, buf, &b))) return st;
     if ((uint64_t)off > b->size || (uint64_t)len > b->size - (uint64_t)off)
@@ -321,6 +501,10 @@ static double comp_value(const uint8_t *p, int ctype, bool normalized)
 pk_status gltf_accessor_get(gltf *g, int64_t i, gltf_accessor *a)
 {
     memset(a, 0, sizeof *a);
+    if ((size_t)i < g->nacc_dec && g->acc_data[i]) { /* decoded from a Draco primitive */
+        *a = g->acc_dec[i];
+        return PK_OK;
+    }
     const cJSON *o = cJSON_GetArrayItem(gltf_array(g, "accessors"), (int)i);
     char path[48];
     snprintf(path, sizeof path, "/accessors/%lld", (long long)i);

@@ -176,6 +176,34 @@ static pk_status mirror_texture(gltf *g, int64_t src, bool colour, bool ms, bool
     return st;
 }
 
+/* A texture's image from EXT_texture_webp (the WebP image where WebP is read
+ * here, else *src, the texture's own source, as the fallback) and
+ * KHR_texture_basisu (never read here: no KTX2 / Basis Universal decoder;
+ * the fallback source, with one warning). */
+static pk_status texture_ext_source(gltf *g, const cJSON *t, const char *path, int64_t *src)
+{
+    static const char *const names[2] = {"EXT_texture_webp", "KHR_texture_basisu"};
+    for (int k = 0; k < 2; k++) {
+        const cJSON *x = gltf_ext(t, names[k]);
+        if (!x) continue;
+        char xp[96];
+        snprintf(xp, sizeof xp, "%s/extensions/%s", path, names[k]);
+        if (!cJSON_IsObject(x)) return gltf_fail(g, PK_ERR_PARSE, "%s: must be an object", xp);
+        int64_t xs;
+        pk_status st = gltf_index(g, x, xp, "source", g->nimages, true, &xs);
+        if (st) return st;
+        if (k == 0 && image_have_webp()) {
+            *src = xs;
+            return PK_OK;
+        }
+        gltf_warn_once(g, k ? GW_BASISU : GW_WEBP, "%s: %s; %s", xp,
+                       k ? "KTX2 / Basis Universal images are not decoded (no decoder in this build)"
+                         : "WebP images are not decoded here (libwebp is needed: Debian libwebp-dev)",
+                       *src >= 0 ? "the texture's fallback source image is read" : "and it has no fallback source");
+    }
+    return PK_OK;
+}
+
 /* Resolves a textureInfo into a tex_ref (kind TEX_NONE when unusable). bake:
  * the transform is baked into the primitive's uvs (identity here). */
 static pk_status make_ref(gltf *g, const tex_info *ti, bool colour, bool bake, const char *user, tex_ref *r)
@@ -190,6 +218,7 @@ static pk_status make_ref(gltf *g, const tex_info *ti, bool colour, bool bake, c
     pk_status st;
     if ((st = gltf_index(g, t, path, "source", g->nimages, false, &src))) return st;
     if ((st = gltf_index(g, t, path, "sampler", gltf_count(g, "samplers"), false, &smp))) return st;
+    if ((st = texture_ext_source(g, t, path, &src))) return st;
     if (src < 0) {
         gltf_warn(g, "%s: no source image this reader can decode (%s drawn without it)", path, user);
         return PK_OK;

@@ -11,6 +11,7 @@
 #include "gltf.h"
 #include "io_util.h"
 #include "readers.h"
+#include "../image/image_read.h"
 #include "../scene/camera.h"
 #include "../scene/material.h"
 
@@ -157,7 +158,8 @@ static bool ext_supported(const char *e)
                                         "KHR_lights_punctual",          "KHR_materials_emissive_strength",
                                         "KHR_materials_transmission",   "KHR_materials_ior",
                                         "KHR_materials_unlit",          "KHR_materials_clearcoat",
-                                        NULL};
+                                        "EXT_meshopt_compression",      "KHR_draco_mesh_compression",
+                                        "EXT_texture_webp",             NULL};
     for (int i = 0; known[i]; i++)
         if (strcmp(e, known[i]) == 0) return true;
     return false;
@@ -181,10 +183,21 @@ static pk_status check_document(gltf *g)
     int k = 0;
     for (const cJSON *e = req ? req->child : NULL; e; e = e->next, k++) {
         if (!cJSON_IsString(e)) return gltf_fail(g, PK_ERR_PARSE, "/extensionsRequired/%d: must be a string", k);
-        if (strcmp(e->valuestring, "KHR_draco_mesh_compression") == 0)
+        char why[700];
+        if (strcmp(e->valuestring, "KHR_draco_mesh_compression") == 0 && !gltf_have_draco(g, why, sizeof why))
             return gltf_fail(g, PK_ERR_UNSUPPORTED,
                              "/extensionsRequired/%d: Draco-compressed meshes (KHR_draco_mesh_compression) are not "
-                             "read; export the model without Draco compression",
+                             "read here (%.200s); export the model without Draco compression",
+                             k, why);
+        if (strcmp(e->valuestring, "EXT_texture_webp") == 0 && !image_have_webp())
+            return gltf_fail(g, PK_ERR_UNSUPPORTED,
+                             "/extensionsRequired/%d: WebP textures (EXT_texture_webp) are not read here (libwebp is "
+                             "needed: Debian libwebp-dev)",
+                             k);
+        if (strcmp(e->valuestring, "KHR_texture_basisu") == 0)
+            return gltf_fail(g, PK_ERR_UNSUPPORTED,
+                             "/extensionsRequired/%d: KTX2 / Basis Universal textures (KHR_texture_basisu) are not "
+                             "read (no decoder); export the textures as PNG, JPEG or WebP",
                              k);
         if (!ext_supported(e->valuestring))
             return gltf_fail(g, PK_ERR_UNSUPPORTED, "/extensionsRequired/%d: extension '%.64s' is required and not supported",
@@ -575,8 +588,7 @@ static pk_status add_primitive(gltf *g, int64_t mi, int pi, const cJSON *p, bool
         gltf_warn_once(g, GW_POINTS, "%s: points and lines are not drawn (further ones not reported)", path);
         return PK_OK;
     }
-    if (gltf_ext(p, "KHR_draco_mesh_compression"))
-        gltf_warn_once(g, GW_EXT, "%s: Draco-compressed data ignored; the uncompressed fallback is read", path);
+    if (gltf_ext(p, "KHR_draco_mesh_compression") && (st = gltf_draco_primitive(g, p, path))) return st;
     const cJSON *attrs = cJSON_GetObjectItemCaseSensitive(p, "attributes");
     if (!cJSON_IsObject(attrs)) return gltf_fail(g, PK_ERR_PARSE, "%s/attributes: required, and must be an object", path);
     if ((st = gltf_index(g, p, path, "indices", gltf_count(g, "accessors"), false, &ii))) return st;

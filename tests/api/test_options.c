@@ -113,7 +113,7 @@ static void check_context_config(void)
     char buf[1024];
     const char *defaults = "cpu.isa=auto,bvh.quality=high,embree.quality=medium,embree.library=libembree3.so.3,"
                            "cuda.library=libcuda.so.1,dnnl.library=libdnnl.so.2,scene.instances=auto,"
-                           "cuda.traversal=sorted,cuda.leaf=16,openvdb.module=,cuda.module=";
+                           "cuda.traversal=sorted,cuda.leaf=16,openvdb.module=,cuda.module=,draco.module=";
     size_t len = pk_context_get_config(ctx, buf, sizeof buf);
     CHECKF(strcmp(buf, defaults) == 0 && len == strlen(defaults), "default config: %s", buf);
     CHECK(pk_context_get_config(ctx, NULL, 0) == len);
@@ -125,7 +125,7 @@ static void check_context_config(void)
     pk_context_get_config(ctx, buf, sizeof buf);
     CHECKF(strcmp(buf, "cpu.isa=avx2,bvh.quality=fast,embree.quality=high,embree.library=/opt/e/libembree3.so.3,"
                        "cuda.library=libcuda.so.1,dnnl.library=libdnnl.so.2,scene.instances=auto,"
-                       "cuda.traversal=sorted,cuda.leaf=16,openvdb.module=,cuda.module=") == 0,
+                       "cuda.traversal=sorted,cuda.leaf=16,openvdb.module=,cuda.module=,draco.module=") == 0,
            "config: %s", buf);
     CHECK(pk_context_set_config(ctx, "scene.instances=keep") == PK_OK);
     pk_context_get_config(ctx, buf, sizeof buf);
@@ -165,7 +165,7 @@ static void check_context_config(void)
     CHECKF(strstr(buf, "cpu.isa=avx2,bvh.quality=fast,embree.quality=high,") == buf, "config changed: %s", buf);
     /* an empty value restores the default */
     CHECK(pk_context_set_config(ctx, "cpu.isa=,bvh.quality=,embree.quality=,embree.library=,cuda.library=,scene.instances=,"
-                                     "cuda.traversal=,cuda.leaf=,openvdb.module=,cuda.module=") ==
+                                     "cuda.traversal=,cuda.leaf=,openvdb.module=,cuda.module=,draco.module=") ==
           PK_OK);
     pk_context_get_config(ctx, buf, sizeof buf);
     CHECKF(strcmp(buf, defaults) == 0, "config after reset: %s", buf);
