@@ -233,7 +233,7 @@ static void test_furnace(void)
                 double want = 1.0;
                 if (!rough && !side) {
                     const double fs = 0.04 + 0.96 * pow(1 - z, 5);
-                    want = fs + 1 - pbsdf_fresnel_dielectric((float)z, 1.5f);
+                    want = fs + 1 - (double)pbsdf_fresnel_dielectric((float)z, 1.5f);
                 }
                 if (!rough) CHECKF(fabs(mean - want) <= 4 * err + 1e-5, "smooth side %d z %g: %g, want %g", side, z,
                                    mean, want);
