@@ -332,7 +332,7 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
     float base[4] = {1, 1, 1, 1}, metallic = 1.0f, roughness = 1.0f, emissive[3] = {0, 0, 0};
     bool found;
     tex_info t_base, t_mr, t_norm, t_emit, t_occ, t_tr, t_cc, t_ccr, t_ccn, t_thick;
-    char tp[160];
+    char tp[192]; /* a pointer into an extension (ep) and a key */
     read_tex_info(g, NULL, path, &t_tr);
     read_tex_info(g, NULL, path, &t_cc);
     read_tex_info(g, NULL, path, &t_ccr);
