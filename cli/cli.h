@@ -127,6 +127,7 @@ typedef struct cli_render_opts {
     const char *defines[64]; /* -D NAME=VALUE */
     size_t ndefines;
     int has_camera_pick; /* --camera N (passed on as the parameter camera=N) */
+    int has_variant;     /* --variant NAME (passed on as the parameter variant=NAME) */
     int denoise;         /* --denoise 1, --no-denoise 0, -1 when neither is given */
     int denoise_fast;    /* --denoise-quality fast */
     const char *weights; /* --weights DIR, NULL when not given */

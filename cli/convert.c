@@ -15,7 +15,7 @@ static const cli_option c_opts[] = {
      .help = "the JSON scene to write (required; .json); its meshes, images and grids are written beside it as "
              "FILE's name with .meshN.ply, .textureN.bin, ... (existing files of those names are replaced)"},
     {.name = "define", .short_name = 'D', .id = C_DEFINE, .kind = CLI_STRING, .arg = "NAME=VALUE",
-     .help = "a parameter of the scene, as for paprsek render (Mitsuba's $NAME, glTF's camera=N); repeatable"},
+     .help = "a parameter of the scene, as for paprsek render (Mitsuba's $NAME, glTF's camera=N and variant=NAME); repeatable"},
     {.name = "config", .id = C_CONFIG, .kind = CLI_STRING, .arg = "KEY=VALUE,...",
      .help = "library configuration, as for paprsek render; render the converted scene with the same "
              "scene.instances"},

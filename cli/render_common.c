@@ -46,6 +46,7 @@ enum {
     OPT_STATS_JSON,
     OPT_DEFINE,
     OPT_CAMERA,
+    OPT_VARIANT,
     OPT_QUIET,
     OPT_DENOISE,
     OPT_NO_DENOISE,
@@ -187,6 +188,10 @@ const cli_option *cli_render_options(size_t *n)
         add((cli_option){.name = "camera", .id = OPT_CAMERA, .kind = CLI_STRING, .arg = "N",
                          .help = "a glTF asset (.gltf, .glb): render its camera N (its cameras array, from "
                                  "0); without it the first camera in node order"});
+        add((cli_option){.name = "variant", .id = OPT_VARIANT, .kind = CLI_STRING, .arg = "NAME",
+                         .help = "a glTF asset with material variants (KHR_materials_variants): draw its "
+                                 "variant NAME (without it the default materials); an unknown name is an "
+                                 "error that lists the asset's variants"});
         add((cli_option){.name = "denoise", .id = OPT_DENOISE, .kind = CLI_FLAG,
                          .help = "denoise the image (Open Image Denoise's network, with the albedo and normal of "
                                  "the same render); the default when neither --spp nor --time nor the scene "
@@ -526,6 +531,16 @@ int cli_render_parse(int argc, char **argv, cli_render_opts *o, void (*help)(FIL
             o->has_camera_pick = 1;
             break;
         }
+        case OPT_VARIANT: {
+            static char vparam[300];
+            if (!v[0] || strlen(v) > 256) return cli_usage_error("--variant: expected a variant's name");
+            if (o->ndefines == sizeof o->defines / sizeof o->defines[0])
+                return cli_usage_error("-D: more than %zu parameters", sizeof o->defines / sizeof o->defines[0]);
+            snprintf(vparam, sizeof vparam, "variant=%s", v);
+            o->defines[o->ndefines++] = vparam;
+            o->has_variant = 1;
+            break;
+        }
         case OPT_QUIET: o->quiet = 1; break;
         case OPT_DENOISE: o->denoise = 1; break;
         case OPT_NO_DENOISE: o->denoise = 0; break;
@@ -822,6 +837,10 @@ int cli_render_check(const cli_render_opts *o, pk_write_options *wo)
         return cli_usage_error("--transparent: PFM has no alpha channel; write .png or .exr");
     if (o->has_camera_pick && (!o->scene || !pk_scene_format(o->scene) || strcmp(pk_scene_format(o->scene), "gltf") != 0))
         return cli_usage_error("--camera: picks a camera of a glTF asset (.gltf, .glb); %s%s%s is not one",
+                               o->scene ? "'" : "", o->scene ? o->scene : "the built-in Cornell box",
+                               o->scene ? "'" : "");
+    if (o->has_variant && (!o->scene || !pk_scene_format(o->scene) || strcmp(pk_scene_format(o->scene), "gltf") != 0))
+        return cli_usage_error("--variant: picks a material variant of a glTF asset (.gltf, .glb); %s%s%s is not one",
                                o->scene ? "'" : "", o->scene ? o->scene : "the built-in Cornell box",
                                o->scene ? "'" : "");
     if (o->scene && same_file(o->scene, o->out))

@@ -152,6 +152,8 @@ int cli_view(int argc, char **argv)
         return cli_usage_error("--bind: '%s' is not an IPv4 address (such as 127.0.0.1 or 0.0.0.0)", bind);
     if (o.has_camera_pick && (!o.scene || !pk_scene_format(o.scene) || strcmp(pk_scene_format(o.scene), "gltf") != 0))
         return cli_usage_error("--camera: picks a camera of a glTF asset (.gltf, .glb)");
+    if (o.has_variant && (!o.scene || !pk_scene_format(o.scene) || strcmp(pk_scene_format(o.scene), "gltf") != 0))
+        return cli_usage_error("--variant: picks a material variant of a glTF asset (.gltf, .glb)");
 
     /* SIGINT and SIGTERM are taken by sigwait below, in this thread only:
      * blocked before any thread starts (the library's too), as threads

@@ -416,7 +416,9 @@ PK_API pk_status pk_scene_load_json_memory(pk_context *ctx, const char *data, si
 /* As pk_scene_load_file; params (nparams strings "NAME=VALUE") set the
  * parameters ($NAME) of a Mitsuba XML scene over its <default> values; a
  * glTF asset takes camera=N (render /cameras/N instead of the first camera
- * in node order; others are warned about). Other formats have no
+ * in node order) and variant=NAME (KHR_materials_variants: the materials
+ * that the variant NAME maps its primitives to; a name the asset does not
+ * have is an error listing its variants); others are warned about. Other formats have no
  * parameters and ignore them. */
 PK_API pk_status pk_scene_load_file_params(pk_context *ctx, const char *path, const char *const *params,
                                            size_t nparams, pk_scene **out);

@@ -308,10 +308,12 @@ static pk_status make_mask(gltf *g, int64_t mi, int32_t tex, float factor, float
 
 /* KHR_materials_volume on a transmissive material (thickness > 0): the mesh
  * bounds a volume. Its boundary refracts: a material that only transmits
- * (transmission 1, not metallic, no clearcoat, no base colour or
- * metallic-roughness texture) becomes a dielectric of its index and
+ * (transmission 1, not metallic, no clearcoat, no base colour,
+ * metallic-roughness or layer texture) becomes a dielectric of its index and
  * roughness whose transmittance is the base colour (applied as light
- * enters); any other stays glTF's thin-walled material (warned). The inside
+ * enters); any other is the metallic-roughness BSDF with its transmission
+ * refracting (material.volume: mix(dielectric, metal, metallic), the
+ * dielectric's transmitted share a rough refraction). The inside
  * absorbs: sigma_a = -ln(attenuationColor) / attenuationDistance, a medium
  * bounded by vacuum outside (a glTF scene has no other media); an infinite
  * distance absorbs nothing and makes no medium. */
@@ -323,11 +325,7 @@ static pk_status make_volume(gltf *g, const char *path, material *m, float trans
         const float r = m->roughness;
         material_dielectric(m, m->ni, r * r, m->kd);
     } else {
-        gltf_warn(g,
-                  "%s: KHR_materials_volume: the boundary of a volume that is not purely transmissive (transmission "
-                  "< 1, metallic, clearcoat or textured) does not refract: it is drawn as a thin sheet around the "
-                  "absorbing inside",
-                  path);
+        m->volume = true; /* the metallic-roughness BSDF whose transmission refracts (pbsdf.h) */
     }
     if (!isfinite(dist)) return PK_OK;
     medium md;
@@ -362,8 +360,13 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
     if (pbr && !cJSON_IsObject(pbr)) return gltf_fail(g, PK_ERR_PARSE, "%s: must be an object", pp);
     float base[4] = {1, 1, 1, 1}, metallic = 1.0f, roughness = 1.0f, emissive[3] = {0, 0, 0};
     bool found;
-    tex_info t_base, t_mr, t_norm, t_emit, t_occ;
-    char tp[160];
+    tex_info t_base, t_mr, t_norm, t_emit, t_occ, t_tr, t_cc, t_ccr, t_ccn, t_thick;
+    char tp[192]; /* a pointer into an extension (ep) and a key */
+    read_tex_info(g, NULL, path, &t_tr);
+    read_tex_info(g, NULL, path, &t_cc);
+    read_tex_info(g, NULL, path, &t_ccr);
+    read_tex_info(g, NULL, path, &t_ccn);
+    read_tex_info(g, NULL, path, &t_thick);
     if (pbr) {
         if ((st = gltf_nums(g, pbr, pp, "baseColorFactor", 4, base, &found))) return st;
         if ((st = gltf_num(g, pbr, pp, "metallicFactor", 0.0, 1.0, 1.0, &metallic))) return st;
@@ -407,6 +410,7 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
     /* extensions */
     float strength = 1.0f, transmission = 0.0f, ior = 1.5f, coat = 0.0f, coat_rough = 0.0f;
     float thickness = 0.0f, att_dist = INFINITY, att_col[3] = {1, 1, 1};
+    bool unlit = false;
     const cJSON *ext = cJSON_GetObjectItemCaseSensitive(o, "extensions");
     for (const cJSON *e = ext ? ext->child : NULL; e; e = e->next) {
         snprintf(ep, sizeof ep, "%s/extensions/%.40s", path, e->string ? e->string : "");
@@ -415,8 +419,9 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
             if ((st = gltf_num(g, e, ep, "emissiveStrength", 0.0, 1e30, 1.0, &strength))) return st;
         } else if (strcmp(e->string, "KHR_materials_transmission") == 0) {
             if ((st = gltf_num(g, e, ep, "transmissionFactor", 0.0, 1.0, 0.0, &transmission))) return st;
-            if (cJSON_GetObjectItemCaseSensitive(e, "transmissionTexture"))
-                gltf_warn(g, "%s: transmissionTexture is not supported (the factor is used alone)", ep);
+            snprintf(tp, sizeof tp, "%s/transmissionTexture", ep);
+            if ((st = read_tex_info(g, cJSON_GetObjectItemCaseSensitive(e, "transmissionTexture"), tp, &t_tr)))
+                return st;
         } else if (strcmp(e->string, "KHR_materials_ior") == 0) {
             if ((st = gltf_num(g, e, ep, "ior", 0.0, 1e30, 1.5, &ior))) return st;
             if (ior == 0.0f) ior = 1.5f; /* never seen through: glTF's "0" is an infinite index; a dielectric default */
@@ -424,10 +429,14 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
         } else if (strcmp(e->string, "KHR_materials_clearcoat") == 0) {
             if ((st = gltf_num(g, e, ep, "clearcoatFactor", 0.0, 1.0, 0.0, &coat))) return st;
             if ((st = gltf_num(g, e, ep, "clearcoatRoughnessFactor", 0.0, 1.0, 0.0, &coat_rough))) return st;
-            if (cJSON_GetObjectItemCaseSensitive(e, "clearcoatTexture") ||
-                cJSON_GetObjectItemCaseSensitive(e, "clearcoatRoughnessTexture") ||
-                cJSON_GetObjectItemCaseSensitive(e, "clearcoatNormalTexture"))
-                gltf_warn(g, "%s: the clearcoat's textures are not supported (its factors are used alone)", ep);
+            snprintf(tp, sizeof tp, "%s/clearcoatTexture", ep);
+            if ((st = read_tex_info(g, cJSON_GetObjectItemCaseSensitive(e, "clearcoatTexture"), tp, &t_cc))) return st;
+            snprintf(tp, sizeof tp, "%s/clearcoatRoughnessTexture", ep);
+            if ((st = read_tex_info(g, cJSON_GetObjectItemCaseSensitive(e, "clearcoatRoughnessTexture"), tp, &t_ccr)))
+                return st;
+            snprintf(tp, sizeof tp, "%s/clearcoatNormalTexture", ep);
+            if ((st = read_tex_info(g, cJSON_GetObjectItemCaseSensitive(e, "clearcoatNormalTexture"), tp, &t_ccn)))
+                return st;
         } else if (strcmp(e->string, "KHR_materials_volume") == 0) {
             /* the mesh is a closed volume (thickness > 0) whose inside absorbs */
             if ((st = gltf_num(g, e, ep, "thicknessFactor", 0.0, 1e30, 0.0, &thickness))) return st;
@@ -442,18 +451,21 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
             for (int k = 0; k < 3; k++)
                 if (!(att_col[k] >= 0.0f && att_col[k] <= 1.0f))
                     return gltf_fail(g, PK_ERR_PARSE, "%s/attenuationColor: %g is outside [0, 1]", ep, (double)att_col[k]);
-            if (cJSON_GetObjectItemCaseSensitive(e, "thicknessTexture"))
-                gltf_warn(g, "%s: thicknessTexture is not used (only whether the thickness is 0 matters here)", ep);
+            /* the thickness map is a rasterizer's estimate of what rays find
+             * here: the extension tells ray tracers to ignore it (checked only) */
+            snprintf(tp, sizeof tp, "%s/thicknessTexture", ep);
+            if ((st = read_tex_info(g, cJSON_GetObjectItemCaseSensitive(e, "thicknessTexture"), tp, &t_thick)))
+                return st;
         } else if (strcmp(e->string, "KHR_materials_sheen") == 0 ||
                    strcmp(e->string, "KHR_materials_specular") == 0 ||
                    strcmp(e->string, "KHR_materials_iridescence") == 0 ||
-                   strcmp(e->string, "KHR_materials_anisotropy") == 0 ||
-                   strcmp(e->string, "KHR_materials_dispersion") == 0) {
+                   strcmp(e->string, "KHR_materials_anisotropy") == 0) {
             gltf_warn(g, "%s: not supported; the material is drawn without it", ep);
+        } else if (strcmp(e->string, "KHR_materials_dispersion") == 0) {
+            gltf_warn_once(g, GW_DISPERSION,
+                           "%s: drawn without dispersion (needs spectral rendering; further ones not reported)", ep);
         } else if (strcmp(e->string, "KHR_materials_unlit") == 0) {
-            gltf_warn(g, "%s: not supported; drawn as a lit diffuse surface of the base colour", ep);
-            metallic = 0.0f;
-            roughness = 1.0f;
+            unlit = true; /* below: an emitter of the base colour that does not scatter */
         } else {
             gltf_warn(g, "%s: unknown material extension ignored", ep);
         }
@@ -461,11 +473,16 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
 
     /* which uv set, and whether one transform serves every texture (then it
      * is baked into the primitive's uvs, rotation included) */
-    tex_info *all[4] = {&t_base, &t_mr, &t_norm, &t_emit};
+    if (transmission == 0.0f) t_tr.present = false; /* (read, never looked up) */
+    if (coat == 0.0f) t_cc.present = t_ccr.present = t_ccn.present = false;
+    if (coat_rough == 0.0f) t_ccr.present = false;
+    if (unlit) t_mr.present = t_norm.present = t_emit.present = t_tr.present = t_cc.present = t_ccr.present =
+        t_ccn.present = false;
+    tex_info *all[8] = {&t_base, &t_mr, &t_norm, &t_emit, &t_tr, &t_cc, &t_ccr, &t_ccn};
     int set = -1;
     bool same = true;
     const tex_info *first = NULL;
-    for (int k = 0; k < 4; k++) {
+    for (int k = 0; k < 8; k++) {
         if (!all[k]->present) continue;
         if (set < 0) set = all[k]->texcoord;
         else if (all[k]->texcoord != set)
@@ -505,6 +522,12 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
         if ((st = make_ref(g, &t_emit, true, bake, path, &er))) goto fail;
         m.map_ke = er;
     }
+    if ((st = make_ref(g, &t_tr, false, bake, path, &m.map_tr))) goto fail;
+    if ((st = make_ref(g, &t_cc, false, bake, path, &m.map_cc))) goto fail;
+    if ((st = make_ref(g, &t_ccr, false, bake, path, &m.map_ccr))) goto fail;
+    if (t_ccn.present)
+        gltf_warn(g, "%s/extensions/KHR_materials_clearcoat/clearcoatNormalTexture: the clearcoat is drawn with the "
+                     "surface's normal (its own normal map is not applied)", path);
     if (amode == 1 || amode == 2) {
         const bool tex_alpha =
             m.map_kd.kind == TEX_IMAGE && (g->s->textures[m.map_kd.tex].nc == 2 || g->s->textures[m.map_kd.tex].nc == 4);
@@ -522,8 +545,23 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
             if (tex_alpha) m.map_d = m.map_kd; /* its alpha channel (linear), the same uv transform and wrap */
         }
     }
-    if (transmission > 0.0f && thickness > 0.0f && (st = make_volume(g, path, &m, transmission, thickness, att_dist,
-                                                                      att_col, t_base.present || t_mr.present)))
+    if (unlit) {
+        /* KHR_materials_unlit: the surface shows its base colour (factor x
+         * texture) whatever the lighting: it emits that radiance and
+         * scatters nothing (docs/scene-format.md); the alpha modes and
+         * doubleSided still apply */
+        m.ke = v3(base[0], base[1], base[2]);
+        tex_ref_init(&m.map_ke);
+        if (m.map_kd.kind) m.map_ke = m.map_kd;
+        tex_ref_init(&m.map_kd);
+        tex_ref_init(&m.map_mr);
+        tex_ref_init(&m.map_norm);
+        material_diffuse(&m, v3s(0.0f));
+        transmission = 0.0f;
+    }
+    if (transmission > 0.0f && thickness > 0.0f &&
+        (st = make_volume(g, path, &m, transmission, thickness, att_dist, att_col,
+                          t_base.present || t_mr.present || m.map_tr.kind || m.map_cc.kind || m.map_ccr.kind)))
         goto fail;
     g->s->materials[idx] = m;
     g->mat_uv[mi].bake = bake;

@@ -159,7 +159,8 @@ static bool ext_supported(const char *e)
                                         "KHR_materials_transmission",   "KHR_materials_ior",
                                         "KHR_materials_unlit",          "KHR_materials_clearcoat",
                                         "EXT_meshopt_compression",      "KHR_draco_mesh_compression",
-                                        "EXT_texture_webp",             NULL};
+                                        "EXT_texture_webp",             "KHR_materials_variants",
+                                        NULL};
     for (int i = 0; known[i]; i++)
         if (strcmp(e, known[i]) == 0) return true;
     return false;
@@ -396,6 +397,64 @@ static pk_status apply_morph(gltf *g, const cJSON *p, const char *path, const fl
     return PK_OK;
 }
 
+/* KHR_materials_variants: the material that primitive p's mappings give
+ * the chosen variant (*mat unchanged when none names it). */
+static pk_status variant_material(gltf *g, const cJSON *p, const char *path, int64_t *mat)
+{
+    const cJSON *e = gltf_ext(p, "KHR_materials_variants");
+    if (!e) return PK_OK;
+    char ep[160];
+    snprintf(ep, sizeof ep, "%s/extensions/KHR_materials_variants/mappings", path);
+    const cJSON *maps = cJSON_IsObject(e) ? cJSON_GetObjectItemCaseSensitive(e, "mappings") : NULL;
+    if (!cJSON_IsArray(maps)) return gltf_fail(g, PK_ERR_PARSE, "%s: required, and must be an array", ep);
+    int k = 0;
+    for (const cJSON *m = maps->child; m; m = m->next, k++) {
+        char mp[192];
+        snprintf(mp, sizeof mp, "%s/%d", ep, k);
+        if (!cJSON_IsObject(m)) return gltf_fail(g, PK_ERR_PARSE, "%s: must be an object", mp);
+        const cJSON *vs = cJSON_GetObjectItemCaseSensitive(m, "variants");
+        if (!cJSON_IsArray(vs)) return gltf_fail(g, PK_ERR_PARSE, "%s/variants: required, and must be an array", mp);
+        bool hit = false;
+        for (const cJSON *v = vs->child; v; v = v->next) {
+            if (!is_integer(v) || v->valuedouble < 0)
+                return gltf_fail(g, PK_ERR_PARSE, "%s/variants: not a variant index", mp);
+            hit |= v->valuedouble == (double)g->variant;
+        }
+        if (!hit) continue;
+        pk_status st = gltf_index(g, m, mp, "material", gltf_count(g, "materials"), true, mat);
+        return st;
+    }
+    return PK_OK;
+}
+
+/* Finds the variant asked for among the asset's; an error naming them when
+ * it is not one. */
+static pk_status find_variant(gltf *g)
+{
+    g->variant = -1;
+    if (!g->variant_name) return PK_OK;
+    const cJSON *vs = cJSON_GetObjectItemCaseSensitive(gltf_ext(g->root, "KHR_materials_variants"), "variants");
+    char list[512] = "";
+    size_t at = 0;
+    int k = 0;
+    for (const cJSON *v = cJSON_IsArray(vs) ? vs->child : NULL; v; v = v->next, k++) {
+        const cJSON *n = cJSON_IsObject(v) ? cJSON_GetObjectItemCaseSensitive(v, "name") : NULL;
+        if (!cJSON_IsString(n))
+            return gltf_fail(g, PK_ERR_PARSE, "/extensions/KHR_materials_variants/variants/%d/name: required, and must "
+                                              "be a string", k);
+        if (strcmp(n->valuestring, g->variant_name) == 0) {
+            g->variant = k;
+            return PK_OK;
+        }
+        if (at < sizeof list - 1)
+            at += (size_t)snprintf(list + at, sizeof list - at, "%s'%.64s'", k ? ", " : "", n->valuestring);
+    }
+    if (!k)
+        return gltf_fail(g, PK_ERR_INVALID_ARGUMENT, "variant '%.64s': the asset has no material variants",
+                         g->variant_name);
+    return gltf_fail(g, PK_ERR_INVALID_ARGUMENT, "variant '%.64s' is not one of the asset's: %s", g->variant_name, list);
+}
+
 /* Linear blend skinning with the node's joint matrices (g->skin): each
  * vertex moves by the sum of its four joints' matrices times their weights
  * (the weights divided by their sum); normals by the inverse transpose of
@@ -593,6 +652,7 @@ static pk_status add_primitive(gltf *g, int64_t mi, int pi, const cJSON *p, bool
     if (!cJSON_IsObject(attrs)) return gltf_fail(g, PK_ERR_PARSE, "%s/attributes: required, and must be an object", path);
     if ((st = gltf_index(g, p, path, "indices", gltf_count(g, "accessors"), false, &ii))) return st;
     if ((st = gltf_index(g, p, path, "material", gltf_count(g, "materials"), false, &mat))) return st;
+    if (g->variant >= 0 && (st = variant_material(g, p, path, &mat))) return st;
     uint32_t smat;
     int uvset;
     if ((st = gltf_material(g, mat, &smat, &uvset))) return st;
@@ -1075,8 +1135,10 @@ static pk_status read_params(gltf *g, const char *const *params, size_t nparams)
             if (end == p + 7 || *end || v < 0 || v > INT32_MAX)
                 return gltf_fail(g, PK_ERR_INVALID_ARGUMENT, "camera '%.32s': expected a camera number", p + 7);
             g->camera_pick = (int)v;
+        } else if (strncmp(p, "variant=", 8) == 0) {
+            g->variant_name = p + 8;
         } else {
-            gltf_warn(g, "parameter '%.64s' ignored (a glTF asset takes camera=N)", p);
+            gltf_warn(g, "parameter '%.64s' ignored (a glTF asset takes camera=N and variant=NAME)", p);
         }
     }
     return PK_OK;
@@ -1120,6 +1182,7 @@ pk_status scene_gltf_parse_params(pk_context *ctx, pk_scene *s, const char *data
         goto out;
     }
     if ((st = check_document(g))) goto out;
+    if ((st = find_variant(g))) goto out;
     g->nbuffers = gltf_count(g, "buffers");
     g->nmaterials = gltf_count(g, "materials");
     g->nimages = gltf_count(g, "images");

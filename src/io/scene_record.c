@@ -19,6 +19,7 @@ const rec_field rec_material[] = {
     F(material, metallic, REC_FLOAT),   F(material, roughness, REC_FLOAT),
     F(material, transmission, REC_FLOAT), F(material, clearcoat, REC_FLOAT),
     F(material, clearcoat_roughness, REC_FLOAT), F(material, tint, REC_VEC3),
+    F(material, volume, REC_BOOL),
     F(material, mix_a, REC_INT),        F(material, mix_b, REC_INT),
     F(material, amount, REC_FLOAT),
     F(material, coat_base, REC_INT),    F(material, base_alpha, REC_FLOAT),
@@ -42,12 +43,14 @@ const size_t rec_nmaterial = sizeof rec_material / sizeof rec_material[0];
 
 const char *const rec_map_names[REC_NMAPS] = {"map_kd",    "map_ks",   "map_ns",   "map_d",
                                               "map_alpha", "map_bump", "map_norm", "map_mr",
-                                              "map_ke",    "map_eta",  "map_k",    "map_tf"};
+                                              "map_ke",    "map_eta",  "map_k",    "map_tf",
+                                              "map_tr",    "map_cc",   "map_ccr"};
 const size_t rec_map_offsets[REC_NMAPS] = {
     offsetof(material, map_kd),    offsetof(material, map_ks),   offsetof(material, map_ns),
     offsetof(material, map_d),     offsetof(material, map_alpha), offsetof(material, map_bump),
     offsetof(material, map_norm),  offsetof(material, map_mr),   offsetof(material, map_ke),
-    offsetof(material, map_eta),   offsetof(material, map_k),    offsetof(material, map_tf)};
+    offsetof(material, map_eta),   offsetof(material, map_k),    offsetof(material, map_tf),
+    offsetof(material, map_tr),    offsetof(material, map_cc),   offsetof(material, map_ccr)};
 
 const rec_field rec_texref[] = {
     {"kind", REC_U8, offsetof(tex_ref, kind)},   F(tex_ref, clamp, REC_BOOL), F(tex_ref, squared, REC_BOOL),

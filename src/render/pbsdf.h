@@ -77,6 +77,11 @@ typedef enum pbsdf_type {
 #define PBSDF_ANISO 8u
 /* coated: the base is a conductor (eta, k relative to the coat, base_alpha), not Lambert */
 #define PBSDF_COATED_METAL 16u
+/* metallic-roughness: the surface bounds a volume (KHR_materials_volume):
+ * its transmission refracts (a rough dielectric of ior and alpha) instead
+ * of passing straight through a thin sheet, and wo may lie inside (wo.z <
+ * 0, the frame's z the outward normal) */
+#define PBSDF_MR_VOLUME 32u
 
 /* Below this roughness a microfacet lobe is treated as perfectly smooth (a
  * delta lobe): the GGX density would exceed float range long before 0. */
@@ -938,6 +943,101 @@ static inline PK_HD bool pbsdf__refract(vec3 w, vec3 m, float ior, vec3 *out)
     if (s2t >= 1.0f) return false;
     float ct = sqrtf(1.0f - s2t);
     *out = v3_norm(v3_add(v3_scale(v3_neg(w), 1.0f / eta), v3_scale(m, c / eta - ct)));
+    return true;
+}
+
+/* ---- glTF metallic-roughness bounding a volume (PBSDF_MR_VOLUME) ----------- */
+
+/* Outside (wo.z > 0) the reflection is the metallic-roughness BSDF's as
+ * above; its transmitted share, (1 - metallic) transmission under the
+ * clearcoat, refracts as a rough dielectric of ior and alpha (Walter et al.
+ * with exact Fresnel: the part of the glTF BTDF that the volume extension
+ * makes refract) into the inside. Inside (wo.z < 0) the boundary is that
+ * dielectric seen from within: its internal reflection (total beyond the
+ * critical angle) in full, its transmission out weighted by the same share;
+ * the rest of the light (the metal's and the diffuse base's part of the
+ * surface, opaque sheets seen from behind) is absorbed. The share takes the
+ * clearcoat's weight of the outside direction and the square root of the
+ * base colour at every crossing (in and out: one base colour for light
+ * that passes through a closed object, as the material's own tint), so the
+ * transmission is reciprocal (the eta^2 rule of a refracting boundary). */
+static inline PK_HD pbsdf pbsdf__mrv_glass(const pbsdf *b)
+{
+    pbsdf g = pbsdf_dielectric(b->ior, b->alpha, v3s(1.0f));
+    g.flags = b->flags & PBSDF_ENERGY;
+    return g;
+}
+/* The transmitted share through the boundary, by the direction outside. */
+static inline PK_HD vec3 pbsdf__mrv_share(const pbsdf *b, vec3 w_out)
+{
+    const float s = (1.0f - b->metallic) * b->transmission * (1.0f - pbsdf__mr_coat(b, w_out));
+    return v3_scale(v3(sqrtf(b->albedo.x), sqrtf(b->albedo.y), sqrtf(b->albedo.z)), s);
+}
+static inline PBSDF_CALLED PK_HD vec3 pbsdf__mrv_eval(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    if (wo.z == 0.0f || wi.z == 0.0f) return v3s(0.0f);
+    if (wo.z > 0.0f && wi.z > 0.0f) return pbsdf__mr_eval(b, wo, wi);
+    const pbsdf g = pbsdf__mrv_glass(b);
+    const vec3 f = pbsdf__dielectric_eval(&g, wo, wi);
+    if (wo.z < 0.0f && wi.z < 0.0f) return f; /* internal reflection */
+    return v3_mul(pbsdf__mrv_share(b, wo.z > 0.0f ? wo : wi), f);
+}
+static inline PBSDF_CALLED PK_HD float pbsdf__mrv_pdf(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    if (wo.z == 0.0f || wi.z == 0.0f) return 0.0f;
+    const pbsdf g = pbsdf__mrv_glass(b);
+    if (wo.z < 0.0f) return pbsdf__dielectric_pdf(&g, wo, wi);
+    float pr[4];
+    pbsdf__mr_probs(b, wo, pr);
+    float p = pr[2] > 0.0f ? pr[2] * pbsdf__dielectric_pdf(&g, wo, wi) : 0.0f;
+    if (wi.z > 0.0f) p += pbsdf__mr_pdf(b, wo, wi);
+    return p;
+}
+/* Samples the boundary's glass: for wo inside all of it (prob = 1), for wo
+ * outside the transmission lobe, chosen with probability prob (the
+ * metallic-roughness BSDF's other lobes sample the rest); u0 in [0, 1). */
+static inline PBSDF_CALLED PK_HD bool pbsdf__mrv_sample(const pbsdf *b, vec3 wo, float u0, float u1, float u2, float prob,
+                                                 vec3 *wi, vec3 *weight, float *pdf, bool *is_delta)
+{
+    const pbsdf g = pbsdf__mrv_glass(b);
+    *is_delta = false;
+    if (pbsdf__smooth(b)) {
+        const float r = pbsdf_fresnel_dielectric(wo.z, b->ior);
+        *is_delta = true;
+        if (wo.z < 0.0f && u0 < r) { /* internal reflection */
+            *wi = pbsdf__mirror(wo);
+            *weight = v3s(1.0f);
+            *pdf = r;
+            return true;
+        }
+        vec3 w;
+        if (!pbsdf__refract(wo, v3(0.0f, 0.0f, 1.0f), b->ior, &w)) return false;
+        const vec3 share = pbsdf__mrv_share(b, wo.z > 0.0f ? wo : w);
+        *wi = w;
+        if (wo.z < 0.0f) { /* f / p = (1 - r) share / (1 - r) */
+            *weight = share;
+            *pdf = 1.0f - r;
+        } else {
+            *weight = v3_scale(share, (1.0f - r) / prob);
+            *pdf = prob;
+        }
+        return true;
+    }
+    vec3 m = pbsdf_mf_sample(&g, wo, u1, u2);
+    if (!(v3_dot(wo, m) * wo.z > 0.0f)) return false;
+    const float r = pbsdf_fresnel_dielectric(v3_dot(wo, m), b->ior);
+    vec3 w;
+    if (u0 < r) {
+        w = v3_sub(v3_scale(m, 2.0f * v3_dot(wo, m)), wo);
+        if (!(w.z * wo.z > 0.0f)) return false;
+    } else {
+        if (!pbsdf__refract(wo, m, b->ior, &w) || !(w.z * wo.z < 0.0f)) return false;
+    }
+    const float p = pbsdf__mrv_pdf(b, wo, w);
+    if (!(p > 0.0f)) return false;
+    *wi = w;
+    *pdf = p;
+    *weight = v3_scale(pbsdf__mrv_eval(b, wo, w), 1.0f / p);
     return true;
 }
 
@@ -2023,7 +2123,8 @@ static inline PK_HD vec3 pbsdf_eval(const pbsdf *b, vec3 wo, vec3 wi)
     if (b->type == PBSDF_PRINCIPLED_THIN) return pbsdf__th_eval(b, wo, wi);
     if (b->type >= PBSDF_THIN_DIELECTRIC) return pbsdf__ext_eval(b, wo, wi);
     if (b->type == PBSDF_DIELECTRIC) return pbsdf__dielectric_eval(b, wo, wi);
-    if (b->type == PBSDF_METALLIC_ROUGHNESS) return pbsdf__mr_eval(b, wo, wi);
+    if (b->type == PBSDF_METALLIC_ROUGHNESS)
+        return b->flags & PBSDF_MR_VOLUME ? pbsdf__mrv_eval(b, wo, wi) : pbsdf__mr_eval(b, wo, wi);
     if (!(wo.z > 0.0f && wi.z > 0.0f)) return v3s(0.0f);
     vec3 h = v3(0.0f, 0.0f, 1.0f);
     switch (b->type) {
@@ -2070,7 +2171,8 @@ static inline PK_HD float pbsdf_pdf(const pbsdf *b, vec3 wo, vec3 wi)
     if (b->type == PBSDF_PRINCIPLED_THIN) return pbsdf__th_pdf(b, wo, wi);
     if (b->type >= PBSDF_THIN_DIELECTRIC) return pbsdf__ext_pdf(b, wo, wi);
     if (b->type == PBSDF_DIELECTRIC) return pbsdf__dielectric_pdf(b, wo, wi);
-    if (b->type == PBSDF_METALLIC_ROUGHNESS) return pbsdf__mr_pdf(b, wo, wi);
+    if (b->type == PBSDF_METALLIC_ROUGHNESS)
+        return b->flags & PBSDF_MR_VOLUME ? pbsdf__mrv_pdf(b, wo, wi) : pbsdf__mr_pdf(b, wo, wi);
     if (!(wo.z > 0.0f && wi.z > 0.0f)) return 0.0f;
     switch (b->type) {
     case PBSDF_DIFFUSE:
@@ -2151,6 +2253,8 @@ static inline PK_HD bool pbsdf_sample(const pbsdf *b, vec3 wo, const float u[3],
         *weight = v3_scale(pbsdf__dielectric_eval(b, wo, w), 1.0f / p);
         return true;
     }
+    if (b->type == PBSDF_METALLIC_ROUGHNESS && (b->flags & PBSDF_MR_VOLUME) && wo.z < 0.0f)
+        return pbsdf__mrv_sample(b, wo, u[0], u[1], u[2], 1.0f, wi, weight, pdf, is_delta);
     if (!(wo.z > 0.0f)) return false;
     vec3 w;
     switch (b->type) {
@@ -2237,6 +2341,9 @@ static inline PK_HD bool pbsdf_sample(const pbsdf *b, vec3 wo, const float u[3],
             float r = sqrtf(u[1]), phi = 2.0f * PK_PI * u[2];
             w = v3(r * cosf(phi), r * sinf(phi), sqrtf(fmaxf(0.0f, 1.0f - u[1])));
             if (!(w.z > 0.0f)) return false;
+        } else if (b->flags & PBSDF_MR_VOLUME) { /* transmission: refracted into the volume */
+            const float u0 = fminf(fmaxf((u[0] - (c - pr[2])) / pr[2], 0.0f), 0.99999994f);
+            return pbsdf__mrv_sample(b, wo, u0, u[1], u[2], pr[2], wi, weight, pdf, is_delta);
         } else { /* transmission: the specular lobe mirrored through the sheet */
             if (smooth) {
                 *wi = v3_neg(wo);
@@ -2251,6 +2358,14 @@ static inline PK_HD bool pbsdf_sample(const pbsdf *b, vec3 wo, const float u[3],
             w = v3_sub(v3_scale(m, 2.0f * v3_dot(wo, m)), wo);
             if (!(w.z > 0.0f)) return false;
             w = pbsdf__mirror_z(w);
+        }
+        if (b->flags & PBSDF_MR_VOLUME) {
+            const float p = pbsdf__mrv_pdf(b, wo, w);
+            if (!(p > 0.0f)) return false;
+            *wi = w;
+            *pdf = p;
+            *weight = v3_scale(pbsdf__mrv_eval(b, wo, w), 1.0f / p);
+            return true;
         }
         float p = pbsdf__mr_pdf(b, wo, w);
         if (!(p > 0.0f)) return false;

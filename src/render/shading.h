@@ -100,6 +100,10 @@ static inline PK_HD shading shading_at(const surface *sf)
                 const float cr = fminf(fmaxf(m->clearcoat_roughness, 0.0f), 1.0f);
                 sh.b = pbsdf_with_clearcoat(sh.b, fminf(m->clearcoat, 1.0f), cr * cr);
             }
+            if (m->volume) { /* bounds a volume: refracts, the frame the outward normal (wo.z < 0 inside) */
+                sh.b.flags |= PBSDF_MR_VOLUME;
+                if (!sf->front) n = v3_neg(n);
+            }
             break;
         }
         case MAT_THIN_DIELECTRIC: sh.b = pbsdf_thin_dielectric(m->eta.x, m->tf); break;

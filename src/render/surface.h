@@ -237,6 +237,21 @@ static inline PK_HD void surface_texture_at(const scene_view *s, const ray *r, c
         tm->k = v3_mul(m->k, v3(fmaxf(k.x, 0.0f), fmaxf(k.y, 0.0f), fmaxf(k.z, 0.0f)));
     }
     if (m->map_tf.kind) tm->tf = v3_mul(m->tf, surface_clamp_rgb(tex_eval_rgb(s->textures, &m->map_tf, q)));
+    if (m->map_tr.kind | m->map_cc.kind | m->map_ccr.kind) { /* glTF's layers: red, red, green */
+        float c[4];
+        if (m->map_tr.kind) {
+            tex_eval_raw(s->textures, &m->map_tr, q, c);
+            tm->transmission = fminf(fmaxf(m->transmission * c[0], 0.0f), 1.0f);
+        }
+        if (m->map_cc.kind) {
+            tex_eval_raw(s->textures, &m->map_cc, q, c);
+            tm->clearcoat = fminf(fmaxf(m->clearcoat * c[0], 0.0f), 1.0f);
+        }
+        if (m->map_ccr.kind) {
+            const int nc = tex_eval_raw(s->textures, &m->map_ccr, q, c);
+            tm->clearcoat_roughness = fminf(fmaxf(m->clearcoat_roughness * (nc >= 3 ? c[1] : c[0]), 0.0f), 1.0f);
+        }
+    }
     if (m->map_ke.kind) { /* the finest level, as light sampling sees it (lights.h), so that both agree */
         const tex_query qe = {uv.u, uv.v, 0.0f, sf->p, sf->ng, s->tex_nodes};
         const vec3 e = tex_eval_rgb(s->textures, &m->map_ke, qe);

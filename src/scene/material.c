@@ -31,6 +31,9 @@ void material_init(material *m)
     tex_ref_init(&m->map_eta);
     tex_ref_init(&m->map_k);
     tex_ref_init(&m->map_tf);
+    tex_ref_init(&m->map_tr);
+    tex_ref_init(&m->map_cc);
+    tex_ref_init(&m->map_ccr);
 }
 
 float material_f0_dielectric(float ior)

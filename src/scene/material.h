@@ -115,6 +115,11 @@ typedef struct material {
     int mix_a, mix_b;
     float amount;
     float metallic, roughness, transmission, clearcoat, clearcoat_roughness;
+    /* MAT_METALLIC_ROUGHNESS: the surface bounds a volume (KHR_materials_
+     * volume with a thickness): its transmission refracts into the inside
+     * (a rough dielectric of ni and the roughness) instead of passing
+     * through a thin sheet, and the inside sees the boundary from within */
+    bool volume;
     /* MAT_COATED: a dielectric coat of index ni and GGX alpha over a base,
      * MATERIAL_BASE_DIFFUSE (Lambert of kd) or MATERIAL_BASE_CONDUCTOR (a
      * metal of complex index eta + i k as a file gives it, relative to
@@ -152,8 +157,13 @@ typedef struct material {
      * and map_k multiply a conductor's eta and k (not clamped above: pbrt's
      * spectrum textures on conductor.eta and .k); map_tf multiplies the
      * transmittance tf of a dielectric, thin dielectric or diffuse
-     * transmitter (clamped to 0..1). */
+     * transmitter (clamped to 0..1). glTF's layers (data, not sRGB; each
+     * value multiplies its constant, clamped to 0..1): map_tr's red channel
+     * the transmission (KHR_materials_transmission), map_cc's red the
+     * clearcoat and map_ccr's green the clearcoat roughness (a grey texture:
+     * its grey). */
     tex_ref map_kd, map_ks, map_ns, map_d, map_alpha, map_bump, map_norm, map_mr, map_ke, map_eta, map_k, map_tf;
+    tex_ref map_tr, map_cc, map_ccr;
     /* map_norm's scale (glTF's normalTexture.scale): the map's x and y are
      * multiplied by it before the normal is normalised; 1 by default */
     float norm_scale;
