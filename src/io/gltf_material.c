@@ -277,6 +277,58 @@ static pk_status make_mask(gltf *g, int64_t mi, int32_t tex, float factor, float
 
 /* ---- materials ------------------------------------------------------------------------ */
 
+/* KHR_materials_specular, _sheen, _iridescence and _anisotropy as read. */
+enum { GX_SPEC, GX_SPEC_COLOR, GX_SHEEN, GX_SHEEN_ROUGH, GX_IRID, GX_IRID_THICK, GX_ANISO, GX_NTEX };
+typedef struct gx_params {
+    float specular, spec_color[3], sheen[3], sheen_rough, irid, irid_ior, irid_min, irid_max, aniso, aniso_rot;
+    tex_info t[GX_NTEX];
+} gx_params;
+
+static void gx_init(gltf *g, gx_params *x)
+{
+    x->specular = 1.0f;
+    x->spec_color[0] = x->spec_color[1] = x->spec_color[2] = 1.0f;
+    x->sheen[0] = x->sheen[1] = x->sheen[2] = 0.0f;
+    x->sheen_rough = x->irid = x->aniso = x->aniso_rot = 0.0f;
+    x->irid_ior = 1.3f, x->irid_min = 100.0f, x->irid_max = 400.0f;
+    for (int k = 0; k < GX_NTEX; k++) read_tex_info(g, NULL, "", &x->t[k]);
+}
+static pk_status gx_tex(gltf *g, const cJSON *e, const char *ep, const char *key, tex_info *ti)
+{
+    char tp[224];
+    snprintf(tp, sizeof tp, "%s/%s", ep, key);
+    return read_tex_info(g, cJSON_GetObjectItemCaseSensitive(e, key), tp, ti);
+}
+/* The extensions' parameters and maps onto the material m (after
+ * material_metallic_roughness and the core maps). */
+static pk_status gx_apply(gltf *g, const gx_params *x, bool bake, const char *path, material *m)
+{
+    m->specular = x->specular;
+    m->specular_color = v3(x->spec_color[0], x->spec_color[1], x->spec_color[2]);
+    m->sheen_color = v3(x->sheen[0], x->sheen[1], x->sheen[2]);
+    m->sheen_roughness = x->sheen_rough;
+    m->iridescence = x->irid;
+    m->iridescence_ior = x->irid_ior;
+    m->iridescence_thickness = x->irid_max;
+    m->iridescence_thickness_min = x->irid_min;
+    m->anisotropy = x->aniso;
+    m->anisotropy_rotation = x->aniso_rot;
+    /* colour textures are sRGB, the others data */
+    static const bool colour[GX_NTEX] = {false, true, true, false, false, false, false};
+    tex_ref *maps[GX_NTEX] = {&m->map_spec, &m->map_spec_color, &m->map_sheen, &m->map_sheen_rough,
+                              &m->map_irid, &m->map_irid_thick, &m->map_aniso};
+    pk_status st;
+    for (int k = 0; k < GX_NTEX; k++)
+        if ((st = make_ref(g, &x->t[k], colour[k], bake, path, maps[k]))) return st;
+    /* a texture on a factor of 0 changes nothing: no texture */
+    if (v3_max_comp(m->sheen_color) <= 0.0f) tex_ref_init(&m->map_sheen), tex_ref_init(&m->map_sheen_rough);
+    if (m->iridescence <= 0.0f) tex_ref_init(&m->map_irid), tex_ref_init(&m->map_irid_thick);
+    if (m->anisotropy <= 0.0f) tex_ref_init(&m->map_aniso);
+    if (m->specular <= 0.0f) tex_ref_init(&m->map_spec);
+    material_gltf_update(m);
+    return PK_OK;
+}
+
 /* KHR_materials_volume on a transmissive material (thickness > 0): the mesh
  * bounds a volume. Its boundary refracts: a material that only transmits
  * (transmission 1, not metallic, no clearcoat, no base colour or
@@ -378,6 +430,9 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
     /* extensions */
     float strength = 1.0f, transmission = 0.0f, ior = 1.5f, coat = 0.0f, coat_rough = 0.0f;
     float thickness = 0.0f, att_dist = INFINITY, att_col[3] = {1, 1, 1};
+    gx_params gx;
+    gx_init(g, &gx);
+    bool gx_used = false;
     const cJSON *ext = cJSON_GetObjectItemCaseSensitive(o, "extensions");
     for (const cJSON *e = ext ? ext->child : NULL; e; e = e->next) {
         snprintf(ep, sizeof ep, "%s/extensions/%.40s", path, e->string ? e->string : "");
@@ -415,11 +470,40 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
                     return gltf_fail(g, PK_ERR_PARSE, "%s/attenuationColor: %g is outside [0, 1]", ep, (double)att_col[k]);
             if (cJSON_GetObjectItemCaseSensitive(e, "thicknessTexture"))
                 gltf_warn(g, "%s: thicknessTexture is not used (only whether the thickness is 0 matters here)", ep);
-        } else if (strcmp(e->string, "KHR_materials_sheen") == 0 ||
-                   strcmp(e->string, "KHR_materials_specular") == 0 ||
-                   strcmp(e->string, "KHR_materials_iridescence") == 0 ||
-                   strcmp(e->string, "KHR_materials_anisotropy") == 0 ||
-                   strcmp(e->string, "KHR_materials_dispersion") == 0) {
+        } else if (strcmp(e->string, "KHR_materials_specular") == 0) {
+            gx_used = true;
+            if ((st = gltf_num(g, e, ep, "specularFactor", 0.0, 1.0, 1.0, &gx.specular))) return st;
+            if ((st = gltf_nums(g, e, ep, "specularColorFactor", 3, gx.spec_color, &found))) return st;
+            for (int k = 0; k < 3; k++)
+                if (!(gx.spec_color[k] >= 0.0f && gx.spec_color[k] < 3.4e38f))
+                    return gltf_fail(g, PK_ERR_PARSE, "%s/specularColorFactor: %g is negative", ep,
+                                     (double)gx.spec_color[k]);
+            if ((st = gx_tex(g, e, ep, "specularTexture", &gx.t[GX_SPEC]))) return st;
+            if ((st = gx_tex(g, e, ep, "specularColorTexture", &gx.t[GX_SPEC_COLOR]))) return st;
+        } else if (strcmp(e->string, "KHR_materials_sheen") == 0) {
+            gx_used = true;
+            if ((st = gltf_nums(g, e, ep, "sheenColorFactor", 3, gx.sheen, &found))) return st;
+            for (int k = 0; k < 3; k++)
+                if (!(gx.sheen[k] >= 0.0f && gx.sheen[k] <= 1.0f))
+                    return gltf_fail(g, PK_ERR_PARSE, "%s/sheenColorFactor: %g is outside [0, 1]", ep,
+                                     (double)gx.sheen[k]);
+            if ((st = gltf_num(g, e, ep, "sheenRoughnessFactor", 0.0, 1.0, 0.0, &gx.sheen_rough))) return st;
+            if ((st = gx_tex(g, e, ep, "sheenColorTexture", &gx.t[GX_SHEEN]))) return st;
+            if ((st = gx_tex(g, e, ep, "sheenRoughnessTexture", &gx.t[GX_SHEEN_ROUGH]))) return st;
+        } else if (strcmp(e->string, "KHR_materials_iridescence") == 0) {
+            gx_used = true;
+            if ((st = gltf_num(g, e, ep, "iridescenceFactor", 0.0, 1.0, 0.0, &gx.irid))) return st;
+            if ((st = gltf_num(g, e, ep, "iridescenceIor", 1.0, 1e30, 1.3, &gx.irid_ior))) return st;
+            if ((st = gltf_num(g, e, ep, "iridescenceThicknessMinimum", 0.0, 1e30, 100.0, &gx.irid_min))) return st;
+            if ((st = gltf_num(g, e, ep, "iridescenceThicknessMaximum", 0.0, 1e30, 400.0, &gx.irid_max))) return st;
+            if ((st = gx_tex(g, e, ep, "iridescenceTexture", &gx.t[GX_IRID]))) return st;
+            if ((st = gx_tex(g, e, ep, "iridescenceThicknessTexture", &gx.t[GX_IRID_THICK]))) return st;
+        } else if (strcmp(e->string, "KHR_materials_anisotropy") == 0) {
+            gx_used = true;
+            if ((st = gltf_num(g, e, ep, "anisotropyStrength", 0.0, 1.0, 0.0, &gx.aniso))) return st;
+            if ((st = gltf_num(g, e, ep, "anisotropyRotation", -1e30, 1e30, 0.0, &gx.aniso_rot))) return st;
+            if ((st = gx_tex(g, e, ep, "anisotropyTexture", &gx.t[GX_ANISO]))) return st;
+        } else if (strcmp(e->string, "KHR_materials_dispersion") == 0) {
             gltf_warn(g, "%s: not supported; the material is drawn without it", ep);
         } else if (strcmp(e->string, "KHR_materials_unlit") == 0) {
             gltf_warn(g, "%s: not supported; drawn as a lit diffuse surface of the base colour", ep);
@@ -432,11 +516,12 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
 
     /* which uv set, and whether one transform serves every texture (then it
      * is baked into the primitive's uvs, rotation included) */
-    tex_info *all[4] = {&t_base, &t_mr, &t_norm, &t_emit};
+    tex_info *all[4 + GX_NTEX] = {&t_base, &t_mr, &t_norm, &t_emit};
+    for (int k = 0; k < GX_NTEX; k++) all[4 + k] = &gx.t[k];
     int set = -1;
     bool same = true;
     const tex_info *first = NULL;
-    for (int k = 0; k < 4; k++) {
+    for (int k = 0; k < 4 + GX_NTEX; k++) {
         if (!all[k]->present) continue;
         if (set < 0) set = all[k]->texcoord;
         else if (all[k]->texcoord != set)
@@ -473,6 +558,7 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
     if (m.map_norm.kind && t_norm.scale != 1.0f)
         gltf_warn_once(g, GW_NORMAL_SCALE, "%s/normalTexture: scale %g is drawn as 1 (further ones not reported)",
                        path, (double)t_norm.scale);
+    if (gx_used && (st = gx_apply(g, &gx, bake, path, &m))) goto fail;
     if (t_emit.present && v3_max_comp(m.ke) > 0.0f) {
         tex_ref er;
         if ((st = make_ref(g, &t_emit, true, bake, path, &er))) goto fail;
