@@ -2,8 +2,9 @@
  * gltf_material.c - glTF materials as the scene's metallic-roughness kind:
  * base colour (factor and sRGB texture), the metallic-roughness texture,
  * normal maps, emission (+KHR_materials_emissive_strength), alpha modes,
- * double-sidedness, KHR_texture_transform, KHR_materials_transmission and
- * KHR_materials_ior; images from files, data: URIs and buffer views, with
+ * double-sidedness, KHR_texture_transform, KHR_materials_transmission,
+ * KHR_materials_ior, and KHR_materials_specular, _sheen, _iridescence and
+ * _anisotropy with their textures; images from files, data: URIs and buffer views, with
  * their samplers' wrap modes. What the model cannot show is warned about
  * (docs/scene-format.md, "glTF 2.0").
  */
