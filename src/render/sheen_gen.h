@@ -15,24 +15,23 @@
 
 #include <math.h>
 
-static inline double sheen_gen_r(int i) { return (double)PK_SH_R_MIN + (1.0 - (double)PK_SH_R_MIN) * (double)i / (PK_SH_R - 1); }
+static inline double sheen_gen_r(int i) {
+    return (double)PK_SH_R_MIN + (1.0 - (double)PK_SH_R_MIN) * (double)i / (PK_SH_R - 1);
+}
 static inline double sheen_gen_mu(int i) { return i == 0 ? (double)PK_EN_MU_MIN : (double)i / (PK_SH_MU - 1); }
 
-static inline double sheen_gen_l(double x, double a)
-{
+static inline double sheen_gen_l(double x, double a) {
     const double t = (1.0 - a) * (1.0 - a);
     const double A = 21.5473 + (25.3245 - 21.5473) * t, B = 3.82987 + (3.32435 - 3.82987) * t;
     const double C = 0.19823 + (0.16801 - 0.19823) * t, D = -1.97760 + (-1.27393 + 1.97760) * t;
     const double E = -4.32054 + (-4.85967 + 4.32054) * t;
     return A / (1.0 + B * pow(x, C)) + D * x + E;
 }
-static inline double sheen_gen_lambda(double a, double c)
-{
+static inline double sheen_gen_lambda(double a, double c) {
     return c < 0.5 ? exp(sheen_gen_l(c, a)) : exp(2.0 * sheen_gen_l(0.5, a) - sheen_gen_l(1.0 - c, a));
 }
 /* D V cos_i for wo = (sin_o, 0, mu), wi = (sin_i cos phi, sin_i sin phi, cos_i). */
-static inline double sheen_gen_f(double a, double mu, double ci, double phi)
-{
+static inline double sheen_gen_f(double a, double mu, double ci, double phi) {
     const double so = sqrt(fmax(0.0, 1.0 - mu * mu)), si = sqrt(fmax(0.0, 1.0 - ci * ci));
     const double hx = so + si * cos(phi), hy = si * sin(phi), hz = mu + ci;
     const double l2 = hx * hx + hy * hy + hz * hz;
@@ -43,8 +42,7 @@ static inline double sheen_gen_f(double a, double mu, double ci, double phi)
 }
 /* E(mu, r) with n x n nodes (phi over [0, pi], doubled: the lobe is
  * symmetric about the plane of wo). */
-static inline double sheen_gen_e(double r, double mu, int n)
-{
+static inline double sheen_gen_e(double r, double mu, int n) {
     const double a = r * r;
     double s = 0.0;
     for (int j = 0; j < n; j++) {

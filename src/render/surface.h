@@ -199,21 +199,20 @@ static inline PK_HD float surface__channel(const scene_view *s, const tex_ref *r
 {
     float c[4];
     const int nc = tex_eval_raw(s->textures, r, q, c);
-    if (ch == 3) return nc == 2 || nc == 4 ? c[nc - 1] : 1.0f;
-    return fminf(fmaxf(nc >= 3 ? c[ch] : c[0], 0.0f), 1.0f);
+    const float v = ch == 3 ? (nc == 2 || nc == 4 ? c[nc - 1] : 1.0f) : nc >= 3 ? c[ch] : c[0];
+    return fminf(fmaxf(v, 0.0f), 1.0f);
 }
 /* glTF's extension maps of a metallic-roughness material (material.h). */
 static inline PK_HD void surface__gltf_maps(const scene_view *s, const material *m, material *tm, tex_query q)
 {
-    if (m->map_spec.kind) tm->specular = m->specular * fminf(fmaxf(surface__channel(s, &m->map_spec, q, 3), 0.0f), 1.0f);
+    if (m->map_spec.kind) tm->specular = m->specular * surface__channel(s, &m->map_spec, q, 3);
     if (m->map_spec_color.kind)
         tm->specular_color =
             v3_mul(m->specular_color, surface_clamp_rgb(tex_eval_rgb(s->textures, &m->map_spec_color, q)));
     if (m->map_sheen.kind)
         tm->sheen_color = v3_mul(m->sheen_color, surface_clamp_rgb(tex_eval_rgb(s->textures, &m->map_sheen, q)));
     if (m->map_sheen_rough.kind)
-        tm->sheen_roughness =
-            m->sheen_roughness * fminf(fmaxf(surface__channel(s, &m->map_sheen_rough, q, 3), 0.0f), 1.0f);
+        tm->sheen_roughness = m->sheen_roughness * surface__channel(s, &m->map_sheen_rough, q, 3);
     if (m->map_irid.kind) tm->iridescence = m->iridescence * surface__channel(s, &m->map_irid, q, 0);
     if (m->map_irid_thick.kind)
         tm->iridescence_thickness = m->iridescence_thickness_min + (m->iridescence_thickness -

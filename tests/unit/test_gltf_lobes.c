@@ -38,15 +38,14 @@ typedef struct mparams {
     bool comp; /* energy compensation (pbsdf_compensate), as glTF assets render */
 } mparams;
 
-static mparams plain(vec3 base, float metal, float rough)
-{
-    mparams p = {base, metal, rough, 0.0f, 1.5f, 0.0f, 1.0f, v3s(1.0f), v3s(0.0f), 0.5f, 0.0f, 1.3f, 400.0f, 0.0f, false};
+static mparams plain(vec3 base, float metal, float rough) {
+    mparams p = {base,      metal, rough, 0.0f, 1.5f,   0.0f, 1.0f, v3s(1.0f),
+                 v3s(0.0f), 0.5f,  0.0f,  1.3f, 400.0f, 0.0f, false};
     return p;
 }
 
 /* The BSDF as the renderer makes it from a material record (shading.h). */
-static pbsdf make(const mparams *p)
-{
+static pbsdf make(const mparams *p) {
     material m;
     material_init(&m);
     material_metallic_roughness(&m, p->base, p->metal, p->rough);
@@ -66,13 +65,11 @@ static pbsdf make(const mparams *p)
 typedef rng prng;
 static prng prng_make(uint64_t seed) { return rng_seed(seed, 0x9e37); }
 static float prng_f(prng *r) { return rng_float(r); }
-static vec3 hemi(prng *g)
-{
+static vec3 hemi(prng *g) {
     const float z = prng_f(g), r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = 2.0f * PK_PI * prng_f(g);
     return v3(r * cosf(phi), r * sinf(phi), fmaxf(z, 1e-3f));
 }
-static vec3 dir_deg(float theta, float phi)
-{
+static vec3 dir_deg(float theta, float phi) {
     const float t = theta * PK_PI / 180.0f;
     return v3(sinf(t) * cosf(phi), sinf(t) * sinf(phi), cosf(t));
 }
@@ -86,8 +83,7 @@ typedef struct d3 {
 static double schlick(double f0, double c) { return f0 + (1.0 - f0) * pow(1.0 - c, 5.0); }
 
 /* Belcour and Barla's film as KHR_materials_iridescence writes it. */
-static d3 ref_film(double outside, double film, double c1, double d, const double f0[3])
-{
+static d3 ref_film(double outside, double film, double c1, double d, const double f0[3]) {
     d3 r;
     const double s2 = (outside / film) * (outside / film) * (1.0 - c1 * c1);
     if (1.0 - s2 < 0.0) {
@@ -112,8 +108,8 @@ static d3 ref_film(double outside, double film, double c1, double d, const doubl
         double xyz[3];
         for (int k = 0; k < 3; k++)
             xyz[k] = val[k] * sqrt(2.0 * M_PI * var[k]) * cos(pos[k] * ph + m * phi[k]) * exp(-ph * ph * var[k]);
-        xyz[0] += 9.7470e-14 * sqrt(2.0 * M_PI * 4.5282e+09) * cos(2.2399e+06 * ph + m * phi[0]) *
-                  exp(-4.5282e+09 * ph * ph);
+        xyz[0] +=
+            9.7470e-14 * sqrt(2.0 * M_PI * 4.5282e+09) * cos(2.2399e+06 * ph + m * phi[0]) * exp(-4.5282e+09 * ph * ph);
         for (int k = 0; k < 3; k++) xyz[k] /= 1.0685e-7;
         S[m][0] = 3.2404542 * xyz[0] - 1.5371385 * xyz[1] - 0.4985314 * xyz[2];
         S[m][1] = -0.9692660 * xyz[0] + 1.8760108 * xyz[1] + 0.0415560 * xyz[2];
@@ -132,21 +128,19 @@ static d3 ref_film(double outside, double film, double c1, double d, const doubl
     return r;
 }
 
-static double ref_sheen_l(double x, double a)
-{
+static double ref_sheen_l(double x, double a) {
     const double t = (1.0 - a) * (1.0 - a);
-    return (21.5473 * (1 - t) + 25.3245 * t) / (1.0 + (3.82987 * (1 - t) + 3.32435 * t) * pow(x, 0.19823 * (1 - t) + 0.16801 * t)) +
+    return (21.5473 * (1 - t) + 25.3245 * t) /
+               (1.0 + (3.82987 * (1 - t) + 3.32435 * t) * pow(x, 0.19823 * (1 - t) + 0.16801 * t)) +
            (-1.97760 * (1 - t) - 1.27393 * t) * x + (-4.32054 * (1 - t) - 4.85967 * t);
 }
-static double ref_sheen_lambda(double c, double a)
-{
+static double ref_sheen_lambda(double c, double a) {
     return c < 0.5 ? exp(ref_sheen_l(c, a)) : exp(2.0 * ref_sheen_l(0.5, a) - ref_sheen_l(1.0 - c, a));
 }
 
 /* f cos of a material with the extensions, reflection (wo.z, wi.z > 0), no
  * clearcoat or compensation, x along the anisotropy's direction. */
-static d3 ref_eval(const mparams *p, vec3 wo, vec3 wi)
-{
+static d3 ref_eval(const mparams *p, vec3 wo, vec3 wi) {
     const double rough = p->rough, aniso = p->aniso, ior = p->ior, spec_w = p->spec, irid = p->irid;
     const double irid_ior = p->irid_ior, irid_d = p->irid_d, trans = p->trans, metal = p->metal;
     const double ox = wo.x, oy = wo.y, oz = wo.z, ix = wi.x, iy = wi.y, iz = wi.z;
@@ -185,7 +179,8 @@ static d3 ref_eval(const mparams *p, vec3 wo, vec3 wi)
     double scale = 1.0, shf = 0.0;
     if (shmax > 0.0) {
         const double r = fmax((double)p->sheen_r, (double)PK_SH_R_MIN), sa = r * r;
-        scale = fmax(0.0, fmin(1.0 - shmax * (double)sheen_e((float)r, wo.z), 1.0 - shmax * (double)sheen_e((float)r, wi.z)));
+        scale = fmax(
+            0.0, fmin(1.0 - shmax * (double)sheen_e((float)r, wo.z), 1.0 - shmax * (double)sheen_e((float)r, wi.z)));
         const double Ds = (2.0 + 1.0 / sa) * pow(1.0 - hz * hz, 0.5 / sa) / (2.0 * M_PI);
         shf = Ds / ((1.0 + ref_sheen_lambda(oz, sa) + ref_sheen_lambda(iz, sa)) * 4.0 * oz);
     }
@@ -197,8 +192,7 @@ static d3 ref_eval(const mparams *p, vec3 wo, vec3 wi)
     return out;
 }
 
-static bool close3(vec3 got, d3 want, double rel, double abs_tol)
-{
+static bool close3(vec3 got, d3 want, double rel, double abs_tol) {
     const double g[3] = {got.x, got.y, got.z};
     for (int k = 0; k < 3; k++)
         if (!(fabs(g[k] - want.v[k]) <= rel * fabs(want.v[k]) + abs_tol)) return false;
@@ -215,8 +209,7 @@ typedef struct lcase {
 static lcase cases[8];
 static int ncases;
 
-static void build_cases(void)
-{
+static void build_cases(void) {
     mparams p = plain(v3(0.8f, 0.5f, 0.3f), 0.0f, 0.5f);
     p.spec = 0.6f, p.spec_col = v3(1.5f, 0.6f, 0.2f);
     cases[ncases++] = (lcase){"specular", p};
@@ -241,8 +234,7 @@ static void build_cases(void)
 
 /* ---- formulas ---------------------------------------------------------------------- */
 
-static void test_film(void)
-{
+static void test_film(void) {
     const float cs[] = {1.0f, 0.8f, 0.5f, 0.2f, 0.05f}, ds[] = {0.0f, 120.0f, 300.0f, 550.0f, 900.0f};
     const float iors[] = {1.3f, 1.6f, 2.0f};
     const vec3 f0s[] = {v3s(0.04f), v3(0.95f, 0.64f, 0.54f), v3(0.2f, 0.6f, 0.9f)};
@@ -274,8 +266,7 @@ static void test_film(void)
     CHECK_NEAR(g.y, r12 + (1.0 - r12) * (1.0 - r12) * r23 / (1.0 - r12 * r23), 1e-5);
 }
 
-static void test_formulas(void)
-{
+static void test_formulas(void) {
     prng g = prng_make(7);
     for (int c = 0; c < ncases; c++) {
         if (cases[c].p.coat > 0.0f || cases[c].p.comp) continue;
@@ -288,8 +279,7 @@ static void test_formulas(void)
             const vec3 got = pbsdf_eval(&b, wo, wi);
             const d3 want = ref_eval(&cases[c].p, wo, wi);
             const double gv[3] = {got.x, got.y, got.z};
-            for (int k = 0; k < 3; k++)
-                worst = fmax(worst, fabs(gv[k] - want.v[k]) / fmax(1e-3, fabs(want.v[k])));
+            for (int k = 0; k < 3; k++) worst = fmax(worst, fabs(gv[k] - want.v[k]) / fmax(1e-3, fabs(want.v[k])));
             bad += !close3(got, want, 2e-3, 1e-5);
         }
         CHECKF(bad == 0, "%s: %d of 2000 evaluations differ from the reference (worst rel %.2e)", cases[c].name, bad,
@@ -324,8 +314,7 @@ static void test_formulas(void)
 #define QUAD_N 32
 #define MIN_EXPECTED 5.0
 
-static double cell_pdf(const pbsdf *b, vec3 wo, int ci, int pj)
-{
+static double cell_pdf(const pbsdf *b, vec3 wo, int ci, int pj) {
     const double c0 = -1.0 + 2.0 * ci / N_THETA, c1 = -1.0 + 2.0 * (ci + 1) / N_THETA;
     const double p0 = 2.0 * M_PI * pj / N_PHI, p1 = 2.0 * M_PI * (pj + 1) / N_PHI;
     const double hc = (c1 - c0) / QUAD_N, hp = (p1 - p0) / QUAD_N;
@@ -343,14 +332,12 @@ static double cell_pdf(const pbsdf *b, vec3 wo, int ci, int pj)
     return s * hc * hp / 9.0;
 }
 
-static int cmp_pair(const void *a, const void *b)
-{
+static int cmp_pair(const void *a, const void *b) {
     const double x = ((const double *)a)[0], y = ((const double *)b)[0];
     return (x > y) - (x < y);
 }
 
-static void chi2_case(const char *name, const pbsdf *b, vec3 wo, uint64_t seed, double alpha)
-{
+static void chi2_case(const char *name, const pbsdf *b, vec3 wo, uint64_t seed, double alpha) {
     static long obs[N_CELLS + 1];
     static double ex[N_CELLS + 1];
     memset(obs, 0, sizeof obs);
@@ -412,20 +399,19 @@ static void chi2_case(const char *name, const pbsdf *b, vec3 wo, uint64_t seed, 
     CHECKF(fabs(total - share) < 4.5 * sd + 2e-3, "%s: pdf integrates to %.4f, sampled share %.4f", name, total, share);
 }
 
-static void test_chi2(void)
-{
+static void test_chi2(void) {
     const float th[] = {30.0f, 70.0f};
     const double alpha = 1e-3 / (2.0 * ncases); /* the family's false-alarm rate 1e-3 */
     for (int c = 0; c < ncases; c++) {
         const pbsdf b = make(&cases[c].p);
-        for (int t = 0; t < 2; t++) chi2_case(cases[c].name, &b, dir_deg(th[t], 0.7f), 1000u + 17u * (unsigned)c + (unsigned)t, alpha);
+        for (int t = 0; t < 2; t++)
+            chi2_case(cases[c].name, &b, dir_deg(th[t], 0.7f), 1000u + 17u * (unsigned)c + (unsigned)t, alpha);
     }
 }
 
 /* ---- reciprocity, white furnace ----------------------------------------------------- */
 
-static void test_reciprocity(void)
-{
+static void test_reciprocity(void) {
     prng g = prng_make(11);
     for (int c = 0; c < ncases; c++) {
         if (cases[c].p.coat > 0.0f) continue; /* the clearcoat weighs by the view's Fresnel alone */
@@ -434,7 +420,8 @@ static void test_reciprocity(void)
         for (int i = 0; i < 5000; i++) {
             const vec3 wo = hemi(&g), wi = hemi(&g);
             const vec3 a = v3_scale(pbsdf_eval(&b, wo, wi), wo.z), r = v3_scale(pbsdf_eval(&b, wi, wo), wi.z);
-            bad += !(fabsf(a.x - r.x) <= 1e-4f * fmaxf(a.x, r.x) + 1e-7f && fabsf(a.y - r.y) <= 1e-4f * fmaxf(a.y, r.y) + 1e-7f &&
+            bad += !(fabsf(a.x - r.x) <= 1e-4f * fmaxf(a.x, r.x) + 1e-7f &&
+                     fabsf(a.y - r.y) <= 1e-4f * fmaxf(a.y, r.y) + 1e-7f &&
                      fabsf(a.z - r.z) <= 1e-4f * fmaxf(a.z, r.z) + 1e-7f);
         }
         CHECKF(bad == 0, "%s: f(wo, wi) != f(wi, wo) for %d of 5000 pairs", cases[c].name, bad);
@@ -442,8 +429,7 @@ static void test_reciprocity(void)
 }
 
 /* Mean sample weight toward wo and its standard error, per channel. */
-static void albedo(const pbsdf *b, vec3 wo, long n, uint64_t seed, double m[3], double se[3])
-{
+static void albedo(const pbsdf *b, vec3 wo, long n, uint64_t seed, double m[3], double se[3]) {
     double s[3] = {0}, s2[3] = {0};
     prng g = prng_make(seed);
     for (long i = 0; i < n; i++) {
@@ -461,8 +447,7 @@ static void albedo(const pbsdf *b, vec3 wo, long n, uint64_t seed, double m[3], 
     }
 }
 
-static void furnace(const char *name, const mparams *p, float max_theta)
-{
+static void furnace(const char *name, const mparams *p, float max_theta) {
     /* compensation gives back light up to the tables' interpolation: 1 % (test_bsdf's tolerance) */
     const double tol = p->comp ? 0.01 : 0.0;
     const pbsdf b = make(p);
@@ -473,15 +458,14 @@ static void furnace(const char *name, const mparams *p, float max_theta)
         for (int k = 0; k < 3; k++) {
             worst = fmax(worst, m[k]);
             /* 4.5 standard errors: a false alarm below 1e-5 per test */
-            CHECKF(m[k] <= 1.0 + tol + 4.5 * se[k], "%s at %.0f degrees: albedo %.4f +- %.4f exceeds 1", name, (double)th,
-                   m[k], se[k]);
+            CHECKF(m[k] <= 1.0 + tol + 4.5 * se[k], "%s at %.0f degrees: albedo %.4f +- %.4f exceeds 1", name,
+                   (double)th, m[k], se[k]);
         }
     }
     printf("  furnace %-32s up to %2.0f degrees: largest albedo %.4f\n", name, (double)max_theta, worst);
 }
 
-static void test_furnace(void)
-{
+static void test_furnace(void) {
     /* the dielectric's diffuse base under fresnel_mix gains toward grazing
      * (Appendix B, test_bsdf): bounded up to 40 degrees, as there */
     const float rs[] = {0.3f, 0.6f, 1.0f};
@@ -524,8 +508,7 @@ static void test_furnace(void)
 
 /* ---- the sheen's albedo table ------------------------------------------------------------- */
 
-static void test_sheen_table(void)
-{
+static void test_sheen_table(void) {
     /* entries against the generator (sheen_gen.h) */
     const int rs[] = {0, 5, 13, 31}, ms[] = {0, 3, 16, 31};
     double worst = 0.0;
@@ -579,8 +562,7 @@ static warning_log wlog;
 /* A document of one triangle with uvs (texture 0: tex_rgbw.png) and the
  * given materials, the triangle's primitive of material 0, a second one of
  * material 1 when two. */
-static void gltf_doc(char *j, size_t n, const char *materials, bool two)
-{
+static void gltf_doc(char *j, size_t n, const char *materials, bool two) {
     const float pu[15] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1};
     static const char al[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     const uint8_t *p = (const uint8_t *)pu;
@@ -603,8 +585,7 @@ static void gltf_doc(char *j, size_t n, const char *materials, bool two)
              uri, materials, two ? ",{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"material\":1}" : "");
 }
 
-static pk_status load(const char *j, pk_scene **out)
-{
+static pk_status load(const char *j, pk_scene **out) {
     pk_context *ctx;
     REQUIRE(pk_context_create(NULL, &ctx) == PK_OK);
     warning_log_clear(&wlog);
@@ -626,8 +607,7 @@ static pk_status load(const char *j, pk_scene **out)
     return st;
 }
 
-static void test_reader(void)
-{
+static void test_reader(void) {
     char j[4096];
     gltf_doc(j, sizeof j,
              "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,0.4,0.3,1],\"roughnessFactor\":0.6},"
@@ -641,7 +621,8 @@ static void test_reader(void)
              "\"iridescenceTexture\":{\"index\":0},\"iridescenceThicknessTexture\":{\"index\":0}},"
              "\"KHR_materials_anisotropy\":{\"anisotropyStrength\":0.6,\"anisotropyRotation\":1.25,"
              "\"anisotropyTexture\":{\"index\":0}}}},"
-             "{\"extensions\":{\"KHR_materials_specular\":{},\"KHR_materials_sheen\":{\"sheenColorTexture\":{\"index\":0}}}}",
+             "{\"extensions\":{\"KHR_materials_specular\":{},\"KHR_materials_sheen\":{\"sheenColorTexture\":{\"index\":"
+             "0}}}}",
              true);
     pk_scene *s = NULL;
     CHECKF(load(j, &s) == PK_OK, "%s", msg);
@@ -683,14 +664,13 @@ static void test_reader(void)
         snprintf(mat, sizeof mat, "{\"extensions\":{%s}}", bad[k][0]);
         gltf_doc(j, sizeof j, mat, false);
         const pk_status st = load(j, &s);
-        CHECKF(st != PK_OK && strstr(msg, bad[k][1]) && strstr(msg, "/materials/0/extensions/KHR_materials_"),
-               "%s: %s", bad[k][0], msg);
+        CHECKF(st != PK_OK && strstr(msg, bad[k][1]) && strstr(msg, "/materials/0/extensions/KHR_materials_"), "%s: %s",
+               bad[k][0], msg);
         if (s) scene_destroy(s);
     }
 }
 
-int main(void)
-{
+int main(void) {
     build_cases();
     test_film();
     test_formulas();
