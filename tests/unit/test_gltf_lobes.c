@@ -610,7 +610,7 @@ static pk_status load(const char *j, pk_scene **out) {
 static void test_reader(void) {
     char j[4096];
     gltf_doc(j, sizeof j,
-             "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,0.4,0.3,1],\"roughnessFactor\":0.6},"
+             "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,0.4,0.3,1],\"metallicFactor\":0,\"roughnessFactor\":0.6},"
              "\"extensions\":{"
              "\"KHR_materials_specular\":{\"specularFactor\":0.7,\"specularColorFactor\":[1.5,0.5,0.25],"
              "\"specularTexture\":{\"index\":0},\"specularColorTexture\":{\"index\":0}},"
