@@ -2,8 +2,9 @@
  * gltf_material.c - glTF materials as the scene's metallic-roughness kind:
  * base colour (factor and sRGB texture), the metallic-roughness texture,
  * normal maps, emission (+KHR_materials_emissive_strength), alpha modes,
- * double-sidedness, KHR_texture_transform, KHR_materials_transmission and
- * KHR_materials_ior; images from files, data: URIs and buffer views, with
+ * double-sidedness, KHR_texture_transform, KHR_materials_transmission,
+ * KHR_materials_ior, and KHR_materials_specular, _sheen, _iridescence and
+ * _anisotropy with their textures; images from files, data: URIs and buffer views, with
  * their samplers' wrap modes. What the model cannot show is warned about
  * (docs/scene-format.md, "glTF 2.0").
  */
@@ -306,6 +307,58 @@ static pk_status make_mask(gltf *g, int64_t mi, int32_t tex, float factor, float
 
 /* ---- materials ------------------------------------------------------------------------ */
 
+/* KHR_materials_specular, _sheen, _iridescence and _anisotropy as read. */
+enum { GX_SPEC, GX_SPEC_COLOR, GX_SHEEN, GX_SHEEN_ROUGH, GX_IRID, GX_IRID_THICK, GX_ANISO, GX_NTEX };
+typedef struct gx_params {
+    float specular, spec_color[3], sheen[3], sheen_rough, irid, irid_ior, irid_min, irid_max, aniso, aniso_rot;
+    tex_info t[GX_NTEX];
+} gx_params;
+
+static void gx_init(gltf *g, gx_params *x)
+{
+    x->specular = 1.0f;
+    x->spec_color[0] = x->spec_color[1] = x->spec_color[2] = 1.0f;
+    x->sheen[0] = x->sheen[1] = x->sheen[2] = 0.0f;
+    x->sheen_rough = x->irid = x->aniso = x->aniso_rot = 0.0f;
+    x->irid_ior = 1.3f, x->irid_min = 100.0f, x->irid_max = 400.0f;
+    for (int k = 0; k < GX_NTEX; k++) read_tex_info(g, NULL, "", &x->t[k]);
+}
+static pk_status gx_tex(gltf *g, const cJSON *e, const char *ep, const char *key, tex_info *ti)
+{
+    char tp[224];
+    snprintf(tp, sizeof tp, "%s/%s", ep, key);
+    return read_tex_info(g, cJSON_GetObjectItemCaseSensitive(e, key), tp, ti);
+}
+/* The extensions' parameters and maps onto the material m (after
+ * material_metallic_roughness and the core maps). */
+static pk_status gx_apply(gltf *g, const gx_params *x, bool bake, const char *path, material *m)
+{
+    m->specular = x->specular;
+    m->specular_color = v3(x->spec_color[0], x->spec_color[1], x->spec_color[2]);
+    m->sheen_color = v3(x->sheen[0], x->sheen[1], x->sheen[2]);
+    m->sheen_roughness = x->sheen_rough;
+    m->iridescence = x->irid;
+    m->iridescence_ior = x->irid_ior;
+    m->iridescence_thickness = x->irid_max;
+    m->iridescence_thickness_min = x->irid_min;
+    m->anisotropy = x->aniso;
+    m->anisotropy_rotation = x->aniso_rot;
+    /* colour textures are sRGB, the others data */
+    static const bool colour[GX_NTEX] = {false, true, true, false, false, false, false};
+    tex_ref *maps[GX_NTEX] = {&m->map_spec, &m->map_spec_color, &m->map_sheen, &m->map_sheen_rough,
+                              &m->map_irid, &m->map_irid_thick, &m->map_aniso};
+    pk_status st;
+    for (int k = 0; k < GX_NTEX; k++)
+        if ((st = make_ref(g, &x->t[k], colour[k], bake, path, maps[k]))) return st;
+    /* a texture on a factor of 0 changes nothing: no texture */
+    if (v3_max_comp(m->sheen_color) <= 0.0f) tex_ref_init(&m->map_sheen), tex_ref_init(&m->map_sheen_rough);
+    if (m->iridescence <= 0.0f) tex_ref_init(&m->map_irid), tex_ref_init(&m->map_irid_thick);
+    if (m->anisotropy <= 0.0f) tex_ref_init(&m->map_aniso);
+    if (m->specular <= 0.0f) tex_ref_init(&m->map_spec);
+    material_gltf_update(m);
+    return PK_OK;
+}
+
 /* KHR_materials_volume on a transmissive material (thickness > 0): the mesh
  * bounds a volume. Its boundary refracts: a material that only transmits
  * (transmission 1, not metallic, no clearcoat, no base colour,
@@ -411,6 +464,9 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
     float strength = 1.0f, transmission = 0.0f, ior = 1.5f, coat = 0.0f, coat_rough = 0.0f;
     float thickness = 0.0f, att_dist = INFINITY, att_col[3] = {1, 1, 1};
     bool unlit = false;
+    gx_params gx;
+    gx_init(g, &gx);
+    bool gx_used = false;
     const cJSON *ext = cJSON_GetObjectItemCaseSensitive(o, "extensions");
     for (const cJSON *e = ext ? ext->child : NULL; e; e = e->next) {
         snprintf(ep, sizeof ep, "%s/extensions/%.40s", path, e->string ? e->string : "");
@@ -456,11 +512,39 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
             snprintf(tp, sizeof tp, "%s/thicknessTexture", ep);
             if ((st = read_tex_info(g, cJSON_GetObjectItemCaseSensitive(e, "thicknessTexture"), tp, &t_thick)))
                 return st;
-        } else if (strcmp(e->string, "KHR_materials_sheen") == 0 ||
-                   strcmp(e->string, "KHR_materials_specular") == 0 ||
-                   strcmp(e->string, "KHR_materials_iridescence") == 0 ||
-                   strcmp(e->string, "KHR_materials_anisotropy") == 0) {
-            gltf_warn(g, "%s: not supported; the material is drawn without it", ep);
+        } else if (strcmp(e->string, "KHR_materials_specular") == 0) {
+            gx_used = true;
+            if ((st = gltf_num(g, e, ep, "specularFactor", 0.0, 1.0, 1.0, &gx.specular))) return st;
+            if ((st = gltf_nums(g, e, ep, "specularColorFactor", 3, gx.spec_color, &found))) return st;
+            for (int k = 0; k < 3; k++)
+                if (!(gx.spec_color[k] >= 0.0f && gx.spec_color[k] < 3.4e38f))
+                    return gltf_fail(g, PK_ERR_PARSE, "%s/specularColorFactor: %g is negative", ep,
+                                     (double)gx.spec_color[k]);
+            if ((st = gx_tex(g, e, ep, "specularTexture", &gx.t[GX_SPEC]))) return st;
+            if ((st = gx_tex(g, e, ep, "specularColorTexture", &gx.t[GX_SPEC_COLOR]))) return st;
+        } else if (strcmp(e->string, "KHR_materials_sheen") == 0) {
+            gx_used = true;
+            if ((st = gltf_nums(g, e, ep, "sheenColorFactor", 3, gx.sheen, &found))) return st;
+            for (int k = 0; k < 3; k++)
+                if (!(gx.sheen[k] >= 0.0f && gx.sheen[k] <= 1.0f))
+                    return gltf_fail(g, PK_ERR_PARSE, "%s/sheenColorFactor: %g is outside [0, 1]", ep,
+                                     (double)gx.sheen[k]);
+            if ((st = gltf_num(g, e, ep, "sheenRoughnessFactor", 0.0, 1.0, 0.0, &gx.sheen_rough))) return st;
+            if ((st = gx_tex(g, e, ep, "sheenColorTexture", &gx.t[GX_SHEEN]))) return st;
+            if ((st = gx_tex(g, e, ep, "sheenRoughnessTexture", &gx.t[GX_SHEEN_ROUGH]))) return st;
+        } else if (strcmp(e->string, "KHR_materials_iridescence") == 0) {
+            gx_used = true;
+            if ((st = gltf_num(g, e, ep, "iridescenceFactor", 0.0, 1.0, 0.0, &gx.irid))) return st;
+            if ((st = gltf_num(g, e, ep, "iridescenceIor", 1.0, 1e30, 1.3, &gx.irid_ior))) return st;
+            if ((st = gltf_num(g, e, ep, "iridescenceThicknessMinimum", 0.0, 1e30, 100.0, &gx.irid_min))) return st;
+            if ((st = gltf_num(g, e, ep, "iridescenceThicknessMaximum", 0.0, 1e30, 400.0, &gx.irid_max))) return st;
+            if ((st = gx_tex(g, e, ep, "iridescenceTexture", &gx.t[GX_IRID]))) return st;
+            if ((st = gx_tex(g, e, ep, "iridescenceThicknessTexture", &gx.t[GX_IRID_THICK]))) return st;
+        } else if (strcmp(e->string, "KHR_materials_anisotropy") == 0) {
+            gx_used = true;
+            if ((st = gltf_num(g, e, ep, "anisotropyStrength", 0.0, 1.0, 0.0, &gx.aniso))) return st;
+            if ((st = gltf_num(g, e, ep, "anisotropyRotation", -1e30, 1e30, 0.0, &gx.aniso_rot))) return st;
+            if ((st = gx_tex(g, e, ep, "anisotropyTexture", &gx.t[GX_ANISO]))) return st;
         } else if (strcmp(e->string, "KHR_materials_dispersion") == 0) {
             gltf_warn_once(g, GW_DISPERSION,
                            "%s: drawn without dispersion (needs spectral rendering; further ones not reported)", ep);
@@ -476,13 +560,18 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
     if (transmission == 0.0f) t_tr.present = false; /* (read, never looked up) */
     if (coat == 0.0f) t_cc.present = t_ccr.present = t_ccn.present = false;
     if (coat_rough == 0.0f) t_ccr.present = false;
-    if (unlit) t_mr.present = t_norm.present = t_emit.present = t_tr.present = t_cc.present = t_ccr.present =
-        t_ccn.present = false;
-    tex_info *all[8] = {&t_base, &t_mr, &t_norm, &t_emit, &t_tr, &t_cc, &t_ccr, &t_ccn};
+    if (unlit) {
+        t_mr.present = t_norm.present = t_emit.present = t_tr.present = t_cc.present = t_ccr.present = t_ccn.present =
+            false;
+        for (int k = 0; k < GX_NTEX; k++) gx.t[k].present = false;
+        gx_used = false;
+    }
+    tex_info *all[8 + GX_NTEX] = {&t_base, &t_mr, &t_norm, &t_emit, &t_tr, &t_cc, &t_ccr, &t_ccn};
+    for (int k = 0; k < GX_NTEX; k++) all[8 + k] = &gx.t[k];
     int set = -1;
     bool same = true;
     const tex_info *first = NULL;
-    for (int k = 0; k < 8; k++) {
+    for (int k = 0; k < 8 + GX_NTEX; k++) {
         if (!all[k]->present) continue;
         if (set < 0) set = all[k]->texcoord;
         else if (all[k]->texcoord != set)
@@ -517,6 +606,7 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
     if ((st = make_ref(g, &t_mr, false, bake, path, &m.map_mr))) goto fail;
     if ((st = make_ref(g, &t_norm, false, bake, path, &m.map_norm))) goto fail;
     if (m.map_norm.kind) m.norm_scale = t_norm.scale;
+    if (gx_used && (st = gx_apply(g, &gx, bake, path, &m))) goto fail;
     if (t_emit.present && v3_max_comp(m.ke) > 0.0f) {
         tex_ref er;
         if ((st = make_ref(g, &t_emit, true, bake, path, &er))) goto fail;
@@ -563,6 +653,9 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
         (st = make_volume(g, path, &m, transmission, thickness, att_dist, att_col,
                           t_base.present || t_mr.present || m.map_tr.kind || m.map_cc.kind || m.map_ccr.kind)))
         goto fail;
+    if (gx_used && (m.volume || m.type == MAT_DIELECTRIC))
+        gltf_warn(g, "%s: the boundary of a volume (KHR_materials_volume) is drawn without KHR_materials_specular, "
+                     "_sheen, _iridescence and _anisotropy", path);
     g->s->materials[idx] = m;
     g->mat_uv[mi].bake = bake;
     if (bake) memcpy(g->mat_uv[mi].m, first->m, sizeof first->m);

@@ -42,6 +42,7 @@
 #include "energy.h"
 #include "optics.h"
 #include "sampling.h"
+#include "sheen.h"
 
 #include <stdbool.h>
 
@@ -82,6 +83,10 @@ typedef enum pbsdf_type {
  * of passing straight through a thin sheet, and wo may lie inside (wo.z <
  * 0, the frame's z the outward normal) */
 #define PBSDF_MR_VOLUME 32u
+/* metallic-roughness: glTF's KHR_materials_specular, _sheen, _iridescence
+ * or _anisotropy (the gx_ fields, PBSDF_ANISO) are in use (pbsdf_gltf_ext):
+ * pbsdf__gx_* evaluate it (the plain model's code is left as it was) */
+#define PBSDF_GLTF_EXT 64u
 
 /* Below this roughness a microfacet lobe is treated as perfectly smooth (a
  * delta lobe): the GGX density would exceed float range long before 0. */
@@ -110,6 +115,11 @@ typedef enum pbsdf_type {
  *                                          base that is transmitted rather than diffuse
  *   coat          [0, 1]                   metallic-roughness: the clearcoat's weight
  *   coat_alpha    [0, 1]                   metallic-roughness: the clearcoat's GGX alpha
+ *   gx_spec, gx_spec_color  [0, 1], >= 0   metallic-roughness (KHR_materials_specular): the
+ *                                          dielectric's specular weight and F0 colour
+ *   gx_sheen, gx_sheen_r    [0, 1]         (KHR_materials_sheen) the sheen's colour and roughness
+ *   gx_irid, gx_irid_ior, gx_irid_d        (KHR_materials_iridescence) the film's strength in
+ *                                          [0, 1], index (> 0) and thickness in nm (>= 0)
  *   ms, ms_albedo                          set by pbsdf_compensate (the multiple-scattering lobe)
  *   on_a, on_b    A, B >= 0                Oren-Nayar: the model's A and B (pbsdf_oren_nayar)
  *   exponent      >= 0                     Phong: the lobe's exponent
@@ -133,6 +143,8 @@ typedef struct pbsdf {
     float ior;
     float metallic, transmission;
     float coat, coat_alpha;
+    vec3 gx_spec_color, gx_sheen;
+    float gx_spec, gx_sheen_r, gx_irid, gx_irid_ior, gx_irid_d;
     vec3 ms;             /* F_ms / (pi (1 - E_avg)) per channel, with PBSDF_ENERGY */
     float ms_albedo;     /* the mean of F_ms: the lobe's albedo is ms_albedo (1 - E(wo.z)) */
     float on_a, on_b, exponent;
@@ -175,6 +187,8 @@ static inline PK_HD pbsdf pbsdf__blank(int type)
     b.ior = 1.5f;
     b.metallic = b.transmission = 0.0f;
     b.coat = b.coat_alpha = 0.0f;
+    b.gx_spec_color = v3s(1.0f), b.gx_sheen = v3s(0.0f);
+    b.gx_spec = 1.0f, b.gx_sheen_r = 0.5f, b.gx_irid = 0.0f, b.gx_irid_ior = 1.3f, b.gx_irid_d = 0.0f;
     b.ms = v3s(0.0f);
     b.ms_albedo = 0.0f;
     b.on_a = 1.0f, b.on_b = b.exponent = 0.0f;
@@ -256,6 +270,17 @@ static inline PK_HD pbsdf pbsdf_with_clearcoat(pbsdf b, float coat, float coat_a
     b.coat = coat;
     b.coat_alpha = coat_alpha;
     return b;
+}
+/* Marks a metallic-roughness b whose glTF extension fields (gx_: specular,
+ * sheen, iridescence) or anisotropy (pbsdf_anisotropic, after it) differ
+ * from the plain model's, so that the extended model evaluates it. */
+static inline PK_HD void pbsdf_gltf_ext(pbsdf *b)
+{
+    if (b->type != PBSDF_METALLIC_ROUGHNESS || (b->flags & PBSDF_MR_VOLUME)) return; /* a volume's: without them */
+    if (b->gx_spec != 1.0f || b->gx_spec_color.x != 1.0f || b->gx_spec_color.y != 1.0f ||
+        b->gx_spec_color.z != 1.0f || b->gx_sheen.x > 0.0f || b->gx_sheen.y > 0.0f || b->gx_sheen.z > 0.0f ||
+        b->gx_irid > 0.0f || (b->flags & PBSDF_ANISO))
+        b->flags |= PBSDF_GLTF_EXT;
 }
 /* Anisotropic roughness for a conductor, dielectric or plastic b made with
  * alpha (the roughness along the local x axis, the surface's tangent):
@@ -679,6 +704,16 @@ static inline PK_HD void pbsdf_compensate(pbsdf *b)
         fms = v3(pbsdf__fms(favg.x, eavg), pbsdf__fms(favg.y, eavg), pbsdf__fms(favg.z, eavg));
     } else if (b->type == PBSDF_PLASTIC) {
         fms = v3s(pbsdf__fms(pbsdf__favg(b->ior, -1.0f), eavg));
+    } else if (b->flags & PBSDF_GLTF_EXT) { /* the same with KHR_materials_specular's weight and F0 colour
+                                              (the iridescent film's Fresnel is left out) */
+        const float r = (b->ior - 1.0f) / (b->ior + 1.0f), m = b->metallic, s = b->gx_spec;
+        const vec3 f0c = v3_min(v3_scale(b->gx_spec_color, r * r), v3s(1.0f));
+        fms = v3((1.0f - m) * pbsdf__fms(s * pbsdf__favg_schlick(f0c.x), eavg) +
+                     m * pbsdf__fms(pbsdf__favg_schlick(b->albedo.x), eavg),
+                 (1.0f - m) * pbsdf__fms(s * pbsdf__favg_schlick(f0c.y), eavg) +
+                     m * pbsdf__fms(pbsdf__favg_schlick(b->albedo.y), eavg),
+                 (1.0f - m) * pbsdf__fms(s * pbsdf__favg_schlick(f0c.z), eavg) +
+                     m * pbsdf__fms(pbsdf__favg_schlick(b->albedo.z), eavg));
     } else { /* glTF: the dielectric's specular lobe (Schlick, f0 of ior) and the metal (Schlick, f0 = base) */
         const float r = (b->ior - 1.0f) / (b->ior + 1.0f), m = b->metallic;
         const float fd = (1.0f - m) * pbsdf__fms(pbsdf__favg_schlick(r * r), eavg);
@@ -873,6 +908,269 @@ static inline PK_HD float pbsdf__mr_pdf(const pbsdf *b, vec3 wo, vec3 wi)
     if (!smooth && pr[0] > 0.0f) p += pr[0] * pbsdf__ggx_refl_pdf(b->alpha, wo, wi);
     if (!pbsdf__coat_smooth(b) && pr[3] > 0.0f) p += pr[3] * pbsdf__ggx_refl_pdf(b->coat_alpha, wo, wi);
     return p;
+}
+
+/* ---- glTF 2.0 PBR extensions on metallic-roughness (PBSDF_GLTF_EXT) ------------ */
+
+/* The extensions of the Khronos specifications, term by term, over the model
+ * above (x = |wo.h|, w = (1 - x)^5, docs/materials.md):
+ *  - KHR_materials_specular: the dielectric's Fresnel colour
+ *      Fd = spec (f0c + (1 - f0c) w),  f0c = min(f0(ior) spec_color, 1),
+ *    its specular lobe weighted by Fd and its base by 1 - max3(Fd)
+ *    (fresnel_mix with weight and f0 colour);
+ *  - KHR_materials_iridescence: Fd and the metal's Fresnel are mixed by the
+ *    strength with the thin film's (pbsdf_iridescence) over base F0 spec f0c
+ *    and the base colour;
+ *  - KHR_materials_anisotropy: the specular and transmission lobes' GGX is
+ *    anisotropic (PBSDF_ANISO: alpha along the frame's x, alpha_v along y);
+ *  - KHR_materials_sheen: sheen colour times the Charlie lobe (sheen.h) over
+ *    the rest, scaled by max(0, min(1 - max3(sheen) E(cos_o), 1 - max3(sheen)
+ *    E(cos_i))) (the specification's reciprocal albedo scaling; clamped at 0
+ *    because the lobe's own albedo exceeds 1 toward grazing at low sheen
+ *    roughness);
+ *  - the clearcoat lies over all of it, as in the plain model.
+ * Every term but the clearcoat's is a function of |wo.h| = |wi.h|, cos_o and
+ * cos_i symmetric in wo and wi: the BSDF is reciprocal without a clearcoat. */
+static inline PK_HD float pbsdf__max3(vec3 c) { return fmaxf(c.x, fmaxf(c.y, c.z)); }
+
+/* The spectral sensitivity of Belcour and Barla (2017), their Gaussian fit
+ * of the CIE XYZ functions in Fourier space, at optical path difference opd
+ * (nm) and phase shift (per X, Y, Z), turned into linear sRGB (Rec. 709). */
+static inline PK_HD vec3 pbsdf__irid_sensitivity(float opd, vec3 shift)
+{
+    const float ph = 2.0f * PK_PI * opd * 1e-9f, ph2 = ph * ph, n = 1.0f / 1.0685e-7f;
+    const float x = 5.4856e-13f * sqrtf(2.0f * PK_PI * 4.3278e9f) * cosf(1.6810e6f * ph + shift.x) *
+                        expf(-4.3278e9f * ph2) +
+                    9.7470e-14f * sqrtf(2.0f * PK_PI * 4.5282e9f) * cosf(2.2399e6f * ph + shift.x) *
+                        expf(-4.5282e9f * ph2);
+    const float y = 4.4201e-13f * sqrtf(2.0f * PK_PI * 9.3046e9f) * cosf(1.7953e6f * ph + shift.y) *
+                    expf(-9.3046e9f * ph2);
+    const float z = 5.2481e-13f * sqrtf(2.0f * PK_PI * 6.6121e9f) * cosf(2.2084e6f * ph + shift.z) *
+                    expf(-6.6121e9f * ph2);
+    return v3_scale(v3(3.2404542f * x - 1.5371385f * y - 0.4985314f * z,
+                       -0.9692660f * x + 1.8760108f * y + 0.0415560f * z,
+                       0.0556434f * x - 0.2040259f * y + 1.0572252f * z),
+                    n);
+}
+static inline PK_HD float pbsdf__schlick(float f0, float c) { return f0 + (1.0f - f0) * pbsdf__schlick_w(c); }
+/* The thin film's Fresnel reflectance (KHR_materials_iridescence, after
+ * Belcour and Barla 2017): a film of index film_ior and thickness d (nm)
+ * between the outside (index outside) and a base of normal-incidence
+ * reflectance f0 (per channel; its index (1 + sqrt f0) / (1 - sqrt f0)),
+ * seen at cos1; Schlick's Fresnel at both interfaces, phase shifts 0 or pi,
+ * the first two orders of the film's interference integrated over the
+ * spectrum analytically. A film of thickness 0 is no film. */
+static inline PBSDF_CALLED PK_HD vec3 pbsdf_iridescence(float outside, float film_ior, float cos1, float d, vec3 f0)
+{
+    cos1 = fminf(fmaxf(cos1, 0.0f), 1.0f);
+    if (!(d > 0.0f))
+        return v3(pbsdf__schlick(f0.x, cos1), pbsdf__schlick(f0.y, cos1), pbsdf__schlick(f0.z, cos1));
+    const float e = outside / film_ior, c2sq = 1.0f - e * e * (1.0f - cos1 * cos1);
+    if (c2sq < 0.0f) return v3s(1.0f); /* total internal reflection */
+    const float cos2 = sqrtf(c2sq);
+    const float r0 = (film_ior - outside) * (film_ior - outside) / ((film_ior + outside) * (film_ior + outside));
+    const float r12 = pbsdf__schlick(r0, cos1), t121 = 1.0f - r12;
+    const float phi21 = film_ior < outside ? 0.0f : PK_PI; /* pi - phi12 */
+    const float f[3] = {f0.x, f0.y, f0.z};
+    float r23[3], phi[3];
+    for (int k = 0; k < 3; k++) {
+        const float s = sqrtf(fminf(fmaxf(f[k], 0.0f), 0.9999f)), bior = (1.0f + s) / (1.0f - s);
+        const float r1 = (bior - film_ior) * (bior - film_ior) / ((bior + film_ior) * (bior + film_ior));
+        r23[k] = pbsdf__schlick(r1, cos2);
+        phi[k] = phi21 + (bior < film_ior ? PK_PI : 0.0f);
+    }
+    const float opd = 2.0f * film_ior * d * cos2;
+    float out[3];
+    vec3 s1 = pbsdf__irid_sensitivity(opd, v3(phi[0], phi[1], phi[2]));
+    vec3 s2 = pbsdf__irid_sensitivity(2.0f * opd, v3(2.0f * phi[0], 2.0f * phi[1], 2.0f * phi[2]));
+    const float sv1[3] = {s1.x, s1.y, s1.z}, sv2[3] = {s2.x, s2.y, s2.z};
+    for (int k = 0; k < 3; k++) {
+        const float r123 = fminf(fmaxf(r12 * r23[k], 1e-5f), 0.9999f), rr = sqrtf(r123);
+        const float rs = t121 * t121 * r23[k] / (1.0f - r123);
+        float cm = rs - t121, i = r12 + rs;
+        cm *= rr;
+        i += cm * 2.0f * sv1[k];
+        cm *= rr;
+        i += cm * 2.0f * sv2[k];
+        out[k] = fmaxf(i, 0.0f);
+    }
+    return v3(out[0], out[1], out[2]);
+}
+
+/* The dielectric's (*fd) and the metal's (*fm) Fresnel colours at |wo.h| = c;
+ * irid false leaves the film out (the lobe choice's estimate). */
+static inline PK_HD void pbsdf__gx_fresnel(const pbsdf *b, float c, bool irid, vec3 *fd, vec3 *fm)
+{
+    const float w = pbsdf__schlick_w(c);
+    const vec3 f0c = v3_min(v3_scale(b->gx_spec_color, pbsdf__mr_f0(b)), v3s(1.0f));
+    *fd = v3_scale(v3_add(f0c, v3_scale(v3_sub(v3s(1.0f), f0c), w)), b->gx_spec);
+    *fm = v3_add(b->albedo, v3_scale(v3_sub(v3s(1.0f), b->albedo), w));
+    if (!irid || !(b->gx_irid > 0.0f)) return;
+    const float t = b->gx_irid;
+    if (b->metallic < 1.0f)
+        *fd = v3_lerp(*fd, pbsdf_iridescence(1.0f, b->gx_irid_ior, c, b->gx_irid_d, v3_scale(f0c, b->gx_spec)), t);
+    if (b->metallic > 0.0f) *fm = v3_lerp(*fm, pbsdf_iridescence(1.0f, b->gx_irid_ior, c, b->gx_irid_d, b->albedo), t);
+}
+static inline PK_HD float pbsdf__gx_sheen_a(const pbsdf *b)
+{
+    const float r = sheen_clamp_r(b->gx_sheen_r);
+    return r * r;
+}
+/* The sheen's albedo scaling of what lies under it for cosines co and ci. */
+static inline PK_HD float pbsdf__gx_sheen_scale(const pbsdf *b, float co, float ci)
+{
+    const float c = pbsdf__max3(b->gx_sheen);
+    if (!(c > 0.0f)) return 1.0f;
+    const float e = fmaxf(sheen_e(b->gx_sheen_r, fabsf(co)), sheen_e(b->gx_sheen_r, fabsf(ci)));
+    return fmaxf(0.0f, 1.0f - c * e);
+}
+
+/* f cos of the non-delta part (wo.z > 0; wi on either side), without the
+ * clearcoat. */
+static inline PBSDF_CALLED PK_HD vec3 pbsdf__gx_eval_base(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    if (!(wo.z > 0.0f) || wi.z == 0.0f) return v3s(0.0f);
+    const float m = b->metallic, t = b->transmission;
+    const bool smooth = pbsdf__smooth(b);
+    vec3 h, fd, fm;
+    if (wi.z < 0.0f) { /* the thin sheet's transmission */
+        if (smooth || !((1.0f - m) * t > 0.0f)) return v3s(0.0f);
+        const float s = pbsdf__mf_refl_cos(b, wo, pbsdf__mirror_z(wi), &h);
+        if (!(s > 0.0f)) return v3s(0.0f);
+        pbsdf__gx_fresnel(b, fabsf(v3_dot(wo, h)), true, &fd, &fm);
+        return v3_scale(b->albedo, (1.0f - m) * t * (1.0f - pbsdf__max3(fd)) * s *
+                                       pbsdf__gx_sheen_scale(b, wo.z, wi.z));
+    }
+    h = v3_norm(v3_add(wo, wi));
+    pbsdf__gx_fresnel(b, fabsf(v3_dot(wo, h)), true, &fd, &fm);
+    vec3 r = v3_scale(b->albedo, (1.0f - m) * (1.0f - t) * (1.0f - pbsdf__max3(fd)) * wi.z / PK_PI);
+    if (!smooth) {
+        const float s = pbsdf__mf_refl_cos(b, wo, wi, &h);
+        if (s > 0.0f) r = v3_add(r, v3_scale(v3_add(v3_scale(fd, 1.0f - m), v3_scale(fm, m)), s));
+        if (b->flags & PBSDF_ENERGY) r = v3_add(r, pbsdf__ms_cos(b, wo, wi));
+    }
+    r = v3_scale(r, pbsdf__gx_sheen_scale(b, wo.z, wi.z));
+    if (pbsdf__max3(b->gx_sheen) > 0.0f) r = v3_add(r, v3_scale(b->gx_sheen, sheen_cos(pbsdf__gx_sheen_a(b), wo, wi)));
+    return r;
+}
+static inline PK_HD vec3 pbsdf__gx_eval(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    vec3 r = pbsdf__gx_eval_base(b, wo, wi);
+    if (!(b->coat > 0.0f)) return r;
+    const float cw = pbsdf__mr_coat(b, wo);
+    r = v3_scale(r, 1.0f - cw);
+    if (wi.z > 0.0f && wo.z > 0.0f && !pbsdf__coat_smooth(b)) {
+        vec3 h;
+        const float s = pbsdf__ggx_refl_cos(b->coat_alpha, wo, wi, &h);
+        if (s > 0.0f) r = v3_add(r, v3s(cw * s));
+    }
+    return r;
+}
+/* The delta lobes of a smooth surface toward wo, under the clearcoat's
+ * share: the mirror's weight and the straight-through transmission's. */
+static inline PK_HD vec3 pbsdf__gx_delta(const pbsdf *b, vec3 wo, bool transmit)
+{
+    vec3 fd, fm;
+    pbsdf__gx_fresnel(b, wo.z, true, &fd, &fm);
+    const float m = b->metallic, k = pbsdf__gx_sheen_scale(b, wo.z, wo.z) * (1.0f - pbsdf__mr_coat(b, wo));
+    if (transmit) return v3_scale(b->albedo, (1.0f - m) * b->transmission * (1.0f - pbsdf__max3(fd)) * k);
+    return v3_scale(v3_add(v3_scale(fd, 1.0f - m), v3_scale(fm, m)), k);
+}
+/* The probabilities of sampling the specular reflection (p[0]), the diffuse
+ * base (p[1]), the transmission (p[2]), the clearcoat (p[3]) and the sheen
+ * (p[4]), in proportion to estimates of the lobes' albedos toward wo. */
+static inline PK_HD void pbsdf__gx_probs(const pbsdf *b, vec3 wo, float p[5])
+{
+    vec3 fd, fm;
+    pbsdf__gx_fresnel(b, wo.z, false, &fd, &fm);
+    const float m = b->metallic, t = b->transmission, cw = pbsdf__mr_coat(b, wo);
+    const float k = pbsdf__gx_sheen_scale(b, wo.z, wo.z) * (1.0f - cw);
+    const float es = ((1.0f - m) * pbsdf__mean(fd) + m * pbsdf__mean(fm)) * k;
+    const float eb = (1.0f - m) * (1.0f - pbsdf__max3(fd)) * pbsdf__mean(b->albedo) * k;
+    float ed = eb * (1.0f - t);
+    if (b->flags & PBSDF_ENERGY) ed += pbsdf__ms_alb(b, wo) * k; /* sampled by the cosine lobe */
+    const float esh = pbsdf__mean(b->gx_sheen) > 0.0f
+                          ? pbsdf__mean(b->gx_sheen) * fminf(sheen_e(b->gx_sheen_r, wo.z), 1.0f) * (1.0f - cw)
+                          : 0.0f;
+    const float et = eb * t, sum = es + ed + et + cw + esh;
+    if (!(sum > 0.0f)) {
+        p[0] = 1.0f, p[1] = p[2] = p[3] = p[4] = 0.0f;
+        return;
+    }
+    p[1] = ed / sum, p[2] = et / sum, p[3] = cw / sum, p[4] = esh / sum;
+    p[0] = fmaxf(0.0f, 1.0f - p[1] - p[2] - p[3] - p[4]);
+}
+/* The mixture density of the lobes' samplers (the sheen's: uniform over the
+ * hemisphere). */
+static inline PBSDF_CALLED PK_HD float pbsdf__gx_pdf(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    if (!(wo.z > 0.0f) || wi.z == 0.0f) return 0.0f;
+    float pr[5];
+    pbsdf__gx_probs(b, wo, pr);
+    const bool smooth = pbsdf__smooth(b);
+    if (wi.z < 0.0f)
+        return smooth || !(pr[2] > 0.0f) ? 0.0f : pr[2] * pbsdf__mf_refl_pdf(b, wo, pbsdf__mirror_z(wi));
+    float p = pr[1] * wi.z / PK_PI + pr[4] * (1.0f / (2.0f * PK_PI));
+    if (!smooth && pr[0] > 0.0f) p += pr[0] * pbsdf__mf_refl_pdf(b, wo, wi);
+    if (!pbsdf__coat_smooth(b) && pr[3] > 0.0f) p += pr[3] * pbsdf__ggx_refl_pdf(b->coat_alpha, wo, wi);
+    return p;
+}
+static inline PBSDF_CALLED PK_HD bool pbsdf__gx_sample(const pbsdf *b, vec3 wo, const float u[3], vec3 *wi,
+                                                       vec3 *weight, float *pdf, bool *is_delta)
+{
+    *is_delta = false;
+    *weight = v3s(0.0f);
+    if (!(wo.z > 0.0f)) return false;
+    float pr[5];
+    pbsdf__gx_probs(b, wo, pr);
+    const bool smooth = pbsdf__smooth(b);
+    int lobe = 0;
+    float c = pr[0];
+    while (lobe < 4 && !(u[0] < c)) c += pr[++lobe];
+    while (!(pr[lobe] > 0.0f)) lobe = (lobe + 1) % 5; /* float rounding: a lobe that has weight */
+    vec3 w;
+    if (lobe == 0 || lobe == 3) { /* specular reflection, or the clearcoat's */
+        const bool coat = lobe == 3;
+        if (coat ? pbsdf__coat_smooth(b) : smooth) {
+            *wi = pbsdf__mirror(wo);
+            const vec3 f = coat ? v3s(pbsdf__mr_coat(b, wo)) : pbsdf__gx_delta(b, wo, false);
+            *weight = v3_scale(f, 1.0f / pr[lobe]);
+            *pdf = pr[lobe];
+            *is_delta = true;
+            return true;
+        }
+        const vec3 m = coat ? pbsdf_ggx_vndf_sample(b->coat_alpha, wo, u[1], u[2]) : pbsdf_mf_sample(b, wo, u[1], u[2]);
+        const float om = v3_dot(wo, m);
+        if (!(om > 0.0f)) return false;
+        w = v3_sub(v3_scale(m, 2.0f * om), wo);
+    } else if (lobe == 1) { /* the diffuse base */
+        const float r = sqrtf(u[1]), phi = 2.0f * PK_PI * u[2];
+        w = v3(r * cosf(phi), r * sinf(phi), sqrtf(fmaxf(0.0f, 1.0f - u[1])));
+    } else if (lobe == 4) { /* the sheen: uniform over the hemisphere */
+        const float z = u[1], r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = 2.0f * PK_PI * u[2];
+        w = v3(r * cosf(phi), r * sinf(phi), z);
+    } else { /* transmission: the specular lobe mirrored through the sheet */
+        if (smooth) {
+            *wi = v3_neg(wo);
+            *weight = v3_scale(pbsdf__gx_delta(b, wo, true), 1.0f / pr[2]);
+            *pdf = pr[2];
+            *is_delta = true;
+            return true;
+        }
+        const vec3 m = pbsdf_mf_sample(b, wo, u[1], u[2]);
+        const float om = v3_dot(wo, m);
+        if (!(om > 0.0f)) return false;
+        w = v3_sub(v3_scale(m, 2.0f * om), wo);
+        if (!(w.z > 0.0f)) return false;
+        w = pbsdf__mirror_z(w);
+    }
+    if (lobe != 2 && !(w.z > 0.0f)) return false;
+    const float p = pbsdf__gx_pdf(b, wo, w);
+    if (!(p > 0.0f)) return false;
+    *wi = w;
+    *pdf = p;
+    *weight = v3_scale(pbsdf__gx_eval(b, wo, w), 1.0f / p);
+    return true;
 }
 
 /* ---- dielectric ------------------------------------------------------------ */
@@ -2110,7 +2408,7 @@ static inline PK_HD bool pbsdf_has_nondelta(const pbsdf *b)
     case PBSDF_DIFFUSE: case PBSDF_PLASTIC: case PBSDF_GLOSSY: return true;
     case PBSDF_METALLIC_ROUGHNESS:
         return !pbsdf__smooth(b) || (1.0f - b->metallic) * (1.0f - b->transmission) > 0.0f ||
-               (b->coat > 0.0f && !pbsdf__coat_smooth(b));
+               (b->coat > 0.0f && !pbsdf__coat_smooth(b)) || pbsdf__max3(b->gx_sheen) > 0.0f;
     default: return !pbsdf__smooth(b);
     }
 }
@@ -2124,7 +2422,9 @@ static inline PK_HD vec3 pbsdf_eval(const pbsdf *b, vec3 wo, vec3 wi)
     if (b->type >= PBSDF_THIN_DIELECTRIC) return pbsdf__ext_eval(b, wo, wi);
     if (b->type == PBSDF_DIELECTRIC) return pbsdf__dielectric_eval(b, wo, wi);
     if (b->type == PBSDF_METALLIC_ROUGHNESS)
-        return b->flags & PBSDF_MR_VOLUME ? pbsdf__mrv_eval(b, wo, wi) : pbsdf__mr_eval(b, wo, wi);
+        return b->flags & PBSDF_MR_VOLUME ? pbsdf__mrv_eval(b, wo, wi)
+               : b->flags & PBSDF_GLTF_EXT ? pbsdf__gx_eval(b, wo, wi)
+                                           : pbsdf__mr_eval(b, wo, wi);
     if (!(wo.z > 0.0f && wi.z > 0.0f)) return v3s(0.0f);
     vec3 h = v3(0.0f, 0.0f, 1.0f);
     switch (b->type) {
@@ -2172,7 +2472,9 @@ static inline PK_HD float pbsdf_pdf(const pbsdf *b, vec3 wo, vec3 wi)
     if (b->type >= PBSDF_THIN_DIELECTRIC) return pbsdf__ext_pdf(b, wo, wi);
     if (b->type == PBSDF_DIELECTRIC) return pbsdf__dielectric_pdf(b, wo, wi);
     if (b->type == PBSDF_METALLIC_ROUGHNESS)
-        return b->flags & PBSDF_MR_VOLUME ? pbsdf__mrv_pdf(b, wo, wi) : pbsdf__mr_pdf(b, wo, wi);
+        return b->flags & PBSDF_MR_VOLUME ? pbsdf__mrv_pdf(b, wo, wi)
+               : b->flags & PBSDF_GLTF_EXT ? pbsdf__gx_pdf(b, wo, wi)
+                                           : pbsdf__mr_pdf(b, wo, wi);
     if (!(wo.z > 0.0f && wi.z > 0.0f)) return 0.0f;
     switch (b->type) {
     case PBSDF_DIFFUSE:
@@ -2314,6 +2616,7 @@ static inline PK_HD bool pbsdf_sample(const pbsdf *b, vec3 wo, const float u[3],
         return true;
     }
     case PBSDF_METALLIC_ROUGHNESS: {
+        if (b->flags & PBSDF_GLTF_EXT) return pbsdf__gx_sample(b, wo, u, wi, weight, pdf, is_delta);
         float pr[4];
         pbsdf__mr_probs(b, wo, pr);
         *weight = v3s(0.0f);

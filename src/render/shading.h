@@ -73,6 +73,26 @@ static inline PK_HD pbsdf shading__coated(const material *m, vec3 p)
     return b;
 }
 
+/* glTF's KHR_materials_specular, _sheen, _iridescence and _anisotropy on a
+ * metallic-roughness BSDF b (made from m, alpha = roughness^2). */
+static inline PK_HD void shading__gltf_ext(pbsdf *b, const material *m)
+{
+    b->gx_spec = fminf(fmaxf(m->specular, 0.0f), 1.0f);
+    b->gx_spec_color = v3_max(m->specular_color, v3s(0.0f));
+    b->gx_sheen = surface_clamp_rgb(m->sheen_color);
+    b->gx_sheen_r = fminf(fmaxf(m->sheen_roughness, 0.0f), 1.0f);
+    b->gx_irid = fminf(fmaxf(m->iridescence, 0.0f), 1.0f);
+    b->gx_irid_ior = fmaxf(m->iridescence_ior, 1e-3f);
+    b->gx_irid_d = fmaxf(m->iridescence_thickness, 0.0f);
+    const float st = fminf(fmaxf(m->anisotropy, 0.0f), 1.0f);
+    if (st > 0.0f) { /* alpha_t = mix(alpha, 1, strength^2) along the frame's x, alpha across */
+        const float ab = b->alpha;
+        b->alpha = ab + (1.0f - ab) * st * st;
+        pbsdf_anisotropic(b, ab);
+    }
+    pbsdf_gltf_ext(b);
+}
+
 static inline PK_HD shading shading_at(const surface *sf)
 {
     const material *m = sf->m;
@@ -103,6 +123,8 @@ static inline PK_HD shading shading_at(const surface *sf)
             if (m->volume) { /* bounds a volume: refracts, the frame the outward normal (wo.z < 0 inside) */
                 sh.b.flags |= PBSDF_MR_VOLUME;
                 if (!sf->front) n = v3_neg(n);
+            } else {
+                shading__gltf_ext(&sh.b, m); /* KHR_materials_specular, _sheen, ... (not on a volume's boundary) */
             }
             break;
         }
@@ -153,6 +175,11 @@ static inline PK_HD shading shading_at(const surface *sf)
         sh.b = pbsdf_diffuse(m->kd);
     }
     sh.frame = sh.b.flags & PBSDF_ANISO ? shading_frame(n, sf->dpdu) : onb_from_normal(n);
+    if ((sh.b.flags & PBSDF_ANISO) && m->type == MAT_METALLIC_ROUGHNESS && m->anisotropy_rotation != 0.0f) {
+        /* glTF's anisotropy direction: rotated from the tangent toward n x tangent */
+        const float c = cosf(m->anisotropy_rotation), s = sinf(m->anisotropy_rotation);
+        sh.frame = shading_frame(n, v3_add(v3_scale(sh.frame.s, c), v3_scale(sh.frame.t, s)));
+    }
     sh.nondelta = sh.opaque > 0.0f && pbsdf_has_nondelta(&sh.b) &&
                   (sh.b.type != PBSDF_DIFFUSE || !black(sh.b.albedo));
     return sh;

@@ -194,6 +194,40 @@ static inline PK_HD float surface_bump_height(const scene_view *s, const tex_ref
     return tex_eval_scalar(s->textures, ref, q);
 }
 
+/* A texture's alpha (ch 3; 1 where it has none), red or green channel. */
+static inline PK_HD float surface__channel(const scene_view *s, const tex_ref *r, tex_query q, int ch)
+{
+    float c[4];
+    const int nc = tex_eval_raw(s->textures, r, q, c);
+    const float v = ch == 3 ? (nc == 2 || nc == 4 ? c[nc - 1] : 1.0f) : nc >= 3 ? c[ch] : c[0];
+    return fminf(fmaxf(v, 0.0f), 1.0f);
+}
+/* glTF's extension maps of a metallic-roughness material (material.h). */
+static inline PK_HD void surface__gltf_maps(const scene_view *s, const material *m, material *tm, tex_query q)
+{
+    if (m->map_spec.kind) tm->specular = m->specular * surface__channel(s, &m->map_spec, q, 3);
+    if (m->map_spec_color.kind)
+        tm->specular_color =
+            v3_mul(m->specular_color, surface_clamp_rgb(tex_eval_rgb(s->textures, &m->map_spec_color, q)));
+    if (m->map_sheen.kind)
+        tm->sheen_color = v3_mul(m->sheen_color, surface_clamp_rgb(tex_eval_rgb(s->textures, &m->map_sheen, q)));
+    if (m->map_sheen_rough.kind)
+        tm->sheen_roughness = m->sheen_roughness * surface__channel(s, &m->map_sheen_rough, q, 3);
+    if (m->map_irid.kind) tm->iridescence = m->iridescence * surface__channel(s, &m->map_irid, q, 0);
+    if (m->map_irid_thick.kind)
+        tm->iridescence_thickness = m->iridescence_thickness_min + (m->iridescence_thickness -
+                                                                    m->iridescence_thickness_min) *
+                                                                       surface__channel(s, &m->map_irid_thick, q, 1);
+    if (m->map_aniso.kind) { /* rg: a direction in the tangent frame (2 c - 1), b: the strength */
+        float c[4];
+        if (tex_eval_raw(s->textures, &m->map_aniso, q, c) >= 3) {
+            const float x = 2.0f * c[0] - 1.0f, y = 2.0f * c[1] - 1.0f;
+            if (x != 0.0f || y != 0.0f) tm->anisotropy_rotation = m->anisotropy_rotation + atan2f(y, x);
+            tm->anisotropy = m->anisotropy * fminf(fmaxf(c[2], 0.0f), 1.0f);
+        }
+    }
+}
+
 static inline PK_HD void surface_texture_at(const scene_view *s, const ray *r, const hit *h, float cone_width, surface *sf, material *tm)
 {
     const material *m = sf->m;
@@ -252,6 +286,7 @@ static inline PK_HD void surface_texture_at(const scene_view *s, const ray *r, c
             tm->clearcoat_roughness = fminf(fmaxf(m->clearcoat_roughness * (nc >= 3 ? c[1] : c[0]), 0.0f), 1.0f);
         }
     }
+    if (m->type == MAT_METALLIC_ROUGHNESS) surface__gltf_maps(s, m, tm, q);
     if (m->map_ke.kind) { /* the finest level, as light sampling sees it (lights.h), so that both agree */
         const tex_query qe = {uv.u, uv.v, 0.0f, sf->p, sf->ng, s->tex_nodes};
         const vec3 e = tex_eval_rgb(s->textures, &m->map_ke, qe);

@@ -3,6 +3,8 @@
  */
 #include "material.h"
 
+#include "../render/sheen.h"
+
 #include <math.h>
 #include <string.h>
 
@@ -34,6 +36,17 @@ void material_init(material *m)
     tex_ref_init(&m->map_tr);
     tex_ref_init(&m->map_cc);
     tex_ref_init(&m->map_ccr);
+    m->specular = 1.0f;
+    m->specular_color = v3s(1.0f);
+    m->iridescence_ior = 1.3f;
+    m->iridescence_thickness = 400.0f, m->iridescence_thickness_min = 100.0f;
+    tex_ref_init(&m->map_spec);
+    tex_ref_init(&m->map_spec_color);
+    tex_ref_init(&m->map_sheen);
+    tex_ref_init(&m->map_sheen_rough);
+    tex_ref_init(&m->map_irid);
+    tex_ref_init(&m->map_irid_thick);
+    tex_ref_init(&m->map_aniso);
 }
 
 float material_f0_dielectric(float ior)
@@ -132,6 +145,15 @@ void material_metallic_roughness(material *m, vec3 base_color, float metallic, f
     m->ks = v3_add(v3s((1.0f - metallic) * 0.04f), v3_scale(base_color, metallic));
     m->illum = 2;
     whitted_gloss(m, m->alpha);
+}
+
+void material_gltf_update(material *m)
+{
+    if (m->type != MAT_METALLIC_ROUGHNESS) return;
+    const float f0 = material_f0_dielectric(m->ni), mt = m->metallic;
+    const vec3 f0c = v3_scale(v3_min(v3_scale(m->specular_color, f0), v3s(1.0f)), m->specular);
+    m->ks = v3_add(v3_scale(f0c, 1.0f - mt), v3_scale(m->kd, mt));
+    m->whitted_sheen = v3_max_comp(m->sheen_color) > 0.0f ? sheen_eavg(m->sheen_roughness) : 0.0f;
 }
 
 void material_principled(material *m, vec3 base_color, float metallic, float roughness)

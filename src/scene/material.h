@@ -145,6 +145,24 @@ typedef struct material {
      * sampling rates of its specular and diffuse transmission */
     bool thin;
     float diff_trans, srate_st, srate_dt;
+    /* MAT_METALLIC_ROUGHNESS, glTF's PBR extensions (material_init's
+     * defaults leave the plain model): KHR_materials_specular's specular
+     * (weight of the dielectric's specular layer, 0..1; 1) and specular_color
+     * (its F0 colour, >= 0; 1); KHR_materials_sheen's sheen_color (0..1; 0 =
+     * no sheen) and sheen_roughness (0..1); KHR_materials_iridescence's
+     * iridescence (strength 0..1; 0 = none), iridescence_ior (the film's
+     * index; 1.3) and its thickness in nm, iridescence_thickness (the
+     * maximum; 400) and iridescence_thickness_min (100): without
+     * map_irid_thick the film is iridescence_thickness thick;
+     * KHR_materials_anisotropy's anisotropy (strength 0..1; 0) and
+     * anisotropy_rotation (radians from the tangent dp/du toward n x dp/du):
+     * the specular lobe's GGX alpha along that direction is mix(alpha, 1,
+     * strength^2), across it alpha. */
+    float specular;
+    vec3 specular_color, sheen_color;
+    float sheen_roughness, iridescence, iridescence_ior, iridescence_thickness, iridescence_thickness_min;
+    float anisotropy, anisotropy_rotation;
+    float whitted_sheen; /* derived (material_gltf_update): the sheen's mean albedo, for the Whitted integrator */
     /* Texture maps (docs/materials.md), kind TEX_NONE when absent. A map's
      * value multiplies its constant: map_kd kd, map_ks ks, map_ns ns,
      * map_alpha alpha; map_mr is glTF's metallic-roughness texture (data,
@@ -164,6 +182,15 @@ typedef struct material {
      * its grey). */
     tex_ref map_kd, map_ks, map_ns, map_d, map_alpha, map_bump, map_norm, map_mr, map_ke, map_eta, map_k, map_tf;
     tex_ref map_tr, map_cc, map_ccr;
+    /* glTF's extension maps (metallic-roughness): map_spec's alpha
+     * multiplies specular, map_spec_color specular_color, map_sheen
+     * sheen_color, map_sheen_rough's alpha sheen_roughness, map_irid's red
+     * iridescence; map_irid_thick's green g makes the film
+     * iridescence_thickness_min + g (iridescence_thickness -
+     * iridescence_thickness_min) thick; map_aniso's red and green are a
+     * direction (2 c - 1) in the tangent frame that rotates the anisotropy's
+     * (by its angle), its blue multiplies the strength. */
+    tex_ref map_spec, map_spec_color, map_sheen, map_sheen_rough, map_irid, map_irid_thick, map_aniso;
     /* map_norm's scale (glTF's normalTexture.scale): the map's x and y are
      * multiplied by it before the normal is normalised; 1 by default */
     float norm_scale;
@@ -267,6 +294,10 @@ PK_HIDDEN void material_coated_conductor_f0(material *m, vec3 reflectance, float
  * material_whitted_kd reads transmission where it is used; the Whitted
  * approximation has no clearcoat). */
 PK_HIDDEN void material_metallic_roughness(material *m, vec3 base_color, float metallic, float roughness);
+/* After setting a metallic-roughness material's extension fields (above):
+ * the Whitted approximation of them (the glossy weight ks of the specular's
+ * F0, the sheen's mean albedo). */
+PK_HIDDEN void material_gltf_update(material *m);
 /* Mitsuba 3's principled with its defaults but for these (see the fields
  * above; set the others after it, then call material_principled_update). */
 PK_HIDDEN void material_principled(material *m, vec3 base_color, float metallic, float roughness);
@@ -279,6 +310,13 @@ PK_HIDDEN void material_principled_update(material *m);
  * (1 - diff_trans)). */
 static inline PK_HD vec3 material_whitted_kd(const material *m)
 {
+    if (m->type == MAT_METALLIC_ROUGHNESS && v3_max_comp(m->sheen_color) > 0.0f) {
+        /* the sheen over the rest: its colour times its mean albedo (whitted_sheen) */
+        const float c = v3_max_comp(m->sheen_color);
+        return v3_add(v3_scale(m->kd, (1.0f - m->metallic) * (1.0f - m->transmission) *
+                                          fmaxf(0.0f, 1.0f - c * m->whitted_sheen)),
+                      v3_scale(m->sheen_color, m->whitted_sheen));
+    }
     if (m->type == MAT_PRINCIPLED) /* principledthin: less its diffuse transmission */
         return v3_scale(m->kd, (1.0f - m->metallic) * (1.0f - m->transmission) * (1.0f - m->diff_trans));
     if (m->type != MAT_METALLIC_ROUGHNESS) return m->kd;
@@ -312,6 +350,7 @@ static inline PK_HD vec3 material_mtl_tint(const material *m)
 static inline PK_HD bool material_anisotropic(const material *m)
 {
     if (m->type == MAT_PRINCIPLED) return m->anisotropic > 0.0f;
+    if (m->type == MAT_METALLIC_ROUGHNESS) return m->anisotropy > 0.0f || m->map_aniso.kind != TEX_NONE;
     return (m->type == MAT_CONDUCTOR || m->type == MAT_DIELECTRIC || m->type == MAT_PLASTIC) && m->alpha_v >= 0.0f &&
            m->alpha_v != m->alpha;
 }

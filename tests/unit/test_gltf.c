@@ -498,7 +498,7 @@ static void test_materials(void)
              "\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":2},"
              "\"KHR_materials_transmission\":{\"transmissionFactor\":0.75},\"KHR_materials_ior\":{\"ior\":1.33},"
              "\"KHR_materials_clearcoat\":{\"clearcoatFactor\":1,\"clearcoatRoughnessFactor\":0.5},"
-             "\"KHR_materials_sheen\":{}}},"
+             "\"KHR_materials_dispersion\":{}}},"
              "{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0},\"baseColorFactor\":[1,1,1,0.5]},"
              "\"emissiveFactor\":[1,0.5,1],\"emissiveTexture\":{\"index\":1},"
              "\"alphaMode\":\"MASK\",\"alphaCutoff\":0.25},"
@@ -523,7 +523,7 @@ static void test_materials(void)
     CHECK(m0->metallic == 0.25f && m0->roughness == 0.5f && m0->transmission == 0.75f && m0->ni == 1.33f);
     CHECK(vnear(m0->ke, v3(2, 4, 6), 0) && m0->two_sided && m0->map_kd.kind == TEX_NONE);
     CHECK(m0->clearcoat == 1.0f && m0->clearcoat_roughness == 0.5f);
-    CHECK(warning_log_has(&wlog, "KHR_materials_sheen: not supported"));
+    CHECK(warning_log_has(&wlog, "KHR_materials_dispersion: not supported"));
     /* MASK: a cut-out of alpha * 0.5 >= 0.25 (tex_holes: alpha 0 or 1) */
     CHECK(m1->map_kd.kind == TEX_IMAGE && m1->map_d.kind == TEX_IMAGE && m1->map_d.tex != m1->map_kd.tex);
     CHECK(m1->d == 1.0f && !m1->two_sided);
