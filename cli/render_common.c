@@ -932,14 +932,15 @@ pk_status cli_render_settings(pk_context *ctx, const cli_render_opts *o, pk_scen
             pk_scene_get_info(scene, &info);
             double c[3], rad = 0.0;
             for (int k = 0; k < 3; k++) {
-                const double h = 0.5 * ((double)info.bounds_max[k] - info.bounds_min[k]);
-                c[k] = o->has_at ? o->at[k] : 0.5 * ((double)info.bounds_min[k] + info.bounds_max[k]);
+                const double h = 0.5 * ((double)info.bounds_max[k] - (double)info.bounds_min[k]);
+                c[k] = o->has_at ? (double)o->at[k] : 0.5 * ((double)info.bounds_min[k] + (double)info.bounds_max[k]);
                 rad += h * h;
             }
             rad = sqrt(rad);
-            const double th = o->orbit[0] * 3.14159265358979323846 / 180.0, ph = o->orbit[1] * 3.14159265358979323846 / 180.0;
-            const double fov = (o->has_fov ? o->fov : cam.fov_deg) * 3.14159265358979323846 / 180.0;
-            double r = o->orbit[2] > 0.0f ? o->orbit[2] : rad / sin(0.5 * fov);
+            const double th = (double)o->orbit[0] * 3.14159265358979323846 / 180.0,
+                         ph = (double)o->orbit[1] * 3.14159265358979323846 / 180.0;
+            const double fov = (double)(o->has_fov ? o->fov : cam.fov_deg) * 3.14159265358979323846 / 180.0;
+            double r = o->orbit[2] > 0.0f ? (double)o->orbit[2] : rad / sin(0.5 * fov);
             if (!(r > 0.0)) r = 1.0;
             double d[3] = {sin(ph) * sin(th), cos(ph), sin(ph) * cos(th)};
             for (int k = 0; k < 3; k++) d[k] = fabs(d[k]) < 1e-12 ? 0.0 : d[k]; /* cos(90°) is 0 */

@@ -42,7 +42,7 @@ static pk_status read_tex_info(gltf *g, const cJSON *o, const char *path, tex_in
     if ((st = gltf_num(g, o, path, "scale", -1e30, 1e30, 1.0, &ti->scale))) return st;
     const cJSON *tt = gltf_ext(o, "KHR_texture_transform");
     if (tt) {
-        char tp[160];
+        char tp[300];
         snprintf(tp, sizeof tp, "%s/extensions/KHR_texture_transform", path);
         if (!cJSON_IsObject(tt)) return gltf_fail(g, PK_ERR_PARSE, "%s: must be an object", tp);
         float off[2] = {0, 0}, sc[2] = {1, 1}, rot;

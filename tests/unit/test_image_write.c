@@ -459,7 +459,7 @@ static void test_alpha(void)
     pi.format = PNG_FORMAT_RGBA;
     REQUIRE(pi.width == 4 && pi.height == 1 && png_image_finish_read(&pi, NULL, buf, 0, NULL));
     for (int i = 0; i < 4; i++) {
-        CHECKF(buf[4 * i + 3] == (int)floor(255.0 * a[i] + 0.5), "pixel %d alpha %d", i, buf[4 * i + 3]);
+        CHECKF(buf[4 * i + 3] == (int)floor(255.0 * (double)a[i] + 0.5), "pixel %d alpha %d", i, buf[4 * i + 3]);
         const double straight = a[i] > 0.0f ? (i == 3 ? 0.3 : 0.4) : 0.0;
         const double s = straight <= 0.0031308 ? 12.92 * straight : 1.055 * pow(straight, 1.0 / 2.4) - 0.055;
         CHECKF(buf[4 * i] == (int)floor(255.0 * s + 0.5), "pixel %d red %d, expected %.2f", i, buf[4 * i], 255.0 * s);

@@ -118,7 +118,7 @@ static void check_against(int curve, void (*ref)(const double *, double *), doub
         ref(din, want);
         image_tonemap(curve, in, out);
         for (int i = 0; i < 3; i++) {
-            const double d = fabs(out[i] - clamp01(want[i]));
+            const double d = fabs((double)out[i] - clamp01(want[i]));
             worst = d > worst ? d : worst;
             CHECKF(d <= tol, "%s (%g, %g, %g) channel %d: %.7f vs %.7f", pk_tonemap_name(curve), din[0], din[1],
                    din[2], i, (double)out[i], clamp01(want[i]));
