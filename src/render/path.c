@@ -77,14 +77,14 @@ static camera_sample ig_camera_sample(const void *self, int px, int py, uint64_t
     return path_camera_place(self, px, py, (uint32_t)index); /* the sampler's indices wrap at 2^32 */
 }
 
-__attribute__((flatten)) static bool ig_sample(const void *self, void *ts, int px, int py, uint64_t index,
-                                               const ray *r, const hit *h, vec3 *L, aov_sample *aov)
+static bool ig_sample(const void *self, void *ts, int px, int py, uint64_t index, const ray *r, const hit *h, vec3 *L,
+                      aov_sample *aov)
 {
     return path_camera_sample_aov(self, ts, px, py, (uint32_t)index, r, h, L, aov);
 }
 
-__attribute__((flatten)) static bool ig_vol_sample(const void *self, void *ts, int px, int py, uint64_t index,
-                                                   const ray *r, const hit *h, vec3 *L, aov_sample *aov)
+static bool ig_vol_sample(const void *self, void *ts, int px, int py, uint64_t index, const ray *r, const hit *h,
+                          vec3 *L, aov_sample *aov)
 {
     return vol_camera_sample_aov(self, ts, px, py, (uint32_t)index, r, h, L, aov);
 }
