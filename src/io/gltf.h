@@ -98,7 +98,7 @@ typedef struct gltf {
 enum {
     GW_POINTS = 1u << 0, GW_COLOR = 1u << 1, GW_UV1 = 1u << 2, GW_TANGENT = 1u << 3, GW_MR_TEX = 1u << 4,
     GW_BLEND = 1u << 6, GW_ROTATION = 1u << 7, GW_CLEARCOAT = 1u << 8,
-    GW_EXT = 1u << 9, GW_MIRROR = 1u << 10, GW_NORMAL_SCALE = 1u << 11, GW_SKIN = 1u << 12, GW_WRAP = 1u << 13,
+    GW_EXT = 1u << 9, GW_MIRROR = 1u << 10, GW_NORMAL_SCALE = 1u << 11, GW_SKIN = 1u << 12,
     GW_ANIM = 1u << 14, GW_RANGE = 1u << 15, GW_UV_SETS = 1u << 16, GW_SINGULAR = 1u << 17, GW_MORPH = 1u << 18,
     GW_INSTANCE_MIRROR = 1u << 19, GW_DISPERSION = 1u << 20,
     GW_MESHOPT = 1u << 27, GW_DRACO = 1u << 28, GW_WEBP = 1u << 29, GW_BASISU = 1u << 30

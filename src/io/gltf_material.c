@@ -245,14 +245,9 @@ static pk_status make_ref(gltf *g, const tex_info *ti, bool colour, bool bake, c
                 return gltf_fail(g, PK_ERR_PARSE, "%s: %s %lld is not a glTF wrap mode", sp, k ? "wrapT" : "wrapS",
                                  (long long)w);
         }
-        r->clamp = ws == 33071 && wt == 33071;
+        r->clamp = (ws == 33071 ? TEX_CLAMP_U : 0) | (wt == 33071 ? TEX_CLAMP_V : 0);
         ms = ws == 33648;
         mt = wt == 33648;
-        if ((ws == 33071) != (wt == 33071))
-            gltf_warn_once(g, GW_WRAP,
-                           "%s: clamping along one axis only is drawn as repeat along both (further ones not "
-                           "reported)",
-                           sp);
     }
     if (!bake) {
         /* glTF's v runs down the image, the scene's up: v_scene = 1 - v_gltf */

@@ -151,7 +151,7 @@ static bool looks_like_normal_map(const texture *t)
 {
     if (t->nc < 3) return false;
     float c[4];
-    texture_bilinear(t, t->nlevels - 1, 0.5f, 0.5f, false, c); /* the 1x1 level: the mean */
+    texture_bilinear(t, t->nlevels - 1, 0.5f, 0.5f, 0, c); /* the 1x1 level: the mean */
     return c[2] > 0.7f && fabsf(c[0] - 0.5f) < 0.15f && fabsf(c[1] - 0.5f) < 0.15f;
 }
 
@@ -181,8 +181,8 @@ static pk_status parse_map(mtl_state *st, const char *kw, size_t kn, const char 
             nr.bm = v[0];
         } else if (kw_ci(o, on, "-clamp")) {
             const char *t = io_skip_blanks(p, le), *te = io_token_end(t, le);
-            if (kw_ci(t, (size_t)(te - t), "on")) nr.clamp = true;
-            else if (kw_ci(t, (size_t)(te - t), "off")) nr.clamp = false;
+            if (kw_ci(t, (size_t)(te - t), "on")) nr.clamp = TEX_CLAMP;
+            else if (kw_ci(t, (size_t)(te - t), "off")) nr.clamp = 0;
             else {
                 io_warn(r, "texture option -clamp needs on or off; ignored");
                 continue;

@@ -220,6 +220,21 @@ static pk_status get_float(jp *p, const cJSON *it, const char *path, float *out)
     return PK_OK;
 }
 
+/* A texture's "clamp": true (both axes), false (repeat), "u" or "v" (that
+ * axis clamps, the other repeats), as a TEX_CLAMP_* mask. */
+static pk_status get_wrap(jp *p, const cJSON *it, const char *path, uint8_t *out)
+{
+    if (cJSON_IsBool(it)) {
+        *out = cJSON_IsTrue(it) ? TEX_CLAMP : 0;
+        return PK_OK;
+    }
+    if (cJSON_IsString(it) && (strcmp(it->valuestring, "u") == 0 || strcmp(it->valuestring, "v") == 0)) {
+        *out = it->valuestring[0] == 'u' ? TEX_CLAMP_U : TEX_CLAMP_V;
+        return PK_OK;
+    }
+    return jfail(p, PK_ERR_PARSE, it, path, "must be true, false, \"u\" or \"v\"");
+}
+
 static pk_status get_floats(jp *p, const cJSON *it, const char *path, float *out, int n)
 {
     if (!cJSON_IsArray(it) || cJSON_GetArraySize(it) != n)
@@ -320,8 +335,7 @@ static pk_status get_texture(jp *p, const cJSON *it, const char *path, bool colo
     }
     if (f[TX_CLAMP]) {
         path_key(fp, path, "clamp");
-        if (!cJSON_IsBool(f[TX_CLAMP])) return jfail(p, PK_ERR_PARSE, f[TX_CLAMP], fp, "must be true or false");
-        r.clamp = cJSON_IsTrue(f[TX_CLAMP]);
+        if ((st = get_wrap(p, f[TX_CLAMP], fp, &r.clamp))) return st;
     }
     if (f[TX_CHECKER]) {
         static const char *const ck[3] = {"even", "odd", "scale"};
@@ -1386,6 +1400,7 @@ static pk_status rec_read(jp *p, const cJSON *obj, const char *path, const rec_f
             st = cJSON_IsBool(m) ? PK_OK : jfail(p, PK_ERR_PARSE, m, fp, "must be true or false");
             *(bool *)at = cJSON_IsTrue(m);
             break;
+        case REC_WRAP: st = get_wrap(p, m, fp, (uint8_t *)at); break;
         default: st = PK_OK;
         }
         if (st) return st;

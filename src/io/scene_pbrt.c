@@ -923,7 +923,7 @@ static pk_status shape_material(pp *p, vec3 ke, int32_t ke_tex, bool two_sided, 
         tex_ref_init(r);
         r->kind = TEX_IMAGE;
         r->tex = ke_tex;
-        r->clamp = true;
+        r->clamp = TEX_CLAMP;
     }
     mat_variant v = {base, ke, two_sided, alpha_tex, ke_tex, idx};
     p->vars[p->nvars++] = v;
@@ -2438,7 +2438,7 @@ static pk_status d_texture(pp *p, const char *name, const char *kind, const char
             t.value = v3s(sc);
             t.ref.kind = TEX_IMAGE;
             t.ref.tex = idx;
-            t.ref.clamp = strcmp(wrap, "clamp") == 0 || strcmp(wrap, "black") == 0;
+            t.ref.clamp = strcmp(wrap, "clamp") == 0 || strcmp(wrap, "black") == 0 ? TEX_CLAMP : 0;
             if (strcmp(wrap, "black") == 0) pwarn(p, p->line, "imagemap: wrap \"black\" is rendered as \"clamp\"");
             if (d.map == TMAP_UV) {
                 t.cls = TC_IMAGE;

@@ -15,7 +15,9 @@
 
 #include <stddef.h>
 
-typedef enum rec_type { REC_FLOAT, REC_VEC3, REC_INT, REC_U8, REC_BOOL, REC_F9, REC_F16, REC_F2 } rec_type;
+/* REC_WRAP: a texture's clamp mask (TEX_CLAMP_*, a uint8_t), written as
+ * false (repeat), true (clamp), "u" or "v" (clamp along that axis only) */
+typedef enum rec_type { REC_FLOAT, REC_VEC3, REC_INT, REC_U8, REC_BOOL, REC_F9, REC_F16, REC_F2, REC_WRAP } rec_type;
 
 typedef struct rec_field {
     const char *name;

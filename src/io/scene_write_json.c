@@ -175,6 +175,11 @@ static pk_status jw_fields(jw *w, bool *first, const rec_field *t, size_t n, con
         case REC_INT: fprintf(w->f, "%d", *(const int *)at); break;
         case REC_U8: fprintf(w->f, "%d", (int)*(const uint8_t *)at); break;
         case REC_BOOL: fputs(*(const bool *)at ? "true" : "false", w->f); break;
+        case REC_WRAP: {
+            const uint8_t c = *(const uint8_t *)at & TEX_CLAMP;
+            fputs(c == TEX_CLAMP ? "true" : c == TEX_CLAMP_U ? "\"u\"" : c == TEX_CLAMP_V ? "\"v\"" : "false", w->f);
+            break;
+        }
         }
         if (st) return st;
     }

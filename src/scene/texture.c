@@ -216,7 +216,7 @@ static vec3 texel_rgb(const texture *t, const tex_level *l, int x, int y)
 
 /* Adds to sum the integral over triangle p (texel units of level l) of the
  * level's texels read as constant squares, repeat or clamp. */
-static void box_integral(const texture *t, const tex_level *l, const double p[6], bool clamp, double sum[3])
+static void box_integral(const texture *t, const tex_level *l, const double p[6], int clamp, double sum[3])
 {
     const double ylo = fmin(p[1], fmin(p[3], p[5])), yhi = fmax(p[1], fmax(p[3], p[5]));
     double row[2 * 16], tmp[2 * 16], cell[2 * 16]; /* clipping adds at most 2 points a side */
@@ -226,14 +226,14 @@ static void box_integral(const texture *t, const tex_level *l, const double p[6]
         if (n < 3) continue;
         double rxlo = row[0], rxhi = row[0];
         for (int i = 1; i < n; i++) rxlo = fmin(rxlo, row[2 * i]), rxhi = fmax(rxhi, row[2 * i]);
-        const int y = (int)wrap64(iy, l->h, clamp);
+        const int y = (int)wrap64(iy, l->h, (clamp & TEX_CLAMP_V) != 0);
         for (int64_t ix = (int64_t)floor(rxlo); (double)ix <= rxhi; ix++) {
             int m = clip_half(row, n, tmp, 0, (double)ix, true);
             m = clip_half(tmp, m, cell, 0, (double)(ix + 1), false);
             if (m < 3) continue;
             const double a = poly_area(cell, m);
             if (!(a > 0.0)) continue;
-            const vec3 c = texel_rgb(t, l, (int)wrap64(ix, l->w, clamp), y);
+            const vec3 c = texel_rgb(t, l, (int)wrap64(ix, l->w, (clamp & TEX_CLAMP_U) != 0), y);
             sum[0] += a * (double)c.x, sum[1] += a * (double)c.y, sum[2] += a * (double)c.z;
         }
     }
@@ -242,7 +242,7 @@ static void box_integral(const texture *t, const tex_level *l, const double p[6]
 /* (texture.h) On the finest level the lookups' bilinear filter is counted
  * too: the mean of the integrals over the triangle moved by (+-1/4, +-1/4)
  * texel. */
-vec3 texture_triangle_mean(const texture *t, const double u[3], const double v[3], bool clamp)
+vec3 texture_triangle_mean(const texture *t, const double u[3], const double v[3], int clamp)
 {
     const tex_level *top = &t->lv[t->nlevels - 1];
     const double du = fmax(u[0], fmax(u[1], u[2])) - fmin(u[0], fmin(u[1], u[2]));
@@ -268,8 +268,8 @@ vec3 texture_triangle_mean(const texture *t, const double u[3], const double v[3
          * texels than the level's side allows (a level that stopped halving
          * on one side under a footprint of many repeats): the image's mean */
         if (!(area > 1e-9)) {
-            const int64_t x = wrap64((int64_t)floor((p[0] + p[2] + p[4]) / 3.0), l->w, clamp);
-            const int64_t y = wrap64((int64_t)floor((p[1] + p[3] + p[5]) / 3.0), l->h, clamp);
+            const int64_t x = wrap64((int64_t)floor((p[0] + p[2] + p[4]) / 3.0), l->w, (clamp & TEX_CLAMP_U) != 0);
+            const int64_t y = wrap64((int64_t)floor((p[1] + p[3] + p[5]) / 3.0), l->h, (clamp & TEX_CLAMP_V) != 0);
             return texel_rgb(t, l, (int)x, (int)y);
         }
         return texel_rgb(t, top, 0, 0);

@@ -44,16 +44,20 @@ typedef struct texture {
 
 typedef enum tex_kind { TEX_NONE, TEX_IMAGE, TEX_CHECKER, TEX_EXPR } tex_kind;
 
+/* Which axes of a lookup clamp instead of repeating (a mask; 0 repeats both). */
+enum { TEX_CLAMP_U = 1, TEX_CLAMP_V = 2, TEX_CLAMP = 3 };
+
 /* A material parameter's texture. The texture's value multiplies the
  * parameter's constant. Lookups use uv' = (s[0] u + o[0], s[1] v + o[1]);
- * outside [0,1) the image repeats, or with clamp its edge texels continue.
+ * outside [0,1) the image repeats, or along the axes clamp names (a mask of
+ * TEX_CLAMP_U and TEX_CLAMP_V) its edge texels continue.
  * A checker is even where floor(scale u') + floor(scale v') is even, else odd.
  * TEX_EXPR: an expression of procedural nodes (tex_node), nnodes of the
  * scene's node table from index node on, evaluated in order; the last is
  * the value. */
 typedef struct tex_ref {
     uint8_t kind;      /* tex_kind; TEX_NONE (0) = the constant alone */
-    bool clamp;
+    uint8_t clamp;     /* TEX_CLAMP_U | TEX_CLAMP_V: the axes that clamp; 0 repeats */
     bool squared;      /* scalars: the value squared (roughness maps read as GGX alpha) */
     int32_t tex;       /* TEX_IMAGE: index into the scene's textures */
     float s[2], o[2];
@@ -100,7 +104,8 @@ PK_HIDDEN pk_status texture_add_pixels(pk_context *ctx, struct pk_scene *s, cons
 PK_HIDDEN vec3 texture_mean_rgb(const texture *t);
 PK_HIDDEN int32_t texture_find(const struct pk_scene *s, const char *key, bool colour);
 /* The mean of a texture over the triangle of texture coordinates (u[k],
- * v[k]) (a reference's transform applied), repeat or clamp, each texel read
+ * v[k]) (a reference's transform applied), repeat or clamp (a TEX_CLAMP_*
+ * mask, per axis), each texel read
  * as a constant square: from the finest mip level on which the triangle's
  * bounding box spans at most TEX_TRI_CELLS texels a side, every texel
  * weighted by the exact area it shares with the triangle. Mip texels are
@@ -109,7 +114,7 @@ PK_HIDDEN int32_t texture_find(const struct pk_scene *s, const char *key, bool c
  * such texels, times the image's contrast). A triangle of no uv area: the
  * texel at its centroid; non-finite uv: the image's mean. */
 #define TEX_TRI_CELLS 8
-PK_HIDDEN vec3 texture_triangle_mean(const texture *t, const double u[3], const double v[3], bool clamp);
+PK_HIDDEN vec3 texture_triangle_mean(const texture *t, const double u[3], const double v[3], int clamp);
 
 
 
@@ -166,19 +171,21 @@ static inline PK_HD float tex_fold(float x, bool clamp)
     return x - floorf(x);
 }
 
-/* Bilinear lookup in level k (clamped to the levels there are); out[0..nc-1]. */
-static inline PK_HD void texture_bilinear(const texture *t, int level, float u, float v, bool clamp, float out[4])
+/* Bilinear lookup in level k (clamped to the levels there are); clamp: a
+ * TEX_CLAMP_* mask, the axes that clamp instead of repeating; out[0..nc-1]. */
+static inline PK_HD void texture_bilinear(const texture *t, int level, float u, float v, int clamp, float out[4])
 {
     if (level < 0) level = 0;
     if (level >= t->nlevels) level = t->nlevels - 1;
     const tex_level *l = &t->lv[level];
-    const float x = tex_fold(u, clamp) * (float)l->w - 0.5f;
-    const float y = (1.0f - tex_fold(v, clamp)) * (float)l->h - 0.5f;
+    const bool cu = (clamp & TEX_CLAMP_U) != 0, cv = (clamp & TEX_CLAMP_V) != 0;
+    const float x = tex_fold(u, cu) * (float)l->w - 0.5f;
+    const float y = (1.0f - tex_fold(v, cv)) * (float)l->h - 0.5f;
     const float fx0 = floorf(x), fy0 = floorf(y);
     const float fx = x - fx0, fy = y - fy0;
     const int x0 = (int)fx0, y0 = (int)fy0;
-    const int xa = tex_wrap(x0, l->w, clamp), xb = tex_wrap(x0 + 1, l->w, clamp);
-    const int ya = tex_wrap(y0, l->h, clamp), yb = tex_wrap(y0 + 1, l->h, clamp);
+    const int xa = tex_wrap(x0, l->w, cu), xb = tex_wrap(x0 + 1, l->w, cu);
+    const int ya = tex_wrap(y0, l->h, cv), yb = tex_wrap(y0 + 1, l->h, cv);
     float a[4], b[4], c[4], d[4];
     tex_fetch(t, l, xa, ya, a);
     tex_fetch(t, l, xb, ya, b);
@@ -202,8 +209,9 @@ static inline PK_HD float texture_level(const texture *t, float width)
     return lod < top ? lod : top;
 }
 
-/* Trilinear lookup for a footprint of width (uv units); out[0..nc-1]. */
-static inline PK_HD void texture_lookup(const texture *t, float u, float v, float width, bool clamp, float out[4])
+/* Trilinear lookup for a footprint of width (uv units), clamp a TEX_CLAMP_*
+ * mask; out[0..nc-1]. */
+static inline PK_HD void texture_lookup(const texture *t, float u, float v, float width, int clamp, float out[4])
 {
     const float lod = texture_level(t, width);
     const int k = (int)lod;
@@ -250,7 +258,7 @@ typedef enum tex_mapping { TMAP_UV, TMAP_SPHERICAL, TMAP_CYLINDRICAL, TMAP_PLANA
 
 typedef struct tex_node {
     uint8_t op, map;
-    bool clamp;      /* TN_IMAGE: clamp instead of repeat */
+    uint8_t clamp;   /* TN_IMAGE: the axes that clamp instead of repeating (TEX_CLAMP_*) */
     bool grey;       /* TN_IMAGE: a float texture (the mean of the channels) */
     int8_t a, b, c;  /* operands */
     int32_t tex;     /* TN_IMAGE: index into the scene's textures */

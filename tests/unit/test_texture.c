@@ -35,24 +35,38 @@ static void test_bilinear(void)
     CHECK(t.lv[1].pxf[0] == 1.5f);
     float o[4];
     /* texel centres: (x + 0.5) / 2, 1 - (y + 0.5) / 2 */
-    texture_bilinear(&t, 0, 0.25f, 0.75f, false, o);
+    texture_bilinear(&t, 0, 0.25f, 0.75f, 0, o);
     CHECK_NEAR(o[0], 0.0, 1e-6);
-    texture_bilinear(&t, 0, 0.75f, 0.25f, false, o);
+    texture_bilinear(&t, 0, 0.75f, 0.25f, 0, o);
     CHECK_NEAR(o[0], 3.0, 1e-6);
-    texture_bilinear(&t, 0, 0.5f, 0.5f, false, o); /* between all four */
+    texture_bilinear(&t, 0, 0.5f, 0.5f, 0, o); /* between all four */
     CHECK_NEAR(o[0], 1.5, 1e-6);
-    texture_bilinear(&t, 0, 0.375f, 0.75f, false, o); /* a quarter from texel 0 toward texel 1 */
+    texture_bilinear(&t, 0, 0.375f, 0.75f, 0, o); /* a quarter from texel 0 toward texel 1 */
     CHECK_NEAR(o[0], 0.25, 1e-6);
     /* the left edge: repeat blends with the right column, clamp does not */
-    texture_bilinear(&t, 0, 0.0f, 0.75f, false, o);
+    texture_bilinear(&t, 0, 0.0f, 0.75f, 0, o);
     CHECK_NEAR(o[0], 0.5, 1e-6);
-    texture_bilinear(&t, 0, 0.0f, 0.75f, true, o);
+    texture_bilinear(&t, 0, 0.0f, 0.75f, TEX_CLAMP, o);
     CHECK_NEAR(o[0], 0.0, 1e-6);
-    texture_bilinear(&t, 0, -3.0f, 0.75f, false, o); /* repeat: -3 is 0 */
+    /* each axis by its own mode (glTF's wrapS and wrapT): u at the left edge,
+     * v at the top edge, where repeat blends with the other side */
+    texture_bilinear(&t, 0, 0.0f, 0.75f, TEX_CLAMP_U, o);
+    CHECK_NEAR(o[0], 0.0, 1e-6);
+    texture_bilinear(&t, 0, 0.0f, 0.75f, TEX_CLAMP_V, o);
     CHECK_NEAR(o[0], 0.5, 1e-6);
-    texture_bilinear(&t, 0, 7.25f, 5.75f, false, o);
+    texture_bilinear(&t, 0, 0.25f, 1.0f, 0, o); /* the top row blends with the bottom one */
+    CHECK_NEAR(o[0], 1.0, 1e-6);
+    texture_bilinear(&t, 0, 0.25f, 1.0f, TEX_CLAMP_U, o);
+    CHECK_NEAR(o[0], 1.0, 1e-6);
+    texture_bilinear(&t, 0, 0.25f, 1.0f, TEX_CLAMP_V, o);
+    CHECK_NEAR(o[0], 0.0, 1e-6);
+    texture_bilinear(&t, 0, -0.5f, 1.5f, TEX_CLAMP, o); /* beyond both edges: the corner texel */
+    CHECK_NEAR(o[0], 0.0, 1e-6);
+    texture_bilinear(&t, 0, -3.0f, 0.75f, 0, o); /* repeat: -3 is 0 */
+    CHECK_NEAR(o[0], 0.5, 1e-6);
+    texture_bilinear(&t, 0, 7.25f, 5.75f, 0, o);
     CHECK_NEAR(o[0], 0.0, 1e-5);
-    texture_bilinear(&t, 0, NAN, INFINITY, false, o); /* non-finite: read at 0 */
+    texture_bilinear(&t, 0, NAN, INFINITY, 0, o); /* non-finite: read at 0 */
     CHECK(isfinite(o[0]));
     texture_free(&ctx->alloc, &t);
 }
@@ -79,11 +93,11 @@ static void test_mipmaps(void)
     /* trilinear: halfway between the levels' bilinear values */
     float a[4], b[4], o[4];
     const float u = 0.3f, v = 0.6f;
-    texture_bilinear(&t, 0, u, v, false, a);
-    texture_bilinear(&t, 1, u, v, false, b);
-    texture_lookup(&t, u, v, 0.25f * sqrtf(2.0f), false, o);
+    texture_bilinear(&t, 0, u, v, 0, a);
+    texture_bilinear(&t, 1, u, v, 0, b);
+    texture_lookup(&t, u, v, 0.25f * sqrtf(2.0f), 0, o);
     CHECK_NEAR(o[0], 0.5 * ((double)a[0] + (double)b[0]), 1e-5);
-    texture_lookup(&t, u, v, 1e9f, false, o); /* the coarsest level: the mean */
+    texture_lookup(&t, u, v, 1e9f, 0, o); /* the coarsest level: the mean */
     CHECK_NEAR(o[0], 7.5, 1e-6);
     texture_free(&ctx->alloc, &t);
 
@@ -110,11 +124,11 @@ static void test_srgb(void)
     REQUIRE(texture_build(ctx, 1, 1, 3, mid, NULL, true, &m) == PK_OK);
     REQUIRE(texture_build(ctx, 1, 1, 3, mid, NULL, false, &md) == PK_OK);
     float o[4];
-    texture_bilinear(&m, 0, 0.5f, 0.5f, false, o);
+    texture_bilinear(&m, 0, 0.5f, 0.5f, 0, o);
     CHECK_NEAR(o[0], pow((128 / 255.0 + 0.055) / 1.055, 2.4), 1e-6);
     CHECK_NEAR(o[1], pow((64 / 255.0 + 0.055) / 1.055, 2.4), 1e-6);
     CHECK_NEAR(o[2], 1.0, 1e-7);
-    texture_bilinear(&md, 0, 0.5f, 0.5f, false, o);
+    texture_bilinear(&md, 0, 0.5f, 0.5f, 0, o);
     CHECK_NEAR(o[0], 128 / 255.0, 1e-6);
     /* the references: colour, scalar (mean of RGB), alpha (the alpha channel) */
     tex_ref r;
@@ -241,7 +255,7 @@ static void test_cache_and_fallback(void)
     CHECK(a->map_kd.kind == TEX_IMAGE && b->map_kd.kind == TEX_IMAGE && a->map_kd.tex == b->map_kd.tex);
     CHECK(a->map_d.kind == TEX_IMAGE && a->map_d.tex != a->map_kd.tex);
     CHECK(b->map_kd.s[0] == 2.0f && b->map_kd.s[1] == 3.0f && b->map_kd.o[0] == 0.5f && b->map_kd.o[1] == 0.25f &&
-          b->map_kd.clamp);
+          b->map_kd.clamp == TEX_CLAMP);
     CHECK(c->map_kd.kind == TEX_NONE && c->map_ks.kind == TEX_NONE && c->kd.x == 0.2f);
     const material *d = &s->materials[scene_find_material(s, "d")];
     /* malformed options are warned about and skipped; the texture is still used */
@@ -417,6 +431,19 @@ static void test_json(void)
            "%s", w.all);
     scene_destroy(s);
 
+    /* clamp along one axis: "u" or "v" */
+    {
+        const char *j = "{\"materials\": {\"m\": {\"kd\": {\"texture\": \"tex_checker.png\", \"clamp\": \"v\"}},"
+                        " \"n\": {\"kd\": {\"texture\": \"tex_checker.png\", \"clamp\": \"u\"}},"
+                        " \"o\": {\"kd\": {\"texture\": \"tex_checker.png\", \"clamp\": true}}}}";
+        REQUIRE(scene_create(ctx, "axes.json", &s) == PK_OK);
+        CHECKF(scene_json_parse(ctx, s, j, strlen(j), "axes.json", PK_TEST_DATA) == PK_OK, "%s", pk_context_error(ctx));
+        CHECK(s->materials[scene_find_material(s, "m")].map_kd.clamp == TEX_CLAMP_V);
+        CHECK(s->materials[scene_find_material(s, "n")].map_kd.clamp == TEX_CLAMP_U);
+        CHECK(s->materials[scene_find_material(s, "o")].map_kd.clamp == TEX_CLAMP);
+        scene_destroy(s);
+    }
+
     /* malformed texture objects are errors naming the value */
     static const struct {
         const char *json, *msg;
@@ -426,6 +453,8 @@ static void test_json(void)
         {"{\"materials\": {\"m\": {\"kd\": {\"texture\": 3}}}}", "materials.m.kd.texture: must be a file name"},
         {"{\"materials\": {\"m\": {\"kd\": {\"checker\": {\"scale\": 0}}}}}", "materials.m.kd.checker.scale: must be a positive"},
         {"{\"materials\": {\"m\": {\"type\": \"diffuse\", \"opacity\": 0.5}}}", "materials.m.opacity: must be a texture object"},
+        {"{\"materials\": {\"m\": {\"kd\": {\"texture\": \"a.png\", \"clamp\": \"w\"}}}}",
+         "materials.m.kd.clamp: must be true, false, \"u\" or \"v\""},
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         REQUIRE(scene_create(ctx, "bad.json", &s) == PK_OK);
