@@ -638,6 +638,9 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
         m.ke = v3(base[0], base[1], base[2]);
         tex_ref_init(&m.map_ke);
         if (m.map_kd.kind) m.map_ke = m.map_kd;
+        /* COLOR_0 multiplies the base colour, so here the emission (white
+         * where the primitive has no colours) */
+        m.emit_vertex_color = true;
         tex_ref_init(&m.map_kd);
         tex_ref_init(&m.map_mr);
         tex_ref_init(&m.map_norm);

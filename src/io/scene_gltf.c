@@ -327,6 +327,28 @@ static pk_status attribute(gltf *g, const cJSON *attrs, const char *path, const 
     return attribute_in(g, attrs, ap, key, ncomp, required, false, count, out);
 }
 
+/* The accessor of COLOR_0 in attrs at ap (a primitive's or a morph
+ * target's), checked: a VEC3 or VEC4 of floats or (deltas aside)
+ * normalized unsigned bytes or shorts; -1 when absent. */
+static pk_status color_accessor(gltf *g, const cJSON *attrs, const char *ap, bool deltas, int64_t *ai, int *ncomp)
+{
+    pk_status st = gltf_index(g, attrs, ap, "COLOR_0", gltf_count(g, "accessors"), false, ai);
+    if (st || *ai < 0) return st;
+    gltf_accessor a;
+    if ((st = gltf_accessor_get(g, *ai, &a))) return st;
+    const bool unorm = a.normalized && (a.ctype == 5121 || a.ctype == 5123);
+    const bool snorm = a.normalized && (a.ctype == 5120 || a.ctype == 5122);
+    if (a.matrix || (a.ncomp != 3 && a.ncomp != 4) || !(a.ctype == 5126 || unorm || (deltas && snorm)))
+        return gltf_fail(g, PK_ERR_PARSE,
+                         deltas ? "/accessors/%lld: COLOR_0 displacements must be a VEC3 or VEC4 of floats or "
+                                  "normalized integers"
+                                : "/accessors/%lld: COLOR_0 must be a VEC3 or VEC4 of floats or normalized unsigned "
+                                  "bytes or shorts",
+                         (long long)*ai);
+    *ncomp = a.ncomp;
+    return PK_OK;
+}
+
 /* COLOR_0 (VEC3 or VEC4 of floats or normalized unsigned bytes or shorts)
  * as RGBA (alpha 1 for VEC3), *out NULL when absent. */
 static pk_status read_colors(gltf *g, const cJSON *attrs, const char *path, size_t *count, float **out)
@@ -335,18 +357,12 @@ static pk_status read_colors(gltf *g, const cJSON *attrs, const char *path, size
     char ap[128];
     snprintf(ap, sizeof ap, "%s/attributes", path);
     int64_t ai;
-    pk_status st = gltf_index(g, attrs, ap, "COLOR_0", gltf_count(g, "accessors"), false, &ai);
+    int ncomp = 0;
+    pk_status st = color_accessor(g, attrs, ap, false, &ai, &ncomp);
     if (st || ai < 0) return st;
-    gltf_accessor a;
-    if ((st = gltf_accessor_get(g, ai, &a))) return st;
-    if (a.matrix || (a.ncomp != 3 && a.ncomp != 4) ||
-        !(a.ctype == 5126 || (a.normalized && (a.ctype == 5121 || a.ctype == 5123))))
-        return gltf_fail(g, PK_ERR_PARSE,
-                         "/accessors/%lld: COLOR_0 must be a VEC3 or VEC4 of floats or normalized unsigned bytes or shorts",
-                         (long long)ai);
     float *c = NULL;
-    if ((st = attribute_in(g, attrs, ap, "COLOR_0", a.ncomp, false, false, count, &c))) return st;
-    if (a.ncomp == 4) {
+    if ((st = attribute_in(g, attrs, ap, "COLOR_0", ncomp, false, false, count, &c))) return st;
+    if (ncomp == 4) {
         *out = c;
         return PK_OK;
     }
@@ -365,10 +381,14 @@ static pk_status read_colors(gltf *g, const cJSON *attrs, const char *path, size
 }
 
 /* Applies the morph targets of primitive p (at path) with weights w[0..nw)
- * to its n positions and normals (nrm may be NULL): each target's
- * POSITION and NORMAL displacements times its weight are added. */
+ * to its n vertices: each target's displacements times its weight are
+ * added to the positions, the normals (nrm, may be NULL), the texture
+ * coordinates (uv, the set uvkey; may be NULL) and the colours (col, RGBA;
+ * may be NULL; a VEC3 displacement leaves alpha). TANGENT displacements are
+ * not read: a morphed primitive's tangents are generated from its posed
+ * shape. */
 static pk_status apply_morph(gltf *g, const cJSON *p, const char *path, const float *w, size_t nw, size_t n,
-                             float *pos, float *nrm)
+                             float *pos, float *nrm, float *uv, const char *uvkey, float *col)
 {
     const cJSON *targets = cJSON_GetObjectItemCaseSensitive(p, "targets");
     if (!targets) return PK_OK;
@@ -383,14 +403,23 @@ static pk_status apply_morph(gltf *g, const cJSON *p, const char *path, const fl
         if (!cJSON_IsObject(t)) return gltf_fail(g, PK_ERR_PARSE, "%s: must be an object", tp);
         const float wk = k < nw ? w[k] : 0.0f;
         if (wk == 0.0f) continue;
-        for (int a = 0; a < 2; a++) {
-            float *dst = a ? nrm : pos, *d = NULL;
+        for (int a = 0; a < 4; a++) {
+            static const char *const keys[3] = {"POSITION", "NORMAL", NULL};
+            float *dst = a == 0 ? pos : a == 1 ? nrm : a == 2 ? uv : col, *d = NULL;
             if (!dst) continue;
+            int nc = a == 2 ? 2 : 3, stride = a == 3 ? 4 : nc;
+            pk_status st;
+            if (a == 3) {
+                int64_t ci;
+                if ((st = color_accessor(g, t, tp, true, &ci, &nc))) return st;
+                if (ci < 0) continue;
+            }
             size_t cnt = n;
-            pk_status st = attribute_in(g, t, tp, a ? "NORMAL" : "POSITION", 3, false, false, &cnt, &d);
+            st = attribute_in(g, t, tp, a == 2 ? uvkey : a == 3 ? "COLOR_0" : keys[a], nc, false, false, &cnt, &d);
             if (st) return st;
             if (!d) continue;
-            for (size_t i = 0; i < 3 * n; i++) dst[i] += wk * d[i];
+            for (size_t i = 0; i < n; i++)
+                for (int c = 0; c < nc; c++) dst[(size_t)stride * i + (size_t)c] += wk * d[(size_t)nc * i + (size_t)c];
             mem_free(&g->ctx->alloc, d);
         }
     }
@@ -456,42 +485,64 @@ static pk_status find_variant(gltf *g)
 }
 
 /* Linear blend skinning with the node's joint matrices (g->skin): each
- * vertex moves by the sum of its four joints' matrices times their weights
- * (the weights divided by their sum); normals by the inverse transpose of
- * that sum. */
+ * vertex moves by the sum of its joints' matrices times their weights (the
+ * weights divided by their sum), over every set JOINTS_k / WEIGHTS_k (four
+ * joints each); normals by the inverse transpose of that sum. */
+#define GLTF_MAX_JOINT_SETS 8
 static pk_status apply_skin(gltf *g, const cJSON *attrs, const char *path, size_t n, float *pos, float *nrm)
 {
-    float *jn = NULL, *wt = NULL;
-    size_t cnt = n;
+    float *jn = NULL, *wt = NULL, *acc = NULL; /* acc: per vertex the 12 summed matrix entries and the weights' sum */
     char ap[128];
     snprintf(ap, sizeof ap, "%s/attributes", path);
-    pk_status st = attribute_in(g, attrs, ap, "JOINTS_0", 4, false, true, &cnt, &jn);
-    if (!st) st = attribute_in(g, attrs, ap, "WEIGHTS_0", 4, false, false, &cnt, &wt);
-    if (st) goto out;
-    if (!jn || !wt) {
+    pk_status st = PK_OK;
+    int sets = 0;
+    for (int k = 0; k < GLTF_MAX_JOINT_SETS; k++) {
+        char jk[16], wk[16];
+        snprintf(jk, sizeof jk, "JOINTS_%d", k);
+        snprintf(wk, sizeof wk, "WEIGHTS_%d", k);
+        size_t cnt = n;
+        if ((st = attribute_in(g, attrs, ap, jk, 4, false, true, &cnt, &jn))) goto out;
+        if ((st = attribute_in(g, attrs, ap, wk, 4, false, false, &cnt, &wt))) goto out;
+        if (!jn || !wt) {
+            if (jn || wt)
+                gltf_warn_once(g, GW_SKIN, "%s: %s without %s is not used", path, jn ? jk : wk, jn ? wk : jk);
+            break;
+        }
+        if (!acc && !(acc = mem_calloc(&g->ctx->alloc, n ? n : 1, 13 * sizeof *acc))) {
+            st = ctx_nomem(g->ctx);
+            goto out;
+        }
+        for (size_t i = 0; i < n; i++) {
+            float *m = acc + 13 * i;
+            for (int c = 0; c < 4; c++) {
+                const float w = wt[4 * i + c], j = jn[4 * i + c];
+                if (w == 0.0f) continue;
+                if (!(j >= 0.0f) || j >= (float)g->nskin) {
+                    st = gltf_fail(g, PK_ERR_PARSE,
+                                   "%s/attributes/%s: joint %.0f of vertex %zu is not one of the skin's %zu", path, jk,
+                                   (double)j, i, g->nskin);
+                    goto out;
+                }
+                const xform *J = &g->skin[(size_t)j];
+                for (int e = 0; e < 12; e++) m[e] += w * J->m[e];
+                m[12] += w;
+            }
+        }
+        mem_free(&g->ctx->alloc, jn);
+        mem_free(&g->ctx->alloc, wt);
+        jn = wt = NULL;
+        sets++;
+    }
+    if (!sets) {
         gltf_warn_once(g, GW_SKIN, "%s: a skinned node's mesh without JOINTS_0 and WEIGHTS_0 is drawn as it stands", path);
         goto out;
     }
-    if (cJSON_GetObjectItemCaseSensitive(attrs, "JOINTS_1"))
-        gltf_warn_once(g, GW_SKIN, "%s/attributes/JOINTS_1: only the first four joints of a vertex move it", path);
     for (size_t i = 0; i < n; i++) {
+        const float *a = acc + 13 * i, sum = a[12];
+        if (!(sum > 0.0f)) continue; /* no weight: left where it is */
         xform m;
         memset(&m, 0, sizeof m);
-        float sum = 0.0f;
-        for (int c = 0; c < 4; c++) {
-            const float w = wt[4 * i + c], j = jn[4 * i + c];
-            if (w == 0.0f) continue;
-            if (!(j >= 0.0f) || j >= (float)g->nskin) {
-                st = gltf_fail(g, PK_ERR_PARSE, "%s/attributes/JOINTS_0: joint %.0f of vertex %zu is not one of the skin's %zu",
-                               path, (double)j, i, g->nskin);
-                goto out;
-            }
-            const xform *J = &g->skin[(size_t)j];
-            for (int e = 0; e < 12; e++) m.m[e] += w * J->m[e];
-            sum += w;
-        }
-        if (!(sum > 0.0f)) continue; /* no weight: left where it is */
-        for (int e = 0; e < 12; e++) m.m[e] /= sum;
+        for (int e = 0; e < 12; e++) m.m[e] = a[e] / sum;
         m.m[15] = 1.0f;
         vec3 *q = (vec3 *)(pos + 3 * i);
         *q = xform_point(&m, *q);
@@ -505,6 +556,7 @@ static pk_status apply_skin(gltf *g, const cJSON *attrs, const char *path, size_
 out:
     mem_free(&g->ctx->alloc, jn);
     mem_free(&g->ctx->alloc, wt);
+    mem_free(&g->ctx->alloc, acc);
     return st;
 }
 
@@ -671,7 +723,7 @@ static pk_status add_primitive(gltf *g, int64_t mi, int pi, const cJSON *p, bool
     bool posed = g->skin != NULL;
     for (size_t k = 0; k < nw; k++) posed |= w[k] != 0.0f && cJSON_GetObjectItemCaseSensitive(p, "targets");
     if (want_tan && !posed && (st = read_tangents(g, attrs, path, &n, &tan))) goto out;
-    if ((st = apply_morph(g, p, path, w, nw, n, pos, nrm))) goto out;
+    if ((st = apply_morph(g, p, path, w, nw, n, pos, nrm, uv, uvset ? "TEXCOORD_1" : "TEXCOORD_0", col))) goto out;
     if (g->skin && (st = apply_skin(g, attrs, path, n, pos, nrm))) goto out;
     size_t nidx = n;
     if (ii >= 0) {

@@ -31,6 +31,14 @@ static double emitted_luminance(const pk_scene *s, const material *m)
 static double emitted_luminance_tri(const pk_scene *s, const scene_view *v, const material *m, uint32_t t)
 {
     const tex_ref *r = &m->map_ke;
+    if (m->emit_vertex_color) {
+        /* the vertex colours' mean over the triangle: their value at the centroid */
+        const rgba c = view_tri_color(v, t, 1.0f / 3.0f, 1.0f / 3.0f);
+        material mc = *m;
+        mc.ke = v3_mul(m->ke, v3(fmaxf(c.r, 0.0f), fmaxf(c.g, 0.0f), fmaxf(c.b, 0.0f)));
+        mc.emit_vertex_color = false;
+        return emitted_luminance_tri(s, v, &mc, t);
+    }
     if (r->kind != TEX_IMAGE) return emitted_luminance(s, m);
     view_tri vt;
     view_tri_get(v, t, &vt);

@@ -329,12 +329,14 @@ static inline PK_HD vec3 point_light_map(const scene_view *s, const point_light 
 /* The radiance that emitter l (a triangle or sphere) sends from its point q
  * when its material has an emission map (map_ke): ke times the map at q's
  * texture coordinates, found as a hit there would find them (the finest
- * level: a light sample has no ray cone). Otherwise le as it is. */
+ * level: a light sample has no ray cone), and times the vertex colour at q
+ * where they multiply the emission (emit_vertex_color). Otherwise le as it
+ * is. */
 static inline PK_HD vec3 light_le_at(const scene_view *s, const light *l, vec3 q, vec3 le)
 {
     const uint32_t prim = l->kind == LIGHT_TRIANGLE ? l->index : (uint32_t)s->ntris + l->index;
     const material *m = &s->materials[view_prim_material(s, prim)];
-    if (!m->map_ke.kind) return le;
+    if (!m->map_ke.kind && !m->emit_vertex_color) return le;
     hit h = {0.0f, prim, 0.0f, 0.0f};
     if (l->kind == LIGHT_TRIANGLE) { /* q's barycentric coordinates (of v[1] and v[2]) */
         const vec3 e1 = v3_sub(l->v[1], l->v[0]), e2 = v3_sub(l->v[2], l->v[0]), d = v3_sub(q, l->v[0]);
@@ -344,6 +346,11 @@ static inline PK_HD vec3 light_le_at(const scene_view *s, const light *l, vec3 q
         h.u = fminf(fmaxf((d11 * d20 - d01 * d21) / den, 0.0f), 1.0f);
         h.v = fminf(fmaxf((d00 * d21 - d01 * d20) / den, 0.0f), 1.0f - h.u);
     }
+    if (m->emit_vertex_color && l->kind == LIGHT_TRIANGLE) {
+        const rgba c = view_tri_color(s, prim, h.u, h.v);
+        le = v3_mul(le, v3(fmaxf(c.r, 0.0f), fmaxf(c.g, 0.0f), fmaxf(c.b, 0.0f)));
+    }
+    if (!m->map_ke.kind) return le;
     const ray r = {q, 0.0f, v3s(0.0f), 1.0f}; /* a sphere's uv is that of r.o + t r.d = q */
     const surface_uv uv = surface_uv_at(s, &r, &h);
     const tex_query tq = {uv.u, uv.v, 0.0f, q, l->normal, s->tex_nodes};

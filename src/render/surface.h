@@ -292,6 +292,10 @@ static inline PK_HD void surface_texture_at(const scene_view *s, const ray *r, c
         const vec3 e = tex_eval_rgb(s->textures, &m->map_ke, qe);
         tm->ke = v3_mul(m->ke, v3(fmaxf(e.x, 0.0f), fmaxf(e.y, 0.0f), fmaxf(e.z, 0.0f)));
     }
+    if (m->emit_vertex_color && surface_is_tri(s, h->prim)) {
+        const rgba c = view_tri_color(s, h->prim, h->u, h->v);
+        tm->ke = v3_mul(tm->ke, v3(fmaxf(c.r, 0.0f), fmaxf(c.g, 0.0f), fmaxf(c.b, 0.0f)));
+    }
     sf->m = tm;
     /* the vertex tangents where the mesh has them (glTF's TANGENT, given or generated) */
     vec3 vt = uv.dpdu;

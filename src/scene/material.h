@@ -201,8 +201,10 @@ typedef struct material {
     bool blend;
     float blend_alpha;
     /* the triangles' vertex colours (glTF's COLOR_0; white where a vertex
-     * has none) multiply kd, and with blend their alpha blend_alpha */
-    bool vertex_color;
+     * has none) multiply kd, and with blend their alpha blend_alpha;
+     * emit_vertex_color: they multiply ke too (glTF's unlit materials, whose
+     * base colour is their emission) */
+    bool vertex_color, emit_vertex_color;
     /* The media on either side (medium.h): medium_out on the side the
      * geometric normal points to, medium_in on the other; an index into the
      * scene's media, MEDIUM_NONE (vacuum) or MEDIUM_INHERIT (the surface

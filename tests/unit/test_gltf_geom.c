@@ -15,6 +15,7 @@
 
 #include "io/gltf.h"
 #include "io/readers.h"
+#include "render/lights.h"
 #include "render/surface.h"
 #include "scene/scene.h"
 #include "scene/scene_view.h"
@@ -161,6 +162,56 @@ static void test_morph(void)
     free(j);
 }
 
+/* One triangle with TEXCOORD_0 and COLOR_0 (VEC4 floats) and a target
+ * that moves the uvs by (0.5, 0.25) and the colours by (-0.5, 0.25, 0)
+ * (a VEC3: alpha stays), at weight 0.5. */
+static void test_morph_attributes(void)
+{
+    bytes b = {0};
+    const float pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0}, uv[6] = {0, 0, 1, 0, 0, 1};
+    const float col[12] = {1, 1, 1, 0.5f, 1, 0, 0, 1, 0, 0, 1, 1};
+    const float duv[6] = {0.5f, 0.25f, 0.5f, 0.25f, 0.5f, 0.25f};
+    const float dcol[9] = {-0.5f, 0.25f, 0, -0.5f, 0.25f, 0, -0.5f, 0.25f, 0};
+    put(&b, pos, sizeof pos);
+    put(&b, uv, sizeof uv);
+    put(&b, col, sizeof col);
+    put(&b, duv, sizeof duv);
+    put(&b, dcol, sizeof dcol);
+    char *uri = b64(b.d, b.n);
+    char *j = malloc(8192);
+    snprintf(j, 8192,
+             "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":%zu,\"uri\":\"%s\"}],"
+             "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":24},"
+             "{\"buffer\":0,\"byteOffset\":60,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":108,\"byteLength\":24},"
+             "{\"buffer\":0,\"byteOffset\":132,\"byteLength\":36}],"
+             "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+             "{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"},"
+             "{\"bufferView\":2,\"componentType\":5126,\"count\":3,\"type\":\"VEC4\"},"
+             "{\"bufferView\":3,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"},"
+             "{\"bufferView\":4,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1,\"COLOR_0\":2},"
+             "\"targets\":[{\"TEXCOORD_0\":3,\"COLOR_0\":4}]}],\"weights\":[0.5]}],"
+             "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}]}",
+             b.n, uri);
+    free(uri);
+    pk_scene *s;
+    CHECKF(load(j, &s) == PK_OK, "%s", msg);
+    free(j);
+    REQUIRE(s && s->ntris == 1 && s->uvs && s->colors);
+    CHECKF(wlog.count == 0, "%s", wlog.last);
+    for (int k = 0; k < 3; k++) {
+        const uv2 t = s->uvs[s->tris[0].t[k]];
+        /* glTF's uv plus half the displacement; the scene's v is 1 - glTF's */
+        CHECKF(fabsf(t.u - (uv[2 * k] + 0.25f)) < 1e-6f && fabsf(t.v - (1.0f - (uv[2 * k + 1] + 0.125f))) < 1e-6f,
+               "vertex %d: uv (%g, %g)", k, (double)t.u, (double)t.v);
+        const rgba c = s->colors[s->tris[0].v[k]];
+        CHECKF(fabsf(c.r - (col[4 * k] - 0.25f)) < 1e-6f && fabsf(c.g - (col[4 * k + 1] + 0.125f)) < 1e-6f &&
+                   c.b == col[4 * k + 2] && c.a == col[4 * k + 3],
+               "vertex %d: colour (%g, %g, %g, %g)", k, (double)c.r, (double)c.g, (double)c.b, (double)c.a);
+    }
+    scene_destroy(s);
+}
+
 /* ---- skins --------------------------------------------------------------------------------- */
 
 /* A two-joint bend: joint 1 (node 1) at the origin, joint 2 (node 2, its
@@ -168,12 +219,17 @@ static void test_morph(void)
  * origin (joint 1), at (1, 1, 0) (half each) and at (0, 2, 0) (joint 2),
  * normals +x; the inverse bind matrices are those of the straight pose.
  * The skinned node's own translation (100, 0, 0) must not apply. */
-static char *skin_doc(float angle_deg, bool with_ibm, const char *joints_extra)
+/* two_sets: the middle vertex's two joints come from JOINTS_0/WEIGHTS_0
+ * and JOINTS_1/WEIGHTS_1, one each. */
+static char *skin_doc2(float angle_deg, bool with_ibm, const char *joints_extra, bool two_sets)
 {
     bytes b = {0};
     const float pos[9] = {0, 0, 0, 1, 1, 0, 0, 2, 0}, nrm[9] = {1, 0, 0, 1, 0, 0, 1, 0, 0};
     const uint8_t jn[12] = {0, 0, 0, 0, 0, 1, 0, 0, 1, 0, 0, 0};
-    const float wt[12] = {1, 0, 0, 0, 0.5f, 0.5f, 0, 0, 1, 0, 0, 0};
+    float wt[12] = {1, 0, 0, 0, 0.5f, 0.5f, 0, 0, 1, 0, 0, 0};
+    const uint8_t jn1[12] = {0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0};
+    const float wt1[12] = {0, 0, 0, 0, 0.5f, 0, 0, 0, 0, 0, 0, 0};
+    if (two_sets) wt[5] = 0.0f;
     const float ibm[32] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, /* identity */
                            1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -1, 0, 1 /* translate (0, -1, 0) */};
     put(&b, pos, sizeof pos);
@@ -181,6 +237,8 @@ static char *skin_doc(float angle_deg, bool with_ibm, const char *joints_extra)
     put(&b, jn, sizeof jn);
     put(&b, wt, sizeof wt);
     put(&b, ibm, sizeof ibm);
+    put(&b, jn1, sizeof jn1);
+    put(&b, wt1, sizeof wt1);
     char *uri = b64(b.d, b.n);
     const double h = (double)angle_deg * (3.14159265358979 / 180.0) / 2.0;
     char *j = malloc(8192);
@@ -188,21 +246,30 @@ static char *skin_doc(float angle_deg, bool with_ibm, const char *joints_extra)
              "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":%zu,\"uri\":\"%s\"}],"
              "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36},{\"buffer\":0,\"byteOffset\":36,\"byteLength\":36},"
              "{\"buffer\":0,\"byteOffset\":72,\"byteLength\":12},{\"buffer\":0,\"byteOffset\":84,\"byteLength\":48},"
-             "{\"buffer\":0,\"byteOffset\":132,\"byteLength\":128}],"
+             "{\"buffer\":0,\"byteOffset\":132,\"byteLength\":128},{\"buffer\":0,\"byteOffset\":260,\"byteLength\":12},"
+             "{\"buffer\":0,\"byteOffset\":272,\"byteLength\":48}],"
              "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
              "{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
              "{\"bufferView\":2,\"componentType\":5121,\"count\":3,\"type\":\"VEC4\"},"
              "{\"bufferView\":3,\"componentType\":5126,\"count\":3,\"type\":\"VEC4\"},"
-             "{\"bufferView\":4,\"componentType\":5126,\"count\":2,\"type\":\"MAT4\"}],"
+             "{\"bufferView\":4,\"componentType\":5126,\"count\":2,\"type\":\"MAT4\"},"
+             "{\"bufferView\":5,\"componentType\":5121,\"count\":3,\"type\":\"VEC4\"},"
+             "{\"bufferView\":6,\"componentType\":5126,\"count\":3,\"type\":\"VEC4\"}],"
              "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"JOINTS_0\":2,"
-             "\"WEIGHTS_0\":3}}]}],"
+             "\"WEIGHTS_0\":3%s}}]}],"
              "\"skins\":[{\"joints\":[1,2]%s%s}],"
              "\"nodes\":[{\"mesh\":0,\"skin\":0,\"translation\":[100,0,0]},{\"children\":[2]},"
              "{\"translation\":[0,1,0],\"rotation\":[0,0,%.17g,%.17g]}],"
              "\"scenes\":[{\"nodes\":[0,1]}]}",
-             b.n, uri, with_ibm ? ",\"inverseBindMatrices\":4" : "", joints_extra, sin(h), cos(h));
+             b.n, uri, two_sets ? ",\"JOINTS_1\":5,\"WEIGHTS_1\":6" : "", with_ibm ? ",\"inverseBindMatrices\":4" : "",
+             joints_extra, sin(h), cos(h));
     free(uri);
     return j;
+}
+
+static char *skin_doc(float angle_deg, bool with_ibm, const char *joints_extra)
+{
+    return skin_doc2(angle_deg, with_ibm, joints_extra, false);
 }
 
 static void test_skin(void)
@@ -223,6 +290,16 @@ static void test_skin(void)
     CHECK(vnear(vnrm(s, 0, 0), v3(1, 0, 0), 1e-5f));
     CHECK(vnear(vnrm(s, 0, 1), v3(r, r, 0), 1e-5f));
     CHECK(vnear(vnrm(s, 0, 2), v3(0, 1, 0), 1e-5f));
+    scene_destroy(s);
+
+    /* the middle vertex's joints split over JOINTS_0 and JOINTS_1: the same pose */
+    j = skin_doc2(90.0f, true, "", true);
+    CHECKF(load(j, &s) == PK_OK, "%s", msg);
+    free(j);
+    REQUIRE(s && s->ntris == 1);
+    CHECKF(wlog.count == 0, "%s", wlog.last);
+    CHECK(vnear(vpos(s, 0, 1), v3(0.5f, 1.5f, 0), 1e-5f) && vnear(vpos(s, 0, 2), v3(-1, 1, 0), 1e-5f));
+    CHECK(vnear(vnrm(s, 0, 1), v3(r, r, 0), 1e-5f));
     scene_destroy(s);
 
     /* the bind pose (no bend) gives the mesh as written, not moved by its node */
@@ -365,6 +442,42 @@ static void test_color(void)
     REQUIRE(s && s->colors);
     CHECK(s->tris[0].material != 0 && s->materials[s->tris[0].material].vertex_color && !s->materials[0].vertex_color);
     CHECK(s->colors[s->tris[0].v[1]].g == 1.0f && s->colors[s->tris[0].v[1]].a == 1.0f);
+    scene_destroy(s);
+
+    /* unlit: the colours multiply the base colour, which is the emission, at
+     * hits, in light samples and in the power that chooses among lights (the
+     * colours' mean over the triangle, 1/3 each) */
+    j = color_doc(",\"material\":0",
+                  ",\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,0.5,0.5,1]},"
+                  "\"extensions\":{\"KHR_materials_unlit\":{}}}]",
+                  "\"componentType\":5121,\"normalized\":true,\"type\":\"VEC4\"");
+    CHECKF(load(j, &s) == PK_OK, "%s", msg);
+    free(j);
+    REQUIRE(s && s->ntris == 2 && s->nemissive == 2);
+    {
+        const scene_view uv = scene_view_of(s);
+        surface us = surface_at(&uv, &r, &h);
+        us = surface_texture(&uv, &r, &h, 0.0f, us, &tm);
+        CHECKF(vnear(us.m->ke, v3(0.25f, 0.125f, 0.125f), 1e-6f), "ke %g %g %g", (double)us.m->ke.x,
+               (double)us.m->ke.y, (double)us.m->ke.z);
+        CHECK(vnear(us.m->kd, v3s(0.0f), 0.0f));
+        env_light env;
+        memset(&env, 0, sizeof env);
+        light_set ls;
+        pk_context *lc;
+        REQUIRE(pk_context_create(NULL, &lc) == PK_OK);
+        REQUIRE(light_set_build(lc, s, &env, &ls) == PK_OK);
+        REQUIRE(ls.n == 2);
+        const light *l = &ls.lights[ls.of_prim[1]];
+        /* the light's radiance at barycentric (1/2, 1/4, 1/4) of the second instance */
+        const vec3 q = v3_add(v3_scale(l->v[0], 0.5f), v3_add(v3_scale(l->v[1], 0.25f), v3_scale(l->v[2], 0.25f)));
+        const vec3 le = light_le_at(&uv, l, q, l->le);
+        CHECKF(vnear(le, v3(0.25f, 0.125f, 0.125f), 1e-6f), "le %g %g %g", (double)le.x, (double)le.y, (double)le.z);
+        /* each triangle: luminance 0.5 / 3 over area 1/2, one side */
+        CHECKF(fabs(ls.power - 2.0 * (0.5 / 3.0) * 0.5 * (double)PK_PI) < 1e-5, "power %g", ls.power);
+        light_set_free(&lc->alloc, &ls);
+        pk_context_destroy(lc);
+    }
     scene_destroy(s);
 
     /* integers that are not normalized are refused */
@@ -693,6 +806,7 @@ static void test_kept(void)
 int main(void)
 {
     test_morph();
+    test_morph_attributes();
     test_skin();
     test_normal_scale();
     test_color();
