@@ -610,9 +610,8 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
     if ((st = make_ref(g, &t_tr, false, bake, path, &m.map_tr))) goto fail;
     if ((st = make_ref(g, &t_cc, false, bake, path, &m.map_cc))) goto fail;
     if ((st = make_ref(g, &t_ccr, false, bake, path, &m.map_ccr))) goto fail;
-    if (t_ccn.present)
-        gltf_warn(g, "%s/extensions/KHR_materials_clearcoat/clearcoatNormalTexture: the clearcoat is drawn with the "
-                     "surface's normal (its own normal map is not applied)", path);
+    if ((st = make_ref(g, &t_ccn, false, bake, path, &m.map_ccn))) goto fail;
+    if (m.map_ccn.kind) m.coat_norm_scale = t_ccn.scale;
     if (amode == 1 || amode == 2) {
         const bool tex_alpha =
             m.map_kd.kind == TEX_IMAGE && (g->s->textures[m.map_kd.tex].nc == 2 || g->s->textures[m.map_kd.tex].nc == 4);

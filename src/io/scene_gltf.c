@@ -719,7 +719,8 @@ static pk_status add_primitive(gltf *g, int64_t mi, int pi, const cJSON *p, bool
     if (!uvset && cJSON_GetObjectItemCaseSensitive(attrs, "TEXCOORD_1"))
         gltf_warn_once(g, GW_UV1, "%s/attributes/TEXCOORD_1: no texture of the material reads it; ignored", path);
     /* the vertex tangents, for the frame of a normal map or of anisotropic roughness */
-    const bool want_tan = g->s->materials[smat].map_norm.kind != TEX_NONE || material_anisotropic(&g->s->materials[smat]);
+    const material *sm = &g->s->materials[smat];
+    const bool want_tan = sm->map_norm.kind != TEX_NONE || sm->map_ccn.kind != TEX_NONE || material_anisotropic(sm);
     bool posed = g->skin != NULL;
     for (size_t k = 0; k < nw; k++) posed |= w[k] != 0.0f && cJSON_GetObjectItemCaseSensitive(p, "targets");
     if (want_tan && !posed && (st = read_tangents(g, attrs, path, &n, &tan))) goto out;

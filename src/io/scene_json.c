@@ -1524,7 +1524,7 @@ static pk_status parse_material_record(jp *p, const cJSON *e, const char *path)
                                         "map_bump", "map_norm", "map_mr",   "map_ke",   "map_eta",  "map_k",
                                         "map_tf",   "map_tr",   "map_cc",   "map_ccr",  "map_spec", "map_spec_color",
                                         "map_sheen", "map_sheen_rough", "map_irid", "map_irid_thick", "map_aniso",
-                                        "interior", "exterior", NULL};
+                                        "map_ccn", "interior", "exterior", NULL};
     material m;
     material_init(&m);
     if ((st = rec_read(p, f[1], fp, rec_material, rec_nmaterial, extra, &m))) return st;

@@ -36,7 +36,7 @@ const rec_field rec_material[] = {
     F(material, srate_diff, REC_FLOAT), F(material, thin, REC_BOOL),
     F(material, diff_trans, REC_FLOAT), F(material, srate_st, REC_FLOAT),
     F(material, srate_dt, REC_FLOAT),
-    F(material, norm_scale, REC_FLOAT), F(material, blend, REC_BOOL),
+    F(material, norm_scale, REC_FLOAT), F(material, coat_norm_scale, REC_FLOAT), F(material, blend, REC_BOOL),
     F(material, blend_alpha, REC_FLOAT), F(material, vertex_color, REC_BOOL),
     F(material, specular, REC_FLOAT),
     F(material, specular_color, REC_VEC3), F(material, sheen_color, REC_VEC3),
@@ -52,7 +52,7 @@ const char *const rec_map_names[REC_NMAPS] = {"map_kd",    "map_ks",   "map_ns",
                                               "map_ke",    "map_eta",  "map_k",    "map_tf",
                                               "map_tr",    "map_cc",   "map_ccr",
                                               "map_spec",  "map_spec_color", "map_sheen", "map_sheen_rough",
-                                              "map_irid",  "map_irid_thick", "map_aniso"};
+                                              "map_irid",  "map_irid_thick", "map_aniso", "map_ccn"};
 const size_t rec_map_offsets[REC_NMAPS] = {
     offsetof(material, map_kd),    offsetof(material, map_ks),   offsetof(material, map_ns),
     offsetof(material, map_d),     offsetof(material, map_alpha), offsetof(material, map_bump),
@@ -61,7 +61,7 @@ const size_t rec_map_offsets[REC_NMAPS] = {
     offsetof(material, map_tr),    offsetof(material, map_cc),   offsetof(material, map_ccr),
     offsetof(material, map_spec),  offsetof(material, map_spec_color), offsetof(material, map_sheen),
     offsetof(material, map_sheen_rough), offsetof(material, map_irid), offsetof(material, map_irid_thick),
-    offsetof(material, map_aniso)};
+    offsetof(material, map_aniso), offsetof(material, map_ccn)};
 
 const rec_field rec_texref[] = {
     {"kind", REC_U8, offsetof(tex_ref, kind)},   F(tex_ref, clamp, REC_WRAP), F(tex_ref, squared, REC_BOOL),

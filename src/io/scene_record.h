@@ -30,7 +30,7 @@ typedef struct rec_field {
 PK_HIDDEN extern const rec_field rec_material[];
 PK_HIDDEN extern const size_t rec_nmaterial;
 /* The maps of a material, in the order of the names. */
-#define REC_NMAPS 22
+#define REC_NMAPS 23
 PK_HIDDEN extern const char *const rec_map_names[REC_NMAPS];
 PK_HIDDEN extern const size_t rec_map_offsets[REC_NMAPS];
 /* The plain fields of a texture reference (the image is "image" or "pixels"). */

@@ -38,6 +38,7 @@
 #ifndef PK_PBSDF_H
 #define PK_PBSDF_H
 
+#include "../math/frame.h"
 #include "../math/vec3.h"
 #include "energy.h"
 #include "optics.h"
@@ -87,6 +88,9 @@ typedef enum pbsdf_type {
  * or _anisotropy (the gx_ fields, PBSDF_ANISO) are in use (pbsdf_gltf_ext):
  * pbsdf__gx_* evaluate it (the plain model's code is left as it was) */
 #define PBSDF_GLTF_EXT 64u
+/* metallic-roughness: the clearcoat has a normal of its own (glTF's
+ * clearcoatNormalTexture), coat_n in the local frame (pbsdf_clearcoat_normal) */
+#define PBSDF_COAT_NORMAL 128u
 
 /* Below this roughness a microfacet lobe is treated as perfectly smooth (a
  * delta lobe): the GGX density would exceed float range long before 0. */
@@ -143,6 +147,7 @@ typedef struct pbsdf {
     float ior;
     float metallic, transmission;
     float coat, coat_alpha;
+    vec3 coat_n;         /* with PBSDF_COAT_NORMAL: the clearcoat's unit normal, local, z > 0 */
     vec3 gx_spec_color, gx_sheen;
     float gx_spec, gx_sheen_r, gx_irid, gx_irid_ior, gx_irid_d;
     vec3 ms;             /* F_ms / (pi (1 - E_avg)) per channel, with PBSDF_ENERGY */
@@ -187,6 +192,7 @@ static inline PK_HD pbsdf pbsdf__blank(int type)
     b.ior = 1.5f;
     b.metallic = b.transmission = 0.0f;
     b.coat = b.coat_alpha = 0.0f;
+    b.coat_n = v3(0.0f, 0.0f, 1.0f);
     b.gx_spec_color = v3s(1.0f), b.gx_sheen = v3s(0.0f);
     b.gx_spec = 1.0f, b.gx_sheen_r = 0.5f, b.gx_irid = 0.0f, b.gx_irid_ior = 1.3f, b.gx_irid_d = 0.0f;
     b.ms = v3s(0.0f);
@@ -270,6 +276,14 @@ static inline PK_HD pbsdf pbsdf_with_clearcoat(pbsdf b, float coat, float coat_a
     b.coat = coat;
     b.coat_alpha = coat_alpha;
     return b;
+}
+/* The clearcoat's own unit normal n, in b's local frame (PBSDF_COAT_NORMAL);
+ * one at or below the surface's horizon is not used. */
+static inline PK_HD void pbsdf_clearcoat_normal(pbsdf *b, vec3 n)
+{
+    if (!(n.z > 1e-4f) || !v3_finite(n)) return;
+    b->coat_n = n;
+    b->flags |= PBSDF_COAT_NORMAL;
 }
 /* Marks a metallic-roughness b whose glTF extension fields (gx_: specular,
  * sheen, iridescence) or anisotropy (pbsdf_anisotropic, after it) differ
@@ -808,12 +822,78 @@ static inline PK_HD float pbsdf__mr_f0(const pbsdf *b)
 }
 static inline PK_HD vec3 pbsdf__mirror_z(vec3 w) { return v3(w.x, w.y, -w.z); }
 
-/* The clearcoat's weight toward wo: coat Fc(wo.z). */
+/* The clearcoat's own normal (PBSDF_COAT_NORMAL, glTF's
+ * clearcoatNormalTexture): the coat's Fresnel weight and its GGX lobe are
+ * those of the frame about coat_n, as the glTF sample renderer has them: the
+ * cosines in Fc and in the lobe's f cos are taken about coat_n (a lobe with a
+ * shading normal of its own). Directions below the coat's hemisphere get
+ * none of its lobe (its weight there is the whole coat, Fc(0) = 1). Without
+ * the flag: +z, and the arithmetic of the plain model. */
+static inline PK_HD float pbsdf__coat_cos(const pbsdf *b, vec3 w)
+{
+    return b->flags & PBSDF_COAT_NORMAL ? v3_dot(b->coat_n, w) : w.z;
+}
+
+/* The clearcoat's weight toward wo: coat Fc(wo.z) (wo . coat_n). */
 static inline PK_HD float pbsdf__mr_coat(const pbsdf *b, vec3 wo)
 {
-    return b->coat > 0.0f ? b->coat * (0.04f + 0.96f * pbsdf__schlick_w(wo.z)) : 0.0f;
+    return b->coat > 0.0f ? b->coat * (0.04f + 0.96f * pbsdf__schlick_w(pbsdf__coat_cos(b, wo))) : 0.0f;
 }
 static inline PK_HD bool pbsdf__coat_smooth(const pbsdf *b) { return b->coat_alpha < PBSDF_ALPHA_SMOOTH; }
+
+/* The coat's rough lobe, f cos (without the weight Fc), wo and wi above the
+ * surface; its density; a sample of it (false where it leaves the coat's or
+ * the surface's hemisphere), and the smooth coat's mirror direction. */
+static inline PK_HD float pbsdf__coat_lobe(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    vec3 h;
+    if (b->flags & PBSDF_COAT_NORMAL) {
+        const onb f = onb_from_normal(b->coat_n);
+        wo = onb_to_local(f, wo), wi = onb_to_local(f, wi);
+        if (!(wo.z > 0.0f && wi.z > 0.0f)) return 0.0f;
+    }
+    return pbsdf__ggx_refl_cos(b->coat_alpha, wo, wi, &h);
+}
+static inline PK_HD float pbsdf__coat_lobe_pdf(const pbsdf *b, vec3 wo, vec3 wi)
+{
+    if (b->flags & PBSDF_COAT_NORMAL) {
+        const onb f = onb_from_normal(b->coat_n);
+        wo = onb_to_local(f, wo), wi = onb_to_local(f, wi);
+        if (!(wo.z > 0.0f && wi.z > 0.0f)) return 0.0f;
+    }
+    return pbsdf__ggx_refl_pdf(b->coat_alpha, wo, wi);
+}
+static inline PK_HD bool pbsdf__coat_lobe_sample(const pbsdf *b, vec3 wo, float u1, float u2, vec3 *wi)
+{
+    onb f;
+    const bool own = (b->flags & PBSDF_COAT_NORMAL) != 0u;
+    if (own) {
+        f = onb_from_normal(b->coat_n);
+        wo = onb_to_local(f, wo);
+        if (!(wo.z > 0.0f)) return false;
+    }
+    const vec3 m = pbsdf_ggx_vndf_sample(b->coat_alpha, wo, u1, u2);
+    const float om = v3_dot(wo, m);
+    vec3 w = v3_sub(v3_scale(m, 2.0f * om), wo);
+    if (own) {
+        if (!(om > 0.0f) || !(w.z > 0.0f)) return false;
+        w = onb_to_world(f, w);
+    }
+    *wi = w;
+    return true;
+}
+static inline PK_HD bool pbsdf__coat_mirror(const pbsdf *b, vec3 wo, vec3 *wi)
+{
+    if (!(b->flags & PBSDF_COAT_NORMAL)) {
+        *wi = pbsdf__mirror(wo);
+        return true;
+    }
+    const float c = v3_dot(b->coat_n, wo);
+    const vec3 w = v3_sub(v3_scale(b->coat_n, 2.0f * c), wo);
+    if (!(c > 0.0f) || !(w.z > 0.0f)) return false;
+    *wi = w;
+    return true;
+}
 
 /* The probabilities of sampling the specular reflection (p[0]), the diffuse
  * base (p[1]), the transmission (p[2]) and the clearcoat (p[3]), in
@@ -888,8 +968,7 @@ static inline PK_HD vec3 pbsdf__mr_eval(const pbsdf *b, vec3 wo, vec3 wi)
     const float cw = pbsdf__mr_coat(b, wo);
     r = v3_scale(r, 1.0f - cw);
     if (wi.z > 0.0f && wo.z > 0.0f && !pbsdf__coat_smooth(b)) {
-        vec3 h;
-        const float s = pbsdf__ggx_refl_cos(b->coat_alpha, wo, wi, &h);
+        const float s = pbsdf__coat_lobe(b, wo, wi);
         if (s > 0.0f) r = v3_add(r, v3s(cw * s));
     }
     return r;
@@ -906,7 +985,7 @@ static inline PK_HD float pbsdf__mr_pdf(const pbsdf *b, vec3 wo, vec3 wi)
         return smooth || !(pr[2] > 0.0f) ? 0.0f : pr[2] * pbsdf__ggx_refl_pdf(b->alpha, wo, pbsdf__mirror_z(wi));
     float p = pr[1] * wi.z / PK_PI;
     if (!smooth && pr[0] > 0.0f) p += pr[0] * pbsdf__ggx_refl_pdf(b->alpha, wo, wi);
-    if (!pbsdf__coat_smooth(b) && pr[3] > 0.0f) p += pr[3] * pbsdf__ggx_refl_pdf(b->coat_alpha, wo, wi);
+    if (!pbsdf__coat_smooth(b) && pr[3] > 0.0f) p += pr[3] * pbsdf__coat_lobe_pdf(b, wo, wi);
     return p;
 }
 
@@ -1060,8 +1139,7 @@ static inline PK_HD vec3 pbsdf__gx_eval(const pbsdf *b, vec3 wo, vec3 wi)
     const float cw = pbsdf__mr_coat(b, wo);
     r = v3_scale(r, 1.0f - cw);
     if (wi.z > 0.0f && wo.z > 0.0f && !pbsdf__coat_smooth(b)) {
-        vec3 h;
-        const float s = pbsdf__ggx_refl_cos(b->coat_alpha, wo, wi, &h);
+        const float s = pbsdf__coat_lobe(b, wo, wi);
         if (s > 0.0f) r = v3_add(r, v3s(cw * s));
     }
     return r;
@@ -1112,7 +1190,7 @@ static inline PBSDF_CALLED PK_HD float pbsdf__gx_pdf(const pbsdf *b, vec3 wo, ve
         return smooth || !(pr[2] > 0.0f) ? 0.0f : pr[2] * pbsdf__mf_refl_pdf(b, wo, pbsdf__mirror_z(wi));
     float p = pr[1] * wi.z / PK_PI + pr[4] * (1.0f / (2.0f * PK_PI));
     if (!smooth && pr[0] > 0.0f) p += pr[0] * pbsdf__mf_refl_pdf(b, wo, wi);
-    if (!pbsdf__coat_smooth(b) && pr[3] > 0.0f) p += pr[3] * pbsdf__ggx_refl_pdf(b->coat_alpha, wo, wi);
+    if (!pbsdf__coat_smooth(b) && pr[3] > 0.0f) p += pr[3] * pbsdf__coat_lobe_pdf(b, wo, wi);
     return p;
 }
 static inline PBSDF_CALLED PK_HD bool pbsdf__gx_sample(const pbsdf *b, vec3 wo, const float u[3], vec3 *wi,
@@ -1132,17 +1210,22 @@ static inline PBSDF_CALLED PK_HD bool pbsdf__gx_sample(const pbsdf *b, vec3 wo, 
     if (lobe == 0 || lobe == 3) { /* specular reflection, or the clearcoat's */
         const bool coat = lobe == 3;
         if (coat ? pbsdf__coat_smooth(b) : smooth) {
-            *wi = pbsdf__mirror(wo);
+            if (!coat) *wi = pbsdf__mirror(wo);
+            else if (!pbsdf__coat_mirror(b, wo, wi)) return false;
             const vec3 f = coat ? v3s(pbsdf__mr_coat(b, wo)) : pbsdf__gx_delta(b, wo, false);
             *weight = v3_scale(f, 1.0f / pr[lobe]);
             *pdf = pr[lobe];
             *is_delta = true;
             return true;
         }
-        const vec3 m = coat ? pbsdf_ggx_vndf_sample(b->coat_alpha, wo, u[1], u[2]) : pbsdf_mf_sample(b, wo, u[1], u[2]);
-        const float om = v3_dot(wo, m);
-        if (!(om > 0.0f)) return false;
-        w = v3_sub(v3_scale(m, 2.0f * om), wo);
+        if (coat && (b->flags & PBSDF_COAT_NORMAL)) {
+            if (!pbsdf__coat_lobe_sample(b, wo, u[1], u[2], &w)) return false;
+        } else {
+            const vec3 m = coat ? pbsdf_ggx_vndf_sample(b->coat_alpha, wo, u[1], u[2]) : pbsdf_mf_sample(b, wo, u[1], u[2]);
+            const float om = v3_dot(wo, m);
+            if (!(om > 0.0f)) return false;
+            w = v3_sub(v3_scale(m, 2.0f * om), wo);
+        }
     } else if (lobe == 1) { /* the diffuse base */
         const float r = sqrtf(u[1]), phi = 2.0f * PK_PI * u[2];
         w = v3(r * cosf(phi), r * sinf(phi), sqrtf(fmaxf(0.0f, 1.0f - u[1])));
@@ -2629,7 +2712,8 @@ static inline PK_HD bool pbsdf_sample(const pbsdf *b, vec3 wo, const float u[3],
         if (lobe == 0 || lobe == 3) { /* specular reflection, or the clearcoat's */
             const bool coat = lobe == 3;
             if (coat ? pbsdf__coat_smooth(b) : smooth) {
-                *wi = pbsdf__mirror(wo);
+                if (!coat) *wi = pbsdf__mirror(wo);
+                else if (!pbsdf__coat_mirror(b, wo, wi)) return false;
                 vec3 f = coat ? v3s(pbsdf__mr_coat(b, wo)) : pbsdf__mr_delta_reflect(b, wo);
                 if (!coat && b->coat > 0.0f) f = v3_scale(f, under);
                 *weight = v3_scale(f, 1.0f / pr[lobe]);
@@ -2637,8 +2721,12 @@ static inline PK_HD bool pbsdf_sample(const pbsdf *b, vec3 wo, const float u[3],
                 *is_delta = true;
                 return true;
             }
-            vec3 m = pbsdf_ggx_vndf_sample(coat ? b->coat_alpha : b->alpha, wo, u[1], u[2]);
-            w = v3_sub(v3_scale(m, 2.0f * v3_dot(wo, m)), wo);
+            if (coat && (b->flags & PBSDF_COAT_NORMAL)) {
+                if (!pbsdf__coat_lobe_sample(b, wo, u[1], u[2], &w)) return false;
+            } else {
+                vec3 m = pbsdf_ggx_vndf_sample(coat ? b->coat_alpha : b->alpha, wo, u[1], u[2]);
+                w = v3_sub(v3_scale(m, 2.0f * v3_dot(wo, m)), wo);
+            }
             if (!(w.z > 0.0f)) return false;
         } else if (lobe == 1) { /* the diffuse base */
             float r = sqrtf(u[1]), phi = 2.0f * PK_PI * u[2];

@@ -180,6 +180,9 @@ static inline PK_HD shading shading_at(const surface *sf)
         const float c = cosf(m->anisotropy_rotation), s = sinf(m->anisotropy_rotation);
         sh.frame = shading_frame(n, v3_add(v3_scale(sh.frame.s, c), v3_scale(sh.frame.t, s)));
     }
+    if (m->type == MAT_METALLIC_ROUGHNESS && sh.b.coat > 0.0f && v3_len2(sf->nc) > 0.0f)
+        /* the clearcoat's own normal, turned with the frame (a volume's inside: the outward one) */
+        pbsdf_clearcoat_normal(&sh.b, onb_to_local(sh.frame, v3_dot(n, sf->ns) < 0.0f ? v3_neg(sf->nc) : sf->nc));
     sh.nondelta = sh.opaque > 0.0f && pbsdf_has_nondelta(&sh.b) &&
                   (sh.b.type != PBSDF_DIFFUSE || !black(sh.b.albedo));
     return sh;

@@ -17,6 +17,7 @@ typedef struct surface {
     bool front;    /* the ray hit the side the geometric normal points to */
     const material *m;
     vec3 dpdu;     /* the tangent dp/du (unnormalised; zero unless the material is anisotropic) */
+    vec3 nc;       /* the clearcoat's own normal (glTF's clearcoatNormalTexture), same side as ng; zero: none */
 } surface;
 
 /* Whether hit number prim is a triangle (of the world arrays or of a kept
@@ -123,6 +124,7 @@ static inline PK_HD surface surface_at(const scene_view *s, const ray *r, const 
     sf.ng = ng;
     sf.ns = ns;
     sf.dpdu = v3s(0.0f);
+    sf.nc = v3s(0.0f);
     return sf;
 }
 
@@ -302,7 +304,7 @@ static inline PK_HD void surface_texture_at(const scene_view *s, const ray *r, c
     float vw = 0.0f;
     const bool has_vt = surface_is_tri(s, h->prim) && view_tri_tangent(s, h->prim, h->u, h->v, &vt, &vw);
     if (material_anisotropic(m)) sf->dpdu = vt; /* the u roughness's direction */
-    if (!m->map_bump.kind && !m->map_norm.kind) return;
+    if (!m->map_bump.kind && !m->map_norm.kind && !m->map_ccn.kind) return;
     /* a frame on the surface, z = the shading normal as it faces the ray */
     const vec3 n = sf->ns;
     vec3 t = v3_sub(vt, v3_scale(n, v3_dot(n, vt)));
@@ -315,6 +317,17 @@ static inline PK_HD void surface_texture_at(const scene_view *s, const ray *r, c
     } else if (v3_dot(b, uv.dpdv) < 0.0f) {
         b = v3_neg(b);
     }
+    if (m->map_ccn.kind) { /* the clearcoat's normal: its own map on the interpolated normal */
+        const vec3 c = tex_eval_rgb(s->textures, &m->map_ccn, q);
+        const float k = m->coat_norm_scale;
+        vec3 cn = v3_add(v3_add(v3_scale(t, k * (2.0f * c.x - 1.0f)), v3_scale(b, k * (2.0f * c.y - 1.0f))),
+                         v3_scale(n, 2.0f * c.z - 1.0f));
+        if (v3_finite(cn) && v3_len2(cn) > 0.0f) {
+            cn = v3_norm(cn);
+            if (v3_dot(cn, sf->ng) > 0.0f) sf->nc = cn; /* one facing away: the surface's normal */
+        }
+    }
+    if (!m->map_bump.kind && !m->map_norm.kind) return;
     vec3 nn = n;
     if (m->map_norm.kind) {
         vec3 c = tex_eval_rgb(s->textures, &m->map_norm, q);

@@ -20,7 +20,7 @@ void material_init(material *m)
     m->illum = 2;
     m->medium_in = m->medium_out = -2; /* MEDIUM_INHERIT */
     m->alpha_v = -1.0f;                /* isotropic */
-    m->norm_scale = 1.0f;
+    m->norm_scale = m->coat_norm_scale = 1.0f;
     tex_ref_init(&m->map_kd);
     tex_ref_init(&m->map_ks);
     tex_ref_init(&m->map_ns);
@@ -36,6 +36,7 @@ void material_init(material *m)
     tex_ref_init(&m->map_tr);
     tex_ref_init(&m->map_cc);
     tex_ref_init(&m->map_ccr);
+    tex_ref_init(&m->map_ccn);
     m->specular = 1.0f;
     m->specular_color = v3s(1.0f);
     m->iridescence_ior = 1.3f;

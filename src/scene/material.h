@@ -179,9 +179,10 @@ typedef struct material {
      * value multiplies its constant, clamped to 0..1): map_tr's red channel
      * the transmission (KHR_materials_transmission), map_cc's red the
      * clearcoat and map_ccr's green the clearcoat roughness (a grey texture:
-     * its grey). */
+     * its grey); map_ccn is the clearcoat's own normal map (tangent space,
+     * as map_norm, its x and y scaled by coat_norm_scale). */
     tex_ref map_kd, map_ks, map_ns, map_d, map_alpha, map_bump, map_norm, map_mr, map_ke, map_eta, map_k, map_tf;
-    tex_ref map_tr, map_cc, map_ccr;
+    tex_ref map_tr, map_cc, map_ccr, map_ccn;
     /* glTF's extension maps (metallic-roughness): map_spec's alpha
      * multiplies specular, map_spec_color specular_color, map_sheen
      * sheen_color, map_sheen_rough's alpha sheen_roughness, map_irid's red
@@ -193,7 +194,7 @@ typedef struct material {
     tex_ref map_spec, map_spec_color, map_sheen, map_sheen_rough, map_irid, map_irid_thick, map_aniso;
     /* map_norm's scale (glTF's normalTexture.scale): the map's x and y are
      * multiplied by it before the normal is normalised; 1 by default */
-    float norm_scale;
+    float norm_scale, coat_norm_scale;
     /* glTF's alphaMode BLEND as stochastic transparency: the surface is
      * there for a ray with probability blend_alpha times map_d's alpha
      * (when map_d is set; then it is no cut-out), decided by a hash of the

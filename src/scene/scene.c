@@ -960,7 +960,8 @@ pk_status scene_commit(pk_context *ctx, pk_scene *s)
                       m->map_alpha.kind != TEX_NONE || m->map_bump.kind != TEX_NONE || m->map_norm.kind != TEX_NONE ||
                       m->map_mr.kind != TEX_NONE || m->map_ke.kind != TEX_NONE || m->map_eta.kind != TEX_NONE ||
                       m->map_k.kind != TEX_NONE || m->map_tf.kind != TEX_NONE || m->map_tr.kind != TEX_NONE ||
-                      m->map_cc.kind != TEX_NONE || m->map_ccr.kind != TEX_NONE || material_anisotropic(m) ||
+                      m->map_cc.kind != TEX_NONE || m->map_ccr.kind != TEX_NONE || m->map_ccn.kind != TEX_NONE ||
+                      material_anisotropic(m) ||
                       m->vertex_color || m->map_spec.kind != TEX_NONE || m->map_spec_color.kind != TEX_NONE ||
                       m->map_sheen.kind != TEX_NONE || m->map_sheen_rough.kind != TEX_NONE ||
                       m->map_irid.kind != TEX_NONE || m->map_irid_thick.kind != TEX_NONE ||
@@ -1032,12 +1033,12 @@ bool scene_check(const pk_scene *s, char *why, size_t n)
     if (tex_bytes != s->texture_bytes) FAIL("texture bytes do not add up");
     for (size_t i = 0; i < s->nmaterials; i++) {
         const material *m = &s->materials[i];
-        const tex_ref *maps[22] = {&m->map_kd,   &m->map_ks,   &m->map_ns, &m->map_d,  &m->map_alpha, &m->map_bump,
+        const tex_ref *maps[23] = {&m->map_kd,   &m->map_ks,   &m->map_ns, &m->map_d,  &m->map_alpha, &m->map_bump,
                                    &m->map_norm, &m->map_mr, &m->map_ke, &m->map_eta, &m->map_k,   &m->map_tf,
-                                   &m->map_tr,   &m->map_cc, &m->map_ccr,
+                                   &m->map_tr,   &m->map_cc, &m->map_ccr, &m->map_ccn,
                                    &m->map_spec, &m->map_spec_color, &m->map_sheen, &m->map_sheen_rough,
                                    &m->map_irid, &m->map_irid_thick, &m->map_aniso};
-        for (int j = 0; j < 22; j++)
+        for (int j = 0; j < 23; j++)
         {
             if (maps[j]->kind == TEX_IMAGE && (maps[j]->tex < 0 || (size_t)maps[j]->tex >= s->ntextures))
                 FAIL("material %zu: texture index out of range", i);

@@ -19,7 +19,10 @@
 #include "io/gltf.h"
 #include "io/readers.h"
 #include "render/pbsdf.h"
+#include "render/shading.h"
+#include "render/surface.h"
 #include "scene/scene.h"
+#include "scene/scene_view.h"
 
 #include <stdint.h>
 
@@ -289,7 +292,7 @@ static void test_reader_layers(void)
              "\"transmissionTexture\":{\"index\":0}},"
              "\"KHR_materials_clearcoat\":{\"clearcoatFactor\":1,\"clearcoatRoughnessFactor\":0.5,"
              "\"clearcoatTexture\":{\"index\":0},\"clearcoatRoughnessTexture\":{\"index\":0},"
-             "\"clearcoatNormalTexture\":{\"index\":0}}}},"
+             "\"clearcoatNormalTexture\":{\"index\":0,\"scale\":0.5}}}},"
              /* 1: a volume that is not purely transmissive, its thickness textured */
              "{\"pbrMetallicRoughness\":{\"metallicFactor\":0.25},\"extensions\":{\"KHR_materials_transmission\":"
              "{\"transmissionFactor\":0.75},\"KHR_materials_volume\":{\"thicknessFactor\":1,"
@@ -316,8 +319,45 @@ static void test_reader_layers(void)
     CHECK(m0->map_cc.kind == TEX_IMAGE && m0->map_ccr.kind == TEX_IMAGE && m0->clearcoat_roughness == 0.5f);
     CHECK(m0->map_tr.tex == m0->map_cc.tex && !s->textures[m0->map_tr.tex].srgb); /* data, not colour */
     CHECK(m0->textured && !m0->volume);
-    CHECK(warning_log_has(&wlog, "clearcoatNormalTexture: the clearcoat is drawn with the surface's normal"));
-    CHECK(!warning_log_has(&wlog, "not supported"));
+    CHECK(m0->map_ccn.kind == TEX_IMAGE && m0->coat_norm_scale == 0.5f && m0->map_ccn.tex == m0->map_cc.tex);
+    CHECK(!warning_log_has(&wlog, "clearcoatNormalTexture") && !warning_log_has(&wlog, "not supported"));
+    /* the clearcoat's normal at texel centres: the map's x and y times 0.5 in the frame t = +x
+     * (u), b = -y (glTF's v runs down +y here), n = +z, normalised; the surface's own normal
+     * stays +z (no normalTexture), and the BSDF gets the coat's in its local frame */
+    {
+        const scene_view v = scene_view_of(s);
+        const float centres[4][2] = {{0.25f, 0.75f}, {0.75f, 0.75f}, {0.25f, 0.25f}, {0.75f, 0.25f}};
+        int used = 0;
+        for (int k = 0; k < 4; k++) {
+            const float uc = centres[k][0], vc = centres[k][1];
+            /* the triangle's uvs (0, 1), (1, 1), (1, 0) (glTF's (0, 0), (1, 0), (1, 1) with v
+             * flipped): uv (u + v, 1 - v) at barycentric (u, v) */
+            const float bu = uc + vc - 1.0f, bv = 1.0f - vc;
+            if (bu < 0.0f || uc > 1.0f) continue; /* outside the triangle */
+            const tex_query q = {uc, vc, 0.0f, v3s(0.0f), v3s(0.0f), v.tex_nodes};
+            const vec3 c = tex_eval_rgb(v.textures, &m0->map_ccn, q);
+            const vec3 tl = v3(0.5f * (2.0f * c.x - 1.0f), 0.5f * (2.0f * c.y - 1.0f), 2.0f * c.z - 1.0f);
+            ray r = {{bu, bv, 1.0f}, 0.0f, {0.0f, 0.0f, -1.0f}, INFINITY};
+            hit h = {1.0f, 0, bu, bv};
+            material tm;
+            const surface sf = surface_texture(&v, &r, &h, 0.0f, surface_at(&v, &r, &h), &tm);
+            CHECK(fabsf(sf.ns.z - 1.0f) < 1e-6f);
+            if (!(tl.z > 0.0f)) { /* a normal facing away is not used */
+                CHECKF(v3_len2(sf.nc) == 0.0f, "texel %d: a coat normal facing away was used", k);
+                continue;
+            }
+            const vec3 want = v3_norm(v3(tl.x, -tl.y, tl.z));
+            CHECKF(fabsf(sf.nc.x - want.x) < 1e-5f && fabsf(sf.nc.y - want.y) < 1e-5f && fabsf(sf.nc.z - want.z) < 1e-5f,
+                   "texel %d: coat normal (%g %g %g), want (%g %g %g)", k, (double)sf.nc.x, (double)sf.nc.y,
+                   (double)sf.nc.z, (double)want.x, (double)want.y, (double)want.z);
+            const shading sh = shading_at(&sf);
+            const vec3 cl = onb_to_local(sh.frame, want);
+            CHECK((sh.b.flags & PBSDF_COAT_NORMAL) && fabsf(sh.b.coat_n.x - cl.x) < 1e-5f &&
+                  fabsf(sh.b.coat_n.y - cl.y) < 1e-5f && fabsf(sh.b.coat_n.z - cl.z) < 1e-5f);
+            used++;
+        }
+        CHECK(used >= 1);
+    }
     /* the general volume: the metallic-roughness BSDF that refracts, the thickness map not warned about */
     CHECK(m1->type == MAT_METALLIC_ROUGHNESS && m1->volume && m1->metallic == 0.25f && m1->transmission == 0.75f);
     CHECK(!warning_log_has(&wlog, "thicknessTexture") && !warning_log_has(&wlog, "thin sheet"));
