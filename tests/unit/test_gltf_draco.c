@@ -93,7 +93,10 @@ static char *document(const uint8_t *stream, size_t slen, const int ids[4], bool
              "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu},{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu},"
              "{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu},{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu}",
              slen, off[0], len[0], off[1], len[1], off[2], len[2], off[3], len[3], off[4], len[4]);
-    for (int k = 0; k < 5; k++) snprintf(bv[k], sizeof bv[k], fallback ? "\"bufferView\":%d," : "", k + 1);
+    for (int k = 0; k < 5; k++) {
+        bv[k][0] = '\0';
+        if (fallback) snprintf(bv[k], sizeof bv[k], "\"bufferView\":%d,", k + 1);
+    }
     snprintf(idsj, sizeof idsj, "{\"POSITION\":%d,\"NORMAL\":%d,\"TEXCOORD_0\":%d,\"COLOR_0\":%d}", ids[0], ids[1],
              ids[2], ids[3]);
     snprintf(ext, sizeof ext, ",\"extensions\":{\"KHR_draco_mesh_compression\":{\"bufferView\":0,\"attributes\":%s}}",
