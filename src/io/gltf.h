@@ -60,7 +60,7 @@ typedef struct gltf {
     bool ext_quantization, ext_texture_transform;
     /* glTF material i -> scene material (0 = not made yet, else index + 1) */
     uint32_t *materials;
-    uint8_t *mat_uvset;    /* the TEXCOORD set a material's textures use (0 or 1) */
+    uint8_t *mat_uvset;    /* the TEXCOORD sets a material's textures read (bit k: TEXCOORD_k) */
     gltf_uv_xform *mat_uv; /* a KHR_texture_transform baked into the uvs */
     size_t nmaterials;
     /* image i decoded as colour (0) / data (1): texture index + 1, 0 = not yet */
@@ -178,9 +178,10 @@ PK_HIDDEN bool gltf_have_draco(gltf *g, char *why, size_t n);
 /* ---- materials (gltf_material.c) ---- */
 
 /* The scene material for glTF material i (-1: the default), made on first
- * use; *uvset: the TEXCOORD set its textures read; g->mat_uv[i] says the
- * uv transform to bake into the primitive's uvs. */
-PK_HIDDEN pk_status gltf_material(gltf *g, int64_t i, uint32_t *mat, int *uvset);
+ * use; *uvsets: the TEXCOORD sets its textures read (bit k: TEXCOORD_k, k
+ * < 2); g->mat_uv[i] says the uv transform to bake into the primitive's
+ * uvs (both sets). */
+PK_HIDDEN pk_status gltf_material(gltf *g, int64_t i, uint32_t *mat, int *uvsets);
 PK_HIDDEN void gltf_materials_free(gltf *g);
 
 #endif

@@ -230,6 +230,7 @@ static pk_status make_ref(gltf *g, const tex_info *ti, bool colour, bool bake, c
     if (tex < 0) return PK_OK;
     r->kind = TEX_IMAGE;
     r->tex = tex;
+    r->uvset = (uint8_t)(ti->texcoord == 1);
     bool ms = false, mt = false;
     if (smp >= 0) {
         const cJSON *so = cJSON_GetArrayItem(gltf_array(g, "samplers"), (int)smp);
@@ -396,7 +397,7 @@ static pk_status make_volume(gltf *g, const char *path, material *m, float trans
     return PK_OK;
 }
 
-static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
+static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvsets)
 {
     const cJSON *o = cJSON_GetArrayItem(gltf_array(g, "materials"), (int)mi);
     char path[48], pp[96], ep[160];
@@ -550,8 +551,8 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
         }
     }
 
-    /* which uv set, and whether one transform serves every texture (then it
-     * is baked into the primitive's uvs, rotation included) */
+    /* which uv sets, and whether one transform serves every texture (then
+     * it is baked into the primitive's uvs, rotation included) */
     if (transmission == 0.0f) t_tr.present = false; /* (read, never looked up) */
     if (coat == 0.0f) t_cc.present = t_ccr.present = t_ccn.present = false;
     if (coat_rough == 0.0f) t_ccr.present = false;
@@ -563,22 +564,21 @@ static pk_status make_material(gltf *g, int64_t mi, uint32_t *out, int *uvset)
     }
     tex_info *all[8 + GX_NTEX] = {&t_base, &t_mr, &t_norm, &t_emit, &t_tr, &t_cc, &t_ccr, &t_ccn};
     for (int k = 0; k < GX_NTEX; k++) all[8 + k] = &gx.t[k];
-    int set = -1;
+    int sets = 0;
     bool same = true;
     const tex_info *first = NULL;
     for (int k = 0; k < 8 + GX_NTEX; k++) {
         if (!all[k]->present) continue;
-        if (set < 0) set = all[k]->texcoord;
-        else if (all[k]->texcoord != set)
-            gltf_warn_once(g, GW_UV_SETS, "%s: textures read different uv sets; all read TEXCOORD_%d", path, set);
+        if (all[k]->texcoord > 1) {
+            gltf_warn_once(g, GW_UV_SETS, "%s: a texture reads TEXCOORD_%d; only TEXCOORD_0 and _1 are read, so it reads "
+                           "TEXCOORD_0 (further ones not reported)", path, all[k]->texcoord);
+            all[k]->texcoord = 0;
+        }
+        sets |= 1 << all[k]->texcoord;
         if (!first) first = all[k];
         else if (!same_transform(first, all[k])) same = false;
     }
-    if (set > 1) {
-        gltf_warn(g, "%s: TEXCOORD_%d is not read; the textures read TEXCOORD_0", path, set);
-        set = 0;
-    }
-    *uvset = set < 0 ? 0 : set;
+    *uvsets = sets;
 
     uint32_t idx;
     char mname[64];
@@ -663,11 +663,11 @@ fail:
     return st;
 }
 
-pk_status gltf_material(gltf *g, int64_t i, uint32_t *mat, int *uvset)
+pk_status gltf_material(gltf *g, int64_t i, uint32_t *mat, int *uvsets)
 {
     if (i < 0) {
         *mat = 0;
-        *uvset = 0;
+        *uvsets = 0;
         return PK_OK;
     }
     if (!g->materials[i]) {
@@ -679,7 +679,7 @@ pk_status gltf_material(gltf *g, int64_t i, uint32_t *mat, int *uvset)
         g->mat_uvset[i] = (uint8_t)set;
     }
     *mat = g->materials[i] - 1;
-    *uvset = g->mat_uvset[i];
+    *uvsets = g->mat_uvset[i];
     return PK_OK;
 }
 

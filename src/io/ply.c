@@ -153,6 +153,7 @@ void ply_mesh_free(pk_context *ctx, ply_mesh *m)
     mem_free(&ctx->alloc, m->uvs);
     mem_free(&ctx->alloc, m->colors);
     mem_free(&ctx->alloc, m->tangents);
+    mem_free(&ctx->alloc, m->uvs1);
     mem_free(&ctx->alloc, m->indices);
     mem_free(&ctx->alloc, m->face_material);
     memset(m, 0, sizeof *m);
@@ -277,6 +278,7 @@ pk_status ply_parse(pk_context *ctx, const char *data, size_t size, const char *
         }
         bool is_vertex = strcmp(el->name, "vertex") == 0, is_face = strcmp(el->name, "face") == 0;
         int px = -1, py = -1, pz = -1, pnx = -1, pny = -1, pnz = -1, pu = -1, pv = -1, pidx = -1, pmat = -1;
+        int pu1 = -1, pv1 = -1;
         int pc[4] = {-1, -1, -1, -1}, pt[4] = {-1, -1, -1, -1};
         static const char *const cnames[4] = {"color_r", "color_g", "color_b", "color_a"};
         static const char *const tnames[4] = {"tangent_x", "tangent_y", "tangent_z", "tangent_w"};
@@ -294,6 +296,8 @@ pk_status ply_parse(pk_context *ctx, const char *data, size_t size, const char *
                     pu = k;
                 else if (!strcmp(pn, "v") || !strcmp(pn, "t") || !strcmp(pn, "texture_v") || !strcmp(pn, "texture_t"))
                     pv = k;
+                else if (!strcmp(pn, "u1")) pu1 = k;
+                else if (!strcmp(pn, "v1")) pv1 = k;
                 for (int q = 0; q < 4; q++) {
                     if (!strcmp(pn, cnames[q])) pc[q] = k;
                     if (!strcmp(pn, tnames[q])) pt[q] = k;
@@ -324,7 +328,8 @@ pk_status ply_parse(pk_context *ctx, const char *data, size_t size, const char *
             const bool hc = pc[0] >= 0 && pc[1] >= 0 && pc[2] >= 0 && pc[3] >= 0;
             const bool ht = pt[0] >= 0 && pt[1] >= 0 && pt[2] >= 0 && pt[3] >= 0;
             if ((hc && !(out->colors = mem_calloc(&ctx->alloc, 4 * ncap, sizeof *out->colors))) ||
-                (ht && !(out->tangents = mem_calloc(&ctx->alloc, 4 * ncap, sizeof *out->tangents)))) {
+                (ht && !(out->tangents = mem_calloc(&ctx->alloc, 4 * ncap, sizeof *out->tangents))) ||
+                (pu1 >= 0 && pv1 >= 0 && !(out->uvs1 = mem_calloc(&ctx->alloc, 2 * ncap, sizeof *out->uvs1)))) {
                 st = ctx_nomem(ctx);
                 goto out;
             }
@@ -391,6 +396,10 @@ pk_status ply_parse(pk_context *ctx, const char *data, size_t size, const char *
                 if (out->uvs) {
                     out->uvs[2 * it] = isfinite((float)vals[pu]) ? (float)vals[pu] : 0.0f;
                     out->uvs[2 * it + 1] = isfinite((float)vals[pv]) ? (float)vals[pv] : 0.0f;
+                }
+                if (out->uvs1) {
+                    out->uvs1[2 * it] = isfinite((float)vals[pu1]) ? (float)vals[pu1] : 0.0f;
+                    out->uvs1[2 * it + 1] = isfinite((float)vals[pv1]) ? (float)vals[pv1] : 0.0f;
                 }
                 for (int ch = 0; ch < 4; ch++) {
                     if (out->colors)

@@ -100,6 +100,7 @@ typedef struct ply_mesh {
      * (color_r, color_g, color_b, color_a) and tangents (tangent_x, _y, _z,
      * _w: scene.h's vtangent), all four properties or none */
     float *colors, *tangents;
+    float *uvs1;          /* 2 * nvertices, or NULL: the second texture-coordinate set (u1, v1) */
     size_t nvertices;
     uint32_t *indices;    /* 3 * ntriangles, each < nvertices */
     size_t ntriangles;

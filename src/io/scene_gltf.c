@@ -383,12 +383,12 @@ static pk_status read_colors(gltf *g, const cJSON *attrs, const char *path, size
 /* Applies the morph targets of primitive p (at path) with weights w[0..nw)
  * to its n vertices: each target's displacements times its weight are
  * added to the positions, the normals (nrm, may be NULL), the texture
- * coordinates (uv, the set uvkey; may be NULL) and the colours (col, RGBA;
+ * coordinates (uv and uv1, TEXCOORD_0 and _1; may be NULL) and the colours (col, RGBA;
  * may be NULL; a VEC3 displacement leaves alpha). TANGENT displacements are
  * not read: a morphed primitive's tangents are generated from its posed
  * shape. */
 static pk_status apply_morph(gltf *g, const cJSON *p, const char *path, const float *w, size_t nw, size_t n,
-                             float *pos, float *nrm, float *uv, const char *uvkey, float *col)
+                             float *pos, float *nrm, float *uv, float *uv1, float *col)
 {
     const cJSON *targets = cJSON_GetObjectItemCaseSensitive(p, "targets");
     if (!targets) return PK_OK;
@@ -403,11 +403,11 @@ static pk_status apply_morph(gltf *g, const cJSON *p, const char *path, const fl
         if (!cJSON_IsObject(t)) return gltf_fail(g, PK_ERR_PARSE, "%s: must be an object", tp);
         const float wk = k < nw ? w[k] : 0.0f;
         if (wk == 0.0f) continue;
-        for (int a = 0; a < 4; a++) {
-            static const char *const keys[3] = {"POSITION", "NORMAL", NULL};
-            float *dst = a == 0 ? pos : a == 1 ? nrm : a == 2 ? uv : col, *d = NULL;
+        for (int a = 0; a < 5; a++) {
+            static const char *const keys[5] = {"POSITION", "NORMAL", "TEXCOORD_0", "COLOR_0", "TEXCOORD_1"};
+            float *dst = a == 0 ? pos : a == 1 ? nrm : a == 2 ? uv : a == 3 ? col : uv1, *d = NULL;
             if (!dst) continue;
-            int nc = a == 2 ? 2 : 3, stride = a == 3 ? 4 : nc;
+            int nc = a == 2 || a == 4 ? 2 : 3, stride = a == 3 ? 4 : nc;
             pk_status st;
             if (a == 3) {
                 int64_t ci;
@@ -415,7 +415,7 @@ static pk_status apply_morph(gltf *g, const cJSON *p, const char *path, const fl
                 if (ci < 0) continue;
             }
             size_t cnt = n;
-            st = attribute_in(g, t, tp, a == 2 ? uvkey : a == 3 ? "COLOR_0" : keys[a], nc, false, false, &cnt, &d);
+            st = attribute_in(g, t, tp, keys[a], nc, false, false, &cnt, &d);
             if (st) return st;
             if (!d) continue;
             for (size_t i = 0; i < n; i++)
@@ -706,25 +706,27 @@ static pk_status add_primitive(gltf *g, int64_t mi, int pi, const cJSON *p, bool
     if ((st = gltf_index(g, p, path, "material", gltf_count(g, "materials"), false, &mat))) return st;
     if (g->variant >= 0 && (st = variant_material(g, p, path, &mat))) return st;
     uint32_t smat;
-    int uvset;
-    if ((st = gltf_material(g, mat, &smat, &uvset))) return st;
+    int uvsets;
+    if ((st = gltf_material(g, mat, &smat, &uvsets))) return st;
 
-    float *pos = NULL, *nrm = NULL, *uv = NULL, *tmp = NULL, *col = NULL, *tan = NULL;
+    float *pos = NULL, *nrm = NULL, *uv = NULL, *uv1 = NULL, *tmp = NULL, *col = NULL, *tan = NULL;
     uint32_t *idx = NULL, *tris = NULL;
     size_t n = 0, ntris = 0;
     if ((st = attribute(g, attrs, path, "POSITION", 3, true, &n, &pos))) goto out;
     if ((st = attribute(g, attrs, path, "NORMAL", 3, false, &n, &nrm))) goto out;
-    if ((st = attribute(g, attrs, path, uvset ? "TEXCOORD_1" : "TEXCOORD_0", 2, false, &n, &uv))) goto out;
+    if ((st = attribute(g, attrs, path, "TEXCOORD_0", 2, false, &n, &uv))) goto out;
+    if ((uvsets & 2) && (st = attribute(g, attrs, path, "TEXCOORD_1", 2, false, &n, &uv1))) goto out;
+    if ((uvsets & 2) && !uv1 && uv)
+        gltf_warn_once(g, GW_UV1, "%s/attributes: a texture of the material reads TEXCOORD_1, which the primitive does "
+                       "not have; it reads TEXCOORD_0 (further ones not reported)", path);
     if ((st = read_colors(g, attrs, path, &n, &col))) goto out;
-    if (!uvset && cJSON_GetObjectItemCaseSensitive(attrs, "TEXCOORD_1"))
-        gltf_warn_once(g, GW_UV1, "%s/attributes/TEXCOORD_1: no texture of the material reads it; ignored", path);
     /* the vertex tangents, for the frame of a normal map or of anisotropic roughness */
     const material *sm = &g->s->materials[smat];
     const bool want_tan = sm->map_norm.kind != TEX_NONE || sm->map_ccn.kind != TEX_NONE || material_anisotropic(sm);
     bool posed = g->skin != NULL;
     for (size_t k = 0; k < nw; k++) posed |= w[k] != 0.0f && cJSON_GetObjectItemCaseSensitive(p, "targets");
     if (want_tan && !posed && (st = read_tangents(g, attrs, path, &n, &tan))) goto out;
-    if ((st = apply_morph(g, p, path, w, nw, n, pos, nrm, uv, uvset ? "TEXCOORD_1" : "TEXCOORD_0", col))) goto out;
+    if ((st = apply_morph(g, p, path, w, nw, n, pos, nrm, uv, uv1, col))) goto out;
     if (g->skin && (st = apply_skin(g, attrs, path, n, pos, nrm))) goto out;
     size_t nidx = n;
     if (ii >= 0) {
@@ -734,16 +736,17 @@ static pk_status add_primitive(gltf *g, int64_t mi, int pi, const cJSON *p, bool
         nidx = a.count;
     }
     if ((st = triangulate(g, path, (int)mode, idx, nidx, n, &tris, &ntris))) goto out;
-    if (uv) {
+    for (int set = 0; set < 2; set++) {
+        float *t = set ? uv1 : uv;
         const gltf_uv_xform *x = mat >= 0 ? &g->mat_uv[mat] : NULL;
-        for (size_t k = 0; k < n; k++) {
-            float u = uv[2 * k], v = uv[2 * k + 1];
+        for (size_t k = 0; t && k < n; k++) {
+            float u = t[2 * k], v = t[2 * k + 1];
             if (x && x->bake) {
                 float u2 = x->m[0] * u + x->m[1] * v + x->m[2], v2 = x->m[3] * u + x->m[4] * v + x->m[5];
                 u = u2, v = v2;
             }
-            uv[2 * k] = u;
-            uv[2 * k + 1] = 1.0f - v; /* glTF's v runs down the image, the scene's up */
+            t[2 * k] = u;
+            t[2 * k + 1] = 1.0f - v; /* glTF's v runs down the image, the scene's up */
         }
     }
     if (nrm) /* unit normals as the specification requires (quantized ones are not) */
@@ -752,7 +755,9 @@ static pk_status add_primitive(gltf *g, int64_t mi, int pi, const cJSON *p, bool
             *q = v3_norm_scaled(*q);
             if (!v3_finite(*q)) *q = v3s(0.0f);
         }
-    if (want_tan && !tan && nrm && uv && (st = gen_tangents(g, pos, nrm, uv, n, tris, ntris, &tan))) goto out;
+    /* generated in the uv set of the normal map (or of the anisotropy's direction map) */
+    const float *tuv = (sm->map_norm.kind ? sm->map_norm.uvset : sm->map_aniso.uvset) && uv1 ? uv1 : uv;
+    if (want_tan && !tan && nrm && tuv && (st = gen_tangents(g, pos, nrm, tuv, n, tris, ntris, &tan))) goto out;
     if (col && smat == 0) { /* the default material with the colours: a copy of its own */
         if (!g->vc_default) {
             uint32_t c;
@@ -770,6 +775,10 @@ static pk_status add_primitive(gltf *g, int64_t mi, int pi, const cJSON *p, bool
         const float *c = col + 4 * k;
         st = scene_set_color(g->ctx, g->s, pbase + k, (rgba){c[0], c[1], c[2], c[3]});
     }
+    /* the second set where a texture reads it (TEXCOORD_0 where the primitive has none) */
+    const float *t1 = uv1 ? uv1 : uv;
+    for (size_t k = 0; t1 && (uvsets & 2) && st == PK_OK && k < n; k++)
+        st = scene_set_uv1(g->ctx, g->s, pbase + k, (uv2){t1[2 * k], t1[2 * k + 1]});
     if (tan && st == PK_OK) { /* through the transform; a mirroring one turns the handedness */
         const xform *x = sb_transform(&g->b);
         const float hand = xform_det3(x) < 0.0 ? -1.0f : 1.0f;
@@ -786,6 +795,7 @@ out:
     mem_free(&g->ctx->alloc, pos);
     mem_free(&g->ctx->alloc, nrm);
     mem_free(&g->ctx->alloc, uv);
+    mem_free(&g->ctx->alloc, uv1);
     mem_free(&g->ctx->alloc, tmp);
     mem_free(&g->ctx->alloc, idx);
     mem_free(&g->ctx->alloc, tris);

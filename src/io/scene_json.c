@@ -284,8 +284,8 @@ static pk_status get_array(jp *p, const cJSON *it, const char *path)
 
 /* ---- textures --------------------------------------------------------------- */
 
-enum { TX_TEXTURE, TX_CHECKER, TX_SCALE, TX_OFFSET, TX_CLAMP, TX_STRENGTH, TX_COUNT };
-static const char *const tx_keys[TX_COUNT] = {"texture", "checker", "scale", "offset", "clamp", "strength"};
+enum { TX_TEXTURE, TX_CHECKER, TX_SCALE, TX_OFFSET, TX_CLAMP, TX_STRENGTH, TX_UVSET, TX_COUNT };
+static const char *const tx_keys[TX_COUNT] = {"texture", "checker", "scale", "offset", "clamp", "strength", "uvset"};
 
 /* A checker's colour: three numbers, or one for a scalar parameter. */
 static pk_status get_checker_value(jp *p, const cJSON *it, const char *path, vec3 *out)
@@ -301,7 +301,7 @@ static pk_status get_checker_value(jp *p, const cJSON *it, const char *path, vec
 }
 
 /* A parameter given as a texture object: {"texture": "file.png", "scale": [su, sv],
- * "offset": [ou, ov], "clamp": false} or {"checker": {"even": c, "odd": c,
+ * "offset": [ou, ov], "clamp": false, "uvset": 0} or {"checker": {"even": c, "odd": c,
  * "scale": n}, ...}; bump maps also take "strength" (-bm). Fills *ref. An image that cannot be used is a warning:
  * ref stays without a texture and *loaded is false. colour: the image holds
  * colours (decoded from sRGB). */
@@ -336,6 +336,13 @@ static pk_status get_texture(jp *p, const cJSON *it, const char *path, bool colo
     if (f[TX_CLAMP]) {
         path_key(fp, path, "clamp");
         if ((st = get_wrap(p, f[TX_CLAMP], fp, &r.clamp))) return st;
+    }
+    if (f[TX_UVSET]) {
+        int set = 0;
+        path_key(fp, path, "uvset");
+        if ((st = get_int(p, f[TX_UVSET], fp, INT32_MIN + 1, INT32_MAX, &set))) return st;
+        if (set != 0 && set != 1) return jfail(p, PK_ERR_PARSE, f[TX_UVSET], fp, "must be 0 or 1 (the uv set)");
+        r.uvset = (uint8_t)set;
     }
     if (f[TX_CHECKER]) {
         static const char *const ck[3] = {"even", "odd", "scale"};
@@ -1462,6 +1469,7 @@ static pk_status read_texref_record(jp *p, const cJSON *it, const char *path, te
     pk_status st = rec_read(p, it, path, rec_texref, rec_ntexref, extra, r);
     if (st) return st;
     if (r->kind > TEX_CHECKER) return jfail(p, PK_ERR_PARSE, it, path, "kind must be 0 (none), 1 (image) or 2 (checker)");
+    if (r->uvset > 1) return jfail(p, PK_ERR_PARSE, it, path, "uvset must be 0 or 1");
     if (r->kind != TEX_IMAGE) return PK_OK;
     char fp[JP_PATH_MAX];
     const cJSON *img = cJSON_GetObjectItemCaseSensitive(it, "image");
@@ -1579,6 +1587,8 @@ static pk_status load_ply_file(jp *p, const cJSON *file, const char *fp, const u
         const float *c = m.tangents + 4 * v;
         st = scene_set_tangent(p->ctx, s, pos0 + v, (vtangent){{c[0], c[1], c[2]}, c[3]});
     }
+    for (size_t v = 0; m.uvs1 && v < m.nvertices && st == PK_OK; v++)
+        st = scene_set_uv1(p->ctx, s, pos0 + v, (uv2){m.uvs1[2 * v], m.uvs1[2 * v + 1]});
     for (size_t t = 0; t < m.ntriangles && st == PK_OK; t++) {
         triangle tri;
         tri.material = 0;

@@ -2365,7 +2365,7 @@ static vec3 tex_mean(pp *p, const tex_node *nodes, int n)
             const float u = ((float)i + 0.5f) / (float)k, v = ((float)j + 0.5f) / (float)k;
             const float ph = 2.0f * PK_PI * u, ct = 2.0f * v - 1.0f, sn = sqrtf(fmaxf(0.0f, 1.0f - ct * ct));
             tex_query q = {u, v, 0.0f, v3(8.0f * u - 4.0f, 8.0f * v - 4.0f, 8.0f * fmodf(u * 7.0f + v * 3.0f, 1.0f) - 4.0f),
-                           v3(sn * cosf(ph), ct, sn * sinf(ph)), nodes};
+                           v3(sn * cosf(ph), ct, sn * sinf(ph)), nodes, u, v, 0.0f};
             sum = v3_add(sum, tex_expr_eval(p->s->textures, &r, q));
         }
     return v3_scale(sum, 1.0f / (float)(k * k));

@@ -67,6 +67,7 @@ const rec_field rec_texref[] = {
     {"kind", REC_U8, offsetof(tex_ref, kind)},   F(tex_ref, clamp, REC_WRAP), F(tex_ref, squared, REC_BOOL),
     F(tex_ref, s, REC_F2),                          F(tex_ref, o, REC_F2),       F(tex_ref, bm, REC_FLOAT),
     F(tex_ref, even, REC_VEC3),                     F(tex_ref, odd, REC_VEC3),   F(tex_ref, checker_scale, REC_FLOAT),
+    F(tex_ref, uvset, REC_U8),
 };
 const size_t rec_ntexref = sizeof rec_texref / sizeof rec_texref[0];
 

@@ -464,6 +464,7 @@ typedef struct tri_src {
     const uv2 *uv;
     const rgba *col;        /* by position, NULL: none */
     const vtangent *tan;    /* by position, NULL: none */
+    const uv2 *uv1;         /* the second texture-coordinate set by position, NULL: none */
 } tri_src;
 
 static bool tri_has_n(const triangle *t) { return t->n[0] >= 0 && t->n[1] >= 0 && t->n[2] >= 0; }
@@ -506,11 +507,12 @@ static pk_status write_run(jw *w, const tri_src *src, size_t t0, size_t t1, mat_
     if (src->col) fputs("property float color_r\nproperty float color_g\nproperty float color_b\nproperty float color_a\n", f);
     if (src->tan)
         fputs("property float tangent_x\nproperty float tangent_y\nproperty float tangent_z\nproperty float tangent_w\n", f);
+    if (src->uv1) fputs("property float u1\nproperty float v1\n", f);
     fprintf(f, "element face %zu\nproperty list uchar uint vertex_indices\nproperty uint material\nend_header\n", ntri);
     for (size_t t = t0; t < t1; t++) {
         const triangle *tr = &src->tris[t];
         for (int j = 0; j < 3; j++) {
-            float v[16];
+            float v[20];
             int n = 0;
             const vec3 p = src->pos[tr->v[j]];
             v[n++] = p.x, v[n++] = p.y, v[n++] = p.z;
@@ -529,6 +531,10 @@ static pk_status write_run(jw *w, const tri_src *src, size_t t0, size_t t1, mat_
             if (src->tan) {
                 const vtangent c = src->tan[tr->v[j]];
                 v[n++] = c.t.x, v[n++] = c.t.y, v[n++] = c.t.z, v[n++] = c.w;
+            }
+            if (src->uv1) {
+                const uv2 q = src->uv1[tr->v[j]];
+                v[n++] = q.u, v[n++] = q.v;
             }
             fwrite(v, sizeof(float), (size_t)n, f);
         }
@@ -595,7 +601,7 @@ static pk_status write_meshes(jw *w)
     }
     fputs(",\n\"meshes\": [", w->f);
     /* the world's triangles, a file (and an entry) per run */
-    const tri_src world = {s->tris, s->ntris, s->positions, s->normals, s->uvs, s->colors, s->tangents};
+    const tri_src world = {s->tris, s->ntris, s->positions, s->normals, s->uvs, s->colors, s->tangents, s->uvs1};
     bool first = true;
     for (size_t t0 = 0; t0 < s->ntris && st == PK_OK;) {
         const size_t t1 = run_end(&world, t0);
@@ -618,7 +624,8 @@ static pk_status write_meshes(jw *w)
         const tri_src src = {s->mesh_tris + m->first_tri, m->ntris, s->mesh_positions + m->first_pos,
                              s->mesh_normals + m->first_nrm, s->mesh_uvs + m->first_uv,
                              s->mesh_colors ? s->mesh_colors + m->first_pos : NULL,
-                             s->mesh_tangents ? s->mesh_tangents + m->first_pos : NULL};
+                             s->mesh_tangents ? s->mesh_tangents + m->first_pos : NULL,
+                             s->mesh_uvs1 ? s->mesh_uvs1 + m->first_pos : NULL};
         fprintf(w->f, "%s\n  {\"ply\": [", first ? "" : ",");
         first = false;
         for (size_t t0 = 0; t0 < src.ntris && st == PK_OK;) {

@@ -25,7 +25,7 @@ static double emitted_luminance(const pk_scene *s, const material *m)
 
 /* The same for emitting triangle t: with an image emission map, ke times
  * the map's mean over the triangle's own texture coordinates (as shading
- * finds them: the vertices' uvs, or (0,0), (1,0), (0,1), through the
+ * finds them: the vertices' uvs of the map's set, or (0,0), (1,0), (0,1), through the
  * reference's scale and offset), so that the bright parts of an emitting
  * texture draw the samples. */
 static double emitted_luminance_tri(const pk_scene *s, const scene_view *v, const material *m, uint32_t t)
@@ -45,7 +45,7 @@ static double emitted_luminance_tri(const pk_scene *s, const scene_view *v, cons
     static const uv2 plain[3] = {{0.0f, 0.0f}, {1.0f, 0.0f}, {0.0f, 1.0f}};
     double tu[3], tv[3];
     for (int k = 0; k < 3; k++) {
-        const uv2 q = vt.has_t ? vt.t[k] : plain[k];
+        const uv2 q = r->uvset && vt.has_t1 ? vt.t1[k] : vt.has_t ? vt.t[k] : plain[k];
         tu[k] = (double)r->s[0] * (double)q.u + (double)r->o[0];
         tv[k] = (double)r->s[1] * (double)q.v + (double)r->o[1];
     }

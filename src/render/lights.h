@@ -353,7 +353,7 @@ static inline PK_HD vec3 light_le_at(const scene_view *s, const light *l, vec3 q
     if (!m->map_ke.kind) return le;
     const ray r = {q, 0.0f, v3s(0.0f), 1.0f}; /* a sphere's uv is that of r.o + t r.d = q */
     const surface_uv uv = surface_uv_at(s, &r, &h);
-    const tex_query tq = {uv.u, uv.v, 0.0f, q, l->normal, s->tex_nodes};
+    const tex_query tq = surface_query(s, &uv, 0.0f, q, l->normal);
     const vec3 c = tex_eval_rgb(s->textures, &m->map_ke, tq);
     return v3_mul(le, v3(fmaxf(c.x, 0.0f), fmaxf(c.y, 0.0f), fmaxf(c.z, 0.0f)));
 }

@@ -153,6 +153,7 @@ pk_status path_gpu_create(pk_context *ctx, const path_tracer *pt, path_gpu **out
     UP(tris, s->ntris)
     UP(colors, s->colors ? s->npositions : 0)
     UP(tangents, s->tangents ? s->npositions : 0)
+    UP(uvs1, s->uvs1 ? s->npositions : 0)
     UP(lights, s->nlights)
     UP(tex_nodes, s->ntex_nodes) /* procedural textures: plain data, evaluated by the same code */
 #undef UP

@@ -32,8 +32,12 @@ typedef struct surface_uv {
     float u, v;
     vec3 dpdu, dpdv;
     float uv_per_len;
+    float u1, v1;        /* the same in the second set (scene_view's uvs1; the first's where there is none) */
+    vec3 dpdu1, dpdv1;
+    float uv_per_len1;
 } surface_uv;
 static inline PK_HD surface_uv surface_uv_at(const scene_view *s, const ray *r, const hit *h);
+static inline PK_HD tex_query surface_query(const scene_view *s, const surface_uv *uv, float width, vec3 p, vec3 n);
 
 /* A number in [0, 1) from the bits of a hit point p, the direction wo and
  * the level of a mix among nested mixes (MurmurHash3's mixing steps): the
@@ -71,7 +75,7 @@ static inline PK_HD const material *surface_mix_choose(const scene_view *s, cons
         float amount = m->amount;
         if (m->map_alpha.kind) {
             const surface_uv uv = surface_uv_at(s, r, h);
-            const tex_query q = {uv.u, uv.v, 0.0f, p, v3s(0.0f), s->tex_nodes};
+            const tex_query q = surface_query(s, &uv, 0.0f, p, v3s(0.0f));
             amount *= fminf(fmaxf(tex_eval_scalar(s->textures, &m->map_alpha, q), 0.0f), 1.0f);
         }
         int pick = m->mix_a;
@@ -135,36 +139,50 @@ static inline PK_HD surface surface_at(const scene_view *s, const ray *r, const 
  * length of a unit of scene length on the surface (the square root of the
  * area ratio), which turns a world footprint into a uv one. */
 #define SURFACE_MIN_COS 0.05f    /* footprints of grazing hits stop growing here */
+/* One texture-coordinate set of a triangle (a, b, c with uvs ta, tb, tc) at
+ * barycentric (bu, bv): *u, *v, the derivatives and the uv length per unit
+ * length (surface_uv_at). */
+static inline PK_HD void surface__tri_uv(vec3 a, vec3 b, vec3 c, uv2 ta, uv2 tb, uv2 tc, float bu, float bv, float *u,
+                                         float *v, vec3 *dpdu, vec3 *dpdv, float *uv_per_len)
+{
+    const float w = 1.0f - bu - bv;
+    *u = ta.u * w + tb.u * bu + tc.u * bv;
+    *v = ta.v * w + tb.v * bu + tc.v * bv;
+    /* dp/du, dp/dv from the two edges (pbrt's construction) */
+    const float du1 = tb.u - ta.u, dv1 = tb.v - ta.v, du2 = tc.u - ta.u, dv2 = tc.v - ta.v;
+    const vec3 e1 = v3_sub(b, a), e2 = v3_sub(c, a);
+    const float det = du1 * dv2 - dv1 * du2;
+    const float area = v3_len(v3_cross(e1, e2));
+    if (fabsf(det) > 1e-20f && isfinite(1.0f / det)) {
+        const float inv = 1.0f / det;
+        *dpdu = v3_scale(v3_sub(v3_scale(e1, dv2), v3_scale(e2, dv1)), inv);
+        *dpdv = v3_scale(v3_sub(v3_scale(e2, du1), v3_scale(e1, du2)), inv);
+    } else { /* uv degenerate: any frame around the normal */
+        *dpdu = v3_norm_scaled(e1);
+        *dpdv = v3_cross(v3_norm_scaled(v3_cross(e1, e2)), *dpdu);
+    }
+    *uv_per_len = area > 0.0f ? sqrtf(fabsf(det) / area) : 0.0f;
+}
+
 static inline PK_HD surface_uv surface_uv_at(const scene_view *s, const ray *r, const hit *h)
 {
     surface_uv q;
     if (surface_is_tri(s, h->prim)) {
         view_tri t;
         view_tri_get(s, h->prim, &t);
-        const vec3 a = t.p[0], b = t.p[1], c = t.p[2];
         uv2 ta = {0.0f, 0.0f}, tb = {1.0f, 0.0f}, tc = {0.0f, 1.0f};
         if (t.has_t) {
             ta = t.t[0];
             tb = t.t[1];
             tc = t.t[2];
         }
-        const float w = 1.0f - h->u - h->v;
-        q.u = ta.u * w + tb.u * h->u + tc.u * h->v;
-        q.v = ta.v * w + tb.v * h->u + tc.v * h->v;
-        /* dp/du, dp/dv from the two edges (pbrt's construction) */
-        const float du1 = tb.u - ta.u, dv1 = tb.v - ta.v, du2 = tc.u - ta.u, dv2 = tc.v - ta.v;
-        const vec3 e1 = v3_sub(b, a), e2 = v3_sub(c, a);
-        const float det = du1 * dv2 - dv1 * du2;
-        const float area = v3_len(v3_cross(e1, e2));
-        if (fabsf(det) > 1e-20f && isfinite(1.0f / det)) {
-            const float inv = 1.0f / det;
-            q.dpdu = v3_scale(v3_sub(v3_scale(e1, dv2), v3_scale(e2, dv1)), inv);
-            q.dpdv = v3_scale(v3_sub(v3_scale(e2, du1), v3_scale(e1, du2)), inv);
-        } else { /* uv degenerate: any frame around the normal */
-            q.dpdu = v3_norm_scaled(e1);
-            q.dpdv = v3_cross(v3_norm_scaled(v3_cross(e1, e2)), q.dpdu);
+        surface__tri_uv(t.p[0], t.p[1], t.p[2], ta, tb, tc, h->u, h->v, &q.u, &q.v, &q.dpdu, &q.dpdv, &q.uv_per_len);
+        if (t.has_t1) {
+            surface__tri_uv(t.p[0], t.p[1], t.p[2], t.t1[0], t.t1[1], t.t1[2], h->u, h->v, &q.u1, &q.v1, &q.dpdu1,
+                            &q.dpdv1, &q.uv_per_len1);
+        } else {
+            q.u1 = q.u, q.v1 = q.v, q.dpdu1 = q.dpdu, q.dpdv1 = q.dpdv, q.uv_per_len1 = q.uv_per_len;
         }
-        q.uv_per_len = area > 0.0f ? sqrtf(fabsf(det) / area) : 0.0f;
     } else {
         const sphere *sp = &s->spheres[h->prim - s->ntris];
         vec3 p = v3_add(r->o, v3_scale(r->d, h->t));
@@ -179,7 +197,18 @@ static inline PK_HD surface_uv surface_uv_at(const scene_view *s, const ray *r, 
         if (st < 1e-6f) q.dpdu = v3_cross(q.dpdv, n);
         /* uv area 1 over the sphere's 4 pi r^2 */
         q.uv_per_len = 1.0f / (rr * 2.0f * sqrtf(PK_PI));
+        q.u1 = q.u, q.v1 = q.v, q.dpdu1 = q.dpdu, q.dpdv1 = q.dpdv, q.uv_per_len1 = q.uv_per_len;
     }
+    return q;
+}
+
+/* The lookup at uv (both sets) with footprint width (in scene length; the
+ * sets' uv_per_len turn it into uv widths) at point p with normal n. */
+static inline PK_HD tex_query surface_query(const scene_view *s, const surface_uv *uv, float width, vec3 p, vec3 n)
+{
+    tex_query q = {uv->u, uv->v, width * uv->uv_per_len, p, n, s->tex_nodes, uv->u1, uv->v1, width * uv->uv_per_len1};
+    if (!isfinite(q.width)) q.width = 0.0f;
+    if (!isfinite(q.width1)) q.width1 = 0.0f;
     return q;
 }
 
@@ -188,11 +217,11 @@ static inline PK_HD vec3 surface_clamp_rgb(vec3 c)
     return v3(fminf(fmaxf(c.x, 0.0f), 1.0f), fminf(fmaxf(c.y, 0.0f), 1.0f), fminf(fmaxf(c.z, 0.0f), 1.0f));
 }
 
-/* Height of a bump map at (u, v) and the point p with normal n (which
- * procedural textures read), the fine level. */
+/* Height of a bump map at (u, v) of its own uv set and the point p with
+ * normal n (which procedural textures read), the fine level. */
 static inline PK_HD float surface_bump_height(const scene_view *s, const tex_ref *ref, float u, float v, vec3 p, vec3 n)
 {
-    tex_query q = {u, v, 0.0f, p, n, s->tex_nodes};
+    tex_query q = {u, v, 0.0f, p, n, s->tex_nodes, u, v, 0.0f};
     return tex_eval_scalar(s->textures, ref, q);
 }
 
@@ -237,10 +266,9 @@ static inline PK_HD void surface_texture_at(const scene_view *s, const ray *r, c
     const surface_uv uv = surface_uv_at(s, r, h);
     const float dl = v3_len(r->d);
     const float cosv = dl > 0.0f ? fabsf(v3_dot(r->d, sf->ng)) / dl : 1.0f;
-    tex_query q = {uv.u, uv.v, cone_width / fmaxf(cosv, SURFACE_MIN_COS) * uv.uv_per_len, sf->p, sf->ng, s->tex_nodes};
-    if (!isfinite(q.width)) q.width = 0.0f;
+    tex_query q = surface_query(s, &uv, cone_width / fmaxf(cosv, SURFACE_MIN_COS), sf->p, sf->ng);
 #ifdef PK_TEX_NO_CONES /* (-D for measurements: the finest level always, bilinear) */
-    q.width = 0.0f;
+    q.width = q.width1 = 0.0f;
 #endif
     /* texture values: colours and alpha in 0..1 (HDR images may hold more), Ns >= 0 */
     if (m->map_kd.kind) tm->kd = v3_mul(m->kd, surface_clamp_rgb(tex_eval_rgb(s->textures, &m->map_kd, q)));
@@ -290,7 +318,7 @@ static inline PK_HD void surface_texture_at(const scene_view *s, const ray *r, c
     }
     if (m->type == MAT_METALLIC_ROUGHNESS) surface__gltf_maps(s, m, tm, q);
     if (m->map_ke.kind) { /* the finest level, as light sampling sees it (lights.h), so that both agree */
-        const tex_query qe = {uv.u, uv.v, 0.0f, sf->p, sf->ng, s->tex_nodes};
+        const tex_query qe = surface_query(s, &uv, 0.0f, sf->p, sf->ng);
         const vec3 e = tex_eval_rgb(s->textures, &m->map_ke, qe);
         tm->ke = v3_mul(m->ke, v3(fmaxf(e.x, 0.0f), fmaxf(e.y, 0.0f), fmaxf(e.z, 0.0f)));
     }
@@ -299,8 +327,11 @@ static inline PK_HD void surface_texture_at(const scene_view *s, const ray *r, c
         tm->ke = v3_mul(tm->ke, v3(fmaxf(c.r, 0.0f), fmaxf(c.g, 0.0f), fmaxf(c.b, 0.0f)));
     }
     sf->m = tm;
-    /* the vertex tangents where the mesh has them (glTF's TANGENT, given or generated) */
-    vec3 vt = uv.dpdu;
+    /* the vertex tangents where the mesh has them (glTF's TANGENT, given or
+     * generated), else the uv set of the normal map (or of the anisotropy's
+     * direction map) */
+    const int ts = m->map_norm.kind ? m->map_norm.uvset : m->map_aniso.kind ? m->map_aniso.uvset : 0;
+    vec3 vt = ts ? uv.dpdu1 : uv.dpdu;
     float vw = 0.0f;
     const bool has_vt = surface_is_tri(s, h->prim) && view_tri_tangent(s, h->prim, h->u, h->v, &vt, &vw);
     if (material_anisotropic(m)) sf->dpdu = vt; /* the u roughness's direction */
@@ -314,7 +345,7 @@ static inline PK_HD void surface_texture_at(const scene_view *s, const ray *r, c
     if (has_vt) { /* the bitangent w (n x t), n the normal on the side the vertex normals give */
         if (!sf->front) b = v3_neg(b);
         if (vw < 0.0f) b = v3_neg(b);
-    } else if (v3_dot(b, uv.dpdv) < 0.0f) {
+    } else if (v3_dot(b, ts ? uv.dpdv1 : uv.dpdv) < 0.0f) {
         b = v3_neg(b);
     }
     if (m->map_ccn.kind) { /* the clearcoat's normal: its own map on the interpolated normal */
@@ -347,20 +378,22 @@ static inline PK_HD void surface_texture_at(const scene_view *s, const ray *r, c
          * over the ray's footprint in uv (pbrt's BumpMap: du = (|du/dx| +
          * |du/dy|) / 2, 0.0005 without one), read at the points moved
          * along dp/du and dp/dv */
-        const bool expr = ref->kind == TEX_EXPR;
-        if (expr) du = q.width > 0.0f ? q.width : 0.0005f;
+        const bool expr = ref->kind == TEX_EXPR, one = ref->uvset != 0;
+        const float bu = one ? uv.u1 : uv.u, bv = one ? uv.v1 : uv.v, bw = one ? q.width1 : q.width;
+        const vec3 dpdu = one ? uv.dpdu1 : uv.dpdu, dpdv = one ? uv.dpdv1 : uv.dpdv;
+        if (expr) du = bw > 0.0f ? bw : 0.0005f;
         const float dv = du;
         const vec3 pn = expr ? sf->p : v3s(0.0f), nn0 = expr ? sf->ng : v3s(0.0f);
-        const vec3 pu = expr ? v3_add(sf->p, v3_scale(uv.dpdu, du)) : pn;
-        const vec3 pv = expr ? v3_add(sf->p, v3_scale(uv.dpdv, dv)) : pn;
-        const float h0 = surface_bump_height(s, ref, uv.u, uv.v, pn, nn0);
-        const float hu = (surface_bump_height(s, ref, uv.u + du, uv.v, pu, nn0) - h0) / du * ref->bm;
-        const float hv = (surface_bump_height(s, ref, uv.u, uv.v + dv, pv, nn0) - h0) / dv * ref->bm;
+        const vec3 pu = expr ? v3_add(sf->p, v3_scale(dpdu, du)) : pn;
+        const vec3 pv = expr ? v3_add(sf->p, v3_scale(dpdv, dv)) : pn;
+        const float h0 = surface_bump_height(s, ref, bu, bv, pn, nn0);
+        const float hu = (surface_bump_height(s, ref, bu + du, bv, pu, nn0) - h0) / du * ref->bm;
+        const float hv = (surface_bump_height(s, ref, bu, bv + dv, pv, nn0) - h0) / dv * ref->bm;
         /* in the frame (t, b, n) with dp/du ~ |dpdu| t and dp/dv ~ |dpdv| b */
-        const float lu = v3_len(uv.dpdu), lv = v3_len(uv.dpdv);
+        const float lu = v3_len(dpdu), lv = v3_len(dpdv);
         if (!(lu > 0.0f) || !(lv > 0.0f)) return;
         nn = v3_sub(n, v3_add(v3_scale(t, hu / lu), v3_scale(b, hv / lv)));
-        if (material_anisotropic(m)) sf->dpdu = v3_add(uv.dpdu, v3_scale(n, hu)); /* the displaced surface's */
+        if (material_anisotropic(m)) sf->dpdu = v3_add(dpdu, v3_scale(n, hu)); /* the displaced surface's */
     }
     if (!v3_finite(nn) || !(v3_len2(nn) > 0.0f)) return;
     nn = v3_norm(nn);
@@ -405,7 +438,7 @@ static inline PK_HD bool surface_is_hole(const scene_view *s, const ray *r, cons
         ca = fminf(fmaxf(view_tri_color(s, h->prim, h->u, h->v).a, 0.0f), 1.0f);
     if (m->blend && !m->map_d.kind) return surface_blend_pass(r, h, m->blend_alpha * ca);
     const surface_uv uv = surface_uv_at(s, r, h);
-    tex_query q = {uv.u, uv.v, 0.0f, v3s(0.0f), v3s(0.0f), s->tex_nodes};
+    tex_query q = surface_query(s, &uv, 0.0f, v3s(0.0f), v3s(0.0f));
     if (m->map_d.kind == TEX_EXPR) {
         const surface sf = surface_at(s, r, h);
         q.p = sf.p, q.n = sf.ng;

@@ -93,6 +93,8 @@ void scene_destroy(pk_scene *s)
     mem_free(a, s->mesh_colors);
     mem_free(a, s->tangents);
     mem_free(a, s->mesh_tangents);
+    mem_free(a, s->uvs1);
+    mem_free(a, s->mesh_uvs1);
     mem_free(a, s->mesh_tris);
     mem_free(a, s->meshes);
     mem_free(a, s->instances);
@@ -130,6 +132,11 @@ pk_status scene_add_position(pk_context *ctx, pk_scene *s, vec3 p)
             return ctx_nomem(ctx);
         s->tangents[s->npositions] = (vtangent){{0.0f, 0.0f, 0.0f}, 0.0f};
     }
+    if (s->uvs1) { /* every position has a second uv: (0, 0) until set */
+        if (!mem_grow(&s->alloc, (void **)&s->uvs1, &s->cap_uvs1, s->npositions + 1, sizeof *s->uvs1))
+            return ctx_nomem(ctx);
+        s->uvs1[s->npositions] = (uv2){0.0f, 0.0f};
+    }
     APPEND(ctx, s, positions, npositions, cap_positions, p, SCENE_MAX_PRIMS, "vertices");
 }
 
@@ -164,6 +171,24 @@ pk_status scene_set_tangent(pk_context *ctx, pk_scene *s, size_t i, vtangent t)
     if (!s->tangents && !tangents_grow(&s->alloc, &s->tangents, &s->cap_tangents, 0, s->npositions))
         return ctx_nomem(ctx);
     s->tangents[i] = t;
+    s->committed = false;
+    return PK_OK;
+}
+
+/* Grows *arr (of *cap) to n second-set uvs, (0, 0) from from on. */
+static bool uvs1_grow(const pk_allocator *a, uv2 **arr, size_t *cap, size_t from, size_t n)
+{
+    if (!mem_grow(a, (void **)arr, cap, n ? n : 1, sizeof **arr)) return false;
+    for (size_t i = from; i < n; i++) (*arr)[i] = (uv2){0.0f, 0.0f};
+    return true;
+}
+
+pk_status scene_set_uv1(pk_context *ctx, pk_scene *s, size_t i, uv2 t)
+{
+    if (i >= s->npositions)
+        return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "%s: texture coordinates for no vertex", s->name);
+    if (!s->uvs1 && !uvs1_grow(&s->alloc, &s->uvs1, &s->cap_uvs1, 0, s->npositions)) return ctx_nomem(ctx);
+    s->uvs1[i] = t;
     s->committed = false;
     return PK_OK;
 }
@@ -701,6 +726,14 @@ pk_status scene_capture_mesh(pk_context *ctx, pk_scene *s, size_t pos0, size_t n
         }
         if (s->tangents) memcpy(s->mesh_tangents + m.first_pos, s->tangents + pos0, m.npos * sizeof *s->tangents);
     }
+    if (s->uvs1 || s->mesh_uvs1) { /* the mesh's second uvs beside its positions */
+        const size_t had = s->mesh_uvs1 ? m.first_pos : 0;
+        if (!uvs1_grow(a, &s->mesh_uvs1, &s->cap_mesh_uvs1, had, s->nmesh_positions)) {
+            s->nmesh_positions = m.first_pos, s->nmesh_normals = m.first_nrm, s->nmesh_uvs = m.first_uv;
+            return ctx_nomem(ctx);
+        }
+        if (s->uvs1) memcpy(s->mesh_uvs1 + m.first_pos, s->uvs1 + pos0, m.npos * sizeof *s->uvs1);
+    }
     for (size_t k = tri0; k < s->ntris; k++) {
         triangle t = s->tris[k];
         for (int j = 0; j < 3; j++) {
@@ -760,6 +793,10 @@ static pk_status place_instance(pk_context *ctx, pk_scene *s, const scene_instan
             if (!v3_finite(tw.t) || t.w == 0.0f) tw = (vtangent){{0.0f, 0.0f, 0.0f}, 0.0f};
             s->tangents[pbase + i] = tw;
         }
+    }
+    if (s->mesh_uvs1) {
+        if (!s->uvs1 && !uvs1_grow(&s->alloc, &s->uvs1, &s->cap_uvs1, 0, s->npositions)) return ctx_nomem(ctx);
+        memcpy(s->uvs1 + pbase, s->mesh_uvs1 + m->first_pos, m->npos * sizeof *s->uvs1);
     }
     for (size_t i = 0; i < m->nnrm; i++) {
         vec3 n = v3_norm_scaled(xform_apply3(nm, s->mesh_normals[m->first_nrm + i]));
@@ -1028,6 +1065,8 @@ bool scene_check(const pk_scene *s, char *why, size_t n)
         if (!v3_finite(s->normals[i])) FAIL("normal %zu is not finite", i);
     for (size_t i = 0; i < s->nuvs; i++)
         if (!isfinite(s->uvs[i].u) || !isfinite(s->uvs[i].v)) FAIL("uv %zu is not finite", i);
+    for (size_t i = 0; s->uvs1 && i < s->npositions; i++)
+        if (!isfinite(s->uvs1[i].u) || !isfinite(s->uvs1[i].v)) FAIL("the second uv of vertex %zu is not finite", i);
     size_t tex_bytes = 0;
     for (size_t i = 0; i < s->ntextures; i++) tex_bytes += s->textures[i].bytes;
     if (tex_bytes != s->texture_bytes) FAIL("texture bytes do not add up");

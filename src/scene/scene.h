@@ -206,6 +206,10 @@ struct pk_scene {
     /* Vertex tangents by position: NULL when no vertex has one, else one
      * for each position (w = 0 where none was given; scene_set_tangent) */
     vtangent *tangents; size_t cap_tangents;
+    /* A second texture-coordinate set by position (glTF's TEXCOORD_1, which
+     * textures with tex_ref.uvset 1 read): NULL when no vertex has one, else
+     * one for each position ((0, 0) where none was given; scene_set_uv1) */
+    uv2 *uvs1;       size_t cap_uvs1;
     sphere *spheres; size_t nspheres, cap_spheres;
     material *materials; size_t nmaterials, cap_materials;
     /* Name index: open addressing, mat_slots (a power of two, > 2 * nmaterials)
@@ -256,6 +260,7 @@ struct pk_scene {
     uv2 *mesh_uvs;        size_t nmesh_uvs, cap_mesh_uvs;
     rgba *mesh_colors;    size_t cap_mesh_colors;  /* NULL, or one for each mesh position */
     vtangent *mesh_tangents; size_t cap_mesh_tangents; /* NULL, or one for each mesh position (object space) */
+    uv2 *mesh_uvs1;       size_t cap_mesh_uvs1;    /* NULL, or one for each mesh position */
     triangle *mesh_tris;  size_t nmesh_tris, cap_mesh_tris;
     scene_mesh *meshes;   size_t nmeshes, cap_meshes;
     scene_instance *instances; size_t ninstances, cap_instances;
@@ -280,6 +285,10 @@ PK_HIDDEN pk_status scene_set_color(pk_context *ctx, pk_scene *s, size_t i, rgba
  * position: t.t of unit length, t.w +1 or -1): the first tangent of a
  * scene gives every other position none (w = 0). */
 PK_HIDDEN pk_status scene_set_tangent(pk_context *ctx, pk_scene *s, size_t i, vtangent t);
+/* Gives position i (< npositions) the second set's texture coordinate t
+ * (scene's convention, v up): the first of a scene gives every other
+ * position (0, 0). */
+PK_HIDDEN pk_status scene_set_uv1(pk_context *ctx, pk_scene *s, size_t i, uv2 t);
 PK_HIDDEN pk_status scene_add_triangle(pk_context *ctx, pk_scene *s, const triangle *t);
 PK_HIDDEN pk_status scene_add_sphere(pk_context *ctx, pk_scene *s, const sphere *sp);
 /* Appends an expression of n procedural nodes (1 <= n <= TEX_MAX_NODES,

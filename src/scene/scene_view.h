@@ -17,6 +17,7 @@ typedef struct scene_view {
     const triangle *tris;     /* ntris, in hit numbering; spheres follow as prims ntris.. */
     const rgba *colors;       /* vertex colours by position, NULL: none (pk_scene's) */
     const vtangent *tangents; /* vertex tangents by position, NULL: none */
+    const uv2 *uvs1;          /* the second texture-coordinate set by position, NULL: none */
     const sphere *spheres;
     const material *materials;
     const point_light *lights;
@@ -37,6 +38,7 @@ typedef struct scene_view {
     const triangle *mesh_tris;
     const rgba *mesh_colors;  /* by mesh position, NULL: none */
     const vtangent *mesh_tangents; /* by mesh position, object space, NULL: none */
+    const uv2 *mesh_uvs1;     /* by mesh position, NULL: none */
     /* Participating media (medium.h): the volumetric path tracer's (the GPU
      * renders scenes without them). */
     const medium *media;
@@ -61,6 +63,7 @@ static inline scene_view scene_view_of(const pk_scene *s)
     v.mesh_tris = s->mesh_tris;
     v.colors = s->colors, v.mesh_colors = s->mesh_colors;
     v.tangents = s->tangents, v.mesh_tangents = s->mesh_tangents;
+    v.uvs1 = s->uvs1, v.mesh_uvs1 = s->mesh_uvs1;
     v.media = s->media, v.nmedia = s->nmedia, v.camera_medium = s->camera_medium;
     v.has_interfaces = s->has_interfaces;
     return v;
@@ -72,7 +75,8 @@ typedef struct view_tri {
     vec3 p[3];          /* vertices */
     vec3 n[3];          /* vertex normals when has_n (possibly zero: then unusable) */
     uv2 t[3];           /* texture coordinates when has_t */
-    bool has_n, has_t;
+    uv2 t1[3];          /* the second set's when has_t1 */
+    bool has_n, has_t, has_t1;
     uint32_t material;
 } view_tri;
 
@@ -103,6 +107,8 @@ static inline PK_HD void view_tri_get(const scene_view *s, uint32_t prim, view_t
             if (out->has_n) out->n[j] = s->normals[t->n[j]];
             if (out->has_t) out->t[j] = s->uvs[t->t[j]];
         }
+        out->has_t1 = s->uvs1 != NULL;
+        for (int j = 0; out->has_t1 && j < 3; j++) out->t1[j] = s->uvs1[t->v[j]];
         out->material = t->material;
         return;
     }
@@ -119,6 +125,8 @@ static inline PK_HD void view_tri_get(const scene_view *s, uint32_t prim, view_t
         }
         if (out->has_t) out->t[j] = s->mesh_uvs[m->first_uv + (size_t)t->t[j]];
     }
+    out->has_t1 = s->mesh_uvs1 != NULL;
+    for (int j = 0; out->has_t1 && j < 3; j++) out->t1[j] = s->mesh_uvs1[m->first_pos + t->v[j]];
     out->material = k->material != SCENE_MESH_MATERIAL ? k->material : t->material;
 }
 

@@ -59,6 +59,7 @@ typedef struct tex_ref {
     uint8_t kind;      /* tex_kind; TEX_NONE (0) = the constant alone */
     uint8_t clamp;     /* TEX_CLAMP_U | TEX_CLAMP_V: the axes that clamp; 0 repeats */
     bool squared;      /* scalars: the value squared (roughness maps read as GGX alpha) */
+    uint8_t uvset;     /* the texture-coordinate set it reads: 0, or 1 (scene.h's uvs1) */
     int32_t tex;       /* TEX_IMAGE: index into the scene's textures */
     float s[2], o[2];
     float bm;          /* bump maps: the multiplier of the heights (-bm) */
@@ -71,11 +72,13 @@ struct tex_node;
 
 /* A lookup: the uv and the footprint width in uv units (0 = the finest
  * level); for procedural expressions also the world-space point p, the
- * geometric normal n and the scene's node table. */
+ * geometric normal n and the scene's node table; u1, v1, width1: the same
+ * in the second texture-coordinate set, which references with uvset 1 read. */
 typedef struct tex_query {
     float u, v, width;
     vec3 p, n;
     const struct tex_node *nodes;
+    float u1, v1, width1;
 } tex_query;
 
 /* Sets a reference to none with the identity transform. */
@@ -512,6 +515,7 @@ static inline PK_HD vec3 tex_expr_eval(const texture *textures, const tex_ref *r
  * expression (3 channels). */
 static inline PK_HD int tex_eval_raw(const texture *textures, const tex_ref *r, tex_query q, float out[4])
 {
+    if (r->uvset) q.u = q.u1, q.v = q.v1, q.width = q.width1;
     if (r->kind == TEX_EXPR) {
         const vec3 c = tex_expr_eval(textures, r, q);
         out[0] = c.x, out[1] = c.y, out[2] = c.z;

@@ -27,6 +27,7 @@ convert_same "$bin" "$tmp" \
   "$data/conformance/box_mr.json" "$data/conformance/box_nomtl.obj" "$data/pbrt/include_main.pbrt" \
   "$data/fuzz_seed_full.json" "$data/fuzz_seed_full.xml" "$data/tex_scene.obj" "$data/obj_mat.obj" \
   "$data/convert/lights.xml" "$data/convert/lights.pbrt" "$data/convert/lights.json" "$data/convert/spot.gltf" \
+  "$data/gltf/uv_sets.gltf" \
   "$data/../../bench/scenes/materials.json" "$data/../../bench/scenes/materials.xml" \
   "$data/sheets/box.pbrt" "$data/sheets/box.xml" "$data/sheets/box.json" || fail=1
 

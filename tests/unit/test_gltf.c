@@ -576,11 +576,14 @@ static void test_mirror_and_uv1(void)
     CHECKF(scene_gltf_parse(ctx, s, j, strlen(j), "t.gltf", PK_TEST_DATA "/gltf") == PK_OK, "%s", pk_context_error(ctx));
     CHECK(wlog.count == 0);
     REQUIRE(s->ntris == 1);
-    /* TEXCOORD_1 read: (0.25, 0) -> the scene's (0.25, 1) */
-    CHECK_NEAR(s->uvs[s->tris[0].t[0]].u, 0.25, 0);
+    /* both sets read, the texture reads the second: TEXCOORD_1's (0.25, 0) -> the scene's (0.25, 1) */
+    REQUIRE(s->uvs1);
+    CHECK_NEAR(s->uvs[s->tris[0].t[0]].u, 0.0, 0);
     CHECK_NEAR(s->uvs[s->tris[0].t[0]].v, 1.0, 0);
+    CHECK_NEAR(s->uvs1[s->tris[0].v[0]].u, 0.25, 0);
+    CHECK_NEAR(s->uvs1[s->tris[0].v[0]].v, 1.0, 0);
     const material *m = &s->materials[s->tris[0].material];
-    REQUIRE(m->map_kd.kind == TEX_IMAGE && s->ntextures == 2 && m->map_kd.tex == 1);
+    REQUIRE(m->map_kd.kind == TEX_IMAGE && s->ntextures == 2 && m->map_kd.tex == 1 && m->map_kd.uvset == 1);
     const texture *src = &s->textures[0], *mir = &s->textures[1];
     REQUIRE(src->lv[0].w == 2 && mir->lv[0].w == 4 && mir->lv[0].h == 4 && src->nc == mir->nc && src->lv[0].px8);
     /* texel (x, y) of the doubled image is the source's mirrored texel */

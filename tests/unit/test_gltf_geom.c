@@ -7,8 +7,9 @@
  * multiplying the base colour at a hit) and alphaMode BLEND as stochastic
  * transparency (its coverage against the binomial spread, deterministic),
  * and vertex tangents: generated on a plane, a sphere and a cube with
- * mirrored uvs against their closed forms, and the same as given ones. Assets are written here, buffers as base64 data:
- * URIs.
+ * mirrored uvs against their closed forms, and the same as given ones;
+ * textures reading TEXCOORD_0 and TEXCOORD_1 (tests/data/gltf/uv_sets.gltf).
+ * Assets are written here, buffers as base64 data: URIs.
  */
 #include "test.h"
 #include "warnings.h"
@@ -360,7 +361,7 @@ static void test_normal_scale(void)
     int checked = 0;
     for (int k = 0; k < 3; k++) {
         const float uc = centres[k][0], vc = centres[k][1];
-        const tex_query q = {uc, vc, 0.0f, v3s(0.0f), v3s(0.0f), v.tex_nodes};
+        const tex_query q = {uc, vc, 0.0f, v3s(0.0f), v3s(0.0f), v.tex_nodes, uc, vc, 0.0f};
         const vec3 c = tex_eval_rgb(v.textures, &m->map_norm, q);
         const vec3 tl = v3(0.25f * (2.0f * c.x - 1.0f), 0.25f * (2.0f * c.y - 1.0f), 2.0f * c.z - 1.0f);
         if (!(tl.z > 0.0f)) continue; /* a normal facing away is not used */
@@ -803,6 +804,119 @@ static void test_kept(void)
     scene_destroy(kept);
 }
 
+/* ---- texture-coordinate sets ------------------------------------------------------------ */
+
+/* The file tests/data/gltf/NAME, read whole (NUL-terminated). */
+static char *fixture(const char *name)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/gltf/%s", PK_TEST_DATA, name);
+    FILE *f = fopen(path, "rb");
+    REQUIRE(f);
+    REQUIRE(fseek(f, 0, SEEK_END) == 0);
+    const long n = ftell(f);
+    REQUIRE(n > 0 && fseek(f, 0, SEEK_SET) == 0);
+    char *j = malloc((size_t)n + 1);
+    REQUIRE(j && fread(j, 1, (size_t)n, f) == (size_t)n);
+    j[n] = '\0';
+    fclose(f);
+    return j;
+}
+
+/* uv_sets.gltf (make_gltf.py): two quads over [-1, 1]^2 at z = 0, moved by
+ * -1.1 and +1.1 in x (and the second again out of view), with TEXCOORD_0 = ((x + 1) / 2, (1 - y) / 2) and
+ * TEXCOORD_1 a quarter turn of it, ((1 - y) / 2, (1 - x) / 2) (object x, y).
+ * The first's base colour reads set 0 and its emission set 1; the second's
+ * normal map reads set 1. At hits, each map is looked up at its own set's
+ * coordinates (the scene's v = 1 - glTF's); the emission a light sample
+ * sees is the one a hit sees; the second quad's generated tangents follow
+ * set 1's u, which runs along -y; and keeping the meshes as instances
+ * changes none of it. */
+static void test_uv_sets(void)
+{
+    char *j = fixture("uv_sets.gltf");
+    pk_scene *s, *kept;
+    CHECKF(load(j, &s) == PK_OK, "%s", msg);
+    CHECKF(wlog.count == 0, "%s", wlog.last);
+    load_config = "scene.instances=keep";
+    CHECKF(load(j, &kept) == PK_OK, "%s", msg);
+    load_config = NULL;
+    free(j);
+    REQUIRE(s && kept && s->ntris == 6 && s->uvs1);
+    /* (triangles: the first quad's 0, 1, the second's 2, 3, its copy's 4, 5) */
+    const scene_view v = scene_view_of(s), vk = scene_view_of(kept);
+    const material *m0 = &s->materials[s->tris[0].material];
+    REQUIRE(m0->map_kd.kind == TEX_IMAGE && m0->map_kd.uvset == 0 && m0->map_ke.kind == TEX_IMAGE &&
+            m0->map_ke.uvset == 1);
+    tex_ref base = m0->map_kd, emit = m0->map_ke;
+    emit.uvset = 0; /* looked up below at coordinates computed here */
+    int checked = 0, differs = 0;
+    for (uint32_t t = 0; t < 2; t++) {
+        for (int k = 0; k < 5; k++) {
+            const float bu = 0.1f + 0.17f * (float)k, bv = 0.07f + 0.11f * (float)k;
+            if (bu + bv > 1.0f) continue;
+            view_tri vt;
+            view_tri_get(&v, t, &vt);
+            const vec3 p = v3_add(v3_add(v3_scale(vt.p[0], 1.0f - bu - bv), v3_scale(vt.p[1], bu)), v3_scale(vt.p[2], bv));
+            const float x = p.x + 1.1f, y = p.y; /* object space */
+            const float u0 = (x + 1.0f) / 2.0f, v0 = 1.0f - (1.0f - y) / 2.0f;
+            const float u1 = (1.0f - y) / 2.0f, v1 = 1.0f - (1.0f - x) / 2.0f;
+            ray r = {{p.x, p.y, 1.0f}, 0.0f, {0.0f, 0.0f, -1.0f}, INFINITY};
+            hit h = {1.0f, t, bu, bv};
+            material tm;
+            const surface sf = surface_texture(&v, &r, &h, 0.0f, surface_at(&v, &r, &h), &tm);
+            (void)sf;
+            const tex_query q0 = {u0, v0, 0.0f, v3s(0.0f), v3s(0.0f), NULL, 0.0f, 0.0f, 0.0f};
+            const tex_query q1 = {u1, v1, 0.0f, v3s(0.0f), v3s(0.0f), NULL, 0.0f, 0.0f, 0.0f};
+            const vec3 kd = tex_eval_rgb(v.textures, &base, q0);
+            const vec3 ke = v3_scale(tex_eval_rgb(v.textures, &emit, q1), 0.5f);
+            CHECKF(vnear(tm.kd, kd, 2e-5f), "tri %u, (%g, %g): kd (%g %g %g), want (%g %g %g)", t, (double)bu, (double)bv,
+                   (double)tm.kd.x, (double)tm.kd.y, (double)tm.kd.z, (double)kd.x, (double)kd.y, (double)kd.z);
+            CHECKF(vnear(tm.ke, ke, 2e-5f), "tri %u, (%g, %g): ke (%g %g %g), want (%g %g %g)", t, (double)bu, (double)bv,
+                   (double)tm.ke.x, (double)tm.ke.y, (double)tm.ke.z, (double)ke.x, (double)ke.y, (double)ke.z);
+            /* set 0's coordinates would give another emission (so the check above can tell the sets apart) */
+            differs += !vnear(v3_scale(tex_eval_rgb(v.textures, &emit, q0), 0.5f), ke, 0.05f);
+            /* a light sample at p sees the same */
+            const light l = light_of_triangle(t, vt.p[0], vt.p[1], vt.p[2], m0);
+            const vec3 le = light_le_at(&v, &l, p, m0->ke);
+            CHECKF(vnear(le, tm.ke, 2e-5f), "tri %u: light sample (%g %g %g), hit (%g %g %g)", t, (double)le.x,
+                   (double)le.y, (double)le.z, (double)tm.ke.x, (double)tm.ke.y, (double)tm.ke.z);
+            checked++;
+        }
+    }
+    CHECK(checked >= 6 && differs >= 3);
+    /* kept as instances (the second quad, placed twice): the same normal at the same hit as flattened */
+    REQUIRE(kept->nkept == 2 && kept->mesh_uvs1 && kept->mesh_tangents);
+    int bent = 0;
+    for (uint32_t t = 0; t < 2; t++) {
+        for (int k = 0; k < 4; k++) {
+            const float bu = 0.15f + 0.2f * (float)k, bv = 0.1f + 0.05f * (float)k;
+            hit h = {1.0f, 2 + t, bu, bv}, hk = {1.0f, (uint32_t)(kept->ntris + kept->nspheres) + t, bu, bv};
+            view_tri vt;
+            view_tri_get(&v, h.prim, &vt);
+            const vec3 p = v3_add(v3_add(v3_scale(vt.p[0], 1.0f - bu - bv), v3_scale(vt.p[1], bu)), v3_scale(vt.p[2], bv));
+            ray r = {{p.x, p.y, 1.0f}, 0.0f, {0.0f, 0.0f, -1.0f}, INFINITY};
+            material tm, tk;
+            const surface a = surface_texture(&v, &r, &h, 0.0f, surface_at(&v, &r, &h), &tm);
+            const surface b = surface_texture(&vk, &r, &hk, 0.0f, surface_at(&vk, &r, &hk), &tk);
+            CHECKF(vnear(a.ns, b.ns, 1e-5f), "tri %u: ns (%g %g %g) flattened, (%g %g %g) kept", t, (double)a.ns.x,
+                   (double)a.ns.y, (double)a.ns.z, (double)b.ns.x, (double)b.ns.y, (double)b.ns.z);
+            bent += a.ns.z < 0.999f;
+        }
+    }
+    CHECKF(bent >= 2, "bent %d", bent); /* (the map bends the normal at some: its red and green texels face away) */
+    /* the second quad's tangents: set 1's u grows along -y */
+    const material *m1 = &s->materials[s->tris[2].material];
+    REQUIRE(m1->map_norm.kind == TEX_IMAGE && m1->map_norm.uvset == 1 && s->tangents);
+    for (int k = 0; k < 3; k++) {
+        const vtangent tg = s->tangents[s->tris[2].v[k]];
+        CHECKF(vnear(tg.t, v3(0.0f, -1.0f, 0.0f), 1e-5f) && tg.w != 0.0f, "vertex %d: tangent (%g %g %g)", k,
+               (double)tg.t.x, (double)tg.t.y, (double)tg.t.z);
+    }
+    scene_destroy(s);
+    scene_destroy(kept);
+}
+
 int main(void)
 {
     test_morph();
@@ -815,5 +929,6 @@ int main(void)
     test_tangents_sphere();
     test_tangents_cube();
     test_kept();
+    test_uv_sets();
     return test_done("test_gltf_geom");
 }

@@ -334,7 +334,7 @@ static void test_reader_layers(void)
              * flipped): uv (u + v, 1 - v) at barycentric (u, v) */
             const float bu = uc + vc - 1.0f, bv = 1.0f - vc;
             if (bu < 0.0f || uc > 1.0f) continue; /* outside the triangle */
-            const tex_query q = {uc, vc, 0.0f, v3s(0.0f), v3s(0.0f), v.tex_nodes};
+            const tex_query q = {uc, vc, 0.0f, v3s(0.0f), v3s(0.0f), v.tex_nodes, uc, vc, 0.0f};
             const vec3 c = tex_eval_rgb(v.textures, &m0->map_ccn, q);
             const vec3 tl = v3(0.5f * (2.0f * c.x - 1.0f), 0.5f * (2.0f * c.y - 1.0f), 2.0f * c.z - 1.0f);
             ray r = {{bu, bv, 1.0f}, 0.0f, {0.0f, 0.0f, -1.0f}, INFINITY};

@@ -136,7 +136,7 @@ static void test_srgb(void)
     r.kind = TEX_IMAGE;
     r.tex = 0;
     texture arr[1] = {c};
-    tex_query q = {0.25f, 0.5f, 0.0f, v3s(0.0f), v3s(0.0f), NULL}; /* the black, transparent texel */
+    tex_query q = {0.25f, 0.5f, 0.0f, v3s(0.0f), v3s(0.0f), NULL, 0.25f, 0.5f, 0.0f}; /* the black, transparent texel */
     CHECK(tex_eval_alpha(arr, &r, q) == 0.0f);
     q.u = 0.75f;
     CHECK(tex_eval_alpha(arr, &r, q) == 1.0f);
@@ -160,7 +160,7 @@ static void test_checker(void)
     r.even = v3(1, 0, 0);
     r.odd = v3(0, 0, 1);
     r.checker_scale = 4.0f;
-    tex_query q = {0.1f, 0.1f, 0.0f, v3s(0.0f), v3s(0.0f), NULL}; /* cell (0, 0): even */
+    tex_query q = {0.1f, 0.1f, 0.0f, v3s(0.0f), v3s(0.0f), NULL, 0.1f, 0.1f, 0.0f}; /* cell (0, 0): even */
     CHECK(tex_eval_rgb(NULL, &r, q).x == 1.0f);
     q.u = 0.3f; /* cell (1, 0): odd */
     CHECK(tex_eval_rgb(NULL, &r, q).z == 1.0f);
@@ -435,12 +435,14 @@ static void test_json(void)
     {
         const char *j = "{\"materials\": {\"m\": {\"kd\": {\"texture\": \"tex_checker.png\", \"clamp\": \"v\"}},"
                         " \"n\": {\"kd\": {\"texture\": \"tex_checker.png\", \"clamp\": \"u\"}},"
-                        " \"o\": {\"kd\": {\"texture\": \"tex_checker.png\", \"clamp\": true}}}}";
+                        " \"o\": {\"kd\": {\"texture\": \"tex_checker.png\", \"clamp\": true, \"uvset\": 1}}}}";
         REQUIRE(scene_create(ctx, "axes.json", &s) == PK_OK);
         CHECKF(scene_json_parse(ctx, s, j, strlen(j), "axes.json", PK_TEST_DATA) == PK_OK, "%s", pk_context_error(ctx));
         CHECK(s->materials[scene_find_material(s, "m")].map_kd.clamp == TEX_CLAMP_V);
         CHECK(s->materials[scene_find_material(s, "n")].map_kd.clamp == TEX_CLAMP_U);
         CHECK(s->materials[scene_find_material(s, "o")].map_kd.clamp == TEX_CLAMP);
+        CHECK(s->materials[scene_find_material(s, "o")].map_kd.uvset == 1);
+        CHECK(s->materials[scene_find_material(s, "n")].map_kd.uvset == 0);
         scene_destroy(s);
     }
 
@@ -455,6 +457,7 @@ static void test_json(void)
         {"{\"materials\": {\"m\": {\"type\": \"diffuse\", \"opacity\": 0.5}}}", "materials.m.opacity: must be a texture object"},
         {"{\"materials\": {\"m\": {\"kd\": {\"texture\": \"a.png\", \"clamp\": \"w\"}}}}",
          "materials.m.kd.clamp: must be true, false, \"u\" or \"v\""},
+        {"{\"materials\": {\"m\": {\"kd\": {\"texture\": \"a.png\", \"uvset\": 2}}}}", "materials.m.kd.uvset: must be"},
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         REQUIRE(scene_create(ctx, "bad.json", &s) == PK_OK);

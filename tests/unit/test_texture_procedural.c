@@ -56,7 +56,7 @@ static vec3 eval(const tex_node *nodes, int n, float u, float v, vec3 p, vec3 nr
     tex_ref r;
     tex_ref_init(&r);
     r.kind = TEX_EXPR, r.node = 0, r.nnodes = n;
-    tex_query q = {u, v, 0.0f, p, nrm, nodes};
+    tex_query q = {u, v, 0.0f, p, nrm, nodes, u, v, 0.0f};
     return tex_expr_eval(NULL, &r, q);
 }
 

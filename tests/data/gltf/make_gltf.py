@@ -10,6 +10,10 @@ made again: python3 tests/data/gltf/make_gltf.py
                     with a percent escape), a texture file next to it, MASK
   instanced.gltf    one mesh placed by three nodes (matrix and T R S), an
                     orthographic camera, a directional light, a strip and a fan
+  uv_sets.gltf      two quads whose textures read different TEXCOORD sets:
+                    base colour TEXCOORD_0, emission and a normal map
+                    TEXCOORD_1 (the map turned by a quarter; the second placed
+                    twice, the second time out of view), a camera and a light
   bad_*.gltf/.glb   hostile assets: an accessor past its view, an index out
                     of range, a malformed data: URI, a lying GLB length, a node
                     cycle
@@ -189,6 +193,43 @@ def make_instanced():
     return write_json(os.path.join(HERE, "instanced.gltf"), doc)
 
 
+def make_uv_sets():
+    b = Buf()
+    vp = b.view(floats([-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0]))
+    vn = b.view(floats([0, 0, 1] * 4))
+    uv0 = [0, 1, 1, 1, 1, 0, 0, 0]
+    vt0 = b.view(floats(uv0))
+    vt1 = b.view(floats(uv0[2:] + uv0[:2]))  # each vertex takes the next one's: a quarter turn
+    vi = b.view(bytes([0, 1, 2, 0, 2, 3]))
+    doc = asset(
+        extensionsUsed=["KHR_lights_punctual"],
+        extensions={"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 400}]}},
+        buffers=[{"byteLength": len(b.data), "uri": data_uri(b.data)}],
+        bufferViews=b.views,
+        accessors=[{"bufferView": vp, "componentType": 5126, "count": 4, "type": "VEC3"},
+                   {"bufferView": vn, "componentType": 5126, "count": 4, "type": "VEC3"},
+                   {"bufferView": vt0, "componentType": 5126, "count": 4, "type": "VEC2"},
+                   {"bufferView": vt1, "componentType": 5126, "count": 4, "type": "VEC2"},
+                   {"bufferView": vi, "componentType": 5121, "count": 6, "type": "SCALAR"}],
+        images=[{"uri": "../tex_checker.png"}, {"uri": "../tex_rgbw.png"}],
+        textures=[{"source": 0}, {"source": 1}],
+        materials=[{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0},
+                    "emissiveTexture": {"index": 1, "texCoord": 1}, "emissiveFactor": [0.5, 0.5, 0.5]},
+                   {"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0},
+                    "normalTexture": {"index": 1, "texCoord": 1}}],
+        meshes=[{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2, "TEXCOORD_1": 3},
+                                 "indices": 4, "material": 0}]},
+                {"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2, "TEXCOORD_1": 3},
+                                 "indices": 4, "material": 1}]}],
+        cameras=[{"type": "perspective", "perspective": {"yfov": 0.9, "aspectRatio": 2, "znear": 0.1}}],
+        nodes=[{"mesh": 0, "translation": [-1.1, 0, 0]}, {"mesh": 1, "translation": [1.1, 0, 0]},
+               {"camera": 0, "translation": [0, 0, 3.2]},
+               {"translation": [0, 1, 2], "extensions": {"KHR_lights_punctual": {"light": 0}}},
+               {"mesh": 1, "translation": [1.1, -3, 0]}],
+        scenes=[{"nodes": [0, 1, 2, 3, 4]}])
+    return write_json(os.path.join(HERE, "uv_sets.gltf"), doc)
+
+
 def tri_doc(accessor_count=3, indices=None, uri=None):
     b = Buf()
     vp = b.view(floats([0, 0, 0, 1, 0, 0, 0, 1, 0]))
@@ -209,6 +250,7 @@ def main():
     seeds["cube.glb"] = glb
     seeds["external.gltf"] = make_external()
     seeds["instanced.gltf"] = make_instanced()
+    seeds["uv_sets.gltf"] = make_uv_sets()
     seeds["bad_accessor.gltf"] = write_json(os.path.join(HERE, "bad_accessor.gltf"), tri_doc(accessor_count=100))
     seeds["bad_index.gltf"] = write_json(os.path.join(HERE, "bad_index.gltf"), tri_doc(indices=[0, 1, 9]))
     seeds["bad_uri.gltf"] = write_json(os.path.join(HERE, "bad_uri.gltf"),
