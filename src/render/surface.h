@@ -259,6 +259,17 @@ static inline PK_HD void surface__gltf_maps(const scene_view *s, const material 
     }
 }
 
+/* A tangent-space normal map's normal (unnormalised) in the frame (t, b, n):
+ * the texel's 2 c - 1, its x and y times scale (glTF's normalTexture.scale). */
+static inline PK_HD vec3 surface__map_normal(const scene_view *s, const tex_ref *r, tex_query q, float scale, vec3 t,
+                                             vec3 b, vec3 n)
+{
+    const vec3 c = tex_eval_rgb(s->textures, r, q);
+    vec3 tl = v3(2.0f * c.x - 1.0f, 2.0f * c.y - 1.0f, 2.0f * c.z - 1.0f);
+    if (scale != 1.0f) tl.x *= scale, tl.y *= scale;
+    return v3_add(v3_add(v3_scale(t, tl.x), v3_scale(b, tl.y)), v3_scale(n, tl.z));
+}
+
 static inline PK_HD void surface_texture_at(const scene_view *s, const ray *r, const hit *h, float cone_width, surface *sf, material *tm)
 {
     const material *m = sf->m;
@@ -349,10 +360,7 @@ static inline PK_HD void surface_texture_at(const scene_view *s, const ray *r, c
         b = v3_neg(b);
     }
     if (m->map_ccn.kind) { /* the clearcoat's normal: its own map on the interpolated normal */
-        const vec3 c = tex_eval_rgb(s->textures, &m->map_ccn, q);
-        const float k = m->coat_norm_scale;
-        vec3 cn = v3_add(v3_add(v3_scale(t, k * (2.0f * c.x - 1.0f)), v3_scale(b, k * (2.0f * c.y - 1.0f))),
-                         v3_scale(n, 2.0f * c.z - 1.0f));
+        vec3 cn = surface__map_normal(s, &m->map_ccn, q, m->coat_norm_scale, t, b, n);
         if (v3_finite(cn) && v3_len2(cn) > 0.0f) {
             cn = v3_norm(cn);
             if (v3_dot(cn, sf->ng) > 0.0f) sf->nc = cn; /* one facing away: the surface's normal */
@@ -361,10 +369,7 @@ static inline PK_HD void surface_texture_at(const scene_view *s, const ray *r, c
     if (!m->map_bump.kind && !m->map_norm.kind) return;
     vec3 nn = n;
     if (m->map_norm.kind) {
-        vec3 c = tex_eval_rgb(s->textures, &m->map_norm, q);
-        vec3 tl = v3(2.0f * c.x - 1.0f, 2.0f * c.y - 1.0f, 2.0f * c.z - 1.0f);
-        if (m->norm_scale != 1.0f) tl.x *= m->norm_scale, tl.y *= m->norm_scale;
-        nn = v3_add(v3_add(v3_scale(t, tl.x), v3_scale(b, tl.y)), v3_scale(n, tl.z));
+        nn = surface__map_normal(s, &m->map_norm, q, m->norm_scale, t, b, n);
     } else {
         /* heights times bm displace along n: n' = (dp/du + dh/du n) x (dp/dv + dh/dv n) */
         const tex_ref *ref = &m->map_bump;
