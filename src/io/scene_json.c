@@ -1528,11 +1528,10 @@ static pk_status parse_material_record(jp *p, const cJSON *e, const char *path)
     if (!cJSON_IsString(f[0]) || !f[0]->valuestring[0])
         return jfail(p, PK_ERR_PARSE, f[0] ? f[0] : e, fp, "must be a non-empty string");
     path_key(fp, path, "record");
-    static const char *const extra[] = {"map_kd",   "map_ks",   "map_ns",   "map_d",    "map_alpha",
-                                        "map_bump", "map_norm", "map_mr",   "map_ke",   "map_eta",  "map_k",
-                                        "map_tf",   "map_tr",   "map_cc",   "map_ccr",  "map_spec", "map_spec_color",
-                                        "map_sheen", "map_sheen_rough", "map_irid", "map_irid_thick", "map_aniso",
-                                        "map_ccn", "interior", "exterior", NULL};
+    /* the record's keys read below: the maps and the media */
+    const char *extra[MATERIAL_NMAPS + 3];
+    for (int k = 0; k < MATERIAL_NMAPS; k++) extra[k] = material_map_names[k];
+    extra[MATERIAL_NMAPS] = "interior", extra[MATERIAL_NMAPS + 1] = "exterior", extra[MATERIAL_NMAPS + 2] = NULL;
     material m;
     material_init(&m);
     if ((st = rec_read(p, f[1], fp, rec_material, rec_nmaterial, extra, &m))) return st;
@@ -1548,12 +1547,12 @@ static pk_status parse_material_record(jp *p, const cJSON *e, const char *path)
         return jfail(p, PK_ERR_PARSE, f[1], fp,
                      "a coated material needs coat_base 0 or 1, coat_thickness > 0, coat_g in (-1, 1), "
                      "coat_maxdepth and coat_nsamples >= 1");
-    for (int k = 0; k < REC_NMAPS; k++) {
-        const cJSON *it = cJSON_GetObjectItemCaseSensitive(f[1], rec_map_names[k]);
+    for (int k = 0; k < MATERIAL_NMAPS; k++) {
+        const cJSON *it = cJSON_GetObjectItemCaseSensitive(f[1], material_map_names[k]);
         if (!it) continue;
         char mp[JP_PATH_MAX];
-        path_key(mp, fp, rec_map_names[k]);
-        if ((st = read_texref_record(p, it, mp, (tex_ref *)(void *)((char *)&m + rec_map_offsets[k])))) return st;
+        path_key(mp, fp, material_map_names[k]);
+        if ((st = read_texref_record(p, it, mp, material_map(&m, k)))) return st;
     }
     if ((st = read_medium_sides(p, f[1], fp, &m))) return st;
     return add_material(p, &m, f[0]->valuestring, NULL);

@@ -47,22 +47,6 @@ const rec_field rec_material[] = {
 };
 const size_t rec_nmaterial = sizeof rec_material / sizeof rec_material[0];
 
-const char *const rec_map_names[REC_NMAPS] = {"map_kd",    "map_ks",   "map_ns",   "map_d",
-                                              "map_alpha", "map_bump", "map_norm", "map_mr",
-                                              "map_ke",    "map_eta",  "map_k",    "map_tf",
-                                              "map_tr",    "map_cc",   "map_ccr",
-                                              "map_spec",  "map_spec_color", "map_sheen", "map_sheen_rough",
-                                              "map_irid",  "map_irid_thick", "map_aniso", "map_ccn"};
-const size_t rec_map_offsets[REC_NMAPS] = {
-    offsetof(material, map_kd),    offsetof(material, map_ks),   offsetof(material, map_ns),
-    offsetof(material, map_d),     offsetof(material, map_alpha), offsetof(material, map_bump),
-    offsetof(material, map_norm),  offsetof(material, map_mr),   offsetof(material, map_ke),
-    offsetof(material, map_eta),   offsetof(material, map_k),    offsetof(material, map_tf),
-    offsetof(material, map_tr),    offsetof(material, map_cc),   offsetof(material, map_ccr),
-    offsetof(material, map_spec),  offsetof(material, map_spec_color), offsetof(material, map_sheen),
-    offsetof(material, map_sheen_rough), offsetof(material, map_irid), offsetof(material, map_irid_thick),
-    offsetof(material, map_aniso), offsetof(material, map_ccn)};
-
 const rec_field rec_texref[] = {
     {"kind", REC_U8, offsetof(tex_ref, kind)},   F(tex_ref, clamp, REC_WRAP), F(tex_ref, squared, REC_BOOL),
     F(tex_ref, s, REC_F2),                          F(tex_ref, o, REC_F2),       F(tex_ref, bm, REC_FLOAT),

@@ -29,10 +29,8 @@ typedef struct rec_field {
  * "interior" and "exterior"). */
 PK_HIDDEN extern const rec_field rec_material[];
 PK_HIDDEN extern const size_t rec_nmaterial;
-/* The maps of a material, in the order of the names. */
-#define REC_NMAPS 23
-PK_HIDDEN extern const char *const rec_map_names[REC_NMAPS];
-PK_HIDDEN extern const size_t rec_map_offsets[REC_NMAPS];
+/* (The maps of a material: material.h's MATERIAL_MAPS, material_map_names
+ * and material_map_offsets.) */
 /* The plain fields of a texture reference (the image is "image" or "pixels"). */
 PK_HIDDEN extern const rec_field rec_texref[];
 PK_HIDDEN extern const size_t rec_ntexref;

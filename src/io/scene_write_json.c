@@ -283,8 +283,8 @@ static pk_status write_materials(jw *w)
                                                              : sizeof(float);
         same = memcmp((const char *)m0 + rec_material[i].offset, (const char *)&d + rec_material[i].offset, sz) == 0;
     }
-    for (int k = 0; k < REC_NMAPS && same; k++)
-        same = ((const tex_ref *)(const void *)((const char *)m0 + rec_map_offsets[k]))->kind == TEX_NONE;
+    for (int k = 0; k < MATERIAL_NMAPS && same; k++)
+        same = material_map_c(m0, k)->kind == TEX_NONE;
     if (!same)
         return ctx_error(w->ctx, PK_ERR_UNSUPPORTED,
                          "%s: the scene changes the default material 0; the JSON format cannot express that", w->out);
@@ -299,10 +299,10 @@ static pk_status write_materials(jw *w)
         bool first = true;
         pk_status st = jw_fields(w, &first, rec_material, rec_nmaterial, m, what);
         if (st) return st;
-        for (int k = 0; k < REC_NMAPS; k++) {
-            const tex_ref *r = (const tex_ref *)(const void *)((const char *)m + rec_map_offsets[k]);
+        for (int k = 0; k < MATERIAL_NMAPS; k++) {
+            const tex_ref *r = material_map_c(m, k);
             if (r->kind == TEX_NONE) continue;
-            jw_key(w, &first, rec_map_names[k]);
+            jw_key(w, &first, material_map_names[k]);
             if ((st = write_texref(w, r, what))) return st;
         }
         if (m->medium_in != MEDIUM_INHERIT) {

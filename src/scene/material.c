@@ -3,6 +3,13 @@
  */
 #include "material.h"
 
+#include <stddef.h>
+
+#define MATERIAL__NAME(f) #f,
+#define MATERIAL__OFFSET(f) offsetof(material, f),
+const char *const material_map_names[MATERIAL_NMAPS] = {MATERIAL_MAPS(MATERIAL__NAME)};
+const size_t material_map_offsets[MATERIAL_NMAPS] = {MATERIAL_MAPS(MATERIAL__OFFSET)};
+
 #include "../render/sheen.h"
 
 #include <math.h>
@@ -21,33 +28,11 @@ void material_init(material *m)
     m->medium_in = m->medium_out = -2; /* MEDIUM_INHERIT */
     m->alpha_v = -1.0f;                /* isotropic */
     m->norm_scale = m->coat_norm_scale = 1.0f;
-    tex_ref_init(&m->map_kd);
-    tex_ref_init(&m->map_ks);
-    tex_ref_init(&m->map_ns);
-    tex_ref_init(&m->map_d);
-    tex_ref_init(&m->map_alpha);
-    tex_ref_init(&m->map_bump);
-    tex_ref_init(&m->map_norm);
-    tex_ref_init(&m->map_mr);
-    tex_ref_init(&m->map_ke);
-    tex_ref_init(&m->map_eta);
-    tex_ref_init(&m->map_k);
-    tex_ref_init(&m->map_tf);
-    tex_ref_init(&m->map_tr);
-    tex_ref_init(&m->map_cc);
-    tex_ref_init(&m->map_ccr);
-    tex_ref_init(&m->map_ccn);
+    for (int k = 0; k < MATERIAL_NMAPS; k++) tex_ref_init(material_map(m, k));
     m->specular = 1.0f;
     m->specular_color = v3s(1.0f);
     m->iridescence_ior = 1.3f;
     m->iridescence_thickness = 400.0f, m->iridescence_thickness_min = 100.0f;
-    tex_ref_init(&m->map_spec);
-    tex_ref_init(&m->map_spec_color);
-    tex_ref_init(&m->map_sheen);
-    tex_ref_init(&m->map_sheen_rough);
-    tex_ref_init(&m->map_irid);
-    tex_ref_init(&m->map_irid_thick);
-    tex_ref_init(&m->map_aniso);
 }
 
 float material_f0_dielectric(float ior)

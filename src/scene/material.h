@@ -218,6 +218,30 @@ typedef struct material {
     bool cutout;     /* derived by scene_commit: map_d is set */
 } material;
 
+/* Every texture map of a material, once: X(field) for each, in the order
+ * scene files write them. The lists below (names, offsets) and every loop
+ * over a material's maps come from it, so that a new map is added here and
+ * in the struct only. */
+#define MATERIAL_MAPS(X)                                                                                            \
+    X(map_kd) X(map_ks) X(map_ns) X(map_d) X(map_alpha) X(map_bump) X(map_norm) X(map_mr) X(map_ke) X(map_eta)     \
+    X(map_k) X(map_tf) X(map_tr) X(map_cc) X(map_ccr) X(map_spec) X(map_spec_color) X(map_sheen)                  \
+    X(map_sheen_rough) X(map_irid) X(map_irid_thick) X(map_aniso) X(map_ccn)
+#define MATERIAL__ONE(f) +1
+enum { MATERIAL_NMAPS = 0 MATERIAL_MAPS(MATERIAL__ONE) };
+/* The maps' field names ("map_kd", ...) and their offsets in material, in
+ * MATERIAL_MAPS's order. */
+PK_HIDDEN extern const char *const material_map_names[MATERIAL_NMAPS];
+PK_HIDDEN extern const size_t material_map_offsets[MATERIAL_NMAPS];
+/* Map k (< MATERIAL_NMAPS) of m. */
+static inline tex_ref *material_map(material *m, int k)
+{
+    return (tex_ref *)(void *)((char *)m + material_map_offsets[k]);
+}
+static inline const tex_ref *material_map_c(const material *m, int k)
+{
+    return (const tex_ref *)(const void *)((const char *)m + material_map_offsets[k]);
+}
+
 /* The MTL defaults (Kd 0.8, illum 2, opaque, no maps, no name). */
 PK_HIDDEN void material_init(material *m);
 

@@ -993,16 +993,9 @@ pk_status scene_commit(pk_context *ctx, pk_scene *s)
     for (size_t i = 0; i < s->nmaterials; i++) {
         material *m = &s->materials[i];
         m->cutout = m->map_d.kind != TEX_NONE || m->blend;
-        m->textured = m->map_kd.kind != TEX_NONE || m->map_ks.kind != TEX_NONE || m->map_ns.kind != TEX_NONE ||
-                      m->map_alpha.kind != TEX_NONE || m->map_bump.kind != TEX_NONE || m->map_norm.kind != TEX_NONE ||
-                      m->map_mr.kind != TEX_NONE || m->map_ke.kind != TEX_NONE || m->map_eta.kind != TEX_NONE ||
-                      m->map_k.kind != TEX_NONE || m->map_tf.kind != TEX_NONE || m->map_tr.kind != TEX_NONE ||
-                      m->map_cc.kind != TEX_NONE || m->map_ccr.kind != TEX_NONE || m->map_ccn.kind != TEX_NONE ||
-                      material_anisotropic(m) ||
-                      m->vertex_color || m->map_spec.kind != TEX_NONE || m->map_spec_color.kind != TEX_NONE ||
-                      m->map_sheen.kind != TEX_NONE || m->map_sheen_rough.kind != TEX_NONE ||
-                      m->map_irid.kind != TEX_NONE || m->map_irid_thick.kind != TEX_NONE ||
-                      m->map_aniso.kind != TEX_NONE;
+        m->textured = material_anisotropic(m) || m->vertex_color;
+        for (int k = 0; k < MATERIAL_NMAPS; k++) /* (map_d makes holes, not a textured surface) */
+            m->textured |= material_map(m, k) != &m->map_d && material_map(m, k)->kind != TEX_NONE;
         s->has_cutout |= m->cutout;
         s->has_interfaces |= m->type == MAT_INTERFACE;
         s->has_textured |= m->textured;
@@ -1072,19 +1065,14 @@ bool scene_check(const pk_scene *s, char *why, size_t n)
     if (tex_bytes != s->texture_bytes) FAIL("texture bytes do not add up");
     for (size_t i = 0; i < s->nmaterials; i++) {
         const material *m = &s->materials[i];
-        const tex_ref *maps[23] = {&m->map_kd,   &m->map_ks,   &m->map_ns, &m->map_d,  &m->map_alpha, &m->map_bump,
-                                   &m->map_norm, &m->map_mr, &m->map_ke, &m->map_eta, &m->map_k,   &m->map_tf,
-                                   &m->map_tr,   &m->map_cc, &m->map_ccr, &m->map_ccn,
-                                   &m->map_spec, &m->map_spec_color, &m->map_sheen, &m->map_sheen_rough,
-                                   &m->map_irid, &m->map_irid_thick, &m->map_aniso};
-        for (int j = 0; j < 23; j++)
-        {
-            if (maps[j]->kind == TEX_IMAGE && (maps[j]->tex < 0 || (size_t)maps[j]->tex >= s->ntextures))
+        for (int j = 0; j < MATERIAL_NMAPS; j++) {
+            const tex_ref *r = material_map_c(m, j);
+            if (r->kind == TEX_IMAGE && (r->tex < 0 || (size_t)r->tex >= s->ntextures))
                 FAIL("material %zu: texture index out of range", i);
-            if (maps[j]->kind == TEX_EXPR &&
-                (maps[j]->node < 0 || maps[j]->nnodes < 1 || (size_t)maps[j]->node > s->ntex_nodes ||
-                 (size_t)maps[j]->nnodes > s->ntex_nodes - (size_t)maps[j]->node ||
-                 !tex_nodes_valid(s->tex_nodes + maps[j]->node, maps[j]->nnodes, s->ntextures)))
+            if (r->kind == TEX_EXPR &&
+                (r->node < 0 || r->nnodes < 1 || (size_t)r->node > s->ntex_nodes ||
+                 (size_t)r->nnodes > s->ntex_nodes - (size_t)r->node ||
+                 !tex_nodes_valid(s->tex_nodes + r->node, r->nnodes, s->ntextures)))
                 FAIL("material %zu: texture expression out of range", i);
         }
         if (m->type == MAT_MIX && scene_mix_depth(s, (uint32_t)i) > MATERIAL_MIX_DEPTH)
