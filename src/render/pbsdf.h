@@ -863,23 +863,18 @@ static inline PK_HD float pbsdf__coat_lobe_pdf(const pbsdf *b, vec3 wo, vec3 wi)
     }
     return pbsdf__ggx_refl_pdf(b->coat_alpha, wo, wi);
 }
+/* (Called for a coat with its own normal only, PBSDF_COAT_NORMAL: a plain
+ * coat's callers sample it in the shading frame themselves.) */
 static inline PK_HD bool pbsdf__coat_lobe_sample(const pbsdf *b, vec3 wo, float u1, float u2, vec3 *wi)
 {
-    onb f;
-    const bool own = (b->flags & PBSDF_COAT_NORMAL) != 0u;
-    if (own) {
-        f = onb_from_normal(b->coat_n);
-        wo = onb_to_local(f, wo);
-        if (!(wo.z > 0.0f)) return false;
-    }
+    const onb f = onb_from_normal(b->coat_n);
+    wo = onb_to_local(f, wo);
+    if (!(wo.z > 0.0f)) return false;
     const vec3 m = pbsdf_ggx_vndf_sample(b->coat_alpha, wo, u1, u2);
     const float om = v3_dot(wo, m);
     vec3 w = v3_sub(v3_scale(m, 2.0f * om), wo);
-    if (own) {
-        if (!(om > 0.0f) || !(w.z > 0.0f)) return false;
-        w = onb_to_world(f, w);
-    }
-    *wi = w;
+    if (!(om > 0.0f) || !(w.z > 0.0f)) return false;
+    *wi = onb_to_world(f, w);
     return true;
 }
 static inline PK_HD bool pbsdf__coat_mirror(const pbsdf *b, vec3 wo, vec3 *wi)
