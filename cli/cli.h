@@ -116,6 +116,8 @@ typedef struct cli_render_opts {
     int has_integrator;
     pk_integrator_kind integrator;
     double time;         /* --time: seconds of passes, 0 when not given */
+    double noise;        /* --noise: the adaptive sampling's target, 0 when not given */
+    int min_spp;         /* --min-spp, 0 when not given */
     unsigned aovs;       /* --aov: PK_AOV_* */
     int has_from, has_at, has_up, has_fov;
     float from[3], at[3], up[3], fov;
@@ -159,9 +161,11 @@ pk_status cli_render_settings(pk_context *ctx, const cli_render_opts *o, pk_scen
  * --time nor the scene file): enough for the denoiser to give a clean
  * image (docs/denoising.md says how it was chosen). */
 #define CLI_CLEAN_SPP 16
+/* Non-zero when --spp was given. */
+int cli_render_spp_given(const cli_render_opts *o);
 /* Non-zero when the render is the default one: no --spp, no --time, no
- * sample count in the scene. It then takes CLI_CLEAN_SPP samples and is
- * denoised unless --no-denoise. */
+ * --noise, no sample count in the scene. It then takes CLI_CLEAN_SPP
+ * samples and is denoised unless --no-denoise. */
 int cli_render_clean_default(const cli_render_opts *o, const pk_scene *scene);
 
 /* ---- denoising (cli/denoise.c) ------------------------------------------- */
@@ -203,8 +207,12 @@ typedef struct cli_denoise_stats {
 void cli_print_denoise_stats(const cli_denoise_stats *dn);
 /* --stats-json: path "-" is standard output; dn NULL or not done: the image
  * was not denoised. Returns 0 or 1 after a message. */
+/* The adaptive sampling rows of --stats (nothing when ad is NULL). */
+void cli_print_adaptive_stats(const pk_adaptive_result *ad, const pk_adaptive *a, const pk_render_options *ro);
+/* ad and a: an adaptive render's result and settings (NULL: none) */
 int cli_write_stats_json(pk_context *ctx, const char *path, const char *scene, const pk_scene *sc,
-                         const pk_render_options *ro, const pk_stats *st, const cli_denoise_stats *dn);
+                         const pk_render_options *ro, const pk_stats *st, const cli_denoise_stats *dn,
+                         const pk_adaptive_result *ad, const pk_adaptive *a);
 
 /* ---- the progress bar (cli/progress.c) --------------------------------- */
 

@@ -803,6 +803,8 @@ int main(int argc, char **argv)
         if (rc == 0) rc = cli_render_check(&o, &wo);
         if (rc == 0 && (o.transparent || (o.aovs & PK_AOV_ALPHA)))
             rc = cli_usage_error("paprsek-mpi: --transparent and --aov alpha are for paprsek render only");
+        if (rc == 0 && (o.noise > 0.0 || o.min_spp))
+            rc = cli_usage_error("paprsek-mpi: --noise and --min-spp (adaptive sampling) are for paprsek render only");
     }
     MPI_Bcast(&rc, 1, MPI_INT, 0, MPI_COMM_WORLD);
     if (rc) {
@@ -1072,7 +1074,7 @@ int main(int argc, char **argv)
                 print_ranks(reps, &ro, wall_s, (uint64_t)ntiles * passes);
                 fflush(stdout);
             }
-            if (o.stats_json && cli_write_stats_json(ctx, o.stats_json, name, scene, &ro, &js, &dn) != 0) rc = 1;
+            if (o.stats_json && cli_write_stats_json(ctx, o.stats_json, name, scene, &ro, &js, &dn, NULL, NULL) != 0) rc = 1;
         }
         free(reps);
     }

@@ -66,6 +66,28 @@ static pk_status render_passes(pk_context *ctx, const pk_scene *scene, pk_render
     pk_renderer_destroy(r);
     return st;
 }
+/* --noise: adaptive sampling into a film of its own (passes of ro->spp,
+ * until the tiles reach the target, --spp's maximum or --time). */
+static pk_status render_adaptive(pk_context *ctx, const pk_scene *scene, const pk_render_options *ro,
+                                 const pk_adaptive *a, unsigned aovs, pk_image **img, pk_film **film_out,
+                                 pk_stats *stats, pk_adaptive_result *res)
+{
+    pk_renderer *r = NULL;
+    pk_film *film = NULL;
+    *img = NULL;
+    pk_status st = pk_renderer_create(ctx, scene, ro, &r);
+    if (st == PK_OK) st = pk_film_create_aovs(ctx, ro->width, ro->height, aovs, &film);
+    if (st == PK_OK) st = pk_renderer_render_adaptive(r, a, film, res);
+    if ((st == PK_OK || st == PK_ERR_CANCELLED) && film) {
+        pk_status rs = pk_film_resolve(ctx, film, img);
+        if (rs != PK_OK) st = rs;
+    }
+    if (r) pk_renderer_get_stats(r, stats);
+    *film_out = film;
+    pk_renderer_destroy(r);
+    return st;
+}
+
 void cli_render_help(FILE *f) { cli_render_usage(f, "usage: paprsek render [SCENE] -o OUT [options]\n"); }
 
 int cli_render(int argc, char **argv)
@@ -118,7 +140,22 @@ int cli_render(int argc, char **argv)
 
     pk_stats stats;
     uint32_t passes = 1;
-    if (o.time > 0.0 || aovs)
+    pk_adaptive ad;
+    pk_adaptive_result adr;
+    memset(&adr, 0, sizeof adr);
+    pk_adaptive_init(&ad);
+    if (o.noise > 0.0) {
+        /* passes of one sample; --spp, when given, is the most a pixel gets */
+        ad.noise = (float)o.noise;
+        if (o.min_spp) ad.min_spp = o.min_spp;
+        if (cli_render_spp_given(&o)) ad.max_spp = ro.spp;
+        if (ad.max_spp < ad.min_spp) ad.min_spp = ad.max_spp;
+        ad.seconds = o.time;
+        ro.spp = 1;
+        ro.progress = NULL; /* (the tiles of each pass are not the render's) */
+        st = render_adaptive(ctx, scene, &ro, &ad, aovs, &img, &film, &stats, &adr);
+        passes = adr.passes;
+    } else if (o.time > 0.0 || aovs)
         st = render_passes(ctx, scene, &ro, o.time, aovs, &bar, &img, &film, &stats, &passes);
     else
         st = pk_render(ctx, scene, &ro, &img, &stats);
@@ -146,7 +183,11 @@ int cli_render(int argc, char **argv)
     if (bar.enabled) {
         char took[32];
         cli_format_duration(took, sizeof took, cli_now() - t0);
-        if (o.time > 0.0)
+        if (o.noise > 0.0)
+            fprintf(stderr, "wrote %s (%dx%d, adaptive: %.1f spp on average, %u to %u%s, %s)\n", o.out, ro.width,
+                    ro.height, (double)adr.samples / ((double)ro.width * (double)ro.height), adr.min_spp, adr.max_spp,
+                    denoise ? ", denoised" : "", took);
+        else if (o.time > 0.0)
             fprintf(stderr, "wrote %s (%dx%d, %u passes of %d spp%s, %s)\n", o.out, ro.width, ro.height, passes,
                     ro.spp, denoise ? ", denoised" : "", took);
         else
@@ -156,9 +197,12 @@ int cli_render(int argc, char **argv)
     const char *name = o.scene ? o.scene : "cornell-box (built in)";
     if (o.stats) {
         cli_print_stats(ctx, name, scene, &ro, &stats);
+        if (o.noise > 0.0) cli_print_adaptive_stats(&adr, &ad, &ro);
         cli_print_denoise_stats(&dn);
     }
-    if (o.stats_json && cli_write_stats_json(ctx, o.stats_json, name, scene, &ro, &stats, &dn) != 0) goto out;
+    if (o.stats_json && cli_write_stats_json(ctx, o.stats_json, name, scene, &ro, &stats, &dn,
+                                                o.noise > 0.0 ? &adr : NULL, &ad) != 0)
+        goto out;
     rc = 0;
     goto out;
 fail:

@@ -40,6 +40,8 @@ enum {
     OPT_ORTHOGRAPHIC,
     OPT_PERSPECTIVE,
     OPT_TIME,
+    OPT_NOISE,
+    OPT_MIN_SPP,
     OPT_ENV,
     OPT_AOV,
     OPT_STATS,
@@ -146,6 +148,14 @@ const cli_option *cli_render_options(size_t *n)
         add((cli_option){.name = "time", .id = OPT_TIME, .kind = CLI_STRING, .arg = "SECONDS",
                          .help = "render passes of --spp samples per pixel until SECONDS have passed (at least "
                                  "one pass); the image is the mean of all passes"});
+        add((cli_option){.name = "noise", .id = OPT_NOISE, .kind = CLI_STRING, .arg = "X",
+                         .help = "adaptive sampling: render passes of one sample per pixel over the 16x16 tiles "
+                                 "whose estimated relative error is still above X (e.g. 0.05: 5 %), from the "
+                                 "difference of two halves of the samples; each pixel gets at least --min-spp "
+                                 "samples and at most --spp (default 1024 with --noise); --time still stops the "
+                                 "render. The statistics say how many samples went where"});
+        add((cli_option){.name = "min-spp", .id = OPT_MIN_SPP, .kind = CLI_STRING, .arg = "N",
+                         .help = "with --noise: the samples every pixel gets before its tile may stop (default 16)"});
         add((cli_option){.name = "env", .id = OPT_ENV, .kind = CLI_STRING, .arg = "SPEC",
                          .help = "the light from the surroundings, replacing the scene's: none (black), R,G,B "
                                  "or V (a constant radiance), or an image FILE (lat-long, +y up: .hdr, .exr, "
@@ -153,7 +163,8 @@ const cli_option *cli_render_options(size_t *n)
                                  "by a white one of radiance 1"});
         add((cli_option){.name = "aov", .id = OPT_AOV, .kind = CLI_STRING, .arg = "LIST",
                          .help = "also write these outputs, from the camera rays: albedo, normal, depth, "
-                                 "heatmap (nodes visited + primitives tested per camera ray), alpha (coverage), comma-separated; "
+                                 "heatmap (nodes visited + primitives tested per camera ray), alpha (coverage), "
+                                 "samples (samples per pixel: where --noise spent them), comma-separated; "
                                  "layers NAME.R/G/B of an .exr OUT, else files beside OUT as NAME.AOV.EXT"});
         add((cli_option){.name = "camera-orbit", .id = OPT_CAMERA_ORBIT, .kind = CLI_STRING,
                          .arg = "THETA,PHI,RADIUS",
@@ -492,6 +503,21 @@ int cli_render_parse(int argc, char **argv, cli_render_opts *o, void (*help)(FIL
             o->projection = PK_PROJECTION_PERSPECTIVE + 1;
             break;
         case OPT_ENV: o->env = v; break;
+        case OPT_NOISE: {
+            char *end;
+            o->noise = strtod(v, &end);
+            if (*end || end == v || !(o->noise > 0.0 && o->noise <= 10.0))
+                return cli_usage_error("--noise: '%s' must be a relative error in (0, 10], such as 0.05", v);
+            break;
+        }
+        case OPT_MIN_SPP: {
+            char *end;
+            const long ms = strtol(v, &end, 10);
+            if (*end || end == v || ms < 1 || ms > 65536)
+                return cli_usage_error("--min-spp: '%s' must be a whole number of samples in 1..65536", v);
+            o->min_spp = (int)ms;
+            break;
+        }
         case OPT_TIME: {
             char *end;
             o->time = strtod(v, &end);
@@ -504,10 +530,13 @@ int cli_render_parse(int argc, char **argv, cli_render_opts *o, void (*help)(FIL
             snprintf(buf, sizeof buf, "%s", v);
             for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
                 unsigned a = pk_aov_parse(tok);
-                if (!a) return cli_usage_error("--aov: unknown output '%s' (albedo, normal, depth, heatmap, alpha)", tok);
+                if (!a)
+                    return cli_usage_error("--aov: unknown output '%s' (albedo, normal, depth, heatmap, alpha, samples)",
+                                           tok);
                 o->aovs |= a;
             }
-            if (!o->aovs) return cli_usage_error("--aov: no output named (albedo, normal, depth, heatmap, alpha)");
+            if (!o->aovs)
+                return cli_usage_error("--aov: no output named (albedo, normal, depth, heatmap, alpha, samples)");
             break;
         }
         case OPT_STATS: o->stats = 1; break;
@@ -704,8 +733,18 @@ void cli_print_denoise_stats(const cli_denoise_stats *dn)
            dn->fast ? "fast" : "high-quality");
 }
 
+void cli_print_adaptive_stats(const pk_adaptive_result *ad, const pk_adaptive *a, const pk_render_options *ro)
+{
+    if (!ad) return;
+    printf("%-28s %.4f (target %.4f), %zu of %zu tiles reached it\n", "adaptive: estimated noise", (double)ad->noise,
+           (double)a->noise, ad->tiles_reached, ad->tiles);
+    printf("%-28s mean %.1f, min %u, max %u (%u passes)\n", "adaptive: samples per pixel",
+           (double)ad->samples / ((double)ro->width * (double)ro->height), ad->min_spp, ad->max_spp, ad->passes);
+}
+
 int cli_write_stats_json(pk_context *ctx, const char *path, const char *scene, const pk_scene *sc,
-                         const pk_render_options *ro, const pk_stats *st, const cli_denoise_stats *dn)
+                         const pk_render_options *ro, const pk_stats *st, const cli_denoise_stats *dn,
+                         const pk_adaptive_result *ad, const pk_adaptive *a)
 {
     pk_scene_info si;
     pk_scene_get_info(sc, &si);
@@ -743,6 +782,12 @@ int cli_write_stats_json(pk_context *ctx, const char *path, const char *scene, c
                 dn->fast ? "fast" : "high", dn->seconds, dn->bytes, dn->seconds > 0 ? dn->flops / dn->seconds * 1e-9 : 0.0);
     else
         fputs(",\n  \"denoise\": null", f);
+    if (ad)
+        fprintf(f,
+                ",\n  \"adaptive\": {\"target\": %.6g, \"noise\": %.6g, \"tiles\": %zu, \"tiles_reached\": %zu, "
+                "\"samples\": %llu, \"mean_spp\": %.3f, \"min_spp\": %u, \"max_spp\": %u, \"passes\": %u}",
+                (double)a->noise, (double)ad->noise, ad->tiles, ad->tiles_reached, (unsigned long long)ad->samples,
+                (double)ad->samples / ((double)ro->width * (double)ro->height), ad->min_spp, ad->max_spp, ad->passes);
     fputs("\n}\n", f);
     if (to_stdout ? fflush(f) != 0 || ferror(f) : fclose(f) != 0)
         return cli_failure("%s: cannot write: %s", to_stdout ? "standard output" : path, strerror(errno));
@@ -794,7 +839,7 @@ static void aov_for_png(pk_image *img, unsigned aov, int quiet)
         for (size_t i = 0; i < 3 * n; i++) px[i] = px[i] * 0.5f + 0.5f;
         return;
     }
-    if (aov != PK_AOV_DEPTH && aov != PK_AOV_HEATMAP) return;
+    if (aov != PK_AOV_DEPTH && aov != PK_AOV_HEATMAP && aov != PK_AOV_SAMPLES) return;
     float lo = INFINITY, hi = 0.0f;
     for (size_t i = 0; i < n; i++) {
         lo = px[3 * i] < lo ? px[3 * i] : lo;
@@ -812,7 +857,9 @@ static void aov_for_png(pk_image *img, unsigned aov, int quiet)
         px[3 * i + 1] = t < 0.5f ? 2.0f * t : 2.0f - 2.0f * t;
         px[3 * i + 2] = t < 0.5f ? 1.0f - 2.0f * t : 0.0f;
     }
-    if (!quiet)
+    if (!quiet && aov == PK_AOV_SAMPLES)
+        fprintf(stderr, "samples: blue %g to red %g samples per pixel\n", (double)lo, (double)hi);
+    else if (!quiet)
         fprintf(stderr, "heatmap: blue %g to red %g nodes visited + primitives tested per camera ray\n", (double)lo,
                 (double)hi);
 }
@@ -821,6 +868,7 @@ static void aov_for_png(pk_image *img, unsigned aov, int quiet)
 
 int cli_render_check(const cli_render_opts *o, pk_write_options *wo)
 {
+    if (o->min_spp && o->noise <= 0.0) return cli_usage_error("--min-spp needs --noise (adaptive sampling)");
     struct stat sb;
     if (stat(o->out, &sb) == 0 && S_ISDIR(sb.st_mode)) return cli_failure("%s: is a folder; name a file in it", o->out);
     const int png = ends_with_ci(o->out, ".png");
@@ -857,13 +905,19 @@ int cli_render_check(const cli_render_opts *o, pk_write_options *wo)
     return 0;
 }
 
-int cli_render_clean_default(const cli_render_opts *o, const pk_scene *scene)
+int cli_render_spp_given(const cli_render_opts *o)
 {
     size_t n;
     const cli_option *opts = cli_render_options(&n);
     for (size_t i = 0; i < n; i++)
-        if (o->int_set[i] && opts[i].render && strcmp(opts[i].render->name, "spp") == 0) return 0;
-    return o->time <= 0.0 && !pk_scene_has_sample_count(scene);
+        if (o->int_set[i] && opts[i].render && strcmp(opts[i].render->name, "spp") == 0) return 1;
+    return 0;
+}
+
+int cli_render_clean_default(const cli_render_opts *o, const pk_scene *scene)
+{
+    if (cli_render_spp_given(o)) return 0;
+    return o->time <= 0.0 && o->noise <= 0.0 && !pk_scene_has_sample_count(scene);
 }
 
 pk_status cli_render_settings(pk_context *ctx, const cli_render_opts *o, pk_scene *scene, pk_render_options *ro)
@@ -989,7 +1043,7 @@ static pk_status cli_render_write_images(pk_context *ctx, const cli_render_opts 
         const char *ln[5];
         size_t nl = 0;
         pk_status ls = PK_OK;
-        for (unsigned a = 1; a <= PK_AOV_ALPHA && ls == PK_OK; a <<= 1)
+        for (unsigned a = 1; a <= PK_AOV_SAMPLES && ls == PK_OK; a <<= 1)
             if (o->aovs & a) {
                 ln[nl] = pk_aov_name(a);
                 ls = pk_film_resolve_aov(ctx, film, a, &li[nl++]);
@@ -1006,7 +1060,7 @@ static pk_status cli_render_write_images(pk_context *ctx, const cli_render_opts 
         pk_status ws = pk_image_write_ex(ctx, img, o->out, &wo);
         if (ws != PK_OK) return ws;
     }
-    for (unsigned a = 1; a <= PK_AOV_ALPHA; a <<= 1) {
+    for (unsigned a = 1; a <= PK_AOV_SAMPLES; a <<= 1) {
         if (!(o->aovs & a) || ends_with_ci(o->out, ".exr")) continue;
         pk_image *ai = NULL;
         char *name = aov_name(o->out, pk_aov_name(a));

@@ -350,11 +350,13 @@ enum {
     PK_AOV_NORMAL = 2u,  /* the shading normal, world space, facing the ray, at that same surface */
     PK_AOV_DEPTH = 4u,   /* distance from the camera to the hit (0 where nothing is hit) */
     PK_AOV_HEATMAP = 8u, /* acceleration-structure nodes visited + primitives tested by the camera ray */
-    PK_AOV_ALPHA = 16u   /* coverage: the fraction of the pixel's samples whose camera ray hit a surface
+    PK_AOV_ALPHA = 16u,  /* coverage: the fraction of the pixel's samples whose camera ray hit a surface
                           * (through map_d holes; glass and mirrors count as surfaces), in all three
                           * channels (pk_write_options.alpha reads the first) */
+    PK_AOV_SAMPLES = 32u /* the number of samples of the pixel, in all three channels (adaptive
+                          * sampling gives pixels different numbers); the film's counts, no storage */
 };
-/* "albedo", "normal", "depth", "heatmap", "alpha" -> PK_AOV_*, 0 when unknown. */
+/* "albedo", "normal", "depth", "heatmap", "alpha", "samples" -> PK_AOV_*, 0 when unknown. */
 PK_API unsigned pk_aov_parse(const char *name);
 PK_API const char *pk_aov_name(unsigned aov);
 
@@ -770,6 +772,42 @@ PK_API void pk_renderer_set_pass(pk_renderer *r, uint32_t pass);
 /* Statistics since pk_renderer_create: the build once, the rays, tests,
  * nodes, pixels and render time of every render added up. */
 PK_API void pk_renderer_get_stats(const pk_renderer *r, pk_stats *stats);
+
+/* Adaptive sampling: passes of opt.spp samples, each over the 16 x 16 tiles
+ * of the image whose noise is still above a target. The passes alternate
+ * between two halves of the samples; a tile's noise is estimated from the
+ * difference of its halves' means, as the relative error of its pixels'
+ * mean: sqrt(mean over the tile's pixels and channels of
+ * ((a - b) / 2)^2 / (m^2 + 0.01)), a and b the halves' means, m the mean of
+ * all (the 0.01 keeps dark pixels from asking for endless samples). A tile
+ * stops once every pixel has min_spp samples and its noise is at most
+ * `noise`, or when its pixels have max_spp; the render stops when every tile
+ * has, or after `seconds`. The result depends on the scene, the options and
+ * these settings only, never on the threads. */
+typedef struct pk_adaptive {
+    float noise;    /* the target relative error (> 0), e.g. 0.05 */
+    int min_spp;    /* samples every pixel gets before its tile may stop (default 16) */
+    int max_spp;    /* the most samples a pixel gets (default 1024) */
+    double seconds; /* a time limit (0, the default: none) */
+} pk_adaptive;
+/* What an adaptive render did. */
+typedef struct pk_adaptive_result {
+    uint32_t passes;        /* passes rendered */
+    uint64_t samples;       /* samples of all pixels */
+    uint32_t min_spp, max_spp; /* the fewest and the most samples of a pixel */
+    size_t tiles;           /* tiles of the image */
+    size_t tiles_reached;   /* tiles that reached the target (the others hit max_spp or the time limit) */
+    float noise;            /* the estimated relative error of the whole image (as above, over every pixel) */
+} pk_adaptive_result;
+
+PK_API void pk_adaptive_init(pk_adaptive *a);
+/* Renders the whole image adaptively into film (which must have the
+ * renderer's size; the film's own samples before the call are counted as
+ * one half: pass an empty film). The renderer's pass number is left after
+ * the last pass. result may be NULL. On PK_ERR_CANCELLED the film holds
+ * the samples of the passes that finished. */
+PK_API pk_status pk_renderer_render_adaptive(pk_renderer *r, const pk_adaptive *a, pk_film *film,
+                                             pk_adaptive_result *result);
 
 /* What lies under a point of the image (pk_renderer_pick). */
 typedef struct pk_pick {

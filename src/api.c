@@ -456,12 +456,12 @@ pk_status pk_film_create_aovs(pk_context *ctx, int width, int height, unsigned a
 {
     if (!ctx || !out) return PK_ERR_INVALID_ARGUMENT;
     *out = NULL;
-    if (aovs & ~(PK_AOV_ALBEDO | PK_AOV_NORMAL | PK_AOV_DEPTH | PK_AOV_HEATMAP | PK_AOV_ALPHA))
+    if (aovs & ~(PK_AOV_ALBEDO | PK_AOV_NORMAL | PK_AOV_DEPTH | PK_AOV_HEATMAP | PK_AOV_ALPHA | PK_AOV_SAMPLES))
         return ctx_error(ctx, PK_ERR_INVALID_ARGUMENT, "unknown AOV bits 0x%x", aovs);
     return film_create(ctx, width, height, aovs, out);
 }
 
-unsigned pk_film_aovs(const pk_film *film) { return film ? film->aovs : 0; }
+unsigned pk_film_aovs(const pk_film *film) { return film ? film->aovs | (film->samples ? PK_AOV_SAMPLES : 0u) : 0; }
 
 static const char *const aov_names[FILM_AOVS] = {"albedo", "normal", "depth", "heatmap", "alpha"};
 
@@ -470,20 +470,26 @@ unsigned pk_aov_parse(const char *name)
     if (!name) return 0;
     for (int k = 0; k < FILM_AOVS; k++)
         if (strcmp(name, aov_names[k]) == 0) return 1u << k;
-    return 0;
+    return strcmp(name, "samples") == 0 ? PK_AOV_SAMPLES : 0;
 }
 
 const char *pk_aov_name(unsigned aov)
 {
     for (int k = 0; k < FILM_AOVS; k++)
         if (aov == 1u << k) return aov_names[k];
-    return "unknown";
+    return aov == PK_AOV_SAMPLES ? "samples" : "unknown";
 }
 
 pk_status pk_film_resolve_aov(pk_context *ctx, const pk_film *film, unsigned aov, pk_image **out)
 {
     if (!ctx || !film || !out) return PK_ERR_INVALID_ARGUMENT;
     *out = NULL;
+    if (aov == PK_AOV_SAMPLES && film->samples) {
+        pk_status st = image_create(ctx, film->width, film->height, out);
+        const size_t n = (size_t)film->width * (size_t)film->height;
+        for (size_t i = 0; st == PK_OK && i < 3 * n; i++) (*out)->pixels[i] = (float)film->counts[i / 3];
+        return st;
+    }
     int k = -1;
     for (int i = 0; i < FILM_AOVS; i++)
         if (aov == 1u << i) k = i;

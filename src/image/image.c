@@ -61,6 +61,7 @@ pk_status film_create(pk_context *ctx, int width, int height, unsigned aovs, pk_
         return ctx_nomem(ctx);
     }
     f->aovs = aovs & ((1u << FILM_AOVS) - 1u);
+    f->samples = (aovs & PK_AOV_SAMPLES) != 0;
     for (int k = 0; k < FILM_AOVS; k++)
         if (f->aovs & (1u << k)) {
             f->aov[k] = mem_calloc(&ctx->alloc, n * 3, sizeof(float));

@@ -24,7 +24,8 @@ struct pk_film {
     int width, height;
     float *sums;
     uint32_t *counts;
-    unsigned aovs;              /* PK_AOV_* held */
+    unsigned aovs;              /* PK_AOV_* held in aov[] (bits below FILM_AOVS) */
+    bool samples;               /* PK_AOV_SAMPLES asked for (read from counts) */
     float *aov[FILM_AOVS];      /* 3 floats per pixel each (sums), NULL when not held */
 };
 

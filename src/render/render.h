@@ -23,6 +23,7 @@ PK_HIDDEN const pk_camera *renderer_camera(const pk_renderer *r);
 PK_HIDDEN pk_status renderer_render(pk_renderer *r, const pk_region *regions, size_t n, pk_film *film);
 PK_HIDDEN void renderer_stats(const pk_renderer *r, pk_stats *stats);
 PK_HIDDEN void renderer_set_pass(pk_renderer *r, uint32_t pass);
+PK_HIDDEN uint32_t renderer_pass(const pk_renderer *r);
 /* What the renderer built once (read only; pick.c). */
 PK_HIDDEN const frame *renderer_frame(const pk_renderer *r);
 /* pk_renderer_pick (pick.c); r and out are not NULL. */

@@ -224,6 +224,7 @@ void renderer_set_path_strategy(pk_renderer *r, int strategy)
     if (r->ig == &integrator_path || r->ig == &integrator_volpath) ((path_tracer *)r->self)->strategy = strategy;
 }
 void renderer_set_pass(pk_renderer *r, uint32_t pass) { r->pass = pass; }
+uint32_t renderer_pass(const pk_renderer *r) { return r->pass; }
 const frame *renderer_frame(const pk_renderer *r) { return &r->fr; }
 
 typedef gpu_tile tile; /* x, y, w, h: at most TILE x TILE */

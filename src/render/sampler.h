@@ -103,9 +103,16 @@ typedef struct sampler {
     uint32_t dim;         /* next dimension */
 } sampler;
 
+/* SAMPLER_SECOND_HALF: indices with this bit are a second, independent
+ * sequence of the pixel (another scrambling, index counted without the
+ * bit), so that adaptive sampling's two halves are independent estimates
+ * whose difference measures the error of their mean (adaptive.c); plain
+ * renders never reach it (2^31 samples of a pixel). */
+#define SAMPLER_SECOND_HALF 0x80000000u
 static inline PK_HD sampler sampler_start(uint32_t px, uint32_t py, uint32_t index, uint32_t seed)
 {
     sampler s;
+    if (index & SAMPLER_SECOND_HALF) seed = smp_hash(seed ^ 0x2f6b4c1du), index &= ~SAMPLER_SECOND_HALF;
     s.pixel_seed = smp_hash2(smp_hash2(px, py), seed);
     s.index = index;
     s.dim = 0;
