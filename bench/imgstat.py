@@ -1,6 +1,6 @@
 #!/usr/bin/python3
-"""Error measures of rendered images (PFM), for bench/denoise.sh and
-bench/noise2.sh.
+"""Error measures of rendered images (PFM), for bench/denoise.sh,
+bench/noise2.sh and bench/adaptive.sh.
 
   imgstat.py relmse IMAGE REFERENCE
       relMSE = mean over pixels and channels of (x - r)^2 / (r^2 + 0.01)
@@ -10,6 +10,13 @@ bench/noise2.sh.
       top; default the Cornell box's back wall, x 0.55-0.70, y 0.28-0.55):
       sqrt(mean((a - b)^2) / 2) / mean((a + b) / 2) on luminance. Unlike
       neighbour differences it stays right for filtered (denoised) images.
+  imgstat.py twoseed A B
+      the relative error of one render over the whole image, from two
+      renders with different seeds: sqrt(mean((a - b)^2 / 2 / (m^2 + 0.01)))
+      over pixels and channels, m = (a + b) / 2 (what --noise aims at)
+  imgstat.py tiles95 A B
+      the same per 16x16 tile (the tiles of --noise): its 95th percentile
+      over the tiles, the error of the worst parts of the image
 """
 import struct
 import sys
@@ -43,6 +50,19 @@ def noise2(a, b, box):
     return float(np.sqrt(np.mean((la - lb) ** 2) / 2) / np.mean((la + lb) / 2))
 
 
+def twoseed(a, b):
+    m = (a + b) / 2
+    return float(np.sqrt(np.mean((a - b) ** 2 / 2 / (m ** 2 + 0.01))))
+
+
+def tiles95(a, b):
+    m = (a + b) / 2
+    rv = np.mean((a - b) ** 2 / 2 / (m ** 2 + 0.01), axis=2)
+    h, w = rv.shape
+    t = [np.sqrt(rv[y:y + 16, x:x + 16].mean()) for y in range(0, h, 16) for x in range(0, w, 16)]
+    return float(np.percentile(t, 95))
+
+
 def main():
     cmd = sys.argv[1]
     if cmd == 'relmse':
@@ -50,6 +70,10 @@ def main():
     elif cmd == 'noise2':
         box = [float(v) for v in sys.argv[4:8]] if len(sys.argv) >= 8 else [0.55, 0.70, 0.28, 0.55]
         print('%.6g' % noise2(read_pfm(sys.argv[2]), read_pfm(sys.argv[3]), box))
+    elif cmd == 'twoseed':
+        print('%.6g' % twoseed(read_pfm(sys.argv[2]), read_pfm(sys.argv[3])))
+    elif cmd == 'tiles95':
+        print('%.6g' % tiles95(read_pfm(sys.argv[2]), read_pfm(sys.argv[3])))
     else:
         sys.exit(__doc__)
 

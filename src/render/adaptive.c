@@ -76,8 +76,9 @@ pk_status pk_renderer_render_adaptive(pk_renderer *r, const pk_adaptive *a, pk_f
     pk_film *odd = NULL;
     uint8_t *active = mem_calloc(&ctx->alloc, ntiles, 1);
     uint32_t *spp_of = mem_calloc(&ctx->alloc, ntiles, sizeof *spp_of); /* samples of the tile's pixels */
+    uint8_t *below = mem_calloc(&ctx->alloc, ntiles, 1); /* the last check found the tile at the target */
     pk_region *reg = mem_realloc_array(&ctx->alloc, NULL, ntiles, sizeof *reg);
-    pk_status st = active && spp_of && reg ? film_create(ctx, w, h, film->aovs, &odd) : ctx_nomem(ctx);
+    pk_status st = active && spp_of && below && reg ? film_create(ctx, w, h, film->aovs, &odd) : ctx_nomem(ctx);
     const uint32_t pass0 = renderer_pass(r);
     uint32_t pass = pass0; /* passes rendered: (pass - pass0 + 1) / 2 even ones, (pass - pass0) / 2 odd ones */
     const uint32_t step = (uint32_t)opt->spp;
@@ -114,7 +115,11 @@ pk_status pk_renderer_render_adaptive(pk_renderer *r, const pk_adaptive *a, pk_f
                     const int x = i * ATILE, y = j * ATILE;
                     const int bw = x + ATILE < w ? ATILE : w - x, bh = y + ATILE < h ? ATILE : h - y;
                     const double rv = block_relvar(film, odd, x, y, bw, bh) / (3.0 * bw * bh);
-                    if (sqrt(rv) <= (double)a->noise) {
+                    /* below the target at two checks in a row: one lucky estimate (a tile whose
+                     * fireflies fell on neither half yet) does not stop it */
+                    if (!(sqrt(rv) <= (double)a->noise)) {
+                        below[k] = 0;
+                    } else if (below[k]++) {
                         active[k] = 0;
                         reached++;
                     }
@@ -147,6 +152,7 @@ pk_status pk_renderer_render_adaptive(pk_renderer *r, const pk_adaptive *a, pk_f
     film_destroy(odd);
     mem_free(&ctx->alloc, active);
     mem_free(&ctx->alloc, spp_of);
+    mem_free(&ctx->alloc, below);
     mem_free(&ctx->alloc, reg);
     return st;
 }
