@@ -328,6 +328,14 @@ static int parse_filter(const char *v, pk_filter *f)
     return rc;
 }
 
+/* Whether v is a number in (0, hi], into *out. */
+static int positive_number(const char *v, double hi, double *out)
+{
+    char *end;
+    *out = strtod(v, &end);
+    return !*end && end != v && *out > 0.0 && *out <= hi;
+}
+
 int cli_render_parse(int argc, char **argv, cli_render_opts *o, void (*help)(FILE *f))
 {
     memset(o, 0, sizeof *o);
@@ -503,13 +511,10 @@ int cli_render_parse(int argc, char **argv, cli_render_opts *o, void (*help)(FIL
             o->projection = PK_PROJECTION_PERSPECTIVE + 1;
             break;
         case OPT_ENV: o->env = v; break;
-        case OPT_NOISE: {
-            char *end;
-            o->noise = strtod(v, &end);
-            if (*end || end == v || !(o->noise > 0.0 && o->noise <= 10.0))
+        case OPT_NOISE:
+            if (!positive_number(v, 10.0, &o->noise))
                 return cli_usage_error("--noise: '%s' must be a relative error in (0, 10], such as 0.05", v);
             break;
-        }
         case OPT_MIN_SPP: {
             char *end;
             const long ms = strtol(v, &end, 10);
@@ -518,13 +523,10 @@ int cli_render_parse(int argc, char **argv, cli_render_opts *o, void (*help)(FIL
             o->min_spp = (int)ms;
             break;
         }
-        case OPT_TIME: {
-            char *end;
-            o->time = strtod(v, &end);
-            if (*end || end == v || !(o->time > 0.0 && o->time <= 1e7))
+        case OPT_TIME:
+            if (!positive_number(v, 1e7, &o->time))
                 return cli_usage_error("--time: '%s' must be a number of seconds in (0, 10000000]", v);
             break;
-        }
         case OPT_AOV: {
             char buf[128];
             snprintf(buf, sizeof buf, "%s", v);

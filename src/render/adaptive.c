@@ -53,6 +53,14 @@ static double block_relvar(const pk_film *even, const pk_film *odd, int x, int y
     return sum;
 }
 
+/* The samples of the tile at (x, y): both halves of its first pixel (a
+ * tile's pixels are rendered together, so all have as many). */
+static uint32_t tile_spp(const pk_film *even, const pk_film *odd, int x, int y)
+{
+    const size_t p = (size_t)y * (size_t)even->width + (size_t)x;
+    return even->counts[p] + odd->counts[p];
+}
+
 pk_status pk_renderer_render_adaptive(pk_renderer *r, const pk_adaptive *a, pk_film *film, pk_adaptive_result *result)
 {
     if (!r || !a || !film) return PK_ERR_INVALID_ARGUMENT;
@@ -75,10 +83,9 @@ pk_status pk_renderer_render_adaptive(pk_renderer *r, const pk_adaptive *a, pk_f
     const size_t ntiles = (size_t)tx * (size_t)ty;
     pk_film *odd = NULL;
     uint8_t *active = mem_calloc(&ctx->alloc, ntiles, 1);
-    uint32_t *spp_of = mem_calloc(&ctx->alloc, ntiles, sizeof *spp_of); /* samples of the tile's pixels */
     uint8_t *below = mem_calloc(&ctx->alloc, ntiles, 1); /* the last check found the tile at the target */
     pk_region *reg = mem_realloc_array(&ctx->alloc, NULL, ntiles, sizeof *reg);
-    pk_status st = active && spp_of && below && reg ? film_create(ctx, w, h, film->aovs, &odd) : ctx_nomem(ctx);
+    pk_status st = active && below && reg ? film_create(ctx, w, h, film->aovs, &odd) : ctx_nomem(ctx);
     const uint32_t pass0 = renderer_pass(r);
     uint32_t pass = pass0; /* passes rendered: (pass - pass0 + 1) / 2 even ones, (pass - pass0) / 2 odd ones */
     const uint32_t step = (uint32_t)opt->spp;
@@ -106,13 +113,12 @@ pk_status pk_renderer_render_adaptive(pk_renderer *r, const pk_adaptive *a, pk_f
         st = renderer_render(r, reg, n, done % 2 ? odd : film);
         if (st != PK_OK) break;
         pass++;
-        for (size_t k = 0; k < ntiles; k++) spp_of[k] += active[k] ? step : 0;
         if ((pass - pass0) % 2 == 0) { /* both halves have the same samples: judge the tiles */
             for (int j = 0; j < ty; j++)
                 for (int i = 0; i < tx; i++) {
                     const size_t k = (size_t)j * (size_t)tx + (size_t)i;
-                    if (!active[k] || spp_of[k] < (uint32_t)a->min_spp) continue;
                     const int x = i * ATILE, y = j * ATILE;
+                    if (!active[k] || tile_spp(film, odd, x, y) < (uint32_t)a->min_spp) continue;
                     const int bw = x + ATILE < w ? ATILE : w - x, bh = y + ATILE < h ? ATILE : h - y;
                     const double rv = block_relvar(film, odd, x, y, bw, bh) / (3.0 * bw * bh);
                     /* below the target at two checks in a row: one lucky estimate (a tile whose
@@ -126,8 +132,11 @@ pk_status pk_renderer_render_adaptive(pk_renderer *r, const pk_adaptive *a, pk_f
                 }
         }
         /* a tile at max_spp stops; so does the render once the time is up (after a whole pass) */
-        for (size_t k = 0; k < ntiles; k++)
-            if (active[k] && spp_of[k] + step > (uint32_t)a->max_spp) active[k] = 0;
+        for (int j = 0; j < ty; j++)
+            for (int i = 0; i < tx; i++) {
+                const size_t k = (size_t)j * (size_t)tx + (size_t)i;
+                if (active[k] && tile_spp(film, odd, i * ATILE, j * ATILE) + step > (uint32_t)a->max_spp) active[k] = 0;
+            }
         if (a->seconds > 0.0 && time_now() - t0 >= a->seconds) break;
         if ((uint64_t)(pass0 + (pass - pass0) / 2 + 1) * step >= SAMPLER_SECOND_HALF) break; /* (2^31 samples) */
     }
@@ -151,7 +160,6 @@ pk_status pk_renderer_render_adaptive(pk_renderer *r, const pk_adaptive *a, pk_f
     renderer_set_pass(r, pass0 + (pass - pass0 + 1) / 2); /* after the even half's last pass */
     film_destroy(odd);
     mem_free(&ctx->alloc, active);
-    mem_free(&ctx->alloc, spp_of);
     mem_free(&ctx->alloc, below);
     mem_free(&ctx->alloc, reg);
     return st;
